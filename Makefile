@@ -1,0 +1,30 @@
+# Two commands for a new user: `make demo` and `make test`.
+PYTHON ?= python3
+VENV ?= .venv
+BIN := $(VENV)/bin
+
+.PHONY: demo test venv system-deps benchmark clean
+
+$(BIN)/nodeforce: pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e '.[test]'
+	touch $@
+
+venv: $(BIN)/nodeforce
+
+# ecospy's native library links against oneTBB, which comes from Debian.
+system-deps:
+	@dpkg -s libtbb12 >/dev/null 2>&1 || { apt-get update -qq && apt-get install -y -qq libtbb12; }
+
+demo: venv
+	$(BIN)/nodeforce demo -o out/demo
+
+test: venv system-deps
+	$(BIN)/python -m pytest -q
+
+benchmark: venv
+	$(BIN)/python benchmarks/bench_search.py
+
+clean:
+	rm -rf $(VENV) out
