@@ -1,0 +1,102 @@
+"""The one place where nodeforce talks FMI 2.0, through FMPy.
+
+An `FmuInstance` extracts and instantiates an FMU once; each `run` resets it, so a search can
+simulate thousands of forcing masks without unzipping or instantiating again. The step loop
+writes the inputs into preallocated ctypes arrays through numpy views and calls FMPy's
+`fmi2SetReal`, `fmi2DoStep` and `fmi2GetReal`, so a step allocates nothing in Python.
+"""
+import shutil
+
+import numpy as np
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import FMU2Slave, fmi2Boolean, fmi2Real, fmi2True, fmi2ValueReference
+
+
+class FmuInstance:
+    """An instantiated co-simulation FMU, reused across runs."""
+
+    def __init__(self, fmu_path, instance_name="nodeforce"):
+        self.path = str(fmu_path)
+        self.description = read_model_description(self.path)
+        self.variables = {v.name: v for v in self.description.modelVariables}
+        self._unzipdir = extract(self.path)
+        self.fmu = FMU2Slave(guid=self.description.guid, unzipDirectory=self._unzipdir,
+                             modelIdentifier=self.description.coSimulation.modelIdentifier,
+                             instanceName=instance_name)
+        self.fmu.instantiate()
+        self._used = False
+
+    def names(self, causality):
+        """Names of the variables of a causality ("parameter", "input", "output")."""
+        return [v.name for v in self.description.modelVariables if v.causality == causality]
+
+    def _refs(self, names):
+        try:
+            return [self.variables[n].valueReference for n in names]
+        except KeyError as e:
+            raise KeyError(f"{self.path} has no variable {e.args[0]}") from None
+
+    def run(self, dt, parameters, start_inputs, input_names, inputs, output_names, start_time=0.0):
+        """Simulate from a fresh state; return the outputs after each step.
+
+        Parameters
+        ----------
+        dt : communication step (s)
+        parameters : {name: value} for Boolean and Real parameters
+        start_inputs : {name: value} inputs set during initialisation
+        input_names : the inputs set before every step
+        inputs : (n_steps, len(input_names)) values, row k applied before step k
+        output_names : the outputs read after every step
+
+        Returns
+        -------
+        (n_steps, len(output_names)) ndarray
+        """
+        fmu = self.fmu
+        if self._used:
+            fmu.reset()
+        self._used = True
+        fmu.setupExperiment(startTime=start_time)
+        fmu.enterInitializationMode()
+        booleans = {n: v for n, v in parameters.items() if self.variables[n].type == "Boolean"}
+        reals = {n: v for n, v in {**parameters, **start_inputs}.items() if n not in booleans}
+        if booleans:
+            fmu.setBoolean(self._refs(booleans), [bool(v) for v in booleans.values()])
+        if reals:
+            fmu.setReal(self._refs(reals), [float(v) for v in reals.values()])
+        fmu.exitInitializationMode()
+
+        inputs = np.asarray(inputs, dtype=float)
+        n_in, n_out = len(input_names), len(output_names)
+        in_refs = (fmi2ValueReference * n_in)(*self._refs(input_names))
+        in_values = (fmi2Real * n_in)()
+        in_view = np.ctypeslib.as_array(in_values)
+        out_refs = (fmi2ValueReference * n_out)(*self._refs(output_names))
+        out_values = (fmi2Real * n_out)()
+        out_view = np.ctypeslib.as_array(out_values)
+        component = fmu.component
+        set_real, do_step, get_real = fmu.fmi2SetReal, fmu.fmi2DoStep, fmu.fmi2GetReal
+        outputs = np.empty((len(inputs), n_out))
+        time = start_time
+        for k, row in enumerate(inputs):
+            if n_in:
+                in_view[:] = row
+                set_real(component, in_refs, n_in, in_values)
+            do_step(component, time, dt, fmi2Boolean(fmi2True))
+            get_real(component, out_refs, n_out, out_values)
+            outputs[k] = out_view
+            time = start_time + (k + 1) * dt
+        fmu.terminate()
+        return outputs
+
+    def close(self):
+        """Free the instance and remove the extracted files."""
+        self.fmu.freeInstance()
+        self.fmu.freeLibrary()
+        shutil.rmtree(self._unzipdir, ignore_errors=True)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()

@@ -1,0 +1,43 @@
+"""Simulate a measured case through the FMU, warm-up included (PHYSICS.md section 5).
+
+The FMU knows one step; the warm-up, the initial measurements and the forcing mask are the
+driver's, and follow the same rules as `model.integrate.simulate`, so both give the same numbers.
+"""
+import numpy as np
+
+from model.integrate import warmup_rows
+
+
+def node_names(prefix, ids):
+    return [f"{prefix}[{i}]" for i in ids]
+
+
+def simulate_fmu(instance, case, force=None, warmup_days=2, output_ids=None, T_default=20.0):
+    """Node temperatures (C) at t_1..t_N, simulated by an `FmuInstance` of the case's building.
+
+    Parameters
+    ----------
+    instance : cosim.fmi2.FmuInstance
+    case : model.case.Case (inputs and measurements on the simulation grid)
+    force : (N,) bool, nodes forced to their measurements; None: no forcing
+    warmup_days : passes over the first day before the run
+    output_ids : node ids to return (default: all)
+    T_default : C, the initial temperature of a node nothing informs (the FMU's T_start)
+
+    Returns
+    -------
+    (N_t, len(output_ids)) ndarray
+    """
+    measured = case.measured
+    n_rows, n = measured.shape
+    forced_ids = [] if force is None else [i + 1 for i in np.flatnonzero(force)]
+    output_ids = list(range(1, n + 1)) if output_ids is None else list(output_ids)
+    parameters = {"T_start": T_default, **{name: True for name in node_names("force", forced_ids)}}
+    measured0 = np.flatnonzero(np.isfinite(measured[0]))
+    start_inputs = {f"T_forced[{i + 1}]": measured[0, i] for i in measured0}
+    rows = warmup_rows(n_rows, case.dt, warmup_days)
+    inputs = np.hstack([case.U[rows], measured[rows][:, np.array(forced_ids, dtype=int) - 1]])
+    out = instance.run(case.dt, parameters, start_inputs,
+                       list(case.input_names) + node_names("T_forced", forced_ids),
+                       inputs, node_names("T", output_ids))
+    return out[len(rows) - (n_rows - 1):]

@@ -1,0 +1,64 @@
+"""Build the FMU of a building file: `nodeforce fmu BUILDING -o MODEL.fmu`.
+
+The FMU carries everything it runs: the slave, the physics modules of `model/` and the building
+description. Its slave module is named after a hash of that content, so two different FMUs in
+one process never share Python modules (pythonfmu imports the slave by name), while the same
+FMU loaded twice does, harmlessly.
+"""
+import hashlib
+import json
+import sys
+import tempfile
+from pathlib import Path
+
+from pythonfmu.builder import FmuBuilder
+
+import model
+from model.building import parse_building
+
+SLAVE = Path(__file__).with_name("slave.py")
+MODEL_DIR = Path(model.__file__).parent
+# The modules the FMU imports; weather and solar stay outside (their results are inputs).
+PHYSICS_MODULES = ("__init__", "errors", "building", "discretise", "network", "integrate")
+
+
+def build_fmu(building_data, destination, source="<building>"):
+    """Write the FMU of a building description.
+
+    Parameters
+    ----------
+    building_data : dict, the building file's JSON content (validated here)
+    destination : path of the .fmu to write
+    source : the building's file name, for error messages
+
+    Returns
+    -------
+    Path of the FMU written
+    """
+    parse_building(building_data, source=source)
+    building_text = json.dumps(building_data, indent=1)
+    sources = {name: (MODEL_DIR / f"{name}.py").read_text() for name in PHYSICS_MODULES}
+    slave_text = SLAVE.read_text()
+    digest = hashlib.sha256("\0".join([building_text, slave_text, *sources.values()]).encode())
+    module = f"nodeforce_{digest.hexdigest()[:16]}"
+
+    destination = Path(destination).resolve()
+    destination.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix="nodeforce_fmu_") as tmp:
+        tmp = Path(tmp)
+        script = tmp / f"{module}.py"
+        script.write_text(slave_text)
+        package = tmp / f"{module}_model"
+        package.mkdir()
+        for name, text in sources.items():
+            (package / f"{name}.py").write_text(text)
+        (tmp / "building.json").write_text(building_text)
+        try:
+            FmuBuilder.build_FMU(script, dest=destination, project_files=[package, tmp / "building.json"],
+                                 canGetAndSetFMUstate=True, canSerializeFMUstate=True)
+        finally:
+            # pythonfmu leaves the build folder on sys.path; the module cache entries it made are
+            # the same code as the FMU's, under the FMU's unique name, and may stay.
+            while str(tmp) in sys.path:
+                sys.path.remove(str(tmp))
+    return destination

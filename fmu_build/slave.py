@@ -1,0 +1,156 @@
+"""The nodal building model as an FMI 2.0 co-simulation slave (pythonfmu).
+
+This file is copied into each FMU as `<module>.py`, with the physics package beside it as
+`<module>_model` and the building description as `resources/building.json`; `<module>` is unique
+to the FMU's content, because pythonfmu imports the slave by module name and Python's module
+cache would otherwise run the first FMU's code for the second.
+
+Variables (INTERFACE.md): parameters `force[i]` and `T_start`; inputs `T_out`, `T_sky`,
+`I_<component>`, the building's named columns and `T_forced[i]` (NaN: no measurement);
+outputs `T[i]`. One doStep of h seconds is one backward-Euler step with the inputs set before
+it. During initialisation, the `T_forced[i]` values set are the measurements at t_0, from which
+the initial state follows PHYSICS.md section 5 (`T_start` where nothing is measured).
+"""
+import importlib
+import json
+import os
+
+import numpy as np
+from pythonfmu import Boolean, Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
+from pythonfmu.enums import Fmi2Initial
+
+_physics = {name: importlib.import_module(f"{__name__}_model.{name}")
+            for name in ("building", "network", "integrate")}
+
+# Reset re-constructs the slave: keep what depends only on the building file per process.
+_MODELS = {}
+
+
+def _model(resources):
+    model = _MODELS.get(resources)
+    if model is None:
+        with open(os.path.join(resources, "building.json"), encoding="utf-8") as f:
+            building = _physics["building"].parse_building(json.load(f), source="building.json")
+        network = _physics["network"].assemble(building)
+        model = _MODELS[resources] = (building, network, {})
+    return model
+
+
+class NodalBuilding(Fmi2Slave):
+
+    author = "nodeforce"
+    description = "Nodal (RC network) building thermal model with a forcing input per node"
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.building, self.network, self._steppers = _model(self.resources)
+        n = self.network.n_nodes
+        names = self.network.input_names
+        # One array holds every variable's value, indexed by value reference: get/set become
+        # numpy indexing instead of pythonfmu's per-variable getter calls.
+        n_vars = 3 * n + 1 + len(names)
+        self._values = np.zeros(n_vars)
+        self._is_real = np.ones(n_vars, dtype=bool)
+        self._is_real[:n] = False
+        for i in range(1, n + 1):
+            self.register_variable(Boolean(
+                f"force[{i}]", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
+                description=f"node {i} is forced to T_forced[{i}]"))
+        self._T_start = n
+        self._values[n] = 20.0
+        self.register_variable(Real(
+            "T_start", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
+            description="initial temperature of a node no measurement informs [degC]"))
+        self._inputs = slice(n + 1, n + 1 + len(names))
+        for name in names:
+            self.register_variable(Real(name, causality=Fmi2Causality.input,
+                                        description=_input_description(name)))
+        self._forced = slice(self._inputs.stop, self._inputs.stop + n)
+        self._values[self._forced] = np.nan
+        for i in range(1, n + 1):
+            self.register_variable(Real(
+                f"T_forced[{i}]", causality=Fmi2Causality.input,
+                description=f"measured temperature of node {i}, NaN if none [degC]"))
+        self._T = slice(self._forced.stop, self._forced.stop + n)
+        self._values[self._T] = self._values[self._T_start]
+        for i in range(1, n + 1):
+            self.register_variable(Real(
+                f"T[{i}]", causality=Fmi2Causality.output, initial=Fmi2Initial.exact,
+                description=f"temperature of node {i} [degC]"))
+        self._initialised = False
+
+    def _stepper(self, dt):
+        stepper = self._steppers.get(dt)
+        if stepper is None:
+            stepper = self._steppers[dt] = _physics["integrate"].ImplicitEuler(self.network, dt)
+        return stepper
+
+    def exit_initialization_mode(self):
+        self._values[self._T] = _physics["integrate"].initial_state(
+            self.building, self._values[self._forced], self._values[self._T_start])
+        self._initialised = True
+
+    def do_step(self, current_time, step_size):
+        T_forced = self._values[self._forced]
+        forced = (self._values[: self.network.n_nodes] != 0.0) & ~np.isnan(T_forced)
+        source = self.network.B @ self._values[self._inputs] + self.network.q
+        self._values[self._T] = self._stepper(step_size).step(
+            self._values[self._T], source, forced, T_forced)
+        return True
+
+    def get_real(self, vrs):
+        if not self._is_real[vrs].all():
+            raise TypeError(f"value references {vrs} are not all Real")
+        return self._values[vrs].tolist()
+
+    def set_real(self, vrs, values):
+        if not self._is_real[vrs].all():
+            raise TypeError(f"value references {vrs} are not all Real")
+        self._values[vrs] = values
+
+    def get_boolean(self, vrs):
+        if self._is_real[vrs].any():
+            raise TypeError(f"value references {vrs} are not all Boolean")
+        return (self._values[vrs] != 0.0).tolist()
+
+    def set_boolean(self, vrs, values):
+        if self._is_real[vrs].any():
+            raise TypeError(f"value references {vrs} are not all Boolean")
+        self._values[vrs] = values
+
+    def _get_fmu_state(self):
+        return {"values": self._values.copy(), "initialised": self._initialised}
+
+    def _set_fmu_state(self, state):
+        self._values[:] = state["values"]
+        self._initialised = state["initialised"]
+
+    @staticmethod
+    def _fmu_state_to_bytes(state):
+        # json writes NaN as a bare token, which json reads back: no value is lost.
+        return json.dumps({"values": np.asarray(state["values"]).tolist(),
+                           "initialised": state["initialised"]}).encode("utf-8")
+
+    @staticmethod
+    def _fmu_state_from_bytes(data):
+        state = json.loads(data.decode("utf-8"))
+        return {"values": np.array(state["values"]), "initialised": state["initialised"]}
+
+    def to_xml(self, model_options=dict()):
+        xml = super().to_xml(model_options)
+        # Python writes NaN as "nan"; xs:double spells it "NaN".
+        for element in xml.iter("Real"):
+            if element.get("start") == "nan":
+                element.set("start", "NaN")
+        return xml
+
+
+def _input_description(name):
+    if name == "T_out":
+        return "outdoor air temperature [degC]"
+    if name == "T_sky":
+        return "sky temperature [degC]"
+    if name.startswith("I_"):
+        return f"solar irradiance on the outside face of {name[2:]} [W/m2]"
+    return f"measured input column {name}"
+

@@ -1,0 +1,48 @@
+"""Spatial discretisation of a multilayer component (PHYSICS.md section 2), per m2 of area.
+
+Conductances are exact integrals of dx/lambda across layer boundaries, capacities exact
+integrals of rho*c over each node's control volume: with two nodes this is the R2C model
+of the paper (K = 1/R and two half capacities).
+"""
+import numpy as np
+
+
+def layer_bounds(thicknesses):
+    """Depths (m) of the layer interfaces, from 0 to the total thickness."""
+    return np.concatenate(([0.0], np.cumsum(thicknesses)))
+
+
+def _integral(bounds, density, a, b):
+    """Integral over [a, b] (m) of a piecewise-constant profile `density` given per layer."""
+    lo = np.clip(bounds[:-1], a, b)
+    hi = np.clip(bounds[1:], a, b)
+    return float(np.sum(density * (hi - lo)))
+
+
+def conductances(layers, depths):
+    """Conductances G_k (W/m2/K) between successive nodes.
+
+    Parameters
+    ----------
+    layers : sequence of (Material, thickness m), inside face first
+    depths : node depths x_0 = 0 < ... < x_m = L (m)
+
+    Returns
+    -------
+    ndarray of m values, G_k = 1 / integral(dx / lambda, x_k, x_k+1)
+    """
+    bounds = layer_bounds([t for _, t in layers])
+    resistivity = np.array([1.0 / m.conductivity for m, _ in layers])
+    return np.array([1.0 / _integral(bounds, resistivity, a, b) for a, b in zip(depths, depths[1:])])
+
+
+def capacities(layers, depths):
+    """Heat capacities C_k (J/m2/K) of the nodes, over [(x_k-1 + x_k)/2, (x_k + x_k+1)/2]
+    clipped to [0, L]: end nodes get half cells."""
+    bounds = layer_bounds([t for _, t in layers])
+    rho_c = np.array([m.density * m.specific_heat for m, _ in layers])
+    x = np.asarray(depths, dtype=float)
+    mid = (x[:-1] + x[1:]) / 2
+    lo = np.concatenate(([x[0]], mid))
+    hi = np.concatenate((mid, [x[-1]]))
+    return np.array([_integral(bounds, rho_c, a, b) for a, b in zip(lo, hi)])

@@ -1,0 +1,142 @@
+"""Backward-Euler integration with forcing (PHYSICS.md section 5, paper eqs. 6 and 7).
+
+One step from t_n to t_n+1 solves `M T^n+1 = V`, with `M = C/dt - A` and
+`V = (C/dt) T^n + B u^n+1 + q`. Forcing node i replaces row i of M by the unit row and v_i by
+the node's measured temperature: a Dirichlet condition. M is factorised once per forcing mask
+(an LU factorisation), so a step is a pair of triangular solves.
+
+The FMU's `doStep` and the direct model's `simulate` both call `ImplicitEuler.step`: one
+arithmetic for every path through the code.
+"""
+import numpy as np
+from scipy.linalg import lu_factor
+from scipy.linalg.lapack import dgetrs
+
+DAY = 86400.0  # s
+
+
+class ImplicitEuler:
+    """The step of a `Network` for a step size dt (s), with LU factors cached per forcing mask."""
+
+    def __init__(self, network, dt):
+        self.network = network
+        self.dt = float(dt)
+        self.c_dt = network.C / self.dt
+        self._M = np.diag(self.c_dt) - network.A
+        self._factors = {}
+
+    def factors(self, forced):
+        """LU factors of M with the rows of the `forced` nodes (bool mask) replaced by unit rows."""
+        key = forced.tobytes()
+        lu = self._factors.get(key)
+        if lu is None:
+            M = self._M.copy()
+            M[forced] = 0.0
+            M[forced, forced] = 1.0
+            lu = self._factors[key] = lu_factor(M, check_finite=False)
+        return lu
+
+    def step(self, T, source, forced, T_forced):
+        """Temperatures (C) at t_n+1 from T at t_n.
+
+        Parameters
+        ----------
+        T : (N,) node temperatures at t_n (C)
+        source : (N,) `B u^n+1 + q` (W)
+        forced : (N,) bool, nodes imposed this step (their measurement exists at t_n+1)
+        T_forced : (N,) imposed temperatures (C); read only where `forced`
+        """
+        v = self.c_dt * T + source
+        v[forced] = T_forced[forced]
+        lu, piv = self.factors(forced)
+        return dgetrs(lu, piv, v)[0]
+
+
+def initial_state(building, measured0, T_default=20.0):
+    """Node temperatures at t_0 (C) from the measurements at t_0.
+
+    A measured node starts at its value; an unmeasured node of a component that has measured
+    nodes starts at the linear interpolation in depth between them (the nearest measured value
+    beyond them); every other node starts at the zone's measured air temperature, or at
+    `T_default` where the air is not measured.
+
+    Parameters
+    ----------
+    building : Building
+    measured0 : (N,) measured temperatures at t_0 (C), NaN where not measured
+    T_default : C, the temperature of a node nothing informs
+    """
+    measured0 = np.asarray(measured0, dtype=float)
+    T = np.empty(len(measured0))
+    for z in building.zones:
+        air = measured0[z.air_node - 1]
+        fallback = air if np.isfinite(air) else T_default
+        T[z.air_node - 1] = fallback
+        T[z.radiant_node - 1] = fallback
+        for c in building.components:
+            if c.inside["zone"] != z.name:
+                continue
+            idx = np.array(c.node_ids) - 1
+            values = measured0[idx]
+            known = np.isfinite(values)
+            if known.any():
+                # np.interp holds the end values beyond the measured range: the nearest value.
+                T[idx] = np.interp(np.array(c.depths), np.array(c.depths)[known], values[known])
+            else:
+                T[idx] = fallback
+    measured = np.isfinite(measured0)
+    T[measured] = measured0[measured]
+    return T
+
+
+def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2, T_default=20.0):
+    """Simulate the network over input samples t_0..t_N; return temperatures at t_1..t_N.
+
+    Parameters
+    ----------
+    building : Building (for the initial state)
+    network : Network
+    U : (N_t+1, n_inputs) inputs at t_0..t_N, columns in `network.input_names`
+    dt : step (s), uniform
+    measured : (N_t+1, N) measured node temperatures (C), NaN where missing; None: nothing measured
+    force : (N,) bool, nodes forced to their measurements for the whole run
+    warmup_days : passes over the first day's inputs (rows 1..24h/dt) before the run
+    T_default : C, the initial temperature of a node nothing informs
+
+    Returns
+    -------
+    (N_t, N) node temperatures (C) at t_1..t_N
+    """
+    n_rows, n = U.shape[0], network.n_nodes
+    if measured is None:
+        measured = np.full((n_rows, n), np.nan)
+    if force is None:
+        force = np.zeros(n, dtype=bool)
+    sources = U @ network.B.T + network.q
+    forced = force & np.isfinite(measured)
+    stepper = ImplicitEuler(network, dt)
+    T = initial_state(building, measured[0], T_default)
+    rows = warmup_rows(n_rows, dt, warmup_days)
+    out = np.empty((n_rows - 1, n))
+    for k, row in enumerate(rows):
+        T = stepper.step(T, sources[row], forced[row], measured[row])
+        if k >= len(rows) - (n_rows - 1):
+            out[k - len(rows) + n_rows - 1] = T
+    return out
+
+
+def warmup_rows(n_rows, dt, warmup_days):
+    """The input row of every step, warm-up included: rows 1..M `warmup_days` times, then 1..N."""
+    per_day = steps_per_day(dt)
+    if warmup_days and n_rows - 1 < per_day:
+        raise ValueError(f"the warm-up needs one day of inputs ({per_day} steps); only {n_rows - 1} given")
+    day = np.arange(1, per_day + 1)
+    return np.concatenate([day] * int(warmup_days) + [np.arange(1, n_rows)])
+
+
+def steps_per_day(dt):
+    """M = 24 h / dt, which must be a whole number of steps."""
+    per_day = DAY / dt
+    if abs(per_day - round(per_day)) > 1e-9:
+        raise ValueError(f"a day is not a whole number of {dt:g} s steps")
+    return int(round(per_day))
