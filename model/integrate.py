@@ -47,9 +47,13 @@ class ImplicitEuler:
         T_forced : (N,) imposed temperatures (C); read only where `forced`
         """
         v = self.c_dt * T + source
-        v[forced] = T_forced[forced]
+        imposed = T_forced[forced]
+        v[forced] = imposed
         lu, piv = self.factors(forced)
-        return dgetrs(lu, piv, v)[0]
+        T_next = dgetrs(lu, piv, v)[0]
+        # Pivoting returns the unit rows' values to rounding only; a Dirichlet node is exact.
+        T_next[forced] = imposed
+        return T_next
 
 
 def initial_state(building, measured0, T_default=20.0):

@@ -1,0 +1,199 @@
+"""Physics checks that do not use the model's own numbers: hand-computed networks, energy
+conservation, limits."""
+import copy
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from model.building import parse_building
+from model.discretise import capacities, conductances
+from model.integrate import simulate
+from model.network import assemble
+
+TESTCELL = json.loads((Path(__file__).parents[1] / "model" / "data" / "testcell.json").read_text())
+
+
+def two_wall_box(outside_floor):
+    """One zone, a wall to the outdoors and a floor whose outside face is `outside_floor`."""
+    return {
+        "format": "nodal-building/1", "name": "box",
+        "site": {"latitude": 0.0, "longitude": 0.0, "altitude": 0.0, "ground_albedo": 0.2},
+        "materials": {"board": {"conductivity": 0.5, "density": 800.0, "specific_heat": 1000.0},
+                      "slab": {"conductivity": 2.0, "density": 2000.0, "specific_heat": 900.0}},
+        "zones": [{"name": "room", "volume": 30.0, "air_node": 5, "radiant_node": 6}],
+        "components": [
+            {"name": "wall", "area": 12.0, "tilt": 90.0, "azimuth": 180.0,
+             "layers": [["board", 0.1]], "nodes": [{"id": 1, "depth": 0.0}, {"id": 2, "depth": 0.1}],
+             "inside": {"zone": "room", "h_conv": 3.0, "h_rad": 5.0},
+             "outside": {"type": "exterior", "h_conv": 16.0, "h_rad": 5.0, "solar_absorptance": 0.6}},
+            {"name": "floor", "area": 10.0, "tilt": 180.0, "azimuth": 0.0,
+             "layers": [["slab", 0.2]], "nodes": [{"id": 3, "depth": 0.0}, {"id": 4, "depth": 0.2}],
+             "inside": {"zone": "room", "h_conv": 2.0, "h_rad": 5.0},
+             "outside": outside_floor},
+        ],
+    }
+
+
+def run_constant(building, inputs, days, dt=3600.0, T0=None):
+    """Simulate with every input held constant; the air starts at T0 (C) if given."""
+    net = assemble(building)
+    n_rows = int(days * 86400 / dt) + 1
+    U = np.tile([inputs.get(name, 0.0) for name in net.input_names], (n_rows, 1))
+    measured = np.full((n_rows, net.n_nodes), np.nan)
+    if T0 is not None:
+        measured[0, building.zones[0].air_node - 1] = T0
+    return net, U, simulate(building, net, U, dt, measured, warmup_days=0)
+
+
+def test_r2c_component_is_one_resistance_and_two_half_capacities():
+    b = parse_building(TESTCELL)
+    door = b.component("door")  # 35 mm of wood, nodes at both faces
+    assert conductances(door.layers, door.depths) == pytest.approx([0.23 / 0.035])
+    assert capacities(door.layers, door.depths) == pytest.approx([600 * 1600 * 0.035 / 2] * 2)
+
+
+def test_multilayer_discretisation_by_hand():
+    floor = parse_building(TESTCELL).component("floor")
+    # nodes at 0, 5, 10, 15, 20, 30, 40 cm; concrete 0-5, polystyrene 5-10, heavy concrete 10-40
+    G = conductances(floor.layers, floor.depths)
+    assert G == pytest.approx([1.4 / 0.05, 0.035 / 0.05, 1.75 / 0.05, 1.75 / 0.05, 1.75 / 0.1, 1.75 / 0.1])
+    C = capacities(floor.layers, floor.depths)
+    rc_concrete, rc_poly, rc_heavy = 2200 * 880, 25 * 1400, 2400 * 880
+    assert C == pytest.approx([
+        rc_concrete * 0.025,
+        rc_concrete * 0.025 + rc_poly * 0.025,
+        rc_poly * 0.025 + rc_heavy * 0.025,
+        rc_heavy * 0.05,
+        rc_heavy * 0.075,
+        rc_heavy * 0.1,
+        rc_heavy * 0.05,
+    ])
+    # the nodes' capacities add up to the whole floor's
+    assert C.sum() == pytest.approx(rc_concrete * 0.05 + rc_poly * 0.05 + rc_heavy * 0.3)
+
+
+def test_steady_state_equals_hand_computed_conductance_network():
+    T_out, T_sky, T_ground = 30.0, 18.0, 12.0
+    b = parse_building(two_wall_box({"type": "boundary", "temperature": T_ground, "h": 8.0}))
+    _, _, T = run_constant(b, {"T_out": T_out, "T_sky": T_sky}, days=60)
+
+    # By hand: the outside surface of the wall sees an equivalent temperature through h_e.
+    F = 0.5  # vertical wall
+    h_e = 16.0 + 5.0
+    T_eq = (16.0 * T_out + 5.0 * (F * T_sky + (1 - F) * T_out)) / h_e
+    G_wall = 12.0 / (1 / h_e + 0.1 / 0.5)
+    G_floor = 10.0 / (1 / 8.0 + 0.2 / 2.0)
+    # In steady state the air and radiant nodes only relay heat between the two surfaces.
+    G_air = 1 / (1 / (12.0 * 3.0) + 1 / (10.0 * 2.0))
+    G_rad = 1 / (1 / (12.0 * 5.0) + 1 / (10.0 * 5.0))
+    Q = (T_eq - T_ground) / (1 / G_wall + 1 / (G_air + G_rad) + 1 / G_floor)
+    # surface temperatures along the chain
+    T_s1 = T_eq - Q / G_wall
+    T_s2 = T_ground + Q / G_floor
+    T_air = (12.0 * 3.0 * T_s1 + 10.0 * 2.0 * T_s2) / (12.0 * 3.0 + 10.0 * 2.0)
+    T_rad = (12.0 * 5.0 * T_s1 + 10.0 * 5.0 * T_s2) / (12.0 * 5.0 + 10.0 * 5.0)
+
+    final = T[-1]
+    assert final[0] == pytest.approx(T_s1, abs=1e-6)
+    assert final[2] == pytest.approx(T_s2, abs=1e-6)
+    assert final[4] == pytest.approx(T_air, abs=1e-6)
+    assert final[5] == pytest.approx(T_rad, abs=1e-6)
+    # and the state is steady: the last two steps agree
+    assert np.abs(T[-1] - T[-2]).max() < 1e-9
+
+
+def boundary_heat_in(building, T, u):
+    """Heat entering the building (W) through its outside faces, the ventilation, the
+    transmitted sun and the gains, written from PHYSICS.md section 3 term by term."""
+    Q = 0.0
+    for c in building.components:
+        e, out = T[c.node_ids[-1] - 1], c.outside
+        if out["type"] == "exterior":
+            F = (1 + np.cos(np.radians(c.tilt))) / 2
+            Q += c.area * (out["h_conv"] * (u["T_out"] - e)
+                           + out["h_rad"] * (F * (u["T_sky"] - e) + (1 - F) * (u["T_out"] - e))
+                           + out["solar_absorptance"] * u[f"I_{c.name}"])
+        elif out["type"] == "boundary":
+            Q += c.area * out["h"] * (out["temperature"] - e)
+        if c.solar_transmittance is not None:
+            Q += c.solar_transmittance * c.area * u[f"I_{c.name}"]
+    for z in building.zones:
+        Q += 1.2 * 1005 * z.volume * z.air_change_rate / 3600 * (u["T_out"] - T[z.air_node - 1])
+        Q += z.internal_gain
+    return Q
+
+
+def test_energy_balance_closes_every_step():
+    data = copy.deepcopy(TESTCELL)
+    data["zones"][0]["air_change_rate"] = 0.7
+    data["zones"][0]["internal_gain"] = 150.0
+    b = parse_building(data)
+    net = assemble(b)
+    dt, n_rows = 900.0, 2 * 96 + 1
+    t = np.arange(n_rows) * dt
+    rng = np.random.default_rng(1)
+    U = np.zeros((n_rows, len(net.input_names)))
+    U[:, 0] = 26 + 4 * np.sin(2 * np.pi * t / 86400)
+    U[:, 1] = U[:, 0] - 12
+    U[:, 2:] = np.clip(900 * np.sin(2 * np.pi * (t - 21600) / 86400), 0, None)[:, None] * rng.uniform(0.3, 1, 7)
+    measured = np.full((n_rows, 23), np.nan)
+    measured[0, 22] = 24.0
+    T = simulate(b, net, U, dt, measured, warmup_days=0)
+    T = np.vstack([np.full(23, 24.0), T])  # every node starts at the measured air temperature
+    for n in range(1, n_rows):
+        stored = np.sum(net.C * (T[n] - T[n - 1])) / dt
+        u = dict(zip(net.input_names, U[n]))
+        heat_in = boundary_heat_in(b, T[n], u)  # implicit Euler: the fluxes at t_n+1
+        scale = max(abs(stored), abs(heat_in), 1.0)
+        assert abs(stored - heat_in) <= 1e-6 * scale, n
+
+
+def test_forced_node_equals_its_measurement_exactly():
+    b = parse_building(TESTCELL)
+    net = assemble(b)
+    dt, n_rows = 900.0, 2 * 96 + 1
+    U = np.zeros((n_rows, len(net.input_names)))
+    U[:, 0], U[:, 1] = 28.0, 15.0
+    measured = np.full((n_rows, 23), np.nan)
+    measured[:, 6] = 20 + np.sin(np.arange(n_rows) / 7.0)  # door inside surface
+    measured[40:45, 6] = np.nan  # missing: those steps compute node 7
+    force = np.zeros(23, dtype=bool)
+    force[6] = True
+    T = simulate(b, net, U, dt, measured, force)
+    have = np.isfinite(measured[1:, 6])
+    assert np.array_equal(T[have, 6], measured[1:, 6][have])
+    # where the measurement is missing the node is computed, not held or invented
+    assert np.all(np.isfinite(T[~have, 6]))
+    assert not np.any(np.isin(T[~have, 6], measured[1:, 6][have]))
+
+
+def adiabatic_testcell():
+    data = copy.deepcopy(TESTCELL)
+    for c in data["components"]:
+        c["outside"] = {"type": "adiabatic"}
+        c.pop("solar_transmittance", None)
+        c.pop("transmitted_solar_to", None)
+    return parse_building(data)
+
+
+def test_adiabatic_building_without_sun_keeps_its_temperature():
+    b = adiabatic_testcell()
+    _, _, T = run_constant(b, {"T_out": 35.0, "T_sky": 0.0}, days=3, dt=900.0, T0=23.0)
+    assert np.abs(T - 23.0).max() < 1e-10
+
+
+def test_adiabatic_building_conserves_heat_from_an_uneven_start():
+    b = adiabatic_testcell()
+    net = assemble(b)
+    n_rows = 3 * 96 + 1
+    U = np.zeros((n_rows, len(net.input_names)))
+    measured = np.full((n_rows, 23), np.nan)
+    measured[0, [0, 8, 16, 22]] = [30.0, 15.0, 22.0, 26.0]
+    T = simulate(b, net, U, 900.0, measured, warmup_days=0)
+    # the stored heat after the first step equals the stored heat at every later step
+    stored = T @ net.C
+    assert np.abs(stored - stored[0]).max() <= 1e-9 * np.abs(stored[0])
+    # and the building tends to one uniform temperature
+    assert T[-1].max() - T[-1].min() < T[0].max() - T[0].min()
