@@ -1,0 +1,268 @@
+"""Scoring chromosomes: J per forcing mask, cached, run in-process, in worker processes or on Dask.
+
+A chromosome (Lauret et al.) is a mask over the measured nodes: True = that node is forced to
+its measured temperature for the whole run.  Its score is J, the sum of squared residuals of
+indoor air temperature (PHYSICS.md section 6), computed by an *evaluator*:
+
+    factory = SomeFactory(...)      # picklable; shipped to every worker
+    evaluator = factory()           # called once per worker process (or per Dask worker thread)
+    evaluator.J(mask)               # mask: tuple[bool, ...] over the chromosome nodes, in order
+
+J may raise: the simulation failed.  That chromosome is then unfit (J = inf, fitness 0), the
+reason is logged on logger "nodeforce.ga", and the search goes on.  A worker process that dies
+(a crash inside a C library) is handled the same way: its masks are retried one at a time in a
+fresh worker and the one that kills it again is scored unfit.  Only a factory that fails to
+build an evaluator stops the search (EvaluatorSetupError): that is a setup error, not a bad
+chromosome.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import logging
+import math
+import multiprocessing
+import pickle
+import threading
+from concurrent.futures import ProcessPoolExecutor
+from typing import Iterable, Sequence
+
+log = logging.getLogger("nodeforce.ga")
+
+Mask = tuple[bool, ...]
+# What a worker returns for one mask: (J, None) or (inf, reason it failed).
+Outcome = tuple[float, "str | None"]
+
+
+class EvaluatorSetupError(RuntimeError):
+    """The evaluator factory itself failed in a worker: no chromosome can be scored."""
+
+
+def factory_token(factory) -> str:
+    """A stable name for a factory: hash of its pickle (same arguments -> same token)."""
+    return hashlib.sha256(pickle.dumps(factory, protocol=4)).hexdigest()
+
+
+def evaluate_masks(evaluator, masks: Iterable[Mask]) -> list[Outcome]:
+    """Score masks one by one with one evaluator; a failed simulation becomes (inf, reason)."""
+    outcomes = []
+    for mask in masks:
+        try:
+            J = float(evaluator.J(tuple(mask)))
+        except Exception as exc:  # any failure of the simulation makes the chromosome unfit
+            outcomes.append((math.inf, f"{type(exc).__name__}: {exc}"))
+            continue
+        outcomes.append((J, None) if math.isfinite(J) else (math.inf, f"J is {J}"))
+    return outcomes
+
+
+def _build(factory):
+    try:
+        return factory()
+    except Exception as exc:
+        raise EvaluatorSetupError(f"evaluator factory failed: {type(exc).__name__}: {exc}") from exc
+
+
+# --- backends: each runs a list of chunks (lists of masks) and returns, per chunk, either its
+# outcomes or the exception that lost the whole chunk (a dead worker).
+
+
+class InProcessBackend:
+    """workers=1: one evaluator in this process, no pool."""
+
+    slots = 1
+
+    def __init__(self, factory):
+        self._evaluator = _build(factory)
+
+    def run(self, chunks):
+        return [evaluate_masks(self._evaluator, chunk) for chunk in chunks]
+
+    def close(self):
+        pass
+
+
+# Per worker process: the evaluator built once by the pool initializer.
+_process_evaluator = None
+_process_setup_error: "str | None" = None
+
+
+def _pool_initializer(factory):
+    # An initializer that raises would break the pool and look like a crash; keep the error
+    # and report it from the tasks instead, so it stops the search as a setup error.
+    global _process_evaluator, _process_setup_error
+    try:
+        _process_evaluator = _build(factory)
+    except EvaluatorSetupError as exc:
+        _process_setup_error = str(exc)
+
+
+def _pool_task(masks):
+    if _process_evaluator is None:
+        raise EvaluatorSetupError(_process_setup_error)
+    return evaluate_masks(_process_evaluator, masks)
+
+
+class ProcessBackend:
+    """A pool of `workers` processes, each holding its own evaluator.
+
+    The pool uses the "spawn" start method: evaluators hold FMU / C-library state that must not
+    be inherited through fork.
+    """
+
+    def __init__(self, factory, workers: int):
+        self._factory = factory
+        self.slots = workers
+        self._pool = self._new_pool()
+
+    def _new_pool(self):
+        return ProcessPoolExecutor(max_workers=self.slots,
+                                   mp_context=multiprocessing.get_context("spawn"),
+                                   initializer=_pool_initializer, initargs=(self._factory,))
+
+    def run(self, chunks):
+        futures = [self._pool.submit(_pool_task, chunk) for chunk in chunks]
+        results, broken = [], False
+        for future in futures:
+            try:
+                results.append(future.result())
+            except EvaluatorSetupError:
+                raise
+            except Exception as exc:  # BrokenProcessPool: a worker died, the pool is unusable
+                results.append(exc)
+                broken = True
+        if broken:
+            self._pool.shutdown(wait=False, cancel_futures=True)
+            self._pool = self._new_pool()
+        return results
+
+    def close(self):
+        self._pool.shutdown(wait=True, cancel_futures=True)
+
+
+# Per Dask worker process: evaluators keyed by (factory token, thread), built on first use.
+# One per thread because an evaluator (an FMU instance) is not safe to share between threads.
+_dask_evaluators: dict = {}
+
+
+def _dask_task(token: str, factory, masks):
+    key = (token, threading.get_ident())
+    if key not in _dask_evaluators:
+        _dask_evaluators[key] = _build(factory)
+    return evaluate_masks(_dask_evaluators[key], masks)
+
+
+class DaskBackend:
+    """Chunks submitted to a dask.distributed scheduler at `address` ("tcp://host:port")."""
+
+    def __init__(self, factory, address: str):
+        from distributed import Client
+
+        self._client = Client(address, set_as_default=False)
+        self._token = factory_token(factory)
+        # Ship the factory once; tasks refer to it instead of carrying it each time.
+        [self._factory] = self._client.scatter([factory], broadcast=True, hash=False)
+
+    @property
+    def slots(self) -> int:
+        return max(1, sum(self._client.nthreads().values()))
+
+    def run(self, chunks):
+        futures = [self._client.submit(_dask_task, self._token, self._factory, chunk, pure=False)
+                   for chunk in chunks]
+        results = []
+        for future in futures:
+            try:
+                results.append(future.result())
+            except EvaluatorSetupError:
+                raise
+            except Exception as exc:  # KilledWorker and the like: the chunk was lost
+                results.append(exc)
+        return results
+
+    def close(self):
+        self._client.close()
+
+
+def open_backend(factory, workers: "int | None", scheduler: "str | None"):
+    """The backend the caller asked for: Dask if a scheduler address is given, else processes."""
+    if scheduler is not None:
+        return DaskBackend(factory, scheduler)
+    if workers == 1:
+        return InProcessBackend(factory)
+    return ProcessBackend(factory, workers)
+
+
+def _split(items: Sequence, parts: int) -> list[list]:
+    """Split into at most `parts` contiguous chunks of near-equal size (one task per slot)."""
+    parts = max(1, min(parts, len(items)))
+    size, extra = divmod(len(items), parts)
+    chunks, start = [], 0
+    for i in range(parts):
+        end = start + size + (1 if i < extra else 0)
+        chunks.append(list(items[start:end]))
+        start = end
+    return chunks
+
+
+class FitnessCache:
+    """J per mask; a chromosome already scored is never simulated again.
+
+    `requests` counts the J values the search asked for (cache hits included); the number of
+    simulations actually run is len(self.J_of) (failed ones included).
+    """
+
+    def __init__(self, backend, known: "dict[Mask, float] | None" = None, node_ids=None):
+        self._backend = backend
+        self._node_ids = node_ids
+        self.J_of: dict[Mask, float] = dict(known or {})
+        self.requests = 0
+
+    @property
+    def unique(self) -> int:
+        return len(self.J_of)
+
+    def J(self, mask: Mask) -> float:
+        return self.J_many([mask])[0]
+
+    def J_many(self, masks: Sequence[Mask], count: bool = True) -> list[float]:
+        """J for each mask; the uncached ones go to the workers together, as one batch."""
+        masks = [tuple(bool(b) for b in m) for m in masks]
+        if count:
+            self.requests += len(masks)
+        todo = list(dict.fromkeys(m for m in masks if m not in self.J_of))
+        if todo:
+            self._simulate(todo)
+        return [self.J_of[m] for m in masks]
+
+    def _simulate(self, todo: list[Mask]):
+        chunks = _split(todo, self._backend.slots)
+        for chunk, result in zip(chunks, self._backend.run(chunks)):
+            if isinstance(result, BaseException):
+                result = self._isolate(chunk, result)
+            for mask, (J, reason) in zip(chunk, result):
+                if reason is not None:
+                    log.warning("forcing nodes %s: simulation failed, scored unfit: %s",
+                                self.describe(mask), reason)
+                self.J_of[mask] = J
+
+    def _isolate(self, chunk, error) -> list[Outcome]:
+        # A dead worker lost the whole chunk; rerun its masks one at a time, sequentially, so a
+        # second crash points at a single mask and does not take innocent ones with it.
+        log.warning("a worker died evaluating %d chromosomes (%s); retrying them one by one",
+                    len(chunk), error)
+        outcomes = []
+        for mask in chunk:
+            [result] = self._backend.run([[mask]])
+            outcomes.append((math.inf, f"worker died: {result}")
+                            if isinstance(result, BaseException) else result[0])
+        return outcomes
+
+    def describe(self, mask: Mask) -> list:
+        """The node ids a mask forces (positions if the cache was not given the ids)."""
+        ids = self._node_ids if self._node_ids is not None else range(len(mask))
+        return [n for n, bit in zip(ids, mask) if bit]
+
+    def best(self) -> Mask:
+        """The lowest-J mask scored so far; ties go to fewer forced nodes, then mask order."""
+        return min(self.J_of, key=lambda m: (self.J_of[m], sum(m), m))

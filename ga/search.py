@@ -1,0 +1,202 @@
+"""Locate the wrong sub-models: search the forcing masks of lowest J (Lauret et al.).
+
+A chromosome has one bit per measured node (the output air node excluded); bit i set = node i
+forced to its measured temperature for the whole run.  Forcing a node cuts the model at that
+node: if J (sum of squared residuals of indoor air temperature) drops, the error lies in the
+sub-models the forced node isolates.  The fitness is f = 1/(1+J) (paper eq. 8).
+
+search() runs the paper's simple GA through PyGAD (roulette selection, one-point crossover
+with probability pc, bit-flip mutation with probability pm per gene, see ga.operators; plus
+one elite carried to the next generation so the best chromosome is never lost), or, when the
+GA's budget population*generations covers all 2^k chromosomes, simply scores them all: the
+exact answer for no more work.  Every J goes through one cache, so a chromosome is simulated
+at most once, whether asked for by the GA, the single-node scores or the parsimony step.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import time
+from itertools import product
+
+import pygad
+from tqdm import tqdm
+
+from ga import checkpoint as ckpt
+from ga.evaluation import FitnessCache, log, open_backend
+from ga.operators import bit_flip_mutation, one_point_crossover, roulette_selection
+from ga.parsimony import smallest_subset, tolerance
+
+
+def search(factory, chromosome_nodes, *, population=30, generations=400, pc=0.8, pm=0.03,
+           seed=0, workers=None, scheduler=None, checkpoint=None, progress=None,
+           noise_sigma=None, n_residuals=None) -> dict:
+    """Search the forcing of lowest J over `chromosome_nodes`; return the locate.json fields.
+
+    factory: picklable callable; factory() -> evaluator with J(mask: tuple[bool, ...]) -> float,
+        mask over chromosome_nodes in order.  Called once per worker.  J may raise: that
+        chromosome is unfit (J = inf), the reason logged on logger "nodeforce.ga".
+    population, generations, pc, pm: the GA settings (paper: 30, 400, 0.8, 0.03).
+    seed: seeds every random draw; same arguments and seed -> same answer.
+    workers: processes evaluating in parallel (default os.cpu_count(); 1 = in this process).
+    scheduler: a dask.distributed scheduler address ("tcp://host:port"); replaces `workers`.
+    checkpoint: a file path; the state is written there after every generation, and a run
+        started again with the same arguments resumes from it (other arguments: ignored).
+    progress: optional callable progress(generation, total, J_min, unique_evaluations), called
+        after each generation (after the checkpoint is written).  A tqdm bar is shown as well
+        when stderr is a terminal.
+    noise_sigma, n_residuals: measurement-noise sd (C) and the number of residuals in J, used to
+        judge which reductions of J are significant (ga.parsimony); None = relative floor only.
+
+    Returns {"chromosome_nodes", "J_unforced", "best_nodes", "J_best", "node_scores",
+    "ranked_nodes", "search": {...}} with J values as floats, None where a simulation failed.
+    """
+    started = time.monotonic()
+    nodes = list(chromosome_nodes)
+    _check_arguments(nodes, population, generations, pc, pm, noise_sigma, n_residuals)
+    k = len(nodes)
+    exhaustive = 2 ** k <= population * generations
+    settings = dict(method="exhaustive" if exhaustive else "ga", population=population,
+                    generations=generations, pc=pc, pm=pm, seed=seed)
+    key = ckpt.run_key(factory, nodes, **settings) if checkpoint else None
+    state = ckpt.load(checkpoint, key) if checkpoint else None
+
+    backend = open_backend(factory, workers or os.cpu_count(), scheduler)
+    try:
+        cache = FitnessCache(backend, ckpt.decode_cache(state["cache"]) if state else None, nodes)
+        if state:
+            cache.requests = state["requests"]
+            log.info("resuming from %s at generation %d", checkpoint, state["generation"])
+        total = math.ceil(2 ** k / population) if exhaustive else generations
+        steps = _Steps(total, state["generation"] if state else 0, cache, checkpoint, key,
+                       progress, settings["method"])
+        try:
+            if exhaustive:
+                _enumerate(cache, k, population, steps)
+            else:
+                _evolve(cache, k, population, pc, pm, seed, state, steps)
+        finally:
+            steps.close()
+        search_requests = cache.requests
+        answer = _answer(cache, nodes, noise_sigma, n_residuals)
+        if checkpoint:
+            # Keep the final scores too, so a rerun is instant; the counter stays at the end of
+            # the search so the rerun counts the final steps exactly once, like this run.
+            steps.save(total, requests=search_requests)
+    finally:
+        backend.close()
+    answer["search"].update(settings, evaluations=cache.requests, unique_evaluations=cache.unique,
+                            seconds=round(time.monotonic() - started, 3))
+    return answer
+
+
+def _check_arguments(nodes, population, generations, pc, pm, noise_sigma, n_residuals):
+    if len(set(map(str, nodes))) != len(nodes):
+        raise ValueError(f"chromosome nodes must be distinct: {nodes}")
+    if population < 2 or generations < 1:
+        raise ValueError("population must be >= 2 and generations >= 1")
+    if not (0 <= pc <= 1 and 0 <= pm <= 1):
+        raise ValueError("pc and pm are probabilities, in [0, 1]")
+    if noise_sigma is not None and not n_residuals:
+        raise ValueError("noise_sigma needs n_residuals, the number of residuals in J")
+
+
+class _Steps:
+    """After each generation: write the checkpoint, then move the bar and call `progress`."""
+
+    def __init__(self, total, done, cache, path, key, progress, method):
+        self.total, self.done = total, done
+        self._cache, self._path, self._key, self._progress = cache, path, key, progress
+        self._bar = tqdm(total=total, initial=done, desc=f"nodeforce {method}", unit="gen",
+                         disable=not sys.stderr.isatty())
+
+    def save(self, generation, requests=None, **extra):
+        ckpt.save(self._path, self._key, {
+            "generation": generation, "cache": ckpt.encode_cache(self._cache.J_of),
+            "requests": self._cache.requests if requests is None else requests, **extra})
+
+    def step(self, generation, **extra):
+        self.done = generation
+        if self._path:
+            self.save(generation, **extra)
+        J_min = self._cache.J_of[self._cache.best()]
+        self._bar.update(generation - self._bar.n)
+        self._bar.set_postfix(J_min=f"{J_min:.4g}", sims=self._cache.unique)
+        if self._progress:
+            self._progress(generation, self.total, J_min, self._cache.unique)
+
+    def close(self):
+        self._bar.close()
+
+
+def _enumerate(cache, k, population, steps):
+    """Exhaustive mode: score all 2^k masks, `population` at a time (one 'generation')."""
+    masks = list(product((False, True), repeat=k))
+    for g in range(steps.done, steps.total):
+        cache.J_many(masks[g * population:(g + 1) * population])
+        steps.step(g + 1)
+
+
+def _evolve(cache, k, population, pc, pm, seed, state, steps):
+    """The GA, driven by PyGAD; resumes from `state` (a checkpoint) when given."""
+    if steps.done == steps.total:
+        return
+
+    def fitness(ga, solutions, indices):
+        # One call per generation (fitness_batch_size = population): the uncached chromosomes
+        # of the generation go to the workers together.  Counted per generation instead (below)
+        # because PyGAD itself skips the elite it already knows.
+        return [1.0 / (1.0 + J) for J in cache.J_many([tuple(s) for s in solutions], count=False)]
+
+    def on_generation(ga):
+        cache.requests += population
+        steps.step(ga.generations_completed, population=ga.population.tolist(),
+                   rng=ckpt.rng_states(ga))
+
+    shape = (dict(initial_population=state["population"]) if state
+             else dict(sol_per_pop=population, num_genes=k))
+    ga = pygad.GA(num_generations=steps.total - steps.done, num_parents_mating=population,
+                  fitness_func=fitness, fitness_batch_size=population, **shape,
+                  gene_type=int, gene_space=[0, 1], parent_selection_type=roulette_selection,
+                  keep_elitism=1, crossover_type=one_point_crossover, crossover_probability=pc,
+                  mutation_type=bit_flip_mutation, mutation_probability=pm,
+                  on_generation=on_generation, random_seed=seed, suppress_warnings=True,
+                  logger=log.getChild("pygad"))
+    if state:
+        # Continue exactly where the checkpoint stopped: same generators, same generation count.
+        ckpt.restore_rng_states(ga, state["rng"])
+        ga.generations_completed = steps.done
+    else:
+        cache.requests += population  # the initial population, scored at the start of run()
+    ga.run()
+
+
+def _answer(cache, nodes, noise_sigma, n_residuals) -> dict:
+    """The locate.json fields: unforced and single-node scores, best chromosome, best_nodes."""
+    k = len(nodes)
+    unforced = (False,) * k
+    singles = [tuple(i == j for j in range(k)) for i in range(k)]
+    J_unforced, *J_single = cache.J_many([unforced] + singles)
+    best = cache.best()
+    J_min = cache.J_of[best]
+    tol = tolerance(J_unforced, noise_sigma, n_residuals)
+    chosen = smallest_subset(cache.J_many, best, J_min + tol)
+    # Ranking: the nodes whose forcing alone lowers J, most helpful (lowest J) first.
+    helpful = sorted((J, i) for i, J in enumerate(J_single) if J < J_unforced)
+    return {
+        "chromosome_nodes": nodes,
+        "J_unforced": _json(J_unforced),
+        "best_nodes": cache.describe(chosen),
+        "J_best": _json(cache.J_of[chosen]),
+        "node_scores": {str(n): _json(J) for n, J in zip(nodes, J_single)},
+        "ranked_nodes": [nodes[i] for _, i in helpful],
+        "search": {"J_min": _json(J_min), "min_nodes": cache.describe(best),
+                   "tolerance": _json(tol)},
+    }
+
+
+def _json(J: float) -> "float | None":
+    """None for a failed simulation (inf), so the result is plain JSON."""
+    return J if math.isfinite(J) else None
