@@ -1,8 +1,19 @@
-"""A measured case on its simulation grid: the inputs and measurements every simulation reads."""
+"""A measured case on its simulation grid: the inputs and measurements every simulation reads.
+
+`prepare_case` turns a building, its weather and its measurements into arrays on one uniform
+time grid: the measurement grid when there are measurements (weather interpolated onto it),
+else the weather's own. It never fills a gap: a missing measurement stays NaN (the node is then
+computed, PHYSICS.md section 5) and a missing input is refused.
+"""
 from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
+
+from .errors import InputError
+from .network import input_names
+from .solar import incident_irradiance, sky_temperature, solar_position
+from .weather import weather_on_grid
 
 
 @dataclass(frozen=True)
@@ -17,3 +28,83 @@ class Case:
     def measured_ids(self):
         """Ids of the nodes with at least one measurement."""
         return [i + 1 for i in np.flatnonzero(np.isfinite(self.measured).any(axis=0))]
+
+    def window(self, start, stop):
+        """The sub-case on rows start..stop (inclusive), t_start becoming its t_0."""
+        rows = slice(start, stop + 1)
+        return Case(self.times[rows], self.dt, self.input_names, self.U[rows], self.measured[rows])
+
+
+def uniform_grid(times, source):
+    """The uniform grid spanning `times` (their most common step, s), or InputError where a
+    time falls off it. Rows absent from a file become grid rows with nothing measured."""
+    if len(times) < 2:
+        raise InputError(source, "time", "needs at least two time stamps")
+    seconds = (times - times[0]).total_seconds().to_numpy()
+    dt = float(pd.Series(np.diff(seconds)).mode().iloc[0])
+    off = np.abs(seconds / dt - np.round(seconds / dt)) > 1e-6
+    if off.any():
+        raise InputError(source, "time", f"{times[np.argmax(off)].isoformat()} is not on the {dt:g} s grid "
+                                         "of the other rows (samples must be uniform)")
+    return pd.date_range(times[0], times[-1], freq=pd.Timedelta(seconds=dt), name="time"), dt
+
+
+def measured_matrix(building, measurements, times):
+    """(len(times), N) node temperatures (C) from `T<id>` columns, NaN where not measured."""
+    source = measurements.attrs.get("source", "measurements")
+    matrix = np.full((len(times), building.n_nodes), np.nan)
+    on_grid = measurements.reindex(times)
+    for column in measurements.columns:
+        node = int(str(column)[1:])
+        if not 1 <= node <= building.n_nodes:
+            raise InputError(source, column, f"node {node} does not exist (the building has nodes 1..{building.n_nodes})")
+        matrix[:, node - 1] = on_grid[column].to_numpy(float)
+    return matrix
+
+
+def prepare_case(building, weather, measurements=None):
+    """The `Case` of a building under a weather, measured or not.
+
+    Parameters
+    ----------
+    building : Building
+    weather : DataFrame from `model.weather.read_weather`
+    measurements : DataFrame from `model.measurements.read_measurements`, or None
+
+    Returns
+    -------
+    Case with inputs `T_out`, `T_sky` (C), `I_<component>` (W/m2, measured column if the weather
+    has it, else pvlib's isotropic transposition) and the building's named columns.
+    """
+    source = weather.attrs.get("source", "weather")
+    if measurements is not None:
+        times, dt = uniform_grid(measurements.index, measurements.attrs.get("source", "measurements"))
+    else:
+        times, dt = uniform_grid(weather.index, source)
+    w = weather_on_grid(weather, times)
+    site = building.site
+    position = solar_position(times, site["latitude"], site["longitude"], site["altitude"])
+    columns = {
+        "T_out": w["T_out"].to_numpy(float),
+        "T_sky": sky_temperature(w["T_out"], ir_h=w.get("ir_h"), T_sky=w.get("T_sky")),
+    }
+    for c in building.exterior_components:
+        measured_sun = w.get(f"I_{c.name}")
+        columns[f"I_{c.name}"] = (measured_sun.to_numpy(float) if measured_sun is not None else
+                                  incident_irradiance(position, w["ghi"], w["dni"], w["dhi"],
+                                                      c.tilt, c.azimuth, site["ground_albedo"]))
+    for name in building.input_columns:
+        if name not in w:
+            raise InputError(source, name, f"the building {building.source} refers to this input column, "
+                                            "which the weather file does not have")
+        columns[name] = w[name].to_numpy(float)
+    names = input_names(building)
+    U = np.column_stack([np.asarray(columns[n], dtype=float) for n in names])
+    missing = ~np.isfinite(U)
+    if missing.any():
+        row, col = np.argwhere(missing)[0]
+        raise InputError(source, names[col], f"no value at {times[row].isoformat()}: every input is needed "
+                                             "at every step, and a gap is not filled in")
+    measured = (measured_matrix(building, measurements, times) if measurements is not None
+                else np.full((len(times), building.n_nodes), np.nan))
+    return Case(times=times, dt=dt, input_names=names, U=U, measured=measured)
