@@ -88,8 +88,8 @@ class Building:
         return next(c for c in self.components if c.name == name)
 
 
-def load_building(path):
-    """Read and validate a building file; return a `Building`."""
+def read_building_data(path):
+    """The JSON content of a building file, validated; InputError if it is not a valid building."""
     try:
         with open(path, encoding="utf-8") as f:
             data = json.load(f)
@@ -97,7 +97,13 @@ def load_building(path):
         raise InputError(path, "file", "not found") from None
     except json.JSONDecodeError as e:
         raise InputError(path, f"line {e.lineno}", f"not valid JSON ({e.msg})") from None
-    return parse_building(data, source=str(path))
+    parse_building(data, source=str(path))
+    return data
+
+
+def load_building(path):
+    """Read and validate a building file; return a `Building`."""
+    return parse_building(read_building_data(path), source=str(path))
 
 
 def parse_building(data, source="<building>"):

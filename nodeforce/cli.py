@@ -1,0 +1,138 @@
+"""The `nodeforce` command line (INTERFACE.md). Bad input: one line on stderr, exit status 2."""
+import argparse
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from model.building import parse_building, read_building_data
+from model.case import prepare_case
+from model.errors import InputError
+from model.measurements import read_measurements
+from model.weather import read_weather
+
+DATA = Path(__file__).parents[1] / "model" / "data"
+
+
+class Parser(argparse.ArgumentParser):
+    def error(self, message):
+        self.exit(2, f"{self.prog}: {message}\n")
+
+
+def node_list(option, text):
+    """Node ids from "1,7,9"."""
+    try:
+        ids = [int(part) for part in text.split(",") if part.strip()]
+    except ValueError:
+        raise InputError(option, text, "must be node ids separated by commas, e.g. 1,7,9") from None
+    if not ids:
+        raise InputError(option, text, "names no node")
+    return ids
+
+
+def load_inputs(args):
+    """Building (data and parsed), and the case of its weather and measurements."""
+    data = read_building_data(args.building)
+    building = parse_building(data, source=args.building)
+    weather = read_weather(args.weather)
+    measurements = read_measurements(args.measurements) if getattr(args, "measurements", None) else None
+    return data, building, prepare_case(building, weather, measurements)
+
+
+def force_mask(case, ids, source):
+    """Boolean mask of forced nodes; each must have a measurement to be forced to."""
+    mask = np.zeros(case.measured.shape[1], dtype=bool)
+    measured = set(case.measured_ids)
+    for i in ids:
+        if i not in measured:
+            raise InputError(source, f"T{i}", f"node {i} is to be forced but has no measurement column T{i}")
+        mask[i - 1] = True
+    return mask
+
+
+def cmd_fmu(args):
+    from fmu_build.build import build_fmu
+    path = build_fmu(read_building_data(args.building), args.output, source=args.building)
+    print(f"wrote {path}")
+
+
+def cmd_simulate(args):
+    from cosim.fmi2 import FmuInstance
+    from cosim.run import simulate_fmu
+    from fmu_build.build import build_fmu
+    from model.report import write_node_temperatures
+    if args.force and not args.measurements:
+        raise InputError("--force", args.force, "forcing needs --measurements to force nodes to")
+    data, building, case = load_inputs(args)
+    force = force_mask(case, node_list("--force", args.force), args.measurements) if args.force else None
+    with tempfile.TemporaryDirectory(prefix="nodeforce_") as tmp:
+        with FmuInstance(build_fmu(data, Path(tmp) / "model.fmu", source=args.building)) as instance:
+            T = simulate_fmu(instance, case, force)
+    write_node_temperatures(args.output, case.times[1:], T)
+    print(f"wrote {args.output}: nodes 1..{T.shape[1]} at {len(T)} times "
+          f"({case.times[1].isoformat()} to {case.times[-1].isoformat()}, step {case.dt:g} s)")
+    air = building.zones[0].air_node
+    residual = case.measured[1:, air - 1] - T[:, air - 1]
+    if np.isfinite(residual).any():
+        print(f"air node {air}: RMSE {np.sqrt(np.nanmean(residual ** 2)):.3f} C against the measurements")
+
+
+def cmd_demo(args):
+    from cosim.fmi2 import FmuInstance
+    from cosim.run import simulate_fmu
+    from fmu_build.build import build_fmu
+    building_path = DATA / "testcell_miami.json"
+    data = read_building_data(building_path)
+    building = parse_building(data, source=str(building_path))
+    weather = read_weather(DATA / "miami_tmy2.csv")
+    june = weather.loc["2001-06-10":"2001-06-15"]
+    case = prepare_case(building, june)
+    out = Path(args.output)
+    fmu = build_fmu(data, out / "testcell.fmu", source=str(building_path))
+    with FmuInstance(fmu) as instance:
+        T = simulate_fmu(instance, case)
+    air = building.zones[0].air_node
+    print(f"{building.name}\nFMU: {fmu}\nweather: Miami TMY2, {case.times[0]:%Y-%m-%d %H:%M} to "
+          f"{case.times[-1]:%Y-%m-%d %H:%M}, step {case.dt:g} s")
+    print(f"{'':<22}{'min':>8}{'mean':>8}{'max':>8}")
+    for label, series in (("outdoor air (C)", case.U[1:, 0]), (f"indoor air T{air} (C)", T[:, air - 1]),
+                          ("roof inside T9 (C)", T[:, 8]), ("floor T17 (C)", T[:, 16])):
+        print(f"{label:<22}{series.min():8.2f}{series.mean():8.2f}{series.max():8.2f}")
+
+
+def parser():
+    p = Parser(prog="nodeforce", description=__doc__)
+    sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
+
+    s = sub.add_parser("fmu", help="build the FMU of a building file")
+    s.add_argument("building")
+    s.add_argument("-o", "--output", required=True, help="the .fmu to write")
+    s.set_defaults(run=cmd_fmu)
+
+    s = sub.add_parser("simulate", help="simulate a building through its FMU")
+    s.add_argument("building")
+    s.add_argument("--weather", required=True)
+    s.add_argument("--measurements")
+    s.add_argument("--force", help="node ids forced to their measurements, e.g. 1,7,9")
+    s.add_argument("-o", "--output", default="sim.csv")
+    s.set_defaults(run=cmd_simulate)
+
+    s = sub.add_parser("demo", help="run nodeforce on the bundled test cell and weather")
+    s.add_argument("-o", "--output", default="out/demo")
+    s.set_defaults(run=cmd_demo)
+    return p
+
+
+def main(argv=None):
+    args = parser().parse_args(argv)
+    try:
+        args.run(args)
+    except InputError as e:
+        print(f"nodeforce: {e}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,119 @@
+"""The command line: what it writes, and one-line errors with exit status 2 for bad input."""
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from model.building import parse_building
+from model.case import prepare_case
+from model.integrate import simulate
+from model.measurements import read_measurements
+from model.network import assemble
+from model.synth import pseudo_measurements
+from nodeforce.cli import main
+from tests.conftest import DATA, SENSORS, record_times
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory, testcell_data, weather):
+    d = tmp_path_factory.mktemp("cli")
+    building = d / "cell.json"
+    building.write_text(json.dumps(testcell_data))
+    measurements = pseudo_measurements(parse_building(testcell_data), weather, record_times(days=2), SENSORS)
+    measured = d / "measured.csv"
+    measurements.to_csv(measured, date_format="%Y-%m-%dT%H:%M:%S%z")
+    weather_csv = d / "weather.csv"
+    weather_csv.write_text((DATA / "miami_tmy2.csv").read_text())
+    return {"dir": d, "building": building, "measurements": measured, "weather": weather_csv}
+
+
+def error_of(capsys, argv):
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "Traceback" not in err
+    return err
+
+
+def test_simulate_writes_every_node_as_the_direct_model_computes(files, testcell, weather):
+    out = files["dir"] / "sim.csv"
+    assert main(["simulate", str(files["building"]), "--weather", str(files["weather"]),
+                 "--measurements", str(files["measurements"]), "--force", "7,17", "-o", str(out)]) == 0
+    sim = pd.read_csv(out)
+    assert list(sim.columns) == ["time"] + [f"T{i}" for i in range(1, 24)]
+    measurements = pd.read_csv(files["measurements"], index_col="time")
+    case = prepare_case(testcell, weather, read_measurements(files["measurements"]))
+    force = np.zeros(23, dtype=bool)
+    force[[6, 16]] = True
+    direct = simulate(testcell, assemble(testcell), case.U, case.dt, case.measured, force)
+    assert len(sim) == len(measurements) - 1  # t_1..t_N
+    assert np.abs(sim.iloc[:, 1:].to_numpy() - direct).max() < 1e-9
+    assert np.array_equal(sim["T7"].to_numpy(), measurements["T7"].to_numpy()[1:])
+
+
+def test_fmu_command_writes_a_valid_fmu(files):
+    from fmpy.validation import validate_fmu
+    out = files["dir"] / "cell.fmu"
+    assert main(["fmu", str(files["building"]), "-o", str(out)]) == 0
+    assert validate_fmu(str(out)) == []
+
+
+def write_building(files, name, mutate):
+    data = json.loads(files["building"].read_text())
+    mutate(data)
+    path = files["dir"] / name
+    path.write_text(json.dumps(data))
+    return str(path)
+
+
+def test_bad_building_files(files, capsys):
+    def run(path):
+        return error_of(capsys, ["simulate", path, "--weather", str(files["weather"])])
+    gap = write_building(files, "gap.json", lambda d: d["zones"][0].update(air_node=30))
+    assert "gap.json: nodes: node ids must be 1..23" in run(gap)
+    deep = write_building(files, "deep.json", lambda d: d["components"][0]["nodes"][1].update(depth=0.5))
+    assert "deep.json: components[0].nodes[1].depth" in run(deep)
+    odd = write_building(files, "odd.json", lambda d: d["components"][0]["layers"][0].__setitem__(0, "cheese"))
+    assert "odd.json: components[0].layers[0]: unknown material 'cheese'" in run(odd)
+
+
+def rewrite_csv(files, source, name, edit):
+    frame = pd.read_csv(files[source])
+    frame = edit(frame)
+    path = files["dir"] / name
+    frame.to_csv(path, index=False)
+    return str(path)
+
+
+def test_bad_weather_files(files, capsys):
+    def run(path):
+        return error_of(capsys, ["simulate", str(files["building"]), "--weather", path])
+    no_dni = rewrite_csv(files, "weather", "no_dni.csv", lambda f: f.drop(columns="dni"))
+    assert "no_dni.csv: dni" in run(no_dni)
+    shuffled = rewrite_csv(files, "weather", "shuffled.csv", lambda f: f.iloc[[0, 2, 1, *range(3, len(f))]])
+    assert "shuffled.csv: time" in run(shuffled)
+    twice = rewrite_csv(files, "weather", "twice.csv", lambda f: pd.concat([f.iloc[:5], f.iloc[4:]]))
+    assert "twice.csv: time" in run(twice)
+    kelvin = rewrite_csv(files, "weather", "kelvin.csv", lambda f: f.assign(T_out=f["T_out"] + 273.15))
+    assert "kelvin.csv: T_out" in run(kelvin) and "elvin" in run(kelvin)
+
+
+def test_bad_measurements_and_forcing(files, capsys):
+    def run(path, *extra):
+        return error_of(capsys, ["simulate", str(files["building"]), "--weather", str(files["weather"]),
+                                 "--measurements", path, *extra])
+    kelvin = rewrite_csv(files, "measurements", "mk.csv", lambda f: f.assign(T7=f["T7"] + 273.15))
+    assert "mk.csv: T7" in run(kelvin)
+    err = run(str(files["measurements"]), "--force", "7,12")
+    assert "T12" in err and "no measurement column" in err
+    assert "--force" in error_of(capsys, ["simulate", str(files["building"]), "--weather",
+                                          str(files["weather"]), "--force", "7"])
+
+
+def test_a_user_mistake_never_shows_a_traceback():
+    result = subprocess.run([sys.executable, "-m", "nodeforce.cli", "simulate", "missing.json",
+                             "--weather", "nowhere.csv"], capture_output=True, text=True)
+    assert result.returncode == 2
+    assert result.stderr.strip() == "nodeforce: missing.json: file: not found"
