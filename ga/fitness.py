@@ -1,0 +1,54 @@
+"""J of a forcing mask, simulated through the FMU (the search's evaluator).
+
+`FmuFitness` is the picklable factory `ga.search` sends to each worker; the worker calls it
+once, extracting and instantiating the FMU once, and then scores every chromosome it is given
+by resetting and re-running that one instance, warm-up included.
+"""
+import zipfile
+
+import numpy as np
+
+from cosim.fmi2 import FmuInstance
+from cosim.run import simulate_fmu
+from model.score import sum_of_squares
+
+
+class FmuFitness:
+    """Factory of evaluators scoring masks over `chromosome_nodes` by J on `output_node`.
+
+    Parameters
+    ----------
+    fmu_path : the building's FMU
+    case : model.case.Case with the measurements
+    chromosome_nodes : node ids, one bit each
+    output_node : the measured air node J is computed on
+    warmup_days : warm-up passes (PHYSICS.md section 5)
+    """
+
+    def __init__(self, fmu_path, case, chromosome_nodes, output_node, warmup_days=2):
+        self.fmu_path = str(fmu_path)
+        # The slave's module name hashes the building and the model code (fmu_build.build), so a
+        # checkpoint keyed on this factory is never resumed against another model.
+        with zipfile.ZipFile(self.fmu_path) as fmu:
+            self.model_id = fmu.read("resources/slavemodule.txt").decode().strip()
+        self.case = case
+        self.chromosome_nodes = np.asarray(chromosome_nodes, dtype=int)
+        self.output_node = int(output_node)
+        self.warmup_days = warmup_days
+
+    def __call__(self):
+        return FmuEvaluator(self)
+
+
+class FmuEvaluator:
+    def __init__(self, spec):
+        self.spec = spec
+        self.instance = FmuInstance(spec.fmu_path)
+        self.measured = spec.case.measured[1:, spec.output_node - 1]
+
+    def J(self, mask):
+        force = np.zeros(self.spec.case.measured.shape[1], dtype=bool)
+        force[self.spec.chromosome_nodes[np.asarray(mask, dtype=bool)] - 1] = True
+        T = simulate_fmu(self.instance, self.spec.case, force, self.spec.warmup_days,
+                         output_ids=[self.spec.output_node])
+        return sum_of_squares(self.measured, T[:, 0])
