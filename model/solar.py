@@ -1,0 +1,104 @@
+"""Sky temperature and solar irradiance on the outside faces of a building (PHYSICS.md section 4).
+
+Pure functions on numpy arrays and pandas indexes, no I/O. The sun position is computed once for
+a time grid (`solar_position`) and reused for every surface (`incident_irradiance`), because it is
+by far the most expensive part and does not depend on the surface.
+"""
+
+import numpy as np
+import pvlib
+
+#: Stefan-Boltzmann constant, W/m2/K4 (CODATA 2018, exact as PHYSICS.md writes it).
+STEFAN_BOLTZMANN = 5.670374419e-8
+
+#: Offset between degrees Celsius and kelvin, K.
+ZERO_CELSIUS = 273.15
+
+
+def sky_temperature(T_out, ir_h=None, T_sky=None):
+    """Effective sky temperature for long-wave exchange, degrees C.
+
+    Chooses its source by which input is given, never mixing sources element by element: a
+    missing `T_sky` or `ir_h` sample gives a missing (NaN) sky temperature rather than one from
+    another formula, so gaps in a measured column stay visible.
+
+    Parameters
+    ----------
+    T_out : array_like
+        Outdoor air temperature, degrees C. Used only when neither other input is given.
+    ir_h : array_like, optional
+        Horizontal infrared irradiance from the sky, W/m2.
+    T_sky : array_like, optional
+        Measured or given sky temperature, degrees C. Takes precedence over `ir_h`.
+
+    Returns
+    -------
+    numpy.ndarray
+        Sky temperature, degrees C: `T_sky` as given; else the black-body temperature of `ir_h`,
+        `(ir_h / sigma)^0.25 - 273.15`; else Swinbank's clear-sky estimate
+        `0.0552 (T_out + 273.15)^1.5 - 273.15`.
+    """
+    if T_sky is not None:
+        return np.asarray(T_sky, dtype=float)
+    if ir_h is not None:
+        return (np.asarray(ir_h, dtype=float) / STEFAN_BOLTZMANN) ** 0.25 - ZERO_CELSIUS
+    return 0.0552 * (np.asarray(T_out, dtype=float) + ZERO_CELSIUS) ** 1.5 - ZERO_CELSIUS
+
+
+def solar_position(times, latitude, longitude, altitude):
+    """Sun position at each sample time, to be shared by all surfaces of a building.
+
+    Parameters
+    ----------
+    times : pandas.DatetimeIndex
+        Sample times, timezone-aware. The position is the instantaneous one at each time, so
+        hour-averaged irradiance should be stamped at the middle of its hour (see model.weather).
+    latitude, longitude : float
+        Site, degrees (north and east positive).
+    altitude : float
+        Site altitude, m.
+
+    Returns
+    -------
+    pandas.DataFrame
+        pvlib's `get_solarposition(times, latitude, longitude, altitude)`; the columns used here
+        are `apparent_zenith` and `azimuth`, degrees (azimuth clockwise from north).
+    """
+    return pvlib.solarposition.get_solarposition(times, latitude, longitude, altitude)
+
+
+def incident_irradiance(position, ghi, dni, dhi, tilt, azimuth, albedo):
+    """Solar irradiance incident on a plane surface, W/m2, isotropic sky.
+
+    Parameters
+    ----------
+    position : pandas.DataFrame
+        Output of `solar_position` for the same sample times as the irradiance arrays.
+    ghi, dni, dhi : array_like
+        Global horizontal, direct normal and diffuse horizontal irradiance, W/m2.
+    tilt : float
+        Surface tilt from horizontal, degrees (0 faces up, 90 vertical, 180 faces down).
+    azimuth : float
+        Direction the surface faces, degrees clockwise from north (180 = south).
+    albedo : float
+        Ground reflectance, 0..1.
+
+    Returns
+    -------
+    numpy.ndarray
+        pvlib's isotropic `get_total_irradiance(...)["poa_global"]`, W/m2, with NaN and negative
+        values set to 0: a missing weather sample contributes no sun (PHYSICS.md section 4).
+    """
+    poa = pvlib.irradiance.get_total_irradiance(
+        tilt,
+        azimuth,
+        np.asarray(position["apparent_zenith"], dtype=float),
+        np.asarray(position["azimuth"], dtype=float),
+        np.asarray(dni, dtype=float),
+        np.asarray(ghi, dtype=float),
+        np.asarray(dhi, dtype=float),
+        albedo=albedo,
+        model="isotropic",
+    )["poa_global"]
+    poa = np.asarray(poa, dtype=float)
+    return np.where(np.isfinite(poa) & (poa > 0.0), poa, 0.0)

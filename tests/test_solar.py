@@ -1,0 +1,77 @@
+"""Sky temperature and incident solar against hand calculations (PHYSICS.md section 4)."""
+
+import numpy as np
+import pandas as pd
+import pvlib
+import pytest
+
+from model.solar import incident_irradiance, sky_temperature, solar_position
+
+SIGMA = 5.670374419e-8
+
+
+def test_swinbank_by_hand():
+    # 0.0552 * 293.15^1.5 = 0.0552 * 293.15 * 17.12163 = 277.060 K, i.e. 3.910 C
+    assert sky_temperature(np.array([20.0]))[0] == pytest.approx(3.910, abs=1e-3)
+
+
+def test_infrared_is_the_inverse_of_black_body_emission():
+    t_sky = np.array([-30.0, 0.0, 10.0, 25.0])
+    ir_h = SIGMA * (t_sky + 273.15) ** 4
+    assert np.allclose(sky_temperature(np.full(4, 99.0), ir_h=ir_h), t_sky, atol=1e-9)
+
+
+def test_given_sky_temperature_wins_and_gaps_are_not_filled_from_another_source():
+    t_sky = np.array([5.0, np.nan])
+    ir_h = np.array([300.0, 300.0])
+    got = sky_temperature(np.array([20.0, 20.0]), ir_h=ir_h, T_sky=t_sky)
+    assert got[0] == 5.0 and np.isnan(got[1])
+    from_ir = sky_temperature(np.array([20.0, 20.0]), ir_h=np.array([np.nan, 300.0]))
+    assert np.isnan(from_ir[0]) and from_ir[1] == pytest.approx((300.0 / SIGMA) ** 0.25 - 273.15)
+
+
+def test_horizontal_surface_receives_global_horizontal():
+    times = pd.date_range("2021-03-10T07:30-05:00", periods=10, freq="1h")
+    position = solar_position(times, 25.8, -80.27, 2.0)
+    cos_z = np.cos(np.radians(position["apparent_zenith"].to_numpy()))
+    dni = np.linspace(100.0, 800.0, 10)
+    dhi = np.linspace(50.0, 150.0, 10)
+    ghi = dhi + dni * cos_z  # closure, so the tilted-frame sum must give ghi back
+    got = incident_irradiance(position, ghi, dni, dhi, tilt=0.0, azimuth=180.0, albedo=0.3)
+    assert np.allclose(got, ghi, rtol=1e-12)
+
+
+def test_south_vertical_wall_at_solar_noon_by_hand():
+    lat, lon, alt = 25.8, -80.27, 2.0
+    day = pd.DatetimeIndex([pd.Timestamp("2021-01-15", tz="Etc/GMT+5")])
+    noon = pvlib.solarposition.sun_rise_set_transit_spa(day, lat, lon)["transit"]
+    times = pd.DatetimeIndex(noon)
+    position = solar_position(times, lat, lon, alt)
+    zenith = position["apparent_zenith"].iloc[0]
+    assert position["azimuth"].iloc[0] == pytest.approx(180.0, abs=0.05)
+    # Mid-January at 25.8 N: declination about -21 deg, so the noon zenith is about 47 deg.
+    assert zenith == pytest.approx(25.8 + 21.2, abs=1.0)
+    ghi, dni, dhi, albedo = 600.0, 800.0, 80.0, 0.2
+    expected = dni * np.sin(np.radians(zenith)) + dhi / 2 + albedo * ghi / 2
+    got = incident_irradiance(position, [ghi], [dni], [dhi], tilt=90.0, azimuth=180.0, albedo=albedo)
+    assert got[0] == pytest.approx(expected, rel=1e-4)
+
+
+def test_north_wall_gets_no_beam_from_a_southern_sun():
+    lat, lon = 25.8, -80.27
+    times = pd.DatetimeIndex([pd.Timestamp("2021-01-15T12:20", tz="Etc/GMT+5")])
+    position = solar_position(times, lat, lon, 2.0)
+    got = incident_irradiance(position, [600.0], [800.0], [80.0], tilt=90.0, azimuth=0.0, albedo=0.2)
+    assert got[0] == pytest.approx(80.0 / 2 + 0.2 * 600.0 / 2)
+
+
+def test_night_missing_and_negative_irradiance_give_zero():
+    times = pd.DatetimeIndex(pd.to_datetime(["2021-06-01T00:00-05:00", "2021-06-01T12:00-05:00",
+                                             "2021-06-01T23:00-05:00"]))
+    position = solar_position(times, 25.8, -80.27, 2.0)
+    ghi = np.array([0.0, np.nan, -3.0])
+    dni = np.array([0.0, 500.0, -1.0])
+    dhi = np.array([0.0, 100.0, -3.0])
+    for tilt, azimuth in ((0.0, 180.0), (90.0, 90.0), (45.0, 270.0)):
+        got = incident_irradiance(position, ghi, dni, dhi, tilt, azimuth, 0.2)
+        assert np.array_equal(got, [0.0, 0.0, 0.0])
