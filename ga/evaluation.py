@@ -222,9 +222,6 @@ class FitnessCache:
     def unique(self) -> int:
         return len(self.J_of)
 
-    def J(self, mask: Mask) -> float:
-        return self.J_many([mask])[0]
-
     def J_many(self, masks: Sequence[Mask], count: bool = True) -> list[float]:
         """J for each mask; the uncached ones go to the workers together, as one batch."""
         masks = [tuple(bool(b) for b in m) for m in masks]

@@ -50,8 +50,17 @@ def search(factory, chromosome_nodes, *, population=30, generations=400, pc=0.8,
     noise_sigma, n_residuals: measurement-noise sd (C) and the number of residuals in J, used to
         judge which reductions of J are significant (ga.parsimony); None = relative floor only.
 
-    Returns {"chromosome_nodes", "J_unforced", "best_nodes", "J_best", "node_scores",
-    "ranked_nodes", "search": {...}} with J values as floats, None where a simulation failed.
+    Returns the locate.json fields it knows, J values as floats (None: the simulation failed):
+      chromosome_nodes; J_unforced (no node forced);
+      node_scores {str(id): J with only that node forced};
+      ranked_nodes: the nodes whose forcing alone lowers J below J_unforced, lowest J first
+        (ties: chromosome order); nodes that do not help are left out;
+      best_nodes: the smallest part of the best chromosome that keeps its reduction of J
+        (ga.parsimony), [] when no reduction is significant; J_best: J with best_nodes forced;
+      search: {method "ga" | "exhaustive", population, generations, pc, pm, seed,
+        evaluations (J values the search asked for, cache hits included), unique_evaluations
+        (simulations run), seconds, J_min and min_nodes (the lowest J found and its chromosome,
+        before parsimony), tolerance (the change of J deemed noise)}.
     """
     started = time.monotonic()
     nodes = list(chromosome_nodes)
@@ -123,7 +132,7 @@ class _Steps:
             self.save(generation, **extra)
         J_min = self._cache.J_of[self._cache.best()]
         self._bar.update(generation - self._bar.n)
-        self._bar.set_postfix(J_min=f"{J_min:.4g}", sims=self._cache.unique)
+        self._bar.set_postfix(best_J=f"{J_min:.4g}", unique=self._cache.unique)
         if self._progress:
             self._progress(generation, self.total, J_min, self._cache.unique)
 
