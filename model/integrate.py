@@ -93,7 +93,8 @@ def initial_state(building, measured0, T_default=20.0):
     return T
 
 
-def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2, T_default=20.0):
+def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2, T_default=20.0,
+             include_start=False):
     """Simulate the network over input samples t_0..t_N; return temperatures at t_1..t_N.
 
     Parameters
@@ -106,10 +107,11 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     force : (N,) bool, nodes forced to their measurements for the whole run
     warmup_days : passes over the first day's inputs (rows 1..24h/dt) before the run
     T_default : C, the initial temperature of a node nothing informs
+    include_start : also return the state at t_0 (after the warm-up) as the first row
 
     Returns
     -------
-    (N_t, N) node temperatures (C) at t_1..t_N
+    (N_t, N) node temperatures (C) at t_1..t_N, or (N_t+1, N) at t_0..t_N with `include_start`
     """
     n_rows, n = U.shape[0], network.n_nodes
     if measured is None:
@@ -121,12 +123,14 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     stepper = ImplicitEuler(network, dt)
     T = initial_state(building, measured[0], T_default)
     rows = warmup_rows(n_rows, dt, warmup_days)
-    out = np.empty((n_rows - 1, n))
+    start = len(rows) - (n_rows - 1)  # the step that reaches t_1
+    out = np.empty((n_rows, n))
+    out[0] = T
     for k, row in enumerate(rows):
         T = stepper.step(T, sources[row], forced[row], measured[row])
-        if k >= len(rows) - (n_rows - 1):
-            out[k - len(rows) + n_rows - 1] = T
-    return out
+        if k >= start - 1:
+            out[k - start + 1] = T
+    return out if include_start else out[1:]
 
 
 def warmup_rows(n_rows, dt, warmup_days):

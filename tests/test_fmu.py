@@ -34,8 +34,8 @@ def test_fmu_equals_direct_model_on_real_weather(fmu, testcell, real_case, force
     with FmuInstance(fmu) as instance:
         through_fmu = simulate_fmu(instance, real_case, force)
     assert np.abs(through_fmu - direct).max() < 1e-9
-    # forcing changes the answer: the comparison is not between two idle models
-    assert np.abs(direct[:, 22] - real_case.measured[1:, 22]).max() > 0.05
+    # the comparison is not between two idle models: the air swings with the weather
+    assert np.ptp(direct[:, 22]) > 2.0
 
 
 def test_fmpy_validate_finds_no_problem(fmu):
