@@ -5,6 +5,7 @@ algebraic radiant nodes, which are no sub-model), builds the FMU, and runs the s
 measurement noise estimated from the measured air.
 """
 import numpy as np
+from scipy.sparse.csgraph import shortest_path
 
 from fmu_build.build import build_fmu
 from ga.fitness import FmuFitness
@@ -22,19 +23,34 @@ def output_node(building, case, source):
     return air
 
 
+def links_to(network, node):
+    """Number of conductances between each node and `node` (ids 1..N -> index 0..N-1)."""
+    coupled = (network.A != 0) & ~np.eye(network.n_nodes, dtype=bool)
+    return shortest_path(coupled, unweighted=True, indices=node - 1)
+
+
 def chromosome_nodes(building, case, source, nodes=None, include_algebraic=False):
-    """The nodes the search may force (ids), ascending."""
+    """The nodes the search may force (ids), nearest the air node first, then by id.
+
+    The order is the search's preference between nodes whose scores the noise cannot separate:
+    forcing a node nearer the zone cuts off more of the sub-model behind it (the inside surface
+    isolates the whole component, a node deeper in cuts only the layers beyond).
+    """
     air = output_node(building, case, source)
+    network = assemble(building)
     measured = set(case.measured_ids) - {air}
     if nodes is None:
-        algebraic = set(np.flatnonzero(assemble(building).algebraic) + 1)
-        return sorted(measured if include_algebraic else measured - algebraic)
-    for i in nodes:
-        if i == air:
-            raise InputError("--nodes", str(i), f"node {i} is the output (indoor air), not a forcing candidate")
-        if i not in measured:
-            raise InputError(source, f"T{i}", f"node {i} is asked for in --nodes but has no measurement column")
-    return sorted(set(nodes))
+        algebraic = set(np.flatnonzero(network.algebraic) + 1)
+        chosen = measured if include_algebraic else measured - algebraic
+    else:
+        for i in nodes:
+            if i == air:
+                raise InputError("--nodes", str(i), f"node {i} is the output (indoor air), not a forcing candidate")
+            if i not in measured:
+                raise InputError(source, f"T{i}", f"node {i} is asked for in --nodes but has no measurement column")
+        chosen = set(nodes)
+    distance = links_to(network, air)
+    return sorted(chosen, key=lambda i: (distance[i - 1], i))
 
 
 def locate(building_data, building, case, workdir, *, source="measurements", nodes=None,

@@ -12,10 +12,23 @@ with n degrees of freedom) has sd sigma^2 * sqrt(2 n): a change of J smaller tha
 sds could be noise alone.  The relative floor keeps a noise-free (or unknown-noise: sigma None)
 case from counting any tiny gain as real.
 
-Rule: best_nodes = the smallest subset S of the best chromosome with
-J(S) <= J_min + tolerance (ties: lowest J, then node order).  The empty subset comes first,
-so best_nodes = [] exactly when J_unforced - J_min <= tolerance: no significant reduction.
-Subsets are searched exhaustively, smallest first, when the best chromosome forces at most
+First, does any forcing explain the residual? Forcing the node of a defective sub-model removes
+most of the error: J falls towards what the noise alone gives, n*sigma^2. A forcing that only
+compensates for a fault elsewhere (one in the air node's own equation, say, which no forcing
+can reach) lowers J by a fraction. So the search has located something only when
+
+    J_min - n sigma^2 <= EXPLAINED * (J_unforced - n sigma^2)
+
+(EXPLAINED = 0.5: the best forcing removes at least half of the error above the noise);
+otherwise best_nodes = [].
+
+Rule: best_nodes = the smallest set S with J(S) <= J_min + tolerance, looked for among the
+empty set, every single node (their scores are computed for the ranking anyway) and the subsets
+of the best chromosome. Within the tolerance the sets cannot be told apart from the noise, so
+among the smallest that fit, the one earliest in the chromosome order wins: the caller orders
+the nodes by preference (nodes nearest the zone first, ga.locate). The empty set comes first, so
+best_nodes = [] exactly when J_unforced - J_min <= tolerance: no significant reduction.
+Subsets of the best chromosome are searched exhaustively, smallest first, when it forces at most
 EXACT_MAX_NODES nodes; otherwise by backward elimination: repeatedly drop the node whose
 removal raises J least, while the rule still holds.
 """
@@ -27,6 +40,7 @@ from itertools import combinations
 from typing import Callable, Sequence
 
 Z_NOISE = 3.0
+EXPLAINED = 0.5
 RELATIVE_FLOOR = 0.01
 EXACT_MAX_NODES = 8
 
@@ -37,6 +51,12 @@ def tolerance(J_unforced: float, noise_sigma: "float | None", n_residuals: "int 
     if noise_sigma is None:
         return floor
     return max(floor, Z_NOISE * noise_sigma ** 2 * math.sqrt(2 * n_residuals))
+
+
+def explains(J_unforced: float, J_min: float, noise_sigma: "float | None", n_residuals: "int | None") -> bool:
+    """Whether the best forcing removes enough of the residual to locate a fault (docstring above)."""
+    J_noise = 0.0 if noise_sigma is None else n_residuals * noise_sigma ** 2
+    return J_min - J_noise <= EXPLAINED * (J_unforced - J_noise)
 
 
 def smallest_subset(J_many: Callable[[Sequence[tuple]], list], best: tuple, limit: float) -> tuple:
@@ -50,17 +70,21 @@ def smallest_subset(J_many: Callable[[Sequence[tuple]], list], best: tuple, limi
 
     if J_many([mask(())])[0] <= limit:
         return mask(())
+    singles = J_many([mask((i,)) for i in range(len(best))])
+    fitting = [i for i, J in enumerate(singles) if J <= limit]
+    if fitting:
+        return mask((fitting[0],))
     members = [i for i, bit in enumerate(best) if bit]
     search = _smallest_first if len(members) <= EXACT_MAX_NODES else _backward_elimination
     return mask(search(J_many, mask, members, limit))
 
 
 def _smallest_first(J_many, mask, members, limit):
-    for size in range(1, len(members)):
+    for size in range(2, len(members)):
         subsets = list(combinations(members, size))
-        fits = [(J, s) for J, s in zip(J_many([mask(s) for s in subsets]), subsets) if J <= limit]
+        fits = [s for J, s in zip(J_many([mask(s) for s in subsets]), subsets) if J <= limit]
         if fits:
-            return min(fits, key=lambda fit: fit[0])[1]  # lowest J; ties: first in node order
+            return fits[0]  # combinations keep the caller's order: the preferred set first
     return members
 
 

@@ -27,7 +27,7 @@ from tqdm import tqdm
 from ga import checkpoint as ckpt
 from ga.evaluation import FitnessCache, log, open_backend
 from ga.operators import bit_flip_mutation, one_point_crossover, roulette_selection
-from ga.parsimony import smallest_subset, tolerance
+from ga.parsimony import explains, smallest_subset, tolerance
 
 
 def search(factory, chromosome_nodes, *, population=30, generations=400, pc=0.8, pm=0.03,
@@ -191,19 +191,36 @@ def _answer(cache, nodes, noise_sigma, n_residuals) -> dict:
     best = cache.best()
     J_min = cache.J_of[best]
     tol = tolerance(J_unforced, noise_sigma, n_residuals)
-    chosen = smallest_subset(cache.J_many, best, J_min + tol)
-    # Ranking: the nodes whose forcing alone lowers J, most helpful (lowest J) first.
-    helpful = sorted((J, i) for i, J in enumerate(J_single) if J < J_unforced)
+    if explains(J_unforced, J_min, noise_sigma, n_residuals):
+        chosen = smallest_subset(cache.J_many, best, J_min + tol)
+    else:
+        chosen = unforced
     return {
         "chromosome_nodes": nodes,
         "J_unforced": _json(J_unforced),
         "best_nodes": cache.describe(chosen),
         "J_best": _json(cache.J_of[chosen]),
         "node_scores": {str(n): _json(J) for n, J in zip(nodes, J_single)},
-        "ranked_nodes": [nodes[i] for _, i in helpful],
+        "ranked_nodes": [nodes[i] for i in rank(J_single, J_unforced, tol)],
         "search": {"J_min": _json(J_min), "min_nodes": cache.describe(best),
                    "tolerance": _json(tol)},
     }
+
+
+def rank(J_single, J_unforced, tol):
+    """Indices of the nodes whose forcing alone lowers J, most helpful first.
+
+    Scores closer than `tol` cannot be told apart from the noise: among them the node earlier in
+    the chromosome order (the caller's preference) comes first.
+    """
+    left = [i for i, J in enumerate(J_single) if J < J_unforced]
+    order = []
+    while left:
+        lowest = min(J_single[i] for i in left)
+        first = min(i for i in left if J_single[i] <= lowest + tol)
+        order.append(first)
+        left.remove(first)
+    return order
 
 
 def _json(J: float) -> "float | None":

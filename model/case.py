@@ -27,7 +27,7 @@ class Case:
     @property
     def measured_ids(self):
         """Ids of the nodes with at least one measurement."""
-        return [i + 1 for i in np.flatnonzero(np.isfinite(self.measured).any(axis=0))]
+        return [int(i) + 1 for i in np.flatnonzero(np.isfinite(self.measured).any(axis=0))]
 
     def window(self, start, stop):
         """The sub-case on rows start..stop (inclusive), t_start becoming its t_0."""

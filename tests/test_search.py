@@ -160,7 +160,7 @@ def test_backward_elimination_beyond_exact_size():
 
 def test_failed_simulations_score_unfit_and_the_run_goes_on(caplog):
     # forcing node index 4 would repair the most, but its simulation always fails
-    spec = linear(12, {1: 30.0, 4: 40.0}, fail_index=4)
+    spec = linear(12, {1: 60.0, 4: 80.0}, fail_index=4)
     with caplog.at_level(logging.WARNING, logger="nodeforce.ga"):
         result = search(spec, NODES12, workers=1, **GA_BUDGET)
     assert result["best_nodes"] == [3]
@@ -168,6 +168,20 @@ def test_failed_simulations_score_unfit_and_the_run_goes_on(caplog):
     assert 9 not in result["ranked_nodes"]
     assert any("simulation failed" in r.message and "solver diverged" in r.message
                for r in caplog.records)
+
+
+def test_a_forcing_that_only_compensates_locates_nothing():
+    # forcing node 2 lowers J by a fifth, well beyond the noise, but leaves most of the error:
+    # the fault is where no forcing reaches (the paper's inside-convection case)
+    spec = linear(6, {2: 20.0}, base=100.0)
+    result = search(spec, [1, 2, 3, 4, 5, 6], workers=1, noise_sigma=0.05, n_residuals=400)
+    assert result["search"]["min_nodes"] == [3]
+    assert result["ranked_nodes"] == [3]
+    assert result["best_nodes"] == []
+    # the same gain, when it removes most of the error, locates node 3
+    located = search(linear(6, {2: 90.0}, base=100.0), [1, 2, 3, 4, 5, 6], workers=1,
+                     noise_sigma=0.05, n_residuals=400)
+    assert located["best_nodes"] == [3]
 
 
 def test_a_crashing_worker_only_loses_its_own_chromosome():
