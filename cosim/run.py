@@ -12,7 +12,8 @@ def node_names(prefix, ids):
     return [f"{prefix}[{i}]" for i in ids]
 
 
-def simulate_fmu(instance, case, force=None, warmup_days=2, output_ids=None, T_default=20.0):
+def simulate_fmu(instance, case, force=None, warmup_days=2, output_ids=None, T_default=20.0,
+                 parameters=None):
     """Node temperatures (C) at t_1..t_N, simulated by an `FmuInstance` of the case's building.
 
     Parameters
@@ -23,6 +24,7 @@ def simulate_fmu(instance, case, force=None, warmup_days=2, output_ids=None, T_d
     warmup_days : passes over the first day before the run
     output_ids : node ids to return (default: all)
     T_default : C, the initial temperature of a node nothing informs (the FMU's T_start)
+    parameters : {name: value} of other FMU parameters (an added effect's `<effect>.<name>`)
 
     Returns
     -------
@@ -32,7 +34,8 @@ def simulate_fmu(instance, case, force=None, warmup_days=2, output_ids=None, T_d
     n_rows, n = measured.shape
     forced_ids = [] if force is None else [i + 1 for i in np.flatnonzero(force)]
     output_ids = list(range(1, n + 1)) if output_ids is None else list(output_ids)
-    parameters = {"T_start": T_default, **{name: True for name in node_names("force", forced_ids)}}
+    parameters = {"T_start": T_default, **{name: True for name in node_names("force", forced_ids)},
+                  **(parameters or {})}
     measured0 = np.flatnonzero(np.isfinite(measured[0]))
     start_inputs = {f"T_forced[{i + 1}]": measured[0, i] for i in measured0}
     rows = warmup_rows(n_rows, case.dt, warmup_days)

@@ -14,15 +14,16 @@ from pathlib import Path
 from pythonfmu.builder import FmuBuilder
 
 import model
+from model import effects
 from model.building import parse_building
 
 SLAVE = Path(__file__).with_name("slave.py")
 MODEL_DIR = Path(model.__file__).parent
 # The modules the FMU imports; weather and solar stay outside (their results are inputs).
-PHYSICS_MODULES = ("__init__", "errors", "building", "discretise", "network", "integrate")
+PHYSICS_MODULES = ("__init__", "errors", "building", "discretise", "effects", "network", "integrate")
 
 
-def build_fmu(building_data, destination, source="<building>"):
+def build_fmu(building_data, destination, source="<building>", effect=None):
     """Write the FMU of a building description.
 
     Parameters
@@ -30,16 +31,21 @@ def build_fmu(building_data, destination, source="<building>"):
     building_data : dict, the building file's JSON content (validated here)
     destination : path of the .fmu to write
     source : the building's file name, for error messages
+    effect : (effect id, target) of `model.effects` whose parameters the FMU exposes as
+        `<effect>.<name>` (start: the values the file declares), or None
 
     Returns
     -------
     Path of the FMU written
     """
     parse_building(building_data, source=source)
+    if effect is not None and not effects.applicable(building_data, *effect):
+        raise ValueError(f"effect {effect[0]} does not apply to {effect[1]!r}")
     building_text = json.dumps(building_data, indent=1)
+    effect_text = json.dumps({"effect": effect[0], "target": effect[1]}) if effect else ""
     sources = {name: (MODEL_DIR / f"{name}.py").read_text() for name in PHYSICS_MODULES}
     slave_text = SLAVE.read_text()
-    digest = hashlib.sha256("\0".join([building_text, slave_text, *sources.values()]).encode())
+    digest = hashlib.sha256("\0".join([building_text, effect_text, slave_text, *sources.values()]).encode())
     module = f"nodeforce_{digest.hexdigest()[:16]}"
 
     destination = Path(destination).resolve()
@@ -53,8 +59,12 @@ def build_fmu(building_data, destination, source="<building>"):
         for name, text in sources.items():
             (package / f"{name}.py").write_text(text)
         (tmp / "building.json").write_text(building_text)
+        resources = [package, tmp / "building.json"]
+        if effect:
+            (tmp / "effect.json").write_text(effect_text)
+            resources.append(tmp / "effect.json")
         try:
-            FmuBuilder.build_FMU(script, dest=destination, project_files=[package, tmp / "building.json"],
+            FmuBuilder.build_FMU(script, dest=destination, project_files=resources,
                                  canGetAndSetFMUstate=True, canSerializeFMUstate=True)
         finally:
             # pythonfmu leaves the build folder on sys.path; the module cache entries it made are

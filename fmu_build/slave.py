@@ -20,19 +20,36 @@ from pythonfmu import Boolean, Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
 from pythonfmu.enums import Fmi2Initial
 
 _physics = {name: importlib.import_module(f"{__name__}_model.{name}")
-            for name in ("building", "network", "integrate")}
+             for name in ("building", "effects", "integrate", "network")}
 
-# Reset re-constructs the slave: keep what depends only on the building file per process.
+# Reset re-constructs the slave: keep what depends only on the model's description per process,
+# for each set of effect parameter values (a calibration tries many).
 _MODELS = {}
 
 
-def _model(resources):
-    model = _MODELS.get(resources)
+def _read(resources):
+    """The building data and the added effect ((id, target) or None) an FMU carries."""
+    with open(os.path.join(resources, "building.json"), encoding="utf-8") as f:
+        data = json.load(f)
+    effect = None
+    path = os.path.join(resources, "effect.json")
+    if os.path.exists(path):
+        with open(path, encoding="utf-8") as f:
+            spec = json.load(f)
+        effect = (spec["effect"], spec["target"])
+    return data, effect
+
+
+def _model(resources, values=()):
+    """(building, network, steppers) for the FMU's building with its effect at `values`."""
+    key = (resources, values)
+    model = _MODELS.get(key)
     if model is None:
-        with open(os.path.join(resources, "building.json"), encoding="utf-8") as f:
-            building = _physics["building"].parse_building(json.load(f), source="building.json")
-        network = _physics["network"].assemble(building)
-        model = _MODELS[resources] = (building, network, {})
+        data, effect = _read(resources)
+        if values:
+            data = _physics["effects"].apply(data, *effect, dict(values))
+        building = _physics["building"].parse_building(data, source="building.json")
+        model = _MODELS[key] = (building, _physics["network"].assemble(building), {})
     return model
 
 
@@ -43,12 +60,14 @@ class NodalBuilding(Fmi2Slave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
+        data, self._effect = _read(self.resources)
         self.building, self.network, self._steppers = _model(self.resources)
         n = self.network.n_nodes
         names = self.network.input_names
+        effect_start = (_physics["effects"].current_values(data, *self._effect) if self._effect else {})
         # One array holds every variable's value, indexed by value reference: get/set become
         # numpy indexing instead of pythonfmu's per-variable getter calls.
-        n_vars = 3 * n + 1 + len(names)
+        n_vars = 3 * n + 1 + len(names) + len(effect_start)
         self._values = np.zeros(n_vars)
         self._is_real = np.ones(n_vars, dtype=bool)
         self._is_real[:n] = False
@@ -77,6 +96,14 @@ class NodalBuilding(Fmi2Slave):
             self.register_variable(Real(
                 f"T[{i}]", causality=Fmi2Causality.output, initial=Fmi2Initial.exact,
                 description=f"temperature of node {i} [degC]"))
+        self._parameters = slice(self._T.stop, n_vars)
+        self._values[self._parameters] = list(effect_start.values())
+        self._parameter_names = tuple(effect_start)
+        for name in self._parameter_names:
+            self.register_variable(Real(
+                f"{self._effect[0]}.{name}", causality=Fmi2Causality.parameter,
+                variability=Fmi2Variability.fixed,
+                description=f"{self._effect[0]} of {self._effect[1]}: {name}"), nested=False)
         self._initialised = False
 
     def _stepper(self, dt):
@@ -86,6 +113,9 @@ class NodalBuilding(Fmi2Slave):
         return stepper
 
     def exit_initialization_mode(self):
+        if self._parameter_names:
+            values = tuple(zip(self._parameter_names, self._values[self._parameters].tolist()))
+            self.building, self.network, self._steppers = _model(self.resources, values)
         self._values[self._T] = _physics["integrate"].initial_state(
             self.building, self._values[self._forced], self._values[self._T_start])
         self._initialised = True

@@ -33,6 +33,7 @@ class Zone:
     air_change_rate: float = 0.0  # 1/h
     internal_gain: float = 0.0  # W
     heat_input: str | None = None  # name of an input column, W
+    convection_factor: float = 1.0  # scale on the inside h_conv of the surfaces facing the zone
 
 
 @dataclass(frozen=True)
@@ -48,6 +49,7 @@ class Component:
     outside: dict  # {"type", ...} as in PHYSICS.md section 1
     solar_transmittance: float | None = None
     transmitted_solar_to: str | None = None
+    conductivity_factor: float = 1.0  # scale on the conductances between its nodes
 
     @property
     def thickness(self):
@@ -232,6 +234,7 @@ def _zone(check, z, where):
         air_change_rate=check.number(z, "air_change_rate", where, default=0.0, low=0),
         internal_gain=check.number(z, "internal_gain", where, default=0.0),
         heat_input=check.text(z, "heat_input", where, optional=True),
+        convection_factor=check.number(z, "convection_factor", where, default=1.0, low=0, low_open=True),
     )
 
 
@@ -326,6 +329,7 @@ def _component(check, c, where, materials, zone_names):
         outside=_outside(check, c.get("outside"), f"{where}.outside", zone_names),
         solar_transmittance=tau,
         transmitted_solar_to=c.get("transmitted_solar_to") if tau is not None else None,
+        conductivity_factor=check.number(c, "conductivity_factor", where, default=1.0, low=0, low_open=True),
     )
 
 

@@ -63,14 +63,14 @@ def assemble(building):
 
     def to_zone(node, zone_name, area, h_conv, h_rad):
         zone = building.zone(zone_name)
-        link(node, zone.air_node - 1, area * h_conv)
+        link(node, zone.air_node - 1, area * h_conv * zone.convection_factor)
         link(node, zone.radiant_node - 1, area * h_rad)
 
     for c in building.components:
         idx = [i - 1 for i in c.node_ids]
         C[idx] += c.area * capacities(c.layers, c.depths)
         for k, g in enumerate(conductances(c.layers, c.depths)):
-            link(idx[k], idx[k + 1], c.area * g)
+            link(idx[k], idx[k + 1], c.area * g * c.conductivity_factor)
         to_zone(idx[0], c.inside["zone"], c.area, c.inside["h_conv"], c.inside["h_rad"])
         e, out = idx[-1], c.outside
         if out["type"] == "exterior":
