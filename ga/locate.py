@@ -55,11 +55,12 @@ def chromosome_nodes(building, case, source, nodes=None, include_algebraic=False
 
 def locate(building_data, building, case, workdir, *, source="measurements", nodes=None,
            include_algebraic=False, population=30, generations=400, pc=0.8, pm=0.03, seed=0,
-           workers=None, scheduler=None, warmup_days=2):
+           workers=None, scheduler=None, warmup_days=2, progress=None):
     """Run the forcing search on a case; return the content of locate.json.
 
     The FMU (`model.fmu`) and the search's checkpoint (`locate.checkpoint.json`) are written in
-    `workdir`, so a run stopped midway and started again resumes.
+    `workdir`, so a run stopped midway and started again resumes. `progress` is called after
+    every generation with (generation, total, best J, unique evaluations).
     """
     air = output_node(building, case, source)
     candidates = chromosome_nodes(building, case, source, nodes, include_algebraic)
@@ -70,6 +71,7 @@ def locate(building_data, building, case, workdir, *, source="measurements", nod
     result = search(FmuFitness(fmu, case, candidates, air, warmup_days), candidates,
                     population=population, generations=generations, pc=pc, pm=pm, seed=seed,
                     workers=workers, scheduler=scheduler, checkpoint=workdir / "locate.checkpoint.json",
+                    progress=progress,
                     noise_sigma=noise_level(case.measured[:, air - 1]),
                     n_residuals=int(np.isfinite(air_measured).sum()))
     return {"measured_nodes": case.measured_ids, "output_node": air, **result}

@@ -107,27 +107,78 @@ def locate_summary(result):
     return "\n".join(lines)
 
 
+def effect_spec(text):
+    """("ground_coupling", "floor", {"U": 0.8, "T_ground": 24.0}) from "ground_coupling@floor:U=0.8,T_ground=24"."""
+    from model.effects import EFFECTS
+    try:
+        head, _, assignments = text.partition(":")
+        effect, target = head.split("@")
+        values = {name: float(value) for name, value in (a.split("=") for a in assignments.split(",") if a)}
+    except ValueError:
+        raise InputError("--effect", text, "must read EFFECT@TARGET:name=value,... e.g. "
+                                           "ground_coupling@floor:U=0.8,T_ground=24") from None
+    if effect not in EFFECTS:
+        raise InputError("--effect", effect, f"unknown effect; one of {', '.join(EFFECTS)}")
+    names = {p.name for p in EFFECTS[effect]}
+    if set(values) - names:
+        raise InputError("--effect", ",".join(sorted(set(values) - names)), f"{effect} has parameters {', '.join(sorted(names))}")
+    return effect, target, values
+
+
+def cmd_synth(args):
+    import pandas as pd
+    from model import effects
+    from model.synth import pseudo_measurements
+    data = read_building_data(args.building)
+    if args.effect:
+        effect, target, values = effect_spec(args.effect)
+        if not effects.applicable(data, effect, target):
+            raise InputError("--effect", f"{effect}@{target}", f"does not apply to {args.building}")
+        data = effects.apply(data, effect, target, values)
+    building = parse_building(data, source=args.building)
+    try:
+        start = pd.Timestamp(args.start)
+    except ValueError:
+        raise InputError("--start", args.start, "not an ISO 8601 time") from None
+    if start.tzinfo is None:
+        raise InputError("--start", args.start, "needs a UTC offset, e.g. 2001-06-10T00:00-05:00")
+    times = pd.date_range(start, periods=int(args.days * 86400 / args.step) + 1,
+                          freq=pd.Timedelta(seconds=args.step), name="time")
+    frame = pseudo_measurements(building, read_weather(args.weather), times, node_list("--sensors", args.sensors),
+                                noise_sd=args.noise, seed=args.seed, history_days=args.history_days)
+    frame.round(4).to_csv(args.output, date_format="%Y-%m-%dT%H:%M:%S%z")
+    print(f"wrote {args.output}: nodes {args.sensors}, {len(times)} times from {times[0].isoformat()}, "
+          f"noise {args.noise} C" + (f", with {args.effect} not in {args.building}" if args.effect else ""))
+
+
+def run_diagnosis(data, building, case, out, source, seed, workers):
+    from diagnose.loop import diagnose
+    from diagnose.report import before_after_table
+    out.mkdir(parents=True, exist_ok=True)
+    report = diagnose(data, building, case, out, source=source, seed=seed, workers=workers)
+    print(before_after_table(report))
+    print(f"wrote {out / 'report.json'}, {out / 'report.md'}, {out / 'building_after.json'}, {out / 'model_after.fmu'}")
+
+
+def cmd_diagnose(args):
+    data, building, case = load_inputs(args)
+    run_diagnosis(data, building, case, Path(args.output), args.measurements, args.seed, args.workers)
+
+
+DEMO_COMMAND = ("nodeforce synth model/data/testcell_miami.json --weather model/data/miami_tmy2.csv "
+                "--effect ground_coupling@floor:U=0.8,T_ground=24 --start 2001-06-10T00:00-05:00 --days 14 "
+                "--history-days 7 --noise 0.1 --seed 1 -o model/data/demo_measurements.csv")
+
+
 def cmd_demo(args):
-    from cosim.fmi2 import FmuInstance
-    from cosim.run import simulate_fmu
-    from fmu_build.build import build_fmu
     building_path = DATA / "testcell_miami.json"
     data = read_building_data(building_path)
     building = parse_building(data, source=str(building_path))
-    weather = read_weather(DATA / "miami_tmy2.csv")
-    june = weather.loc["2001-06-10":"2001-06-15"]
-    case = prepare_case(building, june)
-    out = Path(args.output)
-    fmu = build_fmu(data, out / "testcell.fmu", source=str(building_path))
-    with FmuInstance(fmu) as instance:
-        T = simulate_fmu(instance, case)
-    air = building.zones[0].air_node
-    print(f"{building.name}\nFMU: {fmu}\nweather: Miami TMY2, {case.times[0]:%Y-%m-%d %H:%M} to "
-          f"{case.times[-1]:%Y-%m-%d %H:%M}, step {case.dt:g} s")
-    print(f"{'':<22}{'min':>8}{'mean':>8}{'max':>8}")
-    for label, series in (("outdoor air (C)", case.U[1:, 0]), (f"indoor air T{air} (C)", T[:, air - 1]),
-                          ("roof inside T9 (C)", T[:, 8]), ("floor T17 (C)", T[:, 16])):
-        print(f"{label:<22}{series.min():8.2f}{series.mean():8.2f}{series.max():8.2f}")
+    measurements_path = DATA / "demo_measurements.csv"
+    case = prepare_case(building, read_weather(DATA / "miami_tmy2.csv"), read_measurements(measurements_path))
+    print(f"{building.name}: measurements {measurements_path.name} carry an effect the building file does "
+          f"not declare (made by: {DEMO_COMMAND})")
+    run_diagnosis(data, building, case, Path(args.output), str(measurements_path), args.seed, args.workers)
 
 
 def parser():
@@ -164,8 +215,35 @@ def parser():
     s.add_argument("--scheduler", help="a Dask scheduler address, tcp://host:port")
     s.set_defaults(run=cmd_locate)
 
-    s = sub.add_parser("demo", help="run nodeforce on the bundled test cell and weather")
+    s = sub.add_parser("diagnose", help="localise, add the missing effect, calibrate, report before/after")
+    s.add_argument("building")
+    s.add_argument("--weather", required=True)
+    s.add_argument("--measurements", required=True)
+    s.add_argument("-o", "--output", required=True, help="folder for report.json, report.md, building_after.json")
+    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--workers", type=int, help="processes (default: all cores)")
+    s.set_defaults(run=cmd_diagnose)
+
+    s = sub.add_parser("synth", help="measurements of a building, optionally with an effect its file does not declare")
+    s.add_argument("building")
+    s.add_argument("--weather", required=True)
+    s.add_argument("-o", "--output", required=True, help="the measurements CSV to write")
+    s.add_argument("--start", required=True, help="first time, ISO 8601 with UTC offset")
+    s.add_argument("--days", type=float, default=14.0)
+    s.add_argument("--step", type=float, default=900.0, help="s")
+    s.add_argument("--sensors", default="1,7,9,16,17,23", help="measured node ids")
+    s.add_argument("--noise", type=float, default=0.1, help="sensor noise sd, C")
+    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--history-days", type=float, default=7.0,
+                   help="days of real weather simulated before the record")
+    s.add_argument("--effect", help="EFFECT@TARGET:name=value,... added to the building, e.g. "
+                                    "ground_coupling@floor:U=0.8,T_ground=24")
+    s.set_defaults(run=cmd_synth)
+
+    s = sub.add_parser("demo", help="diagnose the bundled test cell, whose measurements carry an undeclared effect")
     s.add_argument("-o", "--output", default="out/demo")
+    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--workers", type=int, help="processes (default: all cores)")
     s.set_defaults(run=cmd_demo)
     return p
 

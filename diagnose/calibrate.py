@@ -1,0 +1,99 @@
+"""Calibrate an effect's parameters through its FMU, with their uncertainty and identifiability.
+
+Bounded least squares on the air-temperature residual of the calibration window (scipy's
+`least_squares`, trust region reflective). The covariance of the estimate is
+s^2 (J^T J)^-1 with J the Jacobian of the residuals at the optimum and s^2 = SSR / (n - p), the
+usual linearised estimate. A parameter is called identifiable from the data when that estimate
+is tight enough to act on (`IDENTIFIABLE_*` below) and it did not end on a bound.
+"""
+import logging
+
+import numpy as np
+from SALib.analyze import morris as morris_analyze
+from SALib.sample import morris as morris_sample
+from scipy.optimize import least_squares
+
+from cosim.fmi2 import FmuInstance
+from cosim.run import simulate_fmu
+from fmu_build.build import build_fmu
+from model import effects
+
+log = logging.getLogger("nodeforce.diagnose")
+
+# A scale parameter is identifiable when its standard deviation is under this fraction of its
+# value; a temperature (T_ground) when its standard deviation is under this many kelvin.
+IDENTIFIABLE_RELATIVE = 0.25
+IDENTIFIABLE_KELVIN = 1.0
+MORRIS_TRAJECTORIES = 4
+
+
+class Candidate:
+    """The model with one added effect: its own FMU, one instance reused for every run."""
+
+    def __init__(self, data, effect, target, workdir):
+        self.data, self.effect, self.target = data, effect, target
+        self.parameters = effects.EFFECTS[effect]
+        fmu = build_fmu(data, workdir / f"{effect}@{target}.fmu", effect=(effect, target))
+        self.instance = FmuInstance(fmu)
+
+    @property
+    def label(self):
+        return f"{self.effect}@{self.target}"
+
+    def air(self, case, air_node, values):
+        """Simulated air temperature (C) at t_1..t_N with the effect at `values` (sequence)."""
+        parameters = {f"{self.effect}.{p.name}": float(v) for p, v in zip(self.parameters, values)}
+        return simulate_fmu(self.instance, case, output_ids=[air_node], parameters=parameters)[:, 0]
+
+    def close(self):
+        self.instance.close()
+
+
+def calibrate(candidate, case, air_node):
+    """Least-squares values of the candidate's parameters on `case` (the calibration window).
+
+    Returns
+    -------
+    dict {name: {"value", "std", "identifiable"}} and the residual sum of squares J (C2)
+    """
+    measured = case.measured[1:, air_node - 1]
+    have = np.isfinite(measured)
+    lows = np.array([p.low for p in candidate.parameters])
+    highs = np.array([p.high for p in candidate.parameters])
+    start = effects.calibration_start(candidate.data, candidate.effect, candidate.target)
+    x0 = np.clip([start[p.name] for p in candidate.parameters], lows, highs)
+
+    def residuals(x):
+        return measured[have] - candidate.air(case, air_node, x)[have]
+
+    fit = least_squares(residuals, x0, bounds=(lows, highs), x_scale="jac", method="trf")
+    n, k = int(have.sum()), len(x0)
+    J = float(fit.fun @ fit.fun)
+    cov = (J / max(n - k, 1)) * np.linalg.pinv(fit.jac.T @ fit.jac)
+    std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    result = {}
+    for p, value, sd, bound in zip(candidate.parameters, fit.x, std, fit.active_mask):
+        tight = sd < (IDENTIFIABLE_KELVIN if p.unit == "C" else IDENTIFIABLE_RELATIVE * abs(value))
+        identifiable = bool(tight and bound == 0)
+        if not identifiable:
+            log.warning("%s: %s = %.4g +- %.2g %s is not identifiable from these data%s", candidate.label,
+                        p.name, value, sd, p.unit, " (it ended on a bound)" if bound else "")
+        result[p.name] = {"value": float(value), "std": float(sd), "identifiable": identifiable}
+    return result, J
+
+
+def sensitivity(candidate, case, air_node, seed=0):
+    """Morris elementary effects of the parameters, over their bounds, on J of `case`.
+
+    Returns {name: {"mu_star": C2, "sigma": C2}}: mu* ranks how much J moves with a parameter,
+    sigma how much that depends on the others (interaction or non-linearity).
+    """
+    measured = case.measured[1:, air_node - 1]
+    have = np.isfinite(measured)
+    problem = {"num_vars": len(candidate.parameters), "names": [p.name for p in candidate.parameters],
+               "bounds": [[p.low, p.high] for p in candidate.parameters]}
+    X = morris_sample.sample(problem, MORRIS_TRAJECTORIES, num_levels=4, seed=seed)
+    Y = np.array([float(np.sum((measured[have] - candidate.air(case, air_node, x)[have]) ** 2)) for x in X])
+    analysis = morris_analyze.analyze(problem, X, Y, num_levels=4, seed=seed)
+    return {name: {"mu_star": float(m), "sigma": float(s)}
+            for name, m, s in zip(problem["names"], analysis["mu_star"], analysis["sigma"])}
