@@ -1,0 +1,1 @@
+"""Closing the loop: from the residual to the missing effect, calibrated, before and after."""
