@@ -1,0 +1,176 @@
+"""The JSON Schema of the building format (model/data/nodal-building.schema.json) documents what
+parse_building accepts: the bundled files and files carrying every effect validate against it,
+and wrong files are refused by the schema and by the parser alike."""
+import copy
+import json
+from pathlib import Path
+
+import jsonschema
+import pytest
+
+from model import effects
+from model.building import parse_building
+from model.errors import InputError
+
+DATA = Path(__file__).parents[1] / "model" / "data"
+SCHEMA = json.loads((DATA / "nodal-building.schema.json").read_text())
+TESTCELL = json.loads((DATA / "testcell.json").read_text())
+
+# A sensible value for every effect, on the test cell element it fits.
+EFFECT_CASES = {
+    "ground_coupling": ("floor", {"U": 2.0, "T_ground": 24.0}),
+    "infiltration": ("cell", {"n": 1.5}),
+    "internal_gain": ("cell", {"Q": 150.0}),
+    "inside_convection": ("cell", {"factor": 1.3}),
+    "solar_absorptance": ("roof", {"alpha": 0.6}),
+    "conductivity": ("roof", {"factor": 2.0}),
+    "solar_transmittance": ("window", {"tau": 0.6}),
+}
+
+
+@pytest.fixture(scope="module")
+def validator():
+    jsonschema.Draft202012Validator.check_schema(SCHEMA)
+    return jsonschema.Draft202012Validator(SCHEMA)
+
+
+def errors(validator, data):
+    return [f"{'/'.join(map(str, e.absolute_path))}: {e.message}" for e in validator.iter_errors(data)]
+
+
+def test_schema_is_valid_draft_2020_12():
+    jsonschema.Draft202012Validator.check_schema(SCHEMA)
+    assert SCHEMA["$schema"] == "https://json-schema.org/draft/2020-12/schema"
+
+
+def test_every_property_is_described():
+    missing = []
+
+    def walk(node, path):
+        if isinstance(node, dict):
+            for name, sub in node.get("properties", {}).items():
+                if isinstance(sub, dict) and "description" not in sub and "$ref" not in sub:
+                    missing.append(f"{path}/{name}")
+            for key, sub in node.items():
+                if key != "if":  # conditions only select a branch
+                    walk(sub, f"{path}/{key}")
+        elif isinstance(node, list):
+            for i, sub in enumerate(node):
+                walk(sub, f"{path}/{i}")
+
+    walk(SCHEMA, "#")
+    assert missing == []
+
+
+@pytest.mark.parametrize("name", ["testcell.json", "testcell_miami.json"])
+def test_bundled_buildings_validate(validator, name):
+    data = json.loads((DATA / name).read_text())
+    assert errors(validator, data) == []
+    parse_building(data)
+
+
+def test_every_effect_is_covered():
+    assert set(EFFECT_CASES) == set(effects.EFFECTS)
+
+
+@pytest.mark.parametrize("effect", sorted(EFFECT_CASES))
+def test_building_with_an_effect_validates_and_loads(validator, effect):
+    target, values = EFFECT_CASES[effect]
+    assert effects.applicable(TESTCELL, effect, target)
+    data = effects.apply(TESTCELL, effect, target, values)
+    assert data != TESTCELL
+    assert errors(validator, data) == []
+    parse_building(data)
+
+
+def test_building_with_all_effects_validates_and_loads(validator):
+    data = TESTCELL
+    for effect, (target, values) in EFFECT_CASES.items():
+        data = effects.apply(data, effect, target, values)
+    data["zones"][0]["heat_input"] = "heater"
+    assert errors(validator, data) == []
+    b = parse_building(data)
+    assert b.component("floor").outside == {"type": "boundary", "temperature": 24.0, "h": 2.0}
+    assert b.component("roof").conductivity_factor == 2.0
+    assert b.zone("cell").convection_factor == 1.3
+
+
+def test_boundary_temperature_may_be_a_column_name(validator):
+    data = copy.deepcopy(TESTCELL)
+    data["components"][-1]["outside"] = {"type": "boundary", "temperature": "T_cellar", "h": 3.0}
+    assert errors(validator, data) == []
+    assert parse_building(data).input_columns == ("T_cellar",)
+
+
+def _component(data, name):
+    return next(c for c in data["components"] if c["name"] == name)
+
+
+def _unknown_outside_type(d):
+    _component(d, "floor")["outside"] = {"type": "ground"}
+
+
+def _negative_area(d):
+    _component(d, "roof")["area"] = -9.0
+
+
+def _tilt_200(d):
+    _component(d, "roof")["tilt"] = 200.0
+
+
+def _missing_layers(d):
+    del _component(d, "door")["layers"]
+
+
+def _absorptance_1_5(d):
+    _component(d, "roof")["outside"]["solar_absorptance"] = 1.5
+
+
+def _zero_conductivity(d):
+    d["materials"]["wood"]["conductivity"] = 0.0
+
+
+def _boundary_without_h(d):
+    _component(d, "floor")["outside"] = {"type": "boundary", "temperature": 20.0}
+
+
+def _exterior_without_absorptance(d):
+    del _component(d, "door")["outside"]["solar_absorptance"]
+
+
+def _negative_air_change_rate(d):
+    d["zones"][0]["air_change_rate"] = -0.5
+
+
+def _zero_convection_factor(d):
+    d["zones"][0]["convection_factor"] = 0.0
+
+
+def _layer_without_thickness(d):
+    _component(d, "door")["layers"] = [["wood"]]
+
+
+def _latitude_100(d):
+    d["site"]["latitude"] = 100.0
+
+
+def _glazing_without_target(d):
+    del _component(d, "window")["transmitted_solar_to"]
+
+
+def _wrong_format(d):
+    d["format"] = "nodal-building/2"
+
+
+@pytest.mark.parametrize("mutate", [
+    _unknown_outside_type, _negative_area, _tilt_200, _missing_layers, _absorptance_1_5,
+    _zero_conductivity, _boundary_without_h, _exterior_without_absorptance,
+    _negative_air_change_rate, _zero_convection_factor, _layer_without_thickness,
+    _latitude_100, _glazing_without_target, _wrong_format,
+], ids=lambda f: f.__name__.strip("_"))
+def test_wrong_file_is_refused_by_schema_and_parser(validator, mutate):
+    data = copy.deepcopy(TESTCELL)
+    mutate(data)
+    assert errors(validator, data), "the schema accepts it"
+    with pytest.raises(InputError):
+        parse_building(data, source="cell.json")
