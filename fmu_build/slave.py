@@ -104,6 +104,9 @@ class NodalBuilding(Fmi2Slave):
                 f"{self._effect[0]}.{name}", causality=Fmi2Causality.parameter,
                 variability=Fmi2Variability.fixed,
                 description=f"{self._effect[0]} of {self._effect[1]}: {name}"), nested=False)
+        self._force = np.zeros(n, dtype=bool)
+        self._any_forced = False
+        self._indices = {}
         self._initialised = False
 
     def _stepper(self, dt):
@@ -113,6 +116,9 @@ class NodalBuilding(Fmi2Slave):
         return stepper
 
     def exit_initialization_mode(self):
+        # force[i] and the effect parameters are fixed once initialised: read them once here
+        self._force = self._values[: self.network.n_nodes] != 0.0
+        self._any_forced = bool(self._force.any())
         if self._parameter_names:
             values = tuple(zip(self._parameter_names, self._values[self._parameters].tolist()))
             self.building, self.network, self._steppers = _model(self.resources, values)
@@ -121,32 +127,37 @@ class NodalBuilding(Fmi2Slave):
         self._initialised = True
 
     def do_step(self, current_time, step_size):
-        T_forced = self._values[self._forced]
-        forced = (self._values[: self.network.n_nodes] != 0.0) & ~np.isnan(T_forced)
-        source = self.network.B @ self._values[self._inputs] + self.network.q
-        self._values[self._T] = self._stepper(step_size).step(
-            self._values[self._T], source, forced, T_forced)
+        values = self._values
+        T_forced = values[self._forced]
+        # a node whose measurement is missing (NaN) at this step is computed, not forced
+        forced = self._force & ~np.isnan(T_forced) if self._any_forced else self._force
+        source = self.network.B @ values[self._inputs] + self.network.q
+        values[self._T] = self._stepper(step_size).step(values[self._T], source, forced, T_forced)
         return True
 
+    def _index(self, vrs, real):
+        """Index array of value references, checked once to be all Real (or all Boolean):
+        an importer sets and gets the same lists every step."""
+        key = (tuple(vrs), real)
+        index = self._indices.get(key)
+        if index is None:
+            index = np.array(vrs, dtype=np.intp)
+            if (self._is_real[index] != real).any():
+                raise TypeError(f"value references {vrs} are not all {'Real' if real else 'Boolean'}")
+            self._indices[key] = index
+        return index
+
     def get_real(self, vrs):
-        if not self._is_real[vrs].all():
-            raise TypeError(f"value references {vrs} are not all Real")
-        return self._values[vrs].tolist()
+        return self._values[self._index(vrs, True)].tolist()
 
     def set_real(self, vrs, values):
-        if not self._is_real[vrs].all():
-            raise TypeError(f"value references {vrs} are not all Real")
-        self._values[vrs] = values
+        self._values[self._index(vrs, True)] = values
 
     def get_boolean(self, vrs):
-        if self._is_real[vrs].any():
-            raise TypeError(f"value references {vrs} are not all Boolean")
-        return (self._values[vrs] != 0.0).tolist()
+        return (self._values[self._index(vrs, False)] != 0.0).tolist()
 
     def set_boolean(self, vrs, values):
-        if self._is_real[vrs].any():
-            raise TypeError(f"value references {vrs} are not all Boolean")
-        self._values[vrs] = values
+        self._values[self._index(vrs, False)] = values
 
     def _get_fmu_state(self):
         return {"values": self._values.copy(), "initialised": self._initialised}

@@ -38,7 +38,9 @@ EFFECTS = {
     "solar_transmittance": (Parameter("tau", "-", 0.0, 1.0),),
 }
 ZONE_EFFECTS = ("infiltration", "internal_gain", "inside_convection")
-GROUND_U_START = 1.0  # W/m2/K, see calibration_start
+# Where the calibration of an effect the file does not declare starts (see calibration_start).
+ABSENT_START = {("ground_coupling", "U"): 1.0,  # W/m2/K
+                ("infiltration", "n"): 0.5}  # 1/h
 
 
 def _component(data, name):
@@ -88,11 +90,14 @@ def current_values(data, effect, target):
 
 
 def calibration_start(data, effect, target):
-    """Where a calibration starts: the declared values, but an absent ground coupling starts at
-    `GROUND_U_START`, since at U = 0 the ground temperature has no influence to fit."""
+    """Where a calibration starts: the declared values, except that an absent coupling (U = 0,
+    n = 0) starts at `ABSENT_START`: on its bound, a bounded trust-region step is scaled to
+    nothing and the fit stops where it began, and at U = 0 the ground temperature has no
+    influence to fit at all."""
     values = current_values(data, effect, target)
-    if effect == "ground_coupling" and values["U"] == 0.0:
-        values["U"] = GROUND_U_START
+    for name, value in values.items():
+        if value == 0.0 and (effect, name) in ABSENT_START:
+            values[name] = ABSENT_START[(effect, name)]
     return values
 
 

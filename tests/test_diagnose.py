@@ -1,0 +1,88 @@
+"""Closing the loop on measurements that carry an effect the building file does not declare:
+real weather, 0.1 C of sensor noise, the paper's sensors, a history longer than the warm-up."""
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+from fmpy.validation import validate_fmu
+
+from diagnose.loop import diagnose
+from model import effects
+from model.building import load_building, parse_building
+from model.case import prepare_case
+from model.errors import InputError
+from model.synth import pseudo_measurements
+from tests.conftest import SENSORS
+
+NOISE = 0.1
+TRUTH = {
+    "ground_coupling": ("floor", {"U": 0.8, "T_ground": 24.0}),
+    "infiltration": ("cell", {"n": 1.0}),
+    "internal_gain": ("cell", {"Q": 100.0}),
+    "solar_absorptance": ("roof", {"alpha": 0.6}),
+}
+
+
+def record(days=12):
+    return pd.date_range("2001-06-10 00:00", periods=days * 96 + 1, freq="15min", tz="-05:00", name="time")
+
+
+def measured_with(testcell_data, weather, effect=None, seed=5):
+    data = testcell_data
+    if effect:
+        target, values = TRUTH[effect]
+        data = effects.apply(testcell_data, effect, target, values)
+    return pseudo_measurements(parse_building(data), weather, record(), SENSORS, noise_sd=NOISE, seed=seed,
+                               history_days=7)
+
+
+def run(tmp_path, testcell_data, testcell, weather, measurements):
+    case = prepare_case(testcell, weather, measurements)
+    return diagnose(testcell_data, testcell, case, tmp_path, seed=0, workers=1)
+
+
+@pytest.mark.parametrize("effect", list(TRUTH))
+def test_diagnose_finds_the_undeclared_effect(tmp_path, testcell_data, testcell, weather, effect):
+    report = run(tmp_path, testcell_data, testcell, weather, measured_with(testcell_data, weather, effect))
+    target, truth = TRUTH[effect]
+    assert (report["effect"]["effect"], report["effect"]["target"]) == (effect, target)
+    for name, p in report["effect"]["parameters"].items():
+        if p["identifiable"]:
+            if name == "T_ground":
+                assert abs(p["value"] - truth[name]) <= 1.0
+            else:
+                assert abs(p["value"] - truth[name]) <= 0.25 * abs(truth[name]), name
+    before, after = report["before"]["validation"]["rmse"], report["after"]["validation"]["rmse"]
+    assert after <= max(before / 2, 1.5 * NOISE)
+    # the chosen effect is declared in a building file every command loads, and its FMU is valid
+    after_building = load_building(tmp_path / "building_after.json")
+    assert after_building.n_nodes == 23
+    assert validate_fmu(str(tmp_path / "model_after.fmu")) == []
+    assert json.loads((tmp_path / "report.json").read_text())["effect"]["effect"] == effect
+    assert (tmp_path / "report.md").exists() and report["artifacts"]["plots"]
+
+
+def test_no_undeclared_effect_changes_nothing(tmp_path, testcell_data, testcell, weather):
+    report = run(tmp_path, testcell_data, testcell, weather, measured_with(testcell_data, weather))
+    assert report["effect"]["effect"] == "none"
+    assert report["after"] == report["before"]
+    assert json.loads((tmp_path / "building_after.json").read_text()) == testcell_data
+
+
+def test_gaps_stay_gaps_and_short_records_are_refused(tmp_path, testcell_data, testcell, weather):
+    measurements = measured_with(testcell_data, weather, "internal_gain")
+    measurements.iloc[300:340, measurements.columns.get_loc("T23")] = np.nan
+    measurements.iloc[500:520, measurements.columns.get_loc("T16")] = np.nan
+    report = run(tmp_path, testcell_data, testcell, weather, measurements)
+    # the residual counts only measured times: 40 missing air values are not scored
+    n = report["before"]["calibration"]["n"] + report["before"]["validation"]["n"]
+    assert n == len(measurements) - 1 - 96 - 40
+    assert report["effect"]["effect"] == "internal_gain"
+
+    short = measured_with(testcell_data, weather).iloc[: 2 * 96 + 1]
+    with pytest.raises(InputError, match="too short to split"):
+        run(tmp_path, testcell_data, testcell, weather, short)
+    no_air = measured_with(testcell_data, weather).drop(columns="T23")
+    with pytest.raises(InputError, match="T23"):
+        run(tmp_path, testcell_data, testcell, weather, no_air)
