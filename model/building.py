@@ -91,7 +91,12 @@ class Building:
 
 
 def read_building_data(path):
-    """The JSON content of a building file, validated; InputError if it is not a valid building."""
+    """The JSON content of a building file, validated; InputError if it is not a valid building.
+
+    Beyond `parse_building`'s checks, the file must follow the format's JSON Schema
+    (`data/nodal-building.schema.json`), which refuses unknown fields: a misspelt optional
+    field would otherwise be ignored and its default used in silence.
+    """
     try:
         with open(path, encoding="utf-8") as f:
             data = json.load(f)
@@ -100,7 +105,19 @@ def read_building_data(path):
     except json.JSONDecodeError as e:
         raise InputError(path, f"line {e.lineno}", f"not valid JSON ({e.msg})") from None
     parse_building(data, source=str(path))
+    _check_schema(data, str(path))
     return data
+
+
+def _check_schema(data, source):
+    # imported here: the FMU runs this module without jsonschema
+    import jsonschema
+    from importlib.resources import files
+    schema = json.loads(files("model").joinpath("data/nodal-building.schema.json").read_text())
+    error = jsonschema.exceptions.best_match(jsonschema.Draft202012Validator(schema).iter_errors(data))
+    if error is not None:
+        where = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in error.absolute_path).lstrip(".")
+        raise InputError(source, where or "(top level)", error.message)
 
 
 def load_building(path):

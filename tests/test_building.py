@@ -81,3 +81,13 @@ def test_file_errors_name_the_file(tmp_path):
     with pytest.raises(InputError) as e:
         load_building(bad)
     assert str(bad) in str(e.value) and "JSON" in str(e.value)
+
+
+def test_a_misspelt_field_is_refused_not_ignored(tmp_path):
+    data = copy.deepcopy(TESTCELL)
+    data["components"][3]["conductivty_factor"] = 2.0
+    path = tmp_path / "typo.json"
+    path.write_text(json.dumps(data))
+    with pytest.raises(InputError) as e:
+        load_building(path)
+    assert e.value.field == "components[3]" and "conductivty_factor" in e.value.problem
