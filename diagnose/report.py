@@ -361,6 +361,18 @@ def _residual_stats(report, state, window, residual, mask):
     return mean, sd
 
 
+def _finish_time_plot(fig, ax, path, windows, xlabel, ylabel, title, legend_columns):
+    """Window labels, axes, grid and the legend below, shared by the plots against time."""
+    _label_windows(ax, *windows)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    _date_axis(ax, xlabel)
+    ax.grid(alpha=0.3)
+    ax.margins(x=0)
+    fig.legend(loc="outside lower center", ncols=legend_columns, fontsize=9, frameon=False)
+    return _save(fig, path)
+
+
 def plot_temperature(path, report, series):
     """Measured and simulated air temperature, before and after, validation window shaded."""
     times, xlabel = _local_times(series["times"])
@@ -381,15 +393,9 @@ def plot_temperature(path, report, series):
         ax.plot(times, after, color=COLOR_AFTER, lw=1.4, label=f"simulated after ({_effect_label(report)})")
     if measured is not None:
         ax.plot(times, measured, color=COLOR_MEASURED, lw=0, marker=".", ms=2.5, label="measured")
-    _label_windows(ax, scored_from or times[0], start, times[-1])
-    ax.set_ylabel("indoor air temperature (C)")
     node = f" (node {air})" if air is not None else ""
-    ax.set_title(f"Indoor air temperature{node}: measured and simulated")
-    _date_axis(ax, xlabel)
-    ax.grid(alpha=0.3)
-    ax.margins(x=0)
-    fig.legend(loc="outside lower center", ncols=4, fontsize=9, frameon=False)
-    return _save(fig, path)
+    return _finish_time_plot(fig, ax, path, (scored_from or times[0], start, times[-1]), xlabel,
+                             "indoor air temperature (C)", f"Indoor air temperature{node}: measured and simulated", 4)
 
 
 def _effect_label(report):
@@ -431,14 +437,8 @@ def plot_residuals(path, report, series):
     for x, y, color in segments:
         ax.plot(x, y, color=color, lw=2, ls="--", zorder=5, path_effects=outline)
     ax.plot([], [], color="0.3", ls="--", lw=2, label="mean over the window (scored steps)")
-    _label_windows(ax, scored_from or times[0], start, times[-1])
-    ax.set_ylabel("residual measured - simulated (C)")
-    ax.set_title("Indoor air residual before and after the correction")
-    _date_axis(ax, xlabel)
-    ax.grid(alpha=0.3)
-    ax.margins(x=0)
-    fig.legend(loc="outside lower center", ncols=2, fontsize=9, frameon=False)
-    return _save(fig, path)
+    return _finish_time_plot(fig, ax, path, (scored_from or times[0], start, times[-1]), xlabel,
+                             "residual measured - simulated (C)", "Indoor air residual before and after the correction", 2)
 
 
 def _node_sort_key(node):

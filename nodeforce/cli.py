@@ -181,6 +181,14 @@ def cmd_demo(args):
     run_diagnosis(data, building, case, Path(args.output), str(measurements_path), args.seed, args.workers)
 
 
+def case_arguments(s, measurements_required, output_help, output_default=None):
+    """The building, weather and measurements every simulating command reads, and its output."""
+    s.add_argument("building")
+    s.add_argument("--weather", required=True)
+    s.add_argument("--measurements", required=measurements_required)
+    s.add_argument("-o", "--output", required=output_default is None, default=output_default, help=output_help)
+
+
 def parser():
     p = Parser(prog="nodeforce", description=__doc__)
     sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
@@ -191,18 +199,12 @@ def parser():
     s.set_defaults(run=cmd_fmu)
 
     s = sub.add_parser("simulate", help="simulate a building through its FMU")
-    s.add_argument("building")
-    s.add_argument("--weather", required=True)
-    s.add_argument("--measurements")
+    case_arguments(s, False, "the CSV of node temperatures to write", output_default="sim.csv")
     s.add_argument("--force", help="node ids forced to their measurements, e.g. 1,7,9")
-    s.add_argument("-o", "--output", default="sim.csv")
     s.set_defaults(run=cmd_simulate)
 
     s = sub.add_parser("locate", help="search the forcing that best explains the measured air")
-    s.add_argument("building")
-    s.add_argument("--weather", required=True)
-    s.add_argument("--measurements", required=True)
-    s.add_argument("-o", "--output", required=True, help="folder for locate.json")
+    case_arguments(s, True, "folder for locate.json")
     s.add_argument("--nodes", help="forcing candidates (default: every measured node but the air)")
     s.add_argument("--include-algebraic", action="store_true",
                    help="let the search force algebraic (radiant) nodes too")
@@ -216,10 +218,7 @@ def parser():
     s.set_defaults(run=cmd_locate)
 
     s = sub.add_parser("diagnose", help="localise, add the missing effect, calibrate, report before/after")
-    s.add_argument("building")
-    s.add_argument("--weather", required=True)
-    s.add_argument("--measurements", required=True)
-    s.add_argument("-o", "--output", required=True, help="folder for report.json, report.md, building_after.json")
+    case_arguments(s, True, "folder for report.json, report.md, building_after.json")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--workers", type=int, help="processes (default: all cores)")
     s.set_defaults(run=cmd_diagnose)
