@@ -21,9 +21,11 @@ on data the calibration did not see.
 """
 import json
 import math
+import sys
 from dataclasses import replace
 
 import numpy as np
+from tqdm import tqdm
 
 from cosim.fmi2 import FmuInstance
 from cosim.run import simulate_fmu
@@ -90,7 +92,8 @@ def diagnose(building_data, building, case, workdir, *, source="measurements", f
     results, runs, sensitivities = [], {}, {}
     pairs = effects.candidates(building_data, localization["best_nodes"])
     (workdir / "candidates").mkdir(exist_ok=True)
-    for effect, target in pairs:
+    for effect, target in tqdm(pairs, desc="calibrating candidate effects", unit="candidate",
+                               disable=not sys.stderr.isatty()):
         candidate = Candidate(building_data, effect, target, workdir / "candidates")
         try:
             parameters, _ = calibrate(candidate, calibration, air)
