@@ -23,8 +23,9 @@ _physics = {name: importlib.import_module(f"{__name__}_model.{name}")
              for name in ("building", "effects", "integrate", "network")}
 
 # Reset re-constructs the slave: keep what depends only on the model's description per process,
-# for each set of effect parameter values (a calibration tries many).
+# for each set of effect parameter values (a calibration tries many), and its declared variables.
 _MODELS = {}
+_VARIABLES = {}
 
 
 def _read(resources):
@@ -65,49 +66,59 @@ class NodalBuilding(Fmi2Slave):
         n = self.network.n_nodes
         names = self.network.input_names
         effect_start = (_physics["effects"].current_values(data, *self._effect) if self._effect else {})
-        # One array holds every variable's value, indexed by value reference: get/set become
-        # numpy indexing instead of pythonfmu's per-variable getter calls.
-        n_vars = 3 * n + 1 + len(names) + len(effect_start)
-        self._values = np.zeros(n_vars)
-        self._is_real = np.ones(n_vars, dtype=bool)
+        self._parameter_names = tuple(effect_start)
+        # One array holds every variable's value, indexed by value reference, in the order the
+        # variables are declared: get/set become numpy indexing instead of per-variable getters.
+        self._T_start = n
+        self._inputs = slice(n + 1, n + 1 + len(names))
+        self._forced = slice(self._inputs.stop, self._inputs.stop + n)
+        self._T = slice(self._forced.stop, self._forced.stop + n)
+        self._parameters = slice(self._T.stop, self._T.stop + len(effect_start))
+        self._values = np.zeros(self._parameters.stop)
+        self._values[self._T_start] = 20.0
+        self._values[self._forced] = np.nan
+        self._values[self._T] = 20.0
+        self._values[self._parameters] = list(effect_start.values())
+        self._is_real = np.ones(len(self._values), dtype=bool)
         self._is_real[:n] = False
+        # Every accessor reads self._values, so the declarations are the same for every instance
+        # of this FMU: made once, not again at each Reset.
+        declared = _VARIABLES.get(self.resources)
+        if declared is None:
+            self._declare(n, names)
+            _VARIABLES[self.resources] = self.vars
+        else:
+            self.vars = declared
+        self._force = np.zeros(n, dtype=bool)
+        self._force_index = np.zeros(0, dtype=np.intp)
+        self._indices = {}
+        self._initialised = False
+
+    def _declare(self, n, names):
+        """Register the variables, in the order of the value array's layout."""
         for i in range(1, n + 1):
             self.register_variable(Boolean(
                 f"force[{i}]", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
                 description=f"node {i} is forced to T_forced[{i}]"))
-        self._T_start = n
-        self._values[n] = 20.0
         self.register_variable(Real(
             "T_start", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
             description="initial temperature of a node no measurement informs [degC]"))
-        self._inputs = slice(n + 1, n + 1 + len(names))
         for name in names:
             self.register_variable(Real(name, causality=Fmi2Causality.input,
                                         description=_input_description(name)))
-        self._forced = slice(self._inputs.stop, self._inputs.stop + n)
-        self._values[self._forced] = np.nan
         for i in range(1, n + 1):
             self.register_variable(Real(
                 f"T_forced[{i}]", causality=Fmi2Causality.input,
                 description=f"measured temperature of node {i}, NaN if none [degC]"))
-        self._T = slice(self._forced.stop, self._forced.stop + n)
-        self._values[self._T] = self._values[self._T_start]
         for i in range(1, n + 1):
             self.register_variable(Real(
                 f"T[{i}]", causality=Fmi2Causality.output, initial=Fmi2Initial.exact,
                 description=f"temperature of node {i} [degC]"))
-        self._parameters = slice(self._T.stop, n_vars)
-        self._values[self._parameters] = list(effect_start.values())
-        self._parameter_names = tuple(effect_start)
         for name in self._parameter_names:
             self.register_variable(Real(
                 f"{self._effect[0]}.{name}", causality=Fmi2Causality.parameter,
                 variability=Fmi2Variability.fixed,
                 description=f"{self._effect[0]} of {self._effect[1]}: {name}"), nested=False)
-        self._force = np.zeros(n, dtype=bool)
-        self._any_forced = False
-        self._indices = {}
-        self._initialised = False
 
     def _stepper(self, dt):
         stepper = self._steppers.get(dt)
@@ -118,7 +129,7 @@ class NodalBuilding(Fmi2Slave):
     def exit_initialization_mode(self):
         # force[i] and the effect parameters are fixed once initialised: read them once here
         self._force = self._values[: self.network.n_nodes] != 0.0
-        self._any_forced = bool(self._force.any())
+        self._force_index = np.flatnonzero(self._force) + self._forced.start
         if self._parameter_names:
             values = tuple(zip(self._parameter_names, self._values[self._parameters].tolist()))
             self.building, self.network, self._steppers = _model(self.resources, values)
@@ -130,7 +141,7 @@ class NodalBuilding(Fmi2Slave):
         values = self._values
         T_forced = values[self._forced]
         # a node whose measurement is missing (NaN) at this step is computed, not forced
-        forced = self._force & ~np.isnan(T_forced) if self._any_forced else self._force
+        forced = self._force & ~np.isnan(T_forced) if len(self._force_index) else self._force
         source = self.network.B @ values[self._inputs] + self.network.q
         values[self._T] = self._stepper(step_size).step(values[self._T], source, forced, T_forced)
         return True

@@ -26,15 +26,17 @@ class ImplicitEuler:
         self._factors = {}
 
     def factors(self, forced):
-        """LU factors of M with the rows of the `forced` nodes (bool mask) replaced by unit rows."""
+        """LU factors of M with the rows of the `forced` nodes (bool mask) replaced by unit rows,
+        and the indices of those nodes."""
         key = forced.tobytes()
-        lu = self._factors.get(key)
-        if lu is None:
+        factors = self._factors.get(key)
+        if factors is None:
             M = self._M.copy()
             M[forced] = 0.0
             M[forced, forced] = 1.0
-            lu = self._factors[key] = lu_factor(M, check_finite=False)
-        return lu
+            lu, piv = lu_factor(M, check_finite=False)
+            factors = self._factors[key] = (lu, piv, np.flatnonzero(forced))
+        return factors
 
     def step(self, T, source, forced, T_forced):
         """Temperatures (C) at t_n+1 from T at t_n.
@@ -46,13 +48,16 @@ class ImplicitEuler:
         forced : (N,) bool, nodes imposed this step (their measurement exists at t_n+1)
         T_forced : (N,) imposed temperatures (C); read only where `forced`
         """
-        v = self.c_dt * T + source
-        imposed = T_forced[forced]
-        v[forced] = imposed
-        lu, piv = self.factors(forced)
+        v = self.c_dt * T
+        v += source
+        lu, piv, index = self.factors(forced)
+        if not len(index):
+            return dgetrs(lu, piv, v)[0]
+        imposed = T_forced[index]
+        v[index] = imposed
         T_next = dgetrs(lu, piv, v)[0]
         # Pivoting returns the unit rows' values to rounding only; a Dirichlet node is exact.
-        T_next[forced] = imposed
+        T_next[index] = imposed
         return T_next
 
 
