@@ -11,7 +11,8 @@ import numpy as np
 import pandas as pd
 
 from .errors import InputError
-from .network import input_names
+from .integrate import simulate
+from .network import assemble, input_names
 from .solar import incident_irradiance, sky_temperature, solar_position
 from .weather import weather_on_grid
 
@@ -108,3 +109,26 @@ def prepare_case(building, weather, measurements=None):
     measured = (measured_matrix(building, measurements, times) if measurements is not None
                 else np.full((len(times), building.n_nodes), np.nan))
     return Case(times=times, dt=dt, input_names=names, U=U, measured=measured)
+
+
+def simulate_building(building, weather, measurements=None, force=(), warmup_days=2):
+    """Every node's temperature (C) under a weather, with the direct model: the plain Python API.
+
+    Parameters
+    ----------
+    building : Building (`model.building.load_building`)
+    weather : DataFrame from `model.weather.read_weather`
+    measurements : DataFrame from `model.measurements.read_measurements`, or None; it sets the
+        time grid, the initial state and the values forced nodes take
+    force : node ids forced to their measurements for the whole run
+    warmup_days : passes over the first day before the run (PHYSICS.md section 5)
+
+    Returns
+    -------
+    DataFrame indexed by time t_1..t_N, columns `T1..TN`
+    """
+    case = prepare_case(building, weather, measurements)
+    mask = np.zeros(building.n_nodes, dtype=bool)
+    mask[np.asarray(force, dtype=int) - 1] = True
+    T = simulate(building, assemble(building), case.U, case.dt, case.measured, mask, warmup_days)
+    return pd.DataFrame(T, index=case.times[1:], columns=[f"T{i}" for i in range(1, building.n_nodes + 1)])

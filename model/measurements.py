@@ -44,18 +44,3 @@ def read_measurements(path):
     check_celsius(frame, frame.columns)
     return frame
 
-
-def measured_nodes(measurements):
-    """Node ids that have a column in a measurements frame.
-
-    Parameters
-    ----------
-    measurements : pandas.DataFrame
-        As returned by `read_measurements`.
-
-    Returns
-    -------
-    list of int
-        The ids, ascending (a column may still be entirely missing; this lists columns).
-    """
-    return sorted(int(_NODE_COLUMN.fullmatch(name).group(1)) for name in measurements.columns)

@@ -3,7 +3,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from model.case import prepare_case
+from model.case import prepare_case, simulate_building
 from model.errors import InputError
 
 
@@ -48,3 +48,15 @@ def test_a_node_the_building_lacks_is_refused(testcell, weather):
     with pytest.raises(InputError) as e:
         prepare_case(testcell, weather, frame)
     assert e.value.field == "T40" and "1..23" in e.value.problem
+
+
+def test_the_plain_api_simulates_every_node_with_forcing(testcell, weather):
+    times = pd.date_range("2001-06-10", periods=2 * 96 + 1, freq="15min", tz="-05:00")
+    measured = measurements(times, 24 + np.sin(np.arange(len(times)) / 10.0)).rename(columns={"T23": "T9"})
+    free = simulate_building(testcell, weather)
+    forced = simulate_building(testcell, weather, measured, force=[9])
+    assert list(forced.columns) == [f"T{i}" for i in range(1, 24)]
+    assert forced.index.equals(times[1:])
+    assert np.array_equal(forced["T9"].to_numpy(), measured["T9"].to_numpy()[1:])
+    # without measurements the weather's own hourly grid is used
+    assert len(free) == len(weather) - 1 and free.index[0] == weather.index[1]

@@ -5,7 +5,7 @@ import pandas as pd
 import pytest
 
 from model.errors import InputError
-from model.measurements import measured_nodes, read_measurements
+from model.measurements import read_measurements
 
 GOOD = """time,T23,T1,T17
 2024-06-01T00:00:00+04:00,24.1,23.0,22.5
@@ -28,7 +28,6 @@ def test_reads_node_columns_with_empty_cells_missing(tmp_path):
     assert np.isnan(m["T23"].iloc[1]) and np.isnan(m["T1"].iloc[2])
     assert m["T23"].iloc[2] == 24.3
     assert int(m.notna().sum().sum()) == 7  # nothing filled in
-    assert measured_nodes(m) == [1, 17, 23]
 
 
 @pytest.mark.parametrize(
@@ -61,5 +60,5 @@ def test_bad_measurements_name_the_file_and_column(tmp_path, text, column):
 def test_an_all_empty_column_is_still_a_measured_node(tmp_path):
     text = "time,T5,T23\n2024-06-01T00:00Z,,20\n2024-06-01T00:15Z,,21\n"
     m = read_measurements(write(tmp_path, text))
-    assert measured_nodes(m) == [5, 23]
+    assert list(m.columns) == ["T5", "T23"] and m["T5"].isna().all()
     assert m["T5"].isna().all()
