@@ -27,6 +27,8 @@ import threading
 from concurrent.futures import ProcessPoolExecutor
 from typing import Iterable, Sequence
 
+from model.errors import InputError
+
 log = logging.getLogger("nodeforce.ga")
 
 Mask = tuple[bool, ...]
@@ -158,7 +160,10 @@ class DaskBackend:
     def __init__(self, factory, address: str):
         from distributed import Client
 
-        self._client = Client(address, set_as_default=False)
+        try:
+            self._client = Client(address, set_as_default=False, timeout="10s")
+        except (OSError, ValueError, TypeError) as e:
+            raise InputError("--scheduler", address, f"cannot reach a Dask scheduler there ({e})") from None
         self._token = factory_token(factory)
         # Ship the factory once; tasks refer to it instead of carrying it each time.
         [self._factory] = self._client.scatter([factory], broadcast=True, hash=False)

@@ -79,8 +79,22 @@ def cmd_simulate(args):
         print(f"air node {air}: RMSE {np.sqrt(np.nanmean(residual ** 2)):.3f} C against the measurements")
 
 
+def check_search_settings(args):
+    """The GA's settings, refused with the option named rather than deep inside the search."""
+    if args.population < 2:
+        raise InputError("--population", args.population, "a population needs at least 2 chromosomes")
+    if args.generations < 1:
+        raise InputError("--generations", args.generations, "at least one generation")
+    for option, p in (("--pc", args.pc), ("--pm", args.pm)):
+        if not 0.0 <= p <= 1.0:
+            raise InputError(option, p, "a probability, between 0 and 1")
+    if args.workers is not None and args.workers < 1:
+        raise InputError("--workers", args.workers, "at least one worker process")
+
+
 def cmd_locate(args):
     from ga.locate import locate
+    check_search_settings(args)
     data, building, case = load_inputs(args)
     out = Path(args.output)
     out.mkdir(parents=True, exist_ok=True)

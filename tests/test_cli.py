@@ -117,3 +117,19 @@ def test_a_user_mistake_never_shows_a_traceback():
                              "--weather", "nowhere.csv"], capture_output=True, text=True)
     assert result.returncode == 2
     assert result.stderr.strip() == "nodeforce: missing.json: file: not found"
+
+
+@pytest.mark.parametrize("option,value", [("--population", "1"), ("--generations", "0"), ("--pc", "1.5"),
+                                          ("--pm", "-0.1"), ("--workers", "0")])
+def test_bad_search_settings_name_the_option(files, capsys, option, value):
+    err = error_of(capsys, ["locate", str(files["building"]), "--weather", str(files["weather"]),
+                            "--measurements", str(files["measurements"]), "-o", str(files["dir"] / "loc"),
+                            option, value])
+    assert err.startswith(f"nodeforce: {option}: {value}: ")
+
+
+def test_an_unreachable_scheduler_is_a_one_line_error(files, capsys):
+    err = error_of(capsys, ["locate", str(files["building"]), "--weather", str(files["weather"]),
+                            "--measurements", str(files["measurements"]), "-o", str(files["dir"] / "loc"),
+                            "--scheduler", "tcp://127.0.0.1:1"])
+    assert err.startswith("nodeforce: --scheduler: tcp://127.0.0.1:1: cannot reach a Dask scheduler")
