@@ -10,6 +10,7 @@ import numpy as np
 from model.building import parse_building, read_building_data
 from model.case import prepare_case
 from model.errors import InputError
+from model.integrate import steps_per_day
 from model.measurements import read_measurements
 from model.weather import read_weather
 
@@ -38,7 +39,21 @@ def load_inputs(args):
     building = parse_building(data, source=args.building)
     weather = read_weather(args.weather)
     measurements = read_measurements(args.measurements) if getattr(args, "measurements", None) else None
-    return data, building, prepare_case(building, weather, measurements)
+    case = prepare_case(building, weather, measurements)
+    check_warmup(case, args.measurements or args.weather)
+    return data, building, case
+
+
+def check_warmup(case, source):
+    """The warm-up replays the first day (PHYSICS.md section 5): the step must divide a day and
+    the record must hold one."""
+    try:
+        per_day = steps_per_day(case.dt)
+    except ValueError as e:
+        raise InputError(source, "time", f"{e}: the warm-up replays whole days") from None
+    if len(case.times) - 1 < per_day:
+        raise InputError(source, "time", f"{len(case.times) - 1} steps of {case.dt:g} s: the warm-up needs "
+                                          f"at least one day ({per_day} steps)")
 
 
 def force_mask(case, ids, source):
@@ -150,6 +165,14 @@ def cmd_synth(args):
             raise InputError("--effect", f"{effect}@{target}", f"does not apply to {args.building}")
         data = effects.apply(data, effect, target, values)
     building = parse_building(data, source=args.building)
+    for option, value, ok in (("--days", args.days, args.days >= 1), ("--step", args.step, args.step > 0),
+                              ("--noise", args.noise, args.noise >= 0),
+                              ("--history-days", args.history_days, args.history_days >= 0)):
+        if not ok:
+            raise InputError(option, value, "--days must be at least 1 (the warm-up needs a day), --step "
+                                            "positive, --noise and --history-days not negative")
+    if abs(86400 / args.step - round(86400 / args.step)) > 1e-9:
+        raise InputError("--step", args.step, "must divide a day (the warm-up replays whole days)")
     try:
         start = pd.Timestamp(args.start)
     except ValueError:

@@ -133,3 +133,32 @@ def test_an_unreachable_scheduler_is_a_one_line_error(files, capsys):
                             "--measurements", str(files["measurements"]), "-o", str(files["dir"] / "loc"),
                             "--scheduler", "tcp://127.0.0.1:1"])
     assert err.startswith("nodeforce: --scheduler: tcp://127.0.0.1:1: cannot reach a Dask scheduler")
+
+
+def test_a_record_shorter_than_the_warm_up_is_refused(files, capsys):
+    short = rewrite_csv(files, "measurements", "short.csv", lambda f: f.iloc[:40])
+    err = error_of(capsys, ["simulate", str(files["building"]), "--weather", str(files["weather"]),
+                            "--measurements", short])
+    assert "short.csv: time: 39 steps of 900 s" in err and "one day" in err
+
+
+def test_synth_refuses_impossible_settings(files, capsys):
+    base = ["synth", str(files["building"]), "--weather", str(files["weather"]), "-o",
+            str(files["dir"] / "s.csv"), "--start", "2001-06-10T00:00-05:00"]
+    assert "--step" in error_of(capsys, base + ["--step", "700"])
+    assert "--days" in error_of(capsys, base + ["--days", "0.5"])
+    assert "--effect" in error_of(capsys, base + ["--effect", "ground_coupling@roof:U=1"])
+    assert "--start" in error_of(capsys, base[:-1] + ["2001-06-10T00:00"])
+
+
+def test_synth_writes_measurements_that_carry_the_undeclared_effect(files, capsys):
+    base = ["synth", str(files["building"]), "--weather", str(files["weather"]), "--start",
+            "2001-06-10T00:00-05:00", "--days", "2", "--history-days", "1", "--noise", "0"]
+    plain, coupled = files["dir"] / "plain.csv", files["dir"] / "coupled.csv"
+    assert main(base + ["-o", str(plain)]) == 0
+    assert main(base + ["-o", str(coupled), "--effect", "ground_coupling@floor:U=2,T_ground=15"]) == 0
+    a, b = read_measurements(plain), read_measurements(coupled)
+    assert list(a.columns) == [f"T{i}" for i in SENSORS] and len(a) == 2 * 96 + 1
+    # a cold ground under the floor cools the floor most, then the air
+    assert (a["T17"] - b["T17"]).mean() > 1.0
+    assert (a["T23"] - b["T23"]).mean() > 0.1
