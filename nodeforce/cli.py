@@ -188,18 +188,23 @@ def cmd_synth(args):
           f"noise {args.noise} C" + (f", with {args.effect} not in {args.building}" if args.effect else ""))
 
 
-def run_diagnosis(data, building, case, out, source, seed, workers):
+def run_diagnosis(data, building, case, out, source, args):
     from diagnose.loop import diagnose
     from diagnose.report import before_after_table
+    if not 0.0 < args.calibration_fraction < 1.0:
+        raise InputError("--calibration-fraction", args.calibration_fraction, "a fraction between 0 and 1")
+    if args.workers is not None and args.workers < 1:
+        raise InputError("--workers", args.workers, "at least one worker process")
     out.mkdir(parents=True, exist_ok=True)
-    report = diagnose(data, building, case, out, source=source, seed=seed, workers=workers)
+    report = diagnose(data, building, case, out, source=source, fraction=args.calibration_fraction,
+                      seed=args.seed, workers=args.workers)
     print(before_after_table(report))
     print(f"wrote {out / 'report.json'}, {out / 'report.md'}, {out / 'building_after.json'}, {out / 'model_after.fmu'}")
 
 
 def cmd_diagnose(args):
     data, building, case = load_inputs(args)
-    run_diagnosis(data, building, case, Path(args.output), args.measurements, args.seed, args.workers)
+    run_diagnosis(data, building, case, Path(args.output), args.measurements, args)
 
 
 DEMO_COMMAND = ("nodeforce synth model/data/testcell_miami.json --weather model/data/miami_tmy2.csv "
@@ -215,7 +220,7 @@ def cmd_demo(args):
     case = prepare_case(building, read_weather(DATA / "miami_tmy2.csv"), read_measurements(measurements_path))
     print(f"{building.name}: measurements {measurements_path.name} carry an effect the building file does "
           f"not declare (made by: {DEMO_COMMAND})")
-    run_diagnosis(data, building, case, Path(args.output), str(measurements_path), args.seed, args.workers)
+    run_diagnosis(data, building, case, Path(args.output), str(measurements_path), args)
 
 
 def case_arguments(s, measurements_required, output_help, output_default=None):
@@ -224,6 +229,13 @@ def case_arguments(s, measurements_required, output_help, output_default=None):
     s.add_argument("--weather", required=True)
     s.add_argument("--measurements", required=measurements_required)
     s.add_argument("-o", "--output", required=output_default is None, default=output_default, help=output_help)
+
+
+def diagnosis_arguments(s):
+    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--workers", type=int, help="processes (default: all cores)")
+    s.add_argument("--calibration-fraction", type=float, default=0.6,
+                   help="the first part of the record, by time, that calibrates; the rest validates")
 
 
 def parser():
@@ -256,8 +268,7 @@ def parser():
 
     s = sub.add_parser("diagnose", help="localise, add the missing effect, calibrate, report before/after")
     case_arguments(s, True, "folder for report.json, report.md, building_after.json")
-    s.add_argument("--seed", type=int, default=0)
-    s.add_argument("--workers", type=int, help="processes (default: all cores)")
+    diagnosis_arguments(s)
     s.set_defaults(run=cmd_diagnose)
 
     s = sub.add_parser("synth", help="measurements of a building, optionally with an effect its file does not declare")
@@ -278,8 +289,7 @@ def parser():
 
     s = sub.add_parser("demo", help="diagnose the bundled test cell, whose measurements carry an undeclared effect")
     s.add_argument("-o", "--output", default="out/demo")
-    s.add_argument("--seed", type=int, default=0)
-    s.add_argument("--workers", type=int, help="processes (default: all cores)")
+    diagnosis_arguments(s)
     s.set_defaults(run=cmd_demo)
     return p
 

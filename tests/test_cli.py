@@ -162,3 +162,22 @@ def test_synth_writes_measurements_that_carry_the_undeclared_effect(files, capsy
     # a cold ground under the floor cools the floor most, then the air
     assert (a["T17"] - b["T17"]).mean() > 1.0
     assert (a["T23"] - b["T23"]).mean() > 0.1
+
+
+def test_diagnose_refuses_a_fraction_outside_0_1(files, capsys):
+    err = error_of(capsys, ["diagnose", str(files["building"]), "--weather", str(files["weather"]),
+                            "--measurements", str(files["measurements"]), "-o", str(files["dir"] / "d"),
+                            "--calibration-fraction", "1.2"])
+    assert err.startswith("nodeforce: --calibration-fraction: 1.2: ")
+
+
+def test_demo_runs_the_whole_loop_and_finds_the_ground_coupling(tmp_path, capsys):
+    assert main(["demo", "-o", str(tmp_path), "--workers", "1"]) == 0
+    out = capsys.readouterr().out
+    assert "Effect added: ground_coupling on floor" in out
+    assert "validation" in out and "calibration" in out
+    report = json.loads((tmp_path / "report.json").read_text())
+    assert report["localization"]["best_nodes"] in ([16], [17])
+    assert report["after"]["validation"]["rmse"] < 0.5 * report["before"]["validation"]["rmse"]
+    for name in ("report.md", "building_after.json", "model_after.fmu", "air_temperature.png"):
+        assert (tmp_path / name).stat().st_size > 0
