@@ -40,10 +40,19 @@ class Candidate:
     def label(self):
         return f"{self.effect}@{self.target}"
 
+    def node(self, case, node_id, values):
+        """Simulated temperature (C) of a node at t_1..t_N with the effect at `values` (sequence)."""
+        parameters = {f"{self.effect}.{p.name}": float(v) for p, v in zip(self.parameters, values)}
+        return simulate_fmu(self.instance, case, output_ids=[node_id], parameters=parameters)[:, 0]
+
     def air(self, case, air_node, values):
         """Simulated air temperature (C) at t_1..t_N with the effect at `values` (sequence)."""
-        parameters = {f"{self.effect}.{p.name}": float(v) for p, v in zip(self.parameters, values)}
-        return simulate_fmu(self.instance, case, output_ids=[air_node], parameters=parameters)[:, 0]
+        return self.node(case, air_node, values)
+
+    def data_component_face(self):
+        """Id of the target component's outside-face node (the deepest)."""
+        component = next(c for c in self.data["components"] if c["name"] == self.target)
+        return component["nodes"][-1]["id"]
 
     def close(self):
         self.instance.close()
@@ -54,7 +63,8 @@ def calibrate(candidate, case, air_node):
 
     Returns
     -------
-    dict {name: {"value", "std", "identifiable"}} and the residual sum of squares J (C2)
+    dict {name: {"value", "std", "identifiable"}}, the residual sum of squares J (C2), and the
+    quantities the data determine even where the parameters are not (see `derived`)
     """
     measured = case.measured[1:, air_node - 1]
     have = np.isfinite(measured)
@@ -79,7 +89,25 @@ def calibrate(candidate, case, air_node):
             log.warning("%s: %s = %.4g +- %.2g %s is not identifiable from these data%s", candidate.label,
                         p.name, value, sd, p.unit, " (it ended on a bound)" if bound else "")
         result[p.name] = {"value": float(value), "std": float(sd), "identifiable": identifiable}
-    return result, J
+    return result, J, derived(candidate, case, fit.x, cov)
+
+
+def derived(candidate, case, x, cov):
+    """What the data fix when the parameters trade off against each other.
+
+    A ground coupling acts through its heat flux density q = U (T_ground - T_face) (W/m2, into
+    the component), and over weeks the face's temperature barely moves: many (U, T_ground) pairs
+    give the same flux. q is reported with its standard deviation by the delta method,
+    grad q = (T_ground - T_face, U), T_face its mean simulated over the window.
+    """
+    if candidate.effect != "ground_coupling":
+        return {}
+    U, T_ground = x
+    face = candidate.data_component_face()
+    T_face = float(np.mean(candidate.node(case, face, x)))
+    gradient = np.array([T_ground - T_face, U])
+    return {"ground_heat_flux": {"value": float(U * (T_ground - T_face)),
+                                 "std": float(np.sqrt(max(gradient @ cov @ gradient, 0.0))), "unit": "W/m2"}}
 
 
 def sensitivity(candidate, case, air_node, seed=0):

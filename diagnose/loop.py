@@ -96,7 +96,7 @@ def diagnose(building_data, building, case, workdir, *, source="measurements", f
                                disable=not sys.stderr.isatty()):
         candidate = Candidate(building_data, effect, target, workdir / "candidates")
         try:
-            parameters, _ = calibrate(candidate, calibration, air)
+            parameters, _, determined = calibrate(candidate, calibration, air)
             values = [parameters[p.name]["value"] for p in candidate.parameters]
             fitted = candidate.air(calibration, air, values)
             runs[candidate.label] = candidate.air(case, air, values)
@@ -104,7 +104,7 @@ def diagnose(building_data, building, case, workdir, *, source="measurements", f
         finally:
             candidate.close()
         fit = metrics(scored, fitted)
-        results.append({"effect": effect, "target": target, "parameters": parameters,
+        results.append({"effect": effect, "target": target, "parameters": parameters, "derived": determined,
                         "calibration": fit,
                         "validation": metrics(measured[k:], runs[candidate.label][k:]),
                         "bic": bic(fit["J"], fit["n"], len(values))})
@@ -120,7 +120,7 @@ def diagnose(building_data, building, case, workdir, *, source="measurements", f
         data_after = effects.apply(building_data, chosen["effect"], chosen["target"], values)
         after_run = runs[f"{chosen['effect']}@{chosen['target']}"]
         after = {w: chosen[w] for w in ("calibration", "validation")}
-        effect = {key: chosen[key] for key in ("effect", "target", "parameters")}
+        effect = {key: chosen[key] for key in ("effect", "target", "parameters", "derived")}
     else:
         data_after, after_run, after = building_data, before_run, before
         effect = {"effect": "none", "target": None, "parameters": {}}

@@ -191,7 +191,16 @@ def effect_header(report, pm="+-"):
     if _is_none_effect(effect):
         return "Effect added: none: no effect improves the validation error"
     params = fmt_parameters(effect.get("effect"), effect.get("parameters"), pm)
-    return f"Effect added: {_effect_name(effect.get('effect'), effect.get('target'))}" + (f": {params}" if params else "")
+    line = f"Effect added: {_effect_name(effect.get('effect'), effect.get('target'))}" + (f": {params}" if params else "")
+    for name, d in (effect.get("derived") or {}).items():
+        line += (f"\n  the data determine {name.replace('_', ' ')} = "
+                 f"{fmt_value_std(d.get('value'), d.get('std'), pm)} {d.get('unit', '')}".rstrip())
+    return line
+
+
+def _bold_lines(text):
+    """Markdown: each line of `text` in bold, as its own paragraph line."""
+    return [f"**{line.strip()}**  " for line in text.splitlines()]
 
 
 def rationale(report):
@@ -753,7 +762,7 @@ def write_report(out_dir, report: dict, series: dict) -> list[Path]:
           "From the residual of the indoor air, to the nodes whose forcing explains it, to a physical "
           "effect the model lacks, added and calibrated on the calibration window; the validation "
           "window was not seen by the calibration.", "",
-          "## Result", "", f"**{effect_header(report, pm='±')}**", "", rationale(report), "",
+          "## Result", "", *_bold_lines(effect_header(report, pm='±')), "", rationale(report), "",
           "## Period", "",
           f"- calibration: {_period_text(report, 'calibration')}"
           + (f" (residuals scored from {_time_text(period['calibration_scored_from'])}, after the burn-in)"

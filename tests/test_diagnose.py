@@ -55,6 +55,14 @@ def test_diagnose_finds_the_undeclared_effect(tmp_path, testcell_data, testcell,
                 assert abs(p["value"] - truth[name]) <= 0.25 * abs(truth[name]), name
     before, after = report["before"]["validation"]["rmse"], report["after"]["validation"]["rmse"]
     assert after <= max(before / 2, 1.5 * NOISE)
+    if effect == "ground_coupling":
+        # what the data fix even when U and T_ground trade off: the heat flux through the ground,
+        # here against the "real" floor's underside over the scored calibration steps
+        truth_building = parse_building(effects.apply(testcell_data, effect, target, truth))
+        underside = pseudo_measurements(truth_building, weather, record(), [21], history_days=7)["T21"]
+        scored = underside[report["period"]["calibration_scored_from"]:report["period"]["calibration"][1]]
+        flux = truth["U"] * (truth["T_ground"] - scored.mean())
+        assert report["effect"]["derived"]["ground_heat_flux"]["value"] == pytest.approx(flux, rel=0.15)
     # the chosen effect is declared in a building file every command loads, and its FMU is valid
     after_building = load_building(tmp_path / "building_after.json")
     assert after_building.n_nodes == 23
