@@ -36,8 +36,9 @@ class FmuInstance:
         except KeyError as e:
             raise KeyError(f"{self.path} has no variable {e.args[0]}") from None
 
-    def run(self, dt, parameters, start_inputs, input_names, inputs, output_names, start_time=0.0):
-        """Simulate from a fresh state; return the outputs after each step.
+    def run(self, dt, parameters, start_inputs, input_names, inputs, output_names, start_time=0.0,
+            skip=0):
+        """Simulate from a fresh state; return the outputs after each step but the first `skip`.
 
         Parameters
         ----------
@@ -47,10 +48,11 @@ class FmuInstance:
         input_names : the inputs set before every step
         inputs : (n_steps, len(input_names)) values, row k applied before step k
         output_names : the outputs read after every step
+        skip : steps whose outputs are not needed (a warm-up): not read at all
 
         Returns
         -------
-        (n_steps, len(output_names)) ndarray
+        (n_steps - skip, len(output_names)) ndarray
         """
         fmu = self.fmu
         if self._used:
@@ -76,15 +78,16 @@ class FmuInstance:
         out_view = np.ctypeslib.as_array(out_values)
         component = fmu.component
         set_real, do_step, get_real = fmu.fmi2SetReal, fmu.fmi2DoStep, fmu.fmi2GetReal
-        outputs = np.empty((len(inputs), n_out))
+        outputs = np.empty((len(inputs) - skip, n_out))
         time = start_time
         for k, row in enumerate(inputs):
             if n_in:
                 in_view[:] = row
                 set_real(component, in_refs, n_in, in_values)
             do_step(component, time, dt, fmi2Boolean(fmi2True))
-            get_real(component, out_refs, n_out, out_values)
-            outputs[k] = out_view
+            if k >= skip:
+                get_real(component, out_refs, n_out, out_values)
+                outputs[k - skip] = out_view
             time = start_time + (k + 1) * dt
         fmu.terminate()
         return outputs

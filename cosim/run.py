@@ -40,7 +40,6 @@ def simulate_fmu(instance, case, force=None, warmup_days=2, output_ids=None, T_d
     start_inputs = {f"T_forced[{i + 1}]": measured[0, i] for i in measured0}
     rows = warmup_rows(n_rows, case.dt, warmup_days)
     inputs = np.hstack([case.U[rows], measured[rows][:, np.array(forced_ids, dtype=int) - 1]])
-    out = instance.run(case.dt, parameters, start_inputs,
-                       list(case.input_names) + node_names("T_forced", forced_ids),
-                       inputs, node_names("T", output_ids))
-    return out[len(rows) - (n_rows - 1):]
+    return instance.run(case.dt, parameters, start_inputs,
+                        list(case.input_names) + node_names("T_forced", forced_ids),
+                        inputs, node_names("T", output_ids), skip=len(rows) - (n_rows - 1))
