@@ -12,7 +12,8 @@ on data the calibration did not see.
    is the tail of a run over the whole record, so it starts from the state the past left).
 3. The forcing search (`ga.locate`) on the calibration window localises nodes.
 4. Candidates: the effects of the localised nodes' components, and of the air node's own
-   equation (`model.effects.candidates`), each its own FMU with the effect's parameters.
+   equation (`model.effects.candidates`), each its own FMU with the effect's parameters, and,
+   once calibrated, its own building file (`candidates/<effect>@<target>.json/.fmu`).
 5. Each is calibrated on the calibration window (`diagnose.calibrate`).
 6. The chosen effect has the best validation error among those that beat the model without
    them on BIC (calibration window) and lower the validation J by more than noise could
@@ -103,6 +104,9 @@ def diagnose(building_data, building, case, workdir, *, source="measurements", f
             sensitivities[candidate.label] = sensitivity(candidate, calibration, air, seed=seed)
         finally:
             candidate.close()
+        calibrated = effects.apply(building_data, effect, target,
+                                   {name: p["value"] for name, p in parameters.items()})
+        (workdir / "candidates" / f"{candidate.label}.json").write_text(json.dumps(calibrated, indent=2) + "\n")
         fit = metrics(scored, fitted)
         results.append({"effect": effect, "target": target, "parameters": parameters, "derived": determined,
                         "calibration": fit,

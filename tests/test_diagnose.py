@@ -66,6 +66,13 @@ def test_diagnose_finds_the_undeclared_effect(tmp_path, testcell_data, testcell,
     # the chosen effect is declared in a building file every command loads, and its FMU is valid
     after_building = load_building(tmp_path / "building_after.json")
     assert after_building.n_nodes == 23
+    # every candidate exists as a building file declaring its calibrated effect
+    for c in report["candidates"]:
+        declared = json.loads((tmp_path / "candidates" / f"{c['effect']}@{c['target']}.json").read_text())
+        values = effects.current_values(declared, c["effect"], c["target"])
+        for name, p in c["parameters"].items():
+            if not (c["effect"] == "ground_coupling" and values["U"] == 0.0):
+                assert values[name] == pytest.approx(p["value"])
     assert validate_fmu(str(tmp_path / "model_after.fmu")) == []
     assert json.loads((tmp_path / "report.json").read_text())["effect"]["effect"] == effect
     assert (tmp_path / "report.md").exists() and report["artifacts"]["plots"]
