@@ -23,7 +23,6 @@ on data the calibration did not see.
 import json
 import math
 import sys
-from dataclasses import replace
 
 import numpy as np
 from tqdm import tqdm
@@ -56,14 +55,6 @@ def split(case, fraction, source):
     return k
 
 
-def without_burn_in(case, air):
-    """The case with the air's first `BURN_IN_DAYS` left out of every score (NaN in a copy; the
-    measurement at t_0 stays, it sets the initial state)."""
-    measured = case.measured.copy()
-    measured[1:BURN_IN_DAYS * steps_per_day(case.dt) + 1, air - 1] = np.nan
-    return replace(case, measured=measured)
-
-
 def bic(J, n, k):
     """Bayesian information criterion of a least-squares fit with k parameters on n residuals."""
     return n * math.log(J / n) + k * math.log(n)
@@ -74,7 +65,7 @@ def diagnose(building_data, building, case, workdir, *, source="measurements", f
     """Run the whole loop; write the artifacts in `workdir`; return the report.json content."""
     air = output_node(building, case, source)
     k = split(case, fraction, source)
-    calibration = without_burn_in(case.window(0, k), air)
+    calibration = case.window(0, k).unscored_start(air, BURN_IN_DAYS)
     measured = case.measured[1:, air - 1]
     scored = calibration.measured[1:, air - 1]
     sigma = noise_level(case.measured[:, air - 1])

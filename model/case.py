@@ -5,7 +5,7 @@ time grid: the measurement grid when there are measurements (weather interpolate
 else the weather's own. It never fills a gap: a missing measurement stays NaN (the node is then
 computed, PHYSICS.md section 5) and a missing input is refused.
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
@@ -29,6 +29,13 @@ class Case:
     def measured_ids(self):
         """Ids of the nodes with at least one measurement."""
         return [int(i) + 1 for i in np.flatnonzero(np.isfinite(self.measured).any(axis=0))]
+
+    def unscored_start(self, node, days):
+        """The case with `node`'s measurements of the first `days` after t_0 left out of every
+        score (NaN in a copy); the measurement at t_0 stays, as it sets the initial state."""
+        measured = self.measured.copy()
+        measured[1:int(round(days * 86400 / self.dt)) + 1, node - 1] = np.nan
+        return replace(self, measured=measured)
 
     def window(self, start, stop):
         """The sub-case on rows start..stop (inclusive), t_start becoming its t_0."""

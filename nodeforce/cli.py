@@ -111,6 +111,10 @@ def cmd_locate(args):
     from ga.locate import locate
     check_search_settings(args)
     data, building, case = load_inputs(args)
+    if args.burn_in_days:
+        if not 0 < args.burn_in_days < (case.times[-1] - case.times[0]).total_seconds() / 86400:
+            raise InputError("--burn-in-days", args.burn_in_days, "must be positive and shorter than the record")
+        case = case.unscored_start(building.zones[0].air_node, args.burn_in_days)
     out = Path(args.output)
     out.mkdir(parents=True, exist_ok=True)
     result = locate(data, building, case, out, source=args.measurements,
@@ -264,6 +268,9 @@ def parser():
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--workers", type=int, help="processes (default: all cores)")
     s.add_argument("--scheduler", help="a Dask scheduler address, tcp://host:port")
+    s.add_argument("--burn-in-days", type=float, default=0.0,
+                   help="days after t_0 simulated but not scored (default 0: J over t_1..t_N); the "
+                        "warm-up replays the first day, which a record with real history may not match")
     s.set_defaults(run=cmd_locate)
 
     s = sub.add_parser("diagnose", help="localise, add the missing effect, calibrate, report before/after")

@@ -181,3 +181,17 @@ def test_demo_runs_the_whole_loop_and_finds_the_ground_coupling(tmp_path, capsys
     assert report["after"]["validation"]["rmse"] < 0.5 * report["before"]["validation"]["rmse"]
     for name in ("report.md", "building_after.json", "model_after.fmu", "air_temperature.png"):
         assert (tmp_path / name).stat().st_size > 0
+
+
+def test_locate_with_a_burn_in_points_at_the_floor_of_the_demo_data(tmp_path, capsys):
+    # the bundled record has real history: its first day carries the warm-up's transient
+    assert main(["locate", str(DATA / "testcell_miami.json"), "--weather", str(DATA / "miami_tmy2.csv"),
+                 "--measurements", str(DATA / "demo_measurements.csv"), "-o", str(tmp_path),
+                 "--burn-in-days", "1", "--workers", "1"]) == 0
+    result = json.loads((tmp_path / "locate.json").read_text())
+    assert result["search"]["method"] == "exhaustive"
+    assert result["best_nodes"] in ([16], [17]) and result["ranked_nodes"][:2] == [16, 17]
+    assert "--burn-in-days" in error_of(capsys, ["locate", str(DATA / "testcell_miami.json"), "--weather",
+                                                 str(DATA / "miami_tmy2.csv"), "--measurements",
+                                                 str(DATA / "demo_measurements.csv"), "-o", str(tmp_path),
+                                                 "--burn-in-days", "30"])
