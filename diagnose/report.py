@@ -382,19 +382,27 @@ def _finish_time_plot(fig, ax, path, windows, xlabel, ylabel, title, legend_colu
     return _save(fig, path)
 
 
-def plot_temperature(path, report, series):
-    """Measured and simulated air temperature, before and after, validation window shaded."""
+def _time_plot(report, series):
+    """What both plots against time start from: the figure with its burn-in and validation
+    shading, local times, the validation start, the scored start, the measured, before and
+    after series, and whether after is the same as before."""
     times, xlabel = _local_times(series["times"])
     n = len(times)
     start = _local_instant(series.get("validation_start"), series["times"])
-    measured, before, after = (_array(series, k, n) for k in ("measured", "before", "after"))
-    unchanged = _is_none_effect(report.get("effect")) or _same(before, after)
-    air = series.get("air_node")
+    arrays = tuple(_array(series, k, n) for k in ("measured", "before", "after"))
+    unchanged = _is_none_effect(report.get("effect")) or _same(arrays[1], arrays[2])
     scored_from = _burn_in_end(report, series, times)
     fig = _new_figure()
     ax = fig.add_subplot()
     _shade_burn_in(ax, times[0], scored_from)
     _shade_validation(ax, start, times[-1] if n else None)
+    return fig, ax, times, xlabel, start, scored_from, arrays, unchanged
+
+
+def plot_temperature(path, report, series):
+    """Measured and simulated air temperature, before and after, validation window shaded."""
+    fig, ax, times, xlabel, start, scored_from, (measured, before, after), unchanged = _time_plot(report, series)
+    air = series.get("air_node")
     if before is not None:
         label = "simulated (no effect added)" if unchanged else "simulated before"
         ax.plot(times, before, color=COLOR_BEFORE, lw=1.4, label=label)
@@ -414,17 +422,8 @@ def _effect_label(report):
 
 def plot_residuals(path, report, series):
     """Residual before and after over time, mean and sd per window in the legend (Table 5)."""
-    times, xlabel = _local_times(series["times"])
-    n = len(times)
-    start = _local_instant(series.get("validation_start"), series["times"])
-    measured, before, after = (_array(series, k, n) for k in ("measured", "before", "after"))
-    unchanged = _is_none_effect(report.get("effect")) or _same(before, after)
-    scored_from = _burn_in_end(report, series, times)
+    fig, ax, times, xlabel, start, scored_from, (measured, before, after), unchanged = _time_plot(report, series)
     masks = _window_masks(times, start, scored_from)
-    fig = _new_figure()
-    ax = fig.add_subplot()
-    _shade_burn_in(ax, times[0], scored_from)
-    _shade_validation(ax, start, times[-1] if n else None)
     ax.axhline(0, color="0.4", lw=0.8)
     states = [("before", before, COLOR_BEFORE)] + ([] if unchanged else [("after", after, COLOR_AFTER)])
     segments = []
