@@ -14,7 +14,8 @@ on data the calibration did not see.
 4. Candidates: the effects of the localised nodes' components, and of the air node's own
    equation (`model.effects.candidates`), each its own FMU with the effect's parameters, and,
    once calibrated, its own building file (`candidates/<effect>@<target>.json/.fmu`).
-5. Each is calibrated on the calibration window (`diagnose.calibrate`).
+5. Each is calibrated on the calibration window (`diagnose.calibrate`), the candidates in
+   parallel worker processes.
 6. The chosen effect has the best validation error among those that beat the model without
    them on BIC (calibration window) and lower the validation J by more than noise could
    (`ga.parsimony.tolerance`); "none" if no candidate does. The calibration window alone never
@@ -22,7 +23,11 @@ on data the calibration did not see.
 """
 import json
 import math
+import multiprocessing
+import os
 import sys
+from concurrent.futures import ProcessPoolExecutor
+from contextlib import nullcontext
 
 import numpy as np
 from tqdm import tqdm
@@ -55,6 +60,28 @@ def split(case, fraction, source):
     return k
 
 
+def assess(task):
+    """Calibrate one candidate effect and run it: a task for a worker process.
+
+    Returns the calibrated parameters, what the data determine, the simulated air on the
+    calibration window and over the whole record, and the Morris screening; writes the
+    candidate's FMU and its building file, declared at the calibrated values, in `folder`.
+    """
+    building_data, effect, target, folder, calibration, case, air, seed = task
+    candidate = Candidate(building_data, effect, target, folder)
+    try:
+        parameters, _, determined = calibrate(candidate, calibration, air)
+        values = [parameters[p.name]["value"] for p in candidate.parameters]
+        fitted = candidate.air(calibration, air, values)
+        run = candidate.air(case, air, values)
+        screening = sensitivity(candidate, calibration, air, seed=seed)
+    finally:
+        candidate.close()
+    calibrated = effects.apply(building_data, effect, target, {name: p["value"] for name, p in parameters.items()})
+    (folder / f"{candidate.label}.json").write_text(json.dumps(calibrated, indent=2) + "\n")
+    return parameters, determined, fitted, run, screening
+
+
 def bic(J, n, k):
     """Bayesian information criterion of a least-squares fit with k parameters on n residuals."""
     return n * math.log(J / n) + k * math.log(n)
@@ -81,28 +108,24 @@ def diagnose(building_data, building, case, workdir, *, source="measurements", f
                           workers=workers, population=population, generations=generations,
                           progress=lambda generation, total, J, unique: convergence.append((generation, J)))
 
-    results, runs, sensitivities = [], {}, {}
     pairs = effects.candidates(building_data, localization["best_nodes"])
     (workdir / "candidates").mkdir(exist_ok=True)
-    for effect, target in tqdm(pairs, desc="calibrating candidate effects", unit="candidate",
-                               disable=not sys.stderr.isatty()):
-        candidate = Candidate(building_data, effect, target, workdir / "candidates")
-        try:
-            parameters, _, determined = calibrate(candidate, calibration, air)
-            values = [parameters[p.name]["value"] for p in candidate.parameters]
-            fitted = candidate.air(calibration, air, values)
-            runs[candidate.label] = candidate.air(case, air, values)
-            sensitivities[candidate.label] = sensitivity(candidate, calibration, air, seed=seed)
-        finally:
-            candidate.close()
-        calibrated = effects.apply(building_data, effect, target,
-                                   {name: p["value"] for name, p in parameters.items()})
-        (workdir / "candidates" / f"{candidate.label}.json").write_text(json.dumps(calibrated, indent=2) + "\n")
+    tasks = [(building_data, effect, target, workdir / "candidates", calibration, case, air, seed)
+             for effect, target in pairs]
+    n_workers = min(workers or os.cpu_count(), len(tasks))
+    with (ProcessPoolExecutor(n_workers, mp_context=multiprocessing.get_context("spawn"))
+          if n_workers > 1 else nullcontext()) as pool:
+        assessed = list(tqdm((pool.map if pool else map)(assess, tasks), total=len(tasks),
+                             desc="calibrating candidate effects", unit="candidate",
+                             disable=not sys.stderr.isatty()))
+    results, runs, sensitivities = [], {}, {}
+    for (effect, target), (parameters, determined, fitted, run, screening) in zip(pairs, assessed):
+        label = f"{effect}@{target}"
+        runs[label], sensitivities[label] = run, screening
         fit = metrics(scored, fitted)
         results.append({"effect": effect, "target": target, "parameters": parameters, "derived": determined,
-                        "calibration": fit,
-                        "validation": metrics(measured[k:], runs[candidate.label][k:]),
-                        "bic": bic(fit["J"], fit["n"], len(values))})
+                        "calibration": fit, "validation": metrics(measured[k:], run[k:]),
+                        "bic": bic(fit["J"], fit["n"], len(parameters))})
 
     bic_before = bic(before["calibration"]["J"], before["calibration"]["n"], 0)
     margin = tolerance(before["validation"]["J"], sigma, before["validation"]["n"])

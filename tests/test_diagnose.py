@@ -37,9 +37,9 @@ def measured_with(testcell_data, weather, effect=None, seed=5):
                                history_days=7)
 
 
-def run(tmp_path, testcell_data, testcell, weather, measurements):
+def run(tmp_path, testcell_data, testcell, weather, measurements, workers=1):
     case = prepare_case(testcell, weather, measurements)
-    return diagnose(testcell_data, testcell, case, tmp_path, seed=0, workers=1)
+    return diagnose(testcell_data, testcell, case, tmp_path, seed=0, workers=workers)
 
 
 @pytest.mark.parametrize("effect", list(TRUTH))
@@ -79,7 +79,8 @@ def test_diagnose_finds_the_undeclared_effect(tmp_path, testcell_data, testcell,
 
 
 def test_no_undeclared_effect_changes_nothing(tmp_path, testcell_data, testcell, weather):
-    report = run(tmp_path, testcell_data, testcell, weather, measured_with(testcell_data, weather))
+    # two workers: the search and the candidates' calibrations in parallel processes
+    report = run(tmp_path, testcell_data, testcell, weather, measured_with(testcell_data, weather), workers=2)
     assert report["effect"]["effect"] == "none"
     assert report["after"] == report["before"]
     assert json.loads((tmp_path / "building_after.json").read_text()) == testcell_data
