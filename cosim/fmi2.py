@@ -6,6 +6,7 @@ writes the inputs into preallocated ctypes arrays through numpy views and calls 
 `fmi2SetReal`, `fmi2DoStep` and `fmi2GetReal`, so a step allocates nothing in Python.
 """
 import shutil
+import sys
 
 import numpy as np
 from fmpy import extract, read_model_description
@@ -23,7 +24,13 @@ class FmuInstance:
         self.fmu = FMU2Slave(guid=self.description.guid, unzipDirectory=self._unzipdir,
                              modelIdentifier=self.description.coSimulation.modelIdentifier,
                              instanceName=instance_name)
+        on_path = list(sys.path)
         self.fmu.instantiate()
+        # pythonfmu puts the FMU's resources folder first on sys.path for good. Its copy of the
+        # pythonfmu package (no binaries) would then shadow the installed one for every later
+        # import here and in spawned workers, which build FMUs without binaries from it. The
+        # slave is imported by now, and Reset does not import again: the entry can go.
+        sys.path[:] = [p for p in sys.path if p in on_path or not p.startswith(str(self._unzipdir))]
         self._used = False
 
     def names(self, causality):

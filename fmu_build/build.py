@@ -9,9 +9,11 @@ import hashlib
 import json
 import sys
 import tempfile
+import zipfile
 from pathlib import Path
 
 from pythonfmu.builder import FmuBuilder
+from pythonfmu.osutil import get_platform
 
 import model
 from model import effects
@@ -71,4 +73,8 @@ def build_fmu(building_data, destination, source="<building>", effect=None):
             # the same code as the FMU's, under the FMU's unique name, and may stay.
             while str(tmp) in sys.path:
                 sys.path.remove(str(tmp))
+    with zipfile.ZipFile(destination) as fmu:
+        if not any(name.startswith(f"binaries/{get_platform()}/") for name in fmu.namelist()):
+            raise RuntimeError(f"{destination} has no binary for {get_platform()}: the pythonfmu imported "
+                               f"from {FmuBuilder.build_FMU.__code__.co_filename} is a copy without one")
     return destination

@@ -70,6 +70,7 @@ Both also reject outputs left at the default initial="calculated" (pythonfmu wri
 """
 from __future__ import annotations
 
+import functools
 import os
 import re
 import shutil
@@ -82,6 +83,19 @@ import numpy as np
 __all__ = ["run_fmpy", "run_libcosim", "run_ecos", "fmpy_validate", "fmutool_check"]
 
 # --------------------------------------------------------------------------- common checks
+def _restores_sys_path(run):
+    """pythonfmu prepends each instance's resources folder to sys.path for good; its copy of
+    pythonfmu (no binaries) would shadow the installed package here and in spawned workers."""
+    @functools.wraps(run)
+    def wrapper(*args, **kwargs):
+        saved = list(sys.path)
+        try:
+            return run(*args, **kwargs)
+        finally:
+            sys.path[:] = saved
+    return wrapper
+
+
 def _variables(fmu):
     """{name: fmpy ScalarVariable} and the model description of ``fmu``."""
     from fmpy import read_model_description
@@ -136,6 +150,7 @@ def _typed(variable, value):
 
 
 # --------------------------------------------------------------------------- FMPy
+@_restores_sys_path
 def run_fmpy(fmu: str | os.PathLike, parameters: dict[str, float | bool], inputs: dict[str, np.ndarray],
              outputs: list[str], dt: float, n_steps: int) -> np.ndarray:
     """Run ``fmu`` in FMPy for ``n_steps`` steps of ``dt`` s; row k = ``outputs`` after step k."""
@@ -186,6 +201,7 @@ def _fmpy_set(slave, variable, value):
 
 
 # --------------------------------------------------------------------------- libcosim
+@_restores_sys_path
 def run_libcosim(fmu: str | os.PathLike, parameters: dict[str, float | bool], inputs: dict[str, np.ndarray],
                  outputs: list[str], dt: float, n_steps: int) -> np.ndarray:
     """Run ``fmu`` in libcosim (libcosimpy) for ``n_steps`` steps of ``dt`` s; row k = after step k."""
@@ -237,6 +253,7 @@ def run_libcosim(fmu: str | os.PathLike, parameters: dict[str, float | bool], in
 
 
 # --------------------------------------------------------------------------- ecos
+@_restores_sys_path
 def run_ecos(fmu: str | os.PathLike, parameters: dict[str, float | bool], inputs: dict[str, np.ndarray],
              outputs: list[str], dt: float, n_steps: int) -> np.ndarray:
     """Run ``fmu`` in ecos (ecospy) for ``n_steps`` steps of ``dt`` s; row k = after step k."""

@@ -1,10 +1,9 @@
 """The FMU gives the direct model's numbers and behaves as an FMI 2.0 co-simulation slave should."""
 import copy
+import sys
 
 import numpy as np
 import pytest
-from fmpy import extract, read_model_description
-from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
 from cosim.fmi2 import FmuInstance
@@ -51,13 +50,21 @@ def test_reset_and_reuse_give_identical_results(fmu, real_case):
     assert not np.array_equal(first, other)
 
 
+OPEN = []
+
+
+@pytest.fixture(autouse=True)
+def close_instances():
+    yield
+    while OPEN:
+        OPEN.pop().close()
+
+
 def instantiate(path, name):
-    md = read_model_description(str(path))
-    slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(path)),
-                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
-    slave.instantiate()
-    refs = {v.name: v.valueReference for v in md.modelVariables}
-    return slave, refs
+    """The FMPy slave of a new instance (closed after the test) and the value references."""
+    instance = FmuInstance(path, instance_name=name)
+    OPEN.append(instance)
+    return instance.fmu, {n: v.valueReference for n, v in instance.variables.items()}
 
 
 def start(slave, refs, T_start, forced=()):
@@ -97,7 +104,6 @@ def test_several_instances_at_once_do_not_interfere(fmu):
     assert np.allclose(np.array(interleaved_b)[:, 8], 27.0)
     for slave in (a, b, alone):
         slave.terminate()
-        slave.freeInstance()
 
 
 def test_get_and_set_fmu_state_replays_identically(fmu):
@@ -116,7 +122,6 @@ def test_get_and_set_fmu_state_replays_identically(fmu):
     slave.freeFMUstate(state)
     slave.freeFMUstate(restored)
     slave.terminate()
-    slave.freeInstance()
     assert np.array_equal(first, replay)
     assert np.array_equal(first, from_bytes)
 
@@ -134,3 +139,12 @@ def test_two_different_fmus_in_one_process_run_their_own_model(tmp_path, testcel
         direct = simulate(building, assemble(building), real_case.U, real_case.dt, real_case.measured)
         assert np.abs(out[:, 0] - direct[:, 22]).max() < 1e-9
     assert np.abs(out_a - out_b).max() > 0.01
+
+
+def test_an_instance_leaves_sys_path_as_it_found_it(fmu, real_case):
+    # pythonfmu prepends the FMU's resources folder, whose pythonfmu copy has no binaries: left
+    # there, workers spawned later inherit it and build FMUs that cannot run
+    before = list(sys.path)
+    with FmuInstance(fmu) as instance:
+        simulate_fmu(instance, real_case, output_ids=[23])
+        assert sys.path == before
