@@ -90,7 +90,7 @@ class NodalBuilding(Fmi2Slave):
         else:
             self.vars = declared
         self._force = np.zeros(n, dtype=bool)
-        self._force_index = np.zeros(0, dtype=np.intp)
+        self._any_forced = False
         self._indices = {}
         self._initialised = False
 
@@ -129,7 +129,7 @@ class NodalBuilding(Fmi2Slave):
     def exit_initialization_mode(self):
         # force[i] and the effect parameters are fixed once initialised: read them once here
         self._force = self._values[: self.network.n_nodes] != 0.0
-        self._force_index = np.flatnonzero(self._force) + self._forced.start
+        self._any_forced = bool(self._force.any())
         if self._parameter_names:
             values = tuple(zip(self._parameter_names, self._values[self._parameters].tolist()))
             self.building, self.network, self._steppers = _model(self.resources, values)
@@ -140,8 +140,7 @@ class NodalBuilding(Fmi2Slave):
     def do_step(self, current_time, step_size):
         values = self._values
         T_forced = values[self._forced]
-        # a node whose measurement is missing (NaN) at this step is computed, not forced
-        forced = self._force & ~np.isnan(T_forced) if len(self._force_index) else self._force
+        forced = _physics["integrate"].imposed(self._force, T_forced) if self._any_forced else self._force
         source = self.network.B @ values[self._inputs] + self.network.q
         values[self._T] = self._stepper(step_size).step(values[self._T], source, forced, T_forced)
         return True

@@ -53,12 +53,18 @@ class ImplicitEuler:
         lu, piv, index = self.factors(forced)
         if not len(index):
             return dgetrs(lu, piv, v)[0]
-        imposed = T_forced[index]
-        v[index] = imposed
+        T_imposed = T_forced[index]
+        v[index] = T_imposed
         T_next = dgetrs(lu, piv, v)[0]
         # Pivoting returns the unit rows' values to rounding only; a Dirichlet node is exact.
-        T_next[index] = imposed
+        T_next[index] = T_imposed
         return T_next
+
+
+def imposed(force, measured):
+    """The nodes forced at a step (or at every step, row by row): those of the forcing mask whose
+    measurement exists there. A missing one (NaN) leaves its node computed, never invented."""
+    return force & np.isfinite(measured)
 
 
 def initial_state(building, measured0, T_default=20.0):
@@ -124,7 +130,7 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     if force is None:
         force = np.zeros(n, dtype=bool)
     sources = U @ network.B.T + network.q
-    forced = force & np.isfinite(measured)
+    forced = imposed(force, measured)
     stepper = ImplicitEuler(network, dt)
     T = initial_state(building, measured[0], T_default)
     rows = warmup_rows(n_rows, dt, warmup_days)
