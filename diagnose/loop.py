@@ -149,7 +149,7 @@ def diagnose(building_data, building, case, workdir, *, source="measurements", f
     times = case.times
     report = {
         "period": {"calibration": [times[0].isoformat(), times[k].isoformat()],
-                   "calibration_scored_from": times[BURN_IN_DAYS * steps_per_day(case.dt) + 1].isoformat(),
+                   "calibration_scored_from": times[case.steps(BURN_IN_DAYS) + 1].isoformat(),
                    "validation": [times[k + 1].isoformat(), times[-1].isoformat()]},
         "before": before,
         "localization": localization,

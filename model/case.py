@@ -30,11 +30,15 @@ class Case:
         """Ids of the nodes with at least one measurement."""
         return [int(i) + 1 for i in np.flatnonzero(np.isfinite(self.measured).any(axis=0))]
 
+    def steps(self, days):
+        """Number of steps in `days`."""
+        return int(round(days * 86400 / self.dt))
+
     def unscored_start(self, node, days):
         """The case with `node`'s measurements of the first `days` after t_0 left out of every
         score (NaN in a copy); the measurement at t_0 stays, as it sets the initial state."""
         measured = self.measured.copy()
-        measured[1:int(round(days * 86400 / self.dt)) + 1, node - 1] = np.nan
+        measured[1:self.steps(days) + 1, node - 1] = np.nan
         return replace(self, measured=measured)
 
     def window(self, start, stop):
