@@ -17,6 +17,7 @@ from cosim.fmi2 import FmuInstance
 from cosim.run import simulate_fmu
 from fmu_build.build import build_fmu
 from model import effects
+from model.score import sum_of_squares
 
 log = logging.getLogger("nodeforce.diagnose")
 
@@ -63,8 +64,8 @@ def calibrate(candidate, case, air_node):
 
     Returns
     -------
-    dict {name: {"value", "std", "identifiable"}}, the residual sum of squares J (C2), and the
-    quantities the data determine even where the parameters are not (see `derived`)
+    dict {name: {"value", "std", "identifiable"}}, and the quantities the data determine even
+    where the parameters are not (see `derived`)
     """
     measured = case.measured[1:, air_node - 1]
     have = np.isfinite(measured)
@@ -89,7 +90,7 @@ def calibrate(candidate, case, air_node):
             log.warning("%s: %s = %.4g +- %.2g %s is not identifiable from these data%s", candidate.label,
                         p.name, value, sd, p.unit, " (it ended on a bound)" if bound else "")
         result[p.name] = {"value": float(value), "std": float(sd), "identifiable": identifiable}
-    return result, J, derived(candidate, case, fit.x, cov)
+    return result, derived(candidate, case, fit.x, cov)
 
 
 def derived(candidate, case, x, cov):
@@ -117,11 +118,10 @@ def sensitivity(candidate, case, air_node, seed=0):
     sigma how much that depends on the others (interaction or non-linearity).
     """
     measured = case.measured[1:, air_node - 1]
-    have = np.isfinite(measured)
     problem = {"num_vars": len(candidate.parameters), "names": [p.name for p in candidate.parameters],
                "bounds": [[p.low, p.high] for p in candidate.parameters]}
     X = morris_sample.sample(problem, MORRIS_TRAJECTORIES, num_levels=4, seed=seed)
-    Y = np.array([float(np.sum((measured[have] - candidate.air(case, air_node, x)[have]) ** 2)) for x in X])
+    Y = np.array([sum_of_squares(measured, candidate.air(case, air_node, x)) for x in X])
     analysis = morris_analyze.analyze(problem, X, Y, num_levels=4, seed=seed)
     return {name: {"mu_star": float(m), "sigma": float(s)}
             for name, m, s in zip(problem["names"], analysis["mu_star"], analysis["sigma"])}

@@ -70,7 +70,7 @@ def assess(task):
     building_data, effect, target, folder, calibration, case, air, seed = task
     candidate = Candidate(building_data, effect, target, folder)
     try:
-        parameters, _, determined = calibrate(candidate, calibration, air)
+        parameters, determined = calibrate(candidate, calibration, air)
         values = [parameters[p.name]["value"] for p in candidate.parameters]
         fitted = candidate.air(calibration, air, values)
         run = candidate.air(case, air, values)
