@@ -12,6 +12,7 @@ from model.case import prepare_case
 from model.errors import InputError
 from model.integrate import steps_per_day
 from model.measurements import read_measurements
+from model.score import metrics
 from model.weather import read_weather
 
 DATA = Path(__file__).parents[1] / "model" / "data"
@@ -89,9 +90,9 @@ def cmd_simulate(args):
     print(f"wrote {args.output}: nodes 1..{T.shape[1]} at {len(T)} times "
           f"({case.times[1].isoformat()} to {case.times[-1].isoformat()}, step {case.dt:g} s)")
     air = building.zones[0].air_node
-    residual = case.measured[1:, air - 1] - T[:, air - 1]
-    if np.isfinite(residual).any():
-        print(f"air node {air}: RMSE {np.sqrt(np.nanmean(residual ** 2)):.3f} C against the measurements")
+    measured_air = case.measured[1:, air - 1]
+    if np.isfinite(measured_air).any():
+        print(f"air node {air}: RMSE {metrics(measured_air, T[:, air - 1])['rmse']:.3f} C against the measurements")
 
 
 def check_search_settings(args):
@@ -103,6 +104,10 @@ def check_search_settings(args):
     for option, p in (("--pc", args.pc), ("--pm", args.pm)):
         if not 0.0 <= p <= 1.0:
             raise InputError(option, p, "a probability, between 0 and 1")
+    check_workers(args)
+
+
+def check_workers(args):
     if args.workers is not None and args.workers < 1:
         raise InputError("--workers", args.workers, "at least one worker process")
 
@@ -197,8 +202,7 @@ def run_diagnosis(data, building, case, out, source, args):
     from diagnose.report import before_after_table
     if not 0.0 < args.calibration_fraction < 1.0:
         raise InputError("--calibration-fraction", args.calibration_fraction, "a fraction between 0 and 1")
-    if args.workers is not None and args.workers < 1:
-        raise InputError("--workers", args.workers, "at least one worker process")
+    check_workers(args)
     out.mkdir(parents=True, exist_ok=True)
     report = diagnose(data, building, case, out, source=source, fraction=args.calibration_fraction,
                       seed=args.seed, workers=args.workers)
