@@ -39,15 +39,15 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from fmu_build.build import build_fmu
-from ga.fitness import FmuFitness
-from ga.locate import chromosome_nodes, locate, output_node
-from model.building import parse_building
-from model.case import prepare_case
-from model.integrate import initial_state, simulate, warmup_rows
-from model.network import assemble
-from model.synth import pseudo_measurements
-from model.weather import read_weather
+from nodeforce.fmu_build.build import build_fmu
+from nodeforce.ga.fitness import FmuFitness
+from nodeforce.ga.locate import chromosome_nodes, locate, output_node
+from nodeforce.model.building import parse_building
+from nodeforce.model.case import prepare_case
+from nodeforce.model.integrate import initial_state, simulate, warmup_rows
+from nodeforce.model.network import assemble
+from nodeforce.model.synth import pseudo_measurements
+from nodeforce.model.weather import read_weather
 
 DATA = Path(__file__).resolve().parents[1] / "model" / "data"
 DAYS, WARMUP_DAYS = 5, 2

@@ -5,7 +5,7 @@ driver's, and follow the same rules as `model.integrate.simulate`, so both give 
 """
 import numpy as np
 
-from model.integrate import warmup_rows
+from nodeforce.model.integrate import warmup_rows
 
 
 def node_names(prefix, ids):

@@ -13,11 +13,11 @@ from SALib.analyze import morris as morris_analyze
 from SALib.sample import morris as morris_sample
 from scipy.optimize import least_squares
 
-from cosim.fmi2 import FmuInstance
-from cosim.run import simulate_fmu
-from fmu_build.build import build_fmu
-from model import effects
-from model.score import sum_of_squares
+from nodeforce.cosim.fmi2 import FmuInstance
+from nodeforce.cosim.run import simulate_fmu
+from nodeforce.fmu_build.build import build_fmu
+from nodeforce.model import effects
+from nodeforce.model.score import sum_of_squares
 
 log = logging.getLogger("nodeforce.diagnose")
 

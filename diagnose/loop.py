@@ -32,18 +32,18 @@ from contextlib import nullcontext
 import numpy as np
 from tqdm import tqdm
 
-from cosim.fmi2 import FmuInstance
-from cosim.run import simulate_fmu
-from diagnose.calibrate import Candidate, calibrate, sensitivity
-from diagnose.report import write_report
-from fmu_build.build import build_fmu
-from ga.locate import locate, output_node
-from ga.parsimony import tolerance
-from model import effects
-from model.building import parse_building
-from model.errors import InputError
-from model.integrate import steps_per_day
-from model.score import metrics, noise_level
+from nodeforce.cosim.fmi2 import FmuInstance
+from nodeforce.cosim.run import simulate_fmu
+from nodeforce.diagnose.calibrate import Candidate, calibrate, sensitivity
+from nodeforce.diagnose.report import write_report
+from nodeforce.fmu_build.build import build_fmu
+from nodeforce.ga.locate import locate, output_node
+from nodeforce.ga.parsimony import tolerance
+from nodeforce.model import effects
+from nodeforce.model.building import parse_building
+from nodeforce.model.errors import InputError
+from nodeforce.model.integrate import steps_per_day
+from nodeforce.model.score import metrics, noise_level
 
 BURN_IN_DAYS = 1
 

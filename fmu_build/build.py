@@ -15,9 +15,9 @@ from pathlib import Path
 from pythonfmu.builder import FmuBuilder
 from pythonfmu.osutil import get_platform
 
-import model
-from model import effects
-from model.building import parse_building
+from nodeforce import model
+from nodeforce.model import effects
+from nodeforce.model.building import parse_building
 
 SLAVE = Path(__file__).with_name("slave.py")
 MODEL_DIR = Path(model.__file__).parent

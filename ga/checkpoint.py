@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ga.evaluation import Mask, factory_token
+from nodeforce.ga.evaluation import Mask, factory_token
 
 log = logging.getLogger("nodeforce.ga")
 

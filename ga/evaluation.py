@@ -27,7 +27,7 @@ import threading
 from concurrent.futures import ProcessPoolExecutor
 from typing import Iterable, Sequence
 
-from model.errors import InputError
+from nodeforce.model.errors import InputError
 
 log = logging.getLogger("nodeforce.ga")
 

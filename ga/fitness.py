@@ -8,9 +8,9 @@ import zipfile
 
 import numpy as np
 
-from cosim.fmi2 import FmuInstance
-from cosim.run import simulate_fmu
-from model.score import sum_of_squares
+from nodeforce.cosim.fmi2 import FmuInstance
+from nodeforce.cosim.run import simulate_fmu
+from nodeforce.model.score import sum_of_squares
 
 
 class FmuFitness:

@@ -7,12 +7,12 @@ measurement noise estimated from the measured air.
 import numpy as np
 from scipy.sparse.csgraph import shortest_path
 
-from fmu_build.build import build_fmu
-from ga.fitness import FmuFitness
-from ga.search import search
-from model.errors import InputError
-from model.network import assemble
-from model.score import noise_level
+from nodeforce.fmu_build.build import build_fmu
+from nodeforce.ga.fitness import FmuFitness
+from nodeforce.ga.search import search
+from nodeforce.model.errors import InputError
+from nodeforce.model.network import assemble
+from nodeforce.model.score import noise_level
 
 
 def output_node(building, case, source):

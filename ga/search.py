@@ -24,10 +24,10 @@ from itertools import product
 import pygad
 from tqdm import tqdm
 
-from ga import checkpoint as ckpt
-from ga.evaluation import FitnessCache, log, open_backend
-from ga.operators import bit_flip_mutation, one_point_crossover, roulette_selection
-from ga.parsimony import explains, smallest_subset, tolerance
+from nodeforce.ga import checkpoint as ckpt
+from nodeforce.ga.evaluation import FitnessCache, log, open_backend
+from nodeforce.ga.operators import bit_flip_mutation, one_point_crossover, roulette_selection
+from nodeforce.ga.parsimony import explains, smallest_subset, tolerance
 
 
 def search(factory, chromosome_nodes, *, population=30, generations=400, pc=0.8, pm=0.03,

@@ -113,7 +113,7 @@ def _check_schema(data, source):
     # imported here: the FMU runs this module without jsonschema
     import jsonschema
     from importlib.resources import files
-    schema = json.loads(files("model").joinpath("data/nodal-building.schema.json").read_text())
+    schema = json.loads(files(__package__).joinpath("data/nodal-building.schema.json").read_text())
     error = jsonschema.exceptions.best_match(jsonschema.Draft202012Validator(schema).iter_errors(data))
     if error is not None:
         where = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in error.absolute_path).lstrip(".")

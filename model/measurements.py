@@ -6,8 +6,8 @@ filled; the model handles a missing measurement where it uses one (PHYSICS.md se
 
 import re
 
-from model.errors import InputError
-from model.weather import check_celsius, read_time_table
+from nodeforce.model.errors import InputError
+from nodeforce.model.weather import check_celsius, read_time_table
 
 _NODE_COLUMN = re.compile(r"T([1-9][0-9]*)")
 

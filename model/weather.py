@@ -2,7 +2,7 @@
 
 The bundled Miami files are reproduced, from the repository root, with
 
-    python -m model.weather convert \\
+    python -m nodeforce.model.weather convert \\
         /work/venv/lib/python3.11/site-packages/pvlib/data/12839.tm2 model/data/miami_tmy2.csv \\
         --building model/data/testcell.json --building-out model/data/testcell_miami.json
 
@@ -33,7 +33,7 @@ import numpy as np
 import pandas as pd
 import pvlib
 
-from model.errors import InputError
+from nodeforce.model.errors import InputError
 
 REQUIRED_COLUMNS = ("T_out", "ghi", "dni", "dhi")
 OPTIONAL_COLUMNS = ("T_sky", "ir_h")
@@ -306,8 +306,8 @@ def relocate(building, metadata):
 
 
 def main(argv=None):
-    """`python -m model.weather convert SRC DST [--year Y] [--building B --building-out B2]`."""
-    parser = argparse.ArgumentParser(prog="python -m model.weather")
+    """`python -m nodeforce.model.weather convert SRC DST [--year Y] [--building B --building-out B2]`."""
+    parser = argparse.ArgumentParser(prog="python -m nodeforce.model.weather")
     commands = parser.add_subparsers(dest="command", required=True)
     convert = commands.add_parser("convert", help="typical year (TMY2/TMY3/EPW) to weather CSV")
     convert.add_argument("src")
@@ -443,7 +443,7 @@ def _read_epw_weather(source):
         raise InputError(
             source, "time",
             "the EPW mixes years (a typical year): convert it to one year with "
-            f"'python -m model.weather convert {source} OUT.csv --year YYYY'",
+            f"'python -m nodeforce.model.weather convert {source} OUT.csv --year YYYY'",
         )
     weather = _to_mid_hour(end_of_hour, columns, cyclic=False)
     weather.attrs["source"] = source

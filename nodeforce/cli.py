@@ -3,19 +3,20 @@ import argparse
 import json
 import sys
 import tempfile
+from importlib.resources import files
 from pathlib import Path
 
 import numpy as np
 
-from model.building import parse_building, read_building_data
-from model.case import prepare_case
-from model.errors import InputError
-from model.integrate import steps_per_day
-from model.measurements import read_measurements
-from model.score import metrics
-from model.weather import read_weather
+from nodeforce.model.building import parse_building, read_building_data
+from nodeforce.model.case import prepare_case
+from nodeforce.model.errors import InputError
+from nodeforce.model.integrate import steps_per_day
+from nodeforce.model.measurements import read_measurements
+from nodeforce.model.score import metrics
+from nodeforce.model.weather import read_weather
 
-DATA = Path(__file__).parents[1] / "model" / "data"
+DATA = Path(str(files("nodeforce.model") / "data"))
 
 
 class Parser(argparse.ArgumentParser):
@@ -69,16 +70,16 @@ def force_mask(case, ids, source):
 
 
 def cmd_fmu(args):
-    from fmu_build.build import build_fmu
+    from nodeforce.fmu_build.build import build_fmu
     path = build_fmu(read_building_data(args.building), args.output, source=args.building)
     print(f"wrote {path}")
 
 
 def cmd_simulate(args):
-    from cosim.fmi2 import FmuInstance
-    from cosim.run import simulate_fmu
-    from fmu_build.build import build_fmu
-    from model.report import write_node_temperatures
+    from nodeforce.cosim.fmi2 import FmuInstance
+    from nodeforce.cosim.run import simulate_fmu
+    from nodeforce.fmu_build.build import build_fmu
+    from nodeforce.model.report import write_node_temperatures
     if args.force and not args.measurements:
         raise InputError("--force", args.force, "forcing needs --measurements to force nodes to")
     data, building, case = load_inputs(args)
@@ -113,7 +114,7 @@ def check_workers(args):
 
 
 def cmd_locate(args):
-    from ga.locate import locate
+    from nodeforce.ga.locate import locate
     check_search_settings(args)
     data, building, case = load_inputs(args)
     if args.burn_in_days:
@@ -147,7 +148,7 @@ def locate_summary(result):
 
 def effect_spec(text):
     """("ground_coupling", "floor", {"U": 0.8, "T_ground": 24.0}) from "ground_coupling@floor:U=0.8,T_ground=24"."""
-    from model.effects import EFFECTS
+    from nodeforce.model.effects import EFFECTS
     try:
         head, _, assignments = text.partition(":")
         effect, target = head.split("@")
@@ -165,8 +166,8 @@ def effect_spec(text):
 
 def cmd_synth(args):
     import pandas as pd
-    from model import effects
-    from model.synth import pseudo_measurements
+    from nodeforce.model import effects
+    from nodeforce.model.synth import pseudo_measurements
     data = read_building_data(args.building)
     if args.effect:
         effect, target, values = effect_spec(args.effect)
@@ -198,8 +199,8 @@ def cmd_synth(args):
 
 
 def run_diagnosis(data, building, case, out, source, args):
-    from diagnose.loop import diagnose
-    from diagnose.report import before_after_table
+    from nodeforce.diagnose.loop import diagnose
+    from nodeforce.diagnose.report import before_after_table
     if not 0.0 < args.calibration_fraction < 1.0:
         raise InputError("--calibration-fraction", args.calibration_fraction, "a fraction between 0 and 1")
     check_workers(args)

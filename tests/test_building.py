@@ -5,8 +5,8 @@ from pathlib import Path
 
 import pytest
 
-from model.building import load_building, parse_building
-from model.errors import InputError
+from nodeforce.model.building import load_building, parse_building
+from nodeforce.model.errors import InputError
 
 TESTCELL = json.loads((Path(__file__).parents[1] / "model" / "data" / "testcell.json").read_text())
 

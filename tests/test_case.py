@@ -3,8 +3,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from model.case import prepare_case, simulate_building
-from model.errors import InputError
+from nodeforce.model.case import prepare_case, simulate_building
+from nodeforce.model.errors import InputError
 
 
 def measurements(times, values=None):

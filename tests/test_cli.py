@@ -7,12 +7,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from model.building import parse_building
-from model.case import prepare_case
-from model.integrate import simulate
-from model.measurements import read_measurements
-from model.network import assemble
-from model.synth import pseudo_measurements
+from nodeforce.model.building import parse_building
+from nodeforce.model.case import prepare_case
+from nodeforce.model.integrate import simulate
+from nodeforce.model.measurements import read_measurements
+from nodeforce.model.network import assemble
+from nodeforce.model.synth import pseudo_measurements
 from nodeforce.cli import main
 from tests.conftest import DATA, SENSORS, record_times
 

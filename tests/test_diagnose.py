@@ -7,12 +7,12 @@ import pandas as pd
 import pytest
 from fmpy.validation import validate_fmu
 
-from diagnose.loop import diagnose
-from model import effects
-from model.building import load_building, parse_building
-from model.case import prepare_case
-from model.errors import InputError
-from model.synth import pseudo_measurements
+from nodeforce.diagnose.loop import diagnose
+from nodeforce.model import effects
+from nodeforce.model.building import load_building, parse_building
+from nodeforce.model.case import prepare_case
+from nodeforce.model.errors import InputError
+from nodeforce.model.synth import pseudo_measurements
 from tests.conftest import SENSORS
 
 NOISE = 0.1

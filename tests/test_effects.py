@@ -4,13 +4,13 @@ import copy
 import numpy as np
 import pytest
 
-from cosim.fmi2 import FmuInstance
-from cosim.run import simulate_fmu
-from fmu_build.build import build_fmu
-from model import effects
-from model.building import parse_building
-from model.integrate import simulate
-from model.network import assemble
+from nodeforce.cosim.fmi2 import FmuInstance
+from nodeforce.cosim.run import simulate_fmu
+from nodeforce.fmu_build.build import build_fmu
+from nodeforce.model import effects
+from nodeforce.model.building import parse_building
+from nodeforce.model.integrate import simulate
+from nodeforce.model.network import assemble
 
 
 def direct(data, case):

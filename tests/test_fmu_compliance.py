@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from fmu_build.build import build_fmu
+from nodeforce.fmu_build.build import build_fmu
 from tests.importers import fmpy_validate, fmutool_check, run_ecos, run_fmpy, run_libcosim
 
 N_STEPS = 96

@@ -5,10 +5,10 @@ import json
 
 import pytest
 
-from ga.locate import chromosome_nodes, locate
-from model.building import parse_building
-from model.case import prepare_case
-from model.synth import pseudo_measurements
+from nodeforce.ga.locate import chromosome_nodes, locate
+from nodeforce.model.building import parse_building
+from nodeforce.model.case import prepare_case
+from nodeforce.model.synth import pseudo_measurements
 from nodeforce.cli import main
 from tests.conftest import SENSORS, record_times
 

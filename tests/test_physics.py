@@ -7,10 +7,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from model.building import parse_building
-from model.discretise import capacities, conductances
-from model.integrate import simulate
-from model.network import assemble
+from nodeforce.model.building import parse_building
+from nodeforce.model.discretise import capacities, conductances
+from nodeforce.model.integrate import simulate
+from nodeforce.model.network import assemble
 
 TESTCELL = json.loads((Path(__file__).parents[1] / "model" / "data" / "testcell.json").read_text())
 

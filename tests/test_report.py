@@ -5,7 +5,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from diagnose.report import before_after_table, write_report
+from nodeforce.diagnose.report import before_after_table, write_report
 
 PNG = b"\x89PNG\r\n\x1a\n"
 NODES = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 16, 17]

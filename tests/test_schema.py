@@ -8,9 +8,9 @@ from pathlib import Path
 import jsonschema
 import pytest
 
-from model import effects
-from model.building import parse_building
-from model.errors import InputError
+from nodeforce.model import effects
+from nodeforce.model.building import parse_building
+from nodeforce.model.errors import InputError
 
 DATA = Path(__file__).parents[1] / "model" / "data"
 SCHEMA = json.loads((DATA / "nodal-building.schema.json").read_text())

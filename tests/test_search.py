@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ga import parsimony
-from ga.search import search
+from nodeforce.ga import parsimony
+from nodeforce.ga.search import search
 
 NODES12 = [1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 22]  # ids are not positions
 

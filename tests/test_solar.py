@@ -5,7 +5,7 @@ import pandas as pd
 import pvlib
 import pytest
 
-from model.solar import incident_irradiance, sky_temperature, solar_position
+from nodeforce.model.solar import incident_irradiance, sky_temperature, solar_position
 
 SIGMA = 5.670374419e-8
 

@@ -8,9 +8,9 @@ import pandas as pd
 import pvlib
 import pytest
 
-from model.errors import InputError
-from model.solar import solar_position
-from model.weather import (
+from nodeforce.model.errors import InputError
+from nodeforce.model.solar import solar_position
+from nodeforce.model.weather import (
     convert_typical_year,
     main,
     read_weather,
