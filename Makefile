@@ -3,7 +3,7 @@ PYTHON ?= python3
 VENV ?= .venv
 BIN := $(VENV)/bin
 
-.PHONY: demo test venv system-deps benchmark clean
+.PHONY: demo test check venv system-deps benchmark clean
 
 $(BIN)/nodeforce: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -22,6 +22,10 @@ demo: venv
 
 test: venv system-deps
 	$(BIN)/python -m pytest -q
+
+# The edit-test loop: everything but the searches, diagnoses and importer runs (under a minute).
+check: venv
+	$(BIN)/python -m pytest -q -m "not slow"
 
 benchmark: venv
 	$(BIN)/python benchmarks/bench_search.py

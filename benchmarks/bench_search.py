@@ -41,11 +41,12 @@ import pandas as pd
 
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.fitness import FmuFitness
-from nodeforce.ga.locate import chromosome_nodes, locate, output_node
+from nodeforce.ga.locate import chromosome_nodes, locate
 from nodeforce.model.building import parse_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.integrate import initial_state, simulate, warmup_rows
 from nodeforce.model.network import assemble
+from nodeforce.model.score import Objective
 from nodeforce.model.synth import pseudo_measurements
 from nodeforce.model.weather import read_weather
 
@@ -103,7 +104,7 @@ def bare_loop_setup(building, case, force):
     M[forced, forced] = 1.0
     Minv = np.linalg.inv(M)
     rows = warmup_rows(len(case.times), case.dt, WARMUP_DAYS)
-    source = (case.U @ network.B.T + network.q)[rows]
+    source = network.sources(case.U)[rows]
     T_forced = case.measured[rows][:, forced]
     if not np.isfinite(T_forced).all():
         raise SystemExit("the bare loop expects every forced node measured at every step")
@@ -137,8 +138,9 @@ def main(argv=None):
     print("preparing the case (pseudo-measurements, one year of spin-up) ...", flush=True)
 
     data, building, case = the_case()
-    air = output_node(building, case, "pseudo-measurements")
-    nodes = chromosome_nodes(building, case, "pseudo-measurements")
+    objective = Objective.of(building)
+    air = objective.air_nodes[0]
+    nodes = chromosome_nodes(building, case, objective, "pseudo-measurements")
     n_rows = len(case.times)
     steps = len(warmup_rows(n_rows, case.dt, WARMUP_DAYS))
     # A fixed forcing mask, like a chromosome of the GA's random first population: every other
@@ -159,8 +161,8 @@ def main(argv=None):
 
         # 2. one FMU evaluation through the driver, evaluator built once
         (tmp / "fmu").mkdir()
-        fmu = build_fmu(data, tmp / "fmu" / "model.fmu", source=building.source)
-        evaluator = FmuFitness(fmu, case, nodes, air, WARMUP_DAYS)()
+        fmu = build_fmu(building, tmp / "fmu" / "model.fmu")
+        evaluator = FmuFitness(fmu, case, nodes, objective, WARMUP_DAYS)()
         J_fmu = evaluator.J(mask)
         t_fmu = median_time(lambda: evaluator.J(mask), args.repeats)
         J_direct = float(np.sum((T_direct[:, air - 1] - case.measured[1:, air - 1]) ** 2))
@@ -175,7 +177,7 @@ def main(argv=None):
         print(f"running the GA ({population} x {generations}, {workers} workers) ...", flush=True)
         (tmp / "locate").mkdir()
         t0 = time.perf_counter()
-        result = locate(data, building, case, tmp / "locate", population=population, generations=generations,
+        result = locate(building, case, objective, tmp / "locate", population=population, generations=generations,
                         pc=0.8, pm=0.03, seed=0, workers=workers)
         t_ga = time.perf_counter() - t0
 

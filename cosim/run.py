@@ -5,7 +5,7 @@ driver's, and follow the same rules as `model.integrate.simulate`, so both give 
 """
 import numpy as np
 
-from nodeforce.model.integrate import warmup_rows
+from nodeforce.model.integrate import forcing_schedule, warmup_rows
 
 
 def node_names(prefix, ids):
@@ -20,7 +20,8 @@ def simulate_fmu(instance, case, force=None, warmup_days=2, output_ids=None, T_d
     ----------
     instance : cosim.fmi2.FmuInstance
     case : model.case.Case (inputs and measurements on the simulation grid)
-    force : (N,) bool, nodes forced to their measurements; None: no forcing
+    force : (N,) bool, nodes forced to their measurements; None: no forcing (the case's burn-in
+        forces every measured node over its first steps all the same)
     warmup_days : passes over the first day before the run
     output_ids : node ids to return (default: all)
     T_default : C, the initial temperature of a node nothing informs (the FMU's T_start)
@@ -32,14 +33,20 @@ def simulate_fmu(instance, case, force=None, warmup_days=2, output_ids=None, T_d
     """
     measured = case.measured
     n_rows, n = measured.shape
-    forced_ids = [] if force is None else [i + 1 for i in np.flatnonzero(force)]
+    # The FMU forces node i where force[i] is set and T_forced[i] is a number: the schedule's
+    # nodes get force[i], and T_forced[i] is NaN at the steps the schedule leaves them computed.
+    schedule = forcing_schedule(np.zeros(n, dtype=bool) if force is None else force, measured,
+                                case.burn_in_steps)
+    forced_ids = [i + 1 for i in np.flatnonzero(schedule[1:].any(axis=0))]
     output_ids = list(range(1, n + 1)) if output_ids is None else list(output_ids)
     parameters = {"T_start": T_default, **{name: True for name in node_names("force", forced_ids)},
                   **(parameters or {})}
     measured0 = np.flatnonzero(np.isfinite(measured[0]))
     start_inputs = {f"T_forced[{i + 1}]": measured[0, i] for i in measured0}
     rows = warmup_rows(n_rows, case.dt, warmup_days)
-    inputs = np.hstack([case.U[rows], measured[rows][:, np.array(forced_ids, dtype=int) - 1]])
+    columns = np.array(forced_ids, dtype=int) - 1
+    imposed = np.where(schedule[:, columns], measured[:, columns], np.nan)
+    inputs = np.hstack([case.U[rows], imposed[rows]])
     return instance.run(case.dt, parameters, start_inputs,
                         list(case.input_names) + node_names("T_forced", forced_ids),
                         inputs, node_names("T", output_ids), skip=len(rows) - (n_rows - 1))

@@ -16,8 +16,8 @@ from scipy.optimize import least_squares
 from nodeforce.cosim.fmi2 import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.fmu_build.build import build_fmu
-from nodeforce.model import effects
-from nodeforce.model.score import sum_of_squares
+from nodeforce.diagnose.candidates import calibration_start
+from nodeforce.model.effects import EFFECTS
 
 log = logging.getLogger("nodeforce.diagnose")
 
@@ -31,51 +31,43 @@ MORRIS_TRAJECTORIES = 4
 class Candidate:
     """The model with one added effect: its own FMU, one instance reused for every run."""
 
-    def __init__(self, data, effect, target, workdir):
-        self.data, self.effect, self.target = data, effect, target
-        self.parameters = effects.EFFECTS[effect]
-        fmu = build_fmu(data, workdir / f"{effect}@{target}.fmu", effect=(effect, target))
-        self.instance = FmuInstance(fmu)
+    def __init__(self, building, effect, target, workdir):
+        self.building, self.effect, self.target = building, effect, target
+        self.parameters = EFFECTS[effect].parameters
+        self.instance = FmuInstance(build_fmu(building, workdir / f"{self.label}.fmu", effect=(effect, target)))
 
     @property
     def label(self):
         return f"{self.effect}@{self.target}"
 
-    def node(self, case, node_id, values):
-        """Simulated temperature (C) of a node at t_1..t_N with the effect at `values` (sequence)."""
+    def nodes(self, case, node_ids, values):
+        """Simulated temperatures (C) of nodes at t_1..t_N, (N_t, len(node_ids)), with the effect
+        at `values` (sequence)."""
         parameters = {f"{self.effect}.{p.name}": float(v) for p, v in zip(self.parameters, values)}
-        return simulate_fmu(self.instance, case, output_ids=[node_id], parameters=parameters)[:, 0]
-
-    def air(self, case, air_node, values):
-        """Simulated air temperature (C) at t_1..t_N with the effect at `values` (sequence)."""
-        return self.node(case, air_node, values)
-
-    def data_component_face(self):
-        """Id of the target component's outside-face node (the deepest)."""
-        component = next(c for c in self.data["components"] if c["name"] == self.target)
-        return component["nodes"][-1]["id"]
+        return simulate_fmu(self.instance, case, output_ids=node_ids, parameters=parameters)
 
     def close(self):
         self.instance.close()
 
 
-def calibrate(candidate, case, air_node):
-    """Least-squares values of the candidate's parameters on `case` (the calibration window).
+def calibrate(candidate, case, objective):
+    """Least-squares values of the candidate's parameters on `case` (the calibration window), on
+    the residuals of every objective zone.
 
     Returns
     -------
     dict {name: {"value", "std", "identifiable"}}, and the quantities the data determine even
     where the parameters are not (see `derived`)
     """
-    measured = case.measured[1:, air_node - 1]
+    measured = objective.measured(case)
     have = np.isfinite(measured)
     lows = np.array([p.low for p in candidate.parameters])
     highs = np.array([p.high for p in candidate.parameters])
-    start = effects.calibration_start(candidate.data, candidate.effect, candidate.target)
+    start = calibration_start(candidate.building, candidate.effect, candidate.target)
     x0 = np.clip([start[p.name] for p in candidate.parameters], lows, highs)
 
     def residuals(x):
-        return measured[have] - candidate.air(case, air_node, x)[have]
+        return measured[have] - candidate.nodes(case, objective.air_nodes, x)[have]
 
     fit = least_squares(residuals, x0, bounds=(lows, highs), x_scale="jac", method="trf")
     n, k = int(have.sum()), len(x0)
@@ -104,24 +96,24 @@ def derived(candidate, case, x, cov):
     if candidate.effect != "ground_coupling":
         return {}
     U, T_ground = x
-    face = candidate.data_component_face()
-    T_face = float(np.mean(candidate.node(case, face, x)))
+    face = candidate.building.component(candidate.target).node_ids[-1]
+    T_face = float(np.mean(candidate.nodes(case, [face], x)))
     gradient = np.array([T_ground - T_face, U])
     return {"ground_heat_flux": {"value": float(U * (T_ground - T_face)),
                                  "std": float(np.sqrt(max(gradient @ cov @ gradient, 0.0))), "unit": "W/m2"}}
 
 
-def sensitivity(candidate, case, air_node, seed=0):
+def sensitivity(candidate, case, objective, seed=0):
     """Morris elementary effects of the parameters, over their bounds, on J of `case`.
 
     Returns {name: {"mu_star": C2, "sigma": C2}}: mu* ranks how much J moves with a parameter,
     sigma how much that depends on the others (interaction or non-linearity).
     """
-    measured = case.measured[1:, air_node - 1]
+    measured = objective.measured(case)
     problem = {"num_vars": len(candidate.parameters), "names": [p.name for p in candidate.parameters],
                "bounds": [[p.low, p.high] for p in candidate.parameters]}
     X = morris_sample.sample(problem, MORRIS_TRAJECTORIES, num_levels=4, seed=seed)
-    Y = np.array([sum_of_squares(measured, candidate.air(case, air_node, x)) for x in X])
+    Y = np.array([objective.J(measured, candidate.nodes(case, objective.air_nodes, x)) for x in X])
     analysis = morris_analyze.analyze(problem, X, Y, num_levels=4, seed=seed)
     return {name: {"mu_star": float(m), "sigma": float(s)}
             for name, m, s in zip(problem["names"], analysis["mu_star"], analysis["sigma"])}

@@ -2,24 +2,23 @@
 on data the calibration did not see.
 
 1. The record is split by time into a calibration window and a later validation window. The
-   calibration window's first `BURN_IN_DAYS` are simulated but not scored: the warm-up of
-   PHYSICS.md section 5 replays the first day, so the fast nodes start from that day's end
-   rather than from the real day before, and a correct model misses the first day by tenths of
-   a degree (0.74 C on average on the bundled data); scored, that transient is "explained" by
-   forcing any large surface and hides the real fault.
-2. Before: the building as described, simulated through its FMU; metrics on both windows (the
-   calibration window is simulated on its own, as the calibration sees it; the validation window
-   is the tail of a run over the whole record, so it starts from the state the past left).
+   record's first days are a burn-in (PHYSICS.md section 5: every measured node forced, not
+   scored), so the walls start from what the sensors saw rather than from the warm-up's replay
+   of the first day, which a record with real history does not match.
+2. Before: the building as described, simulated through its FMU; metrics on both windows, per
+   objective zone and together (the calibration window is simulated on its own, as the
+   calibration sees it; the validation window is the tail of a run over the whole record, so it
+   starts from the state the past left).
 3. The forcing search (`ga.locate`) on the calibration window localises nodes.
-4. Candidates: the effects of the localised nodes' components, and of the air node's own
-   equation (`model.effects.candidates`), each its own FMU with the effect's parameters, and,
-   once calibrated, its own building file (`candidates/<effect>@<target>.json/.fmu`).
+4. Candidates (`diagnose.candidates`): the effects the localised nodes point at, and those of the
+   objective zones' air equations, each its own FMU with the effect's parameters, and, once
+   calibrated, its own building file (`candidates/<effect>@<target>.json/.fmu`).
 5. Each is calibrated on the calibration window (`diagnose.calibrate`), the candidates in
    parallel worker processes.
 6. The chosen effect has the best validation error among those that beat the model without
    them on BIC (calibration window) and lower the validation J by more than noise could
    (`ga.parsimony.tolerance`); "none" if no candidate does. The calibration window alone never
-   decides.
+   decides. The decision, its margins and its reason go into report.json, which the report reads.
 """
 import json
 import math
@@ -35,50 +34,60 @@ from tqdm import tqdm
 from nodeforce.cosim.fmi2 import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnose.calibrate import Candidate, calibrate, sensitivity
+from nodeforce.diagnose.candidates import candidates
 from nodeforce.diagnose.report import write_report
 from nodeforce.fmu_build.build import build_fmu
-from nodeforce.ga.locate import locate, output_node
+from nodeforce.ga.locate import air_noise, check_measured, locate
 from nodeforce.ga.parsimony import tolerance
-from nodeforce.model import effects
-from nodeforce.model.building import parse_building
+from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
-from nodeforce.model.score import metrics, noise_level
-
-BURN_IN_DAYS = 1
 
 
-def split(case, fraction, source):
-    """Row index k of the last calibration time: t_0..t_k calibrate, t_k+1..t_N validate."""
+def split(case, source, fraction=None, end=None):
+    """Row index k of the last calibration time: t_0..t_k calibrate, t_k+1..t_N validate.
+
+    Parameters
+    ----------
+    case : Case (its burn-in must fit in the calibration window, with a day to score)
+    source : the measurement file, for errors
+    fraction : the part of the record, by time, that calibrates
+    end : pandas Timestamp, the last calibration time (the row at or before it)
+    """
     n = len(case.times) - 1
-    k = int(round(fraction * n))
+    if end is not None:
+        k = int(case.times.searchsorted(end, side="right")) - 1
+        what = f"a calibration ending {end.isoformat()}"
+    else:
+        k = int(round(fraction * n))
+        what = f"a split {fraction:.0%} / {1 - fraction:.0%}"
     day = steps_per_day(case.dt)
-    if k < (BURN_IN_DAYS + 1) * day or n - k < day:
-        raise InputError(source, "time", f"{n} steps of {case.dt:g} s are too short to split {fraction:.0%} / "
-                                          f"{1 - fraction:.0%} into a calibration window of {BURN_IN_DAYS + 1} days "
-                                          f"and a validation window of a day at least")
+    if k < case.burn_in_steps + day or n - k < day:
+        raise InputError(source, "time", f"{n} steps of {case.dt:g} s from {case.times[0].isoformat()}: {what} "
+                                         f"leaves no calibration window of the burn-in plus a day, or no "
+                                         f"validation window of a day")
     return k
 
 
 def assess(task):
     """Calibrate one candidate effect and run it: a task for a worker process.
 
-    Returns the calibrated parameters, what the data determine, the simulated air on the
-    calibration window and over the whole record, and the Morris screening; writes the
+    Returns the calibrated parameters, what the data determine, the simulated objective air on
+    the calibration window and over the whole record, and the Morris screening; writes the
     candidate's FMU and its building file, declared at the calibrated values, in `folder`.
     """
-    building_data, effect, target, folder, calibration, case, air, seed = task
-    candidate = Candidate(building_data, effect, target, folder)
+    building, effect, target, folder, calibration, case, objective, seed = task
+    candidate = Candidate(building, effect, target, folder)
     try:
-        parameters, determined = calibrate(candidate, calibration, air)
+        parameters, determined = calibrate(candidate, calibration, objective)
         values = [parameters[p.name]["value"] for p in candidate.parameters]
-        fitted = candidate.air(calibration, air, values)
-        run = candidate.air(case, air, values)
-        screening = sensitivity(candidate, calibration, air, seed=seed)
+        fitted = candidate.nodes(calibration, objective.air_nodes, values)
+        run = candidate.nodes(case, objective.air_nodes, values)
+        screening = sensitivity(candidate, calibration, objective, seed=seed)
     finally:
         candidate.close()
-    calibrated = effects.apply(building_data, effect, target, {name: p["value"] for name, p in parameters.items()})
-    (folder / f"{candidate.label}.json").write_text(json.dumps(calibrated, indent=2) + "\n")
+    calibrated = EFFECTS[effect].apply(building, target, {name: p["value"] for name, p in parameters.items()})
+    (folder / f"{candidate.label}.json").write_text(json.dumps(calibrated.to_json(), indent=2) + "\n")
     return parameters, determined, fitted, run, screening
 
 
@@ -87,30 +96,60 @@ def bic(J, n, k):
     return n * math.log(J / n) + k * math.log(n)
 
 
-def diagnose(building_data, building, case, workdir, *, source="measurements", fraction=0.6, seed=0,
-             workers=None, population=30, generations=400):
-    """Run the whole loop; write the artifacts in `workdir`; return the report.json content."""
-    air = output_node(building, case, source)
-    k = split(case, fraction, source)
-    calibration = case.window(0, k).unscored_start(air, BURN_IN_DAYS)
-    measured = case.measured[1:, air - 1]
-    scored = calibration.measured[1:, air - 1]
-    sigma = noise_level(case.measured[:, air - 1])
+def decide(results, before, sigma):
+    """The decision record: the chosen candidate (or None), each candidate's two tests, the
+    margins they were judged by, and the reason in one sentence."""
+    bic_before = bic(before["calibration"]["J"], before["calibration"]["n"], 0)
+    J_before = before["validation"]["J"]
+    margin = tolerance(J_before, sigma, before["validation"]["n"])
+    tests = {f"{r['effect']}@{r['target']}": {"beats_bic": r["bic"] < bic_before,
+                                              "beats_validation": r["validation"]["J"] < J_before - margin}
+             for r in results}
+    better = [r for r in results if all(tests[f"{r['effect']}@{r['target']}"].values())]
+    chosen = min(better, key=lambda r: r["validation"]["rmse"]) if better else None
+    rmse_before = before["validation"]["rmse"]
+    if chosen:
+        reason = (f"{chosen['effect']} on {chosen['target']} has the lowest validation RMSE "
+                  f"({chosen['validation']['rmse']:.3f} C, {rmse_before:.3f} C before) of the {len(better)} of "
+                  f"{len(results)} candidates that beat the model without them on BIC ({bic_before:.1f}) and lower "
+                  f"the validation J ({J_before:.3g} C2) by more than the noise margin ({margin:.3g} C2).")
+    elif not results:
+        reason = "No candidate effect was tried, so the model is left as it is."
+    else:
+        n_bic = sum(t["beats_bic"] for t in tests.values())
+        n_val = sum(t["beats_validation"] for t in tests.values())
+        reason = (f"None of the {len(results)} candidates both beats the model without them on BIC "
+                  f"({n_bic} do) and lowers the validation J by more than the noise margin of {margin:.3g} C2 "
+                  f"({n_val} do): no effect is added.")
+    return chosen, {"chosen": f"{chosen['effect']}@{chosen['target']}" if chosen else None, "reason": reason,
+                    "bic_baseline": bic_before, "validation_J_before": J_before, "validation_margin": margin,
+                    "candidates": tests}
 
-    with FmuInstance(build_fmu(building_data, workdir / "model_before.fmu", source=building.source)) as base:
-        before_run = simulate_fmu(base, case, output_ids=[air])[:, 0]
-        before_calibration = simulate_fmu(base, calibration, output_ids=[air])[:, 0]
-    before = {"calibration": metrics(scored, before_calibration),
-              "validation": metrics(measured[k:], before_run[k:])}
+
+def diagnose(building, case, objective, workdir, *, source="measurements", fraction=0.6, calibration_end=None,
+             seed=0, workers=None, population=30, generations=400):
+    """Run the whole loop; write the artifacts in `workdir`; return the report.json content."""
+    check_measured(objective, case, source)
+    k = split(case, source, fraction, calibration_end)
+    calibration = case.window(0, k)
+    measured = objective.measured(case)
+    scored = objective.measured(calibration)
+    sigma = air_noise(case, objective)
+
+    with FmuInstance(build_fmu(building, workdir / "model_before.fmu")) as base:
+        before_run = simulate_fmu(base, case, output_ids=objective.air_nodes)
+        before_calibration = simulate_fmu(base, calibration, output_ids=objective.air_nodes)
+    before = {"calibration": objective.metrics(scored, before_calibration),
+              "validation": objective.metrics(measured[k:], before_run[k:])}
 
     convergence = []
-    localization = locate(building_data, building, calibration, workdir, source=source, seed=seed,
+    localization = locate(building, calibration, objective, workdir, source=source, seed=seed,
                           workers=workers, population=population, generations=generations,
                           progress=lambda generation, total, J, unique: convergence.append((generation, J)))
 
-    pairs = effects.candidates(building_data, localization["best_nodes"])
+    pairs = candidates(building, localization["best_nodes"], objective.zones)
     (workdir / "candidates").mkdir(exist_ok=True)
-    tasks = [(building_data, effect, target, workdir / "candidates", calibration, case, air, seed)
+    tasks = [(building, effect, target, workdir / "candidates", calibration, case, objective, seed)
              for effect, target in pairs]
     n_workers = min(workers or os.cpu_count(), len(tasks))
     with (ProcessPoolExecutor(n_workers, mp_context=multiprocessing.get_context("spawn"))
@@ -122,46 +161,47 @@ def diagnose(building_data, building, case, workdir, *, source="measurements", f
     for (effect, target), (parameters, determined, fitted, run, screening) in zip(pairs, assessed):
         label = f"{effect}@{target}"
         runs[label], sensitivities[label] = run, screening
-        fit = metrics(scored, fitted)
+        fit = objective.metrics(scored, fitted)
         results.append({"effect": effect, "target": target, "parameters": parameters, "derived": determined,
-                        "calibration": fit, "validation": metrics(measured[k:], run[k:]),
+                        "calibration": fit, "validation": objective.metrics(measured[k:], run[k:]),
                         "bic": bic(fit["J"], fit["n"], len(parameters))})
 
-    bic_before = bic(before["calibration"]["J"], before["calibration"]["n"], 0)
-    margin = tolerance(before["validation"]["J"], sigma, before["validation"]["n"])
-    better = [r for r in results if r["bic"] < bic_before
-              and r["validation"]["J"] < before["validation"]["J"] - margin]
-    chosen = min(better, key=lambda r: r["validation"]["rmse"]) if better else None
-
+    chosen, decision = decide(results, before, sigma)
     if chosen:
         values = {name: p["value"] for name, p in chosen["parameters"].items()}
-        data_after = effects.apply(building_data, chosen["effect"], chosen["target"], values)
-        after_run = runs[f"{chosen['effect']}@{chosen['target']}"]
+        after_building = EFFECTS[chosen["effect"]].apply(building, chosen["target"], values)
+        after_run = runs[decision["chosen"]]
         after = {w: chosen[w] for w in ("calibration", "validation")}
         effect = {key: chosen[key] for key in ("effect", "target", "parameters", "derived")}
     else:
-        data_after, after_run, after = building_data, before_run, before
+        after_building, after_run, after = building, before_run, before
         effect = {"effect": "none", "target": None, "parameters": {}}
-    parse_building(data_after, source="building_after.json")
-    (workdir / "building_after.json").write_text(json.dumps(data_after, indent=2) + "\n")
-    fmu_after = build_fmu(data_after, workdir / "model_after.fmu", source="building_after.json")
+    (workdir / "building_after.json").write_text(json.dumps(after_building.to_json(), indent=2) + "\n")
+    fmu_after = build_fmu(after_building, workdir / "model_after.fmu")
 
     times = case.times
     report = {
         "period": {"calibration": [times[0].isoformat(), times[k].isoformat()],
-                   "calibration_scored_from": times[case.steps(BURN_IN_DAYS) + 1].isoformat(),
+                   "calibration_scored_from": times[case.burn_in_steps + 1].isoformat(),
                    "validation": [times[k + 1].isoformat(), times[-1].isoformat()]},
+        "objective": list(objective.zones),
         "before": before,
         "localization": localization,
-        "candidates": [{**r, "bic_baseline": bic_before} for r in results],
+        "candidates": [{**r, "bic_baseline": decision["bic_baseline"]} for r in results],
+        "decision": decision,
         "effect": effect,
         "after": after,
         "sensitivity": sensitivities,
         "noise_sigma": sigma,
+        "node_names": {str(i): name for i, name in building.node_names().items()},
         "artifacts": {"building_after": str(workdir / "building_after.json"), "fmu_after": str(fmu_after)},
     }
-    series = {"times": times[1:], "measured": measured, "before": before_run, "after": after_run,
-              "validation_start": times[k + 1], "convergence": convergence, "air_node": air}
+    series = {"times": times[1:], "validation_start": times[k + 1], "scored_from": times[case.burn_in_steps + 1],
+              "convergence": convergence,
+              "zones": {zone: {"air_node": air, "measured": measured[:, j], "before": before_run[:, j],
+                               "after": after_run[:, j]}
+                        for j, (zone, air) in enumerate(zip(objective.zones, objective.air_nodes))},
+              "inputs": dict(zip(case.input_names, case.U[1:].T))}
     plots = write_report(workdir, report, series)
     report["artifacts"]["plots"] = [str(p) for p in plots]
     report["artifacts"]["report"] = str(workdir / "report.md")

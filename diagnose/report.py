@@ -726,6 +726,9 @@ def write_report(out_dir, report: dict, series: dict) -> list[Path]:
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     report = report or {}
+    if "zones" in series:  # the plots below draw the first objective zone
+        zone = next(iter(series["zones"].values()))
+        series = {**series, **{key: zone[key] for key in ("measured", "before", "after", "air_node")}}
     labels = {str(k): str(v) for k, v in (series.get("node_labels") or {}).items()}
     plots, notes = {}, {}
     if series.get("times") is not None and len(series["times"]):

@@ -16,8 +16,7 @@ from pythonfmu.builder import FmuBuilder
 from pythonfmu.osutil import get_platform
 
 from nodeforce import model
-from nodeforce.model import effects
-from nodeforce.model.building import parse_building
+from nodeforce.model.effects import EFFECTS
 
 SLAVE = Path(__file__).with_name("slave.py")
 MODEL_DIR = Path(model.__file__).parent
@@ -25,25 +24,23 @@ MODEL_DIR = Path(model.__file__).parent
 PHYSICS_MODULES = ("__init__", "errors", "building", "discretise", "effects", "network", "integrate")
 
 
-def build_fmu(building_data, destination, source="<building>", effect=None):
-    """Write the FMU of a building description.
+def build_fmu(building, destination, effect=None):
+    """Write the FMU of a building.
 
     Parameters
     ----------
-    building_data : dict, the building file's JSON content (validated here)
+    building : Building
     destination : path of the .fmu to write
-    source : the building's file name, for error messages
     effect : (effect id, target) of `model.effects` whose parameters the FMU exposes as
-        `<effect>.<name>` (start: the values the file declares), or None
+        `<effect>.<name>` (start: the values the building declares), or None
 
     Returns
     -------
     Path of the FMU written
     """
-    parse_building(building_data, source=source)
-    if effect is not None and not effects.applicable(building_data, *effect):
+    if effect is not None and not EFFECTS[effect[0]].applies(building, effect[1]):
         raise ValueError(f"effect {effect[0]} does not apply to {effect[1]!r}")
-    building_text = json.dumps(building_data, indent=1)
+    building_text = json.dumps(building.to_json(), indent=1)
     effect_text = json.dumps({"effect": effect[0], "target": effect[1]}) if effect else ""
     sources = {name: (MODEL_DIR / f"{name}.py").read_text() for name in PHYSICS_MODULES}
     slave_text = SLAVE.read_text()

@@ -47,9 +47,10 @@ def _model(resources, values=()):
     model = _MODELS.get(key)
     if model is None:
         data, effect = _read(resources)
-        if values:
-            data = _physics["effects"].apply(data, *effect, dict(values))
         building = _physics["building"].parse_building(data, source="building.json")
+        if values:
+            effect_id, target = effect
+            building = _physics["effects"].EFFECTS[effect_id].apply(building, target, dict(values))
         model = _MODELS[key] = (building, _physics["network"].assemble(building), {})
     return model
 
@@ -61,11 +62,12 @@ class NodalBuilding(Fmi2Slave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        data, self._effect = _read(self.resources)
+        _, self._effect = _read(self.resources)
         self.building, self.network, self._steppers = _model(self.resources)
         n = self.network.n_nodes
         names = self.network.input_names
-        effect_start = (_physics["effects"].current_values(data, *self._effect) if self._effect else {})
+        effect_start = (_physics["effects"].EFFECTS[self._effect[0]].read(self.building, self._effect[1])
+                        if self._effect else {})
         self._parameter_names = tuple(effect_start)
         # One array holds every variable's value, indexed by value reference, in the order the
         # variables are declared: get/set become numpy indexing instead of per-variable getters.
@@ -141,7 +143,7 @@ class NodalBuilding(Fmi2Slave):
         values = self._values
         T_forced = values[self._forced]
         forced = _physics["integrate"].imposed(self._force, T_forced) if self._any_forced else self._force
-        source = self.network.B @ values[self._inputs] + self.network.q
+        source = self.network.sources(values[self._inputs])
         values[self._T] = self._stepper(step_size).step(values[self._T], source, forced, T_forced)
         return True
 

@@ -10,22 +10,21 @@ import numpy as np
 
 from nodeforce.cosim.fmi2 import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
-from nodeforce.model.score import sum_of_squares
 
 
 class FmuFitness:
-    """Factory of evaluators scoring masks over `chromosome_nodes` by J on `output_node`.
+    """Factory of evaluators scoring masks over `chromosome_nodes` by the objective's J.
 
     Parameters
     ----------
     fmu_path : the building's FMU
     case : model.case.Case with the measurements
     chromosome_nodes : node ids, one bit each
-    output_node : the measured air node J is computed on
+    objective : model.score.Objective, the zones whose measured air J sums
     warmup_days : warm-up passes (PHYSICS.md section 5)
     """
 
-    def __init__(self, fmu_path, case, chromosome_nodes, output_node, warmup_days=2):
+    def __init__(self, fmu_path, case, chromosome_nodes, objective, warmup_days=2):
         self.fmu_path = str(fmu_path)
         # The slave's module name hashes the building and the model code (fmu_build.build), so a
         # checkpoint keyed on this factory is never resumed against another model.
@@ -33,7 +32,7 @@ class FmuFitness:
             self.model_id = fmu.read("resources/slavemodule.txt").decode().strip()
         self.case = case
         self.chromosome_nodes = np.asarray(chromosome_nodes, dtype=int)
-        self.output_node = int(output_node)
+        self.objective = objective
         self.warmup_days = warmup_days
 
     def __call__(self):
@@ -44,11 +43,11 @@ class FmuEvaluator:
     def __init__(self, spec):
         self.spec = spec
         self.instance = FmuInstance(spec.fmu_path)
-        self.measured = spec.case.measured[1:, spec.output_node - 1]
+        self.measured = spec.objective.measured(spec.case)
 
     def J(self, mask):
         force = np.zeros(self.spec.case.measured.shape[1], dtype=bool)
         force[self.spec.chromosome_nodes[np.asarray(mask, dtype=bool)] - 1] = True
         T = simulate_fmu(self.instance, self.spec.case, force, self.spec.warmup_days,
-                         output_ids=[self.spec.output_node])
-        return sum_of_squares(self.measured, T[:, 0])
+                         output_ids=self.spec.objective.air_nodes)
+        return self.spec.objective.J(self.measured, T)

@@ -1,6 +1,6 @@
 """`nodeforce locate`: which nodes, forced to their measurements, best explain the indoor air.
 
-Chooses the chromosome (every measured node but the output air node and, by default, the
+Chooses the chromosome (every measured node but the objective's air nodes and, by default, the
 algebraic radiant nodes, which are no sub-model), builds the FMU, and runs the search with the
 measurement noise estimated from the measured air.
 """
@@ -15,45 +15,52 @@ from nodeforce.model.network import assemble
 from nodeforce.model.score import noise_level
 
 
-def output_node(building, case, source):
-    """The zone air node J is computed on; it must be measured."""
-    air = building.zones[0].air_node
-    if air not in case.measured_ids:
-        raise InputError(source, f"T{air}", f"the indoor air (node {air}) is not measured; J is computed on it")
-    return air
+def check_measured(objective, case, source):
+    """Every objective zone's air must be measured: J is computed on it."""
+    for zone, air in zip(objective.zones, objective.air_nodes):
+        if air not in case.measured_ids:
+            raise InputError(source, f"T{air}", f"the air of zone {zone} (node {air}) is not measured; "
+                                                "J is computed on it")
 
 
-def links_to(network, node):
-    """Number of conductances between each node and `node` (ids 1..N -> index 0..N-1)."""
+def links_to(network, nodes):
+    """Number of conductances between each node and the nearest of `nodes` (ids)."""
     coupled = (network.A != 0) & ~np.eye(network.n_nodes, dtype=bool)
-    return shortest_path(coupled, unweighted=True, indices=node - 1)
+    return shortest_path(coupled, unweighted=True, indices=np.asarray(nodes) - 1).min(axis=0)
 
 
-def chromosome_nodes(building, case, source, nodes=None, include_algebraic=False):
-    """The nodes the search may force (ids), nearest the air node first, then by id.
+def chromosome_nodes(building, case, objective, source, nodes=None, include_algebraic=False):
+    """The nodes the search may force (ids), nearest the objective's air first, then by id.
 
     The order is the search's preference between nodes whose scores the noise cannot separate:
     forcing a node nearer the zone cuts off more of the sub-model behind it (the inside surface
     isolates the whole component, a node deeper in cuts only the layers beyond).
     """
-    air = output_node(building, case, source)
+    check_measured(objective, case, source)
     network = assemble(building)
-    measured = set(case.measured_ids) - {air}
+    measured = set(case.measured_ids) - set(objective.air_nodes)
     if nodes is None:
         algebraic = set(np.flatnonzero(network.algebraic) + 1)
         chosen = measured if include_algebraic else measured - algebraic
     else:
         for i in nodes:
-            if i == air:
-                raise InputError("--nodes", str(i), f"node {i} is the output (indoor air), not a forcing candidate")
+            if i in objective.air_nodes:
+                raise InputError("--nodes", str(i), f"node {i} is an output (objective air), not a forcing candidate")
             if i not in measured:
                 raise InputError(source, f"T{i}", f"node {i} is asked for in --nodes but has no measurement column")
         chosen = set(nodes)
-    distance = links_to(network, air)
+    distance = links_to(network, objective.air_nodes)
     return sorted(chosen, key=lambda i: (distance[i - 1], i))
 
 
-def locate(building_data, building, case, workdir, *, source="measurements", nodes=None,
+def air_noise(case, objective):
+    """Noise sd (C) of the objective's measured air: the root mean square of each zone's."""
+    sigmas = [noise_level(case.measured[:, air - 1]) for air in objective.air_nodes]
+    sigmas = [s for s in sigmas if s is not None]
+    return float(np.sqrt(np.mean(np.square(sigmas)))) if sigmas else None
+
+
+def locate(building, case, objective, workdir, *, source="measurements", nodes=None,
            include_algebraic=False, population=30, generations=400, pc=0.8, pm=0.03, seed=0,
            workers=None, scheduler=None, warmup_days=2, progress=None):
     """Run the forcing search on a case; return the content of locate.json.
@@ -62,16 +69,14 @@ def locate(building_data, building, case, workdir, *, source="measurements", nod
     `workdir`, so a run stopped midway and started again resumes. `progress` is called after
     every generation with (generation, total, best J, unique evaluations).
     """
-    air = output_node(building, case, source)
-    candidates = chromosome_nodes(building, case, source, nodes, include_algebraic)
+    candidates = chromosome_nodes(building, case, objective, source, nodes, include_algebraic)
     if not candidates:
-        raise InputError(source, "columns", "no measured node besides the indoor air: nothing to force")
-    fmu = build_fmu(building_data, workdir / "model.fmu", source=building.source)
-    air_measured = case.measured[1:, air - 1]
-    result = search(FmuFitness(fmu, case, candidates, air, warmup_days), candidates,
+        raise InputError(source, "columns", "no measured node besides the objective's air: nothing to force")
+    fmu = build_fmu(building, workdir / "model.fmu")
+    result = search(FmuFitness(fmu, case, candidates, objective, warmup_days), candidates,
                     population=population, generations=generations, pc=pc, pm=pm, seed=seed,
                     workers=workers, scheduler=scheduler, checkpoint=workdir / "locate.checkpoint.json",
-                    progress=progress,
-                    noise_sigma=noise_level(case.measured[:, air - 1]),
-                    n_residuals=int(np.isfinite(air_measured).sum()))
-    return {"measured_nodes": case.measured_ids, "output_node": air, **result}
+                    progress=progress, noise_sigma=air_noise(case, objective),
+                    n_residuals=int(np.isfinite(objective.measured(case)).sum()))
+    return {"measured_nodes": case.measured_ids, "output_node": objective.air_nodes[0],
+            "objective": list(objective.zones), "output_nodes": list(objective.air_nodes), **result}

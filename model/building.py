@@ -1,13 +1,23 @@
 """Read and validate a building file (`"format": "nodal-building/1"`, PHYSICS.md section 1).
 
 Every check raises `InputError` naming the file and the field, so a user can fix the file
-without reading code. The result is a tree of frozen dataclasses: the network is assembled
-from it, never from the raw JSON.
+without reading code. The result is one `Building`: a tree of frozen records the network is
+assembled from, which also keeps the JSON it was read from. It writes that JSON back unchanged
+(`to_json`), and a change to it (an effect, `Building.edited`) is a new, validated `Building`:
+the records and the file can never disagree.
+
+Layers are listed from the INSIDE face of a component to its outside face (a building
+description often lists them outside-in). Nodes are given explicitly (`"nodes": [{"id", "depth"}]`)
+or generated from the layers (`"nodes": {"max_spacing": m}`), in which case the tool numbers every
+node: components in file order, each inside to outside, then each zone's air and radiant node.
 """
+import copy
 import json
 import math
+import re
 from dataclasses import dataclass, field
 
+from .discretise import generated_depths
 from .errors import InputError
 
 FORMAT = "nodal-building/1"
@@ -15,6 +25,10 @@ OUTSIDE_TYPES = ("exterior", "adiabatic", "zone", "boundary")
 # Depths are given in metres with a few decimals; a node "at" the outside face may be
 # off by rounding only.
 DEPTH_TOLERANCE = 1e-9
+# A sensor's depth names the node nearest it within this distance (m): positions in a building
+# description are rounded to the millimetre.
+SENSOR_TOLERANCE = 1e-3
+NODE_COLUMN = re.compile(r"T(\d+)$")
 
 
 @dataclass(frozen=True)
@@ -25,6 +39,47 @@ class Material:
 
 
 @dataclass(frozen=True)
+class Surface:
+    """A face seen by a zone: its air through h_conv, its radiant node through h_rad (W/m2/K)."""
+    zone: str
+    h_conv: float
+    h_rad: float
+
+
+@dataclass(frozen=True)
+class Exterior:
+    """Outdoor air, sky and sun (PHYSICS.md section 3)."""
+    h_conv: float  # W/m2/K
+    h_rad: float  # W/m2/K
+    solar_absorptance: float  # -
+    irradiance: str | None = None  # input column of the measured irradiance on the face, W/m2
+
+
+@dataclass(frozen=True)
+class Adiabatic:
+    """No flux through the face."""
+
+
+@dataclass(frozen=True)
+class Boundary:
+    """A prescribed temperature (C, or the name of an input column) through h (W/m2/K)."""
+    temperature: float | str
+    h: float
+
+
+@dataclass(frozen=True)
+class Supply:
+    flow: float  # m3/h
+    temperature: float | str  # C, or an input column
+
+
+@dataclass(frozen=True)
+class Inflow:
+    zone: str  # the zone the air comes from, at its air temperature
+    flow: float  # m3/h
+
+
+@dataclass(frozen=True)
 class Zone:
     name: str
     volume: float  # m3
@@ -32,8 +87,13 @@ class Zone:
     radiant_node: int
     air_change_rate: float = 0.0  # 1/h
     internal_gain: float = 0.0  # W
-    heat_input: str | None = None  # name of an input column, W
+    heat_input: tuple = ()  # input columns, W, summed
+    heat_input_radiative_fraction: float = 0.0  # part of the heat input given to the radiant node
+    supply: Supply | None = None
+    airflow_from: tuple = ()  # Inflow records
+    thermal_bridges: tuple = ()  # (to, UA W/K): "outdoor" or an input column of a temperature
     convection_factor: float = 1.0  # scale on the inside h_conv of the surfaces facing the zone
+    occupied: bool | None = None  # None: not declared
 
 
 @dataclass(frozen=True)
@@ -45,16 +105,25 @@ class Component:
     layers: tuple  # ((Material, thickness m), ...) from the inside face outwards
     node_ids: tuple  # ids, ordered by depth
     depths: tuple  # m from the inside face
-    inside: dict  # {"zone", "h_conv", "h_rad"}
-    outside: dict  # {"type", ...} as in PHYSICS.md section 1
+    inside: Surface
+    outside: Exterior | Adiabatic | Surface | Boundary
     solar_transmittance: float | None = None
     transmitted_solar_to: str | None = None
+    shading: str | None = None  # input column in 0..1 multiplying the transmittance
     conductivity_factor: float = 1.0  # scale on the conductances between its nodes
 
     @property
     def thickness(self):
         """Total thickness of the layers (m)."""
         return sum(t for _, t in self.layers)
+
+    @property
+    def irradiance_input(self):
+        """Name of the input holding the irradiance on the outside face (W/m2): the face's
+        measured column if it names one, else `I_<component>`; None if the face is not exterior."""
+        if not isinstance(self.outside, Exterior):
+            return None
+        return self.outside.irradiance or f"I_{self.name}"
 
 
 @dataclass(frozen=True)
@@ -63,7 +132,9 @@ class Building:
     site: dict  # latitude, longitude (deg), altitude (m), timezone, ground_albedo
     zones: tuple
     components: tuple
+    sensors: dict = field(default_factory=dict)  # sensor name -> node id
     source: str = field(default="<building>", compare=False)
+    data: dict = field(default_factory=dict, compare=False, repr=False)  # the JSON it was read from
 
     @property
     def n_nodes(self):
@@ -72,15 +143,25 @@ class Building:
     @property
     def exterior_components(self):
         """Components whose outside face sees the outdoor air, sky and sun."""
-        return tuple(c for c in self.components if c.outside["type"] == "exterior")
+        return tuple(c for c in self.components if isinstance(c.outside, Exterior))
 
     @property
     def input_columns(self):
-        """Names of measured input columns the building refers to (heat inputs, boundary
-        temperatures), in order of appearance."""
-        names = [z.heat_input for z in self.zones if z.heat_input]
-        names += [c.outside["temperature"] for c in self.components
-                  if c.outside["type"] == "boundary" and isinstance(c.outside["temperature"], str)]
+        """Names of the measured input columns the building refers to (heat inputs, supply and
+        boundary temperatures, measured irradiance, shading), in order of appearance."""
+        names = []
+        for z in self.zones:
+            names += z.heat_input
+            if z.supply is not None and isinstance(z.supply.temperature, str):
+                names.append(z.supply.temperature)
+            names += [to for to, _ in z.thermal_bridges if to != "outdoor"]
+        for c in self.components:
+            if isinstance(c.outside, Boundary) and isinstance(c.outside.temperature, str):
+                names.append(c.outside.temperature)
+            if isinstance(c.outside, Exterior) and c.outside.irradiance:
+                names.append(c.outside.irradiance)
+            if c.shading:
+                names.append(c.shading)
         return tuple(dict.fromkeys(names))
 
     def zone(self, name):
@@ -89,9 +170,44 @@ class Building:
     def component(self, name):
         return next(c for c in self.components if c.name == name)
 
+    def facing(self, zone_name):
+        """Ids of the surface nodes that face a zone (inside faces, and outside faces of partitions)."""
+        ids = [c.node_ids[0] for c in self.components if c.inside.zone == zone_name]
+        ids += [c.node_ids[-1] for c in self.components
+                if isinstance(c.outside, Surface) and c.outside.zone == zone_name]
+        return tuple(ids)
 
-def read_building_data(path):
-    """The JSON content of a building file, validated; InputError if it is not a valid building.
+    def node_names(self):
+        """{id: readable name}: "<component> at <depth> m", "<zone> air", "<zone> radiant"."""
+        names = {}
+        for c in self.components:
+            for i, depth in zip(c.node_ids, c.depths):
+                names[i] = f"{c.name} at {depth:.3f} m"
+        for z in self.zones:
+            names[z.air_node] = f"{z.name} air"
+            names[z.radiant_node] = f"{z.name} radiant"
+        return dict(sorted(names.items()))
+
+    def node_of(self, column):
+        """The node id a measurement column names (`T<id>` or a sensor), or None."""
+        match = NODE_COLUMN.match(str(column))
+        if match:
+            return int(match.group(1))
+        return self.sensors.get(column)
+
+    def to_json(self):
+        """The building file's JSON content (a copy): exactly what it was read from."""
+        return copy.deepcopy(self.data)
+
+    def edited(self, change):
+        """A new Building from this one's JSON changed in place by `change(data)`, validated."""
+        data = self.to_json()
+        change(data)
+        return parse_building(data, source=self.source)
+
+
+def load_building(path):
+    """Read and validate a building file; return a `Building`.
 
     Beyond `parse_building`'s checks, the file must follow the format's JSON Schema
     (`data/nodal-building.schema.json`), which refuses unknown fields: a misspelt optional
@@ -104,12 +220,13 @@ def read_building_data(path):
         raise InputError(path, "file", "not found") from None
     except json.JSONDecodeError as e:
         raise InputError(path, f"line {e.lineno}", f"not valid JSON ({e.msg})") from None
-    parse_building(data, source=str(path))
-    _check_schema(data, str(path))
-    return data
+    building = parse_building(data, source=str(path))
+    check_schema(data, str(path))
+    return building
 
 
-def _check_schema(data, source):
+def check_schema(data, source):
+    """InputError naming the field where `data` does not follow the format's JSON Schema."""
     # imported here: the FMU runs this module without jsonschema
     import jsonschema
     from importlib.resources import files
@@ -118,11 +235,6 @@ def _check_schema(data, source):
     if error is not None:
         where = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in error.absolute_path).lstrip(".")
         raise InputError(source, where or "(top level)", error.message)
-
-
-def load_building(path):
-    """Read and validate a building file; return a `Building`."""
-    return parse_building(read_building_data(path), source=str(path))
 
 
 def parse_building(data, source="<building>"):
@@ -134,24 +246,36 @@ def parse_building(data, source="<building>"):
         check.fail("format", f"must be {FORMAT!r}, found {data.get('format')!r}")
     site = _site(check, data.get("site"))
     materials = _materials(check, check.mapping(data, "materials", "(top level)"))
-    zones = tuple(_zone(check, z, f"zones[{i}]")
-                  for i, z in enumerate(check.sequence(data, "zones", "(top level)")))
-    if not zones:
+    raw_zones = check.sequence(data, "zones", "(top level)")
+    if not raw_zones:
         check.fail("zones", "at least one zone is needed")
-    zone_names = [z.name for z in zones]
+    zone_names = [check.text(z, "name", f"zones[{i}]") for i, z in enumerate(raw_zones)]
     check.unique(zone_names, "zones", "zone name")
     raw_components = check.sequence(data, "components", "(top level)")
-    components = tuple(_component(check, c, f"components[{i}]", materials, zone_names)
-                       for i, c in enumerate(raw_components))
-    check.unique([c.name for c in components], "components", "component name")
+    raw_sensors = data.get("sensors", {})
+    if not isinstance(raw_sensors, dict):
+        check.fail("sensors", "must be an object of sensor name: position")
+    sensor_depths = _sensor_depths(check, raw_sensors, raw_components)
+    components = [_component(check, c, f"components[{i}]", materials, zone_names, sensor_depths)
+                  for i, c in enumerate(raw_components)]
+    check.unique([c["name"] for c in components], "components", "component name")
+    explicit = _explicit_ids(check, raw_zones, components)
+    next_id = iter(range(1, 10 ** 9))
+    if not explicit:
+        for c in components:
+            c["node_ids"] = tuple(next(next_id) for _ in c["depths"])
+    zones = tuple(_zone(check, z, f"zones[{i}]", zone_names, explicit, next_id)
+                  for i, z in enumerate(raw_zones))
+    components = tuple(Component(**c) for c in components)
     names = {c.name for c in components}
     for i, c in enumerate(components):
         if c.transmitted_solar_to is not None and c.transmitted_solar_to not in names:
             check.fail(f"components[{i}].transmitted_solar_to",
                        f"names no component ({c.transmitted_solar_to!r})")
     _check_node_ids(check, zones, components)
-    return Building(name=str(data.get("name", "")), site=site, zones=zones,
-                    components=components, source=source)
+    sensors = {name: _sensor_node(check, name, raw, zones, components) for name, raw in raw_sensors.items()}
+    return Building(name=str(data.get("name", "")), site=site, zones=zones, components=components,
+                    sensors=sensors, source=source, data=copy.deepcopy(data))
 
 
 class _Checker:
@@ -169,8 +293,10 @@ class _Checker:
             self.fail(_join(where, key), "missing or not an object")
         return value
 
-    def sequence(self, obj, key, where):
+    def sequence(self, obj, key, where, *, optional=False):
         value = obj.get(key) if isinstance(obj, dict) else None
+        if value is None and optional:
+            return []
         if not isinstance(value, list):
             self.fail(_join(where, key), "missing or not a list")
         return value
@@ -201,6 +327,15 @@ class _Checker:
         if not isinstance(value, str) or not value:
             self.fail(_join(where, key), "missing or not a non-empty string")
         return value
+
+    def temperature(self, obj, key, where):
+        """A temperature: a number (C) or the name of an input column."""
+        value = obj.get(key) if isinstance(obj, dict) else None
+        if isinstance(value, str):
+            if not value:
+                self.fail(_join(where, key), "an empty column name")
+            return value
+        return self.number(obj, key, where, low=-100, high=100)
 
     def unique(self, values, where, what):
         seen = set()
@@ -240,18 +375,58 @@ def _materials(check, raw):
     return materials
 
 
-def _zone(check, z, where):
+def _zone(check, z, where, zone_names, explicit, next_id):
     if not isinstance(z, dict):
         check.fail(where, "must be an object")
+    heat_input = z.get("heat_input")
+    if heat_input is None:
+        heat_input = ()
+    elif isinstance(heat_input, str):
+        heat_input = (check.text(z, "heat_input", where),)
+    elif isinstance(heat_input, list) and all(isinstance(h, str) and h for h in heat_input):
+        heat_input = tuple(heat_input)
+    else:
+        check.fail(f"{where}.heat_input", "must be a column name or a list of column names")
+    supply = None
+    if z.get("supply") is not None:
+        raw = check.mapping(z, "supply", where)
+        supply = Supply(flow=check.number(raw, "flow", f"{where}.supply", low=0),
+                        temperature=check.temperature(raw, "temperature", f"{where}.supply"))
+    inflows = []
+    for j, raw in enumerate(check.sequence(z, "airflow_from", where, optional=True)):
+        fw = f"{where}.airflow_from[{j}]"
+        source_zone = check.text(raw, "zone", fw)
+        if source_zone not in zone_names:
+            check.fail(f"{fw}.zone", f"names no zone ({source_zone!r})")
+        if source_zone == z.get("name"):
+            check.fail(f"{fw}.zone", "air cannot flow from a zone into itself")
+        inflows.append(Inflow(zone=source_zone, flow=check.number(raw, "flow", fw, low=0)))
+    bridges = z.get("thermal_bridges", {})
+    if not isinstance(bridges, dict):
+        check.fail(f"{where}.thermal_bridges", 'must be an object {"outdoor" or column: UA in W/K}')
+    bridges = tuple((to, check.number(bridges, to, f"{where}.thermal_bridges", low=0)) for to in bridges)
+    occupied = z.get("occupied")
+    if occupied is not None and not isinstance(occupied, bool):
+        check.fail(f"{where}.occupied", f"must be true or false, found {occupied!r}")
+    if explicit:
+        air, radiant = check.integer(z, "air_node", where), check.integer(z, "radiant_node", where)
+    else:
+        air, radiant = next(next_id), next(next_id)
     return Zone(
-        name=check.text(z, "name", where),
+        name=z["name"],
         volume=check.number(z, "volume", where, low=0, low_open=True),
-        air_node=check.integer(z, "air_node", where),
-        radiant_node=check.integer(z, "radiant_node", where),
+        air_node=air,
+        radiant_node=radiant,
         air_change_rate=check.number(z, "air_change_rate", where, default=0.0, low=0),
         internal_gain=check.number(z, "internal_gain", where, default=0.0),
-        heat_input=check.text(z, "heat_input", where, optional=True),
+        heat_input=heat_input,
+        heat_input_radiative_fraction=check.number(z, "heat_input_radiative_fraction", where, default=0.0,
+                                                   low=0, high=1),
+        supply=supply,
+        airflow_from=tuple(inflows),
+        thermal_bridges=bridges,
         convection_factor=check.number(z, "convection_factor", where, default=1.0, low=0, low_open=True),
+        occupied=occupied,
     )
 
 
@@ -261,9 +436,8 @@ def _surface(check, raw, where, zone_names):
     zone = check.text(raw, "zone", where)
     if zone not in zone_names:
         check.fail(f"{where}.zone", f"names no zone ({zone!r})")
-    return {"zone": zone,
-            "h_conv": check.number(raw, "h_conv", where, low=0),
-            "h_rad": check.number(raw, "h_rad", where, low=0)}
+    return Surface(zone=zone, h_conv=check.number(raw, "h_conv", where, low=0),
+                   h_rad=check.number(raw, "h_rad", where, low=0))
 
 
 def _outside(check, raw, where, zone_names):
@@ -273,28 +447,19 @@ def _outside(check, raw, where, zone_names):
     if kind not in OUTSIDE_TYPES:
         check.fail(f"{where}.type", f"must be one of {', '.join(OUTSIDE_TYPES)}; found {kind!r}")
     if kind == "exterior":
-        return {"type": kind,
-                "h_conv": check.number(raw, "h_conv", where, low=0),
-                "h_rad": check.number(raw, "h_rad", where, low=0),
-                "solar_absorptance": check.number(raw, "solar_absorptance", where, low=0, high=1)}
+        return Exterior(h_conv=check.number(raw, "h_conv", where, low=0),
+                        h_rad=check.number(raw, "h_rad", where, low=0),
+                        solar_absorptance=check.number(raw, "solar_absorptance", where, low=0, high=1),
+                        irradiance=check.text(raw, "irradiance", where, optional=True))
     if kind == "zone":
-        return {"type": kind, **_surface(check, raw, where, zone_names)}
+        return _surface(check, raw, where, zone_names)
     if kind == "boundary":
-        temperature = raw.get("temperature")
-        if isinstance(temperature, str):
-            if not temperature:
-                check.fail(f"{where}.temperature", "an empty column name")
-        else:
-            temperature = check.number(raw, "temperature", where, low=-100, high=100)
-        return {"type": kind, "temperature": temperature,
-                "h": check.number(raw, "h", where, low=0, low_open=True)}
-    return {"type": kind}
+        return Boundary(temperature=check.temperature(raw, "temperature", where),
+                        h=check.number(raw, "h", where, low=0, low_open=True))
+    return Adiabatic()
 
 
-def _component(check, c, where, materials, zone_names):
-    if not isinstance(c, dict):
-        check.fail(where, "must be an object")
-    name = check.text(c, "name", where)
+def _layers(check, c, where, materials):
     layers = []
     for j, layer in enumerate(check.sequence(c, "layers", where)):
         lw = f"{where}.layers[{j}]"
@@ -307,9 +472,20 @@ def _component(check, c, where, materials, zone_names):
             check.fail(lw, f"thickness must be a positive number of metres, found {thickness!r}")
         layers.append((materials[material], float(thickness)))
     if not layers:
-        check.fail(f"{where}.layers", "at least one layer is needed")
-    total = sum(t for _, t in layers)
+        check.fail(f"{where}.layers", "at least one layer is needed (listed from the inside face outwards)")
+    return tuple(layers)
 
+
+def _depths(check, c, where, layers, sensor_depths):
+    """(explicit ids or None, depths) of a component's nodes."""
+    total = sum(t for _, t in layers)
+    raw_nodes = c.get("nodes")
+    if isinstance(raw_nodes, dict):
+        spacing = check.number(raw_nodes, "max_spacing", f"{where}.nodes", low=0, low_open=True)
+        boundaries = raw_nodes.get("layer_boundaries", True)
+        if not isinstance(boundaries, bool):
+            check.fail(f"{where}.nodes.layer_boundaries", f"must be true or false, found {boundaries!r}")
+        return None, generated_depths([t for _, t in layers], spacing, boundaries, sensor_depths.get(c.get("name"), ()))
     raw_nodes = check.sequence(c, "nodes", where)
     if len(raw_nodes) < 2:
         check.fail(f"{where}.nodes", "a component needs at least two nodes (inside and outside surface)")
@@ -329,25 +505,82 @@ def _component(check, c, where, materials, zone_names):
         check.fail(f"{where}.nodes[{len(depths) - 1}].depth",
                    f"the last node must be at the outside surface, {total:g} m")
     depths[0], depths[-1] = 0.0, total
+    return tuple(ids), depths
 
+
+def _component(check, c, where, materials, zone_names, sensor_depths):
+    """The fields of a Component (node ids left out where the tool assigns them)."""
+    if not isinstance(c, dict):
+        check.fail(where, "must be an object")
+    name = check.text(c, "name", where)
+    layers = _layers(check, c, where, materials)
+    ids, depths = _depths(check, c, where, layers, sensor_depths)
     tau = c.get("solar_transmittance")
     if tau is not None:
         tau = check.number(c, "solar_transmittance", where, low=0, high=1)
         check.text(c, "transmitted_solar_to", where)
-    return Component(
+    shading = check.text(c, "shading", where, optional=True)
+    if shading is not None and tau is None:
+        check.fail(f"{where}.shading", "only a glazed component (with a solar_transmittance) has a shading")
+    return dict(
         name=name,
         area=check.number(c, "area", where, low=0, low_open=True),
         tilt=check.number(c, "tilt", where, low=0, high=180),
         azimuth=check.number(c, "azimuth", where, low=0, high=360),
-        layers=tuple(layers),
-        node_ids=tuple(ids),
+        layers=layers,
+        node_ids=ids,
         depths=tuple(depths),
         inside=_surface(check, c.get("inside"), f"{where}.inside", zone_names),
         outside=_outside(check, c.get("outside"), f"{where}.outside", zone_names),
         solar_transmittance=tau,
         transmitted_solar_to=c.get("transmitted_solar_to") if tau is not None else None,
+        shading=shading,
         conductivity_factor=check.number(c, "conductivity_factor", where, default=1.0, low=0, low_open=True),
     )
+
+
+def _explicit_ids(check, raw_zones, components):
+    """Whether the file numbers its nodes itself: every id given, or none."""
+    given = [c["node_ids"] is not None for c in components]
+    given += [isinstance(z, dict) and ("air_node" in z or "radiant_node" in z) for z in raw_zones]
+    if any(given) and not all(given):
+        check.fail("nodes", "give every node id (explicit node lists and each zone's air_node and "
+                            "radiant_node) or none, for the tool to number them")
+    return all(given)
+
+
+def _sensor_depths(check, raw_sensors, raw_components):
+    """{component name: depths of the sensors declared on it}, for node generation."""
+    names = {c.get("name") for c in raw_components if isinstance(c, dict)}
+    depths = {}
+    for name, raw in raw_sensors.items():
+        where = f"sensors.{name}"
+        if NODE_COLUMN.match(name):
+            check.fail(where, "a sensor name must not look like a node column T<id>")
+        if not isinstance(raw, dict) or ("zone" in raw) == ("component" in raw):
+            check.fail(where, 'must be {"zone": name} or {"component": name, "depth": m from the inside face}')
+        if "component" in raw:
+            component = check.text(raw, "component", where)
+            if component not in names:
+                check.fail(f"{where}.component", f"names no component ({component!r})")
+            depths.setdefault(component, []).append(check.number(raw, "depth", where, low=0))
+    return depths
+
+
+def _sensor_node(check, name, raw, zones, components):
+    where = f"sensors.{name}"
+    if "zone" in raw:
+        zone = next((z for z in zones if z.name == raw["zone"]), None)
+        if zone is None:
+            check.fail(f"{where}.zone", f"names no zone ({raw['zone']!r})")
+        return zone.air_node
+    c = next(c for c in components if c.name == raw["component"])
+    depth = raw["depth"]
+    k = min(range(len(c.depths)), key=lambda k: abs(c.depths[k] - depth))
+    if abs(c.depths[k] - depth) > SENSOR_TOLERANCE:
+        check.fail(f"{where}.depth", f"{c.name} has no node at {depth} m (nodes at "
+                                     f"{', '.join(f'{d:.3f}' for d in c.depths)} m)")
+    return c.node_ids[k]
 
 
 def _check_node_ids(check, zones, components):

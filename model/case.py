@@ -24,6 +24,7 @@ class Case:
     input_names: tuple  # columns of U, as `model.network.input_names`
     U: np.ndarray  # (N_t+1, n_inputs) inputs at t_0..t_N
     measured: np.ndarray  # (N_t+1, N) node temperatures (C), NaN where not measured
+    burn_in_steps: int = 0  # B: t_1..t_B force every measured node and are not scored
 
     @property
     def measured_ids(self):
@@ -34,17 +35,28 @@ class Case:
         """Number of steps in `days`."""
         return int(round(days * 86400 / self.dt))
 
-    def unscored_start(self, node, days):
-        """The case with `node`'s measurements of the first `days` after t_0 left out of every
-        score (NaN in a copy); the measurement at t_0 stays, as it sets the initial state."""
-        measured = self.measured.copy()
-        measured[1:self.steps(days) + 1, node - 1] = np.nan
-        return replace(self, measured=measured)
+    def with_burn_in(self, days, source="--burn-in-days"):
+        """The case whose first `days` after t_0 are a burn-in (PHYSICS.md section 5)."""
+        steps = self.steps(days)
+        if days < 0 or abs(steps * self.dt - days * 86400) > 1e-6 * self.dt:
+            raise InputError(source, days, f"must be a whole number of {self.dt:g} s steps, not negative")
+        if steps >= len(self.times) - 1:
+            raise InputError(source, days, "the burn-in must be shorter than the record")
+        return replace(self, burn_in_steps=steps)
+
+    def scored(self, columns):
+        """(N_t, k) measurements of the node indices `columns` at t_1..t_N, NaN where missing and
+        over the burn-in, which is not scored."""
+        measured = self.measured[1:, columns].copy()
+        measured[:self.burn_in_steps] = np.nan
+        return measured
 
     def window(self, start, stop):
-        """The sub-case on rows start..stop (inclusive), t_start becoming its t_0."""
+        """The sub-case on rows start..stop (inclusive), t_start becoming its t_0; the burn-in
+        stays with a window that starts at t_0 and is left behind by one that starts later."""
         rows = slice(start, stop + 1)
-        return Case(self.times[rows], self.dt, self.input_names, self.U[rows], self.measured[rows])
+        return Case(self.times[rows], self.dt, self.input_names, self.U[rows], self.measured[rows],
+                    self.burn_in_steps if start == 0 else 0)
 
 
 def uniform_grid(times, source):
@@ -67,7 +79,10 @@ def measured_matrix(building, measurements, times):
     matrix = np.full((len(times), building.n_nodes), np.nan)
     on_grid = measurements.reindex(times)
     for column in measurements.columns:
-        node = int(str(column)[1:])
+        node = building.node_of(column)
+        if node is None:
+            raise InputError(source, column, f"names no node: a measurement column is T<node id> or a sensor "
+                                             f"of {building.source} ({', '.join(building.sensors) or 'none declared'})")
         if not 1 <= node <= building.n_nodes:
             raise InputError(source, column, f"node {node} does not exist (the building has nodes 1..{building.n_nodes})")
         matrix[:, node - 1] = on_grid[column].to_numpy(float)
@@ -101,6 +116,8 @@ def prepare_case(building, weather, measurements=None):
         "T_sky": sky_temperature(w["T_out"], ir_h=w.get("ir_h"), T_sky=w.get("T_sky")),
     }
     for c in building.exterior_components:
+        if c.outside.irradiance:
+            continue
         measured_sun = w.get(f"I_{c.name}")
         columns[f"I_{c.name}"] = (measured_sun.to_numpy(float) if measured_sun is not None else
                                   incident_irradiance(position, w["ghi"], w["dni"], w["dhi"],
@@ -122,7 +139,7 @@ def prepare_case(building, weather, measurements=None):
     return Case(times=times, dt=dt, input_names=names, U=U, measured=measured)
 
 
-def simulate_building(building, weather, measurements=None, force=(), warmup_days=2):
+def simulate_building(building, weather, measurements=None, force=(), warmup_days=2, burn_in_days=0):
     """Every node's temperature (C) under a weather, with the direct model: the plain Python API.
 
     Parameters
@@ -133,13 +150,15 @@ def simulate_building(building, weather, measurements=None, force=(), warmup_day
         time grid, the initial state and the values forced nodes take
     force : node ids forced to their measurements for the whole run
     warmup_days : passes over the first day before the run (PHYSICS.md section 5)
+    burn_in_days : days after t_0 over which every measured node is forced (PHYSICS.md section 5)
 
     Returns
     -------
     DataFrame indexed by time t_1..t_N, columns `T1..TN`
     """
-    case = prepare_case(building, weather, measurements)
+    case = prepare_case(building, weather, measurements).with_burn_in(burn_in_days)
     mask = np.zeros(building.n_nodes, dtype=bool)
     mask[np.asarray(force, dtype=int) - 1] = True
-    T = simulate(building, assemble(building), case.U, case.dt, case.measured, mask, warmup_days)
+    T = simulate(building, assemble(building), case.U, case.dt, case.measured, mask, warmup_days,
+                 burn_in_steps=case.burn_in_steps)
     return pd.DataFrame(T, index=case.times[1:], columns=[f"T{i}" for i in range(1, building.n_nodes + 1)])

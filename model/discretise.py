@@ -4,6 +4,9 @@ Conductances are exact integrals of dx/lambda across layer boundaries, capacitie
 integrals of rho*c over each node's control volume: with two nodes this is the R2C model
 of the paper (K = 1/R and two half capacities).
 """
+import math
+from itertools import accumulate
+
 import numpy as np
 
 
@@ -46,3 +49,19 @@ def capacities(layers, depths):
     lo = np.concatenate(([x[0]], mid))
     hi = np.concatenate((mid, [x[-1]]))
     return np.array([_integral(bounds, rho_c, a, b) for a, b in zip(lo, hi)])
+
+
+def generated_depths(thicknesses, max_spacing, layer_boundaries=True, extra=(), merge=1e-3):
+    """Node depths (m) from the inside face: both surfaces, every layer boundary (unless
+    `layer_boundaries` is false) and the `extra` depths (sensors), with each stretch between them
+    cut into equal cells no thicker than `max_spacing` (m). An extra depth within `merge` (m) of a
+    surface or layer boundary is that node: a sensor "at" an interface is placed to the millimetre."""
+    total = float(sum(thicknesses))
+    fixed = [0.0, total] + (list(accumulate(thicknesses))[:-1] if layer_boundaries else [])
+    fixed += [float(x) for x in extra if min(abs(x - f) for f in fixed) > merge]
+    fixed = sorted(set(fixed))
+    depths = [fixed[0]]
+    for a, b in zip(fixed, fixed[1:]):
+        cells = max(1, math.ceil((b - a) / max_spacing - 1e-9))
+        depths += [a + (b - a) * k / cells for k in range(1, cells + 1)]
+    return depths

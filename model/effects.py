@@ -1,46 +1,53 @@
-"""The effects a diagnosis may add to a model (PHYSICS.md section 7), as changes to the building file.
+"""The effects a diagnosis may add to a model (PHYSICS.md section 7): one record per effect.
 
-Each effect is a change of declared fields, so a model with the effect is an ordinary building
-file that every command loads, and its FMU exposes the effect's parameters as `<effect>.<name>`:
+Each effect is a change of declared fields of the building file, so a model with the effect is
+an ordinary building that every command loads, and its FMU exposes the effect's parameters as
+`<effect>.<name>`. A record says what the effect adds, its parameters (unit and physical
+range), which targets it applies to, how it reads and writes the building, and which nodes'
+forcing points at it. Adding an effect is one record here (and its fields in the building file
+format, if it needs new ones). Which effects a diagnosis tries, and where a calibration starts,
+is the diagnosis' policy (`nodeforce.diagnose.candidates`), not physics.
 
-| effect              | target    | declared as                                                   |
-|---------------------|-----------|---------------------------------------------------------------|
-| ground_coupling     | component | its adiabatic outside face becomes a `boundary` at T_ground    |
-|                     |           | through U (W/m2/K): A U (T_ground - T_e)                       |
-| infiltration        | zone      | `air_change_rate` n (1/h)                                      |
-| internal_gain       | zone      | `internal_gain` Q (W)                                          |
-| solar_absorptance   | component | `outside.solar_absorptance` alpha                              |
-| conductivity        | component | `conductivity_factor`: a scale on its conductances             |
-| inside_convection   | zone      | `convection_factor`: a scale on the inside h_conv facing it    |
-| solar_transmittance | component | `solar_transmittance` tau of a glazing                         |
-
-Pure functions on the file's JSON content (dicts): the FMU runs this module too.
+A `thermal_bridge` target is a zone name for a bridge to the outdoor air, or `<zone>-><column>`
+for a bridge to a boundary temperature column (attic, cellar, neighbour).
 """
-import copy
 from dataclasses import dataclass
+from typing import Callable
+
+from .building import Adiabatic, Boundary
+
+BRIDGE_TO = "->"
 
 
 @dataclass(frozen=True)
 class Parameter:
     name: str
     unit: str
-    low: float  # bounds of a calibration
+    low: float  # the range a calibration may explore
     high: float
 
 
-EFFECTS = {
-    "ground_coupling": (Parameter("U", "W/m2/K", 0.0, 20.0), Parameter("T_ground", "C", -10.0, 40.0)),
-    "infiltration": (Parameter("n", "1/h", 0.0, 20.0),),
-    "internal_gain": (Parameter("Q", "W", -5000.0, 5000.0),),
-    "solar_absorptance": (Parameter("alpha", "-", 0.0, 1.0),),
-    "conductivity": (Parameter("factor", "-", 0.05, 20.0),),
-    "inside_convection": (Parameter("factor", "-", 0.01, 20.0),),
-    "solar_transmittance": (Parameter("tau", "-", 0.0, 1.0),),
-}
-ZONE_EFFECTS = ("infiltration", "internal_gain", "inside_convection")
-# Where the calibration of an effect the file does not declare starts (see calibration_start).
-ABSENT_START = {("ground_coupling", "U"): 1.0,  # W/m2/K
-                ("infiltration", "n"): 0.5}  # 1/h
+@dataclass(frozen=True)
+class Effect:
+    id: str
+    adds: str  # what it adds, in a few words
+    parameters: tuple  # Parameter records
+    targets: Callable  # building -> target names it applies to
+    read: Callable  # (building, target) -> {name: value} declared now (neutral if not declared)
+    write: Callable  # (JSON data, target, {name: value}) -> None: declare the values
+    points_at: Callable  # (building, target) -> node ids whose forcing points at it; () none
+
+    def applies(self, building, target):
+        return target in self.targets(building)
+
+    def apply(self, building, target, values):
+        """A new Building with the effect declared at `values` ({name: value}; the others as
+        declared now)."""
+        values = {**self.read(building, target), **values}
+        return building.edited(lambda data: self.write(data, target, values))
+
+    def parameter(self, name):
+        return next(p for p in self.parameters if p.name == name)
 
 
 def _component(data, name):
@@ -51,99 +58,120 @@ def _zone(data, name):
     return next(z for z in data["zones"] if z["name"] == name)
 
 
-def applicable(data, effect, target):
-    """Whether `effect` can be added to `target` (a component or zone name) of this building."""
-    if effect in ZONE_EFFECTS:
-        return any(z["name"] == target for z in data["zones"])
-    c = next((c for c in data["components"] if c["name"] == target), None)
-    if c is None:
-        return False
-    kind = c["outside"]["type"]
-    if effect == "ground_coupling":
-        return kind == "adiabatic"
-    if effect == "solar_absorptance":
-        return kind == "exterior"
-    if effect == "solar_transmittance":
-        return c.get("solar_transmittance") is not None
-    return effect == "conductivity"
+def _zone_field(key, parameter):
+    """read and write of an effect that is one number of a zone."""
+    def read(building, target):
+        return {parameter: float(getattr(building.zone(target), key))}
+
+    def write(data, target, values):
+        _zone(data, target)[key] = float(values[parameter])
+    return read, write
 
 
-def current_values(data, effect, target):
-    """The parameters' values the file declares now (their neutral values if not declared)."""
-    if effect == "ground_coupling":
-        out = _component(data, target)["outside"]
-        if out["type"] == "boundary" and not isinstance(out["temperature"], str):
-            return {"U": out["h"], "T_ground": out["temperature"]}
-        return {"U": 0.0, "T_ground": 20.0}
-    if effect in ZONE_EFFECTS:
-        z = _zone(data, target)
-        key = {"infiltration": "air_change_rate", "internal_gain": "internal_gain",
-               "inside_convection": "convection_factor"}[effect]
-        name = EFFECTS[effect][0].name
-        return {name: float(z.get(key, 1.0 if effect == "inside_convection" else 0.0))}
-    c = _component(data, target)
-    if effect == "solar_absorptance":
-        return {"alpha": c["outside"]["solar_absorptance"]}
-    if effect == "solar_transmittance":
-        return {"tau": c["solar_transmittance"]}
-    return {"factor": float(c.get("conductivity_factor", 1.0))}
+def _zones(building):
+    return [z.name for z in building.zones]
 
 
-def calibration_start(data, effect, target):
-    """Where a calibration starts: the declared values, except that an absent coupling (U = 0,
-    n = 0) starts at `ABSENT_START`: on its bound, a bounded trust-region step is scaled to
-    nothing and the fit stops where it began, and at U = 0 the ground temperature has no
-    influence to fit at all."""
-    values = current_values(data, effect, target)
-    for name, value in values.items():
-        if value == 0.0 and (effect, name) in ABSENT_START:
-            values[name] = ABSENT_START[(effect, name)]
-    return values
+def _own_nodes(building, target):
+    return building.component(target).node_ids
 
 
-def apply(data, effect, target, values):
-    """A copy of the building data with the effect declared at `values` ({name: value})."""
-    data = copy.deepcopy(data)
-    values = {**current_values(data, effect, target), **values}
-    if effect == "ground_coupling":
-        if values["U"] > 0:  # U = 0 is no coupling: the face stays as declared
-            _component(data, target)["outside"] = {"type": "boundary", "temperature": float(values["T_ground"]),
-                                                   "h": float(values["U"])}
-    elif effect == "infiltration":
-        _zone(data, target)["air_change_rate"] = float(values["n"])
-    elif effect == "internal_gain":
-        _zone(data, target)["internal_gain"] = float(values["Q"])
-    elif effect == "inside_convection":
-        _zone(data, target)["convection_factor"] = float(values["factor"])
-    elif effect == "solar_absorptance":
-        _component(data, target)["outside"]["solar_absorptance"] = float(values["alpha"])
-    elif effect == "solar_transmittance":
-        _component(data, target)["solar_transmittance"] = float(values["tau"])
-    elif effect == "conductivity":
-        _component(data, target)["conductivity_factor"] = float(values["factor"])
-    else:
-        raise KeyError(f"unknown effect {effect!r}")
-    return data
+def _no_node(building, target):
+    return ()
 
 
-def candidates(data, located_nodes):
-    """(effect, target) pairs a diagnosis should try for the nodes the search located.
+# ground coupling: an adiabatic face becomes a `boundary` at T_ground through U (W/m2/K)
+def _ground_read(building, target):
+    out = building.component(target).outside
+    if isinstance(out, Boundary) and not isinstance(out.temperature, str):
+        return {"U": out.h, "T_ground": out.temperature}
+    return {"U": 0.0, "T_ground": 20.0}
 
-    The located nodes' components bring their own effects; the air node's own equation
-    (infiltration, internal gain) is always a candidate, since no forcing can reveal it; when
-    nothing was located, a change of the inside convection (no single node) is one as well.
-    """
-    owner = {n["id"]: c["name"] for c in data["components"] for n in c["nodes"]}
-    components = list(dict.fromkeys(owner[i] for i in located_nodes if i in owner))
-    pairs = []
-    for name in components:
-        for effect in ("ground_coupling", "solar_absorptance", "conductivity"):
-            if applicable(data, effect, name):
-                pairs.append((effect, name))
-        pairs += [("solar_transmittance", c["name"]) for c in data["components"]
-                  if c.get("transmitted_solar_to") == name and c.get("solar_transmittance") is not None]
-    zones = [z["name"] for z in data["zones"]]
-    pairs += [(effect, zone) for zone in zones for effect in ("infiltration", "internal_gain")]
-    if not located_nodes:
-        pairs += [("inside_convection", zone) for zone in zones]
-    return list(dict.fromkeys(pairs))
+
+def _ground_write(data, target, values):
+    if values["U"] > 0:  # U = 0 is no coupling: the face stays as declared
+        _component(data, target)["outside"] = {"type": "boundary", "temperature": float(values["T_ground"]),
+                                               "h": float(values["U"])}
+
+
+def _absorptance_write(data, target, values):
+    _component(data, target)["outside"]["solar_absorptance"] = float(values["alpha"])
+
+
+def _conductivity_write(data, target, values):
+    _component(data, target)["conductivity_factor"] = float(values["factor"])
+
+
+def _transmittance_write(data, target, values):
+    _component(data, target)["solar_transmittance"] = float(values["tau"])
+
+
+def _receiver_nodes(building, target):
+    return building.component(building.component(target).transmitted_solar_to).node_ids
+
+
+# thermal bridge: a conductance UA from a zone's air to the outdoor air or a boundary column
+def bridge_target(zone, to="outdoor"):
+    return zone if to == "outdoor" else f"{zone}{BRIDGE_TO}{to}"
+
+
+def bridge_parts(target):
+    """(zone, "outdoor" or column) of a thermal_bridge target."""
+    zone, _, to = target.partition(BRIDGE_TO)
+    return zone, to or "outdoor"
+
+
+def _bridge_targets(building):
+    """Each zone to the outdoor air and to every boundary column its surfaces see."""
+    targets = []
+    for z in building.zones:
+        columns = [c.outside.temperature for c in building.components
+                   if c.inside.zone == z.name and isinstance(c.outside, Boundary)
+                   and isinstance(c.outside.temperature, str)]
+        columns += [to for to, _ in z.thermal_bridges if to != "outdoor"]
+        targets += [bridge_target(z.name, to) for to in dict.fromkeys(["outdoor", *columns])]
+    return targets
+
+
+def _bridge_read(building, target):
+    zone, to = bridge_parts(target)
+    return {"UA": float(dict(building.zone(zone).thermal_bridges).get(to, 0.0))}
+
+
+def _bridge_write(data, target, values):
+    zone, to = bridge_parts(target)
+    _zone(data, zone).setdefault("thermal_bridges", {})[to] = float(values["UA"])
+
+
+EFFECTS = {e.id: e for e in (
+    Effect("ground_coupling", "a conductance from an adiabatic face to a ground temperature",
+           (Parameter("U", "W/m2/K", 0.0, 20.0), Parameter("T_ground", "C", -10.0, 40.0)),
+           lambda b: [c.name for c in b.components if isinstance(c.outside, Adiabatic)],
+           _ground_read, _ground_write, _own_nodes),
+    Effect("infiltration", "an air change with the outside",
+           (Parameter("n", "1/h", 0.0, 20.0),), _zones,
+           *_zone_field("air_change_rate", "n"), _no_node),
+    Effect("internal_gain", "a constant heat gain to the air",
+           (Parameter("Q", "W", -5000.0, 5000.0),), _zones,
+           *_zone_field("internal_gain", "Q"), _no_node),
+    Effect("solar_absorptance", "a corrected outside solar absorptance",
+           (Parameter("alpha", "-", 0.0, 1.0),),
+           lambda b: [c.name for c in b.exterior_components],
+           lambda b, t: {"alpha": b.component(t).outside.solar_absorptance}, _absorptance_write, _own_nodes),
+    Effect("conductivity", "a scale on a component's conductances",
+           (Parameter("factor", "-", 0.05, 20.0),), lambda b: [c.name for c in b.components],
+           lambda b, t: {"factor": b.component(t).conductivity_factor}, _conductivity_write, _own_nodes),
+    Effect("inside_convection", "a scale on the inside convective coefficients",
+           (Parameter("factor", "-", 0.01, 20.0),), _zones,
+           *_zone_field("convection_factor", "factor"), _no_node),
+    Effect("solar_transmittance", "a corrected transmittance of a glazing",
+           (Parameter("tau", "-", 0.0, 1.0),),
+           lambda b: [c.name for c in b.components if c.solar_transmittance is not None],
+           lambda b, t: {"tau": b.component(t).solar_transmittance}, _transmittance_write, _receiver_nodes),
+    Effect("thermal_bridge", "a conductance from a zone's air to the outdoor air or a boundary temperature",
+           (Parameter("UA", "W/K", 0.0, 200.0),), _bridge_targets, _bridge_read, _bridge_write, _no_node),
+    Effect("heat_input_split", "a corrected radiative fraction of a zone's measured heat input",
+           (Parameter("f_r", "-", 0.0, 1.0),), lambda b: [z.name for z in b.zones if z.heat_input],
+           *_zone_field("heat_input_radiative_fraction", "f_r"),
+           lambda b, t: b.facing(t)),
+)}

@@ -67,6 +67,24 @@ def imposed(force, measured):
     return force & np.isfinite(measured)
 
 
+def forcing_schedule(force, measured, burn_in_steps=0):
+    """(N_t+1, N) bool: the nodes imposed at each input row t_0..t_N (PHYSICS.md section 5).
+
+    Over the burn-in, rows 1..B, every node measured there is forced (a state observer: the
+    record, not a guess, sets the walls' state); from row B+1 on, the mask's nodes whose
+    measurement exists. The warm-up replays rows 1..M with their own forcing.
+
+    Parameters
+    ----------
+    force : (N,) bool, the forcing mask
+    measured : (N_t+1, N) measured temperatures (C), NaN where missing
+    burn_in_steps : B, steps of the burn-in
+    """
+    forced = imposed(np.asarray(force, dtype=bool), measured)
+    forced[1:burn_in_steps + 1] = np.isfinite(measured[1:burn_in_steps + 1])
+    return forced
+
+
 def initial_state(building, measured0, T_default=20.0):
     """Node temperatures at t_0 (C) from the measurements at t_0.
 
@@ -89,7 +107,7 @@ def initial_state(building, measured0, T_default=20.0):
         T[z.air_node - 1] = fallback
         T[z.radiant_node - 1] = fallback
         for c in building.components:
-            if c.inside["zone"] != z.name:
+            if c.inside.zone != z.name:
                 continue
             idx = np.array(c.node_ids) - 1
             values = measured0[idx]
@@ -105,7 +123,7 @@ def initial_state(building, measured0, T_default=20.0):
 
 
 def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2, T_default=20.0,
-             include_start=False):
+             include_start=False, burn_in_steps=0):
     """Simulate the network over input samples t_0..t_N; return temperatures at t_1..t_N.
 
     Parameters
@@ -119,6 +137,7 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     warmup_days : passes over the first day's inputs (rows 1..24h/dt) before the run
     T_default : C, the initial temperature of a node nothing informs
     include_start : also return the state at t_0 (after the warm-up) as the first row
+    burn_in_steps : B, steps over which every measured node is forced (`forcing_schedule`)
 
     Returns
     -------
@@ -129,8 +148,8 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
         measured = np.full((n_rows, n), np.nan)
     if force is None:
         force = np.zeros(n, dtype=bool)
-    sources = U @ network.B.T + network.q
-    forced = imposed(force, measured)
+    sources = network.sources(U)
+    forced = forcing_schedule(force, measured, burn_in_steps)
     stepper = ImplicitEuler(network, dt)
     T = initial_state(building, measured[0], T_default)
     rows = warmup_rows(n_rows, dt, warmup_days)

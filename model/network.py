@@ -1,15 +1,19 @@
-"""Assemble the nodal network `C dT/dt = A T + B u(t) + q` (PHYSICS.md section 3, paper eq. 5).
+"""Assemble the nodal network `C dT/dt = A T + B u(t) + q + s(u)` (PHYSICS.md section 3, paper eq. 5).
 
 Node i of the building file is row i-1. The input vector u holds, in this order: `T_out`,
-`T_sky` (C), `I_<component>` for each exterior component (W/m2 on its outside face), then the
-building's named input columns (heat inputs W, boundary temperatures C). Constant sources
-(internal gains, fixed boundary temperatures) go to q (W) rather than to a constant input,
-so that u holds only what varies in time.
+`T_sky` (C), the irradiance input of each exterior component (W/m2 on its outside face: its
+`irradiance` column, else `I_<component>`), then the building's other named input columns (heat
+inputs W, supply and boundary temperatures C, shading 0..1). Constant sources (internal gains,
+fixed boundary and supply temperatures) go to q (W) rather than to a constant input, so that u
+holds only what varies in time. The transmitted solar of a shaded glazing, tau s(t) A I(t), is
+the product of two inputs: `products` holds those terms, and `sources` adds them, so the
+network stays linear in the temperatures and M is still factorised once per forcing mask.
 """
 from dataclasses import dataclass
 
 import numpy as np
 
+from .building import Adiabatic, Boundary, Exterior, Surface
 from .discretise import capacities, conductances
 
 RHO_C_AIR = 1.2 * 1005.0  # J/m3/K
@@ -22,6 +26,7 @@ class Network:
     B: np.ndarray  # (N, n_inputs)
     q: np.ndarray  # (N,) W
     input_names: tuple  # names of the columns of B
+    products: tuple = ()  # (node index, input a, input b, coefficient): coefficient u_a u_b W
 
     @property
     def n_nodes(self):
@@ -32,16 +37,31 @@ class Network:
         """Boolean mask of the nodes with no capacity (radiant nodes)."""
         return self.C == 0.0
 
+    def sources(self, U):
+        """B u + q + the products of inputs (W), for one input vector u (n_inputs,) or for rows
+        of inputs U (n_rows, n_inputs), which give (n_rows, N)."""
+        U = np.asarray(U, dtype=float)
+        S = U @ self.B.T + self.q
+        for node, a, b, coefficient in self.products:
+            S[..., node] += coefficient * U[..., a] * U[..., b]
+        return S
+
 
 def input_names(building):
     """The input vector's names, in the order of the columns of B."""
-    return (("T_out", "T_sky") + tuple(f"I_{c.name}" for c in building.exterior_components)
-            + building.input_columns)
+    irradiance = tuple(dict.fromkeys(c.irradiance_input for c in building.exterior_components))
+    named = tuple(n for n in building.input_columns if n not in irradiance)
+    return ("T_out", "T_sky") + irradiance + named
 
 
 def sky_view_factor(tilt):
     """F = (1 + cos(tilt)) / 2 for a tilt in degrees from horizontal (1 for a roof, 0.5 for a wall)."""
     return (1.0 + np.cos(np.radians(tilt))) / 2.0
+
+
+def air_conductance(flow):
+    """(rho c)_air V / 3600 (W/K) of an air flow V (m3/h)."""
+    return RHO_C_AIR * flow / 3600.0
 
 
 def assemble(building):
@@ -53,6 +73,7 @@ def assemble(building):
     A = np.zeros((n, n))
     B = np.zeros((n, len(names)))
     q = np.zeros(n)
+    products = []
 
     def link(i, j, g):
         """A conductance g (W/K) between nodes i and j (0-based)."""
@@ -61,44 +82,60 @@ def assemble(building):
         A[i, j] += g
         A[j, i] += g
 
-    def to_zone(node, zone_name, area, h_conv, h_rad):
-        zone = building.zone(zone_name)
-        link(node, zone.air_node - 1, area * h_conv * zone.convection_factor)
-        link(node, zone.radiant_node - 1, area * h_rad)
+    def to_temperature(node, g, temperature):
+        """A conductance g (W/K) from a node to a temperature: a number (C) or an input column."""
+        A[node, node] -= g
+        if isinstance(temperature, str):
+            B[node, col[temperature]] += g
+        else:
+            q[node] += g * temperature
+
+    def to_zone(node, area, surface):
+        zone = building.zone(surface.zone)
+        link(node, zone.air_node - 1, area * surface.h_conv * zone.convection_factor)
+        link(node, zone.radiant_node - 1, area * surface.h_rad)
 
     for c in building.components:
         idx = [i - 1 for i in c.node_ids]
         C[idx] += c.area * capacities(c.layers, c.depths)
         for k, g in enumerate(conductances(c.layers, c.depths)):
             link(idx[k], idx[k + 1], c.area * g * c.conductivity_factor)
-        to_zone(idx[0], c.inside["zone"], c.area, c.inside["h_conv"], c.inside["h_rad"])
+        to_zone(idx[0], c.area, c.inside)
         e, out = idx[-1], c.outside
-        if out["type"] == "exterior":
+        if isinstance(out, Exterior):
             F = sky_view_factor(c.tilt)
-            A[e, e] -= c.area * (out["h_conv"] + out["h_rad"])
-            B[e, col["T_out"]] += c.area * (out["h_conv"] + out["h_rad"] * (1.0 - F))
-            B[e, col["T_sky"]] += c.area * out["h_rad"] * F
-            B[e, col[f"I_{c.name}"]] += c.area * out["solar_absorptance"]
-        elif out["type"] == "zone":
-            to_zone(e, out["zone"], c.area, out["h_conv"], out["h_rad"])
-        elif out["type"] == "boundary":
-            g = c.area * out["h"]
-            A[e, e] -= g
-            if isinstance(out["temperature"], str):
-                B[e, col[out["temperature"]]] += g
-            else:
-                q[e] += g * out["temperature"]
+            A[e, e] -= c.area * (out.h_conv + out.h_rad)
+            B[e, col["T_out"]] += c.area * (out.h_conv + out.h_rad * (1.0 - F))
+            B[e, col["T_sky"]] += c.area * out.h_rad * F
+            B[e, col[c.irradiance_input]] += c.area * out.solar_absorptance
+        elif isinstance(out, Surface):
+            to_zone(e, c.area, out)
+        elif isinstance(out, Boundary):
+            to_temperature(e, c.area * out.h, out.temperature)
+        else:
+            assert isinstance(out, Adiabatic)
         if c.solar_transmittance is not None:
-            receiver = building.component(c.transmitted_solar_to)
-            B[receiver.node_ids[0] - 1, col[f"I_{c.name}"]] += c.solar_transmittance * c.area
+            receiver = building.component(c.transmitted_solar_to).node_ids[0] - 1
+            transmitted = c.solar_transmittance * c.area
+            if c.shading:
+                products.append((receiver, col[c.irradiance_input], col[c.shading], transmitted))
+            else:
+                B[receiver, col[c.irradiance_input]] += transmitted
 
     for z in building.zones:
-        air = z.air_node - 1
+        air, radiant = z.air_node - 1, z.radiant_node - 1
         C[air] += RHO_C_AIR * z.volume
-        g_vent = RHO_C_AIR * z.volume * z.air_change_rate / 3600.0
-        A[air, air] -= g_vent
-        B[air, col["T_out"]] += g_vent
+        to_temperature(air, air_conductance(z.volume * z.air_change_rate), "T_out")
+        if z.supply is not None:
+            to_temperature(air, air_conductance(z.supply.flow), z.supply.temperature)
+        for inflow in z.airflow_from:
+            g = air_conductance(inflow.flow)
+            A[air, air] -= g
+            A[air, building.zone(inflow.zone).air_node - 1] += g
+        for to, UA in z.thermal_bridges:
+            to_temperature(air, UA, "T_out" if to == "outdoor" else to)
         q[air] += z.internal_gain
-        if z.heat_input:
-            B[air, col[z.heat_input]] += 1.0
-    return Network(C=C, A=A, B=B, q=q, input_names=names)
+        for name in z.heat_input:
+            B[air, col[name]] += 1.0 - z.heat_input_radiative_fraction
+            B[radiant, col[name]] += z.heat_input_radiative_fraction
+    return Network(C=C, A=A, B=B, q=q, input_names=names, products=tuple(products))

@@ -8,12 +8,12 @@ from pathlib import Path
 
 import numpy as np
 
-from nodeforce.model.building import parse_building, read_building_data
+from nodeforce.model.building import load_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
 from nodeforce.model.measurements import read_measurements
-from nodeforce.model.score import metrics
+from nodeforce.model.score import Objective
 from nodeforce.model.weather import read_weather
 
 DATA = Path(str(files("nodeforce.model") / "data"))
@@ -36,14 +36,23 @@ def node_list(option, text):
 
 
 def load_inputs(args):
-    """Building (data and parsed), and the case of its weather and measurements."""
-    data = read_building_data(args.building)
-    building = parse_building(data, source=args.building)
+    """The building, the case of its weather and measurements with its burn-in, and the objective."""
+    building = load_building(args.building)
     weather = read_weather(args.weather)
     measurements = read_measurements(args.measurements) if getattr(args, "measurements", None) else None
     case = prepare_case(building, weather, measurements)
     check_warmup(case, args.measurements or args.weather)
-    return data, building, case
+    case = case.with_burn_in(args.burn_in_days)
+    objective = Objective.of(building, zone_list(args.objective) if getattr(args, "objective", None) else None)
+    return building, case, objective
+
+
+def zone_list(text):
+    """Zone names from "living,kitchen"."""
+    names = [part.strip() for part in text.split(",") if part.strip()]
+    if not names:
+        raise InputError("--objective", text, "names no zone")
+    return names
 
 
 def check_warmup(case, source):
@@ -71,7 +80,7 @@ def force_mask(case, ids, source):
 
 def cmd_fmu(args):
     from nodeforce.fmu_build.build import build_fmu
-    path = build_fmu(read_building_data(args.building), args.output, source=args.building)
+    path = build_fmu(load_building(args.building), args.output)
     print(f"wrote {path}")
 
 
@@ -79,21 +88,23 @@ def cmd_simulate(args):
     from nodeforce.cosim.fmi2 import FmuInstance
     from nodeforce.cosim.run import simulate_fmu
     from nodeforce.fmu_build.build import build_fmu
-    from nodeforce.model.report import write_node_temperatures
+    from nodeforce.model.report import write_node_names, write_node_temperatures
     if args.force and not args.measurements:
         raise InputError("--force", args.force, "forcing needs --measurements to force nodes to")
-    data, building, case = load_inputs(args)
+    building, case, objective = load_inputs(args)
     force = force_mask(case, node_list("--force", args.force), args.measurements) if args.force else None
     with tempfile.TemporaryDirectory(prefix="nodeforce_") as tmp:
-        with FmuInstance(build_fmu(data, Path(tmp) / "model.fmu", source=args.building)) as instance:
+        with FmuInstance(build_fmu(building, Path(tmp) / "model.fmu")) as instance:
             T = simulate_fmu(instance, case, force)
     write_node_temperatures(args.output, case.times[1:], T)
+    names = write_node_names(args.output, building)
     print(f"wrote {args.output}: nodes 1..{T.shape[1]} at {len(T)} times "
-          f"({case.times[1].isoformat()} to {case.times[-1].isoformat()}, step {case.dt:g} s)")
-    air = building.zones[0].air_node
-    measured_air = case.measured[1:, air - 1]
-    if np.isfinite(measured_air).any():
-        print(f"air node {air}: RMSE {metrics(measured_air, T[:, air - 1])['rmse']:.3f} C against the measurements")
+          f"({case.times[1].isoformat()} to {case.times[-1].isoformat()}, step {case.dt:g} s); node names in {names}")
+    measured = objective.measured(case)
+    simulated = T[:, np.array(objective.air_nodes) - 1]
+    if np.isfinite(measured).any():
+        for zone, m in objective.metrics(measured, simulated)["zones"].items():
+            print(f"{zone} air: RMSE {m['rmse']:.3f} C against the measurements ({m['n']} scored steps)")
 
 
 def check_search_settings(args):
@@ -116,14 +127,10 @@ def check_workers(args):
 def cmd_locate(args):
     from nodeforce.ga.locate import locate
     check_search_settings(args)
-    data, building, case = load_inputs(args)
-    if args.burn_in_days:
-        if not 0 < args.burn_in_days < (case.times[-1] - case.times[0]).total_seconds() / 86400:
-            raise InputError("--burn-in-days", args.burn_in_days, "must be positive and shorter than the record")
-        case = case.unscored_start(building.zones[0].air_node, args.burn_in_days)
+    building, case, objective = load_inputs(args)
     out = Path(args.output)
     out.mkdir(parents=True, exist_ok=True)
-    result = locate(data, building, case, out, source=args.measurements,
+    result = locate(building, case, objective, out, source=args.measurements,
                     nodes=node_list("--nodes", args.nodes) if args.nodes else None,
                     include_algebraic=args.include_algebraic, population=args.population,
                     generations=args.generations, pc=args.pc, pm=args.pm, seed=args.seed,
@@ -135,7 +142,7 @@ def cmd_locate(args):
 
 def locate_summary(result):
     """A short table of the single-node scores (the paper's Table 4) and the answer."""
-    lines = [f"J unforced: {result['J_unforced']:.3f} C2 on node {result['output_node']}",
+    lines = [f"J unforced: {result['J_unforced']:.3f} C2 on the air of {', '.join(result['objective'])}",
              f"{'node':>6}{'J forced alone':>16}"]
     for node in result["ranked_nodes"][:8]:
         lines.append(f"{node:>6}{result['node_scores'][str(node)]:>16.3f}")
@@ -158,7 +165,7 @@ def effect_spec(text):
                                            "ground_coupling@floor:U=0.8,T_ground=24") from None
     if effect not in EFFECTS:
         raise InputError("--effect", effect, f"unknown effect; one of {', '.join(EFFECTS)}")
-    names = {p.name for p in EFFECTS[effect]}
+    names = {p.name for p in EFFECTS[effect].parameters}
     if set(values) - names:
         raise InputError("--effect", ",".join(sorted(set(values) - names)), f"{effect} has parameters {', '.join(sorted(names))}")
     return effect, target, values
@@ -166,15 +173,14 @@ def effect_spec(text):
 
 def cmd_synth(args):
     import pandas as pd
-    from nodeforce.model import effects
+    from nodeforce.model.effects import EFFECTS
     from nodeforce.model.synth import pseudo_measurements
-    data = read_building_data(args.building)
+    building = load_building(args.building)
     if args.effect:
         effect, target, values = effect_spec(args.effect)
-        if not effects.applicable(data, effect, target):
+        if not EFFECTS[effect].applies(building, target):
             raise InputError("--effect", f"{effect}@{target}", f"does not apply to {args.building}")
-        data = effects.apply(data, effect, target, values)
-    building = parse_building(data, source=args.building)
+        building = EFFECTS[effect].apply(building, target, values)
     for option, value, ok in (("--days", args.days, args.days >= 1), ("--step", args.step, args.step > 0),
                               ("--noise", args.noise, args.noise >= 0),
                               ("--history-days", args.history_days, args.history_days >= 0)):
@@ -198,22 +204,31 @@ def cmd_synth(args):
           f"noise {args.noise} C" + (f", with {args.effect} not in {args.building}" if args.effect else ""))
 
 
-def run_diagnosis(data, building, case, out, source, args):
+def run_diagnosis(building, case, objective, out, source, args):
+    import pandas as pd
     from nodeforce.diagnose.loop import diagnose
     from nodeforce.diagnose.report import before_after_table
     if not 0.0 < args.calibration_fraction < 1.0:
         raise InputError("--calibration-fraction", args.calibration_fraction, "a fraction between 0 and 1")
+    end = None
+    if args.calibration_end:
+        try:
+            end = pd.Timestamp(args.calibration_end)
+        except ValueError:
+            raise InputError("--calibration-end", args.calibration_end, "not an ISO 8601 time") from None
+        if end.tzinfo is None:
+            raise InputError("--calibration-end", args.calibration_end, "needs a UTC offset, e.g. 2013-09-14T00:00+01:00")
     check_workers(args)
     out.mkdir(parents=True, exist_ok=True)
-    report = diagnose(data, building, case, out, source=source, fraction=args.calibration_fraction,
-                      seed=args.seed, workers=args.workers)
+    report = diagnose(building, case, objective, out, source=source, fraction=args.calibration_fraction,
+                      calibration_end=end, seed=args.seed, workers=args.workers)
     print(before_after_table(report))
     print(f"wrote {out / 'report.json'}, {out / 'report.md'}, {out / 'building_after.json'}, {out / 'model_after.fmu'}")
 
 
 def cmd_diagnose(args):
-    data, building, case = load_inputs(args)
-    run_diagnosis(data, building, case, Path(args.output), args.measurements, args)
+    building, case, objective = load_inputs(args)
+    run_diagnosis(building, case, objective, Path(args.output), args.measurements, args)
 
 
 DEMO_COMMAND = ("nodeforce synth model/data/testcell_miami.json --weather model/data/miami_tmy2.csv "
@@ -222,14 +237,13 @@ DEMO_COMMAND = ("nodeforce synth model/data/testcell_miami.json --weather model/
 
 
 def cmd_demo(args):
-    building_path = DATA / "testcell_miami.json"
-    data = read_building_data(building_path)
-    building = parse_building(data, source=str(building_path))
+    building = load_building(DATA / "testcell_miami.json")
     measurements_path = DATA / "demo_measurements.csv"
     case = prepare_case(building, read_weather(DATA / "miami_tmy2.csv"), read_measurements(measurements_path))
     print(f"{building.name}: measurements {measurements_path.name} carry an effect the building file does "
           f"not declare (made by: {DEMO_COMMAND})")
-    run_diagnosis(data, building, case, Path(args.output), str(measurements_path), args)
+    run_diagnosis(building, case.with_burn_in(args.burn_in_days), Objective.of(building), Path(args.output),
+                  str(measurements_path), args)
 
 
 def case_arguments(s, measurements_required, output_help, output_default=None):
@@ -245,6 +259,20 @@ def diagnosis_arguments(s):
     s.add_argument("--workers", type=int, help="processes (default: all cores)")
     s.add_argument("--calibration-fraction", type=float, default=0.6,
                    help="the first part of the record, by time, that calibrates; the rest validates")
+    s.add_argument("--calibration-end",
+                   help="the last calibration time, ISO 8601 with UTC offset (instead of the fraction)")
+    burn_in_argument(s, 1.0)
+
+
+def burn_in_argument(s, default):
+    s.add_argument("--burn-in-days", type=float, default=default,
+                   help=f"days after t_0 over which every measured node is forced and nothing is scored "
+                        f"(PHYSICS.md section 5; default {default:g})")
+
+
+def objective_argument(s):
+    s.add_argument("--objective", help="zones whose measured air J sums, e.g. living,kitchen "
+                                       "(default: the first zone of the building file)")
 
 
 def parser():
@@ -259,6 +287,8 @@ def parser():
     s = sub.add_parser("simulate", help="simulate a building through its FMU")
     case_arguments(s, False, "the CSV of node temperatures to write", output_default="sim.csv")
     s.add_argument("--force", help="node ids forced to their measurements, e.g. 1,7,9")
+    burn_in_argument(s, 0.0)
+    objective_argument(s)
     s.set_defaults(run=cmd_simulate)
 
     s = sub.add_parser("locate", help="search the forcing that best explains the measured air")
@@ -273,14 +303,14 @@ def parser():
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--workers", type=int, help="processes (default: all cores)")
     s.add_argument("--scheduler", help="a Dask scheduler address, tcp://host:port")
-    s.add_argument("--burn-in-days", type=float, default=0.0,
-                   help="days after t_0 simulated but not scored (default 0: J over t_1..t_N); the "
-                        "warm-up replays the first day, which a record with real history may not match")
+    burn_in_argument(s, 0.0)
+    objective_argument(s)
     s.set_defaults(run=cmd_locate)
 
     s = sub.add_parser("diagnose", help="localise, add the missing effect, calibrate, report before/after")
     case_arguments(s, True, "folder for report.json, report.md, building_after.json")
     diagnosis_arguments(s)
+    objective_argument(s)
     s.set_defaults(run=cmd_diagnose)
 
     s = sub.add_parser("synth", help="measurements of a building, optionally with an effect its file does not declare")

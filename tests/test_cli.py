@@ -16,6 +16,8 @@ from nodeforce.model.synth import pseudo_measurements
 from nodeforce.cli import main
 from tests.conftest import DATA, SENSORS, record_times
 
+pytestmark = pytest.mark.slow  # searches, diagnoses or other importers: not in `make check`
+
 
 @pytest.fixture(scope="module")
 def files(tmp_path_factory, testcell_data, weather):

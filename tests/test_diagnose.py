@@ -8,12 +8,15 @@ import pytest
 from fmpy.validation import validate_fmu
 
 from nodeforce.diagnose.loop import diagnose
-from nodeforce.model import effects
+from nodeforce.model.effects import EFFECTS
 from nodeforce.model.building import load_building, parse_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.errors import InputError
+from nodeforce.model.score import Objective
 from nodeforce.model.synth import pseudo_measurements
 from tests.conftest import SENSORS
+
+pytestmark = pytest.mark.slow  # searches, diagnoses or other importers: not in `make check`
 
 NOISE = 0.1
 TRUTH = {
@@ -22,6 +25,9 @@ TRUTH = {
     "internal_gain": ("cell", {"Q": 100.0}),
     "solar_absorptance": ("roof", {"alpha": 0.6}),
 }
+# Days of record: the burn-in sets the floor's state from its sensors, so a weak ground coupling
+# (1.9 W/m2) shows only as the slow drift it causes, which 12 days do not separate from noise.
+DAYS = {"ground_coupling": 20}
 
 
 def record(days=12):
@@ -29,17 +35,18 @@ def record(days=12):
 
 
 def measured_with(testcell_data, weather, effect=None, seed=5):
-    data = testcell_data
+    days = DAYS.get(effect, 12)
+    building = parse_building(testcell_data)
     if effect:
         target, values = TRUTH[effect]
-        data = effects.apply(testcell_data, effect, target, values)
-    return pseudo_measurements(parse_building(data), weather, record(), SENSORS, noise_sd=NOISE, seed=seed,
+        building = EFFECTS[effect].apply(building, target, values)
+    return pseudo_measurements(building, weather, record(days), SENSORS, noise_sd=NOISE, seed=seed,
                                history_days=7)
 
 
 def run(tmp_path, testcell_data, testcell, weather, measurements, workers=1):
-    case = prepare_case(testcell, weather, measurements)
-    return diagnose(testcell_data, testcell, case, tmp_path, seed=0, workers=workers)
+    case = prepare_case(testcell, weather, measurements).with_burn_in(1)
+    return diagnose(testcell, case, Objective.of(testcell), tmp_path, seed=0, workers=workers)
 
 
 @pytest.mark.parametrize("effect", list(TRUTH))
@@ -48,18 +55,19 @@ def test_diagnose_finds_the_undeclared_effect(tmp_path, testcell_data, testcell,
     target, truth = TRUTH[effect]
     assert (report["effect"]["effect"], report["effect"]["target"]) == (effect, target)
     for name, p in report["effect"]["parameters"].items():
+        # a one-parameter effect is determined by these data; U and T_ground trade off (what the
+        # data fix there is the heat flux, checked below)
+        assert p["identifiable"] or effect == "ground_coupling", name
         if p["identifiable"]:
-            if name == "T_ground":
-                assert abs(p["value"] - truth[name]) <= 1.0
-            else:
-                assert abs(p["value"] - truth[name]) <= 0.25 * abs(truth[name]), name
+            tolerance = 1.0 if name == "T_ground" else 0.25 * abs(truth[name])
+            assert abs(p["value"] - truth[name]) <= max(tolerance, 3 * p["std"]), name
     before, after = report["before"]["validation"]["rmse"], report["after"]["validation"]["rmse"]
     assert after <= max(before / 2, 1.5 * NOISE)
     if effect == "ground_coupling":
         # what the data fix even when U and T_ground trade off: the heat flux through the ground,
         # here against the "real" floor's underside over the scored calibration steps
-        truth_building = parse_building(effects.apply(testcell_data, effect, target, truth))
-        underside = pseudo_measurements(truth_building, weather, record(), [21], history_days=7)["T21"]
+        truth_building = EFFECTS[effect].apply(testcell, target, truth)
+        underside = pseudo_measurements(truth_building, weather, record(DAYS[effect]), [21], history_days=7)["T21"]
         scored = underside[report["period"]["calibration_scored_from"]:report["period"]["calibration"][1]]
         flux = truth["U"] * (truth["T_ground"] - scored.mean())
         assert report["effect"]["derived"]["ground_heat_flux"]["value"] == pytest.approx(flux, rel=0.15)
@@ -69,7 +77,7 @@ def test_diagnose_finds_the_undeclared_effect(tmp_path, testcell_data, testcell,
     # every candidate exists as a building file declaring its calibrated effect
     for c in report["candidates"]:
         declared = json.loads((tmp_path / "candidates" / f"{c['effect']}@{c['target']}.json").read_text())
-        values = effects.current_values(declared, c["effect"], c["target"])
+        values = EFFECTS[c["effect"]].read(parse_building(declared), c["target"])
         for name, p in c["parameters"].items():
             if not (c["effect"] == "ground_coupling" and values["U"] == 0.0):
                 assert values[name] == pytest.approx(p["value"])
@@ -97,7 +105,7 @@ def test_gaps_stay_gaps_and_short_records_are_refused(tmp_path, testcell_data, t
     assert report["effect"]["effect"] == "internal_gain"
 
     short = measured_with(testcell_data, weather).iloc[: 2 * 96 + 1]
-    with pytest.raises(InputError, match="too short to split"):
+    with pytest.raises(InputError, match="leaves no calibration window"):
         run(tmp_path, testcell_data, testcell, weather, short)
     no_air = measured_with(testcell_data, weather).drop(columns="T23")
     with pytest.raises(InputError, match="T23"):

@@ -7,14 +7,14 @@ import pytest
 from nodeforce.cosim.fmi2 import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.fmu_build.build import build_fmu
-from nodeforce.model import effects
-from nodeforce.model.building import parse_building
+from nodeforce.diagnose.candidates import candidates
+from nodeforce.model.building import Boundary, parse_building
+from nodeforce.model.effects import EFFECTS
 from nodeforce.model.integrate import simulate
 from nodeforce.model.network import assemble
 
 
-def direct(data, case):
-    b = parse_building(data)
+def direct(b, case):
     return simulate(b, assemble(b), case.U, case.dt, case.measured)
 
 
@@ -26,12 +26,13 @@ CASES = [
     ("conductivity", "door", {"factor": 3.4}),
     ("inside_convection", "cell", {"factor": 0.3}),
     ("solar_transmittance", "window", {"tau": 0.5}),
+    ("thermal_bridge", "cell", {"UA": 4.0}),
 ]
 
 
 @pytest.mark.parametrize("effect,target,values", CASES, ids=[c[0] for c in CASES])
-def test_fmu_parameters_equal_the_declared_effect(tmp_path, testcell_data, real_case, effect, target, values):
-    fmu = build_fmu(testcell_data, tmp_path / "m.fmu", effect=(effect, target))
+def test_fmu_parameters_equal_the_declared_effect(tmp_path, testcell, real_case, effect, target, values):
+    fmu = build_fmu(testcell, tmp_path / "m.fmu", effect=(effect, target))
     parameters = {f"{effect}.{k}": v for k, v in values.items()}
     with FmuInstance(fmu) as instance:
         assert set(parameters) <= set(instance.names("parameter"))
@@ -39,9 +40,9 @@ def test_fmu_parameters_equal_the_declared_effect(tmp_path, testcell_data, real_
         changed = simulate_fmu(instance, real_case, parameters=parameters)
         again = simulate_fmu(instance, real_case)
     # at its start values the FMU is the building as declared; a reset forgets the parameters
-    assert np.abs(start - direct(testcell_data, real_case)).max() < 1e-9
+    assert np.abs(start - direct(testcell, real_case)).max() < 1e-9
     assert np.array_equal(start, again)
-    expected = direct(effects.apply(testcell_data, effect, target, values), real_case)
+    expected = direct(EFFECTS[effect].apply(testcell, target, values), real_case)
     assert np.abs(changed - expected).max() < 1e-9
     assert np.abs(changed - start).max() > 0.05  # the effect does something
 
@@ -51,33 +52,59 @@ def test_conductivity_factor_equals_scaling_the_materials(testcell_data, real_ca
     scaled = copy.deepcopy(testcell_data)
     for name in ("concrete", "polystyrene", "heavy_concrete"):
         scaled["materials"][name]["conductivity"] *= 2.5
-    by_factor = effects.apply(testcell_data, "conductivity", "floor", {"factor": 2.5})
-    assert np.abs(direct(by_factor, real_case) - direct(scaled, real_case)).max() < 1e-9
+    by_factor = EFFECTS["conductivity"].apply(parse_building(testcell_data), "floor", {"factor": 2.5})
+    assert np.abs(direct(by_factor, real_case) - direct(parse_building(scaled), real_case)).max() < 1e-9
 
 
 def test_convection_factor_equals_scaling_every_inside_coefficient(testcell_data, real_case):
     scaled = copy.deepcopy(testcell_data)
     for c in scaled["components"]:
         c["inside"]["h_conv"] *= 0.02
-    by_factor = effects.apply(testcell_data, "inside_convection", "cell", {"factor": 0.02})
-    assert np.abs(direct(by_factor, real_case) - direct(scaled, real_case)).max() < 1e-9
+    by_factor = EFFECTS["inside_convection"].apply(parse_building(testcell_data), "cell", {"factor": 0.02})
+    assert np.abs(direct(by_factor, real_case) - direct(parse_building(scaled), real_case)).max() < 1e-9
 
 
-def test_ground_coupling_is_a_boundary_face(testcell_data):
-    after = effects.apply(testcell_data, "ground_coupling", "floor", {"U": 0.5, "T_ground": 24.0})
-    floor = next(c for c in after["components"] if c["name"] == "floor")
+def test_ground_coupling_is_a_boundary_face(testcell_data, testcell):
+    after = EFFECTS["ground_coupling"].apply(testcell, "floor", {"U": 0.5, "T_ground": 24.0})
+    assert after.component("floor").outside == Boundary(temperature=24.0, h=0.5)
+    floor = next(c for c in after.to_json()["components"] if c["name"] == "floor")
     assert floor["outside"] == {"type": "boundary", "temperature": 24.0, "h": 0.5}
-    assert next(c for c in testcell_data["components"] if c["name"] == "floor")["outside"]["type"] == "adiabatic"
-    assert effects.current_values(after, "ground_coupling", "floor") == {"U": 0.5, "T_ground": 24.0}
+    # the building it came from is unchanged
+    assert testcell.to_json() == testcell_data
+    assert EFFECTS["ground_coupling"].read(after, "floor") == {"U": 0.5, "T_ground": 24.0}
     # once coupled, the floor is no longer adiabatic: the effect cannot be added twice
-    assert not effects.applicable(after, "ground_coupling", "floor")
+    assert not EFFECTS["ground_coupling"].applies(after, "floor")
 
 
-def test_candidates_follow_the_located_nodes(testcell_data):
+def test_every_effect_reads_back_what_it_writes(testcell):
+    for effect, target, values in CASES:
+        after = EFFECTS[effect].apply(testcell, target, values)
+        assert EFFECTS[effect].read(after, target) == pytest.approx(values), effect
+
+
+def test_candidates_follow_the_located_nodes(testcell):
     air = [("infiltration", "cell"), ("internal_gain", "cell")]
     # node 17 is in the floor: adiabatic below, and it receives the window's sun
-    assert effects.candidates(testcell_data, [17]) == [
+    assert candidates(testcell, [17], ["cell"]) == [
         ("ground_coupling", "floor"), ("conductivity", "floor"), ("solar_transmittance", "window"), *air]
-    assert effects.candidates(testcell_data, [9, 10]) == [
+    assert candidates(testcell, [9, 10], ["cell"]) == [
         ("solar_absorptance", "roof"), ("conductivity", "roof"), *air]
-    assert effects.candidates(testcell_data, []) == [*air, ("inside_convection", "cell")]
+    assert candidates(testcell, [], ["cell"]) == [*air, ("inside_convection", "cell")]
+
+
+def test_a_zone_with_supply_air_gets_a_thermal_bridge_not_an_infiltration():
+    from .test_zones import multizone_with_everything
+    b = multizone_with_everything()
+    # zone A has supply air (flow known): its air-to-outside term is a bridge; zone B has none
+    pairs = candidates(b, [], ["A", "B"])
+    assert ("thermal_bridge", "A") in pairs and ("infiltration", "A") not in pairs
+    assert ("infiltration", "B") in pairs
+    # bridges to the boundary columns the zone's surfaces see (A's floor sees T_cellar)
+    assert ("thermal_bridge", "A->T_cellar") in pairs
+    # forcing B's surfaces points at its heat input's radiative split
+    wall_B = b.component("wB").node_ids[0]
+    assert ("heat_input_split", "B") in candidates(b, [wall_B], ["A"])
+    after = EFFECTS["heat_input_split"].apply(b, "B", {"f_r": 0.8})
+    assert after.zone("B").heat_input_radiative_fraction == 0.8
+    after = EFFECTS["thermal_bridge"].apply(b, "A->T_cellar", {"UA": 2.5})
+    assert dict(after.zone("A").thermal_bridges) == {"T_cellar": 2.5}

@@ -16,7 +16,7 @@ from nodeforce.model.network import assemble
 
 @pytest.fixture(scope="module")
 def fmu(tmp_path_factory, testcell_data):
-    return build_fmu(testcell_data, tmp_path_factory.mktemp("fmu") / "testcell.fmu")
+    return build_fmu(parse_building(testcell_data), tmp_path_factory.mktemp("fmu") / "testcell.fmu")
 
 
 def forcing(*ids, n=23):
@@ -129,8 +129,8 @@ def test_get_and_set_fmu_state_replays_identically(fmu):
 def test_two_different_fmus_in_one_process_run_their_own_model(tmp_path, testcell_data, real_case):
     leaky = copy.deepcopy(testcell_data)
     leaky["materials"]["wood"]["conductivity"] = 0.78  # the paper's disturbed door
-    fmu_a = build_fmu(testcell_data, tmp_path / "a.fmu")
-    fmu_b = build_fmu(leaky, tmp_path / "b.fmu")
+    fmu_a = build_fmu(parse_building(testcell_data), tmp_path / "a.fmu")
+    fmu_b = build_fmu(parse_building(leaky), tmp_path / "b.fmu")
     with FmuInstance(fmu_a) as a, FmuInstance(fmu_b) as b:
         out_a = simulate_fmu(a, real_case, output_ids=[23])
         out_b = simulate_fmu(b, real_case, output_ids=[23])

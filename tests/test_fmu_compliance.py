@@ -3,7 +3,10 @@ import numpy as np
 import pytest
 
 from nodeforce.fmu_build.build import build_fmu
+from nodeforce.model.building import parse_building
 from tests.importers import fmpy_validate, fmutool_check, run_ecos, run_fmpy, run_libcosim
+
+pytestmark = pytest.mark.slow  # searches, diagnoses or other importers: not in `make check`
 
 N_STEPS = 96
 DT = 900.0
@@ -11,7 +14,7 @@ DT = 900.0
 
 @pytest.fixture(scope="module")
 def fmu(tmp_path_factory, testcell_data):
-    return build_fmu(testcell_data, tmp_path_factory.mktemp("compliance") / "testcell.fmu")
+    return build_fmu(parse_building(testcell_data), tmp_path_factory.mktemp("compliance") / "testcell.fmu")
 
 
 @pytest.fixture(scope="module")

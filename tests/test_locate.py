@@ -8,9 +8,12 @@ import pytest
 from nodeforce.ga.locate import chromosome_nodes, locate
 from nodeforce.model.building import parse_building
 from nodeforce.model.case import prepare_case
+from nodeforce.model.score import Objective
 from nodeforce.model.synth import pseudo_measurements
 from nodeforce.cli import main
 from tests.conftest import SENSORS, record_times
+
+pytestmark = pytest.mark.slow  # searches, diagnoses or other importers: not in `make check`
 
 
 def disturbed(data, fault):
@@ -35,7 +38,7 @@ def test_search_points_at_the_disturbed_sub_model(tmp_path, testcell_data, testc
     measurements = pseudo_measurements(disturbed(testcell_data, fault), weather, record_times(), every_node,
                                        noise_sd=noise, seed=7)
     case = prepare_case(testcell, weather, measurements)
-    result = locate(testcell_data, testcell, case, tmp_path, population=16, generations=12, seed=3, workers=2)
+    result = locate(testcell, case, Objective.of(testcell), tmp_path, population=16, generations=12, seed=3, workers=2)
     # the radiant node is algebraic: no sub-model, so not a candidate
     assert 22 not in result["chromosome_nodes"] and len(result["chromosome_nodes"]) == 21
     assert result["search"]["method"] == "ga"
@@ -54,10 +57,11 @@ def test_search_points_at_the_disturbed_sub_model(tmp_path, testcell_data, testc
 def test_radiant_node_is_a_candidate_only_on_request(testcell, weather, testcell_data):
     measurements = pseudo_measurements(testcell, weather, record_times(days=2), list(range(1, 24)))
     case = prepare_case(testcell, weather, measurements)
-    assert 22 not in chromosome_nodes(testcell, case, "m.csv")
-    assert 22 in chromosome_nodes(testcell, case, "m.csv", include_algebraic=True)
+    objective = Objective.of(testcell)
+    assert 22 not in chromosome_nodes(testcell, case, objective, "m.csv")
+    assert 22 in chromosome_nodes(testcell, case, objective, "m.csv", include_algebraic=True)
     # nearest the air first: inside surfaces before the nodes behind them
-    order = chromosome_nodes(testcell, case, "m.csv")
+    order = chromosome_nodes(testcell, case, objective, "m.csv")
     assert order.index(9) < order.index(10) and order.index(15) < order.index(17)
 
 
@@ -74,7 +78,7 @@ def test_locate_command_on_the_papers_sensors_is_exhaustive(tmp_path, testcell_d
                  "-o", str(out), "--workers", "1"]) == 0
     result = json.loads((out / "locate.json").read_text())
     assert result["measured_nodes"] == [1, 7, 9, 16, 17, 23]
-    assert result["output_node"] == 23
+    assert result["output_node"] == 23 and result["output_nodes"] == [23] and result["objective"] == ["cell"]
     assert sorted(result["chromosome_nodes"]) == [1, 7, 9, 16, 17]
     # 2^5 = 32 masks fit in 30 x 400: every one is scored, once
     assert result["search"]["method"] == "exhaustive"

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from nodeforce.model.building import parse_building
+from nodeforce.model.building import Boundary, Exterior, parse_building
 from nodeforce.model.discretise import capacities, conductances
 from nodeforce.model.integrate import simulate
 from nodeforce.model.network import assemble
@@ -105,23 +105,40 @@ def test_steady_state_equals_hand_computed_conductance_network():
 
 
 def boundary_heat_in(building, T, u):
-    """Heat entering the building (W) through its outside faces, the ventilation, the
-    transmitted sun and the gains, written from PHYSICS.md section 3 term by term."""
+    """Heat entering the building (W) through its outside faces, the air flows, the transmitted
+    sun and the gains, written from PHYSICS.md section 3 term by term (flows between zones move
+    heat inside the building and leave at the zone's temperature: only what enters from outside
+    or leaves to it counts)."""
+    rho_c = 1.2 * 1005
     Q = 0.0
     for c in building.components:
         e, out = T[c.node_ids[-1] - 1], c.outside
-        if out["type"] == "exterior":
+        if isinstance(out, Exterior):
             F = (1 + np.cos(np.radians(c.tilt))) / 2
-            Q += c.area * (out["h_conv"] * (u["T_out"] - e)
-                           + out["h_rad"] * (F * (u["T_sky"] - e) + (1 - F) * (u["T_out"] - e))
-                           + out["solar_absorptance"] * u[f"I_{c.name}"])
-        elif out["type"] == "boundary":
-            Q += c.area * out["h"] * (out["temperature"] - e)
+            I = u[out.irradiance or f"I_{c.name}"]
+            Q += c.area * (out.h_conv * (u["T_out"] - e)
+                           + out.h_rad * (F * (u["T_sky"] - e) + (1 - F) * (u["T_out"] - e))
+                           + out.solar_absorptance * I)
+        elif isinstance(out, Boundary):
+            T_b = u[out.temperature] if isinstance(out.temperature, str) else out.temperature
+            Q += c.area * out.h * (T_b - e)
         if c.solar_transmittance is not None:
-            Q += c.solar_transmittance * c.area * u[f"I_{c.name}"]
+            I = u[c.outside.irradiance or f"I_{c.name}"]
+            Q += c.solar_transmittance * c.area * I * (u[c.shading] if c.shading else 1.0)
+    # Air: what enters from outside at its temperature, what leaves at the zone's. The flows
+    # between zones enter one zone at the other's temperature and leave it at the same.
     for z in building.zones:
-        Q += 1.2 * 1005 * z.volume * z.air_change_rate / 3600 * (u["T_out"] - T[z.air_node - 1])
-        Q += z.internal_gain
+        air = T[z.air_node - 1]
+        Q += rho_c * z.volume * z.air_change_rate / 3600 * (u["T_out"] - air)
+        if z.supply is not None:
+            T_sup = u[z.supply.temperature] if isinstance(z.supply.temperature, str) else z.supply.temperature
+            Q += rho_c * z.supply.flow / 3600 * T_sup
+        inflow = (z.supply.flow if z.supply else 0.0) + sum(f.flow for f in z.airflow_from)
+        outflow = sum(f.flow for other in building.zones for f in other.airflow_from if f.zone == z.name)
+        Q -= rho_c * (inflow - outflow) / 3600 * air  # the balance leaves the building from here
+        for to, UA in z.thermal_bridges:
+            Q += UA * ((u["T_out"] if to == "outdoor" else u[to]) - air)
+        Q += z.internal_gain + sum(u[name] for name in z.heat_input)
     return Q
 
 

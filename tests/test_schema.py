@@ -8,13 +8,16 @@ from pathlib import Path
 import jsonschema
 import pytest
 
-from nodeforce.model import effects
-from nodeforce.model.building import parse_building
+from nodeforce.model.building import Boundary, parse_building
+from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
 
 DATA = Path(__file__).parents[1] / "model" / "data"
 SCHEMA = json.loads((DATA / "nodal-building.schema.json").read_text())
 TESTCELL = json.loads((DATA / "testcell.json").read_text())
+# the test cell with a measured heater, 30 % radiative
+HEATED = copy.deepcopy(TESTCELL)
+HEATED["zones"][0].update(heat_input="heater", heat_input_radiative_fraction=0.3)
 
 # A sensible value for every effect, on the test cell element it fits.
 EFFECT_CASES = {
@@ -25,6 +28,8 @@ EFFECT_CASES = {
     "solar_absorptance": ("roof", {"alpha": 0.6}),
     "conductivity": ("roof", {"factor": 2.0}),
     "solar_transmittance": ("window", {"tau": 0.6}),
+    "thermal_bridge": ("cell", {"UA": 3.0}),
+    "heat_input_split": ("cell", {"f_r": 0.6}),
 }
 
 
@@ -70,27 +75,27 @@ def test_bundled_buildings_validate(validator, name):
 
 
 def test_every_effect_is_covered():
-    assert set(EFFECT_CASES) == set(effects.EFFECTS)
+    assert set(EFFECT_CASES) == set(EFFECTS)
 
 
 @pytest.mark.parametrize("effect", sorted(EFFECT_CASES))
 def test_building_with_an_effect_validates_and_loads(validator, effect):
     target, values = EFFECT_CASES[effect]
-    assert effects.applicable(TESTCELL, effect, target)
-    data = effects.apply(TESTCELL, effect, target, values)
-    assert data != TESTCELL
+    building = parse_building(HEATED)
+    assert EFFECTS[effect].applies(building, target)
+    data = EFFECTS[effect].apply(building, target, values).to_json()
+    assert data != HEATED
     assert errors(validator, data) == []
     parse_building(data)
 
 
 def test_building_with_all_effects_validates_and_loads(validator):
-    data = TESTCELL
+    building = parse_building(HEATED)
     for effect, (target, values) in EFFECT_CASES.items():
-        data = effects.apply(data, effect, target, values)
-    data["zones"][0]["heat_input"] = "heater"
-    assert errors(validator, data) == []
-    b = parse_building(data)
-    assert b.component("floor").outside == {"type": "boundary", "temperature": 24.0, "h": 2.0}
+        building = EFFECTS[effect].apply(building, target, values)
+    assert errors(validator, building.to_json()) == []
+    b = parse_building(building.to_json())
+    assert b.component("floor").outside == Boundary(temperature=24.0, h=2.0)
     assert b.component("roof").conductivity_factor == 2.0
     assert b.zone("cell").convection_factor == 1.3
 

@@ -1,0 +1,59 @@
+"""Which effects a diagnosis tries, and where their calibrations start: the diagnosis' policy.
+
+Kept apart from the effect records (`nodeforce.model.effects`), which an FMU bundles: changing
+the policy changes no FMU and throws away no saved search.
+"""
+from nodeforce.model.effects import EFFECTS, bridge_parts
+
+# Where the calibration of an effect the file does not declare starts (see calibration_start).
+ABSENT_START = {("ground_coupling", "U"): 1.0,  # W/m2/K
+                ("infiltration", "n"): 0.5,  # 1/h
+                ("thermal_bridge", "UA"): 5.0}  # W/K
+
+
+def candidates(building, located_nodes, zones):
+    """(effect, target) pairs a diagnosis should try.
+
+    Parameters
+    ----------
+    building : Building
+    located_nodes : node ids the forcing search located
+    zones : names of the objective zones
+
+    The effects whose forcing points at a located node come first (those of the located
+    components, a glazing whose sun they receive, a zone's heat input split when its surfaces are
+    located). The air node's own equation is always a candidate, since no forcing can reveal it,
+    for the objective zones and any zone whose air was located: a constant gain, and an air-to-
+    outside conductance, reported as `thermal_bridge` where the zone has mechanical supply air
+    (whose flow is known) and as `infiltration` otherwise (PHYSICS.md section 7), plus bridges to
+    the boundary temperatures the zone's surfaces see. When nothing was located, a change of the
+    inside convection (no single node) is one as well.
+    """
+    located = set(located_nodes)
+    pairs = [(effect.id, target) for effect in EFFECTS.values() for target in effect.targets(building)
+             if located & set(effect.points_at(building, target))]
+    air_zones = list(zones) + [z.name for z in building.zones if z.air_node in located]
+    for name in dict.fromkeys(air_zones):
+        supplied = building.zone(name).supply is not None
+        if not supplied:
+            pairs.append(("infiltration", name))
+        pairs.append(("internal_gain", name))
+        for target in EFFECTS["thermal_bridge"].targets(building):
+            zone, to = bridge_parts(target)
+            if zone == name and (to != "outdoor" or supplied):
+                pairs.append(("thermal_bridge", target))
+    if not located:
+        pairs += [("inside_convection", name) for name in zones]
+    return list(dict.fromkeys(pairs))
+
+
+def calibration_start(building, effect, target):
+    """Where a calibration starts: the declared values, except that an absent coupling (U = 0,
+    n = 0, UA = 0) starts at `ABSENT_START`: on its bound, a bounded trust-region step is scaled
+    to nothing and the fit stops where it began, and at U = 0 the ground temperature has no
+    influence to fit at all."""
+    values = EFFECTS[effect].read(building, target)
+    for name, value in values.items():
+        if value == 0.0 and (effect, name) in ABSENT_START:
+            values[name] = ABSENT_START[(effect, name)]
+    return values
