@@ -80,8 +80,8 @@ def prepare_case(building, weather, measurements=None):
     Parameters
     ----------
     building : Building
-    weather : DataFrame from `model.weather.read_weather`
-    measurements : DataFrame from `model.measurements.read_measurements`, or None
+    weather : DataFrame from `nodeforce.iotools.weather.read_weather`
+    measurements : DataFrame from `nodeforce.iotools.measurements.read_measurements`, or None
 
     Returns
     -------
@@ -128,8 +128,8 @@ def simulate_building(building, weather, measurements=None, force=(), warmup_day
     Parameters
     ----------
     building : Building (`model.building.load_building`)
-    weather : DataFrame from `model.weather.read_weather`
-    measurements : DataFrame from `model.measurements.read_measurements`, or None; it sets the
+    weather : DataFrame from `nodeforce.iotools.weather.read_weather`
+    measurements : DataFrame from `nodeforce.iotools.measurements.read_measurements`, or None; it sets the
         time grid, the initial state and the values forced nodes take
     force : node ids forced to their measurements for the whole run
     warmup_days : passes over the first day before the run (PHYSICS.md section 5)

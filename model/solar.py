@@ -52,7 +52,7 @@ def solar_position(times, latitude, longitude, altitude):
     ----------
     times : pandas.DatetimeIndex
         Sample times, timezone-aware. The position is the instantaneous one at each time, so
-        hour-averaged irradiance should be stamped at the middle of its hour (see model.weather).
+        hour-averaged irradiance should be stamped at the middle of its hour (see nodeforce.iotools.hourly).
     latitude, longitude : float
         Site, degrees (north and east positive).
     altitude : float

@@ -12,9 +12,9 @@ from nodeforce.model.building import parse_building, read_building_data
 from nodeforce.model.case import prepare_case
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
-from nodeforce.model.measurements import read_measurements
+from nodeforce.iotools.measurements import read_measurements
 from nodeforce.model.score import metrics
-from nodeforce.model.weather import read_weather
+from nodeforce.iotools.weather import read_weather
 
 DATA = Path(str(files("nodeforce.model") / "data"))
 

@@ -5,7 +5,7 @@ import pandas as pd
 import pytest
 
 from nodeforce.model.errors import InputError
-from nodeforce.model.measurements import read_measurements
+from nodeforce.iotools.measurements import read_measurements
 
 GOOD = """time,T23,T1,T17
 2024-06-01T00:00:00+04:00,24.1,23.0,22.5

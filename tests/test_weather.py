@@ -10,13 +10,9 @@ import pytest
 
 from nodeforce.model.errors import InputError
 from nodeforce.model.solar import solar_position
-from nodeforce.model.weather import (
-    convert_typical_year,
-    main,
-    read_weather,
-    relocate,
-    weather_on_grid,
-)
+from nodeforce.iotools.typical_year import convert_typical_year, main, relocate
+from nodeforce.iotools.weather import read_weather
+from nodeforce.model.weather import weather_on_grid
 
 PVLIB_DATA = Path(pvlib.__file__).parent / "data"
 MODEL_DATA = Path(__file__).resolve().parents[1] / "model" / "data"
@@ -170,7 +166,7 @@ def test_epw_rows_sit_at_mid_hour_with_codes_as_missing(tmp_path):
 
 def test_typical_year_epw_is_refused_with_the_way_out(tmp_path):
     path = epw(tmp_path, [2011, 1997])
-    with pytest.raises(InputError, match="model.weather convert") as caught:
+    with pytest.raises(InputError, match="iotools.typical_year convert") as caught:
         read_weather(path)
     assert caught.value.field == "time"
 

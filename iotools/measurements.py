@@ -7,7 +7,7 @@ filled; the model handles a missing measurement where it uses one (PHYSICS.md se
 import re
 
 from nodeforce.model.errors import InputError
-from nodeforce.model.weather import check_celsius, read_time_table
+from .timetable import check_celsius, read_time_table
 
 _NODE_COLUMN = re.compile(r"T([1-9][0-9]*)")
 
@@ -31,9 +31,9 @@ def read_measurements(path):
     Raises
     ------
     InputError
-        Naming the file and the column: the checks of `model.weather.read_time_table` (time
+        Naming the file and the column: the checks of `iotools.timetable.read_time_table` (time
         column, times, non-numeric cells), a column not named `T<id>`, no measured column,
-        kelvin-looking temperatures (median above `model.weather.KELVIN_MEDIAN`).
+        kelvin-looking temperatures (median above `iotools.timetable.KELVIN_MEDIAN`).
     """
     frame = read_time_table(path)
     for name in frame.columns:
