@@ -112,6 +112,18 @@ def check_increasing(source, times, where):
         raise InputError(source, "time", f"{where(i)}: {times[i].isoformat()} {what}; times must increase")
 
 
+def instant(option, text):
+    """The tz-aware Timestamp of an ISO 8601 time given with its UTC offset; InputError naming
+    `option` (e.g. "--origin") otherwise."""
+    try:
+        time = pd.Timestamp(text)
+    except ValueError:
+        raise InputError(option, text, "not an ISO 8601 time") from None
+    if time.tzinfo is None:
+        raise InputError(option, text, "needs a UTC offset, e.g. 2013-01-01T00:00+01:00")
+    return time
+
+
 def one_line(error):
     """An exception's message on one line."""
     return " ".join(str(error).split())
