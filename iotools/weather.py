@@ -8,13 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from nodeforce.model.errors import InputError
-from nodeforce.model.weather import (
-    IRRADIANCE_COLUMNS,
-    OPTIONAL_COLUMNS,
-    REQUIRED_COLUMNS,
-    TEMPERATURE_COLUMNS,
-    utc_microseconds,
-)
+from nodeforce.model.weather import IRRADIANCE_COLUMNS, REQUIRED_COLUMNS, TEMPERATURE_COLUMNS, utc_microseconds
 from .hourly import read_epw, to_mid_hour
 from .timetable import check_celsius, read_time_table
 
@@ -30,14 +24,17 @@ def read_weather(path):
     Parameters
     ----------
     path : str or Path
-        Weather CSV (columns `time`, `T_out` C, `ghi`, `dni`, `dhi` W/m2, optional `T_sky` C,
-        `ir_h` W/m2 and `I_<component>` W/m2) or `.epw` file.
+        Weather CSV or `.epw` file. The CSV has `time` and `T_out` (C); `ghi`, `dni`, `dhi` (W/m2)
+        where some face's irradiance is computed; optionally `T_sky` (C), `ir_h` (W/m2),
+        `I_<component>` (W/m2) and any column a building file refers to by name (heat inputs,
+        boundary and supply temperatures, irradiance, shading). Which columns a building may use
+        is checked where the building is known (`nodeforce.model.weather.check_columns`).
 
     Returns
     -------
     pandas.DataFrame
-        Indexed by a tz-aware DatetimeIndex named "time", columns among those above, float, in
-        their units; missing values are NaN. `attrs["source"]` is the path. An EPW file gives
+        Indexed by a tz-aware DatetimeIndex named "time", the file's columns, float, in their
+        units; missing values are NaN. `attrs["source"]` is the path. An EPW file gives
         `T_out`, `ghi`, `dni`, `dhi`, `ir_h` at the middle of each hour (`iotools.hourly`); its
         missing-value codes (99.9 C, 9999 W/m2) become NaN and the first row's `T_out`, which
         would need the reading before the file starts, is NaN.
@@ -45,8 +42,8 @@ def read_weather(path):
     Raises
     ------
     InputError
-        Naming the file and the column: the checks of `read_time_table`, a missing required or an
-        unknown column, kelvin-looking temperatures, irradiance below `IRRADIANCE_FLOOR`, negative
+        Naming the file and the column: the checks of `read_time_table`, no `T_out`, kelvin-looking
+        `T_out` or `T_sky`, irradiance below `IRRADIANCE_FLOOR`, negative
         `ir_h`, an EPW typical year (years mixed; convert it with
         `nodeforce.iotools.typical_year.convert_typical_year`).
     """
@@ -55,12 +52,6 @@ def read_weather(path):
         weather = _read_epw_weather(source)
     else:
         weather = read_time_table(path)
-    for name in weather.columns:
-        if name not in REQUIRED_COLUMNS + OPTIONAL_COLUMNS and not _is_component_irradiance(name):
-            raise InputError(
-                source, name,
-                "unknown weather column (expected T_out, ghi, dni, dhi, T_sky, ir_h or I_<component>)",
-            )
     for name in REQUIRED_COLUMNS:
         if name not in weather.columns:
             raise InputError(source, name, "required weather column is missing")

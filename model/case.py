@@ -5,6 +5,7 @@ time grid: the measurement grid when there are measurements (weather interpolate
 else the weather's own. It never fills a gap: a missing measurement stays NaN (the node is then
 computed, PHYSICS.md section 5) and a missing input is refused.
 """
+import re
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -13,8 +14,8 @@ import pandas as pd
 from .errors import InputError
 from .integrate import simulate
 from .network import assemble, input_names
-from .solar import incident_irradiance, sky_temperature, solar_position
-from .weather import weather_on_grid
+from .solar import incident_irradiance, measured_irradiance, sky_temperature, solar_position
+from .weather import IRRADIANCE_COLUMNS, check_columns, weather_on_grid
 
 
 @dataclass(frozen=True)
@@ -61,13 +62,24 @@ def uniform_grid(times, source):
     return pd.date_range(times[0], times[-1], freq=pd.Timedelta(seconds=dt), name="time"), dt
 
 
+_NODE_COLUMN = re.compile(r"T([1-9][0-9]*)")
+
+
 def measured_matrix(building, measurements, times):
-    """(len(times), N) node temperatures (C) from `T<id>` columns, NaN where not measured."""
+    """(len(times), N) node temperatures (C) from the measurement columns, NaN where not measured.
+
+    A column `T<id>` measures node id (a positive integer without leading zeros); any other
+    column is an InputError naming the measurement file and the column.
+    """
     source = measurements.attrs.get("source", "measurements")
     matrix = np.full((len(times), building.n_nodes), np.nan)
     on_grid = measurements.reindex(times)
     for column in measurements.columns:
-        node = int(str(column)[1:])
+        match = _NODE_COLUMN.fullmatch(str(column))
+        if not match:
+            raise InputError(source, column, "measures no node: measurement columns are named T<node id>, "
+                                             "a positive integer without leading zeros, e.g. T23")
+        node = int(match.group(1))
         if not 1 <= node <= building.n_nodes:
             raise InputError(source, column, f"node {node} does not exist (the building has nodes 1..{building.n_nodes})")
         matrix[:, node - 1] = on_grid[column].to_numpy(float)
@@ -85,26 +97,46 @@ def prepare_case(building, weather, measurements=None):
 
     Returns
     -------
-    Case with inputs `T_out`, `T_sky` (C), `I_<component>` (W/m2, measured column if the weather
-    has it, else pvlib's isotropic transposition) and the building's named columns.
+    Case with inputs `T_out`, `T_sky` (C), `I_<component>` (W/m2, the weather's measured column
+    if `model.solar.measured_irradiance` finds one, else pvlib's isotropic transposition of
+    `ghi`, `dni`, `dhi`) and the building's named columns.
+
+    Raises
+    ------
+    InputError
+        Naming the weather file and the column: a column the building has no use for
+        (`model.weather.check_columns`), `ghi`, `dni` or `dhi` missing where a face's irradiance
+        is computed (naming the face), a named column missing, a gap in an input; naming the
+        measurement file: times off a uniform grid, a column that measures no node.
     """
     source = weather.attrs.get("source", "weather")
+    check_columns(building, weather)
     if measurements is not None:
         times, dt = uniform_grid(measurements.index, measurements.attrs.get("source", "measurements"))
     else:
         times, dt = uniform_grid(weather.index, source)
     w = weather_on_grid(weather, times)
     site = building.site
-    position = solar_position(times, site["latitude"], site["longitude"], site["altitude"])
     columns = {
         "T_out": w["T_out"].to_numpy(float),
         "T_sky": sky_temperature(w["T_out"], ir_h=w.get("ir_h"), T_sky=w.get("T_sky")),
     }
+    computed = []
     for c in building.exterior_components:
-        measured_sun = w.get(f"I_{c.name}")
-        columns[f"I_{c.name}"] = (measured_sun.to_numpy(float) if measured_sun is not None else
-                                  incident_irradiance(position, w["ghi"], w["dni"], w["dhi"],
-                                                      c.tilt, c.azimuth, site["ground_albedo"]))
+        measured_sun = measured_irradiance(c, w.columns)
+        if measured_sun is None:
+            computed.append(c)
+        else:
+            columns[f"I_{c.name}"] = w[measured_sun].to_numpy(float)
+    if computed:
+        for name in IRRADIANCE_COLUMNS:
+            if name not in w:
+                raise InputError(source, name, f"needed to compute the solar irradiance on {computed[0].name}, "
+                                                "which no weather column measures")
+        position = solar_position(times, site["latitude"], site["longitude"], site["altitude"])
+        for c in computed:
+            columns[f"I_{c.name}"] = incident_irradiance(position, w["ghi"], w["dni"], w["dhi"],
+                                                         c.tilt, c.azimuth, site["ground_albedo"])
     for name in building.input_columns:
         if name not in w:
             raise InputError(source, name, f"the building {building.source} refers to this input column, "

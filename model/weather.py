@@ -8,9 +8,11 @@ import pandas as pd
 
 from nodeforce.model.errors import InputError
 
-REQUIRED_COLUMNS = ("T_out", "ghi", "dni", "dhi")
-OPTIONAL_COLUMNS = ("T_sky", "ir_h")
+#: Every weather file has the outdoor air temperature.
+REQUIRED_COLUMNS = ("T_out",)
+#: Needed only where some exterior face's irradiance is computed rather than measured.
 IRRADIANCE_COLUMNS = ("ghi", "dni", "dhi")
+OPTIONAL_COLUMNS = ("T_sky", "ir_h")
 TEMPERATURE_COLUMNS = ("T_out", "T_sky")
 
 #: Two weather rows further apart than this many typical (median) steps bound a gap: samples
@@ -70,6 +72,38 @@ def weather_on_grid(weather, times):
     on_grid = pd.DataFrame(blended, index=times, columns=weather.columns)
     on_grid.attrs["source"] = source
     return on_grid
+
+
+def check_columns(building, weather):
+    """Refuse a weather column the building has no use for: a misspelt name is caught, not ignored.
+
+    Parameters
+    ----------
+    building : Building
+    weather : pandas.DataFrame
+        As returned by `nodeforce.iotools.weather.read_weather` (`attrs["source"]` names the file).
+
+    Raises
+    ------
+    InputError
+        Naming the weather file and the first column that is neither standard (`T_out`, `ghi`,
+        `dni`, `dhi`, `T_sky`, `ir_h`, `I_<exterior component>`) nor one the building refers to
+        (`building.input_columns`).
+    """
+    exterior = [c.name for c in building.exterior_components]
+    known = set(REQUIRED_COLUMNS + IRRADIANCE_COLUMNS + OPTIONAL_COLUMNS + building.input_columns)
+    known.update(f"I_{name}" for name in exterior)
+    for name in weather.columns:
+        if name in known:
+            continue
+        if name.startswith("I_"):
+            problem = (f"names no exterior component of {building.source} (its exterior components: "
+                       f"{', '.join(exterior) or 'none'}): a misspelt name?")
+        else:
+            referred = ", ".join(building.input_columns) or "none"
+            problem = (f"neither a standard weather column ({', '.join(REQUIRED_COLUMNS + IRRADIANCE_COLUMNS + OPTIONAL_COLUMNS)}, "
+                       f"I_<exterior component>) nor one {building.source} refers to ({referred}): a misspelt name?")
+        raise InputError(weather.attrs.get("source", "weather"), name, problem)
 
 
 def utc_microseconds(times):
