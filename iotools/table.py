@@ -8,12 +8,23 @@ for, and a constant column (`--set`) holds exactly the value the user states.
 import csv
 import math
 from pathlib import Path
+from typing import NamedTuple
 
 import pandas as pd
 
 from nodeforce.model.errors import InputError
 from .combitimetable import read_combitimetable
 from .timetable import instant, one_line, write_time_table
+
+
+class Selected(NamedTuple):
+    """A column to write: its name in the CSV (`out`), its name in the table (`name`), and where
+    the user gave the pair, for error messages: `source` (`--select` or the file) and `at`
+    ("line N: " in a file, else "")."""
+    out: str
+    name: str
+    source: str
+    at: str
 
 
 def column_names(text, table_path):
@@ -56,13 +67,12 @@ def column_names(text, table_path):
 
 
 def selection(text):
-    """[(OUT, IN), ...] from `--select OUT=IN,...` or `--select @FILE` (one OUT=IN a line, # comments).
+    """The columns to write, from `--select OUT=IN,...` or `--select @FILE` (one OUT=IN a line,
+    `#` comments and blank lines allowed).
 
     Returns
     -------
-    list of (str, str, str, str)
-        (OUT, IN, source, where): the name written, the name read, and where the pair was given
-        (`--select` or the file, and "" or "line N") for later error messages.
+    list of Selected
     """
     if text.startswith("@"):
         source = text[1:]
@@ -72,23 +82,22 @@ def selection(text):
             raise InputError(source, "file", "not found") from None
         except (OSError, UnicodeDecodeError) as error:
             raise InputError(source, "file", one_line(error)) from None
-        items = [(f"line {n}", line.split("#", 1)[0].strip()) for n, line in enumerate(lines, start=1)]
+        items = [(f"line {n}: ", line.split("#", 1)[0].strip()) for n, line in enumerate(lines, start=1)]
     else:
         source = "--select"
         items = [("", item.strip()) for item in text.split(",")]
     pairs, seen = [], set()
-    for where, item in items:
+    for at, item in items:
         if not item and source != "--select":
             continue
         out, equals, name = (part.strip() for part in item.partition("="))
         if not (equals and out and name):
-            raise InputError(source, item, f"{where + ': ' if where else ''}must read OUT=IN (the name to write, "
-                                           "then the table's column name), e.g. T_out=Ambient_temperature")
+            raise InputError(source, item, f"{at}must read OUT=IN (the name to write, then the table's column "
+                                           "name), e.g. T_out=Ambient_temperature")
         if out in seen or out == "time":
-            raise InputError(source, out, f"{where + ': ' if where else ''}"
-                                          f"{'written twice' if out in seen else 'the time column is always written'}")
+            raise InputError(source, out, at + ("written twice" if out in seen else "the time column is always written"))
         seen.add(out)
-        pairs.append((out, name, source, where))
+        pairs.append(Selected(out, name, source, at))
     if not pairs:
         raise InputError(source, "file", "selects no column")
     return pairs
@@ -140,13 +149,13 @@ def convert_table(table_path, names, origin, select, output, table=None, start=N
         What was written, indexed by time.
     """
     frame = read_combitimetable(table_path, names, origin, table=table)
-    for out, name, source, where in select:
-        if name not in frame.columns:
-            raise InputError(source, name, f"{where + ': ' if where else ''}not a column of {table_path} "
-                                           f"(its names: {_shorten(frame.columns)})")
+    for column in select:
+        if column.name not in frame.columns:
+            raise InputError(column.source, column.name, f"{column.at}not a column of {table_path} "
+                                                         f"(its names: {_shorten(frame.columns)})")
     constant = constant or {}
     for name in constant:
-        if name in (out for out, *_ in select):
+        if name in (column.out for column in select):
             raise InputError("--set", name, "also a column selected with --select")
     if frame.empty:
         raise InputError(table_path, "time", "the table has no rows")
@@ -157,7 +166,7 @@ def convert_table(table_path, names, origin, select, output, table=None, start=N
         raise InputError("--start" if start is not None else "--end", start if start is not None else end,
                          f"no row from {first.isoformat()} to {last.isoformat()} (the table runs from "
                          f"{frame.index[0].isoformat()} to {frame.index[-1].isoformat()})")
-    written = pd.DataFrame({out: kept[name] for out, name, *_ in select}, index=kept.index)
+    written = pd.DataFrame({column.out: kept[column.name] for column in select}, index=kept.index)
     for name, value in constant.items():
         written[name] = value
     write_time_table(written, output)

@@ -106,6 +106,8 @@ def test_names_file_orders_by_column_and_refuses_a_gap(tmp_path):
     names = write(tmp_path, "name,column_1based\nT_b,3\ntime,1\nT_a,2\n", "names.csv")
     assert column_names(str(names), "table.txt") == NAMES
     assert column_names("time, T_a,T_b", "table.txt") == NAMES
+    several = write(tmp_path, "file,name\nother.txt,x\ntable.txt,time\ntable.txt,T_a\ntable.txt,T_b\n", "files.csv")
+    assert column_names(str(several), tmp_path / "table.txt") == NAMES  # the rows of this file only
     gap = write(tmp_path, "name,column_1based\nT_b,4\ntime,1\nT_a,2\n", "gap.csv")
     with pytest.raises(InputError) as caught:
         column_names(str(gap), "table.txt")
@@ -120,7 +122,7 @@ def table_command(tmp_path, *extra):
                  *extra]), out
 
 
-def test_table_command_selects_renames_cuts_and_sets(tmp_path):
+def test_table_command_selects_renames_cuts_and_sets(tmp_path, capsys):
     select = write(tmp_path, "# outdoor air\nT_out=T_b\n\nT23 = T_a  # the zone\n", "select.txt")
     status, out = table_command(tmp_path, "--select", f"@{select}", "--start", "2024-06-01T05:10Z",
                                 "--set", "shading_south=0,ghi=12.5")
@@ -131,6 +133,10 @@ def test_table_command_selects_renames_cuts_and_sets(tmp_path):
                          "2024-06-01T00:20:00-05:00,0.5,22.0,0.0,12.5"]
     weather = read_weather(out)
     assert weather["T_out"].tolist() == [-2.5, 0.5]
+    bad = write(tmp_path, "T_out=T_b\nT23 T_a\n", "bad_select.txt")
+    assert table_command(tmp_path, "--select", f"@{bad}")[0] == 2
+    assert capsys.readouterr().err.strip() == f"nodeforce: {bad}: T23 T_a: line 2: must read OUT=IN (the name " \
+                                              "to write, then the table's column name), e.g. T_out=Ambient_temperature"
     status, out = table_command(tmp_path, "--select", "T1=T_a,T2=T_b", "--end", "2024-06-01T00:10-05:00")
     assert status == 0
     measured = read_measurements(out)
