@@ -18,8 +18,6 @@ from nodeforce.model.errors import InputError
 from nodeforce.model.synth import pseudo_measurements
 from tests.conftest import SENSORS, record_times
 
-DAY = 86400.0
-
 
 def named(testcell_data):
     """The test cell with a measured cellar under its floor and a measured heater in its air."""
