@@ -48,7 +48,7 @@ from nodeforce.model.integrate import initial_state, simulate, warmup_rows
 from nodeforce.model.network import assemble
 from nodeforce.model.score import Objective
 from nodeforce.model.synth import pseudo_measurements
-from nodeforce.model.weather import read_weather
+from nodeforce.iotools.weather import read_weather
 
 DATA = Path(__file__).resolve().parents[1] / "model" / "data"
 DAYS, WARMUP_DAYS = 5, 2

@@ -28,7 +28,7 @@ DEPTH_TOLERANCE = 1e-9
 # A sensor's depth names the node nearest it within this distance (m): positions in a building
 # description are rounded to the millimetre.
 SENSOR_TOLERANCE = 1e-3
-NODE_COLUMN = re.compile(r"T(\d+)$")
+NODE_COLUMN = re.compile(r"T([1-9][0-9]*)$")  # no leading zero: T01 is not T1
 
 
 @dataclass(frozen=True)

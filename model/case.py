@@ -13,8 +13,8 @@ import pandas as pd
 from .errors import InputError
 from .integrate import simulate
 from .network import assemble, input_names
-from .solar import incident_irradiance, sky_temperature, solar_position
-from .weather import weather_on_grid
+from .solar import incident_irradiance, measured_irradiance, sky_temperature, solar_position
+from .weather import IRRADIANCE_COLUMNS, check_columns, weather_on_grid
 
 
 @dataclass(frozen=True)
@@ -73,8 +73,15 @@ def uniform_grid(times, source):
     return pd.date_range(times[0], times[-1], freq=pd.Timedelta(seconds=dt), name="time"), dt
 
 
+
+
 def measured_matrix(building, measurements, times):
-    """(len(times), N) node temperatures (C) from `T<id>` columns, NaN where not measured."""
+    """(len(times), N) node temperatures (C) from the measurement columns, NaN where not measured.
+
+    A column `T<id>` measures node id, a column named as one of the building's sensors measures
+    that sensor's node; any other column is an InputError naming the measurement file and the
+    column.
+    """
     source = measurements.attrs.get("source", "measurements")
     matrix = np.full((len(times), building.n_nodes), np.nan)
     on_grid = measurements.reindex(times)
@@ -95,38 +102,56 @@ def prepare_case(building, weather, measurements=None):
     Parameters
     ----------
     building : Building
-    weather : DataFrame from `model.weather.read_weather`
-    measurements : DataFrame from `model.measurements.read_measurements`, or None
+    weather : DataFrame from `nodeforce.iotools.weather.read_weather`
+    measurements : DataFrame from `nodeforce.iotools.measurements.read_measurements`, or None
 
     Returns
     -------
-    Case with inputs `T_out`, `T_sky` (C), `I_<component>` (W/m2, measured column if the weather
-    has it, else pvlib's isotropic transposition) and the building's named columns.
+    Case with inputs `T_out`, `T_sky` (C), `I_<component>` (W/m2, the weather's measured column
+    if `model.solar.measured_irradiance` finds one, else pvlib's isotropic transposition of
+    `ghi`, `dni`, `dhi`) and the building's named columns.
+
+    Raises
+    ------
+    InputError
+        Naming the weather file and the column: a column the building has no use for
+        (`model.weather.check_columns`), `ghi`, `dni` or `dhi` missing where a face's irradiance
+        is computed (naming the face), a named column missing, a gap in an input; naming the
+        measurement file: times off a uniform grid, a column that measures no node.
     """
     source = weather.attrs.get("source", "weather")
+    check_columns(building, weather)
     if measurements is not None:
         times, dt = uniform_grid(measurements.index, measurements.attrs.get("source", "measurements"))
     else:
         times, dt = uniform_grid(weather.index, source)
     w = weather_on_grid(weather, times)
     site = building.site
-    position = solar_position(times, site["latitude"], site["longitude"], site["altitude"])
     columns = {
         "T_out": w["T_out"].to_numpy(float),
         "T_sky": sky_temperature(w["T_out"], ir_h=w.get("ir_h"), T_sky=w.get("T_sky")),
     }
-    for c in building.exterior_components:
-        if c.outside.irradiance:
-            continue
-        measured_sun = w.get(f"I_{c.name}")
-        columns[f"I_{c.name}"] = (measured_sun.to_numpy(float) if measured_sun is not None else
-                                  incident_irradiance(position, w["ghi"], w["dni"], w["dhi"],
-                                                      c.tilt, c.azimuth, site["ground_albedo"]))
     for name in building.input_columns:
         if name not in w:
             raise InputError(source, name, f"the building {building.source} refers to this input column, "
                                             "which the weather file does not have")
         columns[name] = w[name].to_numpy(float)
+    computed = []
+    for c in building.exterior_components:
+        measured_sun = measured_irradiance(c, w.columns)
+        if measured_sun is None:
+            computed.append(c)
+        else:
+            columns[c.irradiance_input] = w[measured_sun].to_numpy(float)
+    if computed:
+        for name in IRRADIANCE_COLUMNS:
+            if name not in w:
+                raise InputError(source, name, f"needed to compute the solar irradiance on {computed[0].name}, "
+                                                "which no weather column measures")
+        position = solar_position(times, site["latitude"], site["longitude"], site["altitude"])
+        for c in computed:
+            columns[f"I_{c.name}"] = incident_irradiance(position, w["ghi"], w["dni"], w["dhi"],
+                                                         c.tilt, c.azimuth, site["ground_albedo"])
     names = input_names(building)
     U = np.column_stack([np.asarray(columns[n], dtype=float) for n in names])
     missing = ~np.isfinite(U)
@@ -145,8 +170,8 @@ def simulate_building(building, weather, measurements=None, force=(), warmup_day
     Parameters
     ----------
     building : Building (`model.building.load_building`)
-    weather : DataFrame from `model.weather.read_weather`
-    measurements : DataFrame from `model.measurements.read_measurements`, or None; it sets the
+    weather : DataFrame from `nodeforce.iotools.weather.read_weather`
+    measurements : DataFrame from `nodeforce.iotools.measurements.read_measurements`, or None; it sets the
         time grid, the initial state and the values forced nodes take
     force : node ids forced to their measurements for the whole run
     warmup_days : passes over the first day before the run (PHYSICS.md section 5)

@@ -45,6 +45,29 @@ def sky_temperature(T_out, ir_h=None, T_sky=None):
     return 0.0552 * (np.asarray(T_out, dtype=float) + ZERO_CELSIUS) ** 1.5 - ZERO_CELSIUS
 
 
+def measured_irradiance(component, columns):
+    """The weather column measuring the irradiance on a component's outside face, or None.
+
+    Parameters
+    ----------
+    component : Component
+        An exterior component of the building.
+    columns : collection of str
+        The weather's columns.
+
+    Returns
+    -------
+    str or None
+        The face's own `irradiance` column when the building names one (several faces may share
+        it); else `I_<component name>` when the weather has it (W/m2); None when the face's
+        irradiance is to be computed from `ghi`, `dni`, `dhi` (`incident_irradiance`).
+    """
+    if component.outside.irradiance:
+        return component.outside.irradiance
+    name = f"I_{component.name}"
+    return name if name in columns else None
+
+
 def solar_position(times, latitude, longitude, altitude):
     """Sun position at each sample time, to be shared by all surfaces of a building.
 
@@ -52,7 +75,7 @@ def solar_position(times, latitude, longitude, altitude):
     ----------
     times : pandas.DatetimeIndex
         Sample times, timezone-aware. The position is the instantaneous one at each time, so
-        hour-averaged irradiance should be stamped at the middle of its hour (see model.weather).
+        hour-averaged irradiance should be stamped at the middle of its hour (see nodeforce.iotools.hourly).
     latitude, longitude : float
         Site, degrees (north and east positive).
     altitude : float

@@ -12,9 +12,9 @@ from nodeforce.model.building import load_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
-from nodeforce.model.measurements import read_measurements
+from nodeforce.iotools.measurements import read_measurements
+from nodeforce.iotools.weather import read_weather
 from nodeforce.model.score import Objective
-from nodeforce.model.weather import read_weather
 
 DATA = Path(str(files("nodeforce.model") / "data"))
 
@@ -231,6 +231,15 @@ def cmd_diagnose(args):
     run_diagnosis(building, case, objective, Path(args.output), args.measurements, args)
 
 
+def cmd_table(args):
+    from nodeforce.iotools.table import column_names, constants, convert_table, selection
+    written = convert_table(args.table_file, column_names(args.names, args.table_file), args.origin,
+                            selection(args.select), args.output, table=args.table, start=args.start,
+                            end=args.end, constant=constants(args.set) if args.set else None)
+    print(f"wrote {args.output}: {', '.join(written.columns)} at {len(written)} times "
+          f"({written.index[0].isoformat()} to {written.index[-1].isoformat()})")
+
+
 DEMO_COMMAND = ("nodeforce synth model/data/testcell_miami.json --weather model/data/miami_tmy2.csv "
                 "--effect ground_coupling@floor:U=0.8,T_ground=24 --start 2001-06-10T00:00-05:00 --days 14 "
                 "--history-days 7 --noise 0.1 --seed 1 -o model/data/demo_measurements.csv")
@@ -328,6 +337,20 @@ def parser():
     s.add_argument("--effect", help="EFFECT@TARGET:name=value,... added to the building, e.g. "
                                     "ground_coupling@floor:U=0.8,T_ground=24")
     s.set_defaults(run=cmd_synth)
+
+    s = sub.add_parser("table", help="columns of a Modelica CombiTimeTable text file as a weather or measurements CSV")
+    s.add_argument("table_file", metavar="TABLE")
+    s.add_argument("--names", required=True, help="the table's column names, time first: a,b,c or a CSV "
+                                                  "file with a 'name' column (and optionally 'column_1based')")
+    s.add_argument("--origin", required=True, help="the time of 0 s, ISO 8601 with UTC offset")
+    s.add_argument("--select", required=True, help="OUT=IN,... (IN a name of --names, OUT the name written) "
+                                                   "or @FILE with one OUT=IN a line")
+    s.add_argument("-o", "--output", required=True, help="the CSV to write")
+    s.add_argument("--table", help="the table's name, when the file holds several")
+    s.add_argument("--start", help="first time kept, ISO 8601 with UTC offset (inclusive)")
+    s.add_argument("--end", help="last time kept, ISO 8601 with UTC offset (inclusive)")
+    s.add_argument("--set", help="NAME=VALUE,...: constant columns the user states, e.g. shading_south=0")
+    s.set_defaults(run=cmd_table)
 
     s = sub.add_parser("demo", help="diagnose the bundled test cell, whose measurements carry an undeclared effect")
     s.add_argument("-o", "--output", default="out/demo")

@@ -9,7 +9,7 @@ import pytest
 from nodeforce.model.building import parse_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.synth import pseudo_measurements
-from nodeforce.model.weather import read_weather
+from nodeforce.iotools.weather import read_weather
 
 DATA = Path(__file__).parents[1] / "model" / "data"
 SENSORS = (1, 7, 9, 16, 17, 23)

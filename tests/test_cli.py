@@ -10,7 +10,7 @@ import pytest
 from nodeforce.model.building import parse_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.integrate import simulate
-from nodeforce.model.measurements import read_measurements
+from nodeforce.iotools.measurements import read_measurements
 from nodeforce.model.network import assemble
 from nodeforce.model.synth import pseudo_measurements
 from nodeforce.cli import main

@@ -5,7 +5,7 @@ import pandas as pd
 import pytest
 
 from nodeforce.model.errors import InputError
-from nodeforce.model.measurements import read_measurements
+from nodeforce.iotools.measurements import read_measurements
 
 GOOD = """time,T23,T1,T17
 2024-06-01T00:00:00+04:00,24.1,23.0,22.5
@@ -39,9 +39,6 @@ def test_reads_node_columns_with_empty_cells_missing(tmp_path):
         (GOOD.replace("2024-06-01T00:15:00+04:00", "01/06/2024 00:15+04:00"), "time"),  # not ISO
         (GOOD.replace("T00:30:00+04:00", "T00:15:00+04:00"), "time"),  # duplicated
         (GOOD.replace("T00:30:00+04:00", "T00:10:00+04:00"), "time"),  # goes back
-        (GOOD.replace("T1,", "Tair,"), "Tair"),  # not T<id>
-        (GOOD.replace("T1,", "T0,"), "T0"),  # ids start at 1
-        (GOOD.replace("T1,", "T01,"), "T01"),  # would alias T1
         (GOOD.replace("T17", "T23"), "T23"),  # twice
         (GOOD.replace("23.1", "23,1"), "file"),  # decimal comma splits a field
         (GOOD.replace("23.1", "23.1C"), "T1"),  # non-numeric
@@ -55,6 +52,12 @@ def test_bad_measurements_name_the_file_and_column(tmp_path, text, column):
         read_measurements(path)
     assert caught.value.source == str(path)
     assert caught.value.field == column
+
+
+def test_other_names_pass_the_reader_for_the_building_to_resolve(tmp_path):
+    # a column measuring no node is refused where the building is known (tests/test_columns.py)
+    m = read_measurements(write(tmp_path, GOOD.replace("T1,", "living_air,")))
+    assert list(m.columns) == ["T23", "living_air", "T17"] and m["living_air"].iloc[0] == 23.0
 
 
 def test_an_all_empty_column_is_still_a_measured_node(tmp_path):

@@ -2,9 +2,12 @@
 between zones and supply air, radiative heat input, shading, thermal bridges, measured
 irradiance columns and the burn-in."""
 import numpy as np
+import pandas as pd
 import pytest
 
+from nodeforce.iotools.weather import read_weather
 from nodeforce.model.building import parse_building
+from nodeforce.model.case import prepare_case
 from nodeforce.model.integrate import forcing_schedule, simulate
 from nodeforce.model.network import assemble
 
@@ -127,6 +130,38 @@ def test_a_closed_blind_lets_no_sun_through():
     assert net.sources(np.array(list(u.values())))[floor] == 0.0
     u["blind"] = 0.5
     assert net.sources(np.array(list(u.values())))[floor] == pytest.approx(0.6 * 3.0 * 600.0 * 0.5)
+
+
+def weather_csv(path, extra):
+    times = pd.date_range("2013-08-21T00:00+01:00", periods=2 * 144 + 1, freq="10min")
+    hours = (times - times[0]).total_seconds().to_numpy() / 3600
+    sun = np.clip(700 * np.sin(2 * np.pi * (hours - 6) / 24), 0, None)
+    frame = pd.DataFrame({"time": times.strftime("%Y-%m-%dT%H:%M:%S%z"), "T_out": 15 + 5 * np.sin(hours),
+                          "ghi": sun, "dni": sun, "dhi": 0.2 * sun, **extra(sun)})
+    frame.to_csv(path, index=False)
+    return read_weather(path)
+
+
+def test_an_irradiance_column_equals_the_same_values_given_as_I_component(tmp_path):
+    def building(irradiance):
+        data = two_zones()
+        for c in data["components"]:
+            if irradiance:
+                c["outside"]["irradiance"] = "south_facade"
+        return parse_building(data)
+    shared = weather_csv(tmp_path / "a.csv", lambda sun: {"south_facade": 0.8 * sun})
+    own = weather_csv(tmp_path / "b.csv", lambda sun: {"I_wA": 0.8 * sun, "I_wB": 0.8 * sun})
+    T_shared = simulate_case(building(True), shared)
+    T_own = simulate_case(building(False), own)
+    assert np.array_equal(T_shared, T_own)
+    # and the measured column is what the faces get, not the computed transposition
+    T_computed = simulate_case(building(False), weather_csv(tmp_path / "c.csv", lambda sun: {}))
+    assert np.abs(T_computed - T_own).max() > 0.01
+
+
+def simulate_case(building, weather):
+    case = prepare_case(building, weather)
+    return simulate(building, assemble(building), case.U, case.dt, case.measured, warmup_days=1)
 
 
 def test_the_burn_in_forces_every_measured_node_and_only_during_its_days():

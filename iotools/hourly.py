@@ -1,0 +1,92 @@
+"""Hourly weather sources (EPW, TMY2, TMY3) read through pvlib, rows put at mid-hour.
+
+Time convention. These files' irradiance values are energies received over the hour before the
+stamp (Wh/m2, i.e. the hour's mean W/m2) and their temperatures are readings at the stamp. A row
+here is one instant used for the sun position and for the model's inputs, so hourly rows are put
+at the *middle* of their hour (local standard time, the file's UTC offset): the irradiance keeps
+its value (the hour mean is the best estimate at mid-hour) and the temperature becomes the mean of
+the readings at the start and end of the hour (their linear interpolation at mid-hour, as
+`nodeforce.model.weather.weather_on_grid` would do). The infrared `ir_h` is an hour energy like
+the other irradiances.
+
+Each reader returns `(end_of_hour, columns, meta)`: the tz-aware end-of-hour stamps, a dict of
+float arrays in the weather CSV's names and units, and pvlib's metadata with a `name` for the site.
+"""
+
+import numpy as np
+import pandas as pd
+import pvlib
+
+from nodeforce.model.errors import InputError
+from .timetable import one_line
+
+
+def read_epw(source, coerce_year=None):
+    """EPW hours: `T_out` C, `ghi`, `dni`, `dhi`, `ir_h` W/m2, missing-value codes as NaN."""
+    # pvlib stamps EPW hour h (energy over h-1..h, readings at h) at h-1, the start of the hour.
+    try:
+        data, meta = pvlib.iotools.read_epw(source, coerce_year=coerce_year)
+    except (OSError, ValueError, KeyError, IndexError, pd.errors.ParserError) as error:
+        raise InputError(source, "file", f"not a readable EPW file: {one_line(error)}") from None
+    columns = {
+        "T_out": data["temp_air"].where(data["temp_air"] < 99.9),
+        "ghi": data["ghi"].where(data["ghi"] < 9999),
+        "dni": data["dni"].where(data["dni"] < 9999),
+        "dhi": data["dhi"].where(data["dhi"] < 9999),
+        "ir_h": data["ghi_infrared"].where(data["ghi_infrared"] < 9999),
+    }
+    end_of_hour = data.index + pd.Timedelta(hours=1)
+    meta = {**meta, "name": f"{meta['city'].strip()}, {meta['country'].strip()} (EPW {meta['WMO_code'].strip()})"}
+    return end_of_hour, {k: v.to_numpy(float) for k, v in columns.items()}, meta
+
+
+def read_tmy2(source, year):
+    """TMY2 hours put in one calendar `year`: `T_out` C, `ghi`, `dni`, `dhi` W/m2."""
+    # pvlib gives every TMY2 row the first row's year; the calendar is rebuilt in `year` from the
+    # month, day and hour (1-24, end of hour) fields. Temperatures are in tenths of a degree.
+    data, meta = pvlib.iotools.read_tmy2(source)
+    start_of_day = pd.to_datetime(
+        pd.DataFrame({"year": year, "month": data["month"].astype(int), "day": data["day"].astype(int)})
+    )
+    end_of_hour = pd.DatetimeIndex(start_of_day + pd.to_timedelta(data["hour"].to_numpy(), unit="h"))
+    end_of_hour = end_of_hour.tz_localize(fixed_offset(meta["TZ"]))
+    columns = {
+        "T_out": data["DryBulb"].to_numpy(float) / 10.0,
+        "ghi": data["GHI"].to_numpy(float),
+        "dni": data["DNI"].to_numpy(float),
+        "dhi": data["DHI"].to_numpy(float),
+    }
+    meta = {**meta, "name": f"{meta['City'].strip().title()}, {meta['State'].strip()} (TMY2 {meta['WBAN']})"}
+    return end_of_hour, columns, meta
+
+
+def read_tmy3(source, year):
+    """TMY3 hours put in one calendar `year`: `T_out` C, `ghi`, `dni`, `dhi` W/m2."""
+    # pvlib stamps TMY3 rows at the end of their hour; coerce_year puts the last (24:00) row in
+    # January of the next year, which is where it belongs.
+    data, meta = pvlib.iotools.read_tmy3(source, coerce_year=year, map_variables=True)
+    columns = {name: data[col].to_numpy(float) for name, col in
+               (("T_out", "temp_air"), ("ghi", "ghi"), ("dni", "dni"), ("dhi", "dhi"))}
+    station = meta["Name"].strip().strip('"').title()
+    meta = {**meta, "name": f"{station}, {meta['State']} (TMY3 {meta['USAF']})"}
+    return data.index, columns, meta
+
+
+def to_mid_hour(end_of_hour, columns, cyclic):
+    """The weather frame of hourly columns, rows at mid-hour (module docstring).
+
+    Hour energies stay as they are; `T_out` readings at the hour ends are averaged to the
+    mid-hour, the first row's earlier reading being the last of the file when `cyclic` (a typical
+    year) and missing (NaN) otherwise.
+    """
+    columns = dict(columns)
+    reading = columns["T_out"]
+    before = np.concatenate(([reading[-1] if cyclic else np.nan], reading[:-1]))
+    columns["T_out"] = (before + reading) / 2.0
+    index = pd.DatetimeIndex(end_of_hour - pd.Timedelta(minutes=30), name="time")
+    return pd.DataFrame(columns, index=index)
+
+
+def fixed_offset(hours):
+    """"+hh:mm" of a UTC offset in hours."""
+    return f"{'+' if hours >= 0 else '-'}{int(abs(hours)):02d}:{int(round(abs(hours) % 1 * 60)):02d}"

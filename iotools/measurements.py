@@ -1,0 +1,39 @@
+"""Measured temperatures: read and check the measurements CSV (INTERFACE.md, Files).
+
+Measurements are never changed: an empty cell stays missing (NaN) and no value is interpolated or
+filled; the model handles a missing measurement where it uses one (PHYSICS.md section 5).
+"""
+
+from nodeforce.model.errors import InputError
+from .timetable import check_celsius, read_time_table
+
+
+def read_measurements(path):
+    """Read and check a measurements CSV.
+
+    Parameters
+    ----------
+    path : str or Path
+        CSV with a `time` column (ISO 8601 with UTC offset, strictly increasing) and one column
+        per measured temperature (degrees C): `T<id>` for node id (e.g. `T23`), or another name,
+        which the building resolves to a node (`nodeforce.model.case.measured_matrix`, where an
+        unknown name is refused). An empty cell is a missing value.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Float columns, degrees C, in file order, indexed by a tz-aware DatetimeIndex named
+        "time"; missing values are NaN. `attrs["source"]` is the path.
+
+    Raises
+    ------
+    InputError
+        Naming the file and the column: the checks of `iotools.timetable.read_time_table` (time
+        column, times, non-numeric cells), no measured column, kelvin-looking temperatures
+        (median above `iotools.timetable.KELVIN_MEDIAN`).
+    """
+    frame = read_time_table(path)
+    if frame.columns.empty:
+        raise InputError(path, "T<id>", "no measured column besides time")
+    check_celsius(frame, frame.columns)
+    return frame

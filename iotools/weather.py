@@ -1,0 +1,93 @@
+"""Weather files: the weather CSV of PHYSICS.md section 4 or an EPW file, read and checked.
+
+Hourly sources (EPW) have their rows at the middle of the hour (`nodeforce.iotools.hourly`).
+"""
+
+from pathlib import Path
+
+import numpy as np
+
+from nodeforce.model.errors import InputError
+from nodeforce.model.weather import IRRADIANCE_COLUMNS, REQUIRED_COLUMNS, TEMPERATURE_COLUMNS, utc_microseconds
+from .hourly import read_epw, to_mid_hour
+from .timetable import check_celsius, read_time_table
+
+#: Irradiances (W/m2) below this are refused. Pyranometers read a few W/m2 below zero at night
+#: (thermal offset); those pass unchanged and the model clips incident solar at 0. A value far below
+#: is a sign error or a missing-value code (-999, -9999) that must not be read as data.
+IRRADIANCE_FLOOR = -50.0
+
+
+def read_weather(path):
+    """Read and check a weather file: the CSV of PHYSICS.md section 4, or an EPW file (by extension).
+
+    Parameters
+    ----------
+    path : str or Path
+        Weather CSV or `.epw` file. The CSV has `time` and `T_out` (C); `ghi`, `dni`, `dhi` (W/m2)
+        where some face's irradiance is computed; optionally `T_sky` (C), `ir_h` (W/m2),
+        `I_<component>` (W/m2) and any column a building file refers to by name (heat inputs,
+        boundary and supply temperatures, irradiance, shading). Which columns a building may use
+        is checked where the building is known (`nodeforce.model.weather.check_columns`).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Indexed by a tz-aware DatetimeIndex named "time", the file's columns, float, in their
+        units; missing values are NaN. `attrs["source"]` is the path. An EPW file gives
+        `T_out`, `ghi`, `dni`, `dhi`, `ir_h` at the middle of each hour (`iotools.hourly`); its
+        missing-value codes (99.9 C, 9999 W/m2) become NaN and the first row's `T_out`, which
+        would need the reading before the file starts, is NaN.
+
+    Raises
+    ------
+    InputError
+        Naming the file and the column: the checks of `read_time_table`, no `T_out`, kelvin-looking
+        `T_out` or `T_sky`, irradiance below `IRRADIANCE_FLOOR`, negative
+        `ir_h`, an EPW typical year (years mixed; convert it with
+        `nodeforce.iotools.typical_year.convert_typical_year`).
+    """
+    source = str(path)
+    if Path(source).suffix.lower() == ".epw":
+        weather = _read_epw_weather(source)
+    else:
+        weather = read_time_table(path)
+    for name in REQUIRED_COLUMNS:
+        if name not in weather.columns:
+            raise InputError(source, name, "required weather column is missing")
+    check_celsius(weather, TEMPERATURE_COLUMNS)
+    for name in weather.columns:
+        if name in IRRADIANCE_COLUMNS or _is_component_irradiance(name):
+            _check_at_least(weather, name, IRRADIANCE_FLOOR,
+                            "more than a sensor's night offset: a sign error or a missing-value code?")
+    if "ir_h" in weather:
+        _check_at_least(weather, "ir_h", 0.0, "infrared irradiance cannot be negative")
+    return weather
+
+
+def _read_epw_weather(source):
+    end_of_hour, columns, _ = read_epw(source)
+    steps = np.diff(utc_microseconds(end_of_hour))
+    if (steps <= 0).any():
+        raise InputError(
+            source, "time",
+            "the EPW mixes years (a typical year): convert it to one year with "
+            f"'python -m nodeforce.iotools.typical_year convert {source} OUT.csv --year YYYY'",
+        )
+    weather = to_mid_hour(end_of_hour, columns, cyclic=False)
+    weather.attrs["source"] = source
+    return weather
+
+
+def _check_at_least(frame, name, floor, why):
+    low = frame[name] < floor
+    if low.any():
+        t = frame.index[np.flatnonzero(low)[0]]
+        raise InputError(
+            frame.attrs.get("source", "?"), name,
+            f"{frame[name][t]:g} at {t.isoformat()} is below {floor:g} W/m2 ({why})",
+        )
+
+
+def _is_component_irradiance(name):
+    return name.startswith("I_") and len(name) > 2
