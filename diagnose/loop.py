@@ -32,7 +32,7 @@ from contextlib import nullcontext
 import numpy as np
 from tqdm import tqdm
 
-from nodeforce.cosim.fmi2 import FmuInstance
+from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnose.calibrate import Candidate, calibrate, sensitivity
 from nodeforce.diagnose.report import write_report

@@ -76,7 +76,7 @@ def cmd_fmu(args):
 
 
 def cmd_simulate(args):
-    from nodeforce.cosim.fmi2 import FmuInstance
+    from nodeforce.cosim.fmi import FmuInstance
     from nodeforce.cosim.run import simulate_fmu
     from nodeforce.fmu_build.build import build_fmu
     from nodeforce.model.report import write_node_temperatures
