@@ -131,16 +131,19 @@ class NodalBuilding(Fmi2Slave):
     def enter_initialization_mode(self):
         self._state = _variables.INITIALISATION
 
-    def exit_initialization_mode(self):
-        # force[i] and the effect parameters are fixed once initialised: read them once here
+    def _fix_parameters(self):
+        """force[i] and the effect parameters are fixed once initialised: read them once."""
         layout = self.layout
         self._force = self._values[layout.force] != 0.0
         self._any_forced = bool(self._force.any())
         if self._effect_names:
             values = tuple(zip(self._effect_names, self._values[layout.parameters].tolist()))
             self.building, self.network, self._steppers = _model(self.resources, values)
-        self._values[layout.T] = _physics["integrate"].initial_state(
-            self.building, self._values[layout.T_forced], self._values[layout.T_start])
+
+    def exit_initialization_mode(self):
+        self._fix_parameters()
+        self._values[self.layout.T] = _physics["integrate"].initial_state(
+            self.building, self._values[self.layout.T_forced], self._values[self.layout.T_start])
         self._state = _variables.STEPPING
 
     def do_step(self, current_time, step_size):
@@ -168,13 +171,7 @@ class NodalBuilding(Fmi2Slave):
         self._values[:] = state["values"]
         self._state = state["state"]
         if self._state == _variables.STEPPING:
-            self.exit_initialization_mode_from_state()
-
-    def exit_initialization_mode_from_state(self):
-        """The mask and effect values a restored state was initialised with, without its T."""
-        T = self._values[self.layout.T].copy()
-        self.exit_initialization_mode()
-        self._values[self.layout.T] = T
+            self._fix_parameters()
 
     @staticmethod
     def _fmu_state_to_bytes(state):
