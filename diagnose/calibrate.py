@@ -31,10 +31,10 @@ MORRIS_TRAJECTORIES = 4
 class Candidate:
     """The model with one added effect: its own FMU, one instance reused for every run."""
 
-    def __init__(self, data, effect, target, workdir):
+    def __init__(self, data, effect, target, workdir, fmu_kind="python"):
         self.data, self.effect, self.target = data, effect, target
         self.parameters = effects.EFFECTS[effect]
-        fmu = build_fmu(data, workdir / f"{effect}@{target}.fmu", effect=(effect, target))
+        fmu = build_fmu(data, workdir / f"{effect}@{target}.fmu", effect=(effect, target), kind=fmu_kind)
         self.instance = FmuInstance(fmu)
 
     @property

@@ -67,8 +67,8 @@ def assess(task):
     calibration window and over the whole record, and the Morris screening; writes the
     candidate's FMU and its building file, declared at the calibrated values, in `folder`.
     """
-    building_data, effect, target, folder, calibration, case, air, seed = task
-    candidate = Candidate(building_data, effect, target, folder)
+    building_data, effect, target, folder, calibration, case, air, seed, fmu_kind = task
+    candidate = Candidate(building_data, effect, target, folder, fmu_kind)
     try:
         parameters, determined = calibrate(candidate, calibration, air)
         values = [parameters[p.name]["value"] for p in candidate.parameters]
@@ -88,7 +88,7 @@ def bic(J, n, k):
 
 
 def diagnose(building_data, building, case, workdir, *, source="measurements", fraction=0.6, seed=0,
-             workers=None, population=30, generations=400):
+             workers=None, population=30, generations=400, fmu_kind="python"):
     """Run the whole loop; write the artifacts in `workdir`; return the report.json content."""
     air = output_node(building, case, source)
     k = split(case, fraction, source)
@@ -97,7 +97,8 @@ def diagnose(building_data, building, case, workdir, *, source="measurements", f
     scored = calibration.measured[1:, air - 1]
     sigma = noise_level(case.measured[:, air - 1])
 
-    with FmuInstance(build_fmu(building_data, workdir / "model_before.fmu", source=building.source)) as base:
+    with FmuInstance(build_fmu(building_data, workdir / "model_before.fmu", source=building.source,
+                               kind=fmu_kind)) as base:
         before_run = simulate_fmu(base, case, output_ids=[air])[:, 0]
         before_calibration = simulate_fmu(base, calibration, output_ids=[air])[:, 0]
     before = {"calibration": metrics(scored, before_calibration),
@@ -105,12 +106,12 @@ def diagnose(building_data, building, case, workdir, *, source="measurements", f
 
     convergence = []
     localization = locate(building_data, building, calibration, workdir, source=source, seed=seed,
-                          workers=workers, population=population, generations=generations,
+                          workers=workers, population=population, generations=generations, fmu_kind=fmu_kind,
                           progress=lambda generation, total, J, unique: convergence.append((generation, J)))
 
     pairs = effects.candidates(building_data, localization["best_nodes"])
     (workdir / "candidates").mkdir(exist_ok=True)
-    tasks = [(building_data, effect, target, workdir / "candidates", calibration, case, air, seed)
+    tasks = [(building_data, effect, target, workdir / "candidates", calibration, case, air, seed, fmu_kind)
              for effect, target in pairs]
     n_workers = min(workers or os.cpu_count(), len(tasks))
     with (ProcessPoolExecutor(n_workers, mp_context=multiprocessing.get_context("spawn"))
@@ -144,7 +145,7 @@ def diagnose(building_data, building, case, workdir, *, source="measurements", f
         effect = {"effect": "none", "target": None, "parameters": {}}
     parse_building(data_after, source="building_after.json")
     (workdir / "building_after.json").write_text(json.dumps(data_after, indent=2) + "\n")
-    fmu_after = build_fmu(data_after, workdir / "model_after.fmu", source="building_after.json")
+    fmu_after = build_fmu(data_after, workdir / "model_after.fmu", source="building_after.json", kind=fmu_kind)
 
     times = case.times
     report = {

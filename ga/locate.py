@@ -55,7 +55,7 @@ def chromosome_nodes(building, case, source, nodes=None, include_algebraic=False
 
 def locate(building_data, building, case, workdir, *, source="measurements", nodes=None,
            include_algebraic=False, population=30, generations=400, pc=0.8, pm=0.03, seed=0,
-           workers=None, scheduler=None, warmup_days=2, progress=None):
+           workers=None, scheduler=None, warmup_days=2, progress=None, fmu_kind="python"):
     """Run the forcing search on a case; return the content of locate.json.
 
     The FMU (`model.fmu`) and the search's checkpoint (`locate.checkpoint.json`) are written in
@@ -66,7 +66,7 @@ def locate(building_data, building, case, workdir, *, source="measurements", nod
     candidates = chromosome_nodes(building, case, source, nodes, include_algebraic)
     if not candidates:
         raise InputError(source, "columns", "no measured node besides the indoor air: nothing to force")
-    fmu = build_fmu(building_data, workdir / "model.fmu", source=building.source)
+    fmu = build_fmu(building_data, workdir / "model.fmu", source=building.source, kind=fmu_kind)
     air_measured = case.measured[1:, air - 1]
     result = search(FmuFitness(fmu, case, candidates, air, warmup_days), candidates,
                     population=population, generations=generations, pc=pc, pm=pm, seed=seed,

@@ -71,7 +71,8 @@ def force_mask(case, ids, source):
 
 def cmd_fmu(args):
     from nodeforce.fmu_build.build import build_fmu
-    path = build_fmu(read_building_data(args.building), args.output, source=args.building)
+    path = build_fmu(read_building_data(args.building), args.output, source=args.building,
+                     kind="standalone" if args.standalone else "python")
     print(f"wrote {path}")
 
 
@@ -127,7 +128,7 @@ def cmd_locate(args):
                     nodes=node_list("--nodes", args.nodes) if args.nodes else None,
                     include_algebraic=args.include_algebraic, population=args.population,
                     generations=args.generations, pc=args.pc, pm=args.pm, seed=args.seed,
-                    workers=args.workers, scheduler=args.scheduler)
+                    workers=args.workers, scheduler=args.scheduler, fmu_kind=args.fmu)
     (out / "locate.json").write_text(json.dumps(result, indent=2) + "\n")
     print(locate_summary(result))
     print(f"wrote {out / 'locate.json'}")
@@ -206,7 +207,7 @@ def run_diagnosis(data, building, case, out, source, args):
     check_workers(args)
     out.mkdir(parents=True, exist_ok=True)
     report = diagnose(data, building, case, out, source=source, fraction=args.calibration_fraction,
-                      seed=args.seed, workers=args.workers)
+                      seed=args.seed, workers=args.workers, fmu_kind=args.fmu)
     print(before_after_table(report))
     print(f"wrote {out / 'report.json'}, {out / 'report.md'}, {out / 'building_after.json'}, {out / 'model_after.fmu'}")
 
@@ -243,6 +244,7 @@ def case_arguments(s, measurements_required, output_help, output_default=None):
 def diagnosis_arguments(s):
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--workers", type=int, help="processes (default: all cores)")
+    s.add_argument("--fmu", choices=("python", "standalone"), default="python", help="the FMU kind to run")
     s.add_argument("--calibration-fraction", type=float, default=0.6,
                    help="the first part of the record, by time, that calibrates; the rest validates")
 
@@ -254,6 +256,7 @@ def parser():
     s = sub.add_parser("fmu", help="build the FMU of a building file")
     s.add_argument("building")
     s.add_argument("-o", "--output", required=True, help="the .fmu to write")
+    s.add_argument("--standalone", action="store_true", help="C, no Python at run time (needs a C compiler)")
     s.set_defaults(run=cmd_fmu)
 
     s = sub.add_parser("simulate", help="simulate a building through its FMU")
@@ -272,6 +275,7 @@ def parser():
     s.add_argument("--pm", type=float, default=0.03, help="mutation probability per gene")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--workers", type=int, help="processes (default: all cores)")
+    s.add_argument("--fmu", choices=("python", "standalone"), default="python", help="the FMU kind to run")
     s.add_argument("--scheduler", help="a Dask scheduler address, tcp://host:port")
     s.add_argument("--burn-in-days", type=float, default=0.0,
                    help="days after t_0 simulated but not scored (default 0: J over t_1..t_N); the "
