@@ -199,7 +199,7 @@ def documentation(name, standalone, python_minimum="3.10"):
     """documentation/index.html: what an importer needs to run this FMU."""
     if standalone:
         needs = ("<p>This FMU needs no Python: <code>binaries/linux64</code> holds a C library "
-                 "that links only the C library and libm. For another platform compile "
+                 "that links only the C library (symbols up to glibc 2.14). For another platform compile "
                  "<code>sources/*.c</code> (C99) into a shared library named after the model "
                  "identifier.</p>")
     else:
