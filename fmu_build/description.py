@@ -37,7 +37,7 @@ def nodeforce_version():
         meta = metadata("nodeforce")
     except PackageNotFoundError:  # running from a source tree that is not installed
         return "unknown", None
-    return meta["Version"], meta["License"]
+    return meta.get("Version", "unknown"), meta.get("License")
 
 
 @dataclass(frozen=True)
