@@ -1,1 +1,1 @@
-"""Running FMUs: the FMI plumbing (`fmi2`) and the simulation of a measured case through it (`run`)."""
+"""Running FMUs: the FMI plumbing (`fmi`) and the simulation of a measured case through it (`run`)."""

@@ -18,7 +18,7 @@ def simulate_fmu(instance, case, force=None, warmup_days=2, output_ids=None, T_d
 
     Parameters
     ----------
-    instance : cosim.fmi2.FmuInstance
+    instance : cosim.fmi.FmuInstance
     case : model.case.Case (inputs and measurements on the simulation grid)
     force : (N,) bool, nodes forced to their measurements; None: no forcing (the case's burn-in
         forces every measured node over its first steps all the same)

@@ -13,7 +13,7 @@ from SALib.analyze import morris as morris_analyze
 from SALib.sample import morris as morris_sample
 from scipy.optimize import least_squares
 
-from nodeforce.cosim.fmi2 import FmuInstance
+from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.diagnose.candidates import calibration_start
@@ -31,10 +31,11 @@ MORRIS_TRAJECTORIES = 4
 class Candidate:
     """The model with one added effect: its own FMU, one instance reused for every run."""
 
-    def __init__(self, building, effect, target, workdir):
+    def __init__(self, building, effect, target, workdir, fmu_kind="python"):
         self.building, self.effect, self.target = building, effect, target
         self.parameters = EFFECTS[effect].parameters
-        self.instance = FmuInstance(build_fmu(building, workdir / f"{self.label}.fmu", effect=(effect, target)))
+        self.instance = FmuInstance(build_fmu(building, workdir / f"{self.label}.fmu", effect=(effect, target),
+                                              kind=fmu_kind))
 
     @property
     def label(self):

@@ -31,7 +31,7 @@ from contextlib import nullcontext
 import numpy as np
 from tqdm import tqdm
 
-from nodeforce.cosim.fmi2 import FmuInstance
+from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnose.calibrate import Candidate, calibrate, sensitivity
 from nodeforce.diagnose.candidates import candidates
@@ -76,8 +76,8 @@ def assess(task):
     the calibration window and over the whole record, and the Morris screening; writes the
     candidate's FMU and its building file, declared at the calibrated values, in `folder`.
     """
-    building, effect, target, folder, calibration, case, objective, seed = task
-    candidate = Candidate(building, effect, target, folder)
+    building, effect, target, folder, calibration, case, objective, seed, fmu_kind = task
+    candidate = Candidate(building, effect, target, folder, fmu_kind)
     try:
         parameters, determined = calibrate(candidate, calibration, objective)
         values = [parameters[p.name]["value"] for p in candidate.parameters]
@@ -127,7 +127,7 @@ def decide(results, before, sigma):
 
 
 def diagnose(building, case, objective, workdir, *, source="measurements", fraction=0.6, calibration_end=None,
-             seed=0, workers=None, population=30, generations=400):
+             seed=0, workers=None, population=30, generations=400, fmu_kind="python"):
     """Run the whole loop; write the artifacts in `workdir`; return the report.json content."""
     check_measured(objective, case, source)
     k = split(case, source, fraction, calibration_end)
@@ -136,7 +136,7 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
     scored = objective.measured(calibration)
     sigma = air_noise(case, objective)
 
-    with FmuInstance(build_fmu(building, workdir / "model_before.fmu")) as base:
+    with FmuInstance(build_fmu(building, workdir / "model_before.fmu", kind=fmu_kind)) as base:
         before_run = simulate_fmu(base, case, output_ids=objective.air_nodes)
         before_calibration = simulate_fmu(base, calibration, output_ids=objective.air_nodes)
     before = {"calibration": objective.metrics(scored, before_calibration),
@@ -144,12 +144,12 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
 
     convergence = []
     localization = locate(building, calibration, objective, workdir, source=source, seed=seed,
-                          workers=workers, population=population, generations=generations,
+                          workers=workers, population=population, generations=generations, fmu_kind=fmu_kind,
                           progress=lambda generation, total, J, unique: convergence.append((generation, J)))
 
     pairs = candidates(building, localization["best_nodes"], objective.zones)
     (workdir / "candidates").mkdir(exist_ok=True)
-    tasks = [(building, effect, target, workdir / "candidates", calibration, case, objective, seed)
+    tasks = [(building, effect, target, workdir / "candidates", calibration, case, objective, seed, fmu_kind)
              for effect, target in pairs]
     n_workers = min(workers or os.cpu_count(), len(tasks))
     with (ProcessPoolExecutor(n_workers, mp_context=multiprocessing.get_context("spawn"))
@@ -177,7 +177,7 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
         after_building, after_run, after = building, before_run, before
         effect = {"effect": "none", "target": None, "parameters": {}}
     (workdir / "building_after.json").write_text(json.dumps(after_building.to_json(), indent=2) + "\n")
-    fmu_after = build_fmu(after_building, workdir / "model_after.fmu")
+    fmu_after = build_fmu(after_building, workdir / "model_after.fmu", kind=fmu_kind)
 
     times = case.times
     report = {

@@ -5,27 +5,33 @@ This file is copied into each FMU as `<module>.py`, with the physics package bes
 to the FMU's content, because pythonfmu imports the slave by module name and Python's module
 cache would otherwise run the first FMU's code for the second.
 
-Variables (INTERFACE.md): parameters `force[i]` and `T_start`; inputs `T_out`, `T_sky`,
-`I_<component>`, the building's named columns and `T_forced[i]` (NaN: no measurement);
-outputs `T[i]`. One doStep of h seconds is one backward-Euler step with the inputs set before
-it. During initialisation, the `T_forced[i]` values set are the measurements at t_0, from which
-the initial state follows PHYSICS.md section 5 (`T_start` where nothing is measured).
+Variables: `<module>_model/variables.py` (the layout the standalone FMU shares). One doStep of h
+seconds is one backward-Euler step with the inputs set before it. During initialisation, the
+`T_forced[i]` values set are the measurements at t_0, from which the initial state follows
+PHYSICS.md section 5 (`T_start` where nothing is measured). Calls the standard forbids are
+answered with fmi2Error and a logged reason, and change nothing.
+
+The step needs numpy only: an FMU that imports scipy corrupts memory when the host ends.
 """
+import sys
+
+if sys.version_info < (3, 10):
+    raise ImportError(f"this FMU's model code needs Python 3.10 or newer; the host runs Python "
+                      f"{sys.version.split()[0]} (see documentation/index.html in the FMU)")
+
+import functools
 import importlib
 import json
 import os
+from collections import OrderedDict
 
 import numpy as np
-from pythonfmu import Boolean, Fmi2Causality, Fmi2Slave, Fmi2Variability, Real
-from pythonfmu.enums import Fmi2Initial
+from pythonfmu import Fmi2Slave
+from pythonfmu.enums import Fmi2Status
 
 _physics = {name: importlib.import_module(f"{__name__}_model.{name}")
-             for name in ("building", "effects", "integrate", "network")}
-
-# Reset re-constructs the slave: keep what depends only on the model's description per process,
-# for each set of effect parameter values (a calibration tries many), and its declared variables.
-_MODELS = {}
-_VARIABLES = {}
+            for name in ("building", "effects", "integrate", "network", "variables")}
+_variables = _physics["variables"]
 
 
 def _read(resources):
@@ -41,169 +47,140 @@ def _read(resources):
     return data, effect
 
 
+# Reset re-constructs the slave: keep per process what depends only on the model's description,
+# for the few sets of effect parameter values last used (a calibration tries many, in turn).
+@functools.lru_cache(maxsize=8)
 def _model(resources, values=()):
-    """(building, network, steppers) for the FMU's building with its effect at `values`."""
-    key = (resources, values)
-    model = _MODELS.get(key)
-    if model is None:
-        data, effect = _read(resources)
-        building = _physics["building"].parse_building(data, source="building.json")
-        if values:
-            effect_id, target = effect
-            building = _physics["effects"].EFFECTS[effect_id].apply(building, target, dict(values))
-        model = _MODELS[key] = (building, _physics["network"].assemble(building), {})
-    return model
+    """(building, network, steppers by dt) of the FMU's building with its effect at `values`."""
+    data, effect = _read(resources)
+    building = _physics["building"].parse_building(data, source="building.json")
+    if values:
+        building = _physics["effects"].EFFECTS[effect[0]].apply(building, effect[1], dict(values))
+    return building, _physics["network"].assemble(building), {}
 
 
 class NodalBuilding(Fmi2Slave):
 
-    author = "nodeforce"
-    description = "Nodal (RC network) building thermal model with a forcing input per node"
-
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
+        # pythonfmu's binary puts the resources folder first on sys.path and leaves it there; its
+        # copy of pythonfmu (no binaries) would shadow the host's own. The model is imported by
+        # now. (pythonfmu's builder, which instantiates "dummyInstance", removes the entry itself.)
+        while self.instance_name != "dummyInstance" and self.resources in sys.path:
+            sys.path.remove(self.resources)
         _, self._effect = _read(self.resources)
         self.building, self.network, self._steppers = _model(self.resources)
-        n = self.network.n_nodes
-        names = self.network.input_names
         effect_start = (_physics["effects"].EFFECTS[self._effect[0]].read(self.building, self._effect[1])
                         if self._effect else {})
-        self._parameter_names = tuple(effect_start)
-        # One array holds every variable's value, indexed by value reference, in the order the
-        # variables are declared: get/set become numpy indexing instead of per-variable getters.
-        self._T_start = n
-        self._inputs = slice(n + 1, n + 1 + len(names))
-        self._forced = slice(self._inputs.stop, self._inputs.stop + n)
-        self._T = slice(self._forced.stop, self._forced.stop + n)
-        self._parameters = slice(self._T.stop, self._T.stop + len(effect_start))
-        self._values = np.zeros(self._parameters.stop)
-        self._values[self._T_start] = 20.0
-        self._values[self._forced] = np.nan
-        self._values[self._T] = 20.0
-        self._values[self._parameters] = list(effect_start.values())
-        self._is_real = np.ones(len(self._values), dtype=bool)
-        self._is_real[:n] = False
-        # Every accessor reads self._values, so the declarations are the same for every instance
-        # of this FMU: made once, not again at each Reset.
-        declared = _VARIABLES.get(self.resources)
-        if declared is None:
-            self._declare(n, names)
-            _VARIABLES[self.resources] = self.vars
-        else:
-            self.vars = declared
-        self._force = np.zeros(n, dtype=bool)
+        self._effect_names = tuple(effect_start)
+        layout = self.layout = _variables.Layout(
+            self.network.n_nodes, self.network.input_names,
+            [f"{self._effect[0]}.{name}" for name in effect_start])
+        self._values = np.zeros(layout.size)
+        self._values[layout.T_start] = 20.0
+        self._values[layout.T_forced] = np.nan
+        self._values[layout.T] = 20.0
+        self._values[layout.parameters] = list(effect_start.values())
+        self._force = np.zeros(layout.n_nodes, dtype=bool)
         self._any_forced = False
-        self._indices = {}
-        self._initialised = False
+        self._checked = OrderedDict()
+        self._state = _variables.INSTANTIATED
 
-    def _declare(self, n, names):
-        """Register the variables, in the order of the value array's layout."""
-        for i in range(1, n + 1):
-            self.register_variable(Boolean(
-                f"force[{i}]", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
-                description=f"node {i} is forced to T_forced[{i}]"))
-        self.register_variable(Real(
-            "T_start", causality=Fmi2Causality.parameter, variability=Fmi2Variability.fixed,
-            description="initial temperature of a node no measurement informs [degC]"))
-        for name in names:
-            self.register_variable(Real(name, causality=Fmi2Causality.input,
-                                        description=_input_description(name)))
-        for i in range(1, n + 1):
-            self.register_variable(Real(
-                f"T_forced[{i}]", causality=Fmi2Causality.input,
-                description=f"measured temperature of node {i}, NaN if none [degC]"))
-        for i in range(1, n + 1):
-            self.register_variable(Real(
-                f"T[{i}]", causality=Fmi2Causality.output, initial=Fmi2Initial.exact,
-                description=f"temperature of node {i} [degC]"))
-        for name in self._parameter_names:
-            self.register_variable(Real(
-                f"{self._effect[0]}.{name}", causality=Fmi2Causality.parameter,
-                variability=Fmi2Variability.fixed,
-                description=f"{self._effect[0]} of {self._effect[1]}: {name}"), nested=False)
+    def _refuse(self, reason):
+        self.log(reason, Fmi2Status.error)
+        return False
 
-    def _stepper(self, dt):
-        stepper = self._steppers.get(dt)
-        if stepper is None:
-            stepper = self._steppers[dt] = _physics["integrate"].ImplicitEuler(self.network, dt)
-        return stepper
+    def _index(self, vrs, real, setting):
+        """Index array of value references, or the reason the call is refused; kept for the
+        lists an importer sets and gets at every step."""
+        key = (tuple(vrs), real, setting, self._state)
+        found = self._checked.get(key)
+        if found is None:
+            reasons = [self.layout.refusal(vr, real, setting, self._state) for vr in key[0]]
+            reason = next((r for r in reasons if r), None)
+            found = reason if reason else np.array(key[0], dtype=np.intp)
+            self._checked[key] = found
+            if len(self._checked) > 64:
+                self._checked.popitem(last=False)
+        return found
 
-    def exit_initialization_mode(self):
-        # force[i] and the effect parameters are fixed once initialised: read them once here
-        self._force = self._values[: self.network.n_nodes] != 0.0
-        self._any_forced = bool(self._force.any())
-        if self._parameter_names:
-            values = tuple(zip(self._parameter_names, self._values[self._parameters].tolist()))
-            self.building, self.network, self._steppers = _model(self.resources, values)
-        self._values[self._T] = _physics["integrate"].initial_state(
-            self.building, self._values[self._forced], self._values[self._T_start])
-        self._initialised = True
+    def _get(self, vrs, real):
+        index = self._index(vrs, real, False)
+        if isinstance(index, str):
+            raise ValueError(index)
+        values = self._values[index]
+        return (values if real else values != 0.0).tolist()
 
-    def do_step(self, current_time, step_size):
-        values = self._values
-        T_forced = values[self._forced]
-        forced = _physics["integrate"].imposed(self._force, T_forced) if self._any_forced else self._force
-        source = self.network.sources(values[self._inputs])
-        values[self._T] = self._stepper(step_size).step(values[self._T], source, forced, T_forced)
-        return True
-
-    def _index(self, vrs, real):
-        """Index array of value references, checked once to be all Real (or all Boolean):
-        an importer sets and gets the same lists every step."""
-        key = (tuple(vrs), real)
-        index = self._indices.get(key)
-        if index is None:
-            index = np.array(vrs, dtype=np.intp)
-            if (self._is_real[index] != real).any():
-                raise TypeError(f"value references {vrs} are not all {'Real' if real else 'Boolean'}")
-            self._indices[key] = index
-        return index
+    def _set(self, vrs, values, real):
+        index = self._index(vrs, real, True)
+        if isinstance(index, str):
+            raise ValueError(index)
+        self._values[index] = values
 
     def get_real(self, vrs):
-        return self._values[self._index(vrs, True)].tolist()
-
-    def set_real(self, vrs, values):
-        self._values[self._index(vrs, True)] = values
+        return self._get(vrs, True)
 
     def get_boolean(self, vrs):
-        return (self._values[self._index(vrs, False)] != 0.0).tolist()
+        return self._get(vrs, False)
+
+    def set_real(self, vrs, values):
+        self._set(vrs, values, True)
 
     def set_boolean(self, vrs, values):
-        self._values[self._index(vrs, False)] = values
+        self._set(vrs, values, False)
+
+    def enter_initialization_mode(self):
+        self._state = _variables.INITIALISATION
+
+    def _fix_parameters(self):
+        """force[i] and the effect parameters are fixed once initialised: read them once."""
+        layout = self.layout
+        self._force = self._values[layout.force] != 0.0
+        self._any_forced = bool(self._force.any())
+        if self._effect_names:
+            values = tuple(zip(self._effect_names, self._values[layout.parameters].tolist()))
+            self.building, self.network, self._steppers = _model(self.resources, values)
+
+    def exit_initialization_mode(self):
+        self._fix_parameters()
+        self._values[self.layout.T] = _physics["integrate"].initial_state(
+            self.building, self._values[self.layout.T_forced], self._values[self.layout.T_start])
+        self._state = _variables.STEPPING
+
+    def do_step(self, current_time, step_size):
+        if self._state != _variables.STEPPING:
+            return self._refuse("doStep before initialisation ended, or after terminate")
+        if not step_size > 0.0:
+            return self._refuse(f"doStep with communicationStepSize {step_size} s: it must be > 0")
+        values, layout = self._values, self.layout
+        T_forced = values[layout.T_forced]
+        forced = _physics["integrate"].imposed(self._force, T_forced) if self._any_forced else self._force
+        source = self.network.sources(values[layout.inputs])
+        stepper = self._steppers.get(step_size)
+        if stepper is None:
+            stepper = self._steppers[step_size] = _physics["integrate"].ImplicitEuler(self.network, step_size)
+        values[layout.T] = stepper.step(values[layout.T], source, forced, T_forced)
+        return True
+
+    def terminate(self):
+        self._state = _variables.TERMINATED
 
     def _get_fmu_state(self):
-        return {"values": self._values.copy(), "initialised": self._initialised}
+        return {"values": self._values.copy(), "state": self._state}
 
     def _set_fmu_state(self, state):
         self._values[:] = state["values"]
-        self._initialised = state["initialised"]
+        self._state = state["state"]
+        if self._state == _variables.STEPPING:
+            self._fix_parameters()
 
     @staticmethod
     def _fmu_state_to_bytes(state):
         # json writes NaN as a bare token, which json reads back: no value is lost.
         return json.dumps({"values": np.asarray(state["values"]).tolist(),
-                           "initialised": state["initialised"]}).encode("utf-8")
+                           "state": state["state"]}).encode("utf-8")
 
     @staticmethod
     def _fmu_state_from_bytes(data):
         state = json.loads(data.decode("utf-8"))
-        return {"values": np.array(state["values"]), "initialised": state["initialised"]}
-
-    def to_xml(self, model_options=dict()):
-        xml = super().to_xml(model_options)
-        # Python writes NaN as "nan"; xs:double spells it "NaN".
-        for element in xml.iter("Real"):
-            if element.get("start") == "nan":
-                element.set("start", "NaN")
-        return xml
-
-
-def _input_description(name):
-    if name == "T_out":
-        return "outdoor air temperature [degC]"
-    if name == "T_sky":
-        return "sky temperature [degC]"
-    if name.startswith("I_"):
-        return f"solar irradiance on the outside face of {name[2:]} [W/m2]"
-    return f"measured input column {name}"
-
+        return {"values": np.array(state["values"]), "state": state["state"]}

@@ -4,11 +4,9 @@
 once, extracting and instantiating the FMU once, and then scores every chromosome it is given
 by resetting and re-running that one instance, warm-up included.
 """
-import zipfile
-
 import numpy as np
 
-from nodeforce.cosim.fmi2 import FmuInstance
+from nodeforce.cosim.fmi import FmuInstance, content_id
 from nodeforce.cosim.run import simulate_fmu
 
 
@@ -26,10 +24,9 @@ class FmuFitness:
 
     def __init__(self, fmu_path, case, chromosome_nodes, objective, warmup_days=2):
         self.fmu_path = str(fmu_path)
-        # The slave's module name hashes the building and the model code (fmu_build.build), so a
-        # checkpoint keyed on this factory is never resumed against another model.
-        with zipfile.ZipFile(self.fmu_path) as fmu:
-            self.model_id = fmu.read("resources/slavemodule.txt").decode().strip()
+        # The FMU's GUID hashes its content (fmu_build), so a checkpoint keyed on this factory is
+        # never resumed against another model.
+        self.model_id = content_id(self.fmu_path)
         self.case = case
         self.chromosome_nodes = np.asarray(chromosome_nodes, dtype=int)
         self.objective = objective

@@ -62,7 +62,7 @@ def air_noise(case, objective):
 
 def locate(building, case, objective, workdir, *, source="measurements", nodes=None,
            include_algebraic=False, population=30, generations=400, pc=0.8, pm=0.03, seed=0,
-           workers=None, scheduler=None, warmup_days=2, progress=None):
+           workers=None, scheduler=None, warmup_days=2, progress=None, fmu_kind="python"):
     """Run the forcing search on a case; return the content of locate.json.
 
     The FMU (`model.fmu`) and the search's checkpoint (`locate.checkpoint.json`) are written in
@@ -72,7 +72,7 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
     candidates = chromosome_nodes(building, case, objective, source, nodes, include_algebraic)
     if not candidates:
         raise InputError(source, "columns", "no measured node besides the objective's air: nothing to force")
-    fmu = build_fmu(building, workdir / "model.fmu")
+    fmu = build_fmu(building, workdir / "model.fmu", kind=fmu_kind)
     result = search(FmuFitness(fmu, case, candidates, objective, warmup_days), candidates,
                     population=population, generations=generations, pc=pc, pm=pm, seed=seed,
                     workers=workers, scheduler=scheduler, checkpoint=workdir / "locate.checkpoint.json",

@@ -2,41 +2,52 @@
 
 One step from t_n to t_n+1 solves `M T^n+1 = V`, with `M = C/dt - A` and
 `V = (C/dt) T^n + B u^n+1 + q`. Forcing node i replaces row i of M by the unit row and v_i by
-the node's measured temperature: a Dirichlet condition. M is factorised once per forcing mask
-(an LU factorisation), so a step is a pair of triangular solves.
+the node's measured temperature: a Dirichlet condition. M is inverted once per forcing mask, so
+a step is one matrix-vector product.
 
 The FMU's `doStep` and the direct model's `simulate` both call `ImplicitEuler.step`: one
 arithmetic for every path through the code.
 """
+from collections import OrderedDict
+
 import numpy as np
-from scipy.linalg import lu_factor
-from scipy.linalg.lapack import dgetrs
 
 DAY = 86400.0  # s
 
 
 class ImplicitEuler:
-    """The step of a `Network` for a step size dt (s), with LU factors cached per forcing mask."""
+    """The step of a `Network` for a step size dt (s), with the step matrix kept per forcing mask.
+
+    M (with its forced rows made unit rows) is inverted once per mask, so that a step is one
+    matrix-vector product: numpy alone, no scipy (the Python FMU imports this class, and an FMU
+    that loads scipy corrupts memory when pythonfmu's host ends the interpreter). The most
+    recently used `CACHED_MASKS` inverses are kept: a search tries thousands of masks.
+    """
+
+    CACHED_MASKS = 64
 
     def __init__(self, network, dt):
         self.network = network
         self.dt = float(dt)
         self.c_dt = network.C / self.dt
         self._M = np.diag(self.c_dt) - network.A
-        self._factors = {}
+        self._inverses = OrderedDict()
 
-    def factors(self, forced):
-        """LU factors of M with the rows of the `forced` nodes (bool mask) replaced by unit rows,
-        and the indices of those nodes."""
+    def inverse(self, forced):
+        """The inverse of M with the rows of the `forced` nodes (bool mask) replaced by unit
+        rows, and the indices of those nodes."""
         key = forced.tobytes()
-        factors = self._factors.get(key)
-        if factors is None:
+        found = self._inverses.get(key)
+        if found is None:
             M = self._M.copy()
             M[forced] = 0.0
             M[forced, forced] = 1.0
-            lu, piv = lu_factor(M, check_finite=False)
-            factors = self._factors[key] = (lu, piv, np.flatnonzero(forced))
-        return factors
+            found = self._inverses[key] = (np.linalg.inv(M), np.flatnonzero(forced))
+            if len(self._inverses) > self.CACHED_MASKS:
+                self._inverses.popitem(last=False)
+        else:
+            self._inverses.move_to_end(key)
+        return found
 
     def step(self, T, source, forced, T_forced):
         """Temperatures (C) at t_n+1 from T at t_n.
@@ -50,13 +61,13 @@ class ImplicitEuler:
         """
         v = self.c_dt * T
         v += source
-        lu, piv, index = self.factors(forced)
+        inverse, index = self.inverse(forced)
         if not len(index):
-            return dgetrs(lu, piv, v)[0]
+            return inverse @ v
         T_imposed = T_forced[index]
         v[index] = T_imposed
-        T_next = dgetrs(lu, piv, v)[0]
-        # Pivoting returns the unit rows' values to rounding only; a Dirichlet node is exact.
+        T_next = inverse @ v
+        # The product returns the unit rows' values to rounding only; a Dirichlet node is exact.
         T_next[index] = T_imposed
         return T_next
 

@@ -80,12 +80,12 @@ def force_mask(case, ids, source):
 
 def cmd_fmu(args):
     from nodeforce.fmu_build.build import build_fmu
-    path = build_fmu(load_building(args.building), args.output)
+    path = build_fmu(load_building(args.building), args.output, kind="standalone" if args.standalone else "python")
     print(f"wrote {path}")
 
 
 def cmd_simulate(args):
-    from nodeforce.cosim.fmi2 import FmuInstance
+    from nodeforce.cosim.fmi import FmuInstance
     from nodeforce.cosim.run import simulate_fmu
     from nodeforce.fmu_build.build import build_fmu
     from nodeforce.model.report import write_node_names, write_node_temperatures
@@ -134,7 +134,7 @@ def cmd_locate(args):
                     nodes=node_list("--nodes", args.nodes) if args.nodes else None,
                     include_algebraic=args.include_algebraic, population=args.population,
                     generations=args.generations, pc=args.pc, pm=args.pm, seed=args.seed,
-                    workers=args.workers, scheduler=args.scheduler)
+                    workers=args.workers, scheduler=args.scheduler, fmu_kind=args.fmu)
     (out / "locate.json").write_text(json.dumps(result, indent=2) + "\n")
     print(locate_summary(result))
     print(f"wrote {out / 'locate.json'}")
@@ -221,7 +221,7 @@ def run_diagnosis(building, case, objective, out, source, args):
     check_workers(args)
     out.mkdir(parents=True, exist_ok=True)
     report = diagnose(building, case, objective, out, source=source, fraction=args.calibration_fraction,
-                      calibration_end=end, seed=args.seed, workers=args.workers)
+                      calibration_end=end, seed=args.seed, workers=args.workers, fmu_kind=args.fmu)
     print(before_after_table(report))
     print(f"wrote {out / 'report.json'}, {out / 'report.md'}, {out / 'building_after.json'}, {out / 'model_after.fmu'}")
 
@@ -266,6 +266,7 @@ def case_arguments(s, measurements_required, output_help, output_default=None):
 def diagnosis_arguments(s):
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--workers", type=int, help="processes (default: all cores)")
+    s.add_argument("--fmu", choices=("python", "standalone"), default="python", help="the FMU kind to run")
     s.add_argument("--calibration-fraction", type=float, default=0.6,
                    help="the first part of the record, by time, that calibrates; the rest validates")
     s.add_argument("--calibration-end",
@@ -291,6 +292,7 @@ def parser():
     s = sub.add_parser("fmu", help="build the FMU of a building file")
     s.add_argument("building")
     s.add_argument("-o", "--output", required=True, help="the .fmu to write")
+    s.add_argument("--standalone", action="store_true", help="C, no Python at run time (needs a C compiler)")
     s.set_defaults(run=cmd_fmu)
 
     s = sub.add_parser("simulate", help="simulate a building through its FMU")
@@ -311,6 +313,7 @@ def parser():
     s.add_argument("--pm", type=float, default=0.03, help="mutation probability per gene")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--workers", type=int, help="processes (default: all cores)")
+    s.add_argument("--fmu", choices=("python", "standalone"), default="python", help="the FMU kind to run")
     s.add_argument("--scheduler", help="a Dask scheduler address, tcp://host:port")
     burn_in_argument(s, 0.0)
     objective_argument(s)

@@ -4,7 +4,7 @@ import copy
 import numpy as np
 import pytest
 
-from nodeforce.cosim.fmi2 import FmuInstance
+from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.diagnose.candidates import candidates

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from fmpy.validation import validate_fmu
 
-from nodeforce.cosim.fmi2 import FmuInstance
+from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.model.building import parse_building

@@ -1,16 +1,32 @@
-"""The one place where nodeforce talks FMI 2.0, through FMPy.
+"""The one place where nodeforce talks FMI, through FMPy.
 
 An `FmuInstance` extracts and instantiates an FMU once; each `run` resets it, so a search can
 simulate thousands of forcing masks without unzipping or instantiating again. The step loop
 writes the inputs into preallocated ctypes arrays through numpy views and calls FMPy's
 `fmi2SetReal`, `fmi2DoStep` and `fmi2GetReal`, so a step allocates nothing in Python.
+
+The slave class follows the model description's fmiVersion, as FMPy's own `simulate_fmu` does;
+this layer knows nothing of how an FMU was made. Extracted FMUs live in temporary folders named
+`nodeforce_fmu_*`, removed when the instance closes, when instantiation fails, and at the latest
+when the interpreter exits: instances still open then are freed first, while Python still runs
+(a library's own exit handlers must not meet live instances after the interpreter has gone).
 """
+import atexit
 import shutil
-import sys
+import tempfile
+import weakref
 
 import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave, fmi2Boolean, fmi2Real, fmi2True, fmi2ValueReference
+
+SLAVES = {"2.0": FMU2Slave}
+_OPEN = weakref.WeakSet()
+
+
+def content_id(fmu_path):
+    """The FMU's identity: its GUID, which nodeforce's FMUs make a hash of their content."""
+    return read_model_description(str(fmu_path), validate=False).guid
 
 
 class FmuInstance:
@@ -19,18 +35,24 @@ class FmuInstance:
     def __init__(self, fmu_path, instance_name="nodeforce"):
         self.path = str(fmu_path)
         self.description = read_model_description(self.path)
+        slave_class = SLAVES.get(self.description.fmiVersion)
+        if slave_class is None:
+            raise ValueError(f"{self.path} is an FMI {self.description.fmiVersion} FMU; "
+                             f"nodeforce runs FMI {', '.join(SLAVES)}")
+        if self.description.coSimulation is None:
+            raise ValueError(f"{self.path} is not a co-simulation FMU")
         self.variables = {v.name: v for v in self.description.modelVariables}
-        self._unzipdir = extract(self.path)
-        self.fmu = FMU2Slave(guid=self.description.guid, unzipDirectory=self._unzipdir,
-                             modelIdentifier=self.description.coSimulation.modelIdentifier,
-                             instanceName=instance_name)
-        on_path = list(sys.path)
-        self.fmu.instantiate()
-        # pythonfmu puts the FMU's resources folder first on sys.path for good. Its copy of the
-        # pythonfmu package (no binaries) would then shadow the installed one for every later
-        # import here and in spawned workers, which build FMUs without binaries from it. The
-        # slave is imported by now, and Reset does not import again: the entry can go.
-        sys.path[:] = [p for p in sys.path if p in on_path or not p.startswith(str(self._unzipdir))]
+        self._unzipdir = extract(self.path, unzipdir=tempfile.mkdtemp(prefix="nodeforce_fmu_"))
+        self.fmu = None
+        try:
+            self.fmu = slave_class(guid=self.description.guid, unzipDirectory=self._unzipdir,
+                                   modelIdentifier=self.description.coSimulation.modelIdentifier,
+                                   instanceName=instance_name)
+            self.fmu.instantiate()
+        except BaseException:
+            self.close()
+            raise
+        _OPEN.add(self)
         self._used = False
 
     def names(self, causality):
@@ -100,13 +122,26 @@ class FmuInstance:
         return outputs
 
     def close(self):
-        """Free the instance and remove the extracted files."""
-        self.fmu.freeInstance()
-        self.fmu.freeLibrary()
+        """Free the instance and remove the extracted files (again: nothing happens)."""
+        fmu, self.fmu = self.fmu, None
+        if fmu is not None:
+            # FMPy's freeInstance unloads the library too: unloading it twice is undefined
+            # behaviour in glibc's dlclose.
+            if getattr(fmu, "component", None) is not None:
+                fmu.freeInstance()
+            else:
+                fmu.freeLibrary()
         shutil.rmtree(self._unzipdir, ignore_errors=True)
+        _OPEN.discard(self)
 
     def __enter__(self):
         return self
 
     def __exit__(self, *exc):
         self.close()
+
+
+@atexit.register
+def _close_all():
+    for instance in list(_OPEN):
+        instance.close()

@@ -1,0 +1,654 @@
+/* A generic FMI 2.0 co-simulation slave stepping a nodal network (PHYSICS.md section 5).
+
+   The network is data, assembled by nodeforce in Python and shipped as resources/network.txt:
+   C (J/K), A (W/K), B, q (W) at the declared effect parameters p0 and, per set S of effect
+   parameters, a term multiplied by prod_{j in S} (p_j - p0_j); the zones' air and radiant nodes
+   and each component's nodes with their depths (for the initial state). This file only steps:
+       (C/dt - A) T+ = (C/dt) T + B u + q,
+   the rows of forced nodes (force[i] and T_forced[i] not NaN) replaced by T+_i = T_forced[i],
+   with M factorised (LU, partial pivoting) once per pattern of imposed nodes and step size.
+
+   Value references (fmu_build/variables.py): force[1..N] (Boolean), T_start, the inputs,
+   T_forced[1..N], T[1..N] (outputs), the effect parameters. */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmi2.h"
+
+enum { INSTANTIATED, INITIALISATION, STEPPING, TERMINATED };
+#define CACHED_PATTERNS 8
+
+typedef struct {
+    double dt;
+    unsigned char *imposed; /* N */
+    double *lu;             /* N x N, row major */
+    int *piv;               /* N */
+    int used;
+} Factors;
+
+typedef struct {
+    int n, n_in, n_par, n_terms, n_zones, n_groups;
+    double *p0;     /* n_par */
+    int *term_mask; /* n_terms: bit j = parameter j multiplies the term */
+    double *terms;  /* n_terms x (n + n*n + n*n_in + n): C, A, B, q */
+    int *air, *radiant;                 /* n_zones, 0-based nodes */
+    int *group_zone, *group_start, *group_len; /* n_groups */
+    int *group_node; double *group_depth;      /* concatenated */
+} Network;
+
+typedef struct {
+    Network net;
+    char *name;
+    fmi2CallbackFunctions cb;
+    int state, size, clock;
+    double *values, *start_values;
+    double *C, *A, *B, *q; /* at the parameters' values */
+    double *v, *T_next;
+    unsigned char *imposed;
+    Factors cache[CACHED_PATTERNS];
+} Model;
+
+/* ------------------------------------------------------------------ layout */
+static int vr_force(const Model *m) { (void)m; return 0; }
+static int vr_T_start(const Model *m) { return m->net.n; }
+static int vr_inputs(const Model *m) { return m->net.n + 1; }
+static int vr_T_forced(const Model *m) { return vr_inputs(m) + m->net.n_in; }
+static int vr_T(const Model *m) { return vr_T_forced(m) + m->net.n; }
+static int vr_parameters(const Model *m) { return vr_T(m) + m->net.n; }
+
+static void log_error(Model *m, const char *format, ...) {
+    char message[512];
+    va_list args;
+    va_start(args, format);
+    vsnprintf(message, sizeof message, format, args);
+    va_end(args);
+    if (m->cb.logger) m->cb.logger(m->cb.componentEnvironment, m->name, fmi2Error, "logStatusError", "%s", message);
+}
+
+/* Why the standard forbids this get or set, logged; 0 when allowed. */
+static int refused(Model *m, const fmi2ValueReference vr[], size_t nvr, int real, int setting) {
+    size_t k;
+    for (k = 0; k < nvr; k++) {
+        int r = (int)vr[k];
+        int boolean = r < m->net.n;
+        int fixed = r <= vr_T_start(m) || r >= vr_parameters(m);
+        if (vr[k] >= (fmi2ValueReference)m->size) {
+            log_error(m, "value reference %u does not exist (0..%d)", vr[k], m->size - 1);
+            return 1;
+        }
+        if (boolean == real) {
+            log_error(m, "value reference %d is %s, not %s", r, real ? "Boolean" : "Real", real ? "Real" : "Boolean");
+            return 1;
+        }
+        if (!setting) continue;
+        if (r >= vr_T(m) && r < vr_parameters(m)) {
+            log_error(m, "value reference %d is an output, which cannot be set", r);
+            return 1;
+        }
+        if (fixed && m->state != INSTANTIATED && m->state != INITIALISATION) {
+            log_error(m, "value reference %d is a fixed parameter, which cannot change after initialisation", r);
+            return 1;
+        }
+        if (m->state == TERMINATED) {
+            log_error(m, "the slave is terminated");
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* ------------------------------------------------------------------ reading the network */
+static char *file_path(const char *uri, const char *name) {
+    const char *p = uri;
+    char *path, *out;
+    if (strncmp(p, "file://", 7) == 0) {
+        p += 7;
+        if (strncmp(p, "localhost/", 10) == 0) p += 9;
+    } else if (strncmp(p, "file:", 5) == 0) {
+        p += 5;
+    }
+    path = malloc(strlen(p) + strlen(name) + 2);
+    if (!path) return NULL;
+    for (out = path; *p; p++) { /* percent-decoding */
+        if (p[0] == '%' && p[1] && p[2]) {
+            char hex[3] = {p[1], p[2], 0};
+            *out++ = (char)strtol(hex, NULL, 16);
+            p += 2;
+        } else {
+            *out++ = *p;
+        }
+    }
+    if (out > path && out[-1] == '/') out--;
+    *out++ = '/';
+    strcpy(out, name);
+    return path;
+}
+
+static int expect(FILE *f, const char *word) {
+    char token[64];
+    return fscanf(f, "%63s", token) == 1 && strcmp(token, word) == 0;
+}
+
+static int read_ints(FILE *f, int *x, int count) {
+    int k;
+    for (k = 0; k < count; k++)
+        if (fscanf(f, "%d", &x[k]) != 1) return 0;
+    return 1;
+}
+
+static int read_doubles(FILE *f, double *x, long count) {
+    long k;
+    for (k = 0; k < count; k++)
+        if (fscanf(f, "%lf", &x[k]) != 1) return 0;
+    return 1;
+}
+
+static long term_size(const Network *net) { return (long)net->n * (2 + net->n + net->n_in); }
+
+static int read_network(Network *net, FILE *f) {
+    int k, total = 0;
+    if (!expect(f, "nodeforce-network/1") || !expect(f, "sizes") || !read_ints(f, &net->n, 1)
+        || !read_ints(f, &net->n_in, 1) || !read_ints(f, &net->n_par, 1) || !read_ints(f, &net->n_terms, 1)
+        || !read_ints(f, &net->n_zones, 1) || !read_ints(f, &net->n_groups, 1))
+        return 0;
+    net->p0 = calloc((size_t)net->n_par + 1, sizeof(double));
+    net->term_mask = calloc((size_t)net->n_terms, sizeof(int));
+    net->terms = calloc((size_t)(net->n_terms * term_size(net)), sizeof(double));
+    net->air = calloc((size_t)net->n_zones, sizeof(int));
+    net->radiant = calloc((size_t)net->n_zones, sizeof(int));
+    net->group_zone = calloc((size_t)net->n_groups, sizeof(int));
+    net->group_start = calloc((size_t)net->n_groups, sizeof(int));
+    net->group_len = calloc((size_t)net->n_groups, sizeof(int));
+    net->group_node = calloc((size_t)net->n, sizeof(int));
+    net->group_depth = calloc((size_t)net->n, sizeof(double));
+    if (!net->p0 || !net->term_mask || !net->terms || !net->air || !net->radiant || !net->group_zone
+        || !net->group_start || !net->group_len || !net->group_node || !net->group_depth)
+        return 0;
+    if (!expect(f, "p0") || !read_doubles(f, net->p0, net->n_par)) return 0;
+    for (k = 0; k < net->n_terms; k++)
+        if (!expect(f, "term") || !read_ints(f, &net->term_mask[k], 1)
+            || !read_doubles(f, net->terms + k * term_size(net), term_size(net)))
+            return 0;
+    if (!expect(f, "zones")) return 0;
+    for (k = 0; k < net->n_zones; k++)
+        if (!read_ints(f, &net->air[k], 1) || !read_ints(f, &net->radiant[k], 1)) return 0;
+    if (!expect(f, "components")) return 0;
+    for (k = 0; k < net->n_groups; k++) {
+        int j;
+        if (!read_ints(f, &net->group_zone[k], 1) || !read_ints(f, &net->group_len[k], 1)) return 0;
+        net->group_start[k] = total;
+        if (total + net->group_len[k] > net->n) return 0;
+        for (j = 0; j < net->group_len[k]; j++, total++)
+            if (!read_ints(f, &net->group_node[total], 1) || !read_doubles(f, &net->group_depth[total], 1)) return 0;
+    }
+    return expect(f, "end");
+}
+
+static void free_network(Network *net) {
+    free(net->p0); free(net->term_mask); free(net->terms); free(net->air); free(net->radiant);
+    free(net->group_zone); free(net->group_start); free(net->group_len); free(net->group_node);
+    free(net->group_depth);
+}
+
+/* ------------------------------------------------------------------ the numbers */
+/* C, A, B, q at the effect parameters' current values. */
+static void network_at_parameters(Model *m) {
+    const Network *net = &m->net;
+    long size = term_size(net), k;
+    int t, j;
+    double *out = m->C; /* C, A, B, q are one contiguous block */
+    memset(out, 0, (size_t)size * sizeof(double));
+    for (t = 0; t < net->n_terms; t++) {
+        double weight = 1.0;
+        const double *term = net->terms + t * size;
+        for (j = 0; j < net->n_par; j++)
+            if (net->term_mask[t] & (1 << j)) weight *= m->values[vr_parameters(m) + j] - net->p0[j];
+        for (k = 0; k < size; k++) out[k] += weight * term[k];
+    }
+}
+
+/* np.interp(x, xp, fp) with xp increasing: the end values held beyond the range. */
+static double interp(double x, const double *xp, const double *fp, int count) {
+    int j;
+    if (x <= xp[0]) return fp[0];
+    if (x >= xp[count - 1]) return fp[count - 1];
+    for (j = 0; xp[j + 1] <= x; j++) {}
+    return (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j]) * (x - xp[j]) + fp[j];
+}
+
+/* PHYSICS.md section 5: the initial state from the measurements at t_0 and T_start. */
+static void initial_state(Model *m) {
+    const Network *net = &m->net;
+    const double *measured = m->values + vr_T_forced(m);
+    double *T = m->values + vr_T(m), T_start = m->values[vr_T_start(m)];
+    double *xp = malloc((size_t)net->n * sizeof(double)), *fp = malloc((size_t)net->n * sizeof(double));
+    int z, g, i;
+    for (z = 0; z < net->n_zones; z++) {
+        double air = measured[net->air[z]];
+        double fallback = isfinite(air) ? air : T_start;
+        T[net->air[z]] = T[net->radiant[z]] = fallback;
+        for (g = 0; g < net->n_groups; g++) {
+            const int *node = net->group_node + net->group_start[g];
+            const double *depth = net->group_depth + net->group_start[g];
+            int count = 0;
+            if (net->group_zone[g] != z) continue;
+            for (i = 0; i < net->group_len[g]; i++)
+                if (isfinite(measured[node[i]])) {
+                    xp[count] = depth[i];
+                    fp[count++] = measured[node[i]];
+                }
+            for (i = 0; i < net->group_len[g]; i++)
+                T[node[i]] = count ? interp(depth[i], xp, fp, count) : fallback;
+        }
+    }
+    for (i = 0; i < net->n; i++)
+        if (isfinite(measured[i])) T[i] = measured[i];
+    free(xp);
+    free(fp);
+}
+
+static int lu_factor(double *a, int *piv, int n) {
+    int i, j, k;
+    for (k = 0; k < n; k++) {
+        int p = k;
+        for (i = k + 1; i < n; i++)
+            if (fabs(a[i * n + k]) > fabs(a[p * n + k])) p = i;
+        piv[k] = p;
+        if (a[p * n + k] == 0.0) return 0;
+        if (p != k)
+            for (j = 0; j < n; j++) {
+                double swap = a[k * n + j];
+                a[k * n + j] = a[p * n + j];
+                a[p * n + j] = swap;
+            }
+        for (i = k + 1; i < n; i++) {
+            double factor = a[i * n + k] /= a[k * n + k];
+            for (j = k + 1; j < n; j++) a[i * n + j] -= factor * a[k * n + j];
+        }
+    }
+    return 1;
+}
+
+static void lu_solve(const double *a, const int *piv, double *b, int n) {
+    int i, j;
+    for (i = 0; i < n; i++) {
+        double swap = b[i];
+        b[i] = b[piv[i]];
+        b[piv[i]] = swap;
+    }
+    for (i = 0; i < n; i++)
+        for (j = 0; j < i; j++) b[i] -= a[i * n + j] * b[j];
+    for (i = n - 1; i >= 0; i--) {
+        for (j = i + 1; j < n; j++) b[i] -= a[i * n + j] * b[j];
+        b[i] /= a[i * n + i];
+    }
+}
+
+/* The factors of M for this step size and pattern of imposed nodes (cached). */
+static Factors *factors(Model *m, double dt) {
+    int n = m->net.n, i, j, slot = 0;
+    Factors *f;
+    for (i = 0; i < CACHED_PATTERNS; i++) {
+        f = &m->cache[i];
+        if (f->lu && f->dt == dt && memcmp(f->imposed, m->imposed, (size_t)n) == 0) {
+            f->used = ++m->clock;
+            return f;
+        }
+        if (f->used < m->cache[slot].used) slot = i; /* the least recently used (unused: 0) */
+    }
+    f = &m->cache[slot];
+    if (!f->lu) {
+        f->lu = malloc((size_t)n * n * sizeof(double));
+        f->piv = malloc((size_t)n * sizeof(int));
+        f->imposed = malloc((size_t)n);
+        if (!f->lu || !f->piv || !f->imposed) return NULL;
+    }
+    for (i = 0; i < n; i++)
+        for (j = 0; j < n; j++)
+            f->lu[i * n + j] = m->imposed[i] ? (double)(i == j) : (i == j ? m->C[i] / dt : 0.0) - m->A[i * n + j];
+    f->dt = dt;
+    memcpy(f->imposed, m->imposed, (size_t)n);
+    f->used = ++m->clock;
+    if (!lu_factor(f->lu, f->piv, n)) {
+        f->dt = -1.0; /* never matches again */
+        f->used = 0;
+        return NULL;
+    }
+    return f;
+}
+
+static void forget_factors(Model *m) {
+    int i;
+    for (i = 0; i < CACHED_PATTERNS; i++) {
+        m->cache[i].dt = -1.0;
+        m->cache[i].used = 0;
+    }
+}
+
+static fmi2Status step(Model *m, double dt) {
+    const Network *net = &m->net;
+    int n = net->n, i, j;
+    const double *u = m->values + vr_inputs(m), *T_forced = m->values + vr_T_forced(m);
+    double *T = m->values + vr_T(m);
+    Factors *f;
+    for (i = 0; i < n; i++) m->imposed[i] = m->values[vr_force(m) + i] != 0.0 && isfinite(T_forced[i]);
+    f = factors(m, dt);
+    if (!f) {
+        log_error(m, "the step matrix is singular (or memory ran out)");
+        return fmi2Error;
+    }
+    for (i = 0; i < n; i++) {
+        double source = m->q[i];
+        for (j = 0; j < net->n_in; j++) source += m->B[i * net->n_in + j] * u[j];
+        m->v[i] = m->imposed[i] ? T_forced[i] : m->C[i] / dt * T[i] + source;
+    }
+    lu_solve(f->lu, f->piv, m->v, n);
+    for (i = 0; i < n; i++) T[i] = m->imposed[i] ? T_forced[i] : m->v[i];
+    return fmi2OK;
+}
+
+/* ------------------------------------------------------------------ FMI 2.0 */
+FMI2_EXPORT const char *fmi2GetTypesPlatform(void) { return "default"; }
+FMI2_EXPORT const char *fmi2GetVersion(void) { return "2.0"; }
+
+FMI2_EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean on, size_t n, const fmi2String categories[]) {
+    (void)c; (void)on; (void)n; (void)categories;
+    return fmi2OK;
+}
+
+static void free_model(Model *m) {
+    int i;
+    if (!m) return;
+    for (i = 0; i < CACHED_PATTERNS; i++) {
+        free(m->cache[i].lu); free(m->cache[i].piv); free(m->cache[i].imposed);
+    }
+    free_network(&m->net);
+    free(m->name); free(m->values); free(m->start_values); free(m->C); free(m->v); free(m->T_next);
+    free(m->imposed);
+    free(m);
+}
+
+FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, fmi2String resources,
+                                          const fmi2CallbackFunctions *functions, fmi2Boolean visible,
+                                          fmi2Boolean loggingOn) {
+    Model *m = calloc(1, sizeof(Model));
+    char *path;
+    FILE *f;
+    int ok, i;
+    (void)guid; (void)visible; (void)loggingOn;
+    if (!m || !functions) { free(m); return NULL; }
+    memcpy((void *)&m->cb, functions, sizeof m->cb);
+    m->name = malloc(strlen(name ? name : "") + 1);
+    if (!m->name) { free_model(m); return NULL; }
+    strcpy(m->name, name ? name : "");
+    if (type != fmi2CoSimulation) {
+        log_error(m, "this FMU supports co-simulation only");
+        free_model(m);
+        return NULL;
+    }
+    path = resources ? file_path(resources, "network.txt") : NULL;
+    f = path ? fopen(path, "r") : NULL;
+    ok = f && read_network(&m->net, f);
+    if (f) fclose(f);
+    if (!ok) {
+        log_error(m, "cannot read %s", path ? path : "the resources (no fmuResourceLocation)");
+        free(path);
+        free_model(m);
+        return NULL;
+    }
+    free(path);
+    m->size = vr_parameters(m) + m->net.n_par;
+    m->values = calloc((size_t)m->size, sizeof(double));
+    m->start_values = calloc((size_t)m->size, sizeof(double));
+    m->C = calloc((size_t)term_size(&m->net), sizeof(double));
+    m->A = m->C + m->net.n;
+    m->B = m->A + m->net.n * m->net.n;
+    m->q = m->B + m->net.n * m->net.n_in;
+    m->v = calloc((size_t)m->net.n, sizeof(double));
+    m->T_next = calloc((size_t)m->net.n, sizeof(double));
+    m->imposed = calloc((size_t)m->net.n, 1);
+    if (!m->values || !m->start_values || !m->C || !m->v || !m->T_next || !m->imposed) {
+        free_model(m);
+        return NULL;
+    }
+    m->start_values[vr_T_start(m)] = 20.0;
+    for (i = 0; i < m->net.n; i++) {
+        m->start_values[vr_T_forced(m) + i] = NAN;
+        m->start_values[vr_T(m) + i] = 20.0;
+    }
+    for (i = 0; i < m->net.n_par; i++) m->start_values[vr_parameters(m) + i] = m->net.p0[i];
+    memcpy(m->values, m->start_values, (size_t)m->size * sizeof(double));
+    forget_factors(m);
+    m->state = INSTANTIATED;
+    return m;
+}
+
+FMI2_EXPORT void fmi2FreeInstance(fmi2Component c) { free_model((Model *)c); }
+
+FMI2_EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
+                                           fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
+    Model *m = c;
+    (void)toleranceDefined; (void)tolerance; (void)startTime; (void)stopTimeDefined; (void)stopTime;
+    if (m->state != INSTANTIATED) {
+        log_error(m, "fmi2SetupExperiment is allowed only after instantiation");
+        return fmi2Error;
+    }
+    return fmi2OK;
+}
+
+FMI2_EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
+    Model *m = c;
+    if (m->state != INSTANTIATED) {
+        log_error(m, "fmi2EnterInitializationMode is allowed only after instantiation");
+        return fmi2Error;
+    }
+    m->state = INITIALISATION;
+    return fmi2OK;
+}
+
+FMI2_EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
+    Model *m = c;
+    if (m->state != INITIALISATION) {
+        log_error(m, "fmi2ExitInitializationMode outside initialisation mode");
+        return fmi2Error;
+    }
+    network_at_parameters(m);
+    forget_factors(m);
+    initial_state(m);
+    m->state = STEPPING;
+    return fmi2OK;
+}
+
+FMI2_EXPORT fmi2Status fmi2Terminate(fmi2Component c) {
+    ((Model *)c)->state = TERMINATED;
+    return fmi2OK;
+}
+
+FMI2_EXPORT fmi2Status fmi2Reset(fmi2Component c) {
+    Model *m = c;
+    memcpy(m->values, m->start_values, (size_t)m->size * sizeof(double));
+    m->state = INSTANTIATED;
+    return fmi2OK;
+}
+
+FMI2_EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
+    Model *m = c;
+    size_t k;
+    if (refused(m, vr, nvr, 1, 0)) return fmi2Error;
+    for (k = 0; k < nvr; k++) value[k] = m->values[vr[k]];
+    return fmi2OK;
+}
+
+FMI2_EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
+    Model *m = c;
+    size_t k;
+    if (refused(m, vr, nvr, 1, 1)) return fmi2Error;
+    for (k = 0; k < nvr; k++) m->values[vr[k]] = value[k];
+    return fmi2OK;
+}
+
+FMI2_EXPORT fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[]) {
+    Model *m = c;
+    size_t k;
+    if (refused(m, vr, nvr, 0, 0)) return fmi2Error;
+    for (k = 0; k < nvr; k++) value[k] = m->values[vr[k]] != 0.0;
+    return fmi2OK;
+}
+
+FMI2_EXPORT fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean value[]) {
+    Model *m = c;
+    size_t k;
+    if (refused(m, vr, nvr, 0, 1)) return fmi2Error;
+    for (k = 0; k < nvr; k++) m->values[vr[k]] = value[k] ? 1.0 : 0.0;
+    return fmi2OK;
+}
+
+static fmi2Status no_such(Model *m, const char *what, size_t nvr) {
+    if (nvr == 0) return fmi2OK;
+    log_error(m, "this FMU has no %s variables", what);
+    return fmi2Error;
+}
+
+FMI2_EXPORT fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[]) {
+    (void)vr; (void)value;
+    return no_such(c, "Integer", nvr);
+}
+FMI2_EXPORT fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[]) {
+    (void)vr; (void)value;
+    return no_such(c, "Integer", nvr);
+}
+FMI2_EXPORT fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
+    (void)vr; (void)value;
+    return no_such(c, "String", nvr);
+}
+FMI2_EXPORT fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]) {
+    (void)vr; (void)value;
+    return no_such(c, "String", nvr);
+}
+
+/* A state: the state of the slave, then every value. */
+FMI2_EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *state) {
+    Model *m = c;
+    double *copy = *state ? *state : malloc((size_t)(m->size + 1) * sizeof(double));
+    if (!copy) return fmi2Error;
+    copy[0] = m->state;
+    memcpy(copy + 1, m->values, (size_t)m->size * sizeof(double));
+    *state = copy;
+    return fmi2OK;
+}
+
+FMI2_EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state) {
+    Model *m = c;
+    const double *copy = state;
+    if (!copy) return fmi2Error;
+    m->state = (int)copy[0];
+    memcpy(m->values, copy + 1, (size_t)m->size * sizeof(double));
+    if (m->state == STEPPING) { /* the network at the restored parameters */
+        network_at_parameters(m);
+        forget_factors(m);
+    }
+    return fmi2OK;
+}
+
+FMI2_EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state) {
+    (void)c;
+    free(*state);
+    *state = NULL;
+    return fmi2OK;
+}
+
+FMI2_EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate state, size_t *size) {
+    (void)state;
+    *size = (size_t)(((Model *)c)->size + 1) * sizeof(double);
+    return fmi2OK;
+}
+
+FMI2_EXPORT fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate state, fmi2Byte bytes[], size_t size) {
+    if (size < (size_t)(((Model *)c)->size + 1) * sizeof(double)) return fmi2Error;
+    memcpy(bytes, state, (size_t)(((Model *)c)->size + 1) * sizeof(double));
+    return fmi2OK;
+}
+
+FMI2_EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[], size_t size, fmi2FMUstate *state) {
+    Model *m = c;
+    size_t need = (size_t)(m->size + 1) * sizeof(double);
+    if (size != need) {
+        log_error(m, "a serialized state of %lu bytes is not one of this FMU's (%lu)", (unsigned long)size, (unsigned long)need);
+        return fmi2Error;
+    }
+    *state = malloc(need);
+    if (!*state) return fmi2Error;
+    memcpy(*state, bytes, need);
+    return fmi2OK;
+}
+
+FMI2_EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,
+                                                    const fmi2ValueReference z[], size_t nz, const fmi2Real dv[],
+                                                    fmi2Real dz[]) {
+    (void)u; (void)nu; (void)z; (void)nz; (void)dv; (void)dz;
+    log_error(c, "directional derivatives are not provided");
+    return fmi2Error;
+}
+
+FMI2_EXPORT fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                                   const fmi2Integer order[], const fmi2Real value[]) {
+    (void)vr; (void)nvr; (void)order; (void)value;
+    log_error(c, "input derivatives are not used (canInterpolateInputs is false)");
+    return fmi2Error;
+}
+
+FMI2_EXPORT fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                                    const fmi2Integer order[], fmi2Real value[]) {
+    (void)vr; (void)nvr; (void)order; (void)value;
+    log_error(c, "output derivatives are not provided");
+    return fmi2Error;
+}
+
+FMI2_EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
+                                  fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
+    Model *m = c;
+    (void)currentCommunicationPoint; (void)noSetFMUStatePriorToCurrentPoint;
+    if (m->state != STEPPING) {
+        log_error(m, "fmi2DoStep before initialisation ended, or after fmi2Terminate");
+        return fmi2Error;
+    }
+    if (!(communicationStepSize > 0.0)) {
+        log_error(m, "fmi2DoStep with communicationStepSize %g s: it must be > 0", communicationStepSize);
+        return fmi2Error;
+    }
+    return step(m, communicationStepSize);
+}
+
+FMI2_EXPORT fmi2Status fmi2CancelStep(fmi2Component c) {
+    log_error(c, "fmi2CancelStep: steps are never asynchronous here");
+    return fmi2Error;
+}
+
+static fmi2Status no_status(Model *m) {
+    log_error(m, "steps are never asynchronous here: no status to report");
+    return fmi2Discard;
+}
+
+FMI2_EXPORT fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value) {
+    (void)s; (void)value;
+    return no_status(c);
+}
+FMI2_EXPORT fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value) {
+    (void)s; (void)value;
+    return no_status(c);
+}
+FMI2_EXPORT fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value) {
+    (void)s; (void)value;
+    return no_status(c);
+}
+FMI2_EXPORT fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value) {
+    (void)s; (void)value;
+    return no_status(c);
+}
+FMI2_EXPORT fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value) {
+    (void)s; (void)value;
+    return no_status(c);
+}

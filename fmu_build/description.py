@@ -1,0 +1,228 @@
+"""The model description (modelDescription.xml) both FMUs of a building carry, and their FMU files.
+
+The Python and the standalone FMU of one building declare the same variables (`variables.Layout`)
+with their units, the same model structure and default experiment; they differ in the model
+identifier, whether an execution tool (Python) is needed, and the source files. The GUID is a
+hash of everything the FMU carries, so the same model gives the same FMU, byte for byte.
+"""
+import hashlib
+import zipfile
+from dataclasses import dataclass
+from importlib.metadata import PackageNotFoundError, metadata
+from xml.etree.ElementTree import Element, SubElement, indent, tostring
+
+from nodeforce.model.building import Boundary
+from nodeforce.model.effects import EFFECTS
+
+
+DEFAULT_STEP = 900.0  # s, the step of the bundled data when a building declares none
+# FMI 2.0 units: name -> (quantity, SI base-unit exponents and factor/offset to SI)
+UNITS = {
+    "degC": ("ThermodynamicTemperature", {"K": "1", "offset": "273.15"}),
+    "K": ("ThermodynamicTemperature", {"K": "1"}),
+    "W": ("Power", {"kg": "1", "m": "2", "s": "-3"}),
+    "W/m2": ("Irradiance", {"kg": "1", "s": "-3"}),
+    "W/K": ("ThermalConductance", {"kg": "1", "m": "2", "s": "-3", "K": "-1"}),
+    "W/m2/K": ("CoefficientOfHeatTransfer", {"kg": "1", "s": "-3", "K": "-1"}),
+    "1/h": ("AirChangeRate", {"s": "-1", "factor": str(1 / 3600)}),
+}
+EFFECT_UNITS = {"C": "degC", "-": None}  # effects.Parameter.unit spellings that differ from FMI's
+LOG_CATEGORIES = ("logStatusWarning", "logStatusDiscard", "logStatusError", "logStatusFatal", "logAll")
+# A fixed time for every zip entry: the same content gives the same bytes.
+ZIP_TIME = (1980, 1, 1, 0, 0, 0)
+
+
+def nodeforce_version():
+    try:
+        meta = metadata("nodeforce")
+    except PackageNotFoundError:  # running from a source tree that is not installed
+        return "unknown", None
+    return meta.get("Version", "unknown"), meta.get("License")
+
+
+@dataclass(frozen=True)
+class Variable:
+    name: str
+    causality: str  # parameter, input, output
+    type: str  # Real, Boolean
+    start: object  # None for a calculated output
+    unit: object  # a key of UNITS or None
+    description: str
+
+
+def variables(layout, building, effect=None):
+    """The `Variable`s of a model, in value-reference order."""
+    n = range(1, layout.n_nodes + 1)
+    found = [Variable(f"force[{i}]", "parameter", "Boolean", "false", None,
+                      f"node {i} is forced to T_forced[{i}] where that is not NaN") for i in n]
+    found.append(Variable("T_start", "parameter", "Real", "20", "degC",
+                          "initial temperature of a node no measurement at t_0 informs"))
+    found += [Variable(name, "input", "Real", "0", *_input_meaning(building, name))
+              for name in layout.input_names]
+    found += [Variable(f"T_forced[{i}]", "input", "Real", "NaN", "degC",
+                       f"measured temperature of node {i}, NaN if none") for i in n]
+    found += [Variable(f"T[{i}]", "output", "Real", None, "degC", f"temperature of node {i}") for i in n]
+    if effect is not None:
+        effect_id, target, start = effect
+        units = {p.name: EFFECT_UNITS.get(p.unit, p.unit) for p in EFFECTS[effect_id].parameters}
+        found += [Variable(f"{effect_id}.{name}", "parameter", "Real", repr(float(value)), units[name],
+                           f"{effect_id} of {target}: {name}") for name, value in start.items()]
+    return found
+
+
+def _input_meaning(building, name):
+    """(unit, description) of an input of the network (PHYSICS.md sections 1 and 4)."""
+    if name == "T_out":
+        return "degC", "outdoor air temperature"
+    if name == "T_sky":
+        return "degC", "sky temperature"
+    faces = [c.name for c in building.exterior_components if c.irradiance_input == name]
+    if faces:
+        return "W/m2", f"solar irradiance on the outside face of {', '.join(faces)}"
+    for zone in building.zones:
+        if name in zone.heat_input:
+            return "W", f"measured heat input {name} of zone {zone.name}"
+        if zone.supply is not None and zone.supply.temperature == name:
+            return "degC", f"supply air temperature of zone {zone.name}"
+        if name in dict(zone.thermal_bridges):
+            return "degC", f"temperature beyond a thermal bridge of zone {zone.name}"
+    for c in building.components:
+        if isinstance(c.outside, Boundary) and c.outside.temperature == name:
+            return "degC", f"boundary temperature {name} beyond {c.name}"
+        if c.shading == name:
+            return None, f"shading of {c.name}, 0 (closed) to 1 (open)"
+    return None, f"measured input column {name}"
+
+
+def initial_dependencies(building, layout):
+    """{node index (0-based): sorted value references} the initial T of each node depends on
+    (PHYSICS.md section 5): its own measurement, its component's, its zone's air, T_start."""
+    forced = range(layout.T_forced.start, layout.T_forced.stop)
+    depends = {i: {forced[i], layout.T_start} for i in range(layout.n_nodes)}
+    for zone in building.zones:
+        air = zone.air_node - 1
+        for node in (air, zone.radiant_node - 1):
+            depends[node].add(forced[air])
+        for c in building.components:
+            if c.inside.zone == zone.name:
+                for node in c.node_ids:
+                    depends[node - 1] |= {forced[air]} | {forced[j - 1] for j in c.node_ids}
+    return {i: sorted(vrs) for i, vrs in depends.items()}
+
+
+def model_description(layout, building, guid, identifier, name, effect=None, standalone=False,
+                      source_files=(), step=DEFAULT_STEP):
+    """modelDescription.xml (bytes) of a model.
+
+    Parameters
+    ----------
+    layout : variables.Layout; building : model.building.Building
+    guid : the content hash (`content_guid`); identifier : the model identifier (binary name)
+    name : model name; effect : (id, target, {name: start}) or None
+    standalone : the FMU needs no Python; source_files : names under sources/
+    step : default communication step (s)
+    """
+    version, licence = nodeforce_version()
+    root = Element("fmiModelDescription", {
+        "fmiVersion": "2.0", "modelName": name, "guid": guid,
+        "description": "Nodal (RC network) building thermal model with a forcing input per node",
+        "author": "nodeforce", "version": version,
+        "license": f"nodeforce: {licence or 'see the nodeforce distribution'}"
+                   + ("" if standalone else "; pythonfmu runtime: MIT"),
+        "generationTool": f"nodeforce {version}" + ("" if standalone else " with pythonfmu"),
+        "variableNamingConvention": "structured", "numberOfEventIndicators": "0"})
+    cosim = SubElement(root, "CoSimulation", {
+        "modelIdentifier": identifier, "needsExecutionTool": "false" if standalone else "true",
+        "canHandleVariableCommunicationStepSize": "true", "canInterpolateInputs": "false",
+        "canBeInstantiatedOnlyOncePerProcess": "false", "canNotUseMemoryManagementFunctions": "true",
+        "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true"})
+    if source_files:
+        files = SubElement(cosim, "SourceFiles")
+        for file in source_files:
+            SubElement(files, "File", {"name": file})
+    declared = variables(layout, building, effect)
+    units = SubElement(root, "UnitDefinitions")
+    for unit in sorted({v.unit for v in declared if v.unit}):
+        SubElement(SubElement(units, "Unit", {"name": unit}), "BaseUnit", UNITS[unit][1])
+    categories = SubElement(root, "LogCategories")
+    for category in LOG_CATEGORIES:
+        SubElement(categories, "Category", {"name": category})
+    SubElement(root, "DefaultExperiment", {"startTime": "0", "stepSize": repr(float(step))})
+    model_variables = SubElement(root, "ModelVariables")
+    for vr, v in enumerate(declared):
+        attributes = {"name": v.name, "valueReference": str(vr), "description": v.description,
+                      "causality": v.causality}
+        if v.causality == "parameter":
+            attributes.update(variability="fixed", initial="exact")
+        elif v.causality == "output":
+            attributes["initial"] = "calculated"
+        element = SubElement(model_variables, "ScalarVariable", attributes)
+        typed = {} if v.start is None else {"start": v.start}
+        if v.unit:
+            typed.update(quantity=UNITS[v.unit][0], unit=v.unit)
+        SubElement(element, v.type, typed)
+    structure = SubElement(root, "ModelStructure")
+    outputs = SubElement(structure, "Outputs")
+    initial = SubElement(structure, "InitialUnknowns")
+    depends = initial_dependencies(building, layout)
+    for node, vr in enumerate(range(layout.T.start, layout.T.stop)):
+        # A co-simulation output is the state after doStep: no direct feed-through from inputs.
+        SubElement(outputs, "Unknown", {"index": str(vr + 1), "dependencies": ""})
+        SubElement(initial, "Unknown", {"index": str(vr + 1),
+                                        "dependencies": " ".join(str(d + 1) for d in depends[node])})
+    indent(root, "  ")
+    return tostring(root, encoding="UTF-8", xml_declaration=True) + b"\n"
+
+
+def content_hash(*parts):
+    """sha256 (hex) of bytes or str parts."""
+    digest = hashlib.sha256()
+    for part in parts:
+        digest.update(part.encode() if isinstance(part, str) else part)
+        digest.update(b"\0")
+    return digest.hexdigest()
+
+
+def content_guid(*parts):
+    """A GUID that is a hash of the FMU's content (bytes or str parts)."""
+    h = content_hash(*parts)
+    return "{" + f"{h[:8]}-{h[8:12]}-{h[12:16]}-{h[16:20]}-{h[20:32]}" + "}"
+
+
+def write_fmu(destination, files):
+    """Write an FMU (zip) of {archive name: bytes} in name order with fixed times: the same
+    files give the same bytes."""
+    with zipfile.ZipFile(destination, "w", zipfile.ZIP_DEFLATED) as fmu:
+        for name in sorted(files):
+            info = zipfile.ZipInfo(name, ZIP_TIME)
+            info.compress_type = zipfile.ZIP_DEFLATED
+            info.external_attr = (0o755 if name.startswith("binaries/") else 0o644) << 16
+            fmu.writestr(info, files[name])
+    return destination
+
+
+def documentation(name, standalone, python_minimum="3.10"):
+    """documentation/index.html: what an importer needs to run this FMU."""
+    if standalone:
+        needs = ("<p>This FMU needs no Python: <code>binaries/linux64</code> holds a C library "
+                 "that links only the C library (symbols up to glibc 2.14). For another platform compile "
+                 "<code>sources/*.c</code> (C99) into a shared library named after the model "
+                 "identifier.</p>")
+    else:
+        needs = (f"<p>This FMU runs Python code (pythonfmu). The importing process must contain "
+                 f"Python {python_minimum} or newer with numpy: a Python host (FMPy, libcosimpy, "
+                 "ecospy) already does; a C host must preload libpython, e.g. "
+                 "<code>LD_PRELOAD=$(python3 -c 'import sysconfig as s; print(s.get_config_var(\"LIBDIR\")"
+                 " + \"/\" + s.get_config_var(\"LDLIBRARY\"))')</code>, with numpy on "
+                 "<code>PYTHONPATH</code>. The Linux binary needs glibc 2.32 and the C++ runtime "
+                 "of GCC 12; there is no macOS binary. Where that is not available, export the "
+                 "standalone FMU: <code>nodeforce fmu BUILDING --standalone -o MODEL.fmu</code>.</p>")
+    return (f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{name}</title></head><body>\n"
+            f"<h1>{name}</h1>\n{needs}\n"
+            "<p>Variables: parameters <code>force[i]</code> (node i is forced) and <code>T_start</code> "
+            "(degC); inputs <code>T_out</code>, <code>T_sky</code> (degC), <code>I_&lt;component&gt;</code> "
+            "(W/m2), the building's named columns and <code>T_forced[i]</code> (degC, NaN: no "
+            "measurement); outputs <code>T[i]</code> (degC). Set the measurements at t_0 as "
+            "<code>T_forced[i]</code> during initialisation: they set the initial state. One "
+            "<code>fmi2DoStep</code> of h seconds is one backward-Euler step with the inputs set "
+            "before it (the inputs at the end of the step).</p>\n</body></html>\n").encode()

@@ -1,0 +1,72 @@
+"""The FMU's variables, their value references and which calls may change them.
+
+One layout serves both FMUs (the Python slave reads it at run time, the standalone C code gets
+the same counts) and the model description: every value lives in one array indexed by value
+reference, in this order:
+
+    force[1..N]      Boolean parameter, fixed      node i is forced to T_forced[i]
+    T_start          Real parameter, fixed (C)     initial temperature nothing measured informs
+    <inputs>         Real inputs                   network.input_names, in order
+    T_forced[1..N]   Real inputs (C)               measurement of node i, NaN where none
+    T[1..N]          Real outputs (C)              node temperatures
+    <effect>.<name>  Real parameters, fixed        an added effect's parameters
+
+This file is copied into the Python FMU: standard library only, syntax of Python 3.6.
+"""
+
+# What a call may do to a variable, by the slave's state (FMI 2.0 section 4.2.4, table 2).
+INSTANTIATED, INITIALISATION, STEPPING, TERMINATED = range(4)
+
+
+class Layout:
+    """Value references of a model with `n_nodes` nodes, its input names and its effect
+    parameters' full names (`<effect>.<name>`)."""
+
+    def __init__(self, n_nodes, input_names, parameter_names=()):
+        n = int(n_nodes)
+        self.n_nodes = n
+        self.input_names = tuple(input_names)
+        self.parameter_names = tuple(parameter_names)
+        self.force = slice(0, n)
+        self.T_start = n
+        self.inputs = slice(n + 1, n + 1 + len(self.input_names))
+        self.T_forced = slice(self.inputs.stop, self.inputs.stop + n)
+        self.T = slice(self.T_forced.stop, self.T_forced.stop + n)
+        self.parameters = slice(self.T.stop, self.T.stop + len(self.parameter_names))
+        self.size = self.parameters.stop
+
+    def names(self):
+        """Variable names in value-reference order."""
+        n = range(1, self.n_nodes + 1)
+        return ([f"force[{i}]" for i in n] + ["T_start"] + list(self.input_names)
+                + [f"T_forced[{i}]" for i in n] + [f"T[{i}]" for i in n] + list(self.parameter_names))
+
+    def is_boolean(self, vr):
+        return vr < self.n_nodes
+
+    def is_output(self, vr):
+        return self.T.start <= vr < self.T.stop
+
+    def is_fixed(self, vr):
+        """A parameter: settable only before initialisation ends."""
+        return vr <= self.T_start or vr >= self.parameters.start
+
+    def refusal(self, vr, real, setting, state):
+        """Why the standard forbids this get or set (None when it is allowed).
+
+        vr : value reference; real : a Real call (else Boolean); setting : a set call;
+        state : INSTANTIATED, INITIALISATION, STEPPING or TERMINATED
+        """
+        if not 0 <= vr < self.size:
+            return f"value reference {vr} does not exist (0..{self.size - 1})"
+        if self.is_boolean(vr) == real:
+            return f"value reference {vr} is {'Boolean' if real else 'Real'}, not {'Real' if real else 'Boolean'}"
+        if not setting:
+            return None
+        if self.is_output(vr):
+            return f"value reference {vr} is an output, which cannot be set"
+        if self.is_fixed(vr) and state not in (INSTANTIATED, INITIALISATION):
+            return f"value reference {vr} is a fixed parameter, which cannot change after initialisation"
+        if state == TERMINATED:
+            return "the slave is terminated"
+        return None

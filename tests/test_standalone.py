@@ -1,0 +1,252 @@
+"""The standalone FMU (no Python at run time) gives the Python FMU's numbers in a C host, FMPy,
+libcosim and ecos; both FMUs declare units, calculated outputs and their dependencies, and
+refuse the calls the FMI 2.0 standard forbids; the Python FMU runs in a C host with libpython
+preloaded, as the README says, without crashing at exit."""
+import copy
+import os
+import shutil
+import subprocess
+import sysconfig
+import zipfile
+from pathlib import Path
+from xml.etree import ElementTree
+
+import numpy as np
+import pytest
+from fmpy import extract, read_model_description
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import FMU2Slave
+
+from nodeforce.cosim.fmi import content_id
+from nodeforce.fmu_build.build import build_fmu
+from nodeforce.model.building import parse_building
+from tests.importers import fmpy_validate, fmutool_check, run_ecos, run_fmpy, run_libcosim
+
+HOST = Path(__file__).with_name("c_host") / "host.c"
+HEADERS = Path(__file__).parents[1] / "fmu_build" / "c"
+KINDS = ("python", "standalone")
+DISCARD, ERROR = 2, 3  # fmi2Status
+
+
+def two_zones(data):
+    """The test cell with an annex behind a partition: a second zone, heated through a named
+    input, with its own exterior wall."""
+    data = copy.deepcopy(data)
+    data["zones"].append({"name": "annex", "volume": 12.0, "air_node": 24, "radiant_node": 25,
+                          "air_change_rate": 0.5, "heat_input": "Q_annex"})
+    layers = [["fibre_cement", 0.005], ["polyurethane", 0.06], ["fibre_cement", 0.005]]
+    data["components"] += [
+        {"name": "partition", "area": 4.0, "tilt": 90.0, "azimuth": 90.0, "layers": layers,
+         "nodes": [{"id": 26, "depth": 0.0}, {"id": 27, "depth": 0.035}, {"id": 28, "depth": 0.07}],
+         "inside": {"zone": "cell", "h_conv": 3.0, "h_rad": 5.0},
+         "outside": {"type": "zone", "zone": "annex", "h_conv": 3.0, "h_rad": 5.0}},
+        {"name": "annex_wall", "area": 6.0, "tilt": 90.0, "azimuth": 270.0, "layers": layers,
+         "nodes": [{"id": 29, "depth": 0.0}, {"id": 30, "depth": 0.07}],
+         "inside": {"zone": "annex", "h_conv": 5.0, "h_rad": 5.0},
+         "outside": {"type": "exterior", "h_conv": 16.0, "h_rad": 5.0, "solar_absorptance": 0.6}}]
+    return data
+
+
+@pytest.fixture(scope="module")
+def fmus(tmp_path_factory, testcell_data):
+    """{(building, kind): FMU path} for the test cell and the two-zone building."""
+    folder = tmp_path_factory.mktemp("standalone")
+    buildings = {"testcell": testcell_data, "two_zones": two_zones(testcell_data)}
+    return {(name, kind): build_fmu(parse_building(data), folder / f"{name}_{kind}.fmu", kind=kind)
+            for name, data in buildings.items() for kind in KINDS}
+
+
+def scenario(fmu, n_steps=192, seed=0):
+    """Parameters, inputs and outputs of a two-day run: a sinusoidal day, the forced nodes'
+    measurements with gaps (NaN), the initial measurements set during initialisation."""
+    rng = np.random.default_rng(seed)
+    names = [v.name for v in read_model_description(str(fmu)).modelVariables]
+    n = sum(name.startswith("T[") for name in names)
+    t = np.arange(1, n_steps + 1) * 900.0
+    day = np.sin(2 * np.pi * t / 86400)
+    inputs = {}
+    for name in names:
+        if name in ("T_out", "T_sky"):
+            inputs[name] = 24 + 6 * day - (8 if name == "T_sky" else 0)
+        elif name.startswith("I_"):
+            inputs[name] = np.maximum(0, 700 * day)
+        elif name == "Q_annex":
+            inputs[name] = 300 * (day > 0)
+    forced = (1, 9, 17) if n == 23 else (1, 9, 27)
+    for i in forced:
+        measured = 27 + 2 * day + rng.normal(0, 0.1, n_steps)
+        measured[rng.random(n_steps) < 0.1] = np.nan
+        inputs[f"T_forced[{i}]"] = measured
+    parameters = {"T_start": 23.0, **{f"force[{i}]": True for i in forced}, "T_forced[23]": 25.5}
+    return parameters, inputs, [f"T[{i}]" for i in range(1, n + 1)], n_steps
+
+
+def run_c_host(fmu, parameters, inputs, outputs, dt, n_steps, tmp_path, env=None):
+    """Outputs of `fmu` run by the C host (compiled here with cc) in a process of its own."""
+    compiler = shutil.which("cc") or pytest.fail("the C host test needs a C compiler (cc)")
+    host = tmp_path / "host"
+    if not host.exists():
+        subprocess.run([compiler, "-std=c99", "-D_GNU_SOURCE", f"-I{HEADERS}", "-o", str(host), str(HOST), "-ldl"],
+                       check=True)
+    md = read_model_description(str(fmu))
+    vr = {v.name: v for v in md.modelVariables}
+    unzipped = Path(extract(str(fmu), unzipdir=str(tmp_path / "unzipped")))
+    lines = [f"{dt!r} {n_steps}", f"parameters {len(parameters)}"]
+    lines += [f"{vr[name].valueReference} {'B' if vr[name].type == 'Boolean' else 'R'} {float(value)!r}"
+              for name, value in parameters.items()]
+    lines.append("inputs " + " ".join(str(n) for n in [len(inputs)] + [vr[name].valueReference for name in inputs]))
+    lines.append("outputs " + " ".join(str(n) for n in [len(outputs)] + [vr[name].valueReference for name in outputs]))
+    columns = np.column_stack(list(inputs.values()))
+    lines += [" ".join(repr(float(x)) for x in row) for row in columns[:n_steps]]
+    (tmp_path / "scenario.txt").write_text("\n".join(lines) + "\n")
+    library = unzipped / "binaries" / "linux64" / f"{md.coSimulation.modelIdentifier}.so"
+    done = subprocess.run([str(host), str(library), (unzipped / "resources").as_uri(), md.guid,
+                           str(tmp_path / "scenario.txt")], capture_output=True, text=True, env=env, timeout=120)
+    shutil.rmtree(unzipped)
+    return done, (np.loadtxt(done.stdout.splitlines(), ndmin=2) if done.returncode == 0 else None)
+
+
+@pytest.mark.parametrize("building", ["testcell", "two_zones"])
+def test_standalone_in_a_c_host_equals_the_python_fmu_in_fmpy(fmus, building, tmp_path):
+    python_fmu, standalone = fmus[(building, "python")], fmus[(building, "standalone")]
+    parameters, inputs, outputs, n_steps = scenario(python_fmu)
+    reference = run_fmpy(python_fmu, parameters, inputs, outputs, 900.0, n_steps)
+    done, in_c = run_c_host(standalone, parameters, inputs, outputs, 900.0, n_steps, tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert np.abs(in_c - reference).max() < 1e-9
+    # a moving model, forced where measured and free in the gaps
+    assert np.ptp(reference[:, 22]) > 1.0
+    measured = inputs["T_forced[9]"]
+    assert np.array_equal(in_c[np.isfinite(measured), 8], measured[np.isfinite(measured)])
+
+
+def test_the_standalone_binary_needs_no_python(fmus, tmp_path):
+    with zipfile.ZipFile(fmus[("testcell", "standalone")]) as fmu:
+        library = tmp_path / "lib.so"
+        library.write_bytes(fmu.read("binaries/linux64/nodeforce_standalone.so"))
+        assert "sources/nodeforce_fmu.c" in fmu.namelist()
+    needed = subprocess.run(["ldd", str(library)], capture_output=True, text=True).stdout
+    assert "python" not in needed and "stdc++" not in needed
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_checkers_and_importers_agree(fmus, kind):
+    fmu = fmus[("testcell", kind)]
+    assert fmpy_validate(fmu) == []
+    ok, output = fmutool_check(fmu)
+    assert ok, output
+    parameters, inputs, outputs, _ = scenario(fmu)
+    parameters.pop("T_forced[23]")  # libcosim and ecos set parameters only before initialisation
+    reference = run_fmpy(fmus[("testcell", "python")], parameters, inputs, outputs, 900.0, 96)
+    for runner in (run_fmpy, run_libcosim, run_ecos):
+        assert np.abs(runner(fmu, parameters, inputs, outputs, 900.0, 96) - reference).max() < 1e-9
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_model_description_declares_units_initial_and_dependencies(fmus, kind):
+    with zipfile.ZipFile(fmus[("two_zones", kind)]) as fmu:
+        root = ElementTree.fromstring(fmu.read("modelDescription.xml"))
+        assert "documentation/index.html" in fmu.namelist()
+    units = {u.get("name"): u.find("BaseUnit").attrib for u in root.iter("Unit")}
+    assert units["degC"] == {"K": "1", "offset": "273.15"}
+    variables = root.find("ModelVariables").findall("ScalarVariable")
+    by_name = {v.get("name"): (index, v) for index, v in enumerate(variables, start=1)}
+    unit = lambda name: by_name[name][1][0].get("unit")
+    assert [unit(n) for n in ("T[1]", "T_out", "I_roof", "Q_annex", "T_forced[3]", "T_start")] == \
+        ["degC", "degC", "W/m2", "W", "degC", "degC"]
+    assert float(root.find("DefaultExperiment").get("stepSize")) == 900.0
+    assert root.get("version") and root.get("license")
+    outputs = [v for v in variables if v.get("causality") == "output"]
+    assert len(outputs) == 30 and all(v.get("initial") == "calculated" and v[0].get("start") is None for v in outputs)
+    structure = root.find("ModelStructure")
+    assert all(u.get("dependencies") == "" for u in structure.find("Outputs"))
+    initial = {int(u.get("index")): {int(d) for d in u.get("dependencies").split()}
+               for u in structure.find("InitialUnknowns")}
+    index = lambda name: by_name[name][0]
+    # node 27, inside the partition: its own and its component's measurements, the cell's air
+    # (the fallback) and T_start; nothing of the annex, which it does not face from inside
+    assert initial[index("T[27]")] == {index(n) for n in ("T_forced[26]", "T_forced[27]", "T_forced[28]",
+                                                          "T_forced[23]", "T_start")}
+    assert initial[index("T[25]")] == {index(n) for n in ("T_forced[24]", "T_forced[25]", "T_start")}
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_same_model_same_bytes_and_the_guid_is_its_identity(fmus, testcell_data, tmp_path, kind):
+    again = build_fmu(parse_building(testcell_data), tmp_path / "again.fmu", kind=kind)
+    assert again.read_bytes() == fmus[("testcell", kind)].read_bytes()
+    other = copy.deepcopy(testcell_data)
+    other["zones"][0]["internal_gain"] = 10.0
+    assert content_id(build_fmu(parse_building(other), tmp_path / "other.fmu", kind=kind)) != content_id(again)
+
+
+def slave_of(fmu, tmp_path):
+    md = read_model_description(str(fmu))
+    slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(fmu), unzipdir=str(tmp_path / "u")),
+                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="calls")
+    slave.instantiate()
+    slave.setupExperiment(startTime=0.0)
+    slave.enterInitializationMode()
+    slave.exitInitializationMode()
+    return slave, {v.name: v.valueReference for v in md.modelVariables}
+
+
+def status(call, *args):
+    """The fmi2Status of a call through FMPy (which raises on any status above warning)."""
+    try:
+        call(*args)
+    except FMICallException as e:
+        return e.status
+    return 0
+
+
+def test_standalone_refuses_forbidden_calls_with_fmi2_error(fmus, tmp_path):
+    slave, vr = slave_of(fmus[("testcell", "standalone")], tmp_path)
+    before = slave.getReal([vr[f"T[{i}]"] for i in range(1, 24)])
+    assert status(slave.doStep, 0.0, 0.0) == ERROR
+    assert status(slave.doStep, 0.0, -900.0) == ERROR
+    assert status(slave.setReal, [vr["T[23]"]], [99.0]) == ERROR  # an output
+    assert status(slave.setReal, [vr["T_start"]], [99.0]) == ERROR  # fixed, after initialisation
+    assert status(slave.setBoolean, [vr["force[9]"]], [True]) == ERROR
+    assert status(slave.getReal, [vr["force[9]"]]) == ERROR  # a Boolean
+    assert status(slave.getBoolean, [vr["T_start"]]) == ERROR  # a Real
+    assert status(slave.getReal, [10 ** 6]) == ERROR
+    # nothing refused changed anything, and the slave steps on
+    assert slave.getReal([vr[f"T[{i}]"] for i in range(1, 24)]) == before
+    slave.doStep(currentCommunicationPoint=0.0, communicationStepSize=900.0)
+    assert np.isfinite(slave.getReal([vr["T[23]"]])).all()
+    slave.terminate()
+    slave.freeInstance()
+
+
+def test_python_fmu_refuses_forbidden_calls_and_keeps_its_state(fmus, tmp_path):
+    """pythonfmu answers a refused doStep with fmi2Discard (a slave's do_step can only say
+    True or False); the state stays as it was, instead of turning NaN for good."""
+    slave, vr = slave_of(fmus[("testcell", "python")], tmp_path)
+    before = slave.getReal([vr["T[23]"]])
+    assert status(slave.doStep, 0.0, -900.0) in (DISCARD, ERROR)
+    assert slave.getReal([vr["T[23]"]]) == before
+    slave.doStep(currentCommunicationPoint=0.0, communicationStepSize=900.0)
+    assert np.isfinite(slave.getReal([vr["T[23]"]])).all()
+    slave.terminate()
+    slave.freeInstance()
+
+
+def python_host_environment():
+    """The README's recipe: libpython preloaded, numpy importable, for a C host."""
+    library = Path(sysconfig.get_config_var("LIBDIR")) / sysconfig.get_config_var("LDLIBRARY")
+    if not library.exists():
+        pytest.fail(f"this Python has no shared libpython ({library}): the recipe needs one")
+    site = sysconfig.get_paths()["purelib"]
+    return dict(os.environ, LD_PRELOAD=str(library), PYTHONPATH=site)
+
+
+def test_python_fmu_in_a_c_host_runs_twenty_times_without_a_crash_at_exit(fmus, tmp_path):
+    fmu = fmus[("testcell", "python")]
+    parameters, inputs, outputs, _ = scenario(fmu)
+    reference = run_fmpy(fmu, parameters, inputs, outputs, 900.0, 24)
+    env = python_host_environment()
+    for run in range(20):
+        done, T = run_c_host(fmu, parameters, inputs, outputs, 900.0, 24, tmp_path, env=env)
+        assert done.returncode == 0 and "corrupted" not in done.stderr and "free()" not in done.stderr, \
+            f"run {run}: exit {done.returncode}\n{done.stderr}"
+        assert np.abs(T - reference).max() < 1e-9
