@@ -239,8 +239,11 @@ def test_the_file_loads_and_passes_the_schema(data):
     assert list(jsonschema.Draft202012Validator(schema).iter_errors(data)) == []
     b = load_building(BUILDING)
     assert 100 <= b.n_nodes <= 400  # a few hundred: the diagnosis runs many 5000-step simulations
+    depths = np.asarray(b.component("W9").depths)
     for depth in (0.0, 0.34, 0.43):
-        assert np.isclose(b.component("W9").depths, depth).any(), depth
+        assert np.isclose(depths, depth).sum() == 1, depth
+    # the sensor at 0.34 m and the layer boundary at 0.01 + 0.30 + 0.03 m are one node
+    assert np.diff(depths).min() > 0.01
 
 
 def write_weather(measured, path, start, end):

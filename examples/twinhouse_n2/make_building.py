@@ -52,12 +52,13 @@ MATERIALS = {
     "wood": (0.131, 600.0, 1000.0),
 }
 
-# Constructions, layers from the INSIDE (room) face outwards: BUILDING.md's lists reversed.
 def _ext_wall(insulation, thickness):
+    """Layers of an outer wall, inside face first, around its added insulation (m)."""
     return [("int_plaster", 0.01), ("honeycomb_brick_ext", 0.30), ("former_ext_plaster", 0.03),
             (insulation, thickness), ("ext_plaster", 0.01)]
 
 
+# Constructions, layers from the INSIDE (room) face outwards: BUILDING.md's lists reversed.
 CONSTRUCTIONS = {
     "extwall_S_N": _ext_wall("pu_insulation", 0.12),
     "extwall_E": _ext_wall("pu_insulation", 0.08),
