@@ -271,7 +271,7 @@ def test_energy_balance_closes_every_step_on_real_days(tmp_path, data, measured)
     from nodeforce.model.case import prepare_case
     from nodeforce.model.integrate import simulate
     from nodeforce.model.network import assemble
-    from nodeforce.model.weather import read_weather
+    from nodeforce.iotools.weather import read_weather
 
     rows = write_weather(measured, tmp_path / "weather.csv", "2013-09-09T00:00+01:00", "2013-09-11T00:00+01:00")
     b = load_building(BUILDING)
