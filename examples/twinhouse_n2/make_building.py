@@ -1,0 +1,305 @@
+"""Write building.json, the Twin House N2 ground floor, from the tables of BUILDING.md.
+
+Every number below is BUILDING.md's (IDEAS values, IDEAS areas on external dimensions) or a
+modelling assumption stated in README.md; this script is the one place they are written down, and
+tests/test_twinhouse.py checks that building.json is its output. Run it from anywhere:
+
+    python examples/twinhouse_n2/make_building.py
+"""
+import json
+import math
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+
+# --- Surface coefficients, W/m2/K (README "Surface coefficients") --------------------------
+EMISSIVITY = 0.9  # BUILDING.md: longwave emissivity 0.9
+H_RAD_IN = 5.1  # EMISSIVITY x 4 sigma T^3 at 20 C (EN ISO 6946 h_r0 = 5.7)
+H_RAD_OUT = 4.6  # EMISSIVITY x 4 sigma T^3 at 10 C (h_r0 = 5.1)
+H_CONV_OUT = 14.6  # EN ISO 6946 4 + 4 v, v = 2.65 m/s, the measured mean wind speed
+H_CONV_HORIZONTAL_FLOW = 2.5  # EN ISO 6946, walls and windows
+H_CONV_UPWARD_FLOW = 5.0  # EN ISO 6946, both faces of the ceiling
+H_CONV_DOWNWARD_FLOW = 0.7  # EN ISO 6946, both faces of the floor
+
+# --- Air flows (BUILDING.md "Ventilation", "Zones") ---------------------------------------
+SUPPLY_FLOW = 120.0  # m3/h into living, at vent_SUA_corr_AT
+N50 = 1.62  # 1/h, N2
+AIR_CHANGE_RATE = round(N50 / 20, 4)  # 1/h, the n50/20 rule of thumb, every zone alike
+
+HEATER_RADIATIVE_FRACTION = 0.3
+SOLAR_ABSORPTANCE_OUT = 0.23  # light plaster; also the white U-PVC frames and the entrance door
+
+# --- Materials: IDEAS values, (conductivity W/m/K, density kg/m3, specific heat J/kg/K) ----
+MATERIALS = {
+    "ext_plaster": (0.8, 1200.0, 1000.0),
+    "pu_insulation": (0.035, 80.0, 840.0),
+    "former_ext_plaster": (1.0, 1200.0, 1000.0),
+    "honeycomb_brick_ext": (0.22, 800.0, 1000.0),
+    "int_plaster": (1.0, 1200.0, 1000.0),
+    "eps": (0.04, 80.0, 840.0),
+    "mineral_wool": (0.036, 80.0, 840.0),
+    "screed": (1.4, 2000.0, 1000.0),
+    "ceiling_insulation": (0.04, 80.0, 840.0),
+    "concrete": (2.0, 2400.0, 840.0),
+    "ceiling_plaster": (1.0, 1200.0, 840.0),
+    "under_ceiling_insulation": (0.035, 80.0, 1000.0),
+    "floor_concrete": (2.1, 2000.0, 1000.0),
+    "levelling_fill": (0.06, 80.0, 840.0),
+    "pur_board": (0.025, 80.0, 840.0),
+    "composite_pur_panel": (0.023, 80.0, 840.0),
+    "partition_plaster": (0.35, 1200.0, 1000.0),
+    "honeycomb_brick_int": (0.331, 1000.0, 1000.0),
+    "wood": (0.131, 600.0, 1000.0),
+}
+
+def _ext_wall(insulation, thickness):
+    """Layers of an outer wall, inside face first, around its added insulation (m)."""
+    return [("int_plaster", 0.01), ("honeycomb_brick_ext", 0.30), ("former_ext_plaster", 0.03),
+            (insulation, thickness), ("ext_plaster", 0.01)]
+
+
+# Constructions, layers from the INSIDE (room) face outwards: BUILDING.md's lists reversed.
+CONSTRUCTIONS = {
+    "extwall_S_N": _ext_wall("pu_insulation", 0.12),
+    "extwall_E": _ext_wall("pu_insulation", 0.08),
+    "extwall_Ws": _ext_wall("eps", 0.08),
+    "extwall_Wn": _ext_wall("mineral_wool", 0.08),  # int plaster 0.01, not IDEAS' 0.10 typo
+    "ceiling": [("under_ceiling_insulation", 0.10), ("ceiling_plaster", 0.01), ("concrete", 0.22),
+                ("ceiling_insulation", 0.04), ("screed", 0.04)],
+    "floor": [("screed", 0.065), ("composite_pur_panel", 0.033), ("pur_board", 0.03),
+              ("levelling_fill", 0.029), ("floor_concrete", 0.22)],
+    "intwall_1": [("partition_plaster", 0.01), ("honeycomb_brick_int", 0.24), ("partition_plaster", 0.01)],
+    "intwall_2": [("partition_plaster", 0.01), ("honeycomb_brick_int", 0.115), ("partition_plaster", 0.01)],
+    "door": [("wood", 0.04)],
+    "column": [("concrete", 0.07)],
+}
+
+# Node generation (m): fine in the instrumented wall, a few cells in heavy layers elsewhere,
+# two nodes (the paper's R2C) for thin single-layer components and the thin partitions.
+NODES = {
+    "W9": {"max_spacing": 0.05},
+    "extwall": {"max_spacing": 0.1},
+    "slab": {"max_spacing": 0.25},
+    "intwall": {"max_spacing": 0.13, "layer_boundaries": False},
+    "thin": {"max_spacing": 1.0},
+}
+
+# --- Glazing (BUILDING.md "Windows and doors") ---------------------------------------------
+U_GLASS, U_FRAME, PSI_GLASS_EDGE = 1.1, 1.0, 0.05  # W/m2/K, W/m2/K, W/m/K
+G_NORMAL, TAU_NORMAL, TAU_DIFFUSE = 0.525, 0.543, 0.427
+GLASS = (1.0, 2500.0, 750.0)  # EN ISO 10456 glass: the two 4 mm panes carry the capacity
+GLASS_THICKNESS = 0.008
+# id: (zone, azimuth, area m2, frame fraction, opening width m, opening height m)
+WINDOWS = {
+    "W27": ("bedroom", 0.0, 2.1402, 0.397, 1.23, 1.54),
+    "W28": ("bath", 90.0, 2.1402, 0.397, 1.23, 1.54),
+    "W29": ("child", 180.0, 2.1402, 0.397, 1.23, 1.54),
+    "W30": ("living", 180.0, 2.8527, 0.354, 1.11, 2.37),
+    "W31": ("living", 180.0, 5.8116, 0.293, 3.34, 1.54),
+    "W32": ("living", 270.0, 2.1402, 0.397, 1.23, 1.54),
+    "W33": ("kitchen", 270.0, 2.1402, 0.397, 1.23, 1.54),
+}
+SOUTH_SHADING = "shading_south"  # 1 blinds open, 0 closed (N2 Exp1: 0 throughout)
+
+# --- Zones: IDEAS volumes (m3) and measured heat inputs (columns without the N2_ prefix) -----
+ZONES = {
+    "living": (86.42, ["heat_elP_living_room"]),
+    "corridor": (12.09, []),
+    "bath": (15.44, ["heat_elP_bath_room"]),
+    "child": (27.62, ["heat_elP_children_room"]),
+    "kitchen": (18.56, ["heat_elP_kitchen", "HeatInputKitchen"]),
+    "doorway": (14.65, ["heat_elP_doorway"]),
+    "bedroom": (26.82, ["heat_elP_bedroom"]),
+}
+# Air leaves living for the corridor, which passes it on to bath and child (50/50), where it is
+# extracted: (receiving zone, sending zone, m3/h).
+AIRFLOWS = [("corridor", "living", SUPPLY_FLOW), ("bath", "corridor", SUPPLY_FLOW / 2),
+            ("child", "corridor", SUPPLY_FLOW / 2)]
+
+FACADE_IRRADIANCE = {0.0: "Solar_radiation_global_vertical_north",
+                     90.0: "Solar_radiation_global_vertical_east",
+                     180.0: "Solar_radiation_global_vertical_south",
+                     270.0: "Solar_radiation_global_vertical_west"}
+ATTIC, CELLAR = "attic_east_AT", "cellar_AT"
+
+# --- Components of N2 (BUILDING.md "Components of N2 in IDEAS"), IDEAS areas m2 ------------
+# id: (construction, area, azimuth, zone)
+EXTERIOR_OPAQUE = {
+    "W1": ("extwall_S_N", 9.0436, 0.0, "kitchen"),
+    "W2": ("extwall_S_N", 8.0524, 0.0, "doorway"),
+    "W3": ("extwall_S_N", 12.4384, 0.0, "bedroom"),
+    "W4": ("extwall_E", 12.2344, 90.0, "bedroom"),
+    "W5": ("extwall_E", 10.2664, 90.0, "bath"),
+    "W6": ("extwall_E", 11.2832, 90.0, "child"),
+    "W7": ("extwall_S_N", 13.3584, 180.0, "child"),
+    "W8": ("extwall_S_N", 14.726, 180.0, "living"),
+    "W9": ("extwall_Ws", 16.8428, 270.0, "living"),
+    "W10": ("extwall_Wn", 6.2812, 270.0, "living"),
+    "W11": ("extwall_Wn", 10.578, 270.0, "kitchen"),
+    "W26": ("door", 2.014875, 0.0, "doorway"),
+}
+# (floor id, ceiling id, zone, area)
+SLABS = [("W12", "W13", "kitchen", 10.86825), ("W14", "W15", "doorway", 7.917375),
+         ("W16", "W17", "bedroom", 16.43065), ("W18", "W19", "living", 41.153625),
+         ("W20", "W21", "corridor", 5.68095), ("W22", "W23", "bath", 8.0754),
+         ("W24", "W25", "child", 15.1532)]
+# id: (construction, area, room side, other side)
+PARTITIONS = {
+    "W34": ("intwall_2", 11.0208, "doorway", "kitchen"),
+    "W35": ("intwall_1", 11.0208, "bedroom", "doorway"),
+    "W36": ("intwall_1", 11.0536, "living", "kitchen"),
+    "W37": ("intwall_1", 8.0524, "living", "doorway"),
+    "W38": ("intwall_2", 5.9532, "corridor", "bedroom"),
+    "W39": ("intwall_2", 8.4624, "bath", "bedroom"),
+    "W40": ("intwall_1", 10.0368, "corridor", "living"),
+    "W41": ("intwall_2", 10.0368, "bath", "corridor"),
+    "W42": ("intwall_2", 5.9532, "child", "corridor"),
+    "W43": ("intwall_2", 8.4624, "child", "bath"),
+    "W44": ("intwall_1", 11.2832, "child", "living"),
+    "W45": ("door", 1.893375, "living", "kitchen"),  # closed
+    "W46": ("door", 1.893375, "living", "doorway"),  # closed
+    "W47": ("door", 1.893375, "corridor", "bedroom"),  # closed
+    "W48": ("door", 1.893375, "corridor", "living"),  # open: a wood leaf, as in IDEAS
+    "W49": ("door", 1.893375, "child", "corridor"),  # open
+    "W50": ("door", 1.893375, "bath", "corridor"),  # open
+    "W51": ("column", 6.56, "kitchen", "kitchen"),
+    "W52": ("column", 6.56, "bedroom", "bedroom"),
+    "W53": ("column", 6.56, "living", "living"),
+    "W54": ("column", 6.56, "child", "child"),
+    "W55": ("intwall_1", 1.6236, "bedroom", "living"),
+}
+# Where the sun through each window lands: the floor of its room.
+FLOOR_OF = {zone: floor for floor, _, zone, _ in SLABS}
+
+W9_BL1_DEPTH = 0.34  # int plaster 0.01 + brick 0.30 + former ext plaster 0.03: EPS / old wall
+
+
+def window_u(area, frame_fraction, width, height):
+    """U_w (W/m2/K) of a window, EN ISO 10077-1 style: glass and frame by area plus the glass-edge
+    psi along the perimeter of one pane with the opening's aspect ratio (a lower bound for
+    multi-sash windows).
+
+    area : window area, m2; frame_fraction : 0..1; width, height : opening, m.
+    """
+    glass = area * (1.0 - frame_fraction)
+    aspect = width / height
+    perimeter = 2.0 * (math.sqrt(glass * aspect) + math.sqrt(glass / aspect))
+    return ((1.0 - frame_fraction) * U_GLASS + frame_fraction * U_FRAME
+            + PSI_GLASS_EDGE * perimeter / area)
+
+
+def glazing_conductivity():
+    """Conductivity (W/m/K) of the 8 mm equivalent glazing layer that gives the area-weighted
+    mean U_w of the windows between the model's own inside and outside surface coefficients."""
+    total = sum(w[2] for w in WINDOWS.values())
+    u_w = sum(w[2] * window_u(w[2], w[3], w[4], w[5]) for w in WINDOWS.values()) / total
+    r_layer = 1.0 / u_w - 1.0 / (H_CONV_HORIZONTAL_FLOW + H_RAD_IN) - 1.0 / (H_CONV_OUT + H_RAD_OUT)
+    return GLASS_THICKNESS / r_layer
+
+
+def _surface(zone, h_conv):
+    return {"zone": zone, "h_conv": h_conv, "h_rad": H_RAD_IN}
+
+
+def _exterior(irradiance, absorptance):
+    return {"type": "exterior", "h_conv": H_CONV_OUT, "h_rad": H_RAD_OUT,
+            "solar_absorptance": absorptance, "irradiance": irradiance}
+
+
+def _component(name, area, tilt, azimuth, layers, nodes, inside, outside, **extra):
+    return {"name": name, "area": area, "tilt": tilt, "azimuth": azimuth,
+            "layers": [list(layer) for layer in layers], "nodes": nodes,
+            "inside": inside, "outside": outside, **extra}
+
+
+def components():
+    """Every component of the ground floor, in IDEAS id order."""
+    out = []
+    for name, (construction, area, azimuth, zone) in EXTERIOR_OPAQUE.items():
+        nodes = NODES["W9"] if name == "W9" else NODES["thin" if construction == "door" else "extwall"]
+        out.append(_component(name, area, 90.0, azimuth, CONSTRUCTIONS[construction], nodes,
+                              _surface(zone, H_CONV_HORIZONTAL_FLOW),
+                              _exterior(FACADE_IRRADIANCE[azimuth], SOLAR_ABSORPTANCE_OUT)))
+    for floor, ceiling, zone, area in SLABS:
+        out.append(_component(floor, area, 180.0, 0.0, CONSTRUCTIONS["floor"], NODES["slab"],
+                              _surface(zone, H_CONV_DOWNWARD_FLOW),
+                              {"type": "boundary", "temperature": CELLAR,
+                               "h": H_CONV_DOWNWARD_FLOW + H_RAD_IN}))
+        out.append(_component(ceiling, area, 0.0, 0.0, CONSTRUCTIONS["ceiling"], NODES["slab"],
+                              _surface(zone, H_CONV_UPWARD_FLOW),
+                              {"type": "boundary", "temperature": ATTIC,
+                               "h": H_CONV_UPWARD_FLOW + H_RAD_IN}))
+    for name, (zone, azimuth, area, frame, _, _) in WINDOWS.items():
+        extra = {"solar_transmittance": round(G_NORMAL * TAU_DIFFUSE / TAU_NORMAL * (1.0 - frame), 4),
+                 "transmitted_solar_to": FLOOR_OF[zone]}
+        if azimuth == 180.0:
+            extra["shading"] = SOUTH_SHADING
+        out.append(_component(name, area, 90.0, azimuth, [("glazing_equivalent", GLASS_THICKNESS)],
+                              NODES["thin"], _surface(zone, H_CONV_HORIZONTAL_FLOW),
+                              _exterior(FACADE_IRRADIANCE[azimuth], round(SOLAR_ABSORPTANCE_OUT * frame, 4)),
+                              **extra))
+    for name, (construction, area, room, other) in PARTITIONS.items():
+        nodes = NODES["intwall" if construction.startswith("intwall") else "thin"]
+        out.append(_component(name, area, 90.0, 0.0, CONSTRUCTIONS[construction], nodes,
+                              _surface(room, H_CONV_HORIZONTAL_FLOW),
+                              {"type": "zone", **_surface(other, H_CONV_HORIZONTAL_FLOW)}))
+    return sorted(out, key=lambda c: int(c["name"][1:]))
+
+
+def zones():
+    """The seven rooms: IDEAS volumes, no occupants, measured heat inputs, the ventilation path."""
+    out = []
+    for name, (volume, heat_input) in ZONES.items():
+        zone = {"name": name, "volume": volume, "air_change_rate": AIR_CHANGE_RATE,
+                "internal_gain": 0.0, "occupied": False}
+        if heat_input:
+            zone["heat_input"] = heat_input[0] if len(heat_input) == 1 else heat_input
+            zone["heat_input_radiative_fraction"] = HEATER_RADIATIVE_FRACTION
+        if name == "living":
+            zone["supply"] = {"flow": SUPPLY_FLOW, "temperature": "vent_SUA_corr_AT"}
+        inflow = [{"zone": source, "flow": flow} for to, source, flow in AIRFLOWS if to == name]
+        if inflow:
+            zone["airflow_from"] = inflow
+        out.append(zone)
+    return out
+
+
+def sensors():
+    """Sensor names of the measured channels: each room's air, the three W9 nodes."""
+    named = {zone: {"zone": zone} for zone in ZONES}
+    thickness = sum(t for _, t in CONSTRUCTIONS["extwall_Ws"])
+    named.update({"W9_inside": {"component": "W9", "depth": 0.0},
+                  "W9_BL1": {"component": "W9", "depth": W9_BL1_DEPTH},
+                  "W9_outside": {"component": "W9", "depth": round(thickness, 6)}})
+    return named
+
+
+def building():
+    """The whole building file as JSON data."""
+    materials = {name: {"conductivity": k, "density": rho, "specific_heat": c}
+                 for name, (k, rho, c) in MATERIALS.items()}
+    materials["glazing_equivalent"] = {"conductivity": round(glazing_conductivity(), 6),
+                                       "density": GLASS[1], "specific_heat": GLASS[2]}
+    return {
+        "format": "nodal-building/1",
+        "name": "Twin House N2, ground floor (IEA EBC Annex 58)",
+        "description": ("The instrumented ground floor of Twin House N2, Holzkirchen, from "
+                        "BUILDING.md of the shared data (IDEAS values, IDEAS areas on external "
+                        "dimensions); written by examples/twinhouse_n2/make_building.py, every "
+                        "choice stated in examples/twinhouse_n2/README.md."),
+        "site": {"latitude": 47.874, "longitude": 11.728, "altitude": 690.0,
+                 "timezone": "Etc/GMT-1", "ground_albedo": 0.23},
+        "materials": materials,
+        "zones": zones(),
+        "components": components(),
+        "sensors": sensors(),
+    }
+
+
+def text():
+    """building.json's text: the data, indented, with a final newline."""
+    return json.dumps(building(), indent=1) + "\n"
+
+
+if __name__ == "__main__":
+    (HERE / "building.json").write_text(text())
