@@ -43,3 +43,21 @@ def real_case(testcell_data, testcell, weather):
     disturbed["materials"]["wood"]["conductivity"] = 0.78
     measurements = pseudo_measurements(parse_building(disturbed), weather, record_times(), SENSORS)
     return prepare_case(testcell, weather, measurements)
+
+
+def _extracted():
+    """Folders nodeforce made in the temp directory (extracted or built FMUs, simulations)."""
+    import tempfile
+    return {p.name for p in Path(tempfile.gettempdir()).glob("nodeforce_*")}
+
+
+def pytest_sessionstart(session):
+    session.config.nodeforce_extracted = _extracted()
+
+
+def pytest_sessionfinish(session, exitstatus):
+    """The whole suite leaves nothing it extracted in the temp directory."""
+    left = sorted(_extracted() - session.config.nodeforce_extracted)
+    if left:
+        print(f"\nthe test suite left {len(left)} nodeforce folders in the temp directory: {left[:5]}")
+        session.exitstatus = 1
