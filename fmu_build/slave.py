@@ -54,9 +54,13 @@ def _model(resources, values=()):
     """(building, network, steppers by dt) of the FMU's building with its effect at `values`."""
     data, effect = _read(resources)
     building = _physics["building"].parse_building(data, source="building.json")
-    if values:
-        building = _physics["effects"].EFFECTS[effect[0]].apply(building, effect[1], dict(values))
-    return building, _physics["network"].assemble(building), {}
+    if not values:
+        return building, _physics["network"].assemble(building), {}
+    # the FMU's inputs are those of the building as declared, in its order: the effect's network
+    # takes its columns in that order (a bridge to a column moves the column in the building's own)
+    inputs = _model(resources)[1].input_names
+    building = _physics["effects"].EFFECTS[effect[0]].apply(building, effect[1], dict(values))
+    return building, _physics["network"].assemble(building, inputs), {}
 
 
 class NodalBuilding(Fmi2Slave):

@@ -108,3 +108,27 @@ def test_a_zone_with_supply_air_gets_a_thermal_bridge_not_an_infiltration():
     assert after.zone("B").heat_input_radiative_fraction == 0.8
     after = EFFECTS["thermal_bridge"].apply(b, "A->T_cellar", {"UA": 2.5})
     assert dict(after.zone("A").thermal_bridges) == {"T_cellar": 2.5}
+
+
+def test_an_effect_that_moves_an_input_column_keeps_the_fmu_inputs(tmp_path, real_case):
+    # a bridge from the air to the floor's boundary column: the zone's bridge names the column
+    # before the component does, so the building's own input order changes with the effect
+    from .test_zones import multizone_with_everything
+    from nodeforce.model.case import Case
+    b = multizone_with_everything()
+    target = "A->T_cellar"
+    assert EFFECTS["thermal_bridge"].applies(b, target)
+    with_bridge = EFFECTS["thermal_bridge"].apply(b, target, {"UA": 6.0})
+    assert assemble(with_bridge).input_names != assemble(b).input_names
+    net = assemble(b)
+    n_rows = 2 * 96 + 1
+    rng = np.random.default_rng(2)
+    U = rng.uniform(0, 30, (n_rows, len(net.input_names)))
+    U[:, net.input_names.index("blind")] = 1.0
+    times = real_case.times[:n_rows]
+    case = Case(times, 900.0, net.input_names, U, np.full((n_rows, net.n_nodes), np.nan))
+    fmu = build_fmu(b, tmp_path / "m.fmu", effect=("thermal_bridge", target))
+    with FmuInstance(fmu) as instance:
+        changed = simulate_fmu(instance, case, parameters={"thermal_bridge.UA": 6.0})
+    expected = simulate(with_bridge, assemble(with_bridge, net.input_names), U, 900.0, case.measured)
+    assert np.abs(changed - expected).max() < 1e-9
