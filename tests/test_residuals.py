@@ -1,4 +1,6 @@
 """Residual diagnostics on synthetic series whose answer is known by construction."""
+import json
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -35,6 +37,7 @@ def test_white_noise_is_white_and_follows_nothing():
     assert d["sentence"].startswith("No structure")
     assert d["n"] == len(times) and d["ljung_box"]["lag_hours"] == 24
     assert abs(d["acf"][0] - 1) < 1e-12 and max(abs(v) for v in d["acf"][1:]) < 3 * d["acf_bound"]
+    assert json.loads(json.dumps(d)) == d  # report.json holds it as it is
 
 
 def test_a_lagged_input_is_named_with_its_lag():

@@ -353,7 +353,8 @@ def plot_residual_diagnostics(path, report):
         s = d.get("strongest")
         if s:
             lags = np.arange(len(s["ccf"])) * d["step_hours"]
-            ax_ccf.plot(lags, s["ccf"], color=COLOR[state], lw=1.2, label=f"{state}: {s['input']}")
+            ax_ccf.plot(lags, s["ccf"], color=COLOR[state], lw=1.2, ls="--" if state == "after" else "-",
+                        label=f"{state}: {s['input']}")
             for sign in (-1, 1):
                 ax_ccf.axhline(sign * s["bound"], color=COLOR[state], ls=":", lw=1)
             ax_ccf.annotate(f"{s['input']}, {lag_text(s['lag_hours'])}", (s["lag_hours"], s["correlation"]),
