@@ -19,6 +19,8 @@ on data the calibration did not see.
    them on BIC (calibration window) and lower the validation J by more than noise could
    (`ga.parsimony.tolerance`); "none" if no candidate does. The calibration window alone never
    decides. The decision, its margins and its reason go into report.json, which the report reads.
+7. The residual of the first objective zone on the validation window, before and after, is
+   described (`diagnose.residuals`): is it white, and which input or time of day does it follow.
 """
 import json
 import math
@@ -34,8 +36,9 @@ from tqdm import tqdm
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnose.calibrate import Candidate, calibrate, sensitivity
-from nodeforce.diagnose.candidates import candidates
+from nodeforce.diagnose.candidates import candidates, implausible
 from nodeforce.diagnose.report import write_report
+from nodeforce.diagnose.residuals import diagnostics as residual_diagnostics
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.locate import air_noise, check_measured, locate
 from nodeforce.ga.parsimony import tolerance
@@ -96,9 +99,10 @@ def bic(J, n, k):
     return n * math.log(J / n) + k * math.log(n)
 
 
-def decide(results, before, sigma):
+def decide(building, results, before, sigma):
     """The decision record: the chosen candidate (or None), each candidate's two tests, the
-    margins they were judged by, and the reason in one sentence."""
+    margins they were judged by, the reason in one sentence, and whether the building file's own
+    description makes the chosen effect implausible (`candidates.implausible`)."""
     bic_before = bic(before["calibration"]["J"], before["calibration"]["n"], 0)
     J_before = before["validation"]["J"]
     margin = tolerance(J_before, sigma, before["validation"]["n"])
@@ -121,7 +125,11 @@ def decide(results, before, sigma):
         reason = (f"None of the {len(results)} candidates both beats the model without them on BIC "
                   f"({n_bic} do) and lowers the validation J by more than the noise margin of {margin:.3g} C2 "
                   f"({n_val} do): no effect is added.")
+    flag = implausible(building, chosen["effect"], chosen["target"]) if chosen else None
+    if flag:
+        reason += f" Implausible: {flag}."
     return chosen, {"chosen": f"{chosen['effect']}@{chosen['target']}" if chosen else None, "reason": reason,
+                    "implausible": flag,
                     "bic_baseline": bic_before, "validation_J_before": J_before, "validation_margin": margin,
                     "candidates": tests}
 
@@ -166,7 +174,7 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
                         "calibration": fit, "validation": objective.metrics(measured[k:], run[k:]),
                         "bic": bic(fit["J"], fit["n"], len(parameters))})
 
-    chosen, decision = decide(results, before, sigma)
+    chosen, decision = decide(building, results, before, sigma)
     if chosen:
         values = {name: p["value"] for name, p in chosen["parameters"].items()}
         after_building = EFFECTS[chosen["effect"]].apply(building, chosen["target"], values)
@@ -180,6 +188,11 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
     fmu_after = build_fmu(after_building, workdir / "model_after.fmu", kind=fmu_kind)
 
     times = case.times
+    validation = slice(k, None)
+    residuals = {state: residual_diagnostics(times[1:][validation], measured[validation, 0] - run[validation, 0],
+                                             {name: values[validation] for name, values in
+                                              zip(case.input_names, case.U[1:].T)})
+                 for state, run in (("before", before_run), ("after", after_run))}
     report = {
         "period": {"calibration": [times[0].isoformat(), times[k].isoformat()],
                    "calibration_scored_from": times[case.burn_in_steps + 1].isoformat(),
@@ -191,6 +204,7 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
         "decision": decision,
         "effect": effect,
         "after": after,
+        "residuals": residuals,
         "sensitivity": sensitivities,
         "noise_sigma": sigma,
         "node_names": {str(i): name for i, name in building.node_names().items()},

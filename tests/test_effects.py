@@ -132,3 +132,11 @@ def test_an_effect_that_moves_an_input_column_keeps_the_fmu_inputs(tmp_path, rea
         changed = simulate_fmu(instance, case, parameters={"thermal_bridge.UA": 6.0})
     expected = simulate(with_bridge, assemble(with_bridge, net.input_names), U, 900.0, case.measured)
     assert np.abs(changed - expected).max() < 1e-9
+
+
+def test_a_gain_in_a_zone_declared_unoccupied_is_implausible(testcell):
+    from nodeforce.diagnose.candidates import implausible
+    assert implausible(testcell, "internal_gain", "cell") is None  # occupancy not declared
+    empty = testcell.edited(lambda d: d["zones"][0].update(occupied=False))
+    assert "unoccupied" in implausible(empty, "internal_gain", "cell")
+    assert implausible(empty, "infiltration", "cell") is None

@@ -1,4 +1,5 @@
-"""The report writer: the before/after table, report.md and its plots, from a synthetic report."""
+"""The report writer: the before/after table, report.md and its plots, from a report and series
+built by hand (two zones, a localisation, four candidates, the loop's decision)."""
 import copy
 
 import numpy as np
@@ -6,116 +7,175 @@ import pandas as pd
 import pytest
 
 from nodeforce.diagnose.report import before_after_table, write_report
+from nodeforce.diagnose.report.formats import parameter_unit
+from nodeforce.diagnose.residuals import diagnostics
+from nodeforce.model.effects import EFFECTS
 
 PNG = b"\x89PNG\r\n\x1a\n"
 NODES = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 16, 17]
+ALL_PLOTS = ["air_temperature.png", "residuals.png", "residual_diagnostics.png", "node_scores.png",
+             "convergence.png", "candidates.png"]
 
 
-def metrics(rmse, mean, sd, n):
-    return {"J": rmse ** 2 * n, "rmse": rmse, "mean": mean, "sd": sd, "n": n}
+def metrics(rmse, mean, sd, n, zones=None):
+    """METRICS; `zones` {name: (rmse, mean, sd, n)}, by default one zone equal to the total."""
+    m = {"J": rmse ** 2 * n, "rmse": rmse, "mean": mean, "sd": sd, "n": n}
+    zones = zones or {"living": (rmse, mean, sd, n)}
+    return {**m, "zones": {z: {"J": r ** 2 * k, "rmse": r, "mean": mu, "sd": s, "n": k}
+                           for z, (r, mu, s, k) in zones.items()}}
+
+
+def two_zones(total, living, bath):
+    return metrics(*total, zones={"living": living, "bath": bath})
 
 
 def synthetic():
-    """2 days at 15 min, the 2nd the validation window; a door conducting too little (node 7)."""
-    times = pd.date_range("2001-06-10 00:00", periods=2 * 96 + 1, freq="15min", tz="-05:00", name="time")
+    """2 days at 15 min, the 2nd the validation window; a door conducting too little (node 7)
+    seen by two zones, the living room and the bath."""
+    times = pd.date_range("2001-06-10 00:00", periods=2 * 96, freq="15min", tz="-05:00", name="time")
     start = times[96]
     hours = np.arange(len(times)) / 4
     rng = np.random.default_rng(0)
     truth = 27 + 3 * np.sin(2 * np.pi * (hours - 9) / 24)
-    measured = truth + rng.normal(0, 0.1, len(times))
-    measured[[10, 11, 12, 150]] = np.nan
-    before = 26.3 + 2.2 * np.sin(2 * np.pi * (hours - 8) / 24)
-    after = truth + 0.05 * np.sin(2 * np.pi * hours / 6)
+    zones = {}
+    for i, (zone, node) in enumerate((("living", 23), ("bath", 24))):
+        measured = truth - i + rng.normal(0, 0.1, len(times))
+        measured[[10, 11, 12, 150]] = np.nan
+        zones[zone] = {"air_node": node, "measured": measured,
+                       "before": 26.3 - i + 2.2 * np.sin(2 * np.pi * (hours - 8) / 24),
+                       "after": truth - i + 0.05 * np.sin(2 * np.pi * hours / 6)}
+    inputs = {"T_out": 25 + 4 * np.sin(2 * np.pi * (hours - 15) / 24),
+              "I_S": 600 * np.clip(np.sin(np.pi * (hours % 24 - 6) / 12), 0, None)}
+    val = slice(96, None)
+    residual = {state: zones["living"]["measured"][val] - zones["living"][state][val] for state in ("before", "after")}
     scores = {str(k): 300.0 + 20 * k for k in NODES}
     scores["7"] = 12.5
     scores["9"] = None  # a simulation that failed
+    p_door = {"factor": {"value": 1.8734, "std": 0.0312, "identifiable": True}}
     report = {
         "period": {"calibration": [times[0].isoformat(), times[95].isoformat()],
+                   "calibration_scored_from": times[8].isoformat(),
                    "validation": [start.isoformat(), times[-1].isoformat()]},
-        "before": {"calibration": metrics(0.8123, 0.6034, 0.5432, 94),
-                   "validation": metrics(0.9021, 0.7011, 0.5678, 96)},
+        "objective": ["living", "bath"],
+        "before": {"calibration": two_zones((0.8123, 0.6034, 0.5432, 188), (0.7, 0.5, 0.5, 94), (0.9, 0.7, 0.6, 94)),
+                   "validation": two_zones((0.9021, 0.7011, 0.5678, 190), (0.8, 0.6, 0.5, 95), (1.0, 0.8, 0.6, 95))},
         "localization": {
-            "measured_nodes": NODES + [23], "chromosome_nodes": NODES, "output_node": 23,
+            "measured_nodes": NODES + [23, 24], "chromosome_nodes": NODES, "output_nodes": [23, 24],
             "J_unforced": 640.2, "best_nodes": [7], "J_best": 12.5, "node_scores": scores,
             "ranked_nodes": [7] + [k for k in NODES if k not in (7, 9)],
             "search": {"method": "ga", "population": 16, "generations": 12, "pc": 0.8, "pm": 0.03,
                        "seed": 3, "evaluations": 208, "unique_evaluations": 150, "seconds": 42.17,
                        "J_min": 11.9, "min_nodes": [7, 16], "tolerance": 6.4}},
         "candidates": [
-            {"effect": "conductivity", "target": "door",
-             "parameters": {"factor": {"value": 1.8734, "std": 0.0312, "identifiable": True}},
-             "calibration": metrics(0.1012, 0.001, 0.1011, 94), "validation": metrics(0.1234, 0.012, 0.1228, 96),
-             "bic": -412.3, "bic_baseline": -35.1},
+            {"effect": "conductivity", "target": "door", "parameters": p_door, "derived": {},
+             "calibration": metrics(0.1012, 0.001, 0.1011, 188), "validation": metrics(0.1234, 0.012, 0.1228, 190),
+             "bic": -412.3},
             {"effect": "ground_coupling", "target": "floor",
              "parameters": {"U": {"value": 0.52, "std": 0.9, "identifiable": False},
                             "T_ground": {"value": 24.3, "std": None, "identifiable": False}},
-             "calibration": metrics(0.7011, 0.4, 0.57, 94), "validation": metrics(0.8544, 0.6, 0.6, 96),
-             "bic": -20.0, "bic_baseline": -35.1},
-            {"effect": "infiltration", "target": None,
-             "parameters": {"n": {"value": 0.3, "std": 0.05, "identifiable": True}},
-             "calibration": {"J": None, "rmse": None, "mean": None, "sd": None, "n": 94},
-             "validation": {"J": None, "rmse": None, "mean": None, "sd": None, "n": 96},
-             "bic": None, "bic_baseline": -35.1},
+             "derived": {"ground_heat_flux": {"value": -1.7741, "std": 0.047, "unit": "W/m2"}},
+             "calibration": metrics(0.7011, 0.4, 0.57, 188), "validation": metrics(0.8544, 0.6, 0.6, 190),
+             "bic": -20.0},
+            {"effect": "infiltration", "target": "living",
+             "parameters": {"n": {"value": 0.3, "std": 0.05, "identifiable": True}}, "derived": {},
+             "calibration": {"J": None, "rmse": None, "mean": None, "sd": None, "n": 188},
+             "validation": {"J": None, "rmse": None, "mean": None, "sd": None, "n": 190},
+             "bic": None},
             {"effect": "solar_absorptance", "target": "roof",
-             "parameters": {"alpha": {"value": 0.71, "std": 0.02, "identifiable": True}},
-             "calibration": metrics(0.4011, 0.2, 0.35, 94), "validation": metrics(0.5544, 0.3, 0.47, 96),
-             "bic": -150.0, "bic_baseline": -35.1},
+             "parameters": {"alpha": {"value": 0.71, "std": 0.02, "identifiable": True}}, "derived": {},
+             "calibration": metrics(0.4011, 0.2, 0.35, 188),
+             "validation": two_zones((0.5544, 0.3, 0.47, 190), (0.4321, 0.2, 0.4, 95), (0.6543, 0.4, 0.5, 95)),
+             "bic": -150.0},
         ],
-        "effect": {"effect": "conductivity", "target": "door",
-                   "parameters": {"factor": {"value": 1.8734, "std": 0.0312, "identifiable": True}}},
-        "after": {"calibration": metrics(0.1012, 0.001, 0.1011, 94),
-                  "validation": metrics(0.1234, 0.012, 0.1228, 96)},
+        "decision": {"chosen": "conductivity@door",
+                     "reason": "conductivity on door has the lowest validation RMSE of the 2 candidates that beat both tests.",
+                     "bic_baseline": -35.1, "validation_J_before": 154.6, "validation_margin": 7.25,
+                     "candidates": {"conductivity@door": {"beats_bic": True, "beats_validation": True},
+                                    "ground_coupling@floor": {"beats_bic": False, "beats_validation": True},
+                                    "infiltration@living": {"beats_bic": False, "beats_validation": False},
+                                    # the loop's word, though its BIC is below the baseline's
+                                    "solar_absorptance@roof": {"beats_bic": False, "beats_validation": True}}},
+        "effect": {"effect": "conductivity", "target": "door", "parameters": p_door, "derived": {}},
+        "after": {"calibration": two_zones((0.1012, 0.001, 0.1011, 188), (0.1, 0.0, 0.1, 94), (0.1, 0.002, 0.1, 94)),
+                  "validation": two_zones((0.1234, 0.012, 0.1228, 190), (0.11, 0.01, 0.1, 95), (0.13, 0.02, 0.13, 95))},
+        "residuals": {state: diagnostics(times[val], r, {k: v[val] for k, v in inputs.items()}, max_lag_hours=6)
+                      for state, r in residual.items()},
+        "noise_sigma": 0.0987,
         "sensitivity": {"conductivity@door": {"factor": {"mu_star": 85.2, "sigma": 12.1}},
                         "ground_coupling@floor": {"U": {"mu_star": 3.1, "sigma": None},
                                                   "T_ground": {"mu_star": 0.4, "sigma": 0.5}}},
+        "node_names": {"7": "door, inside", "16": "floor, inside", "23": "living air", "24": "bath air"},
+        "reference": {"label": "IDEAS detailed model", "rmse": {"validation": 0.4, "free float": 0.6}},
         "artifacts": {"building_after": "building_after.json", "fmu_after": "model_after.fmu", "plots": []},
     }
-    series = {"times": times, "measured": measured, "before": before, "after": after,
-              "validation_start": start, "convergence": [(g, max(12.5, 640.2 / (1 + g * g))) for g in range(13)],
-              "air_node": 23}
+    series = {"times": times, "validation_start": start, "scored_from": times[8],
+              "convergence": [(g, max(12.5, 640.2 / (1 + g * g))) for g in range(13)],
+              "zones": zones, "inputs": inputs}
     return report, series
 
 
 def no_effect(report, series):
-    report, series = copy.deepcopy(report), dict(series)
+    report, series = copy.deepcopy(report), copy.deepcopy(series)
     report["effect"] = {"effect": "none", "target": None, "parameters": {}}
     report["after"] = copy.deepcopy(report["before"])
     report["localization"]["best_nodes"] = []
     report["localization"]["J_best"] = report["localization"]["J_unforced"]
-    for c in report["candidates"]:
-        c["bic"] = 10.0
-    series["after"] = series["before"].copy()
+    report["decision"].update(chosen=None, reason="No candidate beats the model without an effect on both tests.",
+                              candidates={k: {"beats_bic": False, "beats_validation": False}
+                                          for k in report["decision"]["candidates"]})
+    for zone in series["zones"].values():
+        zone["after"] = zone["before"].copy()
     return report, series
 
 
-def test_table_gives_the_rmse_before_and_after_and_the_chosen_effect():
+def row(table, start):
+    return next(line for line in table.splitlines() if line.startswith(start)).split()
+
+
+def test_table_gives_the_rmse_before_and_after_per_zone_and_the_chosen_effect():
     report, _ = synthetic()
     table = before_after_table(report)
-    lines = table.splitlines()
-    assert lines[0] == "Effect added: conductivity on door: factor = 1.873 +- 0.031"
-    calibration = next(line for line in lines if line.startswith("calibration "))
-    validation = next(line for line in lines if line.startswith("validation "))
-    assert calibration.split() == ["calibration", "|", "0.812", "+0.603", "0.543", "94",
-                                   "|", "0.101", "+0.001", "0.101", "94"]
-    assert validation.split()[2] == "0.902" and validation.split()[7] == "0.123"
+    assert table.splitlines()[0] == "Effect added: conductivity on door: factor = 1.873 +- 0.031"
+    assert row(table, "calibration all zones") == ["calibration", "all", "zones", "|", "0.812", "+0.603", "0.543",
+                                                   "188", "|", "0.101", "+0.001", "0.101", "188"]
+    assert row(table, "validation bath")[3:8] == ["1.000", "+0.800", "0.600", "95", "|"]
+    assert row(table, "validation living")[8] == "0.110"
     assert "2001-06-11 00:00 UTC-05:00" in table
+    assert table.splitlines()[-1] == ("for scale, IDEAS detailed model: RMSE 0.400 C (validation), "
+                                      "0.600 C (free float)")
 
 
-def test_table_flags_parameters_that_are_not_identifiable():
+def test_table_of_a_single_zone_has_one_row_per_window():
     report, _ = synthetic()
-    report["effect"] = copy.deepcopy({k: report["candidates"][1][k] for k in ("effect", "target", "parameters")})
-    header = before_after_table(report).splitlines()[0]
-    assert header.startswith("Effect added: ground_coupling on floor: U = 0.52 +- 0.90 W/m2/K (not identifiable)")
-    assert "T_ground = 24.30 +- n/a C (not identifiable)" in header
+    report["objective"] = ["living"]
+    report.pop("reference")
+    table = before_after_table(report)
+    assert [line.split()[0] for line in table.splitlines() if " | " in line][2:] == ["calibration", "validation"]
+    assert "for scale" not in table
+
+
+def test_table_flags_parameters_that_are_not_identifiable_with_the_registry_units():
+    report, _ = synthetic()
+    report["effect"] = copy.deepcopy({k: report["candidates"][1][k] for k in ("effect", "target", "parameters", "derived")})
+    header = before_after_table(report).splitlines()
+    assert header[0].startswith("Effect added: ground_coupling on floor: U = 0.52 +- 0.90 W/m2/K (not identifiable)")
+    assert "T_ground = 24.30 +- n/a C (not identifiable)" in header[0]
+    assert header[1] == "  the data determine ground heat flux = -1.774 +- 0.047 W/m2"
+
+
+def test_parameter_units_come_from_the_effect_registry():
+    for effect, record in EFFECTS.items():
+        for p in record.parameters:
+            assert parameter_unit(effect, p.name) == ("" if p.unit == "-" else p.unit)
+    assert parameter_unit("no_such_effect", "x") == "" and parameter_unit("ground_coupling", "x") == ""
 
 
 def test_table_with_no_effect_and_missing_values():
-    report, series = no_effect(*synthetic())
-    report["after"]["validation"] = {"J": None, "rmse": None, "mean": float("nan"), "sd": None, "n": None}
+    report, _ = no_effect(*synthetic())
+    report["after"]["validation"]["zones"]["bath"] = {"J": None, "rmse": None, "mean": float("nan"), "sd": None, "n": None}
     table = before_after_table(report)
     assert table.splitlines()[0] == "Effect added: none: no effect improves the validation error"
-    validation = next(line for line in table.splitlines() if line.startswith("validation "))
-    assert validation.split()[-4:] == ["n/a"] * 4
+    assert row(table, "validation bath")[-4:] == ["n/a"] * 4
     assert before_after_table({}).splitlines()[0].endswith("none: no effect improves the validation error")
 
 
@@ -133,32 +193,34 @@ def check_report(tmp_path, report, series, expected_plots):
 
 def test_write_report_with_an_effect(tmp_path):
     report, series = synthetic()
-    report["period"]["calibration_scored_from"] = series["times"][8].isoformat()
-    report["noise_sigma"] = 0.0987
-    md = check_report(tmp_path / "out", report, series, ["air_temperature.png", "residuals.png", "node_scores.png",
-                                                         "convergence.png", "candidates.png"])
-    # Table 4: every node's score, the failed one marked
+    md = check_report(tmp_path / "out", report, series, ALL_PLOTS)
+    # Table 4: every node's score with its name, the failed one marked
     for k in NODES:
         assert f"\n| {k} | " in md
-    assert "| 7 | 12.50 | 2.0 % | 1 | yes |" in md
-    assert "| 9 | n/a (simulation failed) |" in md
-    # Table 5 and the candidates
-    assert "| calibration |" in md and "| +0.603 | +0.001 | 0.543 | 0.101 | 0.812 | 0.101 |" in md
+    assert "| 7 | door, inside | 12.50 | 2.0 % | 1 | yes |" in md
+    assert "| 9 |  | n/a (simulation failed) |" in md
+    # Table 5 per zone and window, the reference beside our RMSE where it has the window
+    assert "| bath | validation |" in md and "| +0.800 | +0.012 |" not in md
+    assert "| living | validation | 2001-06-11 00:00 UTC-05:00 to 2001-06-11 23:45 UTC-05:00 | +0.600 | +0.010 |" in md
+    assert "| 0.902 | 0.123 | 0.400 |" in md and "RMSE IDEAS detailed model (C)" in md
+    assert "| bath | validation |" in md and "| 1.000 | 0.130 |  |" in md  # the reference is the objective's
+    assert "For scale, the IDEAS detailed model: RMSE 0.400 C (validation), 0.600 C (free float)." in md
+    # the decision as the loop wrote it, with its margins; the verdicts are read, not re-derived
+    assert report["decision"]["reason"] in md
+    assert "noise could, 7.250 C² (to below 147.3 C²)" in md and "-35.10" in md
+    assert "| solar_absorptance | roof |" in md and "| -150.0 | -114.9 | no | yes |" in md
     for c in ("conductivity (chosen)", "ground_coupling", "infiltration", "solar_absorptance"):
         assert c in md
     assert "factor = 1.873 ± 0.031" in md and "(not identifiable)" in md
-    assert "lowest validation RMSE (0.123 C, 0.902 C before)" in md
+    assert "ground heat flux = -1.774 ± 0.047 W/m2" in md
+    # validation RMSE of the candidates per zone
+    assert "| solar_absorptance@roof | 0.432 | 0.654 |" in md
+    # residual diagnostics before and after, each its sentence
+    for state in ("before", "after"):
+        assert f"- {state}: {report['residuals'][state]['sentence']}" in md
     assert "Morris" in md and "conductivity@door" in md
     assert "[building_after.json](building_after.json)" in md
     assert "scored from 2001-06-10 02:00 UTC-05:00" in md and "sigma = 0.099 C" in md
-
-
-def test_no_effect_when_the_gain_is_within_the_noise(tmp_path):
-    report, series = no_effect(*synthetic())
-    report["candidates"][3]["bic"] = -150.0
-    md = check_report(tmp_path, report, series, ["air_temperature.png", "residuals.png", "node_scores.png",
-                                                 "convergence.png", "candidates.png"])
-    assert "the best, solar_absorptance on roof, lowers the validation RMSE only from 0.902 C to 0.554 C" in md
 
 
 def test_write_report_with_no_effect_and_an_exhaustive_search(tmp_path):
@@ -166,29 +228,31 @@ def test_write_report_with_no_effect_and_an_exhaustive_search(tmp_path):
     report["localization"]["search"] = {"method": "exhaustive", "evaluations": 64, "unique_evaluations": 64}
     report["localization"]["node_scores"] = {str(k): None for k in NODES}
     report["localization"]["J_unforced"] = None
-    report.pop("sensitivity")
+    for key in ("sensitivity", "residuals", "reference", "node_names"):
+        report.pop(key)
     series["convergence"] = []
     md = check_report(tmp_path, report, series, ["air_temperature.png", "residuals.png", "node_scores.png",
                                                  "candidates.png"])
     assert "none: no effect improves the validation error" in md
     assert "exhaustive" in md and "no convergence curve" in md
-    assert "None of the 4 candidates lowers the BIC" in md
-    assert "Morris" not in md
+    assert "No candidate beats the model without an effect on both tests." in md and "- chosen: none" in md
+    assert "No residual diagnostics in this report." in md
+    assert "Morris" not in md and "For scale" not in md
 
 
 def test_write_report_from_an_almost_empty_report(tmp_path):
     report, series = synthetic()
     minimal = {"period": report["period"], "before": report["before"], "effect": {"effect": "none"},
                "after": {"calibration": None, "validation": None}}
-    series = dict(series, convergence=None, after=None)
-    md = check_report(tmp_path, minimal, series, ["air_temperature.png", "residuals.png"])
-    assert "No candidate effect was tried" in md
+    for zone in series["zones"].values():
+        zone["after"] = None
+    md = check_report(tmp_path, minimal, dict(series, convergence=None), ["air_temperature.png", "residuals.png"])
+    assert "No candidate effect was tried" in md and "The loop recorded no decision" in md
 
 
 @pytest.mark.parametrize("tz", [None, "UTC"])
 def test_write_report_times_without_offset_or_in_utc(tmp_path, tz):
     report, series = synthetic()
     times = series["times"].tz_convert(tz) if tz else series["times"].tz_localize(None)
-    start = times[96]
-    check_report(tmp_path, report, dict(series, times=times, validation_start=start),
-                 ["air_temperature.png", "residuals.png", "node_scores.png", "convergence.png", "candidates.png"])
+    check_report(tmp_path, report, dict(series, times=times, validation_start=times[96], scored_from=times[8]),
+                 ALL_PLOTS)

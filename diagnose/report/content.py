@@ -1,0 +1,76 @@
+"""What the report reads from report.json, in one place: metrics by state, window and zone,
+the effect, the loop's decision (read, never re-derived), node names and the reference."""
+from __future__ import annotations
+
+from .formats import NA, time_text
+
+WINDOWS = ("calibration", "validation")
+STATES = ("before", "after")
+
+
+def metrics(report, state, window, zone=None):
+    """METRICS of `state` ('before', 'after' or a candidate dict) on `window`: of the objective,
+    or of one zone; {} where absent."""
+    source = report.get(state) if isinstance(state, str) else state
+    m = (source or {}).get(window)
+    m = m if isinstance(m, dict) else {}
+    if zone is not None:
+        m = (m.get("zones") or {}).get(zone)
+    return m if isinstance(m, dict) else {}
+
+
+def zones(report, series=None):
+    """The objective's zones: report['objective'], else the zones of the series."""
+    names = report.get("objective") or list(((series or {}).get("zones") or {}))
+    return [str(z) for z in names]
+
+
+def is_none_effect(effect):
+    return not effect or effect.get("effect") in (None, "none")
+
+
+def effect_name(effect, target):
+    return f"{effect} on {target}" if target not in (None, "") else str(effect)
+
+
+def effect_label(report):
+    e = report.get("effect") or {}
+    return "no effect" if is_none_effect(e) else effect_name(e.get("effect"), e.get("target"))
+
+
+def candidate_key(candidate):
+    """'effect@target', the key of the loop's decision and sensitivity."""
+    return f"{candidate.get('effect')}@{candidate.get('target')}"
+
+
+def decision(report):
+    return report.get("decision") or {}
+
+
+def verdict(report, candidate):
+    """The loop's {'beats_bic', 'beats_validation'} for a candidate ({} if not recorded)."""
+    return (decision(report).get("candidates") or {}).get(candidate_key(candidate)) or {}
+
+
+def is_chosen(report, candidate):
+    return decision(report).get("chosen") == candidate_key(candidate)
+
+
+def node_name(report, node):
+    """'W9 at 0.34 m' for a node id, '' when the report names none."""
+    return str((report.get("node_names") or {}).get(str(node), ""))
+
+
+def reference(report):
+    """(label, {phase or window: RMSE in K}) of the reference model, or None."""
+    ref = report.get("reference")
+    if not ref or not ref.get("rmse"):
+        return None
+    return str(ref.get("label") or "reference"), dict(ref["rmse"])
+
+
+def period_text(report, window):
+    span = (report.get("period") or {}).get(window)
+    if not span or len(span) != 2:
+        return NA
+    return f"{time_text(span[0])} to {time_text(span[1])}"

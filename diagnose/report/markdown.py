@@ -1,0 +1,134 @@
+"""report.md: the diagnosis told in order (result, decision, period, before and after, residual
+diagnostics, localisation, candidates, sensitivity, files), with the tables and figures."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from . import content, tables
+from .formats import NA, fmt_search, fmt_sig, num, time_text
+
+
+def _relative(path, out_dir):
+    try:
+        return Path(path).resolve().relative_to(Path(out_dir).resolve()).as_posix()
+    except (ValueError, TypeError, OSError):
+        return str(path)
+
+
+def decision_lines(report):
+    """The loop's decision and its reason, and the margins it applied, as it recorded them."""
+    d = content.decision(report)
+    if not d:
+        return ["*The loop recorded no decision in this report.*"]
+    lines = [d.get("reason") or NA, ""]
+    bic, J, margin = (num(d.get(k)) for k in ("bic_baseline", "validation_J_before", "validation_margin"))
+    lines.append(f"- BIC of the model without an effect (calibration window): {fmt_sig(bic)}; a candidate must "
+                 "have a lower BIC.")
+    threshold = f" (to below {fmt_sig(J - margin)} C²)" if J is not None and margin is not None else ""
+    lines.append(f"- validation J without an effect: {fmt_sig(J)} C²; a candidate must lower it by more than "
+                 f"the noise could, {fmt_sig(margin)} C²{threshold}.")
+    lines.append(f"- chosen: {d.get('chosen') or 'none'}")
+    return lines
+
+
+def localization_lines(report):
+    loc = report.get("localization") or {}
+    if not loc:
+        return ["No localisation in this report."]
+    best = loc.get("best_nodes")
+    outputs = loc.get("output_nodes", loc.get("output_node", NA))
+    out = [f"- measured nodes: {loc.get('measured_nodes', NA)}; output (air) nodes: {outputs}",
+           f"- chromosome (nodes the search may force): {loc.get('chromosome_nodes', NA)}",
+           f"- J unforced: {fmt_sig(loc.get('J_unforced'))} C²; J with best_nodes forced: {fmt_sig(loc.get('J_best'))} C²",
+           f"- **best_nodes: {best if best is not None else NA}**"
+           + (" (no forcing explains the residual: the fault is in the air node's own equation, or nowhere)"
+              if best == [] else "")
+           + (f": {', '.join(content.node_name(report, b) for b in best)}"
+              if best and report.get("node_names") else ""),
+           f"- ranked nodes (most helpful first): {loc.get('ranked_nodes', NA)}"]
+    search = loc.get("search") or {}
+    if search:
+        keys = ("population", "generations", "pc", "pm", "seed") if search.get("method") != "exhaustive" else ()
+        counts = ", ".join(f"{k} {fmt_search(search[k])}" for k in keys + ("evaluations", "unique_evaluations")
+                           if search.get(k) is not None)
+        out.append(f"- search: {search.get('method', NA)}" + (f" ({counts})" if counts else "")
+                   + (f", {fmt_sig(search.get('seconds'), 3)} s" if num(search.get("seconds")) is not None else ""))
+        extra = [text for key, text in (("J_min", f"lowest J found {fmt_sig(search.get('J_min'))} C²"),
+                                        ("min_nodes", f"forcing {search.get('min_nodes')}"),
+                                        ("tolerance", f"noise tolerance on J {fmt_sig(search.get('tolerance'))} C²"))
+                 if search.get(key) is not None]
+        if extra:
+            out.append("- " + "; ".join(extra))
+    return out + ["", "J with each node forced alone (the paper's Table 4):", "", tables.node_scores(report)]
+
+
+def residual_lines(report):
+    diags = report.get("residuals") or {}
+    lines = [f"- {state}: {d.get('sentence', NA)}" for state, d in diags.items() if d]
+    if not lines:
+        return ["No residual diagnostics in this report."]
+    return ["On the validation window, the residual of the objective: Ljung-Box test of whiteness, "
+            "cross-correlation with every input after prewhitening (a significant one exceeds a "
+            "Bonferroni bound over all lags and inputs), and a daily profile beyond the inputs "
+            "(GLSAR F test). Computed on the longest run of consecutive measured steps; nothing is "
+            "filled in.", ""] + lines + ["", tables.residual_diagnostics(report)]
+
+
+def write_markdown(out_dir, report, plots, notes):
+    """Write out_dir/report.md; `plots` {key: path} and `notes` {key: why absent} of the figures."""
+    def figure(key, caption):
+        if key in plots:
+            return [f"![{caption}]({_relative(plots[key], out_dir)})", ""]
+        return [f"*{notes.get(key, '')}*", ""]
+
+    period = report.get("period") or {}
+    search = (report.get("localization") or {}).get("search") or {}
+    ref = tables.reference_text(report)
+    md = ["# nodeforce diagnosis report", "",
+          "From the residual of the indoor air, to the nodes whose forcing explains it, to a physical "
+          "effect the model lacks, added and calibrated on the calibration window; the validation "
+          "window was not seen by the calibration.", "",
+          "## Result", "", *[f"**{line.strip()}**  " for line in tables.effect_header(report, pm="±").splitlines()],
+          "", "## Decision", "", *decision_lines(report), "",
+          "## Period", "",
+          f"- objective zones: {', '.join(content.zones(report)) or NA}",
+          f"- calibration: {content.period_text(report, 'calibration')}"
+          + (f" (residuals scored from {time_text(period['calibration_scored_from'])}, after the burn-in)"
+             if period.get("calibration_scored_from") else ""),
+          f"- validation: {content.period_text(report, 'validation')}"]
+    if num(report.get("noise_sigma")) is not None:
+        md.append(f"- measurement noise of the air, estimated from its second differences: "
+                  f"sigma = {fmt_sig(report['noise_sigma'], 2)} C")
+    md += ["", "## Before and after", "",
+           "Residual r = T_air measured - T_air simulated (a positive mean: the model is too cold); "
+           "mean and standard deviation as in the paper's Table 5, with RMSE, J = Σ r² and n the "
+           "number of measured steps.", "", tables.before_after(report), ""]
+    if ref:
+        md += [f"For scale, the {ref}.", ""]
+    md += figure("temperature", "Measured and simulated indoor air temperature, before and after")
+    md += figure("residuals", "Air residual before and after, mean and sd per window")
+    md += ["## Residual diagnostics", "", *residual_lines(report), ""]
+    md += figure("residual_diagnostics", "Autocorrelation and strongest cross-correlation of the residual")
+    md += ["## Localisation", "", *localization_lines(report), ""]
+    md += figure("node_scores", "J with each node forced alone")
+    md += figure("convergence", "Exhaustive search: best J per batch" if search.get("method") == "exhaustive"
+                 else "GA convergence: best J against the generation")
+    md += ["## Candidate effects", ""]
+    if report.get("candidates"):
+        md += ["Each candidate is calibrated on the calibration window and scored on both; its verdict "
+               "is the loop's (see Decision).", "", tables.candidates(report), ""]
+        per_zone = tables.candidate_zones(report)
+        md += [per_zone, ""] if per_zone else []
+    else:
+        md += ["No candidate effect was tried.", ""]
+    md += figure("candidates", "Validation RMSE per candidate against the baseline")
+    sensitivity = tables.sensitivity(report)
+    if sensitivity:
+        md += ["## Sensitivity of J to the parameters (Morris elementary effects)", "",
+               "μ* is the mean absolute elementary effect of a parameter on J, σ their spread "
+               "(σ/μ* near or above 1: non-linear or interacting).", "", sensitivity, ""]
+    artifacts = {k: v for k, v in (report.get("artifacts") or {}).items() if k != "plots" and v}
+    if artifacts:
+        md += ["## Files", ""] + [f"- {k}: [{_relative(v, out_dir)}]({_relative(v, out_dir)})"
+                                  for k, v in artifacts.items()] + [""]
+    (Path(out_dir) / "report.md").write_text("\n".join(md), encoding="utf-8")
