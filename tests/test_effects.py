@@ -27,7 +27,8 @@ CASES = [
     ("inside_convection", "cell", {"factor": 0.3}),
     ("solar_transmittance", "window", {"tau": 0.5}),
     ("thermal_bridge", "cell", {"UA": 4.0}),
-    ("daily_gain", "cell", {"mean": 30.0, "cos1": -60.0, "sin1": -20.0, "cos2": 10.0, "sin2": 15.0}),
+    ("daily_gain", "cell", {"mean": 30.0, "cos1": -60.0, "sin1": -20.0, "cos2": 10.0, "sin2": 15.0,
+                            "cos3": 5.0, "sin3": -8.0, "cos4": 3.0, "sin4": 2.0}),
     ("proportional_gain", "cell->I_window", {"k": 0.5}),
 ]
 
