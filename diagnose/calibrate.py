@@ -34,6 +34,7 @@ class Candidate:
     def __init__(self, building, effect, target, workdir, fmu_kind="python"):
         self.building, self.effect, self.target = building, effect, target
         self.parameters = EFFECTS[effect].parameters
+        self.declared = EFFECTS[effect].apply(building, target, {})  # what its FMU carries
         self.instance = FmuInstance(build_fmu(building, workdir / f"{self.label}.fmu", effect=(effect, target),
                                               kind=fmu_kind))
 
@@ -45,7 +46,9 @@ class Candidate:
         """Simulated temperatures (C) of nodes at t_1..t_N, (N_t, len(node_ids)), with the effect
         at `values` (sequence)."""
         parameters = {f"{self.effect}.{p.name}": float(v) for p, v in zip(self.parameters, values)}
-        return simulate_fmu(self.instance, case, output_ids=node_ids, parameters=parameters)
+        # the effect may read inputs the building as declared does not (a daily gain, the clock)
+        return simulate_fmu(self.instance, case.with_inputs(self.declared), output_ids=node_ids,
+                            parameters=parameters)
 
     def close(self):
         self.instance.close()

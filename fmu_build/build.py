@@ -50,6 +50,8 @@ def build_fmu(building, destination, effect=None, kind="python"):
         raise ValueError(f"unknown FMU kind {kind!r}: one of {', '.join(KINDS)}")
     if effect is not None and not EFFECTS[effect[0]].applies(building, effect[1]):
         raise ValueError(f"effect {effect[0]} does not apply to {effect[1]!r}")
+    if effect is not None:  # declared at its present values, so the FMU has every input the effect uses
+        building = EFFECTS[effect[0]].apply(building, effect[1], {})
     destination = Path(destination).resolve()
     destination.parent.mkdir(parents=True, exist_ok=True)
     return KINDS[kind](building, destination, effect)

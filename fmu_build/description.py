@@ -13,6 +13,7 @@ from xml.etree.ElementTree import Element, SubElement, indent, tostring
 
 from nodeforce.model.building import Boundary
 from nodeforce.model.effects import EFFECTS
+from nodeforce.model.network import clock_input_names
 
 
 DEFAULT_STEP = 900.0  # s, the step of the bundled data when a building declares none
@@ -76,6 +77,10 @@ def _input_meaning(building, name):
         return "degC", "outdoor air temperature"
     if name == "T_sky":
         return "degC", "sky temperature"
+    if name in clock_input_names(building):
+        function, h = name.removeprefix("day_")[:3], name.removeprefix("day_")[3:]
+        return None, (f"{function}(2 pi {h} tau / 24 h), tau the local clock time of day (h) at the site "
+                      f"({building.site['timezone']}), the basis of the zones' daily gains")
     faces = [c.name for c in building.exterior_components if c.irradiance_input == name]
     if faces:
         return "W/m2", f"solar irradiance on the outside face of {', '.join(faces)}"

@@ -59,6 +59,8 @@ def network_terms(building, effect):
         arrays = [sum((-1) ** (len(subset) - len(inner)) * corners[inner][k]
                       for r in range(len(subset) + 1) for inner in itertools.combinations(subset, r)) / scale
                   for k in range(4)]
+        if subset and all(np.abs(a).max() <= 1e-12 * max(1.0, np.abs(c).max()) for a, c in zip(arrays, corners[()])):
+            continue  # parameters that do not act together (a daily gain's terms): nothing to carry
         terms.append((subset, tuple(arrays)))
     check = {n: p0[n] + 0.7 * delta[n] for n in names}
     expected = at(check)

@@ -29,6 +29,13 @@ DEPTH_TOLERANCE = 1e-9
 # description are rounded to the millimetre.
 SENSOR_TOLERANCE = 1e-3
 NODE_COLUMN = re.compile(r"T([1-9][0-9]*)$")  # no leading zero: T01 is not T1
+# A daily gain profile's harmonics of the day (W on cos and sin of 2 pi h tau / 24 h, tau the local
+# clock time). A block schedule's harmonics fall only as 1/h and the air takes a gain to it almost
+# at once, so few harmonics leave a visible error: for 150 W from 8 to 18 h in the test cell the
+# validation RMSE left is 0.91 C with a constant, 0.21 C with 2 harmonics, 0.12 C with 4 (0.09 C
+# with 6); 4 is where the error nears a sensor's 0.1 C noise with 9 parameters.
+DAY_HARMONICS = 4
+DAY_TERMS = tuple(f"{f}{h}" for h in range(1, DAY_HARMONICS + 1) for f in ("cos", "sin"))
 
 
 @dataclass(frozen=True)
@@ -94,6 +101,8 @@ class Zone:
     thermal_bridges: tuple = ()  # (to, UA W/K): "outdoor" or an input column of a temperature
     convection_factor: float = 1.0  # scale on the inside h_conv of the surfaces facing the zone
     occupied: bool | None = None  # None: not declared
+    daily_gain: tuple = ()  # (term of DAY_TERMS, W) for every term when declared; () not declared
+    proportional_gains: tuple = ()  # (input column, k in W per unit of the column)
 
 
 @dataclass(frozen=True)
@@ -272,6 +281,7 @@ def parse_building(data, source="<building>"):
         if c.transmitted_solar_to is not None and c.transmitted_solar_to not in names:
             check.fail(f"components[{i}].transmitted_solar_to",
                        f"names no component ({c.transmitted_solar_to!r})")
+    _check_proportional_columns(check, zones, components)
     _check_node_ids(check, zones, components)
     sensors = {name: _sensor_node(check, name, raw, zones, components) for name, raw in raw_sensors.items()}
     return Building(name=str(data.get("name", "")), site=site, zones=zones, components=components,
@@ -405,6 +415,16 @@ def _zone(check, z, where, zone_names, explicit, next_id):
     if not isinstance(bridges, dict):
         check.fail(f"{where}.thermal_bridges", 'must be an object {"outdoor" or column: UA in W/K}')
     bridges = tuple((to, check.number(bridges, to, f"{where}.thermal_bridges", low=0)) for to in bridges)
+    daily = z.get("daily_gain")
+    if daily is not None:
+        if not isinstance(daily, dict) or set(daily) - set(DAY_TERMS):
+            check.fail(f"{where}.daily_gain", f"must be an object of W with keys among {', '.join(DAY_TERMS)}")
+        daily = tuple((t, check.number(daily, t, f"{where}.daily_gain", default=0.0)) for t in DAY_TERMS)
+    proportional = z.get("proportional_gains", {})
+    if not isinstance(proportional, dict):
+        check.fail(f"{where}.proportional_gains", "must be an object {input column: k in W per unit of the column}")
+    proportional = tuple((column, check.number(proportional, column, f"{where}.proportional_gains"))
+                         for column in proportional)
     occupied = z.get("occupied")
     if occupied is not None and not isinstance(occupied, bool):
         check.fail(f"{where}.occupied", f"must be true or false, found {occupied!r}")
@@ -427,6 +447,8 @@ def _zone(check, z, where, zone_names, explicit, next_id):
         thermal_bridges=bridges,
         convection_factor=check.number(z, "convection_factor", where, default=1.0, low=0, low_open=True),
         occupied=occupied,
+        daily_gain=daily or (),
+        proportional_gains=proportional,
     )
 
 
@@ -581,6 +603,17 @@ def _sensor_node(check, name, raw, zones, components):
         check.fail(f"{where}.depth", f"{c.name} has no node at {depth} m (nodes at "
                                      f"{', '.join(f'{d:.3f}' for d in c.depths)} m)")
     return c.node_ids[k]
+
+
+def _check_proportional_columns(check, zones, components):
+    """A proportional gain scales a heat input or a face's irradiance the building already reads."""
+    columns = [name for z in zones for name in z.heat_input]
+    columns += [c.irradiance_input for c in components if isinstance(c.outside, Exterior)]
+    for i, z in enumerate(zones):
+        for column, _ in z.proportional_gains:
+            if column not in columns:
+                check.fail(f"zones[{i}].proportional_gains.{column}",
+                           f"names no heat input or face irradiance of the building (one of: {', '.join(columns) or 'none'})")
 
 
 def _check_node_ids(check, zones, components):

@@ -12,7 +12,8 @@ import pandas as pd
 
 from .errors import InputError
 from .integrate import simulate
-from .network import assemble, input_names
+from .building import DAY_TERMS
+from .network import assemble, clock_input_names, day_input, input_names
 from .solar import incident_irradiance, measured_irradiance, sky_temperature, solar_position
 from .weather import IRRADIANCE_COLUMNS, check_columns, weather_on_grid
 
@@ -51,6 +52,19 @@ class Case:
         measured[:self.burn_in_steps] = np.nan
         return measured
 
+    def with_inputs(self, building):
+        """The case with the inputs `building` reads (`model.network.input_names`): its own
+        columns, and the time-of-day basis computed from its times, for a building that differs
+        from the case's by an effect (a daily gain adds the basis; no effect adds a measured column).
+        """
+        columns = dict(zip(self.input_names, self.U.T))
+        columns.update(clock_inputs(building, self.times))
+        names = input_names(building)
+        absent = [n for n in names if n not in columns]
+        if absent:
+            raise InputError(building.source, absent[0], "an input column the case was not prepared with")
+        return replace(self, input_names=names, U=np.column_stack([columns[n] for n in names]))
+
     def window(self, start, stop):
         """The sub-case on rows start..stop (inclusive), t_start becoming its t_0; the burn-in
         stays with a window that starts at t_0 and is left behind by one that starts later."""
@@ -73,6 +87,31 @@ def uniform_grid(times, source):
     return pd.date_range(times[0], times[-1], freq=pd.Timedelta(seconds=dt), name="time"), dt
 
 
+
+def clock_hours(times, timezone, source):
+    """Local clock time of day (h, 0 <= tau < 24) of tz-aware `times` at a site's `timezone` (an IANA
+    name, Etc/GMT+-N or +hh:mm): the wall clock a schedule follows, daylight saving included."""
+    try:
+        local = times.tz_convert(timezone)
+    except Exception as e:  # pandas raises several kinds for an unknown zone
+        raise InputError(source, "site.timezone", f"{timezone!r} is not a time zone ({e})") from None
+    return local.hour + local.minute / 60 + (local.second + local.microsecond / 1e6) / 3600
+
+
+def day_basis(tau, term):
+    """cos or sin of 2 pi h tau / 24 h (no unit) for a `DAY_TERMS` term ("cos1", "sin2", ...) at
+    local clock times tau (h)."""
+    function, h = {"cos": np.cos, "sin": np.sin}[term[:3]], int(term[3:])
+    return function(2 * np.pi * h * np.asarray(tau, dtype=float) / 24.0)
+
+
+def clock_inputs(building, times):
+    """{input name: values at `times`} of the time-of-day basis the building's daily gains need
+    (`model.network.clock_input_names`); {} when no zone declares one."""
+    if not clock_input_names(building):
+        return {}
+    tau = clock_hours(times, building.site["timezone"], building.source)
+    return {day_input(t): day_basis(tau, t) for t in DAY_TERMS}
 
 
 def measured_matrix(building, measurements, times):
@@ -109,7 +148,8 @@ def prepare_case(building, weather, measurements=None):
     -------
     Case with inputs `T_out`, `T_sky` (C), `I_<component>` (W/m2, the weather's measured column
     if `model.solar.measured_irradiance` finds one, else pvlib's isotropic transposition of
-    `ghi`, `dni`, `dhi`) and the building's named columns.
+    `ghi`, `dni`, `dhi`), the building's named columns and, where a zone declares a daily gain,
+    the time-of-day basis `day_cos1`, ... (`clock_inputs`).
 
     Raises
     ------
@@ -117,7 +157,8 @@ def prepare_case(building, weather, measurements=None):
         Naming the weather file and the column: a column the building has no use for
         (`model.weather.check_columns`), `ghi`, `dni` or `dhi` missing where a face's irradiance
         is computed (naming the face), a named column missing, a gap in an input; naming the
-        measurement file: times off a uniform grid, a column that measures no node.
+        measurement file: times off a uniform grid, a column that measures no node; naming the
+        building file: a site timezone that is none, where a daily gain needs the local time.
     """
     source = weather.attrs.get("source", "weather")
     check_columns(building, weather)
@@ -152,6 +193,7 @@ def prepare_case(building, weather, measurements=None):
         for c in computed:
             columns[f"I_{c.name}"] = incident_irradiance(position, w["ghi"], w["dni"], w["dhi"],
                                                          c.tilt, c.azimuth, site["ground_albedo"])
+    columns.update(clock_inputs(building, times))
     names = input_names(building)
     U = np.column_stack([np.asarray(columns[n], dtype=float) for n in names])
     missing = ~np.isfinite(U)

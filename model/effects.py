@@ -9,12 +9,13 @@ format, if it needs new ones). Which effects a diagnosis tries, and where a cali
 is the diagnosis' policy (`nodeforce.diagnose.candidates`), not physics.
 
 A `thermal_bridge` target is a zone name for a bridge to the outdoor air, or `<zone>-><column>`
-for a bridge to a boundary temperature column (attic, cellar, neighbour).
+for a bridge to a boundary temperature column (attic, cellar, neighbour); a `proportional_gain`
+target is `<zone>-><column>`, the column a heat input or a face's irradiance the building reads.
 """
 from dataclasses import dataclass
 from typing import Callable
 
-from .building import Adiabatic, Boundary
+from .building import DAY_TERMS, Adiabatic, Boundary
 
 BRIDGE_TO = "->"
 
@@ -143,6 +144,38 @@ def _bridge_write(data, target, values):
     _zone(data, zone).setdefault("thermal_bridges", {})[to] = float(values["UA"])
 
 
+# daily gain: a zone's gain with a daily profile, its mean (the zone's internal_gain, the one field
+# for a constant gain) and its harmonics of the local clock time (the zone's daily_gain): a
+# schedule's mean is part of it, and a profile fitted without its mean would miss the gain itself.
+def _daily_read(building, target):
+    zone = building.zone(target)
+    return {"mean": zone.internal_gain, **dict.fromkeys(DAY_TERMS, 0.0), **dict(zone.daily_gain)}
+
+
+def _daily_write(data, target, values):
+    zone = _zone(data, target)
+    zone["internal_gain"] = float(values["mean"])
+    zone["daily_gain"] = {t: float(values[t]) for t in DAY_TERMS}
+
+
+# proportional gain: Q = k u_column to a zone's air, for a column the building reads as a heat
+# input (W, k dimensionless) or a face's irradiance (W/m2, k an area in m2)
+def _proportional_targets(building):
+    columns = [name for z in building.zones for name in z.heat_input]
+    columns += [c.irradiance_input for c in building.exterior_components]
+    return [f"{z.name}{BRIDGE_TO}{column}" for z in building.zones for column in dict.fromkeys(columns)]
+
+
+def _proportional_read(building, target):
+    zone, _, column = target.partition(BRIDGE_TO)
+    return {"k": float(dict(building.zone(zone).proportional_gains).get(column, 0.0))}
+
+
+def _proportional_write(data, target, values):
+    zone, _, column = target.partition(BRIDGE_TO)
+    _zone(data, zone).setdefault("proportional_gains", {})[column] = float(values["k"])
+
+
 EFFECTS = {e.id: e for e in (
     Effect("ground_coupling", "a conductance from an adiabatic face to a ground temperature",
            (Parameter("U", "W/m2/K", 0.0, 20.0), Parameter("T_ground", "C", -10.0, 40.0)),
@@ -174,4 +207,11 @@ EFFECTS = {e.id: e for e in (
            (Parameter("f_r", "-", 0.0, 1.0),), lambda b: [z.name for z in b.zones if z.heat_input],
            *_zone_field("heat_input_radiative_fraction", "f_r"),
            lambda b, t: b.facing(t)),
+    Effect("daily_gain", "a heat gain to the air with a daily profile: its mean and harmonics of the local time",
+           (Parameter("mean", "W", -5000.0, 5000.0), *(Parameter(t, "W", -5000.0, 5000.0) for t in DAY_TERMS)),
+           _zones, _daily_read, _daily_write, _no_node),
+    Effect("proportional_gain", "a heat gain to the air of k times an input column (W per unit of the column: "
+                                "dimensionless for a heat input, m2 for an irradiance)",
+           (Parameter("k", "-", -10.0, 10.0),), _proportional_targets, _proportional_read, _proportional_write,
+           _no_node),
 )}

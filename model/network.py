@@ -3,7 +3,10 @@
 Node i of the building file is row i-1. The input vector u holds, in this order: `T_out`,
 `T_sky` (C), the irradiance input of each exterior component (W/m2 on its outside face: its
 `irradiance` column, else `I_<component>`), then the building's other named input columns (heat
-inputs W, supply and boundary temperatures C, shading 0..1). Constant sources (internal gains,
+inputs W, supply and boundary temperatures C, shading 0..1), then, where a zone declares a daily
+gain, the time-of-day basis `day_cos1`, `day_sin1`, ... (no unit: cos and sin of 2 pi h tau / 24 h,
+tau the site's local clock time, computed by `model.case`), whose weights are the gain's W. A
+proportional gain k u adds k to an existing column of B. Constant sources (internal gains,
 fixed boundary and supply temperatures) go to q (W) rather than to a constant input, so that u
 holds only what varies in time. The transmitted solar of a shaded glazing, tau s(t) A I(t), is
 the product of two inputs: `products` holds those terms, and `sources` adds them, so the
@@ -13,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .building import Adiabatic, Boundary, Exterior, Surface
+from .building import DAY_TERMS, Adiabatic, Boundary, Exterior, Surface
 from .discretise import capacities, conductances
 
 RHO_C_AIR = 1.2 * 1005.0  # J/m3/K
@@ -51,7 +54,18 @@ def input_names(building):
     """The input vector's names, in the order of the columns of B."""
     irradiance = tuple(dict.fromkeys(c.irradiance_input for c in building.exterior_components))
     named = tuple(n for n in building.input_columns if n not in irradiance)
-    return ("T_out", "T_sky") + irradiance + named
+    return ("T_out", "T_sky") + irradiance + named + clock_input_names(building)
+
+
+def clock_input_names(building):
+    """The time-of-day inputs (`day_<term>` of `DAY_TERMS`), shared by every zone with a daily gain;
+    () when none declares one."""
+    return tuple(day_input(t) for t in DAY_TERMS) if any(z.daily_gain for z in building.zones) else ()
+
+
+def day_input(term):
+    """The input holding a daily gain's basis function `term` (e.g. "cos1" -> "day_cos1")."""
+    return f"day_{term}"
 
 
 def sky_view_factor(tilt):
@@ -139,6 +153,10 @@ def assemble(building, names=None):
         for to, UA in z.thermal_bridges:
             to_temperature(air, UA, "T_out" if to == "outdoor" else to)
         q[air] += z.internal_gain
+        for term, W in z.daily_gain:
+            B[air, col[day_input(term)]] += W
+        for column, k in z.proportional_gains:
+            B[air, col[column]] += k
         for name in z.heat_input:
             B[air, col[name]] += 1.0 - z.heat_input_radiative_fraction
             B[radiant, col[name]] += z.heat_input_radiative_fraction

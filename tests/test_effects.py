@@ -27,22 +27,27 @@ CASES = [
     ("inside_convection", "cell", {"factor": 0.3}),
     ("solar_transmittance", "window", {"tau": 0.5}),
     ("thermal_bridge", "cell", {"UA": 4.0}),
+    ("daily_gain", "cell", {"mean": 30.0, "cos1": -60.0, "sin1": -20.0, "cos2": 10.0, "sin2": 15.0,
+                            "cos3": 5.0, "sin3": -8.0, "cos4": 3.0, "sin4": 2.0}),
+    ("proportional_gain", "cell->I_window", {"k": 0.5}),
 ]
 
 
 @pytest.mark.parametrize("effect,target,values", CASES, ids=[c[0] for c in CASES])
 def test_fmu_parameters_equal_the_declared_effect(tmp_path, testcell, real_case, effect, target, values):
     fmu = build_fmu(testcell, tmp_path / "m.fmu", effect=(effect, target))
+    # the inputs of the building with the effect declared (a daily gain adds the time of day)
+    case = real_case.with_inputs(EFFECTS[effect].apply(testcell, target, {}))
     parameters = {f"{effect}.{k}": v for k, v in values.items()}
     with FmuInstance(fmu) as instance:
         assert set(parameters) <= set(instance.names("parameter"))
-        start = simulate_fmu(instance, real_case)
-        changed = simulate_fmu(instance, real_case, parameters=parameters)
-        again = simulate_fmu(instance, real_case)
+        start = simulate_fmu(instance, case)
+        changed = simulate_fmu(instance, case, parameters=parameters)
+        again = simulate_fmu(instance, case)
     # at its start values the FMU is the building as declared; a reset forgets the parameters
     assert np.abs(start - direct(testcell, real_case)).max() < 1e-9
     assert np.array_equal(start, again)
-    expected = direct(EFFECTS[effect].apply(testcell, target, values), real_case)
+    expected = direct(EFFECTS[effect].apply(testcell, target, values), case)
     assert np.abs(changed - expected).max() < 1e-9
     assert np.abs(changed - start).max() > 0.05  # the effect does something
 

@@ -30,6 +30,8 @@ EFFECT_CASES = {
     "solar_transmittance": ("window", {"tau": 0.6}),
     "thermal_bridge": ("cell", {"UA": 3.0}),
     "heat_input_split": ("cell", {"f_r": 0.6}),
+    "daily_gain": ("cell", {"mean": 60.0, "cos1": -60.0, "sin1": -20.0, "cos2": 10.0, "sin2": 15.0}),
+    "proportional_gain": ("cell->heater", {"k": -0.2}),
 }
 
 
