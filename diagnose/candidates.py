@@ -3,7 +3,7 @@
 Kept apart from the effect records (`nodeforce.model.effects`), which an FMU bundles: changing
 the policy changes no FMU and throws away no saved search.
 """
-from nodeforce.model.effects import EFFECTS, bridge_parts
+from nodeforce.model.effects import EFFECTS, bridge_parts, bridge_target
 
 # Where the calibration of an effect the file does not declare starts (see calibration_start).
 ABSENT_START = {("ground_coupling", "U"): 1.0,  # W/m2/K
@@ -67,3 +67,38 @@ def implausible(building, effect, target):
         return (f"{target} is declared unoccupied: the gain stands for a heat source the model lacks "
                 "(a heat input mis-measured, a flow of air or sun not modelled), not for occupants")
     return None
+
+
+def follow_up(building, left, zones):
+    """(effect, target) pairs that the structure left in a residual points at: a gain with a daily
+    profile where the residual follows the time of day, a gain proportional to an input column it
+    follows (a heat input mis-measured, sun through an opening the model lacks), for each
+    objective zone. None where the residual is white: nothing is left to explain.
+
+    Parameters
+    ----------
+    building : Building, the model the residual is of
+    left : `diagnose.residuals.diagnostics` of that residual
+    zones : names of the objective zones
+    """
+    if left.get("white"):
+        return []
+    # A residual that is structured but follows no input significantly (inputs of one kind, such
+    # as the irradiances of several faces, are nearly collinear) still points at that kind: every
+    # input a gain may follow is tried, and the clock. The decision's rules (BIC, validation)
+    # judge what is tried, so trying more costs time, never a wrong answer.
+    named = [follows["input"] for follows in left["follows"]]
+    clock = (left["time_of_day"] or {}).get("significant", False)
+    if not named:
+        named, clock = shaped_inputs(building), True
+    pairs = [("daily_gain", zone) for zone in zones] if clock else []
+    targets = EFFECTS["proportional_gain"].targets(building)
+    pairs += [("proportional_gain", target) for name in named for zone in zones
+              for target in [bridge_target(zone, name)] if target in targets]
+    return list(dict.fromkeys(pairs))
+
+
+def shaped_inputs(building):
+    """The input columns a `proportional_gain` may follow (heat inputs, irradiances): the inputs
+    a residual is examined against when choosing what to try next."""
+    return sorted({bridge_parts(target)[1] for target in EFFECTS["proportional_gain"].targets(building)})

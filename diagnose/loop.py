@@ -29,6 +29,7 @@ import os
 import sys
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import nullcontext
+from dataclasses import dataclass
 
 import numpy as np
 from tqdm import tqdm
@@ -36,7 +37,7 @@ from tqdm import tqdm
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnose.calibrate import Candidate, calibrate, sensitivity
-from nodeforce.diagnose.candidates import candidates, implausible
+from nodeforce.diagnose.candidates import candidates, follow_up, implausible, shaped_inputs
 from nodeforce.diagnose.report import write_report
 from nodeforce.diagnose.residuals import diagnostics as residual_diagnostics
 from nodeforce.fmu_build.build import build_fmu
@@ -99,17 +100,18 @@ def bic(J, n, k):
     return n * math.log(J / n) + k * math.log(n)
 
 
-def decide(building, results, before, sigma):
+def decide(building, results, before, sigma, k_before=0):
     """The decision record: the chosen candidate (or None), each candidate's two tests, the
     margins they were judged by, the reason in one sentence, and whether the building file's own
-    description makes the chosen effect implausible (`candidates.implausible`)."""
-    bic_before = bic(before["calibration"]["J"], before["calibration"]["n"], 0)
+    description makes the chosen effect implausible (`candidates.implausible`). `before` holds
+    the metrics of the model the candidates are added to, which has `k_before` fitted parameters."""
+    bic_before = bic(before["calibration"]["J"], before["calibration"]["n"], k_before)
     J_before = before["validation"]["J"]
     margin = tolerance(J_before, sigma, before["validation"]["n"])
-    tests = {f"{r['effect']}@{r['target']}": {"beats_bic": r["bic"] < bic_before,
-                                              "beats_validation": r["validation"]["J"] < J_before - margin}
+    tests = {label(r): {"beats_bic": r["bic"] < bic_before,
+                        "beats_validation": r["validation"]["J"] < J_before - margin}
              for r in results}
-    better = [r for r in results if all(tests[f"{r['effect']}@{r['target']}"].values())]
+    better = [r for r in results if all(tests[label(r)].values())]
     chosen = min(better, key=lambda r: r["validation"]["rmse"]) if better else None
     rmse_before = before["validation"]["rmse"]
     if chosen:
@@ -128,10 +130,52 @@ def decide(building, results, before, sigma):
     flag = implausible(building, chosen["effect"], chosen["target"]) if chosen else None
     if flag:
         reason += f" Implausible: {flag}."
-    return chosen, {"chosen": f"{chosen['effect']}@{chosen['target']}" if chosen else None, "reason": reason,
-                    "implausible": flag,
+    return chosen, {"chosen": label(chosen) if chosen else None, "reason": reason, "implausible": flag,
                     "bic_baseline": bic_before, "validation_J_before": J_before, "validation_margin": margin,
                     "candidates": tests}
+
+
+def label(result):
+    return f"{result['effect']}@{result['target']}"
+
+
+@dataclass
+class Model:
+    """A model of the loop: its building, its objective air simulated on the calibration window
+    (`fitted`) and over the whole record (`run`), its metrics and fitted parameter count."""
+    building: object
+    fitted: np.ndarray
+    run: np.ndarray
+    metrics: dict
+    k: int = 0
+
+
+def assess_all(model, pairs, calibration, case, objective, folder, seed, workers, fmu_kind):
+    """Each (effect, target) added to `model`, calibrated and run, in parallel worker processes:
+    the candidates' records, their `Model`s by label, and their Morris screenings."""
+    tasks = [(model.building, effect, target, folder, calibration, case, objective, seed, fmu_kind)
+             for effect, target in pairs]
+    n_workers = min(workers or os.cpu_count(), len(tasks))
+    with (ProcessPoolExecutor(n_workers, mp_context=multiprocessing.get_context("spawn"))
+          if n_workers > 1 else nullcontext()) as pool:
+        assessed = list(tqdm((pool.map if pool else map)(assess, tasks), total=len(tasks),
+                             desc="calibrating candidate effects", unit="candidate",
+                             disable=not sys.stderr.isatty()))
+    scored, measured = objective.measured(calibration), objective.measured(case)
+    k = len(calibration.times) - 1
+    results, models, sensitivities = [], {}, {}
+    for (effect, target), (parameters, determined, fitted, run, screening) in zip(pairs, assessed):
+        fit = objective.metrics(scored, fitted)
+        result = {"effect": effect, "target": target, "parameters": parameters, "derived": determined,
+                  "calibration": fit, "validation": objective.metrics(measured[k:], run[k:]),
+                  "bic": bic(fit["J"], fit["n"], model.k + len(parameters))}
+        values = {name: p["value"] for name, p in parameters.items()}
+        models[label(result)] = Model(EFFECTS[effect].apply(model.building, target, values), fitted, run,
+                                      {w: result[w] for w in ("calibration", "validation")},
+                                      model.k + len(parameters))
+        results.append(result)
+        sensitivities[label(result)] = screening
+    return results, models, sensitivities
 
 
 def diagnose(building, case, objective, workdir, *, source="measurements", fraction=0.6, calibration_end=None,
@@ -149,41 +193,55 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
         before_calibration = simulate_fmu(base, calibration, output_ids=objective.air_nodes)
     before = {"calibration": objective.metrics(scored, before_calibration),
               "validation": objective.metrics(measured[k:], before_run[k:])}
+    model = Model(building, before_calibration, before_run, before)
 
     convergence = []
     localization = locate(building, calibration, objective, workdir, source=source, seed=seed,
                           workers=workers, population=population, generations=generations, fmu_kind=fmu_kind,
                           progress=lambda generation, total, J, unique: convergence.append((generation, J)))
 
-    pairs = candidates(building, localization["best_nodes"], objective.zones)
-    (workdir / "candidates").mkdir(exist_ok=True)
-    tasks = [(building, effect, target, workdir / "candidates", calibration, case, objective, seed, fmu_kind)
-             for effect, target in pairs]
-    n_workers = min(workers or os.cpu_count(), len(tasks))
-    with (ProcessPoolExecutor(n_workers, mp_context=multiprocessing.get_context("spawn"))
-          if n_workers > 1 else nullcontext()) as pool:
-        assessed = list(tqdm((pool.map if pool else map)(assess, tasks), total=len(tasks),
-                             desc="calibrating candidate effects", unit="candidate",
-                             disable=not sys.stderr.isatty()))
-    results, runs, sensitivities = [], {}, {}
-    for (effect, target), (parameters, determined, fitted, run, screening) in zip(pairs, assessed):
-        label = f"{effect}@{target}"
-        runs[label], sensitivities[label] = run, screening
-        fit = objective.metrics(scored, fitted)
-        results.append({"effect": effect, "target": target, "parameters": parameters, "derived": determined,
-                        "calibration": fit, "validation": objective.metrics(measured[k:], run[k:]),
-                        "bic": bic(fit["J"], fit["n"], len(parameters))})
+    folder = workdir / "candidates"
+    folder.mkdir(exist_ok=True)
+    # What the model's residual follows (an input, the time of day) points at effects of that
+    # shape, tried beside those the forcing search points at; after a choice, the residual left
+    # is asked again, and what it points at is tried on top, by the same rules.
+    def left_by(model):
+        inputs = {name: values for name, values in zip(case.input_names, case.U[1:k + 1].T)
+                  if name in shaped_inputs(model.building)}
+        return residual_diagnostics(calibration.times[1:], scored[:, 0] - model.fitted[:, 0], inputs)
 
+    pairs = candidates(building, localization["best_nodes"], objective.zones)
+    pairs += [pair for pair in follow_up(building, left_by(model), objective.zones) if pair not in pairs]
+    results, models, sensitivities = assess_all(model, pairs, calibration, case, objective, folder, seed,
+                                                workers, fmu_kind)
     chosen, decision = decide(building, results, before, sigma)
-    if chosen:
-        values = {name: p["value"] for name, p in chosen["parameters"].items()}
-        after_building = EFFECTS[chosen["effect"]].apply(building, chosen["target"], values)
-        after_run = runs[decision["chosen"]]
-        after = {w: chosen[w] for w in ("calibration", "validation")}
-        effect = {key: chosen[key] for key in ("effect", "target", "parameters", "derived")}
-    else:
-        after_building, after_run, after = building, before_run, before
-        effect = {"effect": "none", "target": None, "parameters": {}}
+    results = [{**r, "bic_baseline": decision["bic_baseline"]} for r in results]
+    added = [chosen] if chosen else []
+    model = models[label(chosen)] if chosen else model
+
+    left = left_by(model)
+    follow = [pair for pair in follow_up(model.building, left, objective.zones)
+              if pair not in [(a["effect"], a["target"]) for a in added]]
+    decision["structure_left"] = left["sentence"]
+    if follow:
+        more, more_models, more_sensitivities = assess_all(model, follow, calibration, case, objective, folder,
+                                                           seed, workers, fmu_kind)
+        then, follow_decision = decide(model.building, more, model.metrics, sigma, model.k)
+        results += [{**r, "on_top_of": [label(a) for a in added], "bic_baseline": follow_decision["bic_baseline"]}
+                    for r in more]
+        sensitivities.update(more_sensitivities)
+        decision["candidates"].update(follow_decision.pop("candidates"))
+        decision["follow_up"] = follow_decision
+        decision["reason"] += (f" The residual left on the calibration window ({left['sentence']}) points at "
+                               f"{', '.join(f'{e} on {t}' for e, t in follow)}: {follow_decision['reason']}")
+        if then:
+            added.append(then)
+            model = more_models[label(then)]
+            decision["chosen"] = label(then)
+
+    after_building, after_run, after = model.building, model.run, model.metrics
+    effect = ({key: added[-1][key] for key in ("effect", "target", "parameters", "derived")} if added
+              else {"effect": "none", "target": None, "parameters": {}})
     (workdir / "building_after.json").write_text(json.dumps(after_building.to_json(), indent=2) + "\n")
     fmu_after = build_fmu(after_building, workdir / "model_after.fmu", kind=fmu_kind)
 
@@ -200,7 +258,8 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
         "objective": list(objective.zones),
         "before": before,
         "localization": localization,
-        "candidates": [{**r, "bic_baseline": decision["bic_baseline"]} for r in results],
+        "candidates": results,
+        "effects": [{key: a[key] for key in ("effect", "target", "parameters")} for a in added],
         "decision": decision,
         "effect": effect,
         "after": after,
