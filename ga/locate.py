@@ -9,7 +9,7 @@ from scipy.sparse.csgraph import shortest_path
 
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.fitness import FmuFitness
-from nodeforce.ga.search import search
+from nodeforce.ga.search import PATIENCE, search
 from nodeforce.model.errors import InputError
 from nodeforce.model.network import assemble
 from nodeforce.model.score import noise_level
@@ -55,12 +55,14 @@ def chromosome_nodes(building, case, source, nodes=None, include_algebraic=False
 
 def locate(building_data, building, case, workdir, *, source="measurements", nodes=None,
            include_algebraic=False, population=30, generations=400, pc=0.8, pm=0.03, seed=0,
-           workers=None, scheduler=None, warmup_days=2, progress=None):
+           patience=PATIENCE, seeded=True, workers=None, scheduler=None, warmup_days=2, progress=None):
     """Run the forcing search on a case; return the content of locate.json.
 
     The FMU (`model.fmu`) and the search's checkpoint (`locate.checkpoint.json`) are written in
     `workdir`, so a run stopped midway and started again resumes. `progress` is called after
-    every generation with (generation, total, best J, unique evaluations).
+    every generation with (generation, total, best J, unique evaluations). patience and seeded
+    choose the search (ga.search: the defaults stop at convergence; ga.search.PAPER's values
+    give the paper's search).
     """
     air = output_node(building, case, source)
     candidates = chromosome_nodes(building, case, source, nodes, include_algebraic)
@@ -70,6 +72,7 @@ def locate(building_data, building, case, workdir, *, source="measurements", nod
     air_measured = case.measured[1:, air - 1]
     result = search(FmuFitness(fmu, case, candidates, air, warmup_days), candidates,
                     population=population, generations=generations, pc=pc, pm=pm, seed=seed,
+                    patience=patience, seeded=seeded,
                     workers=workers, scheduler=scheduler, checkpoint=workdir / "locate.checkpoint.json",
                     progress=progress,
                     noise_sigma=noise_level(case.measured[:, air - 1]),

@@ -13,15 +13,20 @@ from nodeforce.cli import main
 from tests.conftest import SENSORS, record_times
 
 
-def disturbed(data, fault):
+def disturbed(data, faults):
+    """The building with the sub-models named in `faults` ("door", "hci", "roof", joined by +)
+    disturbed as in the paper's Table 2."""
     d = copy.deepcopy(data)
-    if fault == "door":
-        d["materials"]["wood"]["conductivity"] = 0.78
-    elif fault == "hci":
-        for c in d["components"]:
-            c["inside"]["h_conv"] = 0.1
-    elif fault == "roof":
-        next(c for c in d["components"] if c["name"] == "roof")["outside"]["solar_absorptance"] = 0.9
+    for fault in faults.split("+"):
+        if fault == "door":
+            d["materials"]["wood"]["conductivity"] = 0.78
+        elif fault == "hci":
+            for c in d["components"]:
+                c["inside"]["h_conv"] = 0.1
+        elif fault == "roof":
+            next(c for c in d["components"] if c["name"] == "roof")["outside"]["solar_absorptance"] = 0.9
+        else:
+            raise ValueError(f"unknown fault {fault!r}")
     return parse_building(d)
 
 
