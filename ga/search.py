@@ -43,7 +43,8 @@ from tqdm import tqdm
 from nodeforce.ga import checkpoint as ckpt
 from nodeforce.ga.evaluation import FitnessCache, log, open_backend
 from nodeforce.ga.operators import bit_flip_mutation, one_point_crossover, roulette_selection
-from nodeforce.ga.parsimony import explains, forward_backward, smallest_subset, tolerance
+from nodeforce.ga.parsimony import (explains, forward_backward, noise_tolerance, smallest_subset,
+                                    tolerance)
 
 # Generations without a significant fall of the best J before the GA stops. Measured on the
 # paper's verification cases (benchmarks/bench_search.py --patience-study, README): the seeded
@@ -315,7 +316,7 @@ def _answer(cache, nodes, noise_sigma, n_residuals) -> dict:
     J_min = cache.J_of[best]
     tol = tolerance(J_unforced, noise_sigma, n_residuals)
     if explains(J_unforced, J_min, noise_sigma, n_residuals):
-        chosen = smallest_subset(cache.J_many, best, J_min + tol)
+        chosen = smallest_subset(cache.J_many, best, J_min + tol, noise_tolerance(noise_sigma, n_residuals))
     else:
         chosen = unforced
     return {

@@ -130,6 +130,7 @@ def check_workers(args):
 def cmd_locate(args):
     from nodeforce.ga.locate import locate
     check_search_settings(args)
+    strategy = search_strategy(args)
     data, building, case = load_inputs(args)
     if args.burn_in_days:
         if not 0 < args.burn_in_days < (case.times[-1] - case.times[0]).total_seconds() / 86400:
@@ -139,7 +140,7 @@ def cmd_locate(args):
     out.mkdir(parents=True, exist_ok=True)
     result = locate(data, building, case, out, source=args.measurements,
                     nodes=node_list("--nodes", args.nodes) if args.nodes else None,
-                    include_algebraic=args.include_algebraic, **search_strategy(args), seed=args.seed,
+                    include_algebraic=args.include_algebraic, **strategy, seed=args.seed,
                     workers=args.workers, scheduler=args.scheduler)
     (out / "locate.json").write_text(json.dumps(result, indent=2) + "\n")
     print(locate_summary(result))

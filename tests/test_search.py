@@ -379,3 +379,32 @@ def test_the_fmu_evaluators_leave_no_extracted_folder(tmp_path, monkeypatch, tes
     with pytest.raises(Interrupt):
         search(factory, [1, 7, 9], population=4, generations=2, workers=2, progress=stop_after(1))
     assert list(private.iterdir()) == []
+
+
+def test_parsimony_prefers_the_earlier_node_only_when_the_noise_cannot_separate():
+    # J_unforced 1000: tolerance = the relative floor, 10; the noise alone (sigma 0.1, n 1000)
+    # separates sets whose J differ by more than 1.34. J_min = 0 (node 3 forced).
+    noise = dict(noise_sigma=0.1, n_residuals=1000)
+    assert parsimony.noise_tolerance(**noise) == pytest.approx(3 * 0.01 * np.sqrt(2000))
+    assert parsimony.tolerance(1000.0, **noise) == pytest.approx(10.0)
+    # node 0 compensates the fault at node 3 and fits the tolerance (J 5), but node 3 repairs it
+    # (J 0), measurably better: node 3 is the answer though node 0 comes first
+    spec = Synthetic((-995.0, 0.0, 0.0, -1000.0), pairs=((0, 3, 995.0),), base=1000.0)
+    result = search(spec, [1, 2, 3, 4], population=4, generations=4, workers=1, **noise)
+    assert result["best_nodes"] == [4]
+    # within the noise of each other (J 1 and 0), the earlier one is preferred
+    spec = Synthetic((-999.0, 0.0, 0.0, -1000.0), pairs=((0, 3, 999.0),), base=1000.0)
+    result = search(spec, [1, 2, 3, 4], population=4, generations=4, workers=1, **noise)
+    assert result["best_nodes"] == [1]
+
+
+def test_parsimony_finds_the_pair_whatever_the_best_chromosome():
+    # Two faults, nodes 2 and 5; node 0 compensates most of node 2's and its pair with 5 fits the
+    # tolerance too, but measurably worse. Whatever chromosome the search ends on, the pair is
+    # looked for among all pairs, so a best chromosome holding node 0 does not make it [0, 5].
+    spec = Synthetic((-8.0, 1.0, -10.0, 1.0, 1.0, -80.0), pairs=((0, 2, 8.0),), base=100.0)
+    evaluator = spec()
+    J_many = lambda ms: [evaluator.J(m) for m in ms]  # noqa: E731
+    best = (True, False, True, False, False, True)  # J = 10, with node 0 riding along
+    assert parsimony.smallest_subset(J_many, best, evaluator.J(best) + 3.0, noise_tol=0.5) == \
+        (False, False, True, False, False, True)
