@@ -267,8 +267,11 @@ def _evolve(cache, k, population, pc, pm, seed, state, steps, stop, initial):
 
     Returns why it stopped: "converged" (the `stop` rule) or "generations".
     """
-    if steps.done == steps.total or stop.converged(steps.done):
+    def why():
         return "converged" if stop.converged(steps.done) else "generations"
+
+    if steps.done == steps.total or stop.converged(steps.done):
+        return why()
 
     def fitness(ga, solutions, indices):
         # One call per generation (fitness_batch_size = population): the uncached chromosomes
@@ -304,7 +307,7 @@ def _evolve(cache, k, population, pc, pm, seed, state, steps, stop, initial):
     else:
         cache.requests += population  # the initial population, scored at the start of run()
     ga.run()
-    return "converged" if stop.converged(steps.done) else "generations"
+    return why()
 
 
 def _answer(cache, nodes, noise_sigma, n_residuals) -> dict:
