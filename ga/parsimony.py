@@ -1,4 +1,4 @@
-"""best_nodes: the smallest part of the best chromosome that keeps its reduction of J.
+"""best_nodes: the smallest set of forced nodes that keeps the best chromosome's reduction of J.
 
 The GA returns the chromosome of lowest J, but a node forced there may lower J only by chance
 (noise in the measurements) or not at all (a gene that drifted in and did no harm).  Lauret et

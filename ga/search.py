@@ -84,7 +84,7 @@ def search(factory, chromosome_nodes, *, population=30, generations=400, pc=0.8,
       node_scores {str(id): J with only that node forced};
       ranked_nodes: the nodes whose forcing alone lowers J below J_unforced, lowest J first
         (ties: chromosome order); nodes that do not help are left out;
-      best_nodes: the smallest part of the best chromosome that keeps its reduction of J
+      best_nodes: the smallest set of nodes that keeps the best chromosome's reduction of J
         (ga.parsimony), [] when no reduction is significant; J_best: J with best_nodes forced;
       search: {method "ga" | "exhaustive", population, generations, pc, pm, seed, patience,
         seeded, evaluations (J values the search asked for, cache hits included),
