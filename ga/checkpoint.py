@@ -1,10 +1,11 @@
 """Checkpoints: the search state written after every generation, so a stopped run resumes.
 
 The file is JSON (readable, no code execution on load) holding a key, the generation reached,
-the population, the random generators' states, the fitness cache (J per mask, as a bit string
-"0110...", null for a failed simulation) and the request counter.  The key hashes everything
-that decides the search (the evaluator factory's pickle, the chromosome nodes, the GA
-settings), so a file left by a run with other arguments is ignored, never resumed.
+the population, the random generators' states, the convergence rule's state (ga.search), the
+fitness cache (J per mask, as a bit string "0110...", null for a failed simulation) and the
+request counter.  The key hashes everything that decides the search (the evaluator factory's
+pickle, the chromosome nodes, the GA settings, patience and seeding), so a file left by a run
+with other arguments is ignored, never resumed.
 """
 
 from __future__ import annotations

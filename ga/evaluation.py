@@ -7,6 +7,7 @@ indoor air temperature (PHYSICS.md section 6), computed by an *evaluator*:
     factory = SomeFactory(...)      # picklable; shipped to every worker
     evaluator = factory()           # called once per worker process (or per Dask worker thread)
     evaluator.J(mask)               # mask: tuple[bool, ...] over the chromosome nodes, in order
+    evaluator.close()               # optional; every backend calls it when it shuts down
 
 J may raise: the simulation failed.  That chromosome is then unfit (J = inf, fitness 0), the
 reason is logged on logger "nodeforce.ga", and the search goes on.  A worker process that dies
@@ -22,6 +23,7 @@ import hashlib
 import logging
 import math
 import multiprocessing
+import multiprocessing.util
 import pickle
 import threading
 from concurrent.futures import ProcessPoolExecutor
@@ -58,6 +60,13 @@ def evaluate_masks(evaluator, masks: Iterable[Mask]) -> list[Outcome]:
     return outcomes
 
 
+def close_evaluator(evaluator) -> None:
+    """Release what an evaluator holds (an FMU instance and its extracted files), if it says how."""
+    close = getattr(evaluator, "close", None)
+    if close is not None:
+        close()
+
+
 def _build(factory):
     try:
         return factory()
@@ -81,7 +90,7 @@ class InProcessBackend:
         return [evaluate_masks(self._evaluator, chunk) for chunk in chunks]
 
     def close(self):
-        pass
+        close_evaluator(self._evaluator)
 
 
 # Per worker process: the evaluator built once by the pool initializer.
@@ -97,6 +106,11 @@ def _pool_initializer(factory):
         _process_evaluator = _build(factory)
     except EvaluatorSetupError as exc:
         _process_setup_error = str(exc)
+        return
+    # Closed when the worker exits, which the pool's shutdown makes it do (multiprocessing runs
+    # its finalisers at a worker's normal exit, fork or spawn alike).
+    multiprocessing.util.Finalize(_process_evaluator, close_evaluator, args=(_process_evaluator,),
+                                  exitpriority=10)
 
 
 def _pool_task(masks):
@@ -154,6 +168,12 @@ def _dask_task(token: str, factory, masks):
     return evaluate_masks(_dask_evaluators[key], masks)
 
 
+def _dask_close(token: str) -> None:
+    """Run on every Dask worker when a search ends: its evaluators go, the cluster stays up."""
+    for key in [key for key in _dask_evaluators if key[0] == token]:
+        close_evaluator(_dask_evaluators.pop(key))
+
+
 class DaskBackend:
     """Chunks submitted to a dask.distributed scheduler at `address` ("tcp://host:port")."""
 
@@ -186,7 +206,10 @@ class DaskBackend:
         return results
 
     def close(self):
-        self._client.close()
+        try:
+            self._client.run(_dask_close, self._token)
+        finally:
+            self._client.close()
 
 
 def open_backend(factory, workers: "int | None", scheduler: "str | None"):

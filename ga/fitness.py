@@ -2,12 +2,17 @@
 
 `FmuFitness` is the picklable factory `ga.search` sends to each worker; the worker calls it
 once, extracting and instantiating the FMU once, and then scores every chromosome it is given
-by resetting and re-running that one instance, warm-up included.
+by resetting and re-running that one instance, warm-up included; `close()` frees it.
+`ModelFitness` scores the same J with the direct model (`model.integrate.simulate`, equal to the
+FMU within 1e-9 C) for studies that simulate many thousand masks: the patience measurement and
+the paper-mode comparisons (benchmarks/bench_search.py, tests).
 """
 import numpy as np
 
 from nodeforce.cosim.fmi import FmuInstance, content_id
 from nodeforce.cosim.run import simulate_fmu
+from nodeforce.model.integrate import simulate
+from nodeforce.model.network import assemble
 
 
 class FmuFitness:
@@ -36,15 +41,65 @@ class FmuFitness:
         return FmuEvaluator(self)
 
 
-class FmuEvaluator:
+class ModelFitness:
+    """Factory of evaluators of the same J as `FmuFitness`, simulated by the direct model.
+
+    Parameters
+    ----------
+    building : model.building.Building the case belongs to
+    case, chromosome_nodes, objective, warmup_days : as for FmuFitness
+    """
+
+    def __init__(self, building, case, chromosome_nodes, objective, warmup_days=2):
+        self.building = building
+        self.case = case
+        self.chromosome_nodes = np.asarray(chromosome_nodes, dtype=int)
+        self.objective = objective
+        self.warmup_days = warmup_days
+
+    def __call__(self):
+        return ModelEvaluator(self)
+
+
+class _Evaluator:
+    """J (C2) of a mask over the spec's chromosome nodes; subclasses simulate the objective's air."""
+
     def __init__(self, spec):
         self.spec = spec
-        self.instance = FmuInstance(spec.fmu_path)
         self.measured = spec.objective.measured(spec.case)
 
     def J(self, mask):
         force = np.zeros(self.spec.case.measured.shape[1], dtype=bool)
         force[self.spec.chromosome_nodes[np.asarray(mask, dtype=bool)] - 1] = True
-        T = simulate_fmu(self.instance, self.spec.case, force, self.spec.warmup_days,
-                         output_ids=self.spec.objective.air_nodes)
-        return self.spec.objective.J(self.measured, T)
+        return self.spec.objective.J(self.measured, self.air(force))
+
+    def close(self):
+        """Free what the evaluator holds (nothing for the direct model)."""
+
+
+class FmuEvaluator(_Evaluator):
+    def __init__(self, spec):
+        super().__init__(spec)
+        self.instance = FmuInstance(spec.fmu_path)
+
+    def air(self, force):
+        """Objective air temperatures (C) at t_1..t_N with the `force` (N,) bool nodes forced."""
+        return simulate_fmu(self.instance, self.spec.case, force, self.spec.warmup_days,
+                            output_ids=self.spec.objective.air_nodes)
+
+    def close(self):
+        """Free the FMU instance and remove its extracted files."""
+        self.instance.close()
+
+
+class ModelEvaluator(_Evaluator):
+    def __init__(self, spec):
+        super().__init__(spec)
+        self.network = assemble(spec.building)
+
+    def air(self, force):
+        """Objective air temperatures (C) at t_1..t_N with the `force` (N,) bool nodes forced."""
+        case = self.spec.case
+        T = simulate(self.spec.building, self.network, case.U, case.dt, case.measured, force=force,
+                     warmup_days=self.spec.warmup_days, burn_in_steps=case.burn_in_steps)
+        return T[:, np.array(self.spec.objective.air_nodes) - 1]

@@ -9,7 +9,7 @@ from scipy.sparse.csgraph import shortest_path
 
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.fitness import FmuFitness
-from nodeforce.ga.search import search
+from nodeforce.ga.search import PATIENCE, search
 from nodeforce.model.errors import InputError
 from nodeforce.model.network import assemble
 from nodeforce.model.score import noise_level
@@ -62,12 +62,15 @@ def air_noise(case, objective):
 
 def locate(building, case, objective, workdir, *, source="measurements", nodes=None,
            include_algebraic=False, population=30, generations=400, pc=0.8, pm=0.03, seed=0,
-           workers=None, scheduler=None, warmup_days=2, progress=None, fmu_kind="python"):
+           patience=PATIENCE, seeded=True, workers=None, scheduler=None, warmup_days=2, progress=None,
+           fmu_kind="python"):
     """Run the forcing search on a case; return the content of locate.json.
 
     The FMU (`model.fmu`) and the search's checkpoint (`locate.checkpoint.json`) are written in
     `workdir`, so a run stopped midway and started again resumes. `progress` is called after
-    every generation with (generation, total, best J, unique evaluations).
+    every generation with (generation, total, best J, unique evaluations). patience and seeded
+    choose the search (ga.search: the defaults stop at convergence; ga.search.PAPER's values
+    give the paper's search).
     """
     candidates = chromosome_nodes(building, case, objective, source, nodes, include_algebraic)
     if not candidates:
@@ -75,6 +78,7 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
     fmu = build_fmu(building, workdir / "model.fmu", kind=fmu_kind)
     result = search(FmuFitness(fmu, case, candidates, objective, warmup_days), candidates,
                     population=population, generations=generations, pc=pc, pm=pm, seed=seed,
+                    patience=patience, seeded=seeded,
                     workers=workers, scheduler=scheduler, checkpoint=workdir / "locate.checkpoint.json",
                     progress=progress, noise_sigma=air_noise(case, objective),
                     n_residuals=int(np.isfinite(objective.measured(case)).sum()))

@@ -1,4 +1,4 @@
-"""best_nodes: the smallest part of the best chromosome that keeps its reduction of J.
+"""best_nodes: the smallest set of forced nodes that keeps the best chromosome's reduction of J.
 
 The GA returns the chromosome of lowest J, but a node forced there may lower J only by chance
 (noise in the measurements) or not at all (a gene that drifted in and did no harm).  Lauret et
@@ -23,14 +23,26 @@ can reach) lowers J by a fraction. So the search has located something only when
 otherwise best_nodes = [].
 
 Rule: best_nodes = the smallest set S with J(S) <= J_min + tolerance, looked for among the
-empty set, every single node (their scores are computed for the ranking anyway) and the subsets
-of the best chromosome. Within the tolerance the sets cannot be told apart from the noise, so
-among the smallest that fit, the one earliest in the chromosome order wins: the caller orders
-the nodes by preference (nodes nearest the zone first, ga.locate). The empty set comes first, so
-best_nodes = [] exactly when J_unforced - J_min <= tolerance: no significant reduction.
-Subsets of the best chromosome are searched exhaustively, smallest first, when it forces at most
-EXACT_MAX_NODES nodes; otherwise by backward elimination: repeatedly drop the node whose
-removal raises J least, while the rule still holds.
+empty set, every set of at most EXACT_ANY nodes of the chromosome, and the subsets of the best
+chromosome. Among the smallest sets that fit, the one of lowest J wins, except that sets whose
+J is within the noise alone (noise_tolerance: the tolerance without its relative floor) of the
+lowest cannot be told apart, and among those the one earliest in the chromosome order wins: the
+caller orders the nodes by preference (nodes nearest the zone first, ga.locate). So the inside
+surface of a wrong roof wins over the layer behind it (their J differ by noise), but a wall
+that merely compensates a wrong door does not win over the door because it comes first: its J
+is measurably worse. Sets of up to EXACT_ANY nodes are searched over the whole chromosome, so
+the answer for one or two faults does not depend on the path the search took. The empty set
+comes first, so best_nodes = [] exactly when J_unforced - J_min <= tolerance: no significant
+reduction. Larger subsets of the best chromosome are searched exhaustively, smallest first,
+when it forces at most EXACT_MAX_NODES nodes; otherwise by backward elimination: repeatedly
+drop the node whose removal raises J least, while the rule still holds.
+
+Before the GA, the search runs a forward-backward pass under the same tolerance
+(forward_backward): starting from no forcing, add the node that lowers J most while the fall
+exceeds the tolerance; after each addition drop any node whose removal raises J by no more
+than the tolerance (it no longer pays). It finds additive faults in about k simulations per
+node kept; the GA then has to beat it, which it can only do through interactions between
+sub-models, the paper's reason for a GA.
 """
 
 from __future__ import annotations
@@ -43,14 +55,19 @@ Z_NOISE = 3.0
 EXPLAINED = 0.5
 RELATIVE_FLOOR = 0.01
 EXACT_MAX_NODES = 8
+EXACT_ANY = 2
 
 
 def tolerance(J_unforced: float, noise_sigma: "float | None", n_residuals: "int | None") -> float:
-    """The change of J that is not significant (see the module docstring)."""
-    floor = RELATIVE_FLOOR * J_unforced
+    """The change of J (C2) that is not significant (see the module docstring)."""
+    return max(RELATIVE_FLOOR * J_unforced, noise_tolerance(noise_sigma, n_residuals))
+
+
+def noise_tolerance(noise_sigma: "float | None", n_residuals: "int | None") -> float:
+    """The change of J (C2) measurement noise of sd noise_sigma (C) alone can make; 0 if unknown."""
     if noise_sigma is None:
-        return floor
-    return max(floor, Z_NOISE * noise_sigma ** 2 * math.sqrt(2 * n_residuals))
+        return 0.0
+    return Z_NOISE * noise_sigma ** 2 * math.sqrt(2 * n_residuals)
 
 
 def explains(J_unforced: float, J_min: float, noise_sigma: "float | None", n_residuals: "int | None") -> bool:
@@ -59,10 +76,12 @@ def explains(J_unforced: float, J_min: float, noise_sigma: "float | None", n_res
     return J_min - J_noise <= EXPLAINED * (J_unforced - J_noise)
 
 
-def smallest_subset(J_many: Callable[[Sequence[tuple]], list], best: tuple, limit: float) -> tuple:
-    """The smallest sub-mask of `best` whose J stays <= limit (J_min + tolerance).
+def smallest_subset(J_many: Callable[[Sequence[tuple]], list], best: tuple, limit: float,
+                    noise_tol: float = 0.0) -> tuple:
+    """The smallest mask whose J stays <= limit (J_min + tolerance), by the rule above.
 
-    J_many scores a batch of masks (through the fitness cache, so a batch runs in parallel).
+    J_many scores a batch of masks (through the fitness cache, so a batch runs in parallel);
+    noise_tol (C2) is the noise_tolerance that sets of one size must differ by to be told apart.
     """
     def mask(subset):
         chosen = set(subset)
@@ -70,21 +89,31 @@ def smallest_subset(J_many: Callable[[Sequence[tuple]], list], best: tuple, limi
 
     if J_many([mask(())])[0] <= limit:
         return mask(())
-    singles = J_many([mask((i,)) for i in range(len(best))])
-    fitting = [i for i, J in enumerate(singles) if J <= limit]
-    if fitting:
-        return mask((fitting[0],))
+    for size in range(1, EXACT_ANY + 1):
+        chosen = _preferred(J_many, mask, list(combinations(range(len(best)), size)), limit, noise_tol)
+        if chosen is not None:
+            return mask(chosen)
     members = [i for i, bit in enumerate(best) if bit]
-    search = _smallest_first if len(members) <= EXACT_MAX_NODES else _backward_elimination
-    return mask(search(J_many, mask, members, limit))
+    if len(members) <= EXACT_MAX_NODES:
+        return mask(_smallest_first(J_many, mask, members, limit, noise_tol))
+    return mask(_backward_elimination(J_many, mask, members, limit))
 
 
-def _smallest_first(J_many, mask, members, limit):
-    for size in range(2, len(members)):
-        subsets = list(combinations(members, size))
-        fits = [s for J, s in zip(J_many([mask(s) for s in subsets]), subsets) if J <= limit]
-        if fits:
-            return fits[0]  # combinations keep the caller's order: the preferred set first
+def _preferred(J_many, mask, subsets, limit, noise_tol):
+    """Of the subsets (in preference order) whose J <= limit, the first within noise_tol of the
+    lowest; None if none fits."""
+    fits = [(J, s) for J, s in zip(J_many([mask(s) for s in subsets]), subsets) if J <= limit]
+    if not fits:
+        return None
+    lowest = min(J for J, _ in fits)
+    return next(s for J, s in fits if J <= lowest + noise_tol)
+
+
+def _smallest_first(J_many, mask, members, limit, noise_tol):
+    for size in range(EXACT_ANY + 1, len(members)):
+        chosen = _preferred(J_many, mask, list(combinations(members, size)), limit, noise_tol)
+        if chosen is not None:
+            return chosen
     return members
 
 
@@ -97,3 +126,39 @@ def _backward_elimination(J_many, mask, members, limit):
             break
         kept = candidates[i]
     return kept
+
+
+def forward_backward(J_many: Callable[[Sequence[tuple]], list], k: int, tol: float) -> "tuple[tuple, float]":
+    """Stepwise selection over k nodes judged against the noise; returns (mask, J).
+
+    J_many scores a batch of masks (each step's candidates run in parallel). Ties go to the
+    node earlier in the chromosome order, the caller's preference. A set already visited is
+    never entered again, so the pass ends.
+    """
+    current = (False,) * k
+    [J_current] = J_many([current])
+    visited = {current}
+    while True:
+        grown = [current[:i] + (True,) + current[i + 1:] for i in range(k) if not current[i]]
+        step = _best_unvisited(J_many, grown, visited)
+        if step is None or J_current - step[0] <= tol:
+            return current, J_current
+        J_current, current = step
+        visited.add(current)
+        while sum(current) > 1:
+            shrunk = [current[:i] + (False,) + current[i + 1:] for i in range(k) if current[i]]
+            step = _best_unvisited(J_many, shrunk, visited)
+            if step is None or step[0] - J_current > tol:
+                break
+            J_current, current = step
+            visited.add(current)
+
+
+def _best_unvisited(J_many, masks, visited):
+    """(J, mask) of lowest J among the masks not yet visited (first in order on ties)."""
+    fresh = [m for m in masks if m not in visited]
+    if not fresh:
+        return None
+    Js = J_many(fresh)
+    i = min(range(len(fresh)), key=Js.__getitem__)
+    return Js[i], fresh[i]

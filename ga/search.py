@@ -11,6 +11,19 @@ one elite carried to the next generation so the best chromosome is never lost), 
 GA's budget population*generations covers all 2^k chromosomes, simply scores them all: the
 exact answer for no more work.  Every J goes through one cache, so a chromosome is simulated
 at most once, whether asked for by the GA, the single-node scores or the parsimony step.
+
+By default the GA starts from what the search computes anyway and stops once it has nothing
+left to find (the paper's "convergence criterion", which it does not define):
+
+- before the GA, the unforced and single-node scores and a forward-backward pass
+  (ga.parsimony.forward_backward) are computed; the initial population holds the pass's
+  result, the significant single nodes and their cumulative unions (at most half of it), the
+  rest drawn at random.  The elite keeps the pass's result, so the GA can only beat it;
+- the GA stops when its best J has not fallen by more than the noise tolerance
+  (ga.parsimony.tolerance) for `patience` generations (PATIENCE, measured: README).
+
+PAPER holds the paper's settings: 30 x 400, random initial population, no convergence
+criterion; with them the search is the one of earlier releases, draw for draw.
 """
 
 from __future__ import annotations
@@ -19,27 +32,43 @@ import math
 import os
 import sys
 import time
+from dataclasses import dataclass
+from functools import partial
 from itertools import product
 
+import numpy as np
 import pygad
 from tqdm import tqdm
 
 from nodeforce.ga import checkpoint as ckpt
 from nodeforce.ga.evaluation import FitnessCache, log, open_backend
 from nodeforce.ga.operators import bit_flip_mutation, one_point_crossover, roulette_selection
-from nodeforce.ga.parsimony import explains, smallest_subset, tolerance
+from nodeforce.ga.parsimony import (explains, forward_backward, noise_tolerance, smallest_subset,
+                                    tolerance)
+
+# Generations without a significant fall of the best J before the GA stops. Measured on the
+# paper's verification cases (benchmarks/bench_search.py --cases, README): successive falls of
+# the best J by more than the tolerance came at most 18 generations apart.
+PATIENCE = 25
+# The paper's search: its GA settings, a random initial population, no convergence criterion.
+PAPER = dict(population=30, generations=400, pc=0.8, pm=0.03, patience=None, seeded=False)
 
 
 def search(factory, chromosome_nodes, *, population=30, generations=400, pc=0.8, pm=0.03,
-           seed=0, workers=None, scheduler=None, checkpoint=None, progress=None,
-           noise_sigma=None, n_residuals=None) -> dict:
+           seed=0, patience=PATIENCE, seeded=True, workers=None, scheduler=None, checkpoint=None,
+           progress=None, noise_sigma=None, n_residuals=None) -> dict:
     """Search the forcing of lowest J over `chromosome_nodes`; return the locate.json fields.
 
     factory: picklable callable; factory() -> evaluator with J(mask: tuple[bool, ...]) -> float,
-        mask over chromosome_nodes in order.  Called once per worker.  J may raise: that
-        chromosome is unfit (J = inf), the reason logged on logger "nodeforce.ga".
+        mask over chromosome_nodes in order, and optionally close(), called when the search
+        ends (ga.evaluation).  Called once per worker.  J may raise: that chromosome is unfit
+        (J = inf), the reason logged on logger "nodeforce.ga".
     population, generations, pc, pm: the GA settings (paper: 30, 400, 0.8, 0.03).
     seed: seeds every random draw; same arguments and seed -> same answer.
+    patience: stop the GA once the best J has not fallen by more than the noise tolerance for
+        this many generations; None: run every generation (the paper).
+    seeded: start the GA from the single-node scores and a forward-backward pass (module
+        docstring); False: a random initial population (the paper).  PAPER = both off.
     workers: processes evaluating in parallel (default os.cpu_count(); 1 = in this process).
     scheduler: a dask.distributed scheduler address ("tcp://host:port"); replaces `workers`.
     checkpoint: a file path; the state is written there after every generation, and a run
@@ -55,20 +84,24 @@ def search(factory, chromosome_nodes, *, population=30, generations=400, pc=0.8,
       node_scores {str(id): J with only that node forced};
       ranked_nodes: the nodes whose forcing alone lowers J below J_unforced, lowest J first
         (ties: chromosome order); nodes that do not help are left out;
-      best_nodes: the smallest part of the best chromosome that keeps its reduction of J
+      best_nodes: the smallest set of nodes that keeps the best chromosome's reduction of J
         (ga.parsimony), [] when no reduction is significant; J_best: J with best_nodes forced;
-      search: {method "ga" | "exhaustive", population, generations, pc, pm, seed,
-        evaluations (J values the search asked for, cache hits included), unique_evaluations
-        (simulations run), seconds, J_min and min_nodes (the lowest J found and its chromosome,
-        before parsimony), tolerance (the change of J deemed noise)}.
+      search: {method "ga" | "exhaustive", population, generations, pc, pm, seed, patience,
+        seeded, evaluations (J values the search asked for, cache hits included),
+        unique_evaluations (simulations run), seconds, stopped ("converged": by the patience
+        rule; "generations": every generation ran, or every batch of an exhaustive search),
+        stopped_at (the generation it stopped at), J_min and min_nodes (the lowest J found and
+        its chromosome, before parsimony), tolerance (the change of J deemed noise), and when
+        seeded stepwise_nodes and J_stepwise (the forward-backward pass's result)}.
     """
     started = time.monotonic()
     nodes = list(chromosome_nodes)
-    _check_arguments(nodes, population, generations, pc, pm, noise_sigma, n_residuals)
+    _check_arguments(nodes, population, generations, pc, pm, patience, noise_sigma, n_residuals)
     k = len(nodes)
     exhaustive = 2 ** k <= population * generations
     settings = dict(method="exhaustive" if exhaustive else "ga", population=population,
-                    generations=generations, pc=pc, pm=pm, seed=seed)
+                    generations=generations, pc=pc, pm=pm, seed=seed, patience=patience,
+                    seeded=seeded)
     key = ckpt.run_key(factory, nodes, **settings) if checkpoint else None
     state = ckpt.load(checkpoint, key) if checkpoint else None
 
@@ -81,11 +114,22 @@ def search(factory, chromosome_nodes, *, population=30, generations=400, pc=0.8,
         total = math.ceil(2 ** k / population) if exhaustive else generations
         steps = _Steps(total, state["generation"] if state else 0, cache, checkpoint, key,
                        progress, settings["method"])
+        extra = {}
         try:
             if exhaustive:
                 _enumerate(cache, k, population, steps)
+                stopped = "generations"
             else:
-                _evolve(cache, k, population, pc, pm, seed, state, steps)
+                # A resumed run repeats the steps before the GA from the cache, uncounted.
+                J_many = partial(cache.J_many, count=state is None)
+                start = _start(J_many, k, seeded, patience, noise_sigma, n_residuals)
+                stop = Convergence(patience, start.tolerance,
+                                   **(state["convergence"] if state else {"J_ref": start.J}))
+                initial = (_seeded_population(start, population, k, seed)
+                           if seeded and not state else None)
+                stopped = _evolve(cache, k, population, pc, pm, seed, state, steps, stop, initial)
+                if seeded:
+                    extra = dict(stepwise_nodes=cache.describe(start.mask), J_stepwise=_json(start.J))
         finally:
             steps.close()
         search_requests = cache.requests
@@ -93,21 +137,24 @@ def search(factory, chromosome_nodes, *, population=30, generations=400, pc=0.8,
         if checkpoint:
             # Keep the final scores too, so a rerun is instant; the counter stays at the end of
             # the search so the rerun counts the final steps exactly once, like this run.
-            steps.save(total, requests=search_requests)
+            steps.save(steps.done, requests=search_requests)
     finally:
         backend.close()
     answer["search"].update(settings, evaluations=cache.requests, unique_evaluations=cache.unique,
-                            seconds=round(time.monotonic() - started, 3))
+                            seconds=round(time.monotonic() - started, 3), stopped=stopped,
+                            stopped_at=steps.done, **extra)
     return answer
 
 
-def _check_arguments(nodes, population, generations, pc, pm, noise_sigma, n_residuals):
+def _check_arguments(nodes, population, generations, pc, pm, patience, noise_sigma, n_residuals):
     if len(set(map(str, nodes))) != len(nodes):
         raise ValueError(f"chromosome nodes must be distinct: {nodes}")
     if population < 2 or generations < 1:
         raise ValueError("population must be >= 2 and generations >= 1")
     if not (0 <= pc <= 1 and 0 <= pm <= 1):
         raise ValueError("pc and pm are probabilities, in [0, 1]")
+    if patience is not None and patience < 1:
+        raise ValueError("patience must be >= 1 generation (None: no convergence criterion)")
     if noise_sigma is not None and not n_residuals:
         raise ValueError("noise_sigma needs n_residuals, the number of residuals in J")
 
@@ -118,18 +165,21 @@ class _Steps:
     def __init__(self, total, done, cache, path, key, progress, method):
         self.total, self.done = total, done
         self._cache, self._path, self._key, self._progress = cache, path, key, progress
+        self._extra = {}
         self._bar = tqdm(total=total, initial=done, desc=f"nodeforce {method}", unit="gen",
                          disable=not sys.stderr.isatty())
 
-    def save(self, generation, requests=None, **extra):
+    def save(self, generation, requests=None):
         ckpt.save(self._path, self._key, {
             "generation": generation, "cache": ckpt.encode_cache(self._cache.J_of),
-            "requests": self._cache.requests if requests is None else requests, **extra})
+            "requests": self._cache.requests if requests is None else requests, **self._extra})
 
     def step(self, generation, **extra):
+        """extra: what a resumed run needs besides the cache (GA population, generators)."""
         self.done = generation
+        self._extra = extra
         if self._path:
-            self.save(generation, **extra)
+            self.save(generation)
         J_min = self._cache.J_of[self._cache.best()]
         self._bar.update(generation - self._bar.n)
         self._bar.set_postfix(best_J=f"{J_min:.4g}", unique=self._cache.unique)
@@ -148,10 +198,80 @@ def _enumerate(cache, k, population, steps):
         steps.step(g + 1)
 
 
-def _evolve(cache, k, population, pc, pm, seed, state, steps):
-    """The GA, driven by PyGAD; resumes from `state` (a checkpoint) when given."""
-    if steps.done == steps.total:
-        return
+class Convergence:
+    """The stopping rule: the best J has not fallen by more than `tol` for `patience` generations.
+
+    J_ref is the best J at the last significant fall and `last` its generation (0: before the
+    GA's first generation, J_ref the best J known then).  patience None: never converged.
+    """
+
+    def __init__(self, patience, tol, J_ref=math.inf, last=0):
+        self.patience, self.tol = patience, tol
+        self.J_ref = math.inf if J_ref is None else J_ref
+        self.last = last
+
+    def update(self, generation, J_min):
+        if J_min < self.J_ref - self.tol:
+            self.J_ref, self.last = J_min, generation
+
+    def converged(self, generation) -> bool:
+        return self.patience is not None and generation - self.last >= self.patience
+
+    def state(self) -> dict:
+        return {"J_ref": _json(self.J_ref), "last": self.last}
+
+
+@dataclass(frozen=True)
+class _Start:
+    """What is known before the GA: the scores it is seeded from and the noise tolerance."""
+    J_unforced: float
+    J_single: list
+    tolerance: float
+    mask: tuple   # the forward-backward pass's result
+    J: float      # its J (inf when nothing was computed: the paper's search)
+
+
+def _start(J_many, k, seeded, patience, noise_sigma, n_residuals) -> _Start:
+    """The unforced and single-node scores (the tolerance needs J_unforced) and, when seeded,
+    the forward-backward pass; nothing for the paper's search, which starts from chance."""
+    unforced = (False,) * k
+    if not seeded and patience is None:
+        return _Start(math.inf, [], 0.0, unforced, math.inf)
+    J_unforced, *J_single = J_many([unforced] + _singles(k))
+    tol = tolerance(J_unforced, noise_sigma, n_residuals)
+    mask, J = forward_backward(J_many, k, tol) if seeded else (unforced, math.inf)
+    return _Start(J_unforced, J_single, tol, mask, J)
+
+
+def _singles(k):
+    return [tuple(i == j for j in range(k)) for i in range(k)]
+
+
+def _seeded_population(start, population, k, seed):
+    """Initial population: the pass's result, then the significant single nodes, best first,
+    each followed by the union of it and the better ones; at most half the population, so the
+    random rest keeps the GA free to find interactions the single scores do not show."""
+    helpful = [i for i in rank(start.J_single, start.J_unforced, start.tolerance)
+               if start.J_single[i] < start.J_unforced - start.tolerance]
+    seeds = [start.mask]
+    for m, i in enumerate(helpful):
+        seeds.append(_singles(k)[i])
+        seeds.append(tuple(j in helpful[:m + 1] for j in range(k)))
+    seeds = list(dict.fromkeys(seeds))[:population // 2]
+    random_rows = np.random.default_rng(seed).integers(0, 2, (population - len(seeds), k))
+    return np.vstack([np.array(seeds, dtype=int).reshape(-1, k), random_rows])
+
+
+def _evolve(cache, k, population, pc, pm, seed, state, steps, stop, initial):
+    """The GA, driven by PyGAD; resumes from `state` (a checkpoint) when given.
+
+    Returns why it stopped: "converged" (the `stop` rule) or "generations".
+    """
+    def why():
+        return "converged" if stop.converged(steps.done) else "generations"
+
+    if steps.done == steps.total or stop.converged(steps.done):
+        return why()
 
     def fitness(ga, solutions, indices):
         # One call per generation (fitness_batch_size = population): the uncached chromosomes
@@ -161,11 +281,18 @@ def _evolve(cache, k, population, pc, pm, seed, state, steps):
 
     def on_generation(ga):
         cache.requests += population
-        steps.step(ga.generations_completed, population=ga.population.tolist(),
-                   rng=ckpt.rng_states(ga))
+        g = ga.generations_completed
+        stop.update(g, cache.J_of[cache.best()])
+        steps.step(g, population=ga.population.tolist(), rng=ckpt.rng_states(ga),
+                   convergence=stop.state())
+        return "stop" if stop.converged(g) else None
 
-    shape = (dict(initial_population=state["population"]) if state
-             else dict(sol_per_pop=population, num_genes=k))
+    if state:
+        shape = dict(initial_population=state["population"])
+    elif initial is not None:
+        shape = dict(initial_population=initial)
+    else:
+        shape = dict(sol_per_pop=population, num_genes=k)
     ga = pygad.GA(num_generations=steps.total - steps.done, num_parents_mating=population,
                   fitness_func=fitness, fitness_batch_size=population, **shape,
                   gene_type=int, gene_space=[0, 1], parent_selection_type=roulette_selection,
@@ -180,19 +307,19 @@ def _evolve(cache, k, population, pc, pm, seed, state, steps):
     else:
         cache.requests += population  # the initial population, scored at the start of run()
     ga.run()
+    return why()
 
 
 def _answer(cache, nodes, noise_sigma, n_residuals) -> dict:
     """The locate.json fields: unforced and single-node scores, best chromosome, best_nodes."""
     k = len(nodes)
     unforced = (False,) * k
-    singles = [tuple(i == j for j in range(k)) for i in range(k)]
-    J_unforced, *J_single = cache.J_many([unforced] + singles)
+    J_unforced, *J_single = cache.J_many([unforced] + _singles(k))
     best = cache.best()
     J_min = cache.J_of[best]
     tol = tolerance(J_unforced, noise_sigma, n_residuals)
     if explains(J_unforced, J_min, noise_sigma, n_residuals):
-        chosen = smallest_subset(cache.J_many, best, J_min + tol)
+        chosen = smallest_subset(cache.J_many, best, J_min + tol, noise_tolerance(noise_sigma, n_residuals))
     else:
         chosen = unforced
     return {

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from nodeforce.ga.search import PAPER, PATIENCE
 from nodeforce.model.building import load_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.errors import InputError
@@ -119,6 +120,19 @@ def check_search_settings(args):
     check_workers(args)
 
 
+def search_strategy(args):
+    """locate()'s search settings from the options: the default search or, with --paper, the
+    paper's (GA settings given explicitly still apply: they default to the paper's anyway)."""
+    if args.paper and args.patience is not None:
+        raise InputError("--patience", args.patience, "--paper runs every generation; leave out one of the two")
+    if args.patience is not None and args.patience < 1:
+        raise InputError("--patience", args.patience, "at least one generation")
+    settings = dict(population=args.population, generations=args.generations, pc=args.pc, pm=args.pm)
+    if args.paper:
+        return {**PAPER, **settings}
+    return {**settings, "patience": PATIENCE if args.patience is None else args.patience}
+
+
 def check_workers(args):
     if args.workers is not None and args.workers < 1:
         raise InputError("--workers", args.workers, "at least one worker process")
@@ -127,13 +141,13 @@ def check_workers(args):
 def cmd_locate(args):
     from nodeforce.ga.locate import locate
     check_search_settings(args)
+    strategy = search_strategy(args)
     building, case, objective = load_inputs(args)
     out = Path(args.output)
     out.mkdir(parents=True, exist_ok=True)
     result = locate(building, case, objective, out, source=args.measurements,
                     nodes=node_list("--nodes", args.nodes) if args.nodes else None,
-                    include_algebraic=args.include_algebraic, population=args.population,
-                    generations=args.generations, pc=args.pc, pm=args.pm, seed=args.seed,
+                    include_algebraic=args.include_algebraic, **strategy, seed=args.seed,
                     workers=args.workers, scheduler=args.scheduler, fmu_kind=args.fmu)
     (out / "locate.json").write_text(json.dumps(result, indent=2) + "\n")
     print(locate_summary(result))
@@ -311,6 +325,12 @@ def parser():
     s.add_argument("--generations", type=int, default=400)
     s.add_argument("--pc", type=float, default=0.8, help="crossover probability")
     s.add_argument("--pm", type=float, default=0.03, help="mutation probability per gene")
+    s.add_argument("--patience", type=int,
+                   help=f"stop when the best J has not fallen by more than the noise for this many "
+                        f"generations (default {PATIENCE})")
+    s.add_argument("--paper", action="store_true",
+                   help="the paper's search: random initial population, every generation run, no "
+                        "convergence criterion (with the paper's 30 x 400, pc 0.8, pm 0.03 unless given)")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--workers", type=int, help="processes (default: all cores)")
     s.add_argument("--fmu", choices=("python", "standalone"), default="python", help="the FMU kind to run")

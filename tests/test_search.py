@@ -9,14 +9,21 @@ they pickle into worker processes, as the FMU factory will.
 import itertools
 import logging
 import os
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga import parsimony
-from nodeforce.ga.search import search
+from nodeforce.model.score import Objective
+from nodeforce.ga.fitness import FmuFitness
+from nodeforce.ga.search import PAPER, search
+from nodeforce.model.case import prepare_case
+from nodeforce.model.synth import pseudo_measurements
+from tests.conftest import SENSORS, record_times
 
 NODES12 = [1, 3, 5, 7, 9, 11, 13, 15, 17, 19, 21, 22]  # ids are not positions
 
@@ -81,6 +88,7 @@ def without_time(result):
 
 TWELVE = linear(12, {1: 40.0, 6: 25.0, 9: 15.0})
 GA_BUDGET = dict(population=30, generations=60)  # 1800 evaluations < 2^12: the GA runs
+LONG_GA = dict(population=30, generations=130)  # 3900 < 2^12, more than the searches need
 
 
 def test_ga_finds_the_wrong_submodels():
@@ -258,3 +266,146 @@ def test_dask_cluster_gives_the_same_result(tmp_path):
         on_dask = search(spec, NODES12, scheduler=cluster.scheduler_address, **budget)
     assert without_time(on_dask) == without_time(serial)
     assert evaluators_built(tmp_path) == [1, 1]  # one evaluator per Dask worker
+
+
+# --- the default search: seeded from the single-node scores and a forward-backward pass, stopped
+# at convergence; the paper's search (PAPER) is the same GA without either.
+
+
+def test_forward_backward_adds_what_pays_and_drops_what_no_longer_does():
+    # nodes 0 and 1 each lower J by 30 alone, but together only by 31 (they explain the same
+    # fault); node 2 lowers it by 25 alone and by 25 in any company. Greedy: 0 (70), then 2
+    # (45), then 1 would lower J by 1, under the tolerance: stop at {0, 2}.
+    spec = Synthetic((-30.0, -30.0, -25.0, 4.0), pairs=((0, 1, 29.0),))
+    evaluator = spec()
+    mask, J = parsimony.forward_backward(lambda ms: [evaluator.J(m) for m in ms], 4, tol=2.0)
+    assert mask == (True, False, True, False) and J == pytest.approx(45.0)
+    # a node that paid when it came in is dropped once a later one makes it redundant:
+    # node 1 alone is best (-30), node 0 then lowers J by 20 more, after which node 1 alone
+    # adds only 1 on top of node 0 (pair interaction), so the pass drops it.
+    spec = Synthetic((-49.0, -30.0, 0.5), pairs=((0, 1, 28.0),))
+    evaluator = spec()
+    mask, J = parsimony.forward_backward(lambda ms: [evaluator.J(m) for m in ms], 3, tol=2.0)
+    assert mask == (True, False, False) and J == pytest.approx(51.0)
+
+
+def test_forward_backward_stops_at_nothing_when_nothing_pays():
+    evaluator = linear(5, {2: 0.5})()
+    mask, J = parsimony.forward_backward(lambda ms: [evaluator.J(m) for m in ms], 5, tol=1.0)
+    assert mask == (False,) * 5 and J == 100.0
+
+
+def test_default_search_beats_the_stepwise_pass_on_an_interaction():
+    # Nodes 4 and 7 lower J only together (each alone raises it): no single score, so no
+    # stepwise pass, can find them; the GA must. The forward-backward pass stops at node 0.
+    weights = [-10.0] + [1.0] * 11
+    spec = Synthetic(tuple(weights), pairs=((4, 7, -60.0),))
+    result = search(spec, NODES12, workers=1, seed=1, **LONG_GA)
+    s = result["search"]
+    assert s["stepwise_nodes"] == [1] and s["J_stepwise"] == pytest.approx(90.0)
+    assert s["min_nodes"] == [1, 9, 15] and s["J_min"] == pytest.approx(32.0)
+    assert result["best_nodes"] == [1, 9, 15]
+    assert s["stopped"] == "converged" and s["stopped_at"] < s["generations"]
+
+
+def test_convergence_stops_patience_generations_after_the_last_significant_fall():
+    history = []
+    result = search(TWELVE, NODES12, workers=1, patience=7, **LONG_GA,
+                    progress=lambda g, total, J, unique: history.append(J))
+    s = result["search"]
+    assert s["stopped"] == "converged" and s["stopped_at"] == len(history)
+    tol = s["tolerance"]
+    # the best J before the GA is the stepwise pass's; no later fall exceeded the tolerance by
+    # the last `patience` generations, and the rule did not fire earlier
+    falls, ref = [], s["J_stepwise"]
+    for g, J in enumerate(history, start=1):
+        if J < ref - tol:
+            falls.append(g)
+            ref = J
+    assert s["stopped_at"] - (falls[-1] if falls else 0) == 7
+    assert result["best_nodes"] == [3, 13, 19]
+
+
+def test_paper_mode_is_the_unseeded_ga_to_the_last_generation(tmp_path):
+    singles = ["0" * 12] + ["".join("1" if i == j else "0" for j in range(12)) for i in range(12)]
+    for mode, settings in (("default", {}), ("paper", PAPER)):
+        (tmp_path / mode).mkdir()
+        spec = linear(12, {1: 40.0, 6: 25.0, 9: 15.0}, log_dir=str(tmp_path / mode))
+        result = search(spec, NODES12, workers=1, **{**settings, **GA_BUDGET})
+        first = seen_masks(tmp_path / mode)[:13]  # one process: in the order simulated
+        if mode == "paper":
+            # PyGAD's random first population, every generation run, no stepwise pass
+            assert first != singles
+            assert result["search"]["stopped"] == "generations"
+            assert result["search"]["stopped_at"] == GA_BUDGET["generations"]
+            assert "stepwise_nodes" not in result["search"]
+        else:
+            # the unforced and single-node scores come first, then the stepwise pass
+            assert first == singles
+            assert result["search"]["stepwise_nodes"] == [3, 13, 19]
+        assert result["best_nodes"] == [3, 13, 19]
+
+
+def test_a_converged_run_resumes_as_finished(tmp_path):
+    path = tmp_path / "search.json"
+    spec = linear(12, {1: 40.0, 6: 25.0, 9: 15.0}, log_dir=str(tmp_path))
+    first = search(spec, NODES12, workers=1, patience=5, checkpoint=path, **LONG_GA)
+    assert first["search"]["stopped"] == "converged"
+    seen = len(seen_masks(tmp_path))
+    again = search(spec, NODES12, workers=1, patience=5, checkpoint=path, **LONG_GA)
+    assert without_time(again) == without_time(first)
+    assert len(seen_masks(tmp_path)) == seen  # nothing simulated again
+
+
+def test_the_fmu_evaluators_leave_no_extracted_folder(tmp_path, monkeypatch, testcell_data, testcell,
+                                                      weather):
+    # A private temp dir, so folders other processes make in the shared one do not count;
+    # TMPDIR reaches the spawned workers.
+    fmu = build_fmu(testcell, tmp_path / "cell.fmu")
+    measurements = pseudo_measurements(testcell, weather, record_times(days=1), list(SENSORS))
+    case = prepare_case(testcell, weather, measurements)
+    factory = FmuFitness(fmu, case, [1, 7, 9], Objective.of(testcell), warmup_days=1)
+    private = tmp_path / "tmp"
+    private.mkdir()
+    monkeypatch.setenv("TMPDIR", str(private))
+    monkeypatch.setattr(tempfile, "tempdir", None)  # gettempdir() reads TMPDIR again
+    assert tempfile.gettempdir() == str(private)
+    during = []
+    progress = lambda g, total, J, unique: during.append(len(list(private.iterdir())))  # noqa: E731
+    for workers in (1, 2):
+        search(factory, [1, 7, 9], population=4, generations=2, workers=workers, progress=progress)
+        assert during[-1] >= 1  # the evaluators had extracted the FMU there
+        assert list(private.iterdir()) == []
+    # on failure too: a search stopped by an exception closes its evaluators
+    with pytest.raises(Interrupt):
+        search(factory, [1, 7, 9], population=4, generations=2, workers=2, progress=stop_after(1))
+    assert list(private.iterdir()) == []
+
+
+def test_parsimony_prefers_the_earlier_node_only_when_the_noise_cannot_separate():
+    # J_unforced 1000: tolerance = the relative floor, 10; the noise alone (sigma 0.1, n 1000)
+    # separates sets whose J differ by more than 1.34. J_min = 0 (node 3 forced).
+    noise = dict(noise_sigma=0.1, n_residuals=1000)
+    assert parsimony.noise_tolerance(**noise) == pytest.approx(3 * 0.01 * np.sqrt(2000))
+    assert parsimony.tolerance(1000.0, **noise) == pytest.approx(10.0)
+    # node 0 compensates the fault at node 3 and fits the tolerance (J 5), but node 3 repairs it
+    # (J 0), measurably better: node 3 is the answer though node 0 comes first
+    spec = Synthetic((-995.0, 0.0, 0.0, -1000.0), pairs=((0, 3, 995.0),), base=1000.0)
+    result = search(spec, [1, 2, 3, 4], population=4, generations=4, workers=1, **noise)
+    assert result["best_nodes"] == [4]
+    # within the noise of each other (J 1 and 0), the earlier one is preferred
+    spec = Synthetic((-999.0, 0.0, 0.0, -1000.0), pairs=((0, 3, 999.0),), base=1000.0)
+    result = search(spec, [1, 2, 3, 4], population=4, generations=4, workers=1, **noise)
+    assert result["best_nodes"] == [1]
+
+
+def test_parsimony_finds_the_pair_whatever_the_best_chromosome():
+    # Two faults, nodes 2 and 5; node 0 compensates most of node 2's and its pair with 5 fits the
+    # tolerance too, but measurably worse. Whatever chromosome the search ends on, the pair is
+    # looked for among all pairs, so a best chromosome holding node 0 does not make it [0, 5].
+    spec = Synthetic((-8.0, 1.0, -10.0, 1.0, 1.0, -80.0), pairs=((0, 2, 8.0),), base=100.0)
+    evaluator = spec()
+    J_many = lambda ms: [evaluator.J(m) for m in ms]  # noqa: E731
+    best = (True, False, True, False, False, True)  # J = 10, with node 0 riding along
+    assert parsimony.smallest_subset(J_many, best, evaluator.J(best) + 3.0, noise_tol=0.5) == \
+        (False, False, True, False, False, True)
