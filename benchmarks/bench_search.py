@@ -228,7 +228,6 @@ def main(argv=None):
 
     data, building, case = the_case()
     objective = Objective.of(building)
-    air = objective.air_nodes[0]
     nodes = chromosome_nodes(building, case, objective, "pseudo-measurements")
     n_rows = len(case.times)
     steps = len(warmup_rows(n_rows, case.dt, WARMUP_DAYS))
