@@ -14,6 +14,7 @@ from nodeforce.model.case import prepare_case
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
 from nodeforce.iotools.measurements import read_measurements
+from nodeforce.iotools.timetable import instant
 from nodeforce.iotools.weather import read_weather
 from nodeforce.model.score import Objective
 
@@ -203,12 +204,7 @@ def cmd_synth(args):
                                             "positive, --noise and --history-days not negative")
     if abs(86400 / args.step - round(86400 / args.step)) > 1e-9:
         raise InputError("--step", args.step, "must divide a day (the warm-up replays whole days)")
-    try:
-        start = pd.Timestamp(args.start)
-    except ValueError:
-        raise InputError("--start", args.start, "not an ISO 8601 time") from None
-    if start.tzinfo is None:
-        raise InputError("--start", args.start, "needs a UTC offset, e.g. 2001-06-10T00:00-05:00")
+    start = instant("--start", args.start)
     times = pd.date_range(start, periods=int(args.days * 86400 / args.step) + 1,
                           freq=pd.Timedelta(seconds=args.step), name="time")
     frame = pseudo_measurements(building, read_weather(args.weather), times, node_list("--sensors", args.sensors),
@@ -219,19 +215,11 @@ def cmd_synth(args):
 
 
 def run_diagnosis(building, case, objective, out, source, args):
-    import pandas as pd
     from nodeforce.diagnose.loop import diagnose
     from nodeforce.diagnose.report import before_after_table
     if not 0.0 < args.calibration_fraction < 1.0:
         raise InputError("--calibration-fraction", args.calibration_fraction, "a fraction between 0 and 1")
-    end = None
-    if args.calibration_end:
-        try:
-            end = pd.Timestamp(args.calibration_end)
-        except ValueError:
-            raise InputError("--calibration-end", args.calibration_end, "not an ISO 8601 time") from None
-        if end.tzinfo is None:
-            raise InputError("--calibration-end", args.calibration_end, "needs a UTC offset, e.g. 2013-09-14T00:00+01:00")
+    end = instant("--calibration-end", args.calibration_end) if args.calibration_end else None
     check_workers(args)
     out.mkdir(parents=True, exist_ok=True)
     report = diagnose(building, case, objective, out, source=source, fraction=args.calibration_fraction,
