@@ -95,6 +95,10 @@ def follow_up(building, left, zones):
     targets = EFFECTS["proportional_gain"].targets(building)
     pairs += [("proportional_gain", target) for name in named for zone in zones
               for target in [bridge_target(zone, name)] if target in targets]
+    # a residual that follows a zone's own heat input may also mean its split between air and
+    # surfaces is wrong (how fast the air answers the heater)
+    pairs += [("heat_input_split", zone) for zone in zones
+              if set(named) & set(building.zone(zone).heat_input)]
     return list(dict.fromkeys(pairs))
 
 

@@ -145,3 +145,16 @@ def test_a_gain_in_a_zone_declared_unoccupied_is_implausible(testcell):
     empty = testcell.edited(lambda d: d["zones"][0].update(occupied=False))
     assert "unoccupied" in implausible(empty, "internal_gain", "cell")
     assert implausible(empty, "infiltration", "cell") is None
+
+
+def test_a_residual_that_follows_a_heat_input_points_at_its_gain_and_split():
+    from nodeforce.diagnose.candidates import follow_up
+    from .test_zones import multizone_with_everything
+    b = multizone_with_everything()
+    left = {"white": False, "time_of_day": {"significant": False},
+            "follows": [{"input": "heater", "lag_hours": 0.0, "correlation": -0.7}]}
+    assert follow_up(b, left, ["B"]) == [("proportional_gain", "B->heater"), ("heat_input_split", "B")]
+    # the time of day points at a daily gain; a white residual at nothing
+    assert follow_up(b, {**left, "follows": [], "time_of_day": {"significant": True}, "strongest": None},
+                     ["A"])[0] == ("daily_gain", "A")
+    assert follow_up(b, {**left, "white": True}, ["B"]) == []
