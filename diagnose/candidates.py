@@ -63,7 +63,7 @@ def implausible(building, effect, target):
     """Why the building file's own description makes an effect implausible, or None: a constant
     gain in a zone the file declares unoccupied stands for a heat source the model lacks, not for
     occupants, and the report must say so."""
-    if effect == "internal_gain" and building.zone(target).occupied is False:
+    if effect in ("internal_gain", "daily_gain") and building.zone(target).occupied is False:
         return (f"{target} is declared unoccupied: the gain stands for a heat source the model lacks "
                 "(a heat input mis-measured, a flow of air or sun not modelled), not for occupants")
     return None

@@ -238,6 +238,7 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
             added.append(then)
             model = more_models[label(then)]
             decision["chosen"] = label(then)
+            decision["implausible"] = decision["implausible"] or follow_decision["implausible"]
 
     after_building, after_run, after = model.building, model.run, model.metrics
     effect = ({key: added[-1][key] for key in ("effect", "target", "parameters", "derived")} if added

@@ -144,6 +144,7 @@ def test_a_gain_in_a_zone_declared_unoccupied_is_implausible(testcell):
     assert implausible(testcell, "internal_gain", "cell") is None  # occupancy not declared
     empty = testcell.edited(lambda d: d["zones"][0].update(occupied=False))
     assert "unoccupied" in implausible(empty, "internal_gain", "cell")
+    assert "unoccupied" in implausible(empty, "daily_gain", "cell")
     assert implausible(empty, "infiltration", "cell") is None
 
 
