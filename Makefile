@@ -46,7 +46,8 @@ twinhouse: venv
 		--start 2013-08-27T00:00+01:00 --end 2013-10-01T00:00+01:00 -o $(TWINHOUSE_OUT)/measurements.csv
 	$(BIN)/nodeforce diagnose $(TWINHOUSE_EXAMPLE)/building.json --weather $(TWINHOUSE_OUT)/weather.csv \
 		--measurements $(TWINHOUSE_OUT)/measurements.csv -o $(TWINHOUSE_OUT) --objective living \
-		--calibration-end 2013-09-14T00:00+01:00 --burn-in-days 3 --seed 0
+		--calibration-end 2013-09-14T00:00+01:00 --burn-in-days 3 --seed 0 \
+		--reference $(TWINHOUSE_EXAMPLE)/reference.json
 
 benchmark: venv
 	$(BIN)/python benchmarks/bench_search.py

@@ -179,8 +179,9 @@ def assess_all(model, pairs, calibration, case, objective, folder, seed, workers
 
 
 def diagnose(building, case, objective, workdir, *, source="measurements", fraction=0.6, calibration_end=None,
-             seed=0, workers=None, population=30, generations=400, fmu_kind="python"):
-    """Run the whole loop; write the artifacts in `workdir`; return the report.json content."""
+             seed=0, workers=None, population=30, generations=400, fmu_kind="python", reference=None):
+    """Run the whole loop; write the artifacts in `workdir`; return the report.json content.
+    `reference` ({"label", "rmse": {phase: K}}), another model's error, is reported for scale."""
     check_measured(objective, case, source)
     k = split(case, source, fraction, calibration_end)
     calibration = case.window(0, k)
@@ -270,6 +271,8 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
         "node_names": {str(i): name for i, name in building.node_names().items()},
         "artifacts": {"building_after": str(workdir / "building_after.json"), "fmu_after": str(fmu_after)},
     }
+    if reference:
+        report["reference"] = reference
     series = {"times": times[1:], "validation_start": times[k + 1], "scored_from": times[case.burn_in_steps + 1],
               "convergence": convergence,
               "zones": {zone: {"air_node": air, "measured": measured[:, j], "before": before_run[:, j],

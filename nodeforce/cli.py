@@ -223,9 +223,24 @@ def run_diagnosis(building, case, objective, out, source, args):
     check_workers(args)
     out.mkdir(parents=True, exist_ok=True)
     report = diagnose(building, case, objective, out, source=source, fraction=args.calibration_fraction,
-                      calibration_end=end, seed=args.seed, workers=args.workers, fmu_kind=args.fmu)
+                      calibration_end=end, seed=args.seed, workers=args.workers, fmu_kind=args.fmu,
+                      reference=read_reference(args.reference) if args.reference else None)
     print(before_after_table(report))
     print(f"wrote {out / 'report.json'}, {out / 'report.md'}, {out / 'building_after.json'}, {out / 'model_after.fmu'}")
+
+
+def read_reference(path):
+    """Another model's RMSE for the report's scale: {"label": text, "rmse": {phase: K}}."""
+    try:
+        reference = json.loads(Path(path).read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise InputError(path, "file", "not found") from None
+    except json.JSONDecodeError as e:
+        raise InputError(path, f"line {e.lineno}", f"not valid JSON ({e.msg})") from None
+    rmse = reference.get("rmse") if isinstance(reference, dict) else None
+    if not isinstance(rmse, dict) or not all(isinstance(v, (int, float)) and v >= 0 for v in rmse.values()):
+        raise InputError(path, "rmse", 'must be {"phase or window": RMSE in K, ...}')
+    return {"label": str(reference.get("label", "reference")), "rmse": rmse}
 
 
 def cmd_diagnose(args):
@@ -273,6 +288,8 @@ def diagnosis_arguments(s):
                    help="the first part of the record, by time, that calibrates; the rest validates")
     s.add_argument("--calibration-end",
                    help="the last calibration time, ISO 8601 with UTC offset (instead of the fraction)")
+    s.add_argument("--reference", help='JSON {"label": ..., "rmse": {"phase": K}}: another model\'s error, '
+                                       "shown beside ours in the report for scale")
     burn_in_argument(s, 1.0)
 
 

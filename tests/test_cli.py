@@ -197,3 +197,12 @@ def test_locate_with_a_burn_in_points_at_the_floor_of_the_demo_data(tmp_path, ca
                                                  str(DATA / "miami_tmy2.csv"), "--measurements",
                                                  str(DATA / "demo_measurements.csv"), "-o", str(tmp_path),
                                                  "--burn-in-days", "30"])
+
+
+def test_a_reference_without_rmse_figures_is_a_one_line_error(files, capsys):
+    bad = files["dir"] / "reference.json"
+    bad.write_text(json.dumps({"label": "IDEAS", "rmse": {"free float": "0.6 K"}}))
+    err = error_of(capsys, ["diagnose", str(files["building"]), "--weather", str(files["weather"]),
+                            "--measurements", str(files["measurements"]), "-o", str(files["dir"] / "d"),
+                            "--reference", str(bad)])
+    assert err.startswith(f"nodeforce: {bad}: rmse:")
