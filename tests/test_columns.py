@@ -119,6 +119,7 @@ def test_a_measurement_column_that_names_no_node_is_refused(files, column, says)
     assert says in caught.value.problem
 
 
+@pytest.mark.slow  # processes, a cluster or a whole diagnosis: not in `make check`
 def test_named_columns_through_simulate_locate_and_diagnose(files, capsys):
     common = [files["building"], "--weather", files["weather"], "--measurements", files["measurements"]]
     sim = files["dir"] / "sim.csv"

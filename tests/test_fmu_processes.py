@@ -39,6 +39,7 @@ def test_locate_gives_the_same_answer_through_either_fmu(files, tmp_path, capsys
         assert abs(standalone["node_scores"][node] - J) <= 1e-9 * max(1.0, J)
 
 
+@pytest.mark.slow  # processes, a cluster or a whole diagnosis: not in `make check`
 def test_locate_with_two_workers_ends_cleanly_ten_times(files, tmp_path):
     for run in range(10):
         done = subprocess.run([sys.executable, "-m", "nodeforce.cli", *files, "-o", str(tmp_path / str(run)),

@@ -192,6 +192,7 @@ def test_a_forcing_that_only_compensates_locates_nothing():
     assert located["best_nodes"] == [3]
 
 
+@pytest.mark.slow  # processes, a cluster or a whole diagnosis: not in `make check`
 def test_a_crashing_worker_only_loses_its_own_chromosome():
     # the best chromosome, nodes 1 and 3, kills its worker: the next best wins
     spec = linear(3, {0: 10.0, 2: 5.0}, penalty=20.0, crash_mask=(True, False, True))
@@ -248,6 +249,7 @@ def test_checkpoint_of_other_arguments_is_not_resumed(tmp_path):
                                                       **GA_BUDGET))
 
 
+@pytest.mark.slow  # processes, a cluster or a whole diagnosis: not in `make check`
 def test_two_worker_processes_give_the_same_result(tmp_path):
     serial = search(TWELVE, NODES12, workers=1, **GA_BUDGET)
     spec = linear(12, {1: 40.0, 6: 25.0, 9: 15.0}, log_dir=str(tmp_path))
@@ -256,6 +258,7 @@ def test_two_worker_processes_give_the_same_result(tmp_path):
     assert evaluators_built(tmp_path) == [1, 1]  # one evaluator per worker process
 
 
+@pytest.mark.slow  # processes, a cluster or a whole diagnosis: not in `make check`
 def test_dask_cluster_gives_the_same_result(tmp_path):
     distributed = pytest.importorskip("distributed")
     budget = dict(population=20, generations=15)
@@ -357,6 +360,7 @@ def test_a_converged_run_resumes_as_finished(tmp_path):
     assert len(seen_masks(tmp_path)) == seen  # nothing simulated again
 
 
+@pytest.mark.slow  # processes, a cluster or a whole diagnosis: not in `make check`
 def test_the_fmu_evaluators_leave_no_extracted_folder(tmp_path, monkeypatch, testcell_data, testcell,
                                                       weather):
     # A private temp dir, so folders other processes make in the shared one do not count;

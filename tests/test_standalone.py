@@ -240,6 +240,7 @@ def python_host_environment():
     return dict(os.environ, LD_PRELOAD=str(library), PYTHONPATH=site)
 
 
+@pytest.mark.slow  # processes, a cluster or a whole diagnosis: not in `make check`
 def test_python_fmu_in_a_c_host_runs_twenty_times_without_a_crash_at_exit(fmus, tmp_path):
     fmu = fmus[("testcell", "python")]
     parameters, inputs, outputs, _ = scenario(fmu)

@@ -316,6 +316,7 @@ def test_energy_balance_closes_every_step_on_real_days(tmp_path, data, measured)
     assert np.all(np.abs(stored - heat_in[1:]) <= 1e-6 * scale)
 
 
+@pytest.mark.slow  # processes, a cluster or a whole diagnosis: not in `make check`
 def test_diagnose_end_to_end_on_a_few_real_days(tmp_path):
     """The conversion and the diagnosis `make twinhouse` runs, on four days of the heat pulses.
     Of the nine forcing candidates, the corridor's air and W9's three nodes only: 16 forcing
