@@ -207,8 +207,8 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
     # shape, tried beside those the forcing search points at; after a choice, the residual left
     # is asked again, and what it points at is tried on top, by the same rules.
     def left_by(model):
-        inputs = {name: values for name, values in zip(case.input_names, case.U[1:k + 1].T)
-                  if name in shaped_inputs(model.building)}
+        shaped = shaped_inputs(model.building)
+        inputs = {name: values for name, values in zip(case.input_names, case.U[1:k + 1].T) if name in shaped}
         return residual_diagnostics(calibration.times[1:], scored[:, 0] - model.fitted[:, 0], inputs)
 
     pairs = candidates(building, localization["best_nodes"], objective.zones)

@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 
 from nodeforce.model.errors import InputError
-from .timetable import instant, one_line
+from .timetable import check_column_names, instant, one_line
 
 _VERSION = re.compile(r"#1(?![0-9.])")
 _DECLARATION = re.compile(r"(?:double|float)\s+([A-Za-z_][A-Za-z0-9_]*)\s*\(\s*(\d+)\s*,\s*(\d+)\s*\)")
@@ -137,13 +137,7 @@ def _check_names(source, table, names, n_cols):
     if len(names) != n_cols:
         raise InputError(source, "names", f"{len(names)} names for the {n_cols} columns of table {table} "
                                           "(the first names the time column)")
-    seen = set()
-    for name in names:
-        if not name:
-            raise InputError(source, "names", "a column has an empty name")
-        if name in seen:
-            raise InputError(source, name, "two columns are given this name")
-        seen.add(name)
+    check_column_names(source, names, "names")
     if "time" in names[1:]:
         raise InputError(source, "time", "names a data column; 'time' is the time column of the CSV written")
 

@@ -138,14 +138,20 @@ def _header(source):
     if not header:
         raise InputError(source, "file", "empty file (no header line)")
     header = [name.strip() for name in header]
-    seen = set()
-    for name in header:
-        if not name:
-            raise InputError(source, "header", "a column has no name")
-        if name in seen:
-            raise InputError(source, name, "column appears twice in the header")
-        seen.add(name)
+    check_column_names(source, header, "header")
     return header
+
+
+def check_column_names(source, names, field):
+    """InputError naming `source` where a column of `names` (given in `field`, e.g. "header")
+    has no name or shares its name with another."""
+    seen = set()
+    for name in names:
+        if not name:
+            raise InputError(source, field, "a column has no name")
+        if name in seen:
+            raise InputError(source, name, f"two columns have this name in the {field}")
+        seen.add(name)
 
 
 def _parse_times(source, text):

@@ -82,8 +82,9 @@ def assemble(building, names=None):
     """Build the `Network` of a validated `Building`, its inputs in the order of `names` (default
     `input_names(building)`), which must hold every input the building needs."""
     n = building.n_nodes
-    names = input_names(building) if names is None else tuple(names)
-    missing = set(input_names(building)) - set(names)
+    needed = input_names(building)
+    names = needed if names is None else tuple(names)
+    missing = set(needed) - set(names)
     if missing:
         raise ValueError(f"the building needs inputs {sorted(missing)} that are not among {names}")
     col = {name: j for j, name in enumerate(names)}
