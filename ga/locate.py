@@ -9,6 +9,7 @@ from scipy.sparse.csgraph import shortest_path
 
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.fitness import FmuFitness
+from nodeforce.ga.parsimony import EXPLAINED, removed
 from nodeforce.ga.search import PATIENCE, search
 from nodeforce.model.errors import InputError
 from nodeforce.model.network import assemble
@@ -82,5 +83,38 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
                     workers=workers, scheduler=scheduler, checkpoint=workdir / "locate.checkpoint.json",
                     progress=progress, noise_sigma=air_noise(case, objective),
                     n_residuals=int(np.isfinite(objective.measured(case)).sum()))
-    return {"measured_nodes": case.measured_ids, "output_node": objective.air_nodes[0],
-            "objective": list(objective.zones), "output_nodes": list(objective.air_nodes), **result}
+    result = {"measured_nodes": case.measured_ids, "output_node": objective.air_nodes[0],
+              "objective": list(objective.zones), "output_nodes": list(objective.air_nodes), **result}
+    return {**result, "finding": finding(building, result)}
+
+
+def finding(building, result):
+    """What the search found, in the words its numbers allow: which share of the error above the
+    noise the best forcing removes, against the share needed to call it the fault, and which
+    components the sensors let the search test at all (a fault elsewhere cannot be located)."""
+    names = building.node_names()
+    J_unforced, J_noise = result["J_unforced"], result["search"]["J_noise"]
+
+    def forcing(nodes):
+        return "forcing " + ", ".join(f"node {i} ({names[i]})" for i in nodes)
+
+    of = "of J" if not J_noise else "of J above the noise floor"
+    best, strongest = result["best_nodes"], result["search"]["min_nodes"]
+    if best:
+        share = removed(J_unforced, result["J_best"], J_noise)
+        said = f"{forcing(best)} removes {share:.0%} {of}: the fault is in the sub-model behind it."
+    elif strongest and result["ranked_nodes"]:
+        share = removed(J_unforced, result["search"]["J_min"], J_noise)
+        first = result["ranked_nodes"][0]
+        alone = removed(J_unforced, result["node_scores"][str(first)], J_noise)
+        said = (f"No forcing locates the fault: the best, {forcing(strongest)}, removes {share:.0%} {of}, "
+                f"below the {1 - EXPLAINED:.0%} needed to call it the fault; {forcing([first])} alone "
+                f"removes {alone:.0%}.")
+    else:
+        said = "No forcing lowers J by more than the noise tolerance."
+    tested = [c.name for c in building.components if set(c.node_ids) & set(result["chromosome_nodes"])]
+    if len(tested) < len(building.components):
+        said += (f" Only {len(tested)} of the {len(building.components)} components have a measured node the search "
+                 f"may force ({', '.join(tested) or 'none'}): a fault in another, or in the air's own equation, "
+                 "cannot be located by forcing.")
+    return said

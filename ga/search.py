@@ -43,7 +43,7 @@ from tqdm import tqdm
 from nodeforce.ga import checkpoint as ckpt
 from nodeforce.ga.evaluation import FitnessCache, log, open_backend
 from nodeforce.ga.operators import bit_flip_mutation, one_point_crossover, roulette_selection
-from nodeforce.ga.parsimony import (explains, forward_backward, noise_tolerance, smallest_subset,
+from nodeforce.ga.parsimony import (explains, forward_backward, noise_floor, noise_tolerance, smallest_subset,
                                     tolerance)
 
 # Generations without a significant fall of the best J before the GA stops. Measured on the
@@ -330,7 +330,8 @@ def _answer(cache, nodes, noise_sigma, n_residuals) -> dict:
         "node_scores": {str(n): _json(J) for n, J in zip(nodes, J_single)},
         "ranked_nodes": [nodes[i] for i in rank(J_single, J_unforced, tol)],
         "search": {"J_min": _json(J_min), "min_nodes": cache.describe(best),
-                   "tolerance": _json(tol)},
+                   "tolerance": _json(tol),
+                   "J_noise": _json(noise_floor(noise_sigma, n_residuals))},
     }
 
 

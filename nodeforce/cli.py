@@ -161,10 +161,11 @@ def locate_summary(result):
              f"{'node':>6}{'J forced alone':>16}"]
     for node in result["ranked_nodes"][:8]:
         lines.append(f"{node:>6}{result['node_scores'][str(node)]:>16.3f}")
-    found = ", ".join(map(str, result["best_nodes"])) or "none: no forcing explains the residual"
+    found = ", ".join(map(str, result["best_nodes"])) or "none"
     search = result["search"]
     lines.append(f"best nodes: {found} (J = {result['J_best']:.3f}); {search['method']} search, "
                  f"{search['unique_evaluations']} simulations in {search['seconds']:.1f} s")
+    lines.append(result["finding"])
     return "\n".join(lines)
 
 

@@ -413,3 +413,19 @@ def test_parsimony_finds_the_pair_whatever_the_best_chromosome():
     best = (True, False, True, False, False, True)  # J = 10, with node 0 riding along
     assert parsimony.smallest_subset(J_many, best, evaluator.J(best) + 3.0, noise_tol=0.5) == \
         (False, False, True, False, False, True)
+
+
+def test_the_finding_says_what_the_best_forcing_removes_and_what_the_sensors_cover(testcell):
+    from nodeforce.ga.locate import finding
+    # node 3 forced removes 20 of the 99 C2 above the noise floor (400 x 0.05^2 = 1 C2): 20 %
+    result = search(linear(6, {2: 20.0}, base=100.0), [1, 2, 3, 4, 5, 6], workers=1,
+                    noise_sigma=0.05, n_residuals=400)
+    said = finding(testcell, result)
+    assert "No forcing locates the fault" in said
+    assert "the best, forcing node 3 (west_wall at 0.000 m), removes 20% of J above the noise floor" in said
+    assert "below the 50% needed" in said
+    # nodes 1-6 belong to the east, west and south walls: 3 of the test cell's 8 components
+    assert "Only 3 of the 8 components" in said and "east_wall, west_wall, south_wall" in said
+    located = finding(testcell, search(linear(6, {2: 90.0}, base=100.0), [1, 2, 3, 4, 5, 6], workers=1,
+                                       noise_sigma=0.05, n_residuals=400))
+    assert located.startswith("forcing node 3 (west_wall at 0.000 m) removes 91% of J above the noise floor")

@@ -41,10 +41,9 @@ def localization_lines(report):
            f"- chromosome (nodes the search may force): {loc.get('chromosome_nodes', NA)}",
            f"- J unforced: {fmt_sig(loc.get('J_unforced'))} C²; J with best_nodes forced: {fmt_sig(loc.get('J_best'))} C²",
            f"- **best_nodes: {best if best is not None else NA}**"
-           + (" (no forcing explains the residual: the fault is in the air node's own equation, or nowhere)"
-              if best == [] else "")
            + (f": {', '.join(content.node_name(report, b) for b in best)}"
               if best and report.get("node_names") else ""),
+           *([f"- {loc['finding']}"] if loc.get("finding") else []),
            f"- ranked nodes (most helpful first): {loc.get('ranked_nodes', NA)}"]
     search = loc.get("search") or {}
     if search:
