@@ -47,7 +47,7 @@ twinhouse: venv
 	$(BIN)/nodeforce diagnose $(TWINHOUSE_EXAMPLE)/building.json --weather $(TWINHOUSE_OUT)/weather.csv \
 		--measurements $(TWINHOUSE_OUT)/measurements.csv -o $(TWINHOUSE_OUT) --objective living \
 		--calibration-end 2013-09-14T00:00+01:00 --burn-in-days 3 --seed 0 \
-		--reference $(TWINHOUSE_EXAMPLE)/reference.json
+		--reference $(TWINHOUSE_EXAMPLE)/reference.json --phases $(TWINHOUSE_EXAMPLE)/phases.csv
 
 benchmark: venv
 	$(BIN)/python benchmarks/bench_search.py

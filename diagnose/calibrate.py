@@ -1,9 +1,10 @@
 """Calibrate an effect's parameters through its FMU, with their uncertainty and identifiability.
 
 Bounded least squares on the air-temperature residual of the calibration window (scipy's
-`least_squares`, trust region reflective). The covariance of the estimate is
-s^2 (J^T J)^-1 with J the Jacobian of the residuals at the optimum and s^2 = SSR / (n - p), the
-usual linearised estimate. A parameter is called identifiable from the data when that estimate
+`least_squares`, trust region reflective). The covariance of the estimate is the linearised
+sandwich of `diagnose.significance`, which allows for the residual's correlation in time (the
+textbook s^2 (J^T J)^-1 assumes independent residuals and, on real records, is several times
+too tight). A parameter is called identifiable from the data when that estimate
 is tight enough to act on (`IDENTIFIABLE_*` below) and it did not end on a bound.
 """
 import logging
@@ -17,6 +18,7 @@ from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.diagnose.candidates import calibration_start
+from nodeforce.diagnose.significance import bandwidth, parameter_covariance
 from nodeforce.model.effects import EFFECTS
 
 log = logging.getLogger("nodeforce.diagnose")
@@ -74,9 +76,7 @@ def calibrate(candidate, case, objective):
         return measured[have] - candidate.nodes(case, objective.air_nodes, x)[have]
 
     fit = least_squares(residuals, x0, bounds=(lows, highs), x_scale="jac", method="trf")
-    n, k = int(have.sum()), len(x0)
-    J = float(fit.fun @ fit.fun)
-    cov = (J / max(n - k, 1)) * np.linalg.pinv(fit.jac.T @ fit.jac)
+    cov = parameter_covariance(fit.jac, fit.fun, np.nonzero(have)[0], bandwidth(case.dt))
     std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     result = {}
     for p, value, sd, bound in zip(candidate.parameters, fit.x, std, fit.active_mask):

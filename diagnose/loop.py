@@ -16,11 +16,15 @@ on data the calibration did not see.
 5. Each is calibrated on the calibration window (`diagnose.calibrate`), the candidates in
    parallel worker processes.
 6. The chosen effect has the best validation error among those that beat the model without
-   them on BIC (calibration window) and lower the validation J by more than noise could
-   (`ga.parsimony.tolerance`); "none" if no candidate does. The calibration window alone never
-   decides. The decision, its margins and its reason go into report.json, which the report reads.
+   them on BIC (calibration window) and lower the validation J by more than the sensor noise
+   (`ga.parsimony.tolerance`) and Z_NOISE standard deviations of that fall as the residuals'
+   correlated scatter makes it (`diagnose.significance.change_of_J`, a Diebold-Mariano-type
+   comparison of the two models on the same window); "none" if no candidate does. The
+   calibration window alone never decides. The decision, its margins and its reason go into report.json, which the report reads.
 7. The residual of the first objective zone on the validation window, before and after, is
    described (`diagnose.residuals`): is it white, and which input or time of day does it follow.
+8. Given the experiment's phases, every model is scored on each (`diagnose.phases`), and an
+   added effect that makes a phase worse is flagged in the decision's reason.
 """
 import json
 import math
@@ -39,13 +43,16 @@ from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnose.calibrate import Candidate, calibrate, sensitivity
 from nodeforce.diagnose.candidates import candidates, follow_up, implausible, shaped_inputs
 from nodeforce.diagnose.report import write_report
+from nodeforce.diagnose.phases import phase_errors, worsened
 from nodeforce.diagnose.residuals import diagnostics as residual_diagnostics
+from nodeforce.diagnose.significance import bandwidth, change_of_J
 from nodeforce.fmu_build.build import build_fmu
-from nodeforce.ga.locate import air_noise, check_measured, locate
-from nodeforce.ga.parsimony import tolerance
+from nodeforce.ga.locate import check_measured, locate
+from nodeforce.ga.parsimony import Z_NOISE, tolerance
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
+from nodeforce.model.score import Noise
 
 
 def split(case, source, fraction=None, end=None):
@@ -108,9 +115,12 @@ def decide(building, results, before, sigma, k_before=0):
     bic_before = bic(before["calibration"]["J"], before["calibration"]["n"], k_before)
     J_before = before["validation"]["J"]
     margin = tolerance(J_before, sigma, before["validation"]["n"])
-    tests = {label(r): {"beats_bic": r["bic"] < bic_before,
-                        "beats_validation": r["validation"]["J"] < J_before - margin}
-             for r in results}
+    tests = {}
+    for r in results:
+        # the fall must beat the sensor noise and the residuals' own correlated scatter
+        needed = max(margin, Z_NOISE * r["validation_fall"]["sd"])
+        tests[label(r)] = {"beats_bic": r["bic"] < bic_before, "validation_margin": needed,
+                           "beats_validation": r["validation_fall"]["J"] > needed}
     better = [r for r in results if all(tests[label(r)].values())]
     chosen = min(better, key=lambda r: r["validation"]["rmse"]) if better else None
     rmse_before = before["validation"]["rmse"]
@@ -118,15 +128,16 @@ def decide(building, results, before, sigma, k_before=0):
         reason = (f"{chosen['effect']} on {chosen['target']} has the lowest validation RMSE "
                   f"({chosen['validation']['rmse']:.3f} C, {rmse_before:.3f} C before) of the {len(better)} of "
                   f"{len(results)} candidates that beat the model without them on BIC ({bic_before:.1f}) and lower "
-                  f"the validation J ({J_before:.3g} C2) by more than the noise margin ({margin:.3g} C2).")
+                  f"the validation J ({J_before:.3g} C2) by more than the noise and the residuals' own "
+                  f"correlated scatter could ({tests[label(chosen)]['validation_margin']:.3g} C2 for it).")
     elif not results:
         reason = "No candidate effect was tried, so the model is left as it is."
     else:
         n_bic = sum(t["beats_bic"] for t in tests.values())
         n_val = sum(t["beats_validation"] for t in tests.values())
         reason = (f"None of the {len(results)} candidates both beats the model without them on BIC "
-                  f"({n_bic} do) and lowers the validation J by more than the noise margin of {margin:.3g} C2 "
-                  f"({n_val} do): no effect is added.")
+                  f"({n_bic} do) and lowers the validation J by more than the noise and the residuals' own "
+                  f"correlated scatter could ({n_val} do): no effect is added.")
     flag = implausible(building, chosen["effect"], chosen["target"]) if chosen else None
     if flag:
         reason += f" Implausible: {flag}."
@@ -166,8 +177,10 @@ def assess_all(model, pairs, calibration, case, objective, folder, seed, workers
     results, models, sensitivities = [], {}, {}
     for (effect, target), (parameters, determined, fitted, run, screening) in zip(pairs, assessed):
         fit = objective.metrics(scored, fitted)
+        fall, sd = change_of_J(measured[k:] - model.run[k:], measured[k:] - run[k:], bandwidth(case.dt))
         result = {"effect": effect, "target": target, "parameters": parameters, "derived": determined,
                   "calibration": fit, "validation": objective.metrics(measured[k:], run[k:]),
+                  "validation_fall": {"J": fall, "sd": sd},
                   "bic": bic(fit["J"], fit["n"], model.k + len(parameters))}
         values = {name: p["value"] for name, p in parameters.items()}
         models[label(result)] = Model(EFFECTS[effect].apply(model.building, target, values), fitted, run,
@@ -179,15 +192,19 @@ def assess_all(model, pairs, calibration, case, objective, folder, seed, workers
 
 
 def diagnose(building, case, objective, workdir, *, source="measurements", fraction=0.6, calibration_end=None,
-             seed=0, workers=None, population=30, generations=400, fmu_kind="python", reference=None):
+             seed=0, workers=None, population=30, generations=400, fmu_kind="python", reference=None,
+             noise=None, phases=None):
     """Run the whole loop; write the artifacts in `workdir`; return the report.json content.
-    `reference` ({"label", "rmse": {phase: K}}), another model's error, is reported for scale."""
+    `reference` ({"label", "rmse": {phase: K}}), another model's error, is reported for scale;
+    `noise` (C) is the air sensors' noise sd if the user knows it, else it is estimated;
+    `phases` (iotools.phases.Phase records) are the experiment's phases, each model scored on each."""
     check_measured(objective, case, source)
     k = split(case, source, fraction, calibration_end)
     calibration = case.window(0, k)
     measured = objective.measured(case)
     scored = objective.measured(calibration)
-    sigma = air_noise(case, objective)
+    noise = Noise.of(objective.measured(case), noise)
+    sigma = noise.sigma
 
     with FmuInstance(build_fmu(building, workdir / "model_before.fmu", kind=fmu_kind)) as base:
         before_run = simulate_fmu(base, case, output_ids=objective.air_nodes)
@@ -199,6 +216,7 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
     convergence = []
     localization = locate(building, calibration, objective, workdir, source=source, seed=seed,
                           workers=workers, population=population, generations=generations, fmu_kind=fmu_kind,
+                          noise=noise.sigma if noise.given else None,
                           progress=lambda generation, total, J, unique: convergence.append((generation, J)))
 
     folder = workdir / "candidates"
@@ -216,6 +234,7 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
     results, models, sensitivities = assess_all(model, pairs, calibration, case, objective, folder, seed,
                                                 workers, fmu_kind)
     chosen, decision = decide(building, results, before, sigma)
+    runs = {key: m.run for key, m in models.items()}
     results = [{**r, "bic_baseline": decision["bic_baseline"]} for r in results]
     added = [chosen] if chosen else []
     model = models[label(chosen)] if chosen else model
@@ -231,6 +250,7 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
         results += [{**r, "on_top_of": [label(a) for a in added], "bic_baseline": follow_decision["bic_baseline"]}
                     for r in more]
         sensitivities.update(more_sensitivities)
+        runs.update({key: m.run for key, m in more_models.items()})
         decision["candidates"].update(follow_decision.pop("candidates"))
         decision["follow_up"] = follow_decision
         decision["reason"] += (f" The residual left on the calibration window ({left['sentence']}) points at "
@@ -248,6 +268,13 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
     fmu_after = build_fmu(after_building, workdir / "model_after.fmu", kind=fmu_kind)
 
     times = case.times
+    by_phase = phase_errors(phases or (), times[1:], measured, {"before": before_run, **runs, "after": after_run})
+    if by_phase and added:
+        decision["worsened_phases"] = worsened(by_phase, "before", "after")
+        if decision["worsened_phases"]:
+            decision["reason"] += (" It lowers the total error but makes the phase " + "; ".join(
+                f"{w['phase']} worse ({w['before']:.3f} C -> {w['after']:.3f} C)" for w in decision["worsened_phases"])
+                + ", which the total hides.")
     validation = slice(k, None)
     residuals = {state: residual_diagnostics(times[1:][validation], measured[validation, 0] - run[validation, 0],
                                              {name: values[validation] for name, values in
@@ -268,11 +295,14 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
         "residuals": residuals,
         "sensitivity": sensitivities,
         "noise_sigma": sigma,
+        "noise": noise.to_json(),
         "node_names": {str(i): name for i, name in building.node_names().items()},
         "artifacts": {"building_after": str(workdir / "building_after.json"), "fmu_after": str(fmu_after)},
     }
     if reference:
         report["reference"] = reference
+    if by_phase:
+        report["phases"] = by_phase
     series = {"times": times[1:], "validation_start": times[k + 1], "scored_from": times[case.burn_in_steps + 1],
               "convergence": convergence,
               "zones": {zone: {"air_node": air, "measured": measured[:, j], "before": before_run[:, j],

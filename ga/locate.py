@@ -2,7 +2,7 @@
 
 Chooses the chromosome (every measured node but the objective's air nodes and, by default, the
 algebraic radiant nodes, which are no sub-model), builds the FMU, and runs the search with the
-measurement noise estimated from the measured air.
+sensors' noise given by the user or estimated from the measured air.
 """
 import numpy as np
 from scipy.sparse.csgraph import shortest_path
@@ -13,7 +13,7 @@ from nodeforce.ga.parsimony import EXPLAINED, removed
 from nodeforce.ga.search import PATIENCE, search
 from nodeforce.model.errors import InputError
 from nodeforce.model.network import assemble
-from nodeforce.model.score import noise_level
+from nodeforce.model.score import Noise
 
 
 def check_measured(objective, case, source):
@@ -54,22 +54,16 @@ def chromosome_nodes(building, case, objective, source, nodes=None, include_alge
     return sorted(chosen, key=lambda i: (distance[i - 1], i))
 
 
-def air_noise(case, objective):
-    """Noise sd (C) of the objective's measured air: the root mean square of each zone's."""
-    sigmas = [noise_level(case.measured[:, air - 1]) for air in objective.air_nodes]
-    sigmas = [s for s in sigmas if s is not None]
-    return float(np.sqrt(np.mean(np.square(sigmas)))) if sigmas else None
-
-
 def locate(building, case, objective, workdir, *, source="measurements", nodes=None,
            include_algebraic=False, population=30, generations=400, pc=0.8, pm=0.03, seed=0,
            patience=PATIENCE, seeded=True, workers=None, scheduler=None, warmup_days=2, progress=None,
-           fmu_kind="python"):
+           fmu_kind="python", noise=None):
     """Run the forcing search on a case; return the content of locate.json.
 
     The FMU (`model.fmu`) and the search's checkpoint (`locate.checkpoint.json`) are written in
     `workdir`, so a run stopped midway and started again resumes. `progress` is called after
-    every generation with (generation, total, best J, unique evaluations). patience and seeded
+    every generation with (generation, total, best J, unique evaluations). `noise` is the air
+    sensors' noise sd (C) if the user knows it, else it is estimated (`model.score.Noise`). patience and seeded
     choose the search (ga.search: the defaults stop at convergence; ga.search.PAPER's values
     give the paper's search).
     """
@@ -77,14 +71,16 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
     if not candidates:
         raise InputError(source, "columns", "no measured node besides the objective's air: nothing to force")
     fmu = build_fmu(building, workdir / "model.fmu", kind=fmu_kind)
+    noise = Noise.of(objective.measured(case), noise)
     result = search(FmuFitness(fmu, case, candidates, objective, warmup_days), candidates,
                     population=population, generations=generations, pc=pc, pm=pm, seed=seed,
                     patience=patience, seeded=seeded,
                     workers=workers, scheduler=scheduler, checkpoint=workdir / "locate.checkpoint.json",
-                    progress=progress, noise_sigma=air_noise(case, objective),
+                    progress=progress, noise_sigma=noise.sigma,
                     n_residuals=int(np.isfinite(objective.measured(case)).sum()))
     result = {"measured_nodes": case.measured_ids, "output_node": objective.air_nodes[0],
-              "objective": list(objective.zones), "output_nodes": list(objective.air_nodes), **result}
+              "objective": list(objective.zones), "output_nodes": list(objective.air_nodes), **result,
+              "noise": noise.to_json()}
     return {**result, "finding": finding(building, result)}
 
 

@@ -55,7 +55,7 @@ def read_time_table(path):
     raw.columns = header
     if raw.empty:
         raise InputError(source, "time", "no data rows")
-    times = _parse_times(source, raw["time"])
+    times = parse_times(source, raw["time"])
     check_increasing(source, times, where=lambda i: f"line {i + 2}")
     frame = pd.DataFrame(
         {name: _numeric(source, name, raw[name]) for name in header if name != "time"},
@@ -154,7 +154,9 @@ def check_column_names(source, names, field):
         seen.add(name)
 
 
-def _parse_times(source, text):
+def parse_times(source, text):
+    """The DatetimeIndex of a time column of ISO 8601 texts with UTC offsets; InputError naming
+    `source` and the line of the first empty, offset-less or unreadable time."""
     text = text.str.strip()
     empty = text.isna() | (text == "")
     if empty.any():

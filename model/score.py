@@ -25,20 +25,87 @@ def metrics(measured, simulated):
             "sd": float(r.std(ddof=1)) if len(r) > 1 else 0.0, "n": int(len(r))}
 
 
+# White noise gives second differences of lag-1 autocorrelation -2/3; a signal's curvature pulls
+# it towards +1. Below this bound the noise dominates the second differences and is seen.
+WHITE_LAG1 = -0.5
+
+
+def _second_differences(series):
+    x = np.asarray(series, dtype=float)
+    return x[2:] - 2 * x[1:-1] + x[:-2]
+
+
 def noise_level(series):
     """Estimated sd (C) of white sensor noise on a smooth measured temperature.
 
     Second differences remove a signal that is locally linear; on white noise of sd sigma they
     have sd sigma*sqrt(6). The median absolute deviation keeps steps and outliers from
-    inflating the estimate. Gaps (NaN) split the series; no value is filled in.
+    inflating the estimate. Gaps (NaN) split the series; no value is filled in. Where the
+    signal's curvature dominates the second differences (`noise_visible` is False) this is an
+    upper bound of the white noise, not an estimate.
     """
-    x = np.asarray(series, dtype=float)
-    d2 = x[2:] - 2 * x[1:-1] + x[:-2]
+    d2 = _second_differences(series)
     d2 = d2[np.isfinite(d2)]
     if len(d2) < 10:
         return None
     mad = np.median(np.abs(d2 - np.median(d2)))
     return float(mad / 0.6744897501960817 / np.sqrt(6.0))
+
+
+def second_difference_lag1(series):
+    """Lag-1 autocorrelation of the second differences (-2/3 for white noise), None if too short."""
+    d2 = _second_differences(series)
+    pairs = np.isfinite(d2[1:]) & np.isfinite(d2[:-1])
+    if pairs.sum() < 10:
+        return None
+    return float(np.corrcoef(d2[1:][pairs], d2[:-1][pairs])[0, 1])
+
+
+@dataclass(frozen=True)
+class Noise:
+    """The sensor noise of the objective's measured air: its sd (C), None if unknown, and where
+    that number comes from: the user's `--noise` (a sensor's stated accuracy), or second
+    differences of the measurement, with their lag-1 autocorrelation telling whether the noise
+    is visible in them at all (on real records of precise sensors the signal's curvature over
+    one step outweighs the white noise, and the error that matters is slow)."""
+    sigma: float | None
+    given: bool = False
+    lag1: float | None = None
+
+    @classmethod
+    def of(cls, measured_air, given=None):
+        """From the user's sd `given` (C), else from the (N_t, k) measured air of the objective:
+        the root mean square of each zone's second-difference estimate."""
+        if given is not None:
+            return cls(float(given), given=True)
+        columns = np.atleast_2d(np.asarray(measured_air, dtype=float).T)
+        sigmas = [s for s in map(noise_level, columns) if s is not None]
+        lags = [r for r in map(second_difference_lag1, columns) if r is not None]
+        return cls(float(np.sqrt(np.mean(np.square(sigmas)))) if sigmas else None,
+                   lag1=max(lags) if lags else None)
+
+    @property
+    def visible(self):
+        """Whether sigma is the noise itself (given, or white noise dominating the differences)."""
+        return self.given or (self.lag1 is not None and self.lag1 < WHITE_LAG1)
+
+    def sentence(self):
+        if self.given:
+            return f"sensor noise of the air: sigma = {self.sigma:.3g} C, as given (--noise)"
+        if self.sigma is None:
+            return "sensor noise of the air: unknown (too few measured steps); give --noise"
+        if self.visible:
+            return (f"sensor noise of the air, estimated from its second differences: sigma = {self.sigma:.2g} C "
+                    f"(they look like white noise: lag-1 autocorrelation {self.lag1:.2f}, -0.67 for white noise)")
+        return (f"sensor noise of the air: not visible in the measurements, whose second differences follow the "
+                f"signal's own curvature (lag-1 autocorrelation {self.lag1:.2f}, not the -0.67 of white noise): "
+                f"{self.sigma:.2g} C is only an upper bound of the white part of the sensor error, and slow errors "
+                f"(offsets, radiation, stratification) are not in it; give the sensors' accuracy with --noise. "
+                f"The decisions allow for the residuals' correlation in time instead")
+
+    def to_json(self):
+        return {"sigma": self.sigma, "given": self.given, "lag1": self.lag1, "visible": self.visible,
+                "sentence": self.sentence()}
 
 
 @dataclass(frozen=True)

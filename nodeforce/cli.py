@@ -149,7 +149,7 @@ def cmd_locate(args):
     result = locate(building, case, objective, out, source=args.measurements,
                     nodes=node_list("--nodes", args.nodes) if args.nodes else None,
                     include_algebraic=args.include_algebraic, **strategy, seed=args.seed,
-                    workers=args.workers, scheduler=args.scheduler, fmu_kind=args.fmu)
+                    workers=args.workers, scheduler=args.scheduler, fmu_kind=args.fmu, noise=noise(args))
     (out / "locate.json").write_text(json.dumps(result, indent=2) + "\n")
     print(locate_summary(result))
     print(f"wrote {out / 'locate.json'}")
@@ -217,6 +217,7 @@ def cmd_synth(args):
 
 def run_diagnosis(building, case, objective, out, source, args):
     from nodeforce.diagnose.loop import diagnose
+    from nodeforce.iotools.phases import read_phases
     from nodeforce.diagnose.report import before_after_table
     if not 0.0 < args.calibration_fraction < 1.0:
         raise InputError("--calibration-fraction", args.calibration_fraction, "a fraction between 0 and 1")
@@ -225,7 +226,8 @@ def run_diagnosis(building, case, objective, out, source, args):
     out.mkdir(parents=True, exist_ok=True)
     report = diagnose(building, case, objective, out, source=source, fraction=args.calibration_fraction,
                       calibration_end=end, seed=args.seed, workers=args.workers, fmu_kind=args.fmu,
-                      reference=read_reference(args.reference) if args.reference else None)
+                      reference=read_reference(args.reference) if args.reference else None, noise=noise(args),
+                      phases=read_phases(args.phases) if args.phases else None)
     print(before_after_table(report))
     print(f"wrote {out / 'report.json'}, {out / 'report.md'}, {out / 'building_after.json'}, {out / 'model_after.fmu'}")
 
@@ -291,6 +293,9 @@ def diagnosis_arguments(s):
                    help="the last calibration time, ISO 8601 with UTC offset (instead of the fraction)")
     s.add_argument("--reference", help='JSON {"label": ..., "rmse": {"phase": K}}: another model\'s error, '
                                        "shown beside ours in the report for scale")
+    s.add_argument("--phases", help="CSV time,phase: the experiment's phases (each from its time to the next); "
+                                    "every model is scored on each and a phase made worse is flagged")
+    noise_argument(s)
     burn_in_argument(s, 1.0)
 
 
@@ -298,6 +303,18 @@ def burn_in_argument(s, default):
     s.add_argument("--burn-in-days", type=float, default=default,
                    help=f"days after t_0 over which every measured node is forced and nothing is scored "
                         f"(PHYSICS.md section 5; default {default:g})")
+
+
+def noise_argument(s):
+    s.add_argument("--noise", type=float, help="sd of the air sensors' error, C (their stated accuracy; "
+                                               "default: estimated from the measured air, see the report)")
+
+
+def noise(args):
+    """The user's --noise (C), which must be positive, or None."""
+    if args.noise is not None and not args.noise > 0:
+        raise InputError("--noise", args.noise, "the sensors' error sd must be positive, in C")
+    return args.noise
 
 
 def objective_argument(s):
@@ -341,6 +358,7 @@ def parser():
     s.add_argument("--workers", type=int, help="processes (default: all cores)")
     s.add_argument("--fmu", choices=("python", "standalone"), default="python", help="the FMU kind to run")
     s.add_argument("--scheduler", help="a Dask scheduler address, tcp://host:port")
+    noise_argument(s)
     burn_in_argument(s, 0.0)
     objective_argument(s)
     s.set_defaults(run=cmd_locate)

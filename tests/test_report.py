@@ -69,7 +69,7 @@ def synthetic():
         "candidates": [
             {"effect": "conductivity", "target": "door", "parameters": p_door, "derived": {},
              "calibration": metrics(0.1012, 0.001, 0.1011, 188), "validation": metrics(0.1234, 0.012, 0.1228, 190),
-             "bic": -412.3},
+             "validation_fall": {"J": 151.7, "sd": 4.1}, "bic": -412.3},
             {"effect": "ground_coupling", "target": "floor",
              "parameters": {"U": {"value": 0.52, "std": 0.9, "identifiable": False},
                             "T_ground": {"value": 24.3, "std": None, "identifiable": False}},
@@ -90,7 +90,8 @@ def synthetic():
         "decision": {"chosen": "conductivity@door",
                      "reason": "conductivity on door has the lowest validation RMSE of the 2 candidates that beat both tests.",
                      "bic_baseline": -35.1, "validation_J_before": 154.6, "validation_margin": 7.25,
-                     "candidates": {"conductivity@door": {"beats_bic": True, "beats_validation": True},
+                     "candidates": {"conductivity@door": {"beats_bic": True, "beats_validation": True,
+                                                          "validation_margin": 12.3},
                                     "ground_coupling@floor": {"beats_bic": False, "beats_validation": True},
                                     "infiltration@living": {"beats_bic": False, "beats_validation": False},
                                     # the loop's word, though its BIC is below the baseline's
@@ -101,6 +102,12 @@ def synthetic():
         "residuals": {state: diagnostics(times[val], r, {k: v[val] for k, v in inputs.items()}, max_lag_hours=6)
                       for state, r in residual.items()},
         "noise_sigma": 0.0987,
+        "noise": {"sigma": 0.0987, "given": False, "visible": True,
+                  "sentence": "sensor noise of the air, estimated from its second differences: sigma = 0.099 C"},
+        "phases": [{"phase": "held at 30 C", "start": "2001-06-10T00:00:00-05:00", "end": "2001-06-11T00:00:00-05:00",
+                    "n": 96, "rmse": {"before": 0.57, "conductivity@door": 0.75, "after": 0.75}},
+                   {"phase": "free float", "start": "2001-06-11T00:00:00-05:00", "end": None,
+                    "n": 95, "rmse": {"before": 0.90, "conductivity@door": 0.12, "after": 0.12}}],
         "sensitivity": {"conductivity@door": {"factor": {"mu_star": 85.2, "sigma": 12.1}},
                         "ground_coupling@floor": {"U": {"mu_star": 3.1, "sigma": None},
                                                   "T_ground": {"mu_star": 0.4, "sigma": 0.5}}},
@@ -207,8 +214,12 @@ def test_write_report_with_an_effect(tmp_path):
     assert "For scale, the IDEAS detailed model: RMSE 0.400 C (validation), 0.600 C (free float)." in md
     # the decision as the loop wrote it, with its margins; the verdicts are read, not re-derived
     assert report["decision"]["reason"] in md
-    assert "noise could, 7.250 C² (to below 147.3 C²)" in md and "-35.10" in md
-    assert "| solar_absorptance | roof |" in md and "| -150.0 | -114.9 | no | yes |" in md
+    assert "the sensor noise could (7.250 C²)" in md and "-35.10" in md
+    assert "| solar_absorptance | roof |" in md and "| -150.0 | -114.9 | n/a | n/a | no | yes |" in md
+    assert "| 151.7 | 12.30 | yes | yes |" in md  # the fall of J and the fall it needed
+    # each phase, before, every candidate and after; the phase made worse is marked
+    assert "| held at 30 C | 2001-06-10 00:00 UTC-05:00 | 96 | 0.570 | 0.750 ▲ | 0.750 ▲ |" in md
+    assert "| free float | 2001-06-11 00:00 UTC-05:00 | 95 | 0.900 | 0.120 | 0.120 |" in md
     for c in ("conductivity (chosen)", "ground_coupling", "infiltration", "solar_absorptance"):
         assert c in md
     assert "factor = 1.873 ± 0.031" in md and "(not identifiable)" in md

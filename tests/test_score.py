@@ -10,7 +10,7 @@ from nodeforce.diagnose.loop import bic
 from nodeforce.model.building import parse_building
 from nodeforce.model.case import Case
 from nodeforce.model.integrate import initial_state
-from nodeforce.model.score import Objective, noise_level
+from nodeforce.model.score import Noise, Objective, noise_level
 
 from .test_zones import two_zones
 
@@ -25,6 +25,34 @@ def test_noise_level_recovers_white_noise_on_a_smooth_signal():
     gappy[100:300] = np.nan  # gaps split the series; nothing is filled
     assert noise_level(gappy) == pytest.approx(0.2, rel=0.05)
     assert noise_level(np.full(8, 20.0)) is None  # too short to tell
+
+
+def test_white_noise_is_seen_and_an_averaging_sensor_hides_it():
+    t = np.arange(5000) * 600.0
+    smooth = 20 + 3 * np.sin(2 * np.pi * t / 86400)
+    rng = np.random.default_rng(1)
+    white = Noise.of((smooth + rng.normal(0, 0.1, len(t)))[:, None])
+    assert white.visible and white.sigma == pytest.approx(0.1, rel=0.05)
+    assert white.lag1 == pytest.approx(-2 / 3, abs=0.03)  # the second differences of white noise
+    # a precise sensor on a room whose air follows heater pulses through a 1 h lag: the signal's
+    # curvature over a step outweighs the noise, which the estimate then only bounds from above
+    pulses = np.where((t // 7200) % 3 == 0, 2.0, 0.0)
+    air = np.empty_like(t)
+    air[0] = 20.0
+    for k in range(1, len(t)):
+        air[k] = air[k - 1] + (20.0 + pulses[k] - air[k - 1]) * (1 - np.exp(-600.0 / 3600.0))
+    hidden = Noise.of((air + rng.normal(0, 0.002, len(t)))[:, None])
+    assert not hidden.visible and "not visible" in hidden.sentence() and hidden.sigma > 0.002
+    given = Noise.of(air[:, None], given=0.1)
+    assert given.visible and given.sigma == 0.1 and "as given" in given.sentence()
+
+
+def test_the_twin_house_air_sensors_are_smooth_at_their_step():
+    # 10-minute means of the living room's air: second differences dominated by the signal
+    from .test_twinhouse import shared
+    data = np.loadtxt(shared("validationdataN2Exp1.txt"), comments="#", skiprows=2)
+    noise = Noise.of(data[:, [5]])  # N2_living_AT_h125cm
+    assert not noise.visible and noise.lag1 > -0.3
 
 
 def test_bic_by_hand_and_the_price_of_a_parameter():

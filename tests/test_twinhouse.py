@@ -331,11 +331,27 @@ def test_diagnose_end_to_end_on_a_few_real_days(tmp_path):
     sensors = selection("measurement_columns.txt", keep={"living", "corridor", "W9_inside", "W9_BL1", "W9_outside"})
     assert len(sensors) == 5
     assert main(["table", *table, "--select", ",".join(sensors), "-o", str(measurements)]) == 0
+    phases = tmp_path / "phases.csv"
+    # the second phase is the validation window (the first holds the burn-in and the calibration)
+    phases.write_text("time,phase\n2013-09-09T00:00+01:00,first half\n2013-09-11T00:10+01:00,second half\n")
     assert main(["diagnose", str(BUILDING), "--weather", str(weather), "--measurements", str(measurements),
                  "-o", str(out), "--objective", "living", "--calibration-end", "2013-09-11T00:00+01:00",
-                 "--burn-in-days", "1", "--seed", "0"]) == 0
-    assert (out / "report.md").is_file()
+                 "--burn-in-days", "1", "--seed", "0", "--phases", str(phases)]) == 0
+    md = (out / "report.md").read_text()
     report = json.loads((out / "report.json").read_text())
+    # the report's claims, against the numbers they stand on
+    loc = report["localization"]
+    assert loc["finding"] in md
+    J = loc["J_best"] if loc["best_nodes"] else loc["search"]["J_min"]
+    share = (loc["J_unforced"] - J) / (loc["J_unforced"] - loc["search"]["J_noise"])
+    assert f"removes {share:.0%} of J" in loc["finding"]
+    assert "Only 1 of the" in loc["finding"]  # of the house's components, W9 alone has sensors
+    assert not report["noise"]["visible"] and "not visible" in md  # precise sensors, a smooth record
+    second = report["phases"][1]
+    assert second["rmse"]["before"] == pytest.approx(report["before"]["validation"]["rmse"])
+    assert second["rmse"]["after"] == pytest.approx(report["after"]["validation"]["rmse"])
+    for worse in report["decision"].get("worsened_phases", []):
+        assert f"{worse['phase']} worse" in report["decision"]["reason"]
     assert report["objective"] == ["living"]
     assert pd.Timestamp(report["period"]["calibration"][1]) == pd.Timestamp("2013-09-11T00:00+01:00")
     for side in ("before", "after"):

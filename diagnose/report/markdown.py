@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from . import content, tables
+from ..phases import WORSE
 from .formats import NA, fmt_search, fmt_sig, num, time_text
 
 
@@ -24,9 +25,10 @@ def decision_lines(report):
     bic, J, margin = (num(d.get(k)) for k in ("bic_baseline", "validation_J_before", "validation_margin"))
     lines.append(f"- BIC of the model without an effect (calibration window): {fmt_sig(bic)}; a candidate must "
                  "have a lower BIC.")
-    threshold = f" (to below {fmt_sig(J - margin)} C²)" if J is not None and margin is not None else ""
     lines.append(f"- validation J without an effect: {fmt_sig(J)} C²; a candidate must lower it by more than "
-                 f"the noise could, {fmt_sig(margin)} C²{threshold}.")
+                 f"the sensor noise could ({fmt_sig(margin)} C²) and by more than three standard deviations of "
+                 "that fall as the residuals' correlation in time makes it (the fall needed, per candidate, "
+                 "in the candidates table).")
     lines.append(f"- chosen: {d.get('chosen') or 'none'}")
     return lines
 
@@ -95,15 +97,19 @@ def write_markdown(out_dir, report, plots, notes):
           + (f" (residuals scored from {time_text(period['calibration_scored_from'])}, after the burn-in)"
              if period.get("calibration_scored_from") else ""),
           f"- validation: {content.period_text(report, 'validation')}"]
-    if num(report.get("noise_sigma")) is not None:
-        md.append(f"- measurement noise of the air, estimated from its second differences: "
-                  f"sigma = {fmt_sig(report['noise_sigma'], 2)} C")
+    if (report.get("noise") or {}).get("sentence"):
+        md.append(f"- {report['noise']['sentence']}")
     md += ["", "## Before and after", "",
            "Residual r = T_air measured - T_air simulated (a positive mean: the model is too cold); "
            "mean and standard deviation as in the paper's Table 5, with RMSE, J = Σ r² and n the "
            "number of measured steps.", "", tables.before_after(report), ""]
     if ref:
         md += [f"For scale, the {ref}.", ""]
+    by_phase = tables.phases(report)
+    if by_phase:
+        md += ["RMSE (C) of the objective's air in each phase of the record, over both windows (the "
+               f"calibration fitted the first): ▲ marks a phase made worse than before by {WORSE:.0%} or more.", "",
+               by_phase, ""]
     md += figure("temperature", "Measured and simulated indoor air temperature, before and after")
     md += figure("residuals", "Air residual before and after, mean and sd per window")
     md += ["## Residual diagnostics", "", *residual_lines(report), ""]

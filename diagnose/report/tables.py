@@ -6,6 +6,7 @@ from __future__ import annotations
 from . import content
 from .content import STATES, WINDOWS, metrics
 from .formats import (NA, fmt_bic, fmt_derived, fmt_int, fmt_parameters, fmt_sig, fmt_temp, num, time_text)
+from ..phases import WORSE
 from ..residuals import lag_text
 
 
@@ -142,10 +143,11 @@ def candidates(report):
                      fmt_temp(metrics(report, c, "validation").get("rmse")),
                      fmt_temp(metrics(report, c, "validation").get("mean"), True),
                      fmt_bic(bic), f"{bic - base:+.1f}" if bic is not None and base is not None else NA,
+                     fmt_sig((c.get("validation_fall") or {}).get("J")), fmt_sig(verdict.get("validation_margin")),
                      _yes_no(verdict.get("beats_bic")), _yes_no(verdict.get("beats_validation"))])
     return markdown(["effect", "target", "parameters (value ± std)", "the data determine",
                      "calibration RMSE (C)", "validation RMSE (C)", "validation mean (C)", "BIC", "ΔBIC",
-                     "beats BIC", "beats validation"], rows)
+                     "validation fall of J (C²)", "fall needed (C²)", "beats BIC", "beats validation"], rows)
 
 
 def candidate_zones(report):
@@ -188,3 +190,20 @@ def residual_diagnostics(report):
                       f"p = {fmt_sig(daily.get('p_value'), 2)}") if daily else NA])
     return markdown(["residual", "steps analysed", "Ljung-Box Q", "p", "white",
                      "follows most (input, lag, prewhitened r)", "daily profile (amplitude, peak)"], rows) if rows else ""
+
+
+def phases(report):
+    """RMSE (C) of each phase of the record: before, every candidate, after; a value made worse
+    than before by the loop's margin (diagnose.phases.WORSE) is marked ▲."""
+    rows = report.get("phases") or []
+    if not rows:
+        return ""
+    labels = list(rows[0]["rmse"])
+
+    def cell(row, label):
+        value, before = num(row["rmse"].get(label)), num(row["rmse"].get("before"))
+        worse = value is not None and before is not None and label != "before" and value >= (1 + WORSE) * before
+        return fmt_temp(value) + (" ▲" if worse else "")
+    return markdown(["phase", "from", "n"] + labels,
+                    [[row["phase"], time_text(row["start"]), fmt_int(row["n"])] + [cell(row, label) for label in labels]
+                     for row in rows])

@@ -1,0 +1,44 @@
+"""Each model's error phase by phase (heated at a set point, heat pulses, free float...).
+
+A record mixes regimes that test different parts of a model: where the air is held at a set
+point the information is in the heat input, where it floats the air is a real model output. A
+candidate's total can improve while one phase gets worse, which the total hides; the report
+shows every phase and flags an added effect that makes one worse.
+"""
+import numpy as np
+
+from nodeforce.model.score import metrics
+
+# A phase is made worse when its RMSE rises by this fraction or more.
+WORSE = 0.05
+
+
+def phase_errors(phases, times, measured, runs):
+    """The RMSE (C) of every run on every phase, over the scored steps the phase holds.
+
+    Parameters
+    ----------
+    phases : iotools.phases.Phase records
+    times : DatetimeIndex of the rows of `measured` and of each run
+    measured : (N_t, n_zones) measured air of the objective (C), NaN where not scored
+    runs : {label: (N_t, n_zones) simulated air (C)}
+
+    Returns
+    -------
+    [{"phase", "start", "end", "n", "rmse": {label: C, or None where the phase holds no scored step}}]
+    """
+    rows = []
+    for phase in phases:
+        inside = np.asarray(phase.mask(times))
+        n = int(np.isfinite(measured[inside]).sum())
+        rows.append({"phase": phase.name, "start": phase.start.isoformat(),
+                     "end": phase.end.isoformat() if phase.end is not None else None, "n": n,
+                     "rmse": {label: metrics(measured[inside], run[inside])["rmse"] if n else None
+                              for label, run in runs.items()}})
+    return rows
+
+
+def worsened(rows, before, after):
+    """The phases whose RMSE rises by WORSE or more from run `before` to run `after`."""
+    return [{"phase": row["phase"], "before": row["rmse"][before], "after": row["rmse"][after]}
+            for row in rows if row["n"] and row["rmse"][after] >= (1 + WORSE) * row["rmse"][before]]

@@ -1,0 +1,81 @@
+"""diagnose.significance against Monte Carlo: the spread, over many records, of what one record
+gives, for residuals correlated in time as a building model's are (AR(1), one day ~ 144 steps)."""
+import numpy as np
+import pytest
+
+from nodeforce.diagnose.significance import bandwidth, change_of_J, parameter_covariance
+
+N, PHI, LAGS = 2000, 0.97, 144
+
+
+def ar1(rng, n, phi, sd, count):
+    """`count` AR(1) series of n steps, stationary, innovations of sd `sd`."""
+    e = rng.normal(0.0, sd, (count, n))
+    x = np.empty_like(e)
+    x[:, 0] = e[:, 0] / np.sqrt(1 - phi ** 2)
+    for t in range(1, n):
+        x[:, t] = phi * x[:, t - 1] + e[:, t]
+    return x
+
+
+def test_one_day_of_ten_minute_steps_is_the_bandwidth():
+    assert bandwidth(600.0) == 144 and bandwidth(900.0) == 96
+
+
+def test_the_uncertainty_of_a_fitted_offset_matches_its_spread_over_records():
+    # least squares of a constant offset c on y_t = c + e_t: the Jacobian is -1 per residual,
+    # c_hat is the mean; its true sd over records is the Monte Carlo spread
+    rng = np.random.default_rng(1)
+    records = ar1(rng, N, PHI, 0.02, 300)
+    spread = records.mean(axis=1).std()
+    sds, textbook = [], []
+    for y in records[:40]:
+        r = y - y.mean()
+        sds.append(np.sqrt(parameter_covariance(-np.ones((N, 1)), r, np.arange(N), LAGS)[0, 0]))
+        textbook.append(r.std(ddof=1) / np.sqrt(N))
+    # the HAC estimate is near the true spread (Bartlett weights bias it low by a few tenths at
+    # this correlation), the independent-residual one is several times too small
+    assert 0.6 * spread < np.median(sds) < 1.2 * spread
+    assert np.median(textbook) < 0.3 * spread
+
+
+def test_with_white_residuals_it_is_the_textbook_uncertainty():
+    # one record's HAC estimate scatters (by ~15 % at this bandwidth); over 30 records its
+    # median is the textbook value s^2 (J^T J)^-1
+    rng = np.random.default_rng(2)
+    x = np.linspace(0.0, 1.0, N)
+    jac = -np.column_stack([np.ones(N), x])
+    ratios = []
+    for r in rng.normal(0.0, 0.1, (30, N)):
+        hac = parameter_covariance(jac, r, np.arange(N), LAGS)
+        textbook = (r @ r) / (N - 2) * np.linalg.inv(jac.T @ jac)
+        ratios.append(np.sqrt(np.diag(hac) / np.diag(textbook)))
+    assert np.median(ratios, axis=0) == pytest.approx([1.0, 1.0], abs=0.1)
+
+
+def test_zones_of_one_step_are_one_moment():
+    # two zones with the same residual at every step: summing their scores per step doubles
+    # the score, so the HAC variance of their common offset is that of one zone's
+    rng = np.random.default_rng(3)
+    r = ar1(rng, N, PHI, 0.02, 1)[0]
+    one = parameter_covariance(-np.ones((N, 1)), r, np.arange(N), LAGS)
+    two = parameter_covariance(-np.ones((2 * N, 1)), np.repeat(r, 2), np.repeat(np.arange(N), 2), LAGS)
+    assert two[0, 0] == pytest.approx(one[0, 0], rel=1e-12)
+
+
+def test_the_fall_of_J_is_exact_and_its_spread_matches_records():
+    rng = np.random.default_rng(4)
+    common = ar1(rng, N, PHI, 0.02, 300)
+    before = common + 0.05  # a model off by 0.05 C, and the same model corrected
+    falls = [change_of_J(b[:, None], a[:, None], LAGS) for b, a in zip(before, common)]
+    for (fall, _), b, a in zip(falls, before, common):
+        assert fall == pytest.approx(b @ b - a @ a)
+    spread = np.std([f for f, _ in falls])
+    assert 0.6 * spread < np.median([sd for _, sd in falls]) < 1.2 * spread
+
+
+def test_unmeasured_steps_contribute_nothing():
+    before = np.array([[1.0, np.nan], [2.0, 1.0], [np.nan, np.nan], [1.0, 1.0]])
+    after = np.array([[0.5, np.nan], [1.0, 1.0], [np.nan, np.nan], [0.0, 0.0]])
+    fall, _ = change_of_J(before, after, 1)
+    assert fall == pytest.approx((1 - 0.25) + (5 - 2) + (2 - 0))
