@@ -267,3 +267,18 @@ def test_write_report_times_without_offset_or_in_utc(tmp_path, tz):
     times = series["times"].tz_convert(tz) if tz else series["times"].tz_localize(None)
     check_report(tmp_path, report, dict(series, times=times, validation_start=times[96], scored_from=times[8]),
                  ALL_PLOTS)
+
+
+def test_a_long_effect_name_keeps_the_time_plots_legend_inside_the_figure(tmp_path, monkeypatch):
+    from nodeforce.diagnose.report import figures
+    report, series = synthetic()
+    report["effect"]["target"] = "living->west_facade_global_vertical_irradiance_measured"
+    saved = []
+    original = figures._save
+    monkeypatch.setattr(figures, "_save", lambda fig, path: saved.append(fig) or original(fig, path))
+    figures.plot_temperature(tmp_path / "t.png", report, series)
+    figures.plot_residuals(tmp_path / "r.png", report, series)
+    for fig in saved:
+        renderer = fig.canvas.get_renderer()
+        box, frame = fig.legends[0].get_window_extent(renderer), fig.bbox
+        assert frame.x0 <= box.x0 and box.x1 <= frame.x1, (box, frame)

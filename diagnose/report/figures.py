@@ -126,7 +126,11 @@ class TimeAxes:
         self.axes[-1].set_xlabel(self.xlabel)
         self.fig.suptitle(title)
         handles, labels = self.axes[0].get_legend_handles_labels()
-        self.fig.legend(handles, labels, loc="outside lower center", ncols=legend_columns, fontsize=9, frameon=False)
+        # as many columns as the longest label lets fit across the figure (9 pt: about 14
+        # characters an inch, with room for the line sample), so none is cut at the edge
+        fit = int(self.fig.get_figwidth() * 14 // (max(map(len, labels), default=1) + 6))
+        self.fig.legend(handles, labels, loc="outside lower center", ncols=max(1, min(legend_columns, fit)),
+                        fontsize=9, frameon=False)
         return _save(self.fig, path)
 
 
