@@ -251,8 +251,7 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
                     for r in more]
         sensitivities.update(more_sensitivities)
         runs.update({key: m.run for key, m in more_models.items()})
-        decision["candidates"].update(follow_decision.pop("candidates"))
-        decision["follow_up"] = follow_decision
+        decision["follow_up"] = follow_decision  # its own candidates: one may repeat a first-round label
         decision["reason"] += (f" The residual left on the calibration window ({left['sentence']}) points at "
                                f"{', '.join(f'{e} on {t}' for e, t in follow)}: {follow_decision['reason']}")
         if then:

@@ -282,3 +282,21 @@ def test_a_long_effect_name_keeps_the_time_plots_legend_inside_the_figure(tmp_pa
         renderer = fig.canvas.get_renderer()
         box, frame = fig.legends[0].get_window_extent(renderer), fig.bbox
         assert frame.x0 <= box.x0 and box.x1 <= frame.x1, (box, frame)
+
+
+def test_a_candidate_tried_again_on_top_is_judged_and_marked_in_its_own_round(tmp_path):
+    from nodeforce.diagnose.report import content
+    report, _ = synthetic()
+    first = next(c for c in report["candidates"] if c["effect"] == "conductivity")
+    again = {**copy.deepcopy(first), "on_top_of": ["conductivity@door"], "effect": "solar_absorptance",
+             "target": "roof"}
+    roof = next(c for c in report["candidates"] if c["effect"] == "solar_absorptance")
+    report["candidates"].append(again)
+    report["effects"] = [{"effect": "conductivity", "target": "door"}, {"effect": "solar_absorptance", "target": "roof"}]
+    report["decision"]["chosen"] = "solar_absorptance@roof"
+    report["decision"]["follow_up"] = {"chosen": "solar_absorptance@roof", "candidates": {
+        "solar_absorptance@roof": {"beats_bic": True, "beats_validation": True, "validation_margin": 1.5}}}
+    # the first round's roof: its own verdict, not chosen; the same label on top: chosen, its verdict
+    assert content.verdict(report, roof) == report["decision"]["candidates"]["solar_absorptance@roof"]
+    assert not content.is_chosen(report, roof) and content.is_chosen(report, first)
+    assert content.verdict(report, again)["validation_margin"] == 1.5 and content.is_chosen(report, again)

@@ -48,12 +48,23 @@ def decision(report):
 
 
 def verdict(report, candidate):
-    """The loop's {'beats_bic', 'beats_validation'} for a candidate ({} if not recorded)."""
-    return (decision(report).get("candidates") or {}).get(candidate_key(candidate)) or {}
+    """The loop's {'beats_bic', 'beats_validation', 'validation_margin'} for a candidate ({} if
+    not recorded); one tried on top of a first choice is judged in the follow-up decision."""
+    judged = decision(report)
+    if candidate.get("on_top_of"):
+        judged = judged.get("follow_up") or {}
+    return (judged.get("candidates") or {}).get(candidate_key(candidate)) or {}
 
 
 def is_chosen(report, candidate):
-    return decision(report).get("chosen") == candidate_key(candidate)
+    """Whether the loop added this candidate, in the round it was tried in (the first round's
+    choice is the first of `effects`; one tried on top is the follow-up decision's)."""
+    d = decision(report)
+    if candidate.get("on_top_of"):
+        return (d.get("follow_up") or {}).get("chosen") == candidate_key(candidate)
+    if report.get("effects"):
+        return candidate_key(report["effects"][0]) == candidate_key(candidate)
+    return d.get("chosen") == candidate_key(candidate)
 
 
 def node_name(report, node):
