@@ -10,9 +10,6 @@ The export checks that form against a direct assembly elsewhere and refuses an e
 not fit it.
 """
 import itertools
-import os
-import shutil
-import subprocess
 import tempfile
 from pathlib import Path
 
@@ -21,8 +18,9 @@ import numpy as np
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.network import assemble
 
-C_DIR = Path(__file__).with_name("c")
-SOURCES = ("nodeforce_fmu.c", "fmi2.h")
+from .compiler import C_DIR, compile_library
+
+SOURCES = ("nodeforce_fmu.c", "fmi2.h", "variables.h", "resources.h")
 IDENTIFIER = "nodeforce_standalone"
 
 
@@ -97,26 +95,14 @@ def network_text(building, effect):
     return "\n".join(lines) + "\n"
 
 
-def compile_library(sources_dir, output):
-    """Compile the C sources into a shared library; a clear error without a C compiler."""
-    compiler = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
-    if not compiler or not shutil.which(compiler.split()[0]):
-        raise RuntimeError("no C compiler found (cc, gcc or $CC): the standalone FMU's linux64 binary is "
-                           "compiled at export; install one (e.g. apt-get install gcc)")
-    command = [*compiler.split(), "-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden",
-               "-o", str(output), "nodeforce_fmu.c", "-lm"]
-    done = subprocess.run(command, cwd=sources_dir, capture_output=True, text=True)
-    if done.returncode:
-        raise RuntimeError(f"compiling the standalone FMU failed: {' '.join(command)}\n{done.stderr}")
-
-
 def standalone_files(building, effect):
     """({archive name: bytes}, model identifier, source file names) of the standalone FMU."""
     files = {f"sources/{name}": (C_DIR / name).read_bytes() for name in SOURCES}
     files["resources/network.txt"] = network_text(building, effect).encode()
     with tempfile.TemporaryDirectory(prefix="nodeforce_fmu_") as tmp:
-        for name in SOURCES:
-            shutil.copy(C_DIR / name, tmp)
-        compile_library(tmp, Path(tmp) / f"{IDENTIFIER}.so")
+        try:
+            compile_library("nodeforce_fmu.c", Path(tmp) / f"{IDENTIFIER}.so", libraries=("m",))
+        except RuntimeError as e:
+            raise RuntimeError(f"the standalone FMU's linux64 binary is compiled at export: {e}") from None
         files[f"binaries/linux64/{IDENTIFIER}.so"] = (Path(tmp) / f"{IDENTIFIER}.so").read_bytes()
     return files, IDENTIFIER, ("nodeforce_fmu.c",)

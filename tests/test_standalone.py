@@ -1,7 +1,7 @@
 """The standalone FMU (no Python at run time) gives the Python FMU's numbers in a C host, FMPy,
 libcosim and ecos; both FMUs declare units, calculated outputs and their dependencies, and
-refuse the calls the FMI 2.0 standard forbids; the Python FMU runs in a C host with libpython
-preloaded, as the README says, without crashing at exit."""
+refuse the calls the FMI 2.0 standard forbids with fmi2Error; the Python FMU runs in a C host
+(its guard loads libpython), as the README says, without crashing at exit."""
 import copy
 import os
 import shutil
@@ -25,7 +25,7 @@ from tests.importers import fmpy_validate, fmutool_check, run_ecos, run_fmpy, ru
 HOST = Path(__file__).with_name("c_host") / "host.c"
 HEADERS = Path(__file__).parents[1] / "fmu_build" / "c"
 KINDS = ("python", "standalone")
-DISCARD, ERROR = 2, 3  # fmi2Status
+ERROR = 3  # fmi2Status
 
 
 def two_zones(data):
@@ -179,14 +179,15 @@ def test_same_model_same_bytes_and_the_guid_is_its_identity(fmus, testcell_data,
     assert content_id(build_fmu(parse_building(other), tmp_path / "other.fmu", kind=kind)) != content_id(again)
 
 
-def slave_of(fmu, tmp_path):
+def slave_of(fmu, tmp_path, initialise=True):
     md = read_model_description(str(fmu))
     slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(fmu), unzipdir=str(tmp_path / "u")),
                       modelIdentifier=md.coSimulation.modelIdentifier, instanceName="calls")
     slave.instantiate()
     slave.setupExperiment(startTime=0.0)
-    slave.enterInitializationMode()
-    slave.exitInitializationMode()
+    if initialise:
+        slave.enterInitializationMode()
+        slave.exitInitializationMode()
     return slave, {v.name: v.valueReference for v in md.modelVariables}
 
 
@@ -199,9 +200,13 @@ def status(call, *args):
     return 0
 
 
-def test_standalone_refuses_forbidden_calls_with_fmi2_error(fmus, tmp_path):
-    slave, vr = slave_of(fmus[("testcell", "standalone")], tmp_path)
-    before = slave.getReal([vr[f"T[{i}]"] for i in range(1, 24)])
+@pytest.mark.parametrize("kind", KINDS)
+def test_forbidden_calls_get_fmi2_error_and_change_nothing(fmus, tmp_path, kind):
+    """Both FMUs (the Python one through its guard) answer what the standard forbids with
+    fmi2Error (not pythonfmu's fmi2Discard or fmi2Fatal), and the state stays as it was."""
+    slave, vr = slave_of(fmus[("testcell", kind)], tmp_path)
+    outputs = [vr[f"T[{i}]"] for i in range(1, 24)]
+    before = slave.getReal(outputs)
     assert status(slave.doStep, 0.0, 0.0) == ERROR
     assert status(slave.doStep, 0.0, -900.0) == ERROR
     assert status(slave.setReal, [vr["T[23]"]], [99.0]) == ERROR  # an output
@@ -210,34 +215,46 @@ def test_standalone_refuses_forbidden_calls_with_fmi2_error(fmus, tmp_path):
     assert status(slave.getReal, [vr["force[9]"]]) == ERROR  # a Boolean
     assert status(slave.getBoolean, [vr["T_start"]]) == ERROR  # a Real
     assert status(slave.getReal, [10 ** 6]) == ERROR
+    assert status(slave.getInteger, [0]) == ERROR  # no Integer variables
     # nothing refused changed anything, and the slave steps on
-    assert slave.getReal([vr[f"T[{i}]"] for i in range(1, 24)]) == before
+    assert slave.getReal(outputs) == before
+    assert slave.getBoolean([vr["force[9]"]]) == [False]
     slave.doStep(currentCommunicationPoint=0.0, communicationStepSize=900.0)
-    assert np.isfinite(slave.getReal([vr["T[23]"]])).all()
+    after = slave.getReal(outputs)
+    assert np.isfinite(after).all() and after != before
     slave.terminate()
     slave.freeInstance()
 
 
-def test_python_fmu_refuses_forbidden_calls_and_keeps_its_state(fmus, tmp_path):
-    """pythonfmu answers a refused doStep with fmi2Discard (a slave's do_step can only say
-    True or False); the state stays as it was, instead of turning NaN for good."""
-    slave, vr = slave_of(fmus[("testcell", "python")], tmp_path)
-    before = slave.getReal([vr["T[23]"]])
-    assert status(slave.doStep, 0.0, -900.0) in (DISCARD, ERROR)
-    assert slave.getReal([vr["T[23]"]]) == before
+def test_the_guard_keeps_the_slave_state_across_fmu_states(fmus, tmp_path):
+    """The guard's own state travels with an FMU state: restored to initialisation, a fixed
+    parameter may be set again; serialised and read back, the state gives the same step."""
+    slave, vr = slave_of(fmus[("testcell", "python")], tmp_path, initialise=False)
+    slave.enterInitializationMode()
+    during = slave.getFMUstate()
+    slave.exitInitializationMode()
+    assert status(slave.setReal, [vr["T_start"]], [25.0]) == ERROR
+    slave.setFMUstate(during)
+    slave.setReal([vr["T_start"]], [25.0])  # allowed again
+    slave.exitInitializationMode()
+    stepping = slave.getFMUstate()
+    restored = slave.deSerializeFMUstate(slave.serializeFMUstate(stepping))
     slave.doStep(currentCommunicationPoint=0.0, communicationStepSize=900.0)
-    assert np.isfinite(slave.getReal([vr["T[23]"]])).all()
+    once = slave.getReal([vr["T[23]"]])
+    slave.setFMUstate(restored)
+    slave.doStep(currentCommunicationPoint=0.0, communicationStepSize=900.0)
+    assert slave.getReal([vr["T[23]"]]) == once
+    for state in (during, stepping, restored):
+        slave.freeFMUstate(state)
     slave.terminate()
     slave.freeInstance()
 
 
 def python_host_environment():
-    """The README's recipe: libpython preloaded, numpy importable, for a C host."""
-    library = Path(sysconfig.get_config_var("LIBDIR")) / sysconfig.get_config_var("LDLIBRARY")
-    if not library.exists():
-        pytest.fail(f"this Python has no shared libpython ({library}): the recipe needs one")
-    site = sysconfig.get_paths()["purelib"]
-    return dict(os.environ, LD_PRELOAD=str(library), PYTHONPATH=site)
+    """A C host's environment for the Python FMU: numpy importable; no LD_PRELOAD, the guard
+    loads libpython itself."""
+    env = {k: v for k, v in os.environ.items() if k != "LD_PRELOAD"}
+    return dict(env, PYTHONPATH=sysconfig.get_paths()["purelib"])
 
 
 @pytest.mark.slow  # processes, a cluster or a whole diagnosis: not in `make check`
@@ -251,3 +268,13 @@ def test_python_fmu_in_a_c_host_runs_twenty_times_without_a_crash_at_exit(fmus, 
         assert done.returncode == 0 and "corrupted" not in done.stderr and "free()" not in done.stderr, \
             f"run {run}: exit {done.returncode}\n{done.stderr}"
         assert np.abs(T - reference).max() < 1e-9
+
+
+def test_a_c_host_without_libpython_gets_one_logged_line(fmus, tmp_path):
+    fmu = fmus[("testcell", "python")]
+    parameters, inputs, outputs, _ = scenario(fmu)
+    env = dict(python_host_environment(), NODEFORCE_LIBPYTHON=str(tmp_path / "libpython-missing.so"))
+    done, _ = run_c_host(fmu, parameters, inputs, outputs, 900.0, 2, tmp_path, env=env)
+    assert done.returncode == 1
+    logged = [line for line in done.stderr.splitlines() if "libpython" in line]
+    assert len(logged) == 1 and "NODEFORCE_LIBPYTHON" in logged[0] and "libpython-missing.so" in logged[0]

@@ -8,8 +8,7 @@
    the rows of forced nodes (force[i] and T_forced[i] not NaN) replaced by T+_i = T_forced[i],
    with M factorised (LU, partial pivoting) once per pattern of imposed nodes and step size.
 
-   Value references (fmu_build/variables.py): force[1..N] (Boolean), T_start, the inputs,
-   T_forced[1..N], T[1..N] (outputs), the effect parameters. */
+   Value references and the calls refused: variables.h (shared with the Python FMU's guard). */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -17,8 +16,9 @@
 #include <string.h>
 
 #include "fmi2.h"
+#include "resources.h"
+#include "variables.h"
 
-enum { INSTANTIATED, INITIALISATION, STEPPING, TERMINATED };
 #define CACHED_PATTERNS 8
 
 typedef struct {
@@ -41,6 +41,7 @@ typedef struct {
 
 typedef struct {
     Network net;
+    Layout layout; /* the value references of net's sizes */
     char *name;
     fmi2CallbackFunctions cb;
     int state, size, clock;
@@ -51,14 +52,6 @@ typedef struct {
     Factors cache[CACHED_PATTERNS];
 } Model;
 
-/* ------------------------------------------------------------------ layout */
-static int vr_force(const Model *m) { (void)m; return 0; }
-static int vr_T_start(const Model *m) { return m->net.n; }
-static int vr_inputs(const Model *m) { return m->net.n + 1; }
-static int vr_T_forced(const Model *m) { return vr_inputs(m) + m->net.n_in; }
-static int vr_T(const Model *m) { return vr_T_forced(m) + m->net.n; }
-static int vr_parameters(const Model *m) { return vr_T(m) + m->net.n; }
-
 static void log_error(Model *m, const char *format, ...) {
     char message[512];
     va_list args;
@@ -68,65 +61,15 @@ static void log_error(Model *m, const char *format, ...) {
     if (m->cb.logger) m->cb.logger(m->cb.componentEnvironment, m->name, fmi2Error, "logStatusError", "%s", message);
 }
 
-/* Why the standard forbids this get or set, logged; 0 when allowed. */
+/* A get or set the standard forbids (variables.h), its reason logged: 1 when refused. */
 static int refused(Model *m, const fmi2ValueReference vr[], size_t nvr, int real, int setting) {
-    size_t k;
-    for (k = 0; k < nvr; k++) {
-        int r = (int)vr[k];
-        int boolean = r < m->net.n;
-        int fixed = r <= vr_T_start(m) || r >= vr_parameters(m);
-        if (vr[k] >= (fmi2ValueReference)m->size) {
-            log_error(m, "value reference %u does not exist (0..%d)", vr[k], m->size - 1);
-            return 1;
-        }
-        if (boolean == real) {
-            log_error(m, "value reference %d is %s, not %s", r, real ? "Boolean" : "Real", real ? "Real" : "Boolean");
-            return 1;
-        }
-        if (!setting) continue;
-        if (r >= vr_T(m) && r < vr_parameters(m)) {
-            log_error(m, "value reference %d is an output, which cannot be set", r);
-            return 1;
-        }
-        if (fixed && m->state != INSTANTIATED && m->state != INITIALISATION) {
-            log_error(m, "value reference %d is a fixed parameter, which cannot change after initialisation", r);
-            return 1;
-        }
-        if (m->state == TERMINATED) {
-            log_error(m, "the slave is terminated");
-            return 1;
-        }
-    }
-    return 0;
+    char reason[256];
+    if (!refusal(&m->layout, vr, nvr, real, setting, m->state, reason, sizeof reason)) return 0;
+    log_error(m, "%s", reason);
+    return 1;
 }
 
 /* ------------------------------------------------------------------ reading the network */
-static char *file_path(const char *uri, const char *name) {
-    const char *p = uri;
-    char *path, *out;
-    if (strncmp(p, "file://", 7) == 0) {
-        p += 7;
-        if (strncmp(p, "localhost/", 10) == 0) p += 9;
-    } else if (strncmp(p, "file:", 5) == 0) {
-        p += 5;
-    }
-    path = malloc(strlen(p) + strlen(name) + 2);
-    if (!path) return NULL;
-    for (out = path; *p; p++) { /* percent-decoding */
-        if (p[0] == '%' && p[1] && p[2]) {
-            char hex[3] = {p[1], p[2], 0};
-            *out++ = (char)strtol(hex, NULL, 16);
-            p += 2;
-        } else {
-            *out++ = *p;
-        }
-    }
-    if (out > path && out[-1] == '/') out--;
-    *out++ = '/';
-    strcpy(out, name);
-    return path;
-}
-
 static int expect(FILE *f, const char *word) {
     char token[64];
     return fscanf(f, "%63s", token) == 1 && strcmp(token, word) == 0;
@@ -205,7 +148,7 @@ static void network_at_parameters(Model *m) {
         double weight = 1.0;
         const double *term = net->terms + t * size;
         for (j = 0; j < net->n_par; j++)
-            if (net->term_mask[t] & (1 << j)) weight *= m->values[vr_parameters(m) + j] - net->p0[j];
+            if (net->term_mask[t] & (1 << j)) weight *= m->values[vr_parameters(&m->layout) + j] - net->p0[j];
         for (k = 0; k < size; k++) out[k] += weight * term[k];
     }
 }
@@ -222,8 +165,8 @@ static double interp(double x, const double *xp, const double *fp, int count) {
 /* PHYSICS.md section 5: the initial state from the measurements at t_0 and T_start. */
 static void initial_state(Model *m) {
     const Network *net = &m->net;
-    const double *measured = m->values + vr_T_forced(m);
-    double *T = m->values + vr_T(m), T_start = m->values[vr_T_start(m)];
+    const double *measured = m->values + vr_T_forced(&m->layout);
+    double *T = m->values + vr_T(&m->layout), T_start = m->values[vr_T_start(&m->layout)];
     double *xp = malloc((size_t)net->n * sizeof(double)), *fp = malloc((size_t)net->n * sizeof(double));
     int z, g, i;
     for (z = 0; z < net->n_zones; z++) {
@@ -331,10 +274,10 @@ static void forget_factors(Model *m) {
 static fmi2Status step(Model *m, double dt) {
     const Network *net = &m->net;
     int n = net->n, i, j;
-    const double *u = m->values + vr_inputs(m), *T_forced = m->values + vr_T_forced(m);
-    double *T = m->values + vr_T(m);
+    const double *u = m->values + vr_inputs(&m->layout), *T_forced = m->values + vr_T_forced(&m->layout);
+    double *T = m->values + vr_T(&m->layout);
     Factors *f;
-    for (i = 0; i < n; i++) m->imposed[i] = m->values[vr_force(m) + i] != 0.0 && isfinite(T_forced[i]);
+    for (i = 0; i < n; i++) m->imposed[i] = m->values[vr_force(&m->layout) + i] != 0.0 && isfinite(T_forced[i]);
     f = factors(m, dt);
     if (!f) {
         log_error(m, "the step matrix is singular (or memory ran out)");
@@ -389,7 +332,7 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
         free_model(m);
         return NULL;
     }
-    path = resources ? file_path(resources, "network.txt") : NULL;
+    path = resources ? resource_path(resources, "network.txt") : NULL;
     f = path ? fopen(path, "r") : NULL;
     ok = f && read_network(&m->net, f);
     if (f) fclose(f);
@@ -400,7 +343,10 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
         return NULL;
     }
     free(path);
-    m->size = vr_parameters(m) + m->net.n_par;
+    m->layout.n = m->net.n;
+    m->layout.n_in = m->net.n_in;
+    m->layout.n_par = m->net.n_par;
+    m->size = layout_size(&m->layout);
     m->values = calloc((size_t)m->size, sizeof(double));
     m->start_values = calloc((size_t)m->size, sizeof(double));
     m->C = calloc((size_t)term_size(&m->net), sizeof(double));
@@ -414,12 +360,12 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
         free_model(m);
         return NULL;
     }
-    m->start_values[vr_T_start(m)] = 20.0;
+    m->start_values[vr_T_start(&m->layout)] = 20.0;
     for (i = 0; i < m->net.n; i++) {
-        m->start_values[vr_T_forced(m) + i] = NAN;
-        m->start_values[vr_T(m) + i] = 20.0;
+        m->start_values[vr_T_forced(&m->layout) + i] = NAN;
+        m->start_values[vr_T(&m->layout) + i] = 20.0;
     }
-    for (i = 0; i < m->net.n_par; i++) m->start_values[vr_parameters(m) + i] = m->net.p0[i];
+    for (i = 0; i < m->net.n_par; i++) m->start_values[vr_parameters(&m->layout) + i] = m->net.p0[i];
     memcpy(m->values, m->start_values, (size_t)m->size * sizeof(double));
     forget_factors(m);
     m->state = INSTANTIATED;
@@ -507,8 +453,9 @@ FMI2_EXPORT fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference 
 }
 
 static fmi2Status no_such(Model *m, const char *what, size_t nvr) {
-    if (nvr == 0) return fmi2OK;
-    log_error(m, "this FMU has no %s variables", what);
+    char reason[256];
+    if (!no_such_type(what, nvr, reason, sizeof reason)) return fmi2OK;
+    log_error(m, "%s", reason);
     return fmi2Error;
 }
 
@@ -610,13 +557,10 @@ FMI2_EXPORT fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2V
 FMI2_EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
                                   fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
     Model *m = c;
+    char reason[256];
     (void)currentCommunicationPoint; (void)noSetFMUStatePriorToCurrentPoint;
-    if (m->state != STEPPING) {
-        log_error(m, "fmi2DoStep before initialisation ended, or after fmi2Terminate");
-        return fmi2Error;
-    }
-    if (!(communicationStepSize > 0.0)) {
-        log_error(m, "fmi2DoStep with communicationStepSize %g s: it must be > 0", communicationStepSize);
+    if (step_refusal(m->state, communicationStepSize, reason, sizeof reason)) {
+        log_error(m, "%s", reason);
         return fmi2Error;
     }
     return step(m, communicationStepSize);
