@@ -3,6 +3,7 @@ libcosim and ecos; both FMUs declare units, calculated outputs and their depende
 refuse the calls the FMI 2.0 standard forbids with fmi2Error; the Python FMU runs in a C host
 (its guard loads libpython), as the README says, without crashing at exit."""
 import copy
+import json
 import os
 import shutil
 import subprocess
@@ -47,11 +48,20 @@ def two_zones(data):
     return data
 
 
+def shaded(data):
+    """The test cell with a blind on its glazing: the transmitted sun is then the product of
+    two inputs, the irradiance and the blind's column."""
+    data = copy.deepcopy(data)
+    glazing = next(c for c in data["components"] if "solar_transmittance" in c)
+    glazing["shading"] = "blind"
+    return data
+
+
 @pytest.fixture(scope="module")
 def fmus(tmp_path_factory, testcell_data):
-    """{(building, kind): FMU path} for the test cell and the two-zone building."""
+    """{(building, kind): FMU path} for the test cell, the two-zone building and the shaded cell."""
     folder = tmp_path_factory.mktemp("standalone")
-    buildings = {"testcell": testcell_data, "two_zones": two_zones(testcell_data)}
+    buildings = {"testcell": testcell_data, "two_zones": two_zones(testcell_data), "shaded": shaded(testcell_data)}
     return {(name, kind): build_fmu(parse_building(data), folder / f"{name}_{kind}.fmu", kind=kind)
             for name, data in buildings.items() for kind in KINDS}
 
@@ -60,18 +70,22 @@ def scenario(fmu, n_steps=192, seed=0):
     """Parameters, inputs and outputs of a two-day run: a sinusoidal day, the forced nodes'
     measurements with gaps (NaN), the initial measurements set during initialisation."""
     rng = np.random.default_rng(seed)
-    names = [v.name for v in read_model_description(str(fmu)).modelVariables]
-    n = sum(name.startswith("T[") for name in names)
+    variables = [v for v in read_model_description(str(fmu)).modelVariables if v.causality == "input"]
+    n = sum(v.name.startswith("T_forced[") for v in variables)
     t = np.arange(1, n_steps + 1) * 900.0
     day = np.sin(2 * np.pi * t / 86400)
     inputs = {}
-    for name in names:
-        if name in ("T_out", "T_sky"):
-            inputs[name] = 24 + 6 * day - (8 if name == "T_sky" else 0)
-        elif name.startswith("I_"):
-            inputs[name] = np.maximum(0, 700 * day)
-        elif name == "Q_annex":
-            inputs[name] = 300 * (day > 0)
+    for v in variables:
+        if v.name in ("T_out", "T_sky"):
+            inputs[v.name] = 24 + 6 * day - (8 if v.name == "T_sky" else 0)
+        elif v.unit == "W/m2":  # irradiance
+            inputs[v.name] = np.maximum(0, 700 * day)
+        elif v.unit == "W":  # a heat input
+            inputs[v.name] = 300 * (day > 0)
+        elif v.description.startswith("shading of"):  # drawn and opened, not in step with the sun
+            inputs[v.name] = 0.5 + 0.5 * np.cos(2 * np.pi * t / 30000)
+        elif v.unit == "degC" and not v.name.startswith("T_forced["):  # a boundary or supply temperature
+            inputs[v.name] = 21 + 2 * day
     forced = (1, 9, 17) if n == 23 else (1, 9, 27)
     for i in forced:
         measured = 27 + 2 * day + rng.normal(0, 0.1, n_steps)
@@ -106,7 +120,7 @@ def run_c_host(fmu, parameters, inputs, outputs, dt, n_steps, tmp_path, env=None
     return done, (np.loadtxt(done.stdout.splitlines(), ndmin=2) if done.returncode == 0 else None)
 
 
-@pytest.mark.parametrize("building", ["testcell", "two_zones"])
+@pytest.mark.parametrize("building", ["testcell", "two_zones", "shaded"])
 def test_standalone_in_a_c_host_equals_the_python_fmu_in_fmpy(fmus, building, tmp_path):
     python_fmu, standalone = fmus[(building, "python")], fmus[(building, "standalone")]
     parameters, inputs, outputs, n_steps = scenario(python_fmu)
@@ -118,6 +132,27 @@ def test_standalone_in_a_c_host_equals_the_python_fmu_in_fmpy(fmus, building, tm
     assert np.ptp(reference[:, 22]) > 1.0
     measured = inputs["T_forced[9]"]
     assert np.array_equal(in_c[np.isfinite(measured), 8], measured[np.isfinite(measured)])
+    if building == "shaded":  # the blind matters: the same run without it differs
+        unshaded = run_fmpy(fmus[("testcell", "python")], parameters,
+                            {name: x for name, x in inputs.items() if name != "blind"}, outputs, 900.0, n_steps)
+        assert np.abs(unshaded - reference).max() > 0.1
+
+
+TWINHOUSE = Path(__file__).parents[1] / "examples" / "twinhouse_n2" / "building.json"
+
+
+@pytest.mark.slow  # two FMUs of 267 nodes
+def test_standalone_equals_the_python_fmu_on_the_twin_house(tmp_path):
+    """The Twin House's south glazings have blinds (shading_south): both FMUs, a day."""
+    building = parse_building(json.loads(TWINHOUSE.read_text()))
+    python_fmu, standalone = (build_fmu(building, tmp_path / f"{kind}.fmu", kind=kind) for kind in KINDS)
+    parameters, inputs, outputs, n_steps = scenario(python_fmu, n_steps=96)
+    assert "shading_south" in inputs
+    reference = run_fmpy(python_fmu, parameters, inputs, outputs, 900.0, n_steps)
+    done, in_c = run_c_host(standalone, parameters, inputs, outputs, 900.0, n_steps, tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert np.abs(in_c - reference).max() < 1e-9
+    assert np.ptp(reference).max() > 1.0
 
 
 def test_the_standalone_binary_needs_no_python(fmus, tmp_path):

@@ -1,10 +1,12 @@
 /* A generic FMI 2.0 co-simulation slave stepping a nodal network (PHYSICS.md section 5).
 
    The network is data, assembled by nodeforce in Python and shipped as resources/network.txt:
-   C (J/K), A (W/K), B, q (W) at the declared effect parameters p0 and, per set S of effect
-   parameters, a term multiplied by prod_{j in S} (p_j - p0_j); the zones' air and radiant nodes
-   and each component's nodes with their depths (for the initial state). This file only steps:
-       (C/dt - A) T+ = (C/dt) T + B u + q,
+   C (J/K), A (W/K), B, q (W) and the coefficients P (W) of the products of two inputs (a shaded
+   glazing's transmitted sun, P_k u_a u_b on node i) at the declared effect parameters p0 and,
+   per set S of effect parameters, a term multiplied by prod_{j in S} (p_j - p0_j); the zones'
+   air and radiant nodes and each component's nodes with their depths (for the initial state).
+   This file only steps:
+       (C/dt - A) T+ = (C/dt) T + B u + q + s(u),   s_i(u) = sum over products k on i of P_k u_a u_b,
    the rows of forced nodes (force[i] and T_forced[i] not NaN) replaced by T+_i = T_forced[i],
    with M factorised (LU, partial pivoting) once per pattern of imposed nodes and step size.
 
@@ -30,10 +32,11 @@ typedef struct {
 } Factors;
 
 typedef struct {
-    int n, n_in, n_par, n_terms, n_zones, n_groups;
+    int n, n_in, n_par, n_terms, n_zones, n_groups, n_products;
     double *p0;     /* n_par */
+    int *product;   /* n_products x 3: node, input a, input b */
     int *term_mask; /* n_terms: bit j = parameter j multiplies the term */
-    double *terms;  /* n_terms x (n + n*n + n*n_in + n): C, A, B, q */
+    double *terms;  /* n_terms x (n + n*n + n*n_in + n + n_products): C, A, B, q, P */
     int *air, *radiant;                 /* n_zones, 0-based nodes */
     int *group_zone, *group_start, *group_len; /* n_groups */
     int *group_node; double *group_depth;      /* concatenated */
@@ -46,7 +49,7 @@ typedef struct {
     fmi2CallbackFunctions cb;
     int state, size, clock;
     double *values, *start_values;
-    double *C, *A, *B, *q; /* at the parameters' values */
+    double *C, *A, *B, *q, *P; /* at the parameters' values */
     double *v, *T_next;
     unsigned char *imposed;
     Factors cache[CACHED_PATTERNS];
@@ -89,15 +92,16 @@ static int read_doubles(FILE *f, double *x, long count) {
     return 1;
 }
 
-static long term_size(const Network *net) { return (long)net->n * (2 + net->n + net->n_in); }
+static long term_size(const Network *net) { return (long)net->n * (2 + net->n + net->n_in) + net->n_products; }
 
 static int read_network(Network *net, FILE *f) {
     int k, total = 0;
-    if (!expect(f, "nodeforce-network/1") || !expect(f, "sizes") || !read_ints(f, &net->n, 1)
+    if (!expect(f, "nodeforce-network/2") || !expect(f, "sizes") || !read_ints(f, &net->n, 1)
         || !read_ints(f, &net->n_in, 1) || !read_ints(f, &net->n_par, 1) || !read_ints(f, &net->n_terms, 1)
-        || !read_ints(f, &net->n_zones, 1) || !read_ints(f, &net->n_groups, 1))
+        || !read_ints(f, &net->n_zones, 1) || !read_ints(f, &net->n_groups, 1) || !read_ints(f, &net->n_products, 1))
         return 0;
     net->p0 = calloc((size_t)net->n_par + 1, sizeof(double));
+    net->product = calloc((size_t)net->n_products * 3 + 1, sizeof(int));
     net->term_mask = calloc((size_t)net->n_terms, sizeof(int));
     net->terms = calloc((size_t)(net->n_terms * term_size(net)), sizeof(double));
     net->air = calloc((size_t)net->n_zones, sizeof(int));
@@ -107,10 +111,15 @@ static int read_network(Network *net, FILE *f) {
     net->group_len = calloc((size_t)net->n_groups, sizeof(int));
     net->group_node = calloc((size_t)net->n, sizeof(int));
     net->group_depth = calloc((size_t)net->n, sizeof(double));
-    if (!net->p0 || !net->term_mask || !net->terms || !net->air || !net->radiant || !net->group_zone
+    if (!net->p0 || !net->product || !net->term_mask || !net->terms || !net->air || !net->radiant || !net->group_zone
         || !net->group_start || !net->group_len || !net->group_node || !net->group_depth)
         return 0;
     if (!expect(f, "p0") || !read_doubles(f, net->p0, net->n_par)) return 0;
+    if (!expect(f, "products") || !read_ints(f, net->product, net->n_products * 3)) return 0;
+    for (k = 0; k < net->n_products; k++) {
+        const int *p = net->product + 3 * k;
+        if (p[0] < 0 || p[0] >= net->n || p[1] < 0 || p[1] >= net->n_in || p[2] < 0 || p[2] >= net->n_in) return 0;
+    }
     for (k = 0; k < net->n_terms; k++)
         if (!expect(f, "term") || !read_ints(f, &net->term_mask[k], 1)
             || !read_doubles(f, net->terms + k * term_size(net), term_size(net)))
@@ -131,7 +140,7 @@ static int read_network(Network *net, FILE *f) {
 }
 
 static void free_network(Network *net) {
-    free(net->p0); free(net->term_mask); free(net->terms); free(net->air); free(net->radiant);
+    free(net->p0); free(net->product); free(net->term_mask); free(net->terms); free(net->air); free(net->radiant);
     free(net->group_zone); free(net->group_start); free(net->group_len); free(net->group_node);
     free(net->group_depth);
 }
@@ -142,7 +151,7 @@ static void network_at_parameters(Model *m) {
     const Network *net = &m->net;
     long size = term_size(net), k;
     int t, j;
-    double *out = m->C; /* C, A, B, q are one contiguous block */
+    double *out = m->C; /* C, A, B, q, P are one contiguous block */
     memset(out, 0, (size_t)size * sizeof(double));
     for (t = 0; t < net->n_terms; t++) {
         double weight = 1.0;
@@ -273,7 +282,7 @@ static void forget_factors(Model *m) {
 
 static fmi2Status step(Model *m, double dt) {
     const Network *net = &m->net;
-    int n = net->n, i, j;
+    int n = net->n, i, j, k;
     const double *u = m->values + vr_inputs(&m->layout), *T_forced = m->values + vr_T_forced(&m->layout);
     double *T = m->values + vr_T(&m->layout);
     Factors *f;
@@ -283,11 +292,15 @@ static fmi2Status step(Model *m, double dt) {
         log_error(m, "the step matrix is singular (or memory ran out)");
         return fmi2Error;
     }
-    for (i = 0; i < n; i++) {
-        double source = m->q[i];
-        for (j = 0; j < net->n_in; j++) source += m->B[i * net->n_in + j] * u[j];
-        m->v[i] = m->imposed[i] ? T_forced[i] : m->C[i] / dt * T[i] + source;
+    for (i = 0; i < n; i++) { /* the sources */
+        m->v[i] = m->q[i];
+        for (j = 0; j < net->n_in; j++) m->v[i] += m->B[i * net->n_in + j] * u[j];
     }
+    for (k = 0; k < net->n_products; k++) {
+        const int *p = net->product + 3 * k;
+        m->v[p[0]] += m->P[k] * u[p[1]] * u[p[2]];
+    }
+    for (i = 0; i < n; i++) m->v[i] = m->imposed[i] ? T_forced[i] : m->C[i] / dt * T[i] + m->v[i];
     lu_solve(f->lu, f->piv, m->v, n);
     for (i = 0; i < n; i++) T[i] = m->imposed[i] ? T_forced[i] : m->v[i];
     return fmi2OK;
@@ -353,6 +366,7 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
     m->A = m->C + m->net.n;
     m->B = m->A + m->net.n * m->net.n;
     m->q = m->B + m->net.n * m->net.n_in;
+    m->P = m->q + m->net.n;
     m->v = calloc((size_t)m->net.n, sizeof(double));
     m->T_next = calloc((size_t)m->net.n, sizeof(double));
     m->imposed = calloc((size_t)m->net.n, 1);
