@@ -138,6 +138,23 @@ def test_standalone_in_a_c_host_equals_the_python_fmu_in_fmpy(fmus, building, tm
         assert np.abs(unshaded - reference).max() > 0.1
 
 
+def test_an_effect_on_a_shaded_glazing_is_carried_by_the_standalone_fmu(fmus, testcell_data, tmp_path):
+    """A corrected transmittance scales the product of inputs itself: its coefficient is a term
+    of the effect's parameter. Both FMUs at a tau other than the declared one agree."""
+    building = parse_building(shaded(testcell_data))
+    glazing = next(c.name for c in building.components if c.shading)
+    effect = ("solar_transmittance", glazing)
+    built = {kind: build_fmu(building, tmp_path / f"{kind}.fmu", effect=effect, kind=kind) for kind in KINDS}
+    parameters, inputs, outputs, n_steps = scenario(built["python"], n_steps=96)
+    at_declared = run_fmpy(built["python"], parameters, inputs, outputs, 900.0, n_steps)
+    parameters["solar_transmittance.tau"] = 0.3
+    reference = run_fmpy(built["python"], parameters, inputs, outputs, 900.0, n_steps)
+    assert np.abs(reference - at_declared).max() > 0.1  # tau matters
+    done, in_c = run_c_host(built["standalone"], parameters, inputs, outputs, 900.0, n_steps, tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert np.abs(in_c - reference).max() < 1e-9
+
+
 TWINHOUSE = Path(__file__).parents[1] / "examples" / "twinhouse_n2" / "building.json"
 
 

@@ -185,8 +185,11 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
                                           fmi2Boolean loggingOn) {
     GuardFile file;
     Guard *g;
-    char *path = resources ? resource_path(resources, "guard.txt") : NULL;
-    int ok = path && read_guard_file(path, &file);
+    char *path;
+    int ok;
+    if (!functions) return NULL; /* no logger to say why: the standard requires the callbacks */
+    path = resources ? resource_path(resources, "guard.txt") : NULL;
+    ok = path && read_guard_file(path, &file);
     if (!ok) {
         log_error(functions, name, "cannot read %s", path ? path : "the resources (no fmuResourceLocation)");
         free(path);
