@@ -3,7 +3,8 @@
 Two kinds of FMU, with the same variables and the same numbers:
 
 - "python" (the default, the one the search drives): pythonfmu runs `slave.py` with the physics
-  modules of `model/` and the building description it carries. Its slave module is named after
+  modules of `model/` and the building description it carries, behind the guard of `guard.py`
+  (fmi2Error for forbidden calls; libpython for a host without Python). Its slave module is named after
   a hash of that content, so two different FMUs in one process never share Python modules
   (pythonfmu imports the slave by name), while the same FMU loaded twice does, harmlessly.
 - "standalone" (`standalone.py`): the assembled network as data, stepped by generic C code; no
@@ -22,6 +23,7 @@ from nodeforce.model.effects import EFFECTS
 from nodeforce.model.network import input_names
 
 from . import description
+from .guard import guarded
 from .variables import Layout
 
 SLAVE = Path(__file__).with_name("slave.py")
@@ -105,13 +107,14 @@ def _build_python(building, destination, effect):
                            f"from {FmuBuilder.build_FMU.__code__.co_filename} is a copy without one")
     # pythonfmu names the binaries after the slave class, and finds the module in slavemodule.txt
     identifier = Path(next(name for name in files if name.startswith("binaries/"))).stem
-    return _write(destination, files, building, effect, identifier, standalone=False)
+    files, is_guarded = guarded(files, identifier, model_interface(building, effect)[0])
+    return _write(destination, files, building, effect, identifier, standalone=False, guarded=is_guarded)
 
 
-def _write(destination, files, building, effect, identifier, standalone, source_files=()):
+def _write(destination, files, building, effect, identifier, standalone, source_files=(), guarded=True):
     """Add the documentation and the model description (GUID: hash of every file) and write."""
     name = building.name or identifier
-    files = {**files, "documentation/index.html": description.documentation(name, standalone)}
+    files = {**files, "documentation/index.html": description.documentation(name, standalone, guarded)}
     guid = description.content_guid(*(part for item in sorted(files.items()) for part in item))
     layout, effect_spec = model_interface(building, effect)
     files["modelDescription.xml"] = description.model_description(

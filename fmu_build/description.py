@@ -206,22 +206,38 @@ def write_fmu(destination, files):
     return destination
 
 
-def documentation(name, standalone, python_minimum="3.10"):
-    """documentation/index.html: what an importer needs to run this FMU."""
+def documentation(name, standalone, guarded=True, python_minimum="3.10"):
+    """documentation/index.html: what an importer needs to run this FMU.
+
+    standalone : the C FMU; else the Python FMU, with its guard (guard.py) or, exported without a
+    C compiler, without it."""
     if standalone:
         needs = ("<p>This FMU needs no Python: <code>binaries/linux64</code> holds a C library "
                  "that links only the C library (symbols up to glibc 2.14). For another platform compile "
                  "<code>sources/*.c</code> (C99) into a shared library named after the model "
-                 "identifier.</p>")
+                 "identifier. Calls the FMI 2.0 standard forbids get fmi2Error, the reason logged.</p>")
+    elif guarded:
+        needs = (f"<p>This FMU runs Python code (pythonfmu): the importing machine needs Python "
+                 f"{python_minimum} or newer with numpy. A Python host (FMPy, libcosimpy, ecospy) runs it as "
+                 "is. In a process without Python, the FMU's binary (a guard in front of pythonfmu's, "
+                 "<code>binaries/linux64/*.pythonfmu.so</code>) loads the libpython named in "
+                 "<code>resources/guard.txt</code>, or the one the environment variable "
+                 "<code>NODEFORCE_LIBPYTHON</code> names; numpy must be importable there (e.g. on "
+                 "<code>PYTHONPATH</code>). Calls the FMI 2.0 standard forbids get fmi2Error, the reason "
+                 "logged. pythonfmu's Linux binary needs glibc 2.32 and the C++ runtime of GCC 12; there "
+                 "is no macOS binary, and the win64 one has no guard. Where that is not available, export "
+                 "the standalone FMU: <code>nodeforce fmu BUILDING --standalone -o MODEL.fmu</code>.</p>")
     else:
-        needs = (f"<p>This FMU runs Python code (pythonfmu). The importing process must contain "
-                 f"Python {python_minimum} or newer with numpy: a Python host (FMPy, libcosimpy, "
-                 "ecospy) already does; a C host must preload libpython, e.g. "
-                 "<code>LD_PRELOAD=$(python3 -c 'import sysconfig as s; print(s.get_config_var(\"LIBDIR\")"
-                 " + \"/\" + s.get_config_var(\"LDLIBRARY\"))')</code>, with numpy on "
-                 "<code>PYTHONPATH</code>. The Linux binary needs glibc 2.32 and the C++ runtime "
-                 "of GCC 12; there is no macOS binary. Where that is not available, export the "
-                 "standalone FMU: <code>nodeforce fmu BUILDING --standalone -o MODEL.fmu</code>.</p>")
+        needs = (f"<p>This FMU runs Python code (pythonfmu) and was exported without a C compiler, so "
+                 f"without its guard. The importing process must contain Python {python_minimum} or newer "
+                 "with numpy: a Python host (FMPy, libcosimpy, ecospy) already does; a C host must preload "
+                 "libpython, e.g. <code>LD_PRELOAD=$(python3 -c 'import sysconfig as s; "
+                 "print(s.get_config_var(\"LIBDIR\") + \"/\" + s.get_config_var(\"LDLIBRARY\"))')</code>, "
+                 "with numpy on <code>PYTHONPATH</code>. Calls the FMI 2.0 standard forbids are refused "
+                 "with the reason logged, but reported as fmi2Discard (doStep) or fmi2Fatal (get/set). "
+                 "The Linux binary needs glibc 2.32 and the C++ runtime of GCC 12; there is no macOS "
+                 "binary. Where that is not available, export the standalone FMU: "
+                 "<code>nodeforce fmu BUILDING --standalone -o MODEL.fmu</code>.</p>")
     return (f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{name}</title></head><body>\n"
             f"<h1>{name}</h1>\n{needs}\n"
             "<p>Variables: parameters <code>force[i]</code> (node i is forced) and <code>T_start</code> "

@@ -1,7 +1,9 @@
 """The standalone FMU: the assembled network as data, stepped by generic C code; no Python at
 run time (`nodeforce fmu BUILDING --standalone -o MODEL.fmu`).
 
-Python assembles (model.network), C only steps (c/nodeforce_fmu.c, PHYSICS.md section 5). An
+Python assembles (model.network), C only steps (c/nodeforce_fmu.c, PHYSICS.md section 5). A
+shaded glazing's transmitted sun, the product of two inputs, is data too: which node and inputs,
+and its coefficient in each term. An
 added effect's parameters stay FMU parameters: every effect of model.effects changes the network
 affinely in each of its parameters (ground coupling's q = A U T_ground is bilinear), so the
 network is exported as its value at the declared parameters p0 plus, per set S of parameters, a
@@ -10,9 +12,6 @@ The export checks that form against a direct assembly elsewhere and refuses an e
 not fit it.
 """
 import itertools
-import os
-import shutil
-import subprocess
 import tempfile
 from pathlib import Path
 
@@ -21,25 +20,38 @@ import numpy as np
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.network import assemble
 
-C_DIR = Path(__file__).with_name("c")
-SOURCES = ("nodeforce_fmu.c", "fmi2.h")
+from .compiler import C_DIR, compile_library
+
+SOURCES = ("nodeforce_fmu.c", "fmi2.h", "variables.h", "resources.h")
 IDENTIFIER = "nodeforce_standalone"
 
 
-def _arrays(network):
-    if network.products:
-        raise ValueError("a shaded glazing's transmitted sun is a product of two inputs, which the standalone "
-                         "FMU's C step does not compute: no standalone export of a building with 'shading'")
-    return (network.C, network.A, network.B, network.q)
+def product_keys(networks):
+    """The (node, input a, input b) of every product of inputs in these networks (a shaded
+    glazing's transmitted sun, coefficient u_a u_b W), in a fixed order."""
+    return sorted({(node, a, b) for network in networks for node, a, b, _ in network.products})
+
+
+def _arrays(network, keys):
+    """(C, A, B, q, P) of a network; P the coefficients (W) of its products at `keys`."""
+    P = np.zeros(len(keys))
+    for node, a, b, coefficient in network.products:
+        if (node, a, b) not in keys:
+            raise ValueError("the effect adds a product of inputs its declared network lacks: no standalone export")
+        P[keys.index((node, a, b))] += coefficient
+    return (network.C, network.A, network.B, network.q, P)
 
 
 def network_terms(building, effect):
-    """(p0, [(set of parameter indices, (C, A, B, q))]) of the network as a multi-affine
-    function of the effect's parameters; one term (the network) without an effect.
+    """(p0, product keys, [(set of parameter indices, (C, A, B, q, P))]) of the network as a
+    multi-affine function of the effect's parameters; one term (the network) without an effect.
+    P holds the coefficients of the products of inputs at the keys (`product_keys`).
 
     Raises ValueError if the effect's network is not of that form (to 1e-9 relative)."""
     if effect is None:
-        return [], [((), _arrays(assemble(building)))]
+        network = assemble(building)
+        keys = product_keys([network])
+        return [], keys, [((), _arrays(network, keys))]
     p0 = EFFECTS[effect[0]].read(building, effect[1])
     names = list(p0)
     delta = {name: -value / 2 if value else 1.0 for name, value in p0.items()}
@@ -47,35 +59,38 @@ def network_terms(building, effect):
     inputs = assemble(building).input_names  # the FMU's inputs, in the declared building's order
 
     def at(values):
-        return _arrays(assemble(EFFECTS[effect[0]].apply(building, effect[1], values), inputs))
+        return assemble(EFFECTS[effect[0]].apply(building, effect[1], values), inputs)
 
-    corners = {}
+    networks = {}
     for r in range(len(names) + 1):
         for subset in itertools.combinations(range(len(names)), r):
-            corners[subset] = at({n: p0[n] + (delta[n] if j in subset else 0.0) for j, n in enumerate(names)})
+            networks[subset] = at({n: p0[n] + (delta[n] if j in subset else 0.0) for j, n in enumerate(names)})
+    keys = product_keys(networks.values())
+    corners = {subset: _arrays(network, keys) for subset, network in networks.items()}
     terms = []
     for subset in corners:  # inclusion-exclusion over the corners of the subset
         scale = np.prod([delta[names[j]] for j in subset])
         arrays = [sum((-1) ** (len(subset) - len(inner)) * corners[inner][k]
                       for r in range(len(subset) + 1) for inner in itertools.combinations(subset, r)) / scale
-                  for k in range(4)]
-        if subset and all(np.abs(a).max() <= 1e-12 * max(1.0, np.abs(c).max()) for a, c in zip(arrays, corners[()])):
+                  for k in range(5)]
+        if subset and all(np.abs(a).max(initial=0.0) <= 1e-12 * max(1.0, np.abs(c).max(initial=0.0))
+                          for a, c in zip(arrays, corners[()])):
             continue  # parameters that do not act together (a daily gain's terms): nothing to carry
         terms.append((subset, tuple(arrays)))
     check = {n: p0[n] + 0.7 * delta[n] for n in names}
-    expected = at(check)
+    expected = _arrays(at(check), keys)
     for k, exact in enumerate(expected):
         value = sum(np.prod([check[names[j]] - p0[names[j]] for j in subset]) * arrays[k]
                     for subset, arrays in terms)
-        if np.abs(value - exact).max() > 1e-9 * max(1.0, np.abs(exact).max()):
+        if np.abs(value - exact).max(initial=0.0) > 1e-9 * max(1.0, np.abs(exact).max(initial=0.0)):
             raise ValueError(f"effect {effect[0]} does not change the network affinely in each parameter: "
                              "no standalone export")
-    return [p0[n] for n in names], terms
+    return [p0[n] for n in names], keys, terms
 
 
 def network_text(building, effect):
     """resources/network.txt: the format c/nodeforce_fmu.c reads (numbers that round-trip)."""
-    p0, terms = network_terms(building, effect)
+    p0, keys, terms = network_terms(building, effect)
     n = building.n_nodes
     groups = []
     for c in building.components:
@@ -84,9 +99,11 @@ def network_text(building, effect):
         zone = next(k for k, z in enumerate(building.zones) if z.name == c.inside.zone)
         groups.append((zone, list(zip(c.node_ids, c.depths))))
     numbers = lambda values: " ".join(repr(float(v)) for v in np.ravel(values))
-    lines = ["nodeforce-network/1",
-             f"sizes {n} {terms[0][1][2].shape[1]} {len(p0)} {len(terms)} {len(building.zones)} {len(groups)}",
-             f"p0 {numbers(p0)}"]
+    lines = ["nodeforce-network/2",
+             f"sizes {n} {terms[0][1][2].shape[1]} {len(p0)} {len(terms)} {len(building.zones)} {len(groups)} "
+             f"{len(keys)}",
+             f"p0 {numbers(p0)}",
+             "products " + " ".join(f"{node} {a} {b}" for node, a, b in keys)]
     for subset, arrays in terms:
         lines.append(f"term {sum(1 << j for j in subset)}")
         lines += [numbers(a) for a in arrays]
@@ -97,26 +114,14 @@ def network_text(building, effect):
     return "\n".join(lines) + "\n"
 
 
-def compile_library(sources_dir, output):
-    """Compile the C sources into a shared library; a clear error without a C compiler."""
-    compiler = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
-    if not compiler or not shutil.which(compiler.split()[0]):
-        raise RuntimeError("no C compiler found (cc, gcc or $CC): the standalone FMU's linux64 binary is "
-                           "compiled at export; install one (e.g. apt-get install gcc)")
-    command = [*compiler.split(), "-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden",
-               "-o", str(output), "nodeforce_fmu.c", "-lm"]
-    done = subprocess.run(command, cwd=sources_dir, capture_output=True, text=True)
-    if done.returncode:
-        raise RuntimeError(f"compiling the standalone FMU failed: {' '.join(command)}\n{done.stderr}")
-
-
 def standalone_files(building, effect):
     """({archive name: bytes}, model identifier, source file names) of the standalone FMU."""
     files = {f"sources/{name}": (C_DIR / name).read_bytes() for name in SOURCES}
     files["resources/network.txt"] = network_text(building, effect).encode()
     with tempfile.TemporaryDirectory(prefix="nodeforce_fmu_") as tmp:
-        for name in SOURCES:
-            shutil.copy(C_DIR / name, tmp)
-        compile_library(tmp, Path(tmp) / f"{IDENTIFIER}.so")
+        try:
+            compile_library("nodeforce_fmu.c", Path(tmp) / f"{IDENTIFIER}.so", libraries=("m",))
+        except RuntimeError as e:
+            raise RuntimeError(f"the standalone FMU's linux64 binary is compiled at export: {e}") from None
         files[f"binaries/linux64/{IDENTIFIER}.so"] = (Path(tmp) / f"{IDENTIFIER}.so").read_bytes()
     return files, IDENTIFIER, ("nodeforce_fmu.c",)

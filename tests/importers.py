@@ -58,6 +58,18 @@ independent. fmi2Reset re-creates the Python object: parameters must be set agai
 as the standard says, and the re-run is then identical. getFMUstate/setFMUstate work through
 FMPy when the slave overrides ``_get_fmu_state``/``_set_fmu_state``.
 
+OMSimulator is not a runner here: the ``omsimulator`` package on PyPI has no wheel (every version
+is a source package whose build downloads OMSimulator's binaries from the OpenModelica build
+server, which CI cannot reach) and no Debian package carries it. Its source says why it cannot
+record our FMU's results: ``ComponentFMUCS::getReal`` fails on any NaN it reads ("getReal returned
+NAN"), and ``updateSignals`` reads every input and output to record it, so an unset or missing
+``T_forced[i]`` (NaN: no measurement) stops the recording. ``oms_removeSignalsFromResults(model,
+".*T_forced.*")`` before simulating leaves those signals out.
+
+The Python FMU's ``binaries/linux64/<id>.so`` is nodeforce's guard (fmu_build/c/guard.c) in front of
+pythonfmu's binary: forbidden calls get fmi2Error in every importer, and a host without Python
+(the C host, the checkers' own simulators) needs no LD_PRELOAD.
+
 Checkers: ``fmpy_validate`` (``fmpy.validation.validate_fmu``: XSD + names + ModelStructure +
 start values) and ``fmutool_check`` (fmu-manipulation-toolbox ``fmutool -input X.fmu -check``:
 XSD + semantic rules; exit status 0 and "seems to be compliant with FMI-2.0" / "No semantic

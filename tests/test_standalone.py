@@ -1,8 +1,9 @@
 """The standalone FMU (no Python at run time) gives the Python FMU's numbers in a C host, FMPy,
 libcosim and ecos; both FMUs declare units, calculated outputs and their dependencies, and
-refuse the calls the FMI 2.0 standard forbids; the Python FMU runs in a C host with libpython
-preloaded, as the README says, without crashing at exit."""
+refuse the calls the FMI 2.0 standard forbids with fmi2Error; the Python FMU runs in a C host
+(its guard loads libpython), as the README says, without crashing at exit."""
 import copy
+import json
 import os
 import shutil
 import subprocess
@@ -25,7 +26,7 @@ from tests.importers import fmpy_validate, fmutool_check, run_ecos, run_fmpy, ru
 HOST = Path(__file__).with_name("c_host") / "host.c"
 HEADERS = Path(__file__).parents[1] / "fmu_build" / "c"
 KINDS = ("python", "standalone")
-DISCARD, ERROR = 2, 3  # fmi2Status
+ERROR = 3  # fmi2Status
 
 
 def two_zones(data):
@@ -47,11 +48,20 @@ def two_zones(data):
     return data
 
 
+def shaded(data):
+    """The test cell with a blind on its glazing: the transmitted sun is then the product of
+    two inputs, the irradiance and the blind's column."""
+    data = copy.deepcopy(data)
+    glazing = next(c for c in data["components"] if "solar_transmittance" in c)
+    glazing["shading"] = "blind"
+    return data
+
+
 @pytest.fixture(scope="module")
 def fmus(tmp_path_factory, testcell_data):
-    """{(building, kind): FMU path} for the test cell and the two-zone building."""
+    """{(building, kind): FMU path} for the test cell, the two-zone building and the shaded cell."""
     folder = tmp_path_factory.mktemp("standalone")
-    buildings = {"testcell": testcell_data, "two_zones": two_zones(testcell_data)}
+    buildings = {"testcell": testcell_data, "two_zones": two_zones(testcell_data), "shaded": shaded(testcell_data)}
     return {(name, kind): build_fmu(parse_building(data), folder / f"{name}_{kind}.fmu", kind=kind)
             for name, data in buildings.items() for kind in KINDS}
 
@@ -60,18 +70,22 @@ def scenario(fmu, n_steps=192, seed=0):
     """Parameters, inputs and outputs of a two-day run: a sinusoidal day, the forced nodes'
     measurements with gaps (NaN), the initial measurements set during initialisation."""
     rng = np.random.default_rng(seed)
-    names = [v.name for v in read_model_description(str(fmu)).modelVariables]
-    n = sum(name.startswith("T[") for name in names)
+    variables = [v for v in read_model_description(str(fmu)).modelVariables if v.causality == "input"]
+    n = sum(v.name.startswith("T_forced[") for v in variables)
     t = np.arange(1, n_steps + 1) * 900.0
     day = np.sin(2 * np.pi * t / 86400)
     inputs = {}
-    for name in names:
-        if name in ("T_out", "T_sky"):
-            inputs[name] = 24 + 6 * day - (8 if name == "T_sky" else 0)
-        elif name.startswith("I_"):
-            inputs[name] = np.maximum(0, 700 * day)
-        elif name == "Q_annex":
-            inputs[name] = 300 * (day > 0)
+    for v in variables:
+        if v.name in ("T_out", "T_sky"):
+            inputs[v.name] = 24 + 6 * day - (8 if v.name == "T_sky" else 0)
+        elif v.unit == "W/m2":  # irradiance
+            inputs[v.name] = np.maximum(0, 700 * day)
+        elif v.unit == "W":  # a heat input
+            inputs[v.name] = 300 * (day > 0)
+        elif v.description.startswith("shading of"):  # drawn and opened, not in step with the sun
+            inputs[v.name] = 0.5 + 0.5 * np.cos(2 * np.pi * t / 30000)
+        elif v.unit == "degC" and not v.name.startswith("T_forced["):  # a boundary or supply temperature
+            inputs[v.name] = 21 + 2 * day
     forced = (1, 9, 17) if n == 23 else (1, 9, 27)
     for i in forced:
         measured = 27 + 2 * day + rng.normal(0, 0.1, n_steps)
@@ -106,7 +120,7 @@ def run_c_host(fmu, parameters, inputs, outputs, dt, n_steps, tmp_path, env=None
     return done, (np.loadtxt(done.stdout.splitlines(), ndmin=2) if done.returncode == 0 else None)
 
 
-@pytest.mark.parametrize("building", ["testcell", "two_zones"])
+@pytest.mark.parametrize("building", ["testcell", "two_zones", "shaded"])
 def test_standalone_in_a_c_host_equals_the_python_fmu_in_fmpy(fmus, building, tmp_path):
     python_fmu, standalone = fmus[(building, "python")], fmus[(building, "standalone")]
     parameters, inputs, outputs, n_steps = scenario(python_fmu)
@@ -118,6 +132,44 @@ def test_standalone_in_a_c_host_equals_the_python_fmu_in_fmpy(fmus, building, tm
     assert np.ptp(reference[:, 22]) > 1.0
     measured = inputs["T_forced[9]"]
     assert np.array_equal(in_c[np.isfinite(measured), 8], measured[np.isfinite(measured)])
+    if building == "shaded":  # the blind matters: the same run without it differs
+        unshaded = run_fmpy(fmus[("testcell", "python")], parameters,
+                            {name: x for name, x in inputs.items() if name != "blind"}, outputs, 900.0, n_steps)
+        assert np.abs(unshaded - reference).max() > 0.1
+
+
+def test_an_effect_on_a_shaded_glazing_is_carried_by_the_standalone_fmu(fmus, testcell_data, tmp_path):
+    """A corrected transmittance scales the product of inputs itself: its coefficient is a term
+    of the effect's parameter. Both FMUs at a tau other than the declared one agree."""
+    building = parse_building(shaded(testcell_data))
+    glazing = next(c.name for c in building.components if c.shading)
+    effect = ("solar_transmittance", glazing)
+    built = {kind: build_fmu(building, tmp_path / f"{kind}.fmu", effect=effect, kind=kind) for kind in KINDS}
+    parameters, inputs, outputs, n_steps = scenario(built["python"], n_steps=96)
+    at_declared = run_fmpy(built["python"], parameters, inputs, outputs, 900.0, n_steps)
+    parameters["solar_transmittance.tau"] = 0.3
+    reference = run_fmpy(built["python"], parameters, inputs, outputs, 900.0, n_steps)
+    assert np.abs(reference - at_declared).max() > 0.1  # tau matters
+    done, in_c = run_c_host(built["standalone"], parameters, inputs, outputs, 900.0, n_steps, tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert np.abs(in_c - reference).max() < 1e-9
+
+
+TWINHOUSE = Path(__file__).parents[1] / "examples" / "twinhouse_n2" / "building.json"
+
+
+@pytest.mark.slow  # two FMUs of 267 nodes
+def test_standalone_equals_the_python_fmu_on_the_twin_house(tmp_path):
+    """The Twin House's south glazings have blinds (shading_south): both FMUs, a day."""
+    building = parse_building(json.loads(TWINHOUSE.read_text()))
+    python_fmu, standalone = (build_fmu(building, tmp_path / f"{kind}.fmu", kind=kind) for kind in KINDS)
+    parameters, inputs, outputs, n_steps = scenario(python_fmu, n_steps=96)
+    assert "shading_south" in inputs
+    reference = run_fmpy(python_fmu, parameters, inputs, outputs, 900.0, n_steps)
+    done, in_c = run_c_host(standalone, parameters, inputs, outputs, 900.0, n_steps, tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert np.abs(in_c - reference).max() < 1e-9
+    assert np.ptp(reference).max() > 1.0
 
 
 def test_the_standalone_binary_needs_no_python(fmus, tmp_path):
@@ -179,14 +231,15 @@ def test_same_model_same_bytes_and_the_guid_is_its_identity(fmus, testcell_data,
     assert content_id(build_fmu(parse_building(other), tmp_path / "other.fmu", kind=kind)) != content_id(again)
 
 
-def slave_of(fmu, tmp_path):
+def slave_of(fmu, tmp_path, initialise=True):
     md = read_model_description(str(fmu))
     slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(str(fmu), unzipdir=str(tmp_path / "u")),
                       modelIdentifier=md.coSimulation.modelIdentifier, instanceName="calls")
     slave.instantiate()
     slave.setupExperiment(startTime=0.0)
-    slave.enterInitializationMode()
-    slave.exitInitializationMode()
+    if initialise:
+        slave.enterInitializationMode()
+        slave.exitInitializationMode()
     return slave, {v.name: v.valueReference for v in md.modelVariables}
 
 
@@ -199,9 +252,13 @@ def status(call, *args):
     return 0
 
 
-def test_standalone_refuses_forbidden_calls_with_fmi2_error(fmus, tmp_path):
-    slave, vr = slave_of(fmus[("testcell", "standalone")], tmp_path)
-    before = slave.getReal([vr[f"T[{i}]"] for i in range(1, 24)])
+@pytest.mark.parametrize("kind", KINDS)
+def test_forbidden_calls_get_fmi2_error_and_change_nothing(fmus, tmp_path, kind):
+    """Both FMUs (the Python one through its guard) answer what the standard forbids with
+    fmi2Error (not pythonfmu's fmi2Discard or fmi2Fatal), and the state stays as it was."""
+    slave, vr = slave_of(fmus[("testcell", kind)], tmp_path)
+    outputs = [vr[f"T[{i}]"] for i in range(1, 24)]
+    before = slave.getReal(outputs)
     assert status(slave.doStep, 0.0, 0.0) == ERROR
     assert status(slave.doStep, 0.0, -900.0) == ERROR
     assert status(slave.setReal, [vr["T[23]"]], [99.0]) == ERROR  # an output
@@ -210,34 +267,46 @@ def test_standalone_refuses_forbidden_calls_with_fmi2_error(fmus, tmp_path):
     assert status(slave.getReal, [vr["force[9]"]]) == ERROR  # a Boolean
     assert status(slave.getBoolean, [vr["T_start"]]) == ERROR  # a Real
     assert status(slave.getReal, [10 ** 6]) == ERROR
+    assert status(slave.getInteger, [0]) == ERROR  # no Integer variables
     # nothing refused changed anything, and the slave steps on
-    assert slave.getReal([vr[f"T[{i}]"] for i in range(1, 24)]) == before
+    assert slave.getReal(outputs) == before
+    assert slave.getBoolean([vr["force[9]"]]) == [False]
     slave.doStep(currentCommunicationPoint=0.0, communicationStepSize=900.0)
-    assert np.isfinite(slave.getReal([vr["T[23]"]])).all()
+    after = slave.getReal(outputs)
+    assert np.isfinite(after).all() and after != before
     slave.terminate()
     slave.freeInstance()
 
 
-def test_python_fmu_refuses_forbidden_calls_and_keeps_its_state(fmus, tmp_path):
-    """pythonfmu answers a refused doStep with fmi2Discard (a slave's do_step can only say
-    True or False); the state stays as it was, instead of turning NaN for good."""
-    slave, vr = slave_of(fmus[("testcell", "python")], tmp_path)
-    before = slave.getReal([vr["T[23]"]])
-    assert status(slave.doStep, 0.0, -900.0) in (DISCARD, ERROR)
-    assert slave.getReal([vr["T[23]"]]) == before
+def test_the_guard_keeps_the_slave_state_across_fmu_states(fmus, tmp_path):
+    """The guard's own state travels with an FMU state: restored to initialisation, a fixed
+    parameter may be set again; serialised and read back, the state gives the same step."""
+    slave, vr = slave_of(fmus[("testcell", "python")], tmp_path, initialise=False)
+    slave.enterInitializationMode()
+    during = slave.getFMUstate()
+    slave.exitInitializationMode()
+    assert status(slave.setReal, [vr["T_start"]], [25.0]) == ERROR
+    slave.setFMUstate(during)
+    slave.setReal([vr["T_start"]], [25.0])  # allowed again
+    slave.exitInitializationMode()
+    stepping = slave.getFMUstate()
+    restored = slave.deSerializeFMUstate(slave.serializeFMUstate(stepping))
     slave.doStep(currentCommunicationPoint=0.0, communicationStepSize=900.0)
-    assert np.isfinite(slave.getReal([vr["T[23]"]])).all()
+    once = slave.getReal([vr["T[23]"]])
+    slave.setFMUstate(restored)
+    slave.doStep(currentCommunicationPoint=0.0, communicationStepSize=900.0)
+    assert slave.getReal([vr["T[23]"]]) == once
+    for state in (during, stepping, restored):
+        slave.freeFMUstate(state)
     slave.terminate()
     slave.freeInstance()
 
 
 def python_host_environment():
-    """The README's recipe: libpython preloaded, numpy importable, for a C host."""
-    library = Path(sysconfig.get_config_var("LIBDIR")) / sysconfig.get_config_var("LDLIBRARY")
-    if not library.exists():
-        pytest.fail(f"this Python has no shared libpython ({library}): the recipe needs one")
-    site = sysconfig.get_paths()["purelib"]
-    return dict(os.environ, LD_PRELOAD=str(library), PYTHONPATH=site)
+    """A C host's environment for the Python FMU: numpy importable; no LD_PRELOAD, the guard
+    loads libpython itself."""
+    env = {k: v for k, v in os.environ.items() if k != "LD_PRELOAD"}
+    return dict(env, PYTHONPATH=sysconfig.get_paths()["purelib"])
 
 
 @pytest.mark.slow  # processes, a cluster or a whole diagnosis: not in `make check`
@@ -251,3 +320,13 @@ def test_python_fmu_in_a_c_host_runs_twenty_times_without_a_crash_at_exit(fmus, 
         assert done.returncode == 0 and "corrupted" not in done.stderr and "free()" not in done.stderr, \
             f"run {run}: exit {done.returncode}\n{done.stderr}"
         assert np.abs(T - reference).max() < 1e-9
+
+
+def test_a_c_host_without_libpython_gets_one_logged_line(fmus, tmp_path):
+    fmu = fmus[("testcell", "python")]
+    parameters, inputs, outputs, _ = scenario(fmu)
+    env = dict(python_host_environment(), NODEFORCE_LIBPYTHON=str(tmp_path / "libpython-missing.so"))
+    done, _ = run_c_host(fmu, parameters, inputs, outputs, 900.0, 2, tmp_path, env=env)
+    assert done.returncode == 1
+    logged = [line for line in done.stderr.splitlines() if "libpython" in line]
+    assert len(logged) == 1 and "NODEFORCE_LIBPYTHON" in logged[0] and "libpython-missing.so" in logged[0]

@@ -1,15 +1,16 @@
 /* A generic FMI 2.0 co-simulation slave stepping a nodal network (PHYSICS.md section 5).
 
    The network is data, assembled by nodeforce in Python and shipped as resources/network.txt:
-   C (J/K), A (W/K), B, q (W) at the declared effect parameters p0 and, per set S of effect
-   parameters, a term multiplied by prod_{j in S} (p_j - p0_j); the zones' air and radiant nodes
-   and each component's nodes with their depths (for the initial state). This file only steps:
-       (C/dt - A) T+ = (C/dt) T + B u + q,
+   C (J/K), A (W/K), B, q (W) and the coefficients P (W) of the products of two inputs (a shaded
+   glazing's transmitted sun, P_k u_a u_b on node i) at the declared effect parameters p0 and,
+   per set S of effect parameters, a term multiplied by prod_{j in S} (p_j - p0_j); the zones'
+   air and radiant nodes and each component's nodes with their depths (for the initial state).
+   This file only steps:
+       (C/dt - A) T+ = (C/dt) T + B u + q + s(u),   s_i(u) = sum over products k on i of P_k u_a u_b,
    the rows of forced nodes (force[i] and T_forced[i] not NaN) replaced by T+_i = T_forced[i],
    with M factorised (LU, partial pivoting) once per pattern of imposed nodes and step size.
 
-   Value references (fmu_build/variables.py): force[1..N] (Boolean), T_start, the inputs,
-   T_forced[1..N], T[1..N] (outputs), the effect parameters. */
+   Value references and the calls refused: variables.h (shared with the Python FMU's guard). */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -17,8 +18,9 @@
 #include <string.h>
 
 #include "fmi2.h"
+#include "resources.h"
+#include "variables.h"
 
-enum { INSTANTIATED, INITIALISATION, STEPPING, TERMINATED };
 #define CACHED_PATTERNS 8
 
 typedef struct {
@@ -30,10 +32,11 @@ typedef struct {
 } Factors;
 
 typedef struct {
-    int n, n_in, n_par, n_terms, n_zones, n_groups;
+    int n, n_in, n_par, n_terms, n_zones, n_groups, n_products;
     double *p0;     /* n_par */
+    int *product;   /* n_products x 3: node, input a, input b */
     int *term_mask; /* n_terms: bit j = parameter j multiplies the term */
-    double *terms;  /* n_terms x (n + n*n + n*n_in + n): C, A, B, q */
+    double *terms;  /* n_terms x (n + n*n + n*n_in + n + n_products): C, A, B, q, P */
     int *air, *radiant;                 /* n_zones, 0-based nodes */
     int *group_zone, *group_start, *group_len; /* n_groups */
     int *group_node; double *group_depth;      /* concatenated */
@@ -41,23 +44,16 @@ typedef struct {
 
 typedef struct {
     Network net;
+    Layout layout; /* the value references of net's sizes */
     char *name;
     fmi2CallbackFunctions cb;
     int state, size, clock;
     double *values, *start_values;
-    double *C, *A, *B, *q; /* at the parameters' values */
+    double *C, *A, *B, *q, *P; /* at the parameters' values */
     double *v, *T_next;
     unsigned char *imposed;
     Factors cache[CACHED_PATTERNS];
 } Model;
-
-/* ------------------------------------------------------------------ layout */
-static int vr_force(const Model *m) { (void)m; return 0; }
-static int vr_T_start(const Model *m) { return m->net.n; }
-static int vr_inputs(const Model *m) { return m->net.n + 1; }
-static int vr_T_forced(const Model *m) { return vr_inputs(m) + m->net.n_in; }
-static int vr_T(const Model *m) { return vr_T_forced(m) + m->net.n; }
-static int vr_parameters(const Model *m) { return vr_T(m) + m->net.n; }
 
 static void log_error(Model *m, const char *format, ...) {
     char message[512];
@@ -68,65 +64,15 @@ static void log_error(Model *m, const char *format, ...) {
     if (m->cb.logger) m->cb.logger(m->cb.componentEnvironment, m->name, fmi2Error, "logStatusError", "%s", message);
 }
 
-/* Why the standard forbids this get or set, logged; 0 when allowed. */
+/* A get or set the standard forbids (variables.h), its reason logged: 1 when refused. */
 static int refused(Model *m, const fmi2ValueReference vr[], size_t nvr, int real, int setting) {
-    size_t k;
-    for (k = 0; k < nvr; k++) {
-        int r = (int)vr[k];
-        int boolean = r < m->net.n;
-        int fixed = r <= vr_T_start(m) || r >= vr_parameters(m);
-        if (vr[k] >= (fmi2ValueReference)m->size) {
-            log_error(m, "value reference %u does not exist (0..%d)", vr[k], m->size - 1);
-            return 1;
-        }
-        if (boolean == real) {
-            log_error(m, "value reference %d is %s, not %s", r, real ? "Boolean" : "Real", real ? "Real" : "Boolean");
-            return 1;
-        }
-        if (!setting) continue;
-        if (r >= vr_T(m) && r < vr_parameters(m)) {
-            log_error(m, "value reference %d is an output, which cannot be set", r);
-            return 1;
-        }
-        if (fixed && m->state != INSTANTIATED && m->state != INITIALISATION) {
-            log_error(m, "value reference %d is a fixed parameter, which cannot change after initialisation", r);
-            return 1;
-        }
-        if (m->state == TERMINATED) {
-            log_error(m, "the slave is terminated");
-            return 1;
-        }
-    }
-    return 0;
+    char reason[256];
+    if (!refusal(&m->layout, vr, nvr, real, setting, m->state, reason, sizeof reason)) return 0;
+    log_error(m, "%s", reason);
+    return 1;
 }
 
 /* ------------------------------------------------------------------ reading the network */
-static char *file_path(const char *uri, const char *name) {
-    const char *p = uri;
-    char *path, *out;
-    if (strncmp(p, "file://", 7) == 0) {
-        p += 7;
-        if (strncmp(p, "localhost/", 10) == 0) p += 9;
-    } else if (strncmp(p, "file:", 5) == 0) {
-        p += 5;
-    }
-    path = malloc(strlen(p) + strlen(name) + 2);
-    if (!path) return NULL;
-    for (out = path; *p; p++) { /* percent-decoding */
-        if (p[0] == '%' && p[1] && p[2]) {
-            char hex[3] = {p[1], p[2], 0};
-            *out++ = (char)strtol(hex, NULL, 16);
-            p += 2;
-        } else {
-            *out++ = *p;
-        }
-    }
-    if (out > path && out[-1] == '/') out--;
-    *out++ = '/';
-    strcpy(out, name);
-    return path;
-}
-
 static int expect(FILE *f, const char *word) {
     char token[64];
     return fscanf(f, "%63s", token) == 1 && strcmp(token, word) == 0;
@@ -146,15 +92,16 @@ static int read_doubles(FILE *f, double *x, long count) {
     return 1;
 }
 
-static long term_size(const Network *net) { return (long)net->n * (2 + net->n + net->n_in); }
+static long term_size(const Network *net) { return (long)net->n * (2 + net->n + net->n_in) + net->n_products; }
 
 static int read_network(Network *net, FILE *f) {
     int k, total = 0;
-    if (!expect(f, "nodeforce-network/1") || !expect(f, "sizes") || !read_ints(f, &net->n, 1)
+    if (!expect(f, "nodeforce-network/2") || !expect(f, "sizes") || !read_ints(f, &net->n, 1)
         || !read_ints(f, &net->n_in, 1) || !read_ints(f, &net->n_par, 1) || !read_ints(f, &net->n_terms, 1)
-        || !read_ints(f, &net->n_zones, 1) || !read_ints(f, &net->n_groups, 1))
+        || !read_ints(f, &net->n_zones, 1) || !read_ints(f, &net->n_groups, 1) || !read_ints(f, &net->n_products, 1))
         return 0;
     net->p0 = calloc((size_t)net->n_par + 1, sizeof(double));
+    net->product = calloc((size_t)net->n_products * 3 + 1, sizeof(int));
     net->term_mask = calloc((size_t)net->n_terms, sizeof(int));
     net->terms = calloc((size_t)(net->n_terms * term_size(net)), sizeof(double));
     net->air = calloc((size_t)net->n_zones, sizeof(int));
@@ -164,10 +111,15 @@ static int read_network(Network *net, FILE *f) {
     net->group_len = calloc((size_t)net->n_groups, sizeof(int));
     net->group_node = calloc((size_t)net->n, sizeof(int));
     net->group_depth = calloc((size_t)net->n, sizeof(double));
-    if (!net->p0 || !net->term_mask || !net->terms || !net->air || !net->radiant || !net->group_zone
+    if (!net->p0 || !net->product || !net->term_mask || !net->terms || !net->air || !net->radiant || !net->group_zone
         || !net->group_start || !net->group_len || !net->group_node || !net->group_depth)
         return 0;
     if (!expect(f, "p0") || !read_doubles(f, net->p0, net->n_par)) return 0;
+    if (!expect(f, "products") || !read_ints(f, net->product, net->n_products * 3)) return 0;
+    for (k = 0; k < net->n_products; k++) {
+        const int *p = net->product + 3 * k;
+        if (p[0] < 0 || p[0] >= net->n || p[1] < 0 || p[1] >= net->n_in || p[2] < 0 || p[2] >= net->n_in) return 0;
+    }
     for (k = 0; k < net->n_terms; k++)
         if (!expect(f, "term") || !read_ints(f, &net->term_mask[k], 1)
             || !read_doubles(f, net->terms + k * term_size(net), term_size(net)))
@@ -188,7 +140,7 @@ static int read_network(Network *net, FILE *f) {
 }
 
 static void free_network(Network *net) {
-    free(net->p0); free(net->term_mask); free(net->terms); free(net->air); free(net->radiant);
+    free(net->p0); free(net->product); free(net->term_mask); free(net->terms); free(net->air); free(net->radiant);
     free(net->group_zone); free(net->group_start); free(net->group_len); free(net->group_node);
     free(net->group_depth);
 }
@@ -199,13 +151,13 @@ static void network_at_parameters(Model *m) {
     const Network *net = &m->net;
     long size = term_size(net), k;
     int t, j;
-    double *out = m->C; /* C, A, B, q are one contiguous block */
+    double *out = m->C; /* C, A, B, q, P are one contiguous block */
     memset(out, 0, (size_t)size * sizeof(double));
     for (t = 0; t < net->n_terms; t++) {
         double weight = 1.0;
         const double *term = net->terms + t * size;
         for (j = 0; j < net->n_par; j++)
-            if (net->term_mask[t] & (1 << j)) weight *= m->values[vr_parameters(m) + j] - net->p0[j];
+            if (net->term_mask[t] & (1 << j)) weight *= m->values[vr_parameters(&m->layout) + j] - net->p0[j];
         for (k = 0; k < size; k++) out[k] += weight * term[k];
     }
 }
@@ -222,8 +174,8 @@ static double interp(double x, const double *xp, const double *fp, int count) {
 /* PHYSICS.md section 5: the initial state from the measurements at t_0 and T_start. */
 static void initial_state(Model *m) {
     const Network *net = &m->net;
-    const double *measured = m->values + vr_T_forced(m);
-    double *T = m->values + vr_T(m), T_start = m->values[vr_T_start(m)];
+    const double *measured = m->values + vr_T_forced(&m->layout);
+    double *T = m->values + vr_T(&m->layout), T_start = m->values[vr_T_start(&m->layout)];
     double *xp = malloc((size_t)net->n * sizeof(double)), *fp = malloc((size_t)net->n * sizeof(double));
     int z, g, i;
     for (z = 0; z < net->n_zones; z++) {
@@ -330,21 +282,25 @@ static void forget_factors(Model *m) {
 
 static fmi2Status step(Model *m, double dt) {
     const Network *net = &m->net;
-    int n = net->n, i, j;
-    const double *u = m->values + vr_inputs(m), *T_forced = m->values + vr_T_forced(m);
-    double *T = m->values + vr_T(m);
+    int n = net->n, i, j, k;
+    const double *u = m->values + vr_inputs(&m->layout), *T_forced = m->values + vr_T_forced(&m->layout);
+    double *T = m->values + vr_T(&m->layout);
     Factors *f;
-    for (i = 0; i < n; i++) m->imposed[i] = m->values[vr_force(m) + i] != 0.0 && isfinite(T_forced[i]);
+    for (i = 0; i < n; i++) m->imposed[i] = m->values[vr_force(&m->layout) + i] != 0.0 && isfinite(T_forced[i]);
     f = factors(m, dt);
     if (!f) {
         log_error(m, "the step matrix is singular (or memory ran out)");
         return fmi2Error;
     }
-    for (i = 0; i < n; i++) {
-        double source = m->q[i];
-        for (j = 0; j < net->n_in; j++) source += m->B[i * net->n_in + j] * u[j];
-        m->v[i] = m->imposed[i] ? T_forced[i] : m->C[i] / dt * T[i] + source;
+    for (i = 0; i < n; i++) { /* the sources */
+        m->v[i] = m->q[i];
+        for (j = 0; j < net->n_in; j++) m->v[i] += m->B[i * net->n_in + j] * u[j];
     }
+    for (k = 0; k < net->n_products; k++) {
+        const int *p = net->product + 3 * k;
+        m->v[p[0]] += m->P[k] * u[p[1]] * u[p[2]];
+    }
+    for (i = 0; i < n; i++) m->v[i] = m->imposed[i] ? T_forced[i] : m->C[i] / dt * T[i] + m->v[i];
     lu_solve(f->lu, f->piv, m->v, n);
     for (i = 0; i < n; i++) T[i] = m->imposed[i] ? T_forced[i] : m->v[i];
     return fmi2OK;
@@ -389,7 +345,7 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
         free_model(m);
         return NULL;
     }
-    path = resources ? file_path(resources, "network.txt") : NULL;
+    path = resources ? resource_path(resources, "network.txt") : NULL;
     f = path ? fopen(path, "r") : NULL;
     ok = f && read_network(&m->net, f);
     if (f) fclose(f);
@@ -400,13 +356,17 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
         return NULL;
     }
     free(path);
-    m->size = vr_parameters(m) + m->net.n_par;
+    m->layout.n = m->net.n;
+    m->layout.n_in = m->net.n_in;
+    m->layout.n_par = m->net.n_par;
+    m->size = layout_size(&m->layout);
     m->values = calloc((size_t)m->size, sizeof(double));
     m->start_values = calloc((size_t)m->size, sizeof(double));
     m->C = calloc((size_t)term_size(&m->net), sizeof(double));
     m->A = m->C + m->net.n;
     m->B = m->A + m->net.n * m->net.n;
     m->q = m->B + m->net.n * m->net.n_in;
+    m->P = m->q + m->net.n;
     m->v = calloc((size_t)m->net.n, sizeof(double));
     m->T_next = calloc((size_t)m->net.n, sizeof(double));
     m->imposed = calloc((size_t)m->net.n, 1);
@@ -414,12 +374,12 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
         free_model(m);
         return NULL;
     }
-    m->start_values[vr_T_start(m)] = 20.0;
+    m->start_values[vr_T_start(&m->layout)] = 20.0;
     for (i = 0; i < m->net.n; i++) {
-        m->start_values[vr_T_forced(m) + i] = NAN;
-        m->start_values[vr_T(m) + i] = 20.0;
+        m->start_values[vr_T_forced(&m->layout) + i] = NAN;
+        m->start_values[vr_T(&m->layout) + i] = 20.0;
     }
-    for (i = 0; i < m->net.n_par; i++) m->start_values[vr_parameters(m) + i] = m->net.p0[i];
+    for (i = 0; i < m->net.n_par; i++) m->start_values[vr_parameters(&m->layout) + i] = m->net.p0[i];
     memcpy(m->values, m->start_values, (size_t)m->size * sizeof(double));
     forget_factors(m);
     m->state = INSTANTIATED;
@@ -507,8 +467,9 @@ FMI2_EXPORT fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference 
 }
 
 static fmi2Status no_such(Model *m, const char *what, size_t nvr) {
-    if (nvr == 0) return fmi2OK;
-    log_error(m, "this FMU has no %s variables", what);
+    char reason[256];
+    if (!no_such_type(what, nvr, reason, sizeof reason)) return fmi2OK;
+    log_error(m, "%s", reason);
     return fmi2Error;
 }
 
@@ -610,13 +571,10 @@ FMI2_EXPORT fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2V
 FMI2_EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
                                   fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
     Model *m = c;
+    char reason[256];
     (void)currentCommunicationPoint; (void)noSetFMUStatePriorToCurrentPoint;
-    if (m->state != STEPPING) {
-        log_error(m, "fmi2DoStep before initialisation ended, or after fmi2Terminate");
-        return fmi2Error;
-    }
-    if (!(communicationStepSize > 0.0)) {
-        log_error(m, "fmi2DoStep with communicationStepSize %g s: it must be > 0", communicationStepSize);
+    if (step_refusal(m->state, communicationStepSize, reason, sizeof reason)) {
+        log_error(m, "%s", reason);
         return fmi2Error;
     }
     return step(m, communicationStepSize);

@@ -1,0 +1,383 @@
+/* The guard in front of the Python FMU: binaries/linux64/<modelIdentifier>.so is this library,
+   pythonfmu's binary ships beside it under the name resources/guard.txt gives.
+
+   Why: pythonfmu's C++ wrapper turns every Python exception into fmi2Fatal (get/set) or
+   fmi2Discard (doStep), so the slave can refuse a call but cannot answer fmi2Error. The guard
+   refuses the calls the standard forbids with fmi2Error and the reason logged (the checks of
+   variables.h, the same as the standalone FMU's) and forwards every other call unchanged.
+
+   And: pythonfmu's binary does not link libpython, it expects Python in the host process. When
+   the process has none (Py_IsInitialized not found), the guard loads libpython with RTLD_GLOBAL
+   first: $NODEFORCE_LIBPYTHON, else the path recorded at export in resources/guard.txt.
+
+   The guard does not depend on the model: it reads the sizes of the layout from
+   resources/guard.txt at instantiation, a file of four lines:
+       nodeforce-guard/1
+       sizes N N_IN N_PAR
+       binary FILE_NAME         pythonfmu's binary, in this library's folder
+       libpython PATH
+
+   Loading. pythonfmu's binary is opened once per load of this library, RTLD_LOCAL: its fmi2*
+   names, the same as ours, then stay out of the global scope, and we call it only through the
+   pointers dlsym gives. Its own calls cannot land here either: it has no relocations against
+   fmi2* names (objdump -R), so RTLD_DEEPBIND, which would also give it a C++ runtime scope of
+   its own, is not needed. It is closed once, when this library is unloaded (its destructor):
+   pythonfmu ends the interpreter it started when it is unloaded, so closing it per instance
+   would end Python between two instances, which numpy does not survive. */
+#define _GNU_SOURCE
+#include <dlfcn.h>
+#include <pthread.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmi2.h"
+#include "resources.h"
+#include "variables.h"
+
+#define LIBPYTHON_VARIABLE "NODEFORCE_LIBPYTHON"
+
+#define FORWARDED(X)                                                                                          \
+    X(fmi2SetDebugLogging) X(fmi2Instantiate) X(fmi2FreeInstance) X(fmi2SetupExperiment)                      \
+    X(fmi2EnterInitializationMode) X(fmi2ExitInitializationMode) X(fmi2Terminate) X(fmi2Reset) X(fmi2GetReal) \
+    X(fmi2GetInteger) X(fmi2GetBoolean) X(fmi2GetString) X(fmi2SetReal) X(fmi2SetInteger) X(fmi2SetBoolean)   \
+    X(fmi2SetString) X(fmi2GetFMUstate) X(fmi2SetFMUstate) X(fmi2FreeFMUstate) X(fmi2SerializedFMUstateSize)  \
+    X(fmi2SerializeFMUstate) X(fmi2DeSerializeFMUstate) X(fmi2GetDirectionalDerivative)                       \
+    X(fmi2SetRealInputDerivatives) X(fmi2GetRealOutputDerivatives) X(fmi2DoStep) X(fmi2CancelStep)            \
+    X(fmi2GetStatus) X(fmi2GetRealStatus) X(fmi2GetIntegerStatus) X(fmi2GetBooleanStatus) X(fmi2GetStringStatus)
+
+#define MEMBER(name) name##TYPE *name;
+static struct {
+    void *library;
+    FORWARDED(MEMBER)
+} inner;
+static pthread_mutex_t loading = PTHREAD_MUTEX_INITIALIZER;
+
+typedef struct {
+    fmi2Component inner;
+    Layout layout;
+    int state;
+    char *name;
+    fmi2CallbackFunctions cb;
+} Guard;
+
+/* A state of the slave: the guard's state beside pythonfmu's. */
+typedef struct {
+    int state;
+    fmi2FMUstate inner;
+} GuardState;
+
+static void log_error(const fmi2CallbackFunctions *cb, const char *name, const char *format, ...) {
+    char message[1024];
+    va_list args;
+    va_start(args, format);
+    vsnprintf(message, sizeof message, format, args);
+    va_end(args);
+    if (cb && cb->logger) cb->logger(cb->componentEnvironment, name, fmi2Error, "logStatusError", "%s", message);
+}
+
+/* ------------------------------------------------------------------ resources/guard.txt */
+typedef struct {
+    Layout layout;
+    char binary[256];
+    char libpython[4096];
+} GuardFile;
+
+/* The rest of a line after "word ", without its newline. */
+static int read_field(FILE *f, const char *word, char *value, size_t size) {
+    char line[4352];
+    size_t n = strlen(word), length;
+    if (!fgets(line, sizeof line, f) || strncmp(line, word, n) != 0 || line[n] != ' ') return 0;
+    length = strcspn(line + n + 1, "\r\n");
+    if (length == 0 || length >= size) return 0;
+    memcpy(value, line + n + 1, length);
+    value[length] = 0;
+    return 1;
+}
+
+static int read_guard_file(const char *path, GuardFile *g) {
+    char header[64], sizes[64];
+    FILE *f = fopen(path, "r");
+    int ok = f && fgets(header, sizeof header, f) && strcmp(header, "nodeforce-guard/1\n") == 0
+             && read_field(f, "sizes", sizes, sizeof sizes)
+             && sscanf(sizes, "%d %d %d", &g->layout.n, &g->layout.n_in, &g->layout.n_par) == 3
+             && read_field(f, "binary", g->binary, sizeof g->binary)
+             && read_field(f, "libpython", g->libpython, sizeof g->libpython);
+    if (f) fclose(f);
+    return ok;
+}
+
+/* ------------------------------------------------------------------ loading pythonfmu's binary */
+static void here(void) {}
+
+/* Python in the process, then pythonfmu's binary and its functions; 0 with the reason logged. */
+static int load(const GuardFile *file, const fmi2CallbackFunctions *cb, const char *name) {
+    Dl_info self;
+    char *path;
+    const char *slash, *libpython = getenv(LIBPYTHON_VARIABLE);
+    void *library;
+    if (inner.library) return 1;
+    if (!dlsym(RTLD_DEFAULT, "Py_IsInitialized")) {
+        if (!libpython || !*libpython) libpython = file->libpython;
+        if (!dlopen(libpython, RTLD_NOW | RTLD_GLOBAL)) {
+            log_error(cb, name, "this process has no Python and libpython cannot be loaded (%s): set %s to the "
+                      "libpython3 shared library of a Python with numpy", dlerror(), LIBPYTHON_VARIABLE);
+            return 0;
+        }
+    }
+    if (!dladdr((void *)here, &self) || !(slash = strrchr(self.dli_fname, '/'))) {
+        log_error(cb, name, "cannot find the folder of the FMU's binary");
+        return 0;
+    }
+    path = malloc((size_t)(slash - self.dli_fname) + strlen(file->binary) + 2);
+    if (!path) return 0;
+    sprintf(path, "%.*s/%s", (int)(slash - self.dli_fname), self.dli_fname, file->binary);
+    library = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    free(path);
+    if (!library) {
+        log_error(cb, name, "cannot load pythonfmu's binary: %s", dlerror());
+        return 0;
+    }
+#define LOOK_UP(function)                                                              \
+    if (!(inner.function = (function##TYPE *)dlsym(library, #function))) {           \
+        log_error(cb, name, "pythonfmu's binary has no function %s", #function);      \
+        dlclose(library);                                                              \
+        return 0;                                                                      \
+    }
+    FORWARDED(LOOK_UP)
+    inner.library = library;
+    return 1;
+}
+
+__attribute__((destructor)) static void unload(void) {
+    if (inner.library) dlclose(inner.library);
+    inner.library = NULL;
+}
+
+/* ------------------------------------------------------------------ FMI 2.0 */
+static fmi2Status refuse(Guard *g, const char *reason) {
+    log_error(&g->cb, g->name, "%s", reason);
+    return fmi2Error;
+}
+
+/* A state change that happens when the slave accepts the call. */
+static fmi2Status moved(Guard *g, fmi2Status status, int state) {
+    if (status <= fmi2Warning) g->state = state;
+    return status;
+}
+
+FMI2_EXPORT const char *fmi2GetTypesPlatform(void) { return "default"; }
+FMI2_EXPORT const char *fmi2GetVersion(void) { return "2.0"; }
+
+FMI2_EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean on, size_t n, const fmi2String categories[]) {
+    return inner.fmi2SetDebugLogging(((Guard *)c)->inner, on, n, categories);
+}
+
+static void free_guard(Guard *g) {
+    if (!g) return;
+    free(g->name);
+    free(g);
+}
+
+FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, fmi2String resources,
+                                          const fmi2CallbackFunctions *functions, fmi2Boolean visible,
+                                          fmi2Boolean loggingOn) {
+    GuardFile file;
+    Guard *g;
+    char *path;
+    int ok;
+    if (!functions) return NULL; /* no logger to say why: the standard requires the callbacks */
+    path = resources ? resource_path(resources, "guard.txt") : NULL;
+    ok = path && read_guard_file(path, &file);
+    if (!ok) {
+        log_error(functions, name, "cannot read %s", path ? path : "the resources (no fmuResourceLocation)");
+        free(path);
+        return NULL;
+    }
+    free(path);
+    pthread_mutex_lock(&loading);
+    ok = load(&file, functions, name);
+    pthread_mutex_unlock(&loading);
+    g = ok ? calloc(1, sizeof(Guard)) : NULL;
+    if (!g) return NULL;
+    g->name = malloc(strlen(name ? name : "") + 1);
+    if (!g->name) {
+        free_guard(g);
+        return NULL;
+    }
+    strcpy(g->name, name ? name : "");
+    memcpy((void *)&g->cb, functions, sizeof g->cb);
+    g->layout = file.layout;
+    g->state = INSTANTIATED;
+    g->inner = inner.fmi2Instantiate(name, type, guid, resources, functions, visible, loggingOn);
+    if (!g->inner) {
+        free_guard(g);
+        return NULL;
+    }
+    return g;
+}
+
+FMI2_EXPORT void fmi2FreeInstance(fmi2Component c) {
+    Guard *g = c;
+    if (!g) return;
+    inner.fmi2FreeInstance(g->inner);
+    free_guard(g);
+}
+
+FMI2_EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
+                                           fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
+    return inner.fmi2SetupExperiment(((Guard *)c)->inner, toleranceDefined, tolerance, startTime, stopTimeDefined,
+                                     stopTime);
+}
+
+FMI2_EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
+    Guard *g = c;
+    return moved(g, inner.fmi2EnterInitializationMode(g->inner), INITIALISATION);
+}
+
+FMI2_EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
+    Guard *g = c;
+    return moved(g, inner.fmi2ExitInitializationMode(g->inner), STEPPING);
+}
+
+FMI2_EXPORT fmi2Status fmi2Terminate(fmi2Component c) {
+    Guard *g = c;
+    return moved(g, inner.fmi2Terminate(g->inner), TERMINATED);
+}
+
+FMI2_EXPORT fmi2Status fmi2Reset(fmi2Component c) {
+    Guard *g = c;
+    return moved(g, inner.fmi2Reset(g->inner), INSTANTIATED);
+}
+
+/* The get and set calls: refused here (variables.h), or forwarded. */
+#define GET_OR_SET(function, value_type, real, setting)                                                       \
+    FMI2_EXPORT fmi2Status function(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, value_type) { \
+        Guard *g = c;                                                                                         \
+        char reason[256];                                                                                     \
+        if (refusal(&g->layout, vr, nvr, real, setting, g->state, reason, sizeof reason))                    \
+            return refuse(g, reason);                                                                         \
+        return inner.function(g->inner, vr, nvr, value);                                                      \
+    }
+GET_OR_SET(fmi2GetReal, fmi2Real value[], 1, 0)
+GET_OR_SET(fmi2SetReal, const fmi2Real value[], 1, 1)
+GET_OR_SET(fmi2GetBoolean, fmi2Boolean value[], 0, 0)
+GET_OR_SET(fmi2SetBoolean, const fmi2Boolean value[], 0, 1)
+
+#define NO_SUCH_TYPE(function, value_type, type)                                                              \
+    FMI2_EXPORT fmi2Status function(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, value_type) { \
+        Guard *g = c;                                                                                         \
+        char reason[256];                                                                                     \
+        if (no_such_type(type, nvr, reason, sizeof reason)) return refuse(g, reason);                        \
+        return inner.function(g->inner, vr, nvr, value);                                                      \
+    }
+NO_SUCH_TYPE(fmi2GetInteger, fmi2Integer value[], "Integer")
+NO_SUCH_TYPE(fmi2SetInteger, const fmi2Integer value[], "Integer")
+NO_SUCH_TYPE(fmi2GetString, fmi2String value[], "String")
+NO_SUCH_TYPE(fmi2SetString, const fmi2String value[], "String")
+
+FMI2_EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *state) {
+    Guard *g = c;
+    GuardState *s = *state ? *state : calloc(1, sizeof(GuardState));
+    fmi2Status status;
+    if (!s) return refuse(g, "out of memory for a state");
+    status = inner.fmi2GetFMUstate(g->inner, &s->inner);
+    if (status > fmi2Warning) {
+        if (!*state) free(s);
+        return status;
+    }
+    s->state = g->state;
+    *state = s;
+    return status;
+}
+
+FMI2_EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state) {
+    Guard *g = c;
+    GuardState *s = state;
+    if (!s) return refuse(g, "fmi2SetFMUstate without a state");
+    return moved(g, inner.fmi2SetFMUstate(g->inner, s->inner), s->state);
+}
+
+FMI2_EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state) {
+    Guard *g = c;
+    GuardState *s = *state;
+    fmi2Status status = fmi2OK;
+    if (!s) return fmi2OK;
+    if (s->inner) status = inner.fmi2FreeFMUstate(g->inner, &s->inner);
+    free(s);
+    *state = NULL;
+    return status;
+}
+
+/* A serialized state: one byte of the guard's state, then pythonfmu's bytes. */
+FMI2_EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate state, size_t *size) {
+    Guard *g = c;
+    fmi2Status status = inner.fmi2SerializedFMUstateSize(g->inner, ((GuardState *)state)->inner, size);
+    if (status <= fmi2Warning) *size += 1;
+    return status;
+}
+
+FMI2_EXPORT fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate state, fmi2Byte bytes[], size_t size) {
+    Guard *g = c;
+    GuardState *s = state;
+    if (size < 1) return refuse(g, "fmi2SerializeFMUstate: no room for the state");
+    bytes[0] = (fmi2Byte)s->state;
+    return inner.fmi2SerializeFMUstate(g->inner, s->inner, bytes + 1, size - 1);
+}
+
+FMI2_EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[], size_t size,
+                                               fmi2FMUstate *state) {
+    Guard *g = c;
+    GuardState *s;
+    fmi2Status status;
+    if (size < 1 || bytes[0] < INSTANTIATED || bytes[0] > TERMINATED)
+        return refuse(g, "these bytes are not a serialized state of this FMU");
+    s = calloc(1, sizeof(GuardState));
+    if (!s) return refuse(g, "out of memory for a state");
+    s->state = bytes[0];
+    status = inner.fmi2DeSerializeFMUstate(g->inner, bytes + 1, size - 1, &s->inner);
+    if (status > fmi2Warning) {
+        free(s);
+        return status;
+    }
+    *state = s;
+    return status;
+}
+
+FMI2_EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,
+                                                    const fmi2ValueReference z[], size_t nz, const fmi2Real dv[],
+                                                    fmi2Real dz[]) {
+    return inner.fmi2GetDirectionalDerivative(((Guard *)c)->inner, u, nu, z, nz, dv, dz);
+}
+
+FMI2_EXPORT fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                                   const fmi2Integer order[], const fmi2Real value[]) {
+    return inner.fmi2SetRealInputDerivatives(((Guard *)c)->inner, vr, nvr, order, value);
+}
+
+FMI2_EXPORT fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                                    const fmi2Integer order[], fmi2Real value[]) {
+    return inner.fmi2GetRealOutputDerivatives(((Guard *)c)->inner, vr, nvr, order, value);
+}
+
+FMI2_EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
+                                  fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
+    Guard *g = c;
+    char reason[256];
+    if (step_refusal(g->state, communicationStepSize, reason, sizeof reason)) return refuse(g, reason);
+    return inner.fmi2DoStep(g->inner, currentCommunicationPoint, communicationStepSize,
+                            noSetFMUStatePriorToCurrentPoint);
+}
+
+FMI2_EXPORT fmi2Status fmi2CancelStep(fmi2Component c) { return inner.fmi2CancelStep(((Guard *)c)->inner); }
+
+#define STATUS(function, value_type)                                                              \
+    FMI2_EXPORT fmi2Status function(fmi2Component c, const fmi2StatusKind s, value_type *value) { \
+        return inner.function(((Guard *)c)->inner, s, value);                                     \
+    }
+STATUS(fmi2GetStatus, fmi2Status)
+STATUS(fmi2GetRealStatus, fmi2Real)
+STATUS(fmi2GetIntegerStatus, fmi2Integer)
+STATUS(fmi2GetBooleanStatus, fmi2Boolean)
+STATUS(fmi2GetStringStatus, fmi2String)
