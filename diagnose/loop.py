@@ -203,7 +203,7 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
     calibration = case.window(0, k)
     measured = objective.measured(case)
     scored = objective.measured(calibration)
-    noise = Noise.of(objective.measured(case), noise)
+    noise = Noise.of(measured, noise)
     sigma = noise.sigma
 
     with FmuInstance(build_fmu(building, workdir / "model_before.fmu", kind=fmu_kind)) as base:

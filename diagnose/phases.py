@@ -38,7 +38,13 @@ def phase_errors(phases, times, measured, runs):
     return rows
 
 
+def is_worse(before, after):
+    """Whether an RMSE (C) went from `before` to `after` by a rise of WORSE or more; False where
+    either is unknown (a phase without a scored step)."""
+    return before is not None and after is not None and after >= (1 + WORSE) * before
+
+
 def worsened(rows, before, after):
     """The phases whose RMSE rises by WORSE or more from run `before` to run `after`."""
     return [{"phase": row["phase"], "before": row["rmse"][before], "after": row["rmse"][after]}
-            for row in rows if row["n"] and row["rmse"][after] >= (1 + WORSE) * row["rmse"][before]]
+            for row in rows if is_worse(row["rmse"][before], row["rmse"][after])]

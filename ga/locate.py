@@ -71,13 +71,14 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
     if not candidates:
         raise InputError(source, "columns", "no measured node besides the objective's air: nothing to force")
     fmu = build_fmu(building, workdir / "model.fmu", kind=fmu_kind)
-    noise = Noise.of(objective.measured(case), noise)
+    measured = objective.measured(case)
+    noise = Noise.of(measured, noise)
     result = search(FmuFitness(fmu, case, candidates, objective, warmup_days), candidates,
                     population=population, generations=generations, pc=pc, pm=pm, seed=seed,
                     patience=patience, seeded=seeded,
                     workers=workers, scheduler=scheduler, checkpoint=workdir / "locate.checkpoint.json",
                     progress=progress, noise_sigma=noise.sigma,
-                    n_residuals=int(np.isfinite(objective.measured(case)).sum()))
+                    n_residuals=int(np.isfinite(measured).sum()))
     result = {"measured_nodes": case.measured_ids, "output_node": objective.air_nodes[0],
               "objective": list(objective.zones), "output_nodes": list(objective.air_nodes), **result,
               "noise": noise.to_json()}

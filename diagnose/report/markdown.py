@@ -6,6 +6,7 @@ from pathlib import Path
 
 from . import content, tables
 from ..phases import WORSE
+from ...ga.parsimony import Z_NOISE
 from .formats import NA, fmt_search, fmt_sig, num, time_text
 
 
@@ -26,7 +27,7 @@ def decision_lines(report):
     lines.append(f"- BIC of the model without an effect (calibration window): {fmt_sig(bic)}; a candidate must "
                  "have a lower BIC.")
     lines.append(f"- validation J without an effect: {fmt_sig(J)} C²; a candidate must lower it by more than "
-                 f"the sensor noise could ({fmt_sig(margin)} C²) and by more than three standard deviations of "
+                 f"the sensor noise could ({fmt_sig(margin)} C²) and by more than {Z_NOISE:g} standard deviations of "
                  "that fall as the residuals' correlation in time makes it (the fall needed, per candidate, "
                  "in the candidates table).")
     lines.append(f"- chosen: {d.get('chosen') or 'none'}")

@@ -6,7 +6,7 @@ from __future__ import annotations
 from . import content
 from .content import STATES, WINDOWS, metrics
 from .formats import (NA, fmt_bic, fmt_derived, fmt_int, fmt_parameters, fmt_sig, fmt_temp, num, time_text)
-from ..phases import WORSE
+from ..phases import is_worse
 from ..residuals import lag_text
 
 
@@ -202,8 +202,7 @@ def phases(report):
 
     def cell(row, label):
         value, before = num(row["rmse"].get(label)), num(row["rmse"].get("before"))
-        worse = value is not None and before is not None and label != "before" and value >= (1 + WORSE) * before
-        return fmt_temp(value) + (" ▲" if worse else "")
+        return fmt_temp(value) + (" ▲" if label != "before" and is_worse(before, value) else "")
     return markdown(["phase", "from", "n"] + labels,
                     [[row["phase"], time_text(row["start"]), fmt_int(row["n"])] + [cell(row, label) for label in labels]
                      for row in rows])
