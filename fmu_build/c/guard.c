@@ -231,25 +231,16 @@ FMI2_EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranc
                                      stopTime);
 }
 
-FMI2_EXPORT fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
-    Guard *g = c;
-    return moved(g, inner.fmi2EnterInitializationMode(g->inner), INITIALISATION);
-}
-
-FMI2_EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
-    Guard *g = c;
-    return moved(g, inner.fmi2ExitInitializationMode(g->inner), STEPPING);
-}
-
-FMI2_EXPORT fmi2Status fmi2Terminate(fmi2Component c) {
-    Guard *g = c;
-    return moved(g, inner.fmi2Terminate(g->inner), TERMINATED);
-}
-
-FMI2_EXPORT fmi2Status fmi2Reset(fmi2Component c) {
-    Guard *g = c;
-    return moved(g, inner.fmi2Reset(g->inner), INSTANTIATED);
-}
+/* The calls that move the instance to another state: forwarded, the state kept if they succeed. */
+#define MOVES_TO(function, to)                                 \
+    FMI2_EXPORT fmi2Status function(fmi2Component c) {         \
+        Guard *g = c;                                          \
+        return moved(g, inner.function(g->inner), to);         \
+    }
+MOVES_TO(fmi2EnterInitializationMode, INITIALISATION)
+MOVES_TO(fmi2ExitInitializationMode, STEPPING)
+MOVES_TO(fmi2Terminate, TERMINATED)
+MOVES_TO(fmi2Reset, INSTANTIATED)
 
 /* The get and set calls: refused here (variables.h), or forwarded. */
 #define GET_OR_SET(function, value_type, real, setting)                                                       \

@@ -590,23 +590,13 @@ static fmi2Status no_status(Model *m) {
     return fmi2Discard;
 }
 
-FMI2_EXPORT fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value) {
-    (void)s; (void)value;
-    return no_status(c);
-}
-FMI2_EXPORT fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value) {
-    (void)s; (void)value;
-    return no_status(c);
-}
-FMI2_EXPORT fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value) {
-    (void)s; (void)value;
-    return no_status(c);
-}
-FMI2_EXPORT fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value) {
-    (void)s; (void)value;
-    return no_status(c);
-}
-FMI2_EXPORT fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value) {
-    (void)s; (void)value;
-    return no_status(c);
-}
+#define NO_STATUS(function, value_type)                                                          \
+    FMI2_EXPORT fmi2Status function(fmi2Component c, const fmi2StatusKind s, value_type *value) { \
+        (void)s; (void)value;                                                                    \
+        return no_status(c);                                                                     \
+    }
+NO_STATUS(fmi2GetStatus, fmi2Status)
+NO_STATUS(fmi2GetRealStatus, fmi2Real)
+NO_STATUS(fmi2GetIntegerStatus, fmi2Integer)
+NO_STATUS(fmi2GetBooleanStatus, fmi2Boolean)
+NO_STATUS(fmi2GetStringStatus, fmi2String)
