@@ -90,7 +90,9 @@ def _ground_read(building, target):
 
 
 def _ground_write(data, target, values):
-    if values["U"] > 0:  # U = 0 is no coupling: the face stays as declared
+    # U = 0 is no coupling: the face stays as declared; any other U, negative or NaN too, is
+    # declared, and the building's own check refuses what is not a conductance
+    if values["U"] != 0:
         _component(data, target)["outside"] = {"type": "boundary", "temperature": float(values["T_ground"]),
                                                "h": float(values["U"])}
 

@@ -10,6 +10,7 @@ from nodeforce.fmu_build.build import build_fmu
 from nodeforce.diagnose.candidates import candidates
 from nodeforce.model.building import Boundary, parse_building
 from nodeforce.model.effects import EFFECTS
+from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import simulate
 from nodeforce.model.network import assemble
 
@@ -79,6 +80,14 @@ def test_ground_coupling_is_a_boundary_face(testcell_data, testcell):
     assert EFFECTS["ground_coupling"].read(after, "floor") == {"U": 0.5, "T_ground": 24.0}
     # once coupled, the floor is no longer adiabatic: the effect cannot be added twice
     assert not EFFECTS["ground_coupling"].applies(after, "floor")
+
+
+@pytest.mark.parametrize("U, says", [(-1.0, "must be > 0, found -1.0"), (float("nan"), "must be a finite number")])
+def test_a_ground_conductance_that_is_none_is_refused_not_dropped(testcell, U, says):
+    """U = 0 is no coupling; a negative or NaN U is not a conductance, and was once taken as 0."""
+    assert EFFECTS["ground_coupling"].apply(testcell, "floor", {"U": 0.0}).to_json() == testcell.to_json()
+    with pytest.raises(InputError, match=r"outside\.h: " + says):
+        EFFECTS["ground_coupling"].apply(testcell, "floor", {"U": U, "T_ground": 15.0})
 
 
 def test_every_effect_reads_back_what_it_writes(testcell):
