@@ -13,9 +13,11 @@ $(BIN)/nodeforce: pyproject.toml
 
 venv: $(BIN)/nodeforce
 
-# ecospy's native library links against oneTBB, which comes from Debian.
+# ecospy's native library links against oneTBB, which comes from Debian; valgrind checks that the
+# Python FMU's host never touches freed memory (tests/test_fmu_memory.py).
+SYSTEM_PACKAGES := libtbb12 valgrind
 system-deps:
-	@dpkg -s libtbb12 >/dev/null 2>&1 || { apt-get update -qq && apt-get install -y -qq libtbb12; }
+	@dpkg -s $(SYSTEM_PACKAGES) >/dev/null 2>&1 || { apt-get update -qq && apt-get install -y -qq $(SYSTEM_PACKAGES); }
 
 demo: venv
 	$(BIN)/nodeforce demo -o out/demo

@@ -224,7 +224,9 @@ def documentation(name, standalone, guarded=True, python_minimum="3.10"):
                  "<code>resources/guard.txt</code>, or the one the environment variable "
                  "<code>NODEFORCE_LIBPYTHON</code> names; numpy must be importable there (e.g. on "
                  "<code>PYTHONPATH</code>). Calls the FMI 2.0 standard forbids get fmi2Error, the reason "
-                 "logged. pythonfmu's Linux binary needs glibc 2.32 and the C++ runtime of GCC 12; there "
+                 "logged. A call in which the model raises (an effect parameter it refuses, for example) "
+                 "gets fmi2Error too, not pythonfmu's fmi2Fatal: fmi2Reset then gives a new instance. "
+                 "pythonfmu's Linux binary needs glibc 2.32 and the C++ runtime of GCC 12; there "
                  "is no macOS binary, and the win64 one has no guard. Where that is not available, export "
                  "the standalone FMU: <code>nodeforce fmu BUILDING --standalone -o MODEL.fmu</code>.</p>")
     else:
@@ -235,7 +237,9 @@ def documentation(name, standalone, guarded=True, python_minimum="3.10"):
                  "print(s.get_config_var(\"LIBDIR\") + \"/\" + s.get_config_var(\"LDLIBRARY\"))')</code>, "
                  "with numpy on <code>PYTHONPATH</code>. Calls the FMI 2.0 standard forbids are refused "
                  "with the reason logged, but reported as fmi2Discard (doStep) or fmi2Fatal (get/set). "
-                 "The Linux binary needs glibc 2.32 and the C++ runtime of GCC 12; there is no macOS "
+                 "pythonfmu's binary releases Python objects twice when the model raises and when the "
+                 "process ends, which can corrupt the host's memory: do not call an instance again after "
+                 "fmi2Fatal. The Linux binary needs glibc 2.32 and the C++ runtime of GCC 12; there is no macOS "
                  "binary. Where that is not available, export the standalone FMU: "
                  "<code>nodeforce fmu BUILDING --standalone -o MODEL.fmu</code>.</p>")
     return (f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{name}</title></head><body>\n"

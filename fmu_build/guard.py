@@ -1,12 +1,14 @@
 """The guard in front of the Python FMU's binary (c/guard.c): fmi2Error for the calls the
-standard forbids, and libpython loaded when the importing process has no Python.
+standard forbids and for those in which the model raises, libpython loaded when the importing
+process has no Python, and the host kept out of pythonfmu's two double releases of memory (when
+the model raises, and at process exit).
 
 The Python FMU's `binaries/linux64/<identifier>.so` becomes the guard, pythonfmu's binary ships
 beside it as `<identifier>.pythonfmu.so`, and `resources/guard.txt` tells the guard the layout's
 sizes, that file name and the libpython of the exporting Python. The guard does not depend on the
 model: it is compiled once per process. Without a C compiler the FMU is written without it,
 with a one-line warning (pythonfmu then answers forbidden calls with fmi2Discard or fmi2Fatal,
-and a C host must preload libpython).
+a C host must preload libpython, and pythonfmu's double releases reach the host).
 """
 import functools
 import sys

@@ -95,8 +95,9 @@ def scenario(fmu, n_steps=192, seed=0):
     return parameters, inputs, [f"T[{i}]" for i in range(1, n + 1)], n_steps
 
 
-def run_c_host(fmu, parameters, inputs, outputs, dt, n_steps, tmp_path, env=None):
-    """Outputs of `fmu` run by the C host (compiled here with cc) in a process of its own."""
+def run_c_host(fmu, parameters, inputs, outputs, dt, n_steps, tmp_path, env=None, prefix=()):
+    """Outputs of `fmu` run by the C host (compiled here with cc) in a process of its own,
+    started through `prefix` (a tool such as valgrind) if given."""
     compiler = shutil.which("cc") or pytest.fail("the C host test needs a C compiler (cc)")
     host = tmp_path / "host"
     if not host.exists():
@@ -114,8 +115,8 @@ def run_c_host(fmu, parameters, inputs, outputs, dt, n_steps, tmp_path, env=None
     lines += [" ".join(repr(float(x)) for x in row) for row in columns[:n_steps]]
     (tmp_path / "scenario.txt").write_text("\n".join(lines) + "\n")
     library = unzipped / "binaries" / "linux64" / f"{md.coSimulation.modelIdentifier}.so"
-    done = subprocess.run([str(host), str(library), (unzipped / "resources").as_uri(), md.guid,
-                           str(tmp_path / "scenario.txt")], capture_output=True, text=True, env=env, timeout=120)
+    done = subprocess.run([*prefix, str(host), str(library), (unzipped / "resources").as_uri(), md.guid,
+                           str(tmp_path / "scenario.txt")], capture_output=True, text=True, env=env, timeout=600)
     shutil.rmtree(unzipped)
     return done, (np.loadtxt(done.stdout.splitlines(), ndmin=2) if done.returncode == 0 else None)
 

@@ -21,9 +21,23 @@
    names, the same as ours, then stay out of the global scope, and we call it only through the
    pointers dlsym gives. Its own calls cannot land here either: it has no relocations against
    fmi2* names (objdump -R), so RTLD_DEEPBIND, which would also give it a C++ runtime scope of
-   its own, is not needed. It is closed once, when this library is unloaded (its destructor):
-   pythonfmu ends the interpreter it started when it is unloaded, so closing it per instance
-   would end Python between two instances, which numpy does not survive. */
+   its own, is not needed. It is never closed: glibc cannot unload it anyway (its GNU unique
+   symbols make it RTLD_NODELETE), and pythonfmu ends the interpreter it started when it is
+   unloaded, which numpy does not survive between two instances.
+
+   Two defects of pythonfmu 0.7.0's binary corrupt the host's memory; the guard keeps the host
+   out of both (tests/test_fmu_memory.py shows each):
+   - At process exit it releases its Python state twice: its static destructor frees the state,
+     then its ELF destructor (finalizePythonInterpreter) releases the freed state again, and
+     glibc later reports "corrupted double-linked list" or nothing, by chance. The guard calls
+     finalizePythonInterpreter itself from an exit handler registered after pythonfmu's static
+     destructors, so it runs first: the state is released once, the later calls find it empty.
+     The guard stays loaded to the end of the process (RTLD_NODELETE) so that its handler does.
+   - When the model raises, it releases the instance's Python objects, answers fmi2Fatal, and
+     releases them again in the next call that touches them (fmi2Reset, fmi2FreeInstance). The
+     guard sets that instance aside, never calls it again (its few bytes are left allocated),
+     and answers fmi2Error, as for any failed call of this instance: fmi2Reset instantiates the
+     model anew, fmi2FreeInstance frees the rest. */
 #define _GNU_SOURCE
 #include <dlfcn.h>
 #include <pthread.h>
@@ -50,15 +64,20 @@
 #define MEMBER(name) name##TYPE *name;
 static struct {
     void *library;
+    void (*finalize)(void); /* pythonfmu's finalizePythonInterpreter, if it has one */
     FORWARDED(MEMBER)
 } inner;
 static pthread_mutex_t loading = PTHREAD_MUTEX_INITIALIZER;
 
 typedef struct {
     fmi2Component inner;
+    int lost; /* the model raised: `inner` is set aside (see the top of this file) */
     Layout layout;
     int state;
-    char *name;
+    char *name, *guid, *resources;
+    fmi2Type type;
+    fmi2Boolean visible, logging;
+    const fmi2CallbackFunctions *functions; /* the host's, kept by the standard's rules */
     fmi2CallbackFunctions cb;
 } Guard;
 
@@ -111,6 +130,10 @@ static int read_guard_file(const char *path, GuardFile *g) {
 /* ------------------------------------------------------------------ loading pythonfmu's binary */
 static void here(void) {}
 
+/* The exit handler of the top of this file: pythonfmu's state released once, before its
+   static destructors run. */
+static void release_python(void) { inner.finalize(); }
+
 /* Python in the process, then pythonfmu's binary and its functions; 0 with the reason logged. */
 static int load(const GuardFile *file, const fmi2CallbackFunctions *cb, const char *name) {
     Dl_info self;
@@ -147,19 +170,29 @@ static int load(const GuardFile *file, const fmi2CallbackFunctions *cb, const ch
     }
     FORWARDED(LOOK_UP)
     inner.library = library;
+    inner.finalize = (void (*)(void))dlsym(library, "finalizePythonInterpreter");
+    if (inner.finalize && dlopen(self.dli_fname, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE)) atexit(release_python);
     return 1;
 }
 
-__attribute__((destructor)) static void unload(void) {
-    if (inner.library) dlclose(inner.library);
-    inner.library = NULL;
-}
-
 /* ------------------------------------------------------------------ FMI 2.0 */
+#define LOST "the model raised an exception (pythonfmu logs it when logging is on): this instance answers " \
+             "fmi2Error until fmi2Reset or fmi2FreeInstance"
+
 static fmi2Status refuse(Guard *g, const char *reason) {
     log_error(&g->cb, g->name, "%s", reason);
     return fmi2Error;
 }
+
+/* pythonfmu's answer, but fmi2Fatal, which sets the instance aside (the top of this file). */
+static fmi2Status answered(Guard *g, fmi2Status status) {
+    if (status != fmi2Fatal) return status;
+    g->lost = 1;
+    return refuse(g, LOST);
+}
+
+/* A call forwarded to pythonfmu's instance, unless it is set aside. */
+#define FORWARD(g, call) ((g)->lost ? refuse((g), LOST) : answered((g), inner.call))
 
 /* A state change that happens when the slave accepts the call. */
 static fmi2Status moved(Guard *g, fmi2Status status, int state) {
@@ -171,13 +204,27 @@ FMI2_EXPORT const char *fmi2GetTypesPlatform(void) { return "default"; }
 FMI2_EXPORT const char *fmi2GetVersion(void) { return "2.0"; }
 
 FMI2_EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean on, size_t n, const fmi2String categories[]) {
-    return inner.fmi2SetDebugLogging(((Guard *)c)->inner, on, n, categories);
+    Guard *g = c;
+    return FORWARD(g, fmi2SetDebugLogging(g->inner, on, n, categories));
+}
+
+static char *copy(const char *text) {
+    char *copied = malloc(strlen(text ? text : "") + 1);
+    if (copied) strcpy(copied, text ? text : "");
+    return copied;
 }
 
 static void free_guard(Guard *g) {
     if (!g) return;
     free(g->name);
+    free(g->guid);
+    free(g->resources);
     free(g);
+}
+
+/* pythonfmu's instance of the model, made from what the guard keeps of fmi2Instantiate. */
+static fmi2Component instantiate(Guard *g) {
+    return inner.fmi2Instantiate(g->name, g->type, g->guid, g->resources, g->functions, g->visible, g->logging);
 }
 
 FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, fmi2String resources,
@@ -201,16 +248,17 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
     pthread_mutex_unlock(&loading);
     g = ok ? calloc(1, sizeof(Guard)) : NULL;
     if (!g) return NULL;
-    g->name = malloc(strlen(name ? name : "") + 1);
-    if (!g->name) {
-        free_guard(g);
-        return NULL;
-    }
-    strcpy(g->name, name ? name : "");
+    g->name = copy(name);
+    g->guid = copy(guid);
+    g->resources = copy(resources);
+    g->type = type;
+    g->visible = visible;
+    g->logging = loggingOn;
+    g->functions = functions;
     memcpy((void *)&g->cb, functions, sizeof g->cb);
     g->layout = file.layout;
     g->state = INSTANTIATED;
-    g->inner = inner.fmi2Instantiate(name, type, guid, resources, functions, visible, loggingOn);
+    g->inner = g->name && g->guid && g->resources ? instantiate(g) : NULL;
     if (!g->inner) {
         free_guard(g);
         return NULL;
@@ -221,26 +269,40 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
 FMI2_EXPORT void fmi2FreeInstance(fmi2Component c) {
     Guard *g = c;
     if (!g) return;
-    inner.fmi2FreeInstance(g->inner);
+    if (!g->lost) inner.fmi2FreeInstance(g->inner);
     free_guard(g);
 }
 
 FMI2_EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
                                            fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
-    return inner.fmi2SetupExperiment(((Guard *)c)->inner, toleranceDefined, tolerance, startTime, stopTimeDefined,
-                                     stopTime);
+    Guard *g = c;
+    return FORWARD(g, fmi2SetupExperiment(g->inner, toleranceDefined, tolerance, startTime, stopTimeDefined,
+                                          stopTime));
 }
 
 /* The calls that move the instance to another state: forwarded, the state kept if they succeed. */
 #define MOVES_TO(function, to)                                 \
     FMI2_EXPORT fmi2Status function(fmi2Component c) {         \
         Guard *g = c;                                          \
-        return moved(g, inner.function(g->inner), to);         \
+        return moved(g, FORWARD(g, function(g->inner)), to);   \
     }
 MOVES_TO(fmi2EnterInitializationMode, INITIALISATION)
 MOVES_TO(fmi2ExitInitializationMode, STEPPING)
 MOVES_TO(fmi2Terminate, TERMINATED)
-MOVES_TO(fmi2Reset, INSTANTIATED)
+
+/* After a failed call, fmi2Reset is how the standard lets the host go on: an instance set aside
+   is replaced by a new one. */
+FMI2_EXPORT fmi2Status fmi2Reset(fmi2Component c) {
+    Guard *g = c;
+    fmi2Component fresh;
+    if (!g->lost) return moved(g, answered(g, inner.fmi2Reset(g->inner)), INSTANTIATED);
+    fresh = instantiate(g);
+    if (!fresh) return refuse(g, "fmi2Reset: the model cannot be instantiated again");
+    g->inner = fresh;
+    g->lost = 0;
+    g->state = INSTANTIATED;
+    return fmi2OK;
+}
 
 /* The get and set calls: refused here (variables.h), or forwarded. */
 #define GET_OR_SET(function, value_type, real, setting)                                                       \
@@ -249,7 +311,7 @@ MOVES_TO(fmi2Reset, INSTANTIATED)
         char reason[256];                                                                                     \
         if (refusal(&g->layout, vr, nvr, real, setting, g->state, reason, sizeof reason))                    \
             return refuse(g, reason);                                                                         \
-        return inner.function(g->inner, vr, nvr, value);                                                      \
+        return FORWARD(g, function(g->inner, vr, nvr, value));                                                \
     }
 GET_OR_SET(fmi2GetReal, fmi2Real value[], 1, 0)
 GET_OR_SET(fmi2SetReal, const fmi2Real value[], 1, 1)
@@ -261,7 +323,7 @@ GET_OR_SET(fmi2SetBoolean, const fmi2Boolean value[], 0, 1)
         Guard *g = c;                                                                                         \
         char reason[256];                                                                                     \
         if (no_such_type(type, nvr, reason, sizeof reason)) return refuse(g, reason);                        \
-        return inner.function(g->inner, vr, nvr, value);                                                      \
+        return FORWARD(g, function(g->inner, vr, nvr, value));                                                \
     }
 NO_SUCH_TYPE(fmi2GetInteger, fmi2Integer value[], "Integer")
 NO_SUCH_TYPE(fmi2SetInteger, const fmi2Integer value[], "Integer")
@@ -273,7 +335,7 @@ FMI2_EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *state) {
     GuardState *s = *state ? *state : calloc(1, sizeof(GuardState));
     fmi2Status status;
     if (!s) return refuse(g, "out of memory for a state");
-    status = inner.fmi2GetFMUstate(g->inner, &s->inner);
+    status = FORWARD(g, fmi2GetFMUstate(g->inner, &s->inner));
     if (status > fmi2Warning) {
         if (!*state) free(s);
         return status;
@@ -287,9 +349,11 @@ FMI2_EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state) {
     Guard *g = c;
     GuardState *s = state;
     if (!s) return refuse(g, "fmi2SetFMUstate without a state");
-    return moved(g, inner.fmi2SetFMUstate(g->inner, s->inner), s->state);
+    return moved(g, FORWARD(g, fmi2SetFMUstate(g->inner, s->inner)), s->state);
 }
 
+/* Allowed on an instance set aside too: pythonfmu's fmi2FreeFMUstate releases the state's own
+   Python object and touches nothing of the instance. */
 FMI2_EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state) {
     Guard *g = c;
     GuardState *s = *state;
@@ -304,7 +368,7 @@ FMI2_EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state) {
 /* A serialized state: one byte of the guard's state, then pythonfmu's bytes. */
 FMI2_EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate state, size_t *size) {
     Guard *g = c;
-    fmi2Status status = inner.fmi2SerializedFMUstateSize(g->inner, ((GuardState *)state)->inner, size);
+    fmi2Status status = FORWARD(g, fmi2SerializedFMUstateSize(g->inner, ((GuardState *)state)->inner, size));
     if (status <= fmi2Warning) *size += 1;
     return status;
 }
@@ -314,7 +378,7 @@ FMI2_EXPORT fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate state
     GuardState *s = state;
     if (size < 1) return refuse(g, "fmi2SerializeFMUstate: no room for the state");
     bytes[0] = (fmi2Byte)s->state;
-    return inner.fmi2SerializeFMUstate(g->inner, s->inner, bytes + 1, size - 1);
+    return FORWARD(g, fmi2SerializeFMUstate(g->inner, s->inner, bytes + 1, size - 1));
 }
 
 FMI2_EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[], size_t size,
@@ -327,7 +391,7 @@ FMI2_EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte b
     s = calloc(1, sizeof(GuardState));
     if (!s) return refuse(g, "out of memory for a state");
     s->state = bytes[0];
-    status = inner.fmi2DeSerializeFMUstate(g->inner, bytes + 1, size - 1, &s->inner);
+    status = FORWARD(g, fmi2DeSerializeFMUstate(g->inner, bytes + 1, size - 1, &s->inner));
     if (status > fmi2Warning) {
         free(s);
         return status;
@@ -339,17 +403,20 @@ FMI2_EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte b
 FMI2_EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,
                                                     const fmi2ValueReference z[], size_t nz, const fmi2Real dv[],
                                                     fmi2Real dz[]) {
-    return inner.fmi2GetDirectionalDerivative(((Guard *)c)->inner, u, nu, z, nz, dv, dz);
+    Guard *g = c;
+    return FORWARD(g, fmi2GetDirectionalDerivative(g->inner, u, nu, z, nz, dv, dz));
 }
 
 FMI2_EXPORT fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                                    const fmi2Integer order[], const fmi2Real value[]) {
-    return inner.fmi2SetRealInputDerivatives(((Guard *)c)->inner, vr, nvr, order, value);
+    Guard *g = c;
+    return FORWARD(g, fmi2SetRealInputDerivatives(g->inner, vr, nvr, order, value));
 }
 
 FMI2_EXPORT fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                                     const fmi2Integer order[], fmi2Real value[]) {
-    return inner.fmi2GetRealOutputDerivatives(((Guard *)c)->inner, vr, nvr, order, value);
+    Guard *g = c;
+    return FORWARD(g, fmi2GetRealOutputDerivatives(g->inner, vr, nvr, order, value));
 }
 
 FMI2_EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
@@ -357,15 +424,19 @@ FMI2_EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunication
     Guard *g = c;
     char reason[256];
     if (step_refusal(g->state, communicationStepSize, reason, sizeof reason)) return refuse(g, reason);
-    return inner.fmi2DoStep(g->inner, currentCommunicationPoint, communicationStepSize,
-                            noSetFMUStatePriorToCurrentPoint);
+    return FORWARD(g, fmi2DoStep(g->inner, currentCommunicationPoint, communicationStepSize,
+                                 noSetFMUStatePriorToCurrentPoint));
 }
 
-FMI2_EXPORT fmi2Status fmi2CancelStep(fmi2Component c) { return inner.fmi2CancelStep(((Guard *)c)->inner); }
+FMI2_EXPORT fmi2Status fmi2CancelStep(fmi2Component c) {
+    Guard *g = c;
+    return FORWARD(g, fmi2CancelStep(g->inner));
+}
 
 #define STATUS(function, value_type)                                                              \
     FMI2_EXPORT fmi2Status function(fmi2Component c, const fmi2StatusKind s, value_type *value) { \
-        return inner.function(((Guard *)c)->inner, s, value);                                     \
+        Guard *g = c;                                                                             \
+        return FORWARD(g, function(g->inner, s, value));                                          \
     }
 STATUS(fmi2GetStatus, fmi2Status)
 STATUS(fmi2GetRealStatus, fmi2Real)
