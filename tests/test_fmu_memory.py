@@ -68,7 +68,8 @@ def coupled_fmu(tmp_path_factory, testcell_data):
 
 
 def python_process(script, *args, env=None, prefix=()):
-    """A Python process running `script` from the repository root (no output captured beyond it)."""
+    """A Python process running `script` from the repository root, started through `prefix` (a
+    tool such as valgrind) if given; its output captured."""
     return subprocess.run([*prefix, sys.executable, "-c", script, *map(str, args)], cwd=ROOT, env=env,
                           capture_output=True, text=True, timeout=600)
 
