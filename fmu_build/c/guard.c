@@ -77,8 +77,7 @@ typedef struct {
     char *name, *guid, *resources;
     fmi2Type type;
     fmi2Boolean visible, logging;
-    const fmi2CallbackFunctions *functions; /* the host's, kept by the standard's rules */
-    fmi2CallbackFunctions cb;
+    const fmi2CallbackFunctions *functions; /* the host's: valid until fmi2FreeInstance (FMI 2.0) */
 } Guard;
 
 /* A state of the slave: the guard's state beside pythonfmu's. */
@@ -180,7 +179,7 @@ static int load(const GuardFile *file, const fmi2CallbackFunctions *cb, const ch
              "fmi2Error until fmi2Reset or fmi2FreeInstance"
 
 static fmi2Status refuse(Guard *g, const char *reason) {
-    log_error(&g->cb, g->name, "%s", reason);
+    log_error(g->functions, g->name, "%s", reason);
     return fmi2Error;
 }
 
@@ -255,7 +254,6 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
     g->visible = visible;
     g->logging = loggingOn;
     g->functions = functions;
-    memcpy((void *)&g->cb, functions, sizeof g->cb);
     g->layout = file.layout;
     g->state = INSTANTIATED;
     g->inner = g->name && g->guid && g->resources ? instantiate(g) : NULL;
