@@ -24,6 +24,7 @@ UNITS = {
     "W": ("Power", {"kg": "1", "m": "2", "s": "-3"}),
     "W/m2": ("Irradiance", {"kg": "1", "s": "-3"}),
     "W/K": ("ThermalConductance", {"kg": "1", "m": "2", "s": "-3", "K": "-1"}),
+    "J/K": ("HeatCapacity", {"kg": "1", "m": "2", "s": "-2", "K": "-1"}),
     "W/m2/K": ("CoefficientOfHeatTransfer", {"kg": "1", "s": "-3", "K": "-1"}),
     "1/h": ("AirChangeRate", {"s": "-1", "factor": str(1 / 3600)}),
 }

@@ -98,6 +98,9 @@ def network_text(building, effect):
             raise ValueError(f"component {c.name}: node depths must increase for the initial state")
         zone = next(k for k, z in enumerate(building.zones) if z.name == c.inside.zone)
         groups.append((zone, list(zip(c.node_ids, c.depths))))
+    # a node a zone effect adds is a group of one, never measured: it starts with the zone's air
+    zone_index = {z.name: k for k, z in enumerate(building.zones)}
+    groups += [(zone_index[zone], [(i, 0.0)]) for i, (zone, _) in building.added_nodes.items()]
     numbers = lambda values: " ".join(repr(float(v)) for v in np.ravel(values))
     lines = ["nodeforce-network/2",
              f"sizes {n} {terms[0][1][2].shape[1]} {len(p0)} {len(terms)} {len(building.zones)} {len(groups)} "

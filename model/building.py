@@ -15,7 +15,7 @@ import copy
 import json
 import math
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from .discretise import generated_depths
 from .errors import InputError
@@ -87,6 +87,13 @@ class Inflow:
 
 
 @dataclass(frozen=True)
+class Lumped:
+    """A node a zone effect adds (PHYSICS.md section 7): its capacity and its conductance to the zone."""
+    capacity: float  # J/K; 0 makes the node algebraic
+    conductance: float  # W/K, > 0
+
+
+@dataclass(frozen=True)
 class Zone:
     name: str
     volume: float  # m3
@@ -103,6 +110,11 @@ class Zone:
     occupied: bool | None = None  # None: not declared
     daily_gain: tuple = ()  # (term of DAY_TERMS, W) for every term when declared; () not declared
     proportional_gains: tuple = ()  # (input column, k in W per unit of the column)
+    internal_mass: Lumped | None = None  # furniture and undeclared mass, coupled to the air
+    heat_input_lag: Lumped | None = None  # the heater's own capacity, between heat input and zone
+    envelope_factor: float = 1.0  # scale on the conductances of the zone's components to outside
+    mass_node: int | None = None  # ids of the nodes those two add (PHYSICS.md section 7)
+    heater_node: int | None = None
 
 
 @dataclass(frozen=True)
@@ -147,7 +159,19 @@ class Building:
 
     @property
     def n_nodes(self):
-        return sum(len(c.node_ids) for c in self.components) + 2 * len(self.zones)
+        return sum(len(c.node_ids) for c in self.components) + 2 * len(self.zones) + len(self.added_nodes)
+
+    @property
+    def added_nodes(self):
+        """{id: (zone name, what)} of the nodes zone effects add after the building's own (an
+        internal mass, a heater's capacity), which no sensor measures."""
+        added = {}
+        for z in self.zones:
+            if z.mass_node is not None:
+                added[z.mass_node] = (z.name, "internal mass")
+            if z.heater_node is not None:
+                added[z.heater_node] = (z.name, "heater")
+        return dict(sorted(added.items()))
 
     @property
     def exterior_components(self):
@@ -195,6 +219,8 @@ class Building:
         for z in self.zones:
             names[z.air_node] = f"{z.name} air"
             names[z.radiant_node] = f"{z.name} radiant"
+        for i, (zone, what) in self.added_nodes.items():
+            names[i] = f"{zone} {what}"
         return dict(sorted(names.items()))
 
     def node_of(self, column):
@@ -283,6 +309,7 @@ def parse_building(data, source="<building>"):
                        f"names no component ({c.transmitted_solar_to!r})")
     _check_proportional_columns(check, zones, components)
     _check_node_ids(check, zones, components)
+    zones = _number_added_nodes(zones, sum(len(c.node_ids) for c in components) + 2 * len(zones))
     sensors = {name: _sensor_node(check, name, raw, zones, components) for name, raw in raw_sensors.items()}
     return Building(name=str(data.get("name", "")), site=site, zones=zones, components=components,
                     sensors=sensors, source=source, data=copy.deepcopy(data))
@@ -425,6 +452,9 @@ def _zone(check, z, where, zone_names, explicit, next_id):
         check.fail(f"{where}.proportional_gains", "must be an object {input column: k in W per unit of the column}")
     proportional = tuple((column, check.number(proportional, column, f"{where}.proportional_gains"))
                          for column in proportional)
+    lumped = {key: _lumped(check, z, key, where) for key in ("internal_mass", "heat_input_lag")}
+    if lumped["heat_input_lag"] is not None and not heat_input:
+        check.fail(f"{where}.heat_input_lag", "the zone has no heat_input whose heater it would delay")
     occupied = z.get("occupied")
     if occupied is not None and not isinstance(occupied, bool):
         check.fail(f"{where}.occupied", f"must be true or false, found {occupied!r}")
@@ -449,7 +479,32 @@ def _zone(check, z, where, zone_names, explicit, next_id):
         occupied=occupied,
         daily_gain=daily or (),
         proportional_gains=proportional,
+        envelope_factor=check.number(z, "envelope_factor", where, default=1.0, low=0, low_open=True),
+        **lumped,
     )
+
+
+def _lumped(check, z, key, where):
+    """The `Lumped` node a zone effect declares under `key`, or None."""
+    raw = z.get(key)
+    if raw is None:
+        return None
+    if not isinstance(raw, dict):
+        check.fail(f"{where}.{key}", 'must be {"capacity": J/K, "conductance": W/K}')
+    return Lumped(capacity=check.number(raw, "capacity", f"{where}.{key}", low=0),
+                  conductance=check.number(raw, "conductance", f"{where}.{key}", low=0, low_open=True))
+
+
+def _number_added_nodes(zones, last):
+    """The zones with ids for the nodes their effects add: after the building's `last` node, zone
+    by zone in file order, its internal mass before its heater (PHYSICS.md section 7)."""
+    ids = iter(range(last + 1, 10 ** 9))
+    numbered = []
+    for z in zones:
+        mass = next(ids) if z.internal_mass is not None else None
+        heater = next(ids) if z.heat_input_lag is not None else None
+        numbered.append(replace(z, mass_node=mass, heater_node=heater))
+    return tuple(numbered)
 
 
 def _surface(check, raw, where, zone_names):

@@ -131,6 +131,10 @@ def measured_matrix(building, measurements, times):
                                              f"of {building.source} ({', '.join(building.sensors) or 'none declared'})")
         if not 1 <= node <= building.n_nodes:
             raise InputError(source, column, f"node {node} does not exist (the building has nodes 1..{building.n_nodes})")
+        if node in building.added_nodes:
+            zone, what = building.added_nodes[node]
+            raise InputError(source, column, f"node {node} is the {what} of zone {zone} a model effect adds, "
+                                             "which stands for no sensor's position and is never measured")
         matrix[:, node - 1] = on_grid[column].to_numpy(float)
     return matrix
 

@@ -15,7 +15,8 @@ target is `<zone>-><column>`, the column a heat input or a face's irradiance the
 from dataclasses import dataclass
 from typing import Callable
 
-from .building import DAY_TERMS, Adiabatic, Boundary
+from .building import DAY_TERMS, Adiabatic, Boundary, Exterior
+from .network import RHO_C_AIR
 
 BRIDGE_TO = "->"
 
@@ -178,6 +179,37 @@ def _proportional_write(data, target, values):
     _zone(data, zone).setdefault("proportional_gains", {})[column] = float(values["k"])
 
 
+# internal mass, heater lag: a node of capacity C coupled to the zone by H (PHYSICS.md section 7).
+# Not declared, the node is neutral: no capacity, so it holds the zone's temperature and carries
+# no heat (the heater passes its input on at once); its conductance is then any positive value,
+# the zone air's capacity over NEUTRAL_TIME, a magnitude a calibration may start from.
+NEUTRAL_TIME = 1800.0  # s
+
+
+def neutral_conductance(building, zone):
+    """W/K: a coupling of the magnitude of the zone's air capacity over `NEUTRAL_TIME`."""
+    return RHO_C_AIR * building.zone(zone).volume / NEUTRAL_TIME
+
+
+def _lumped_field(key, capacity, conductance):
+    """read and write of a zone effect that adds a node (`building.Lumped` under `key`)."""
+    def read(building, target):
+        declared = getattr(building.zone(target), key)
+        if declared is None:
+            return {capacity: 0.0, conductance: neutral_conductance(building, target)}
+        return {capacity: declared.capacity, conductance: declared.conductance}
+
+    def write(data, target, values):
+        _zone(data, target)[key] = {"capacity": float(values[capacity]), "conductance": float(values[conductance])}
+    return read, write
+
+
+def _envelope_targets(building):
+    """Zones with a component to the outdoors or a boundary: what an envelope factor scales."""
+    return [z.name for z in building.zones
+            if any(c.inside.zone == z.name and isinstance(c.outside, (Exterior, Boundary)) for c in building.components)]
+
+
 EFFECTS = {e.id: e for e in (
     Effect("ground_coupling", "a conductance from an adiabatic face to a ground temperature",
            (Parameter("U", "W/m2/K", 0.0, 20.0), Parameter("T_ground", "C", -10.0, 40.0)),
@@ -209,6 +241,17 @@ EFFECTS = {e.id: e for e in (
            (Parameter("f_r", "-", 0.0, 1.0),), lambda b: [z.name for z in b.zones if z.heat_input],
            *_zone_field("heat_input_radiative_fraction", "f_r"),
            lambda b, t: b.facing(t)),
+    Effect("internal_mass", "the zone's furniture and undeclared internal mass: a node coupled to its air",
+           (Parameter("C_m", "J/K", 0.0, 1e9), Parameter("H_m", "W/K", 0.01, 1e5)), _zones,
+           *_lumped_field("internal_mass", "C_m", "H_m"), _no_node),
+    Effect("heat_input_lag", "the heater's own capacity: a node between its measured heat input and the zone",
+           (Parameter("C_h", "J/K", 0.0, 1e8), Parameter("H_h", "W/K", 0.01, 1e5)),
+           lambda b: [z.name for z in b.zones if z.heat_input],
+           *_lumped_field("heat_input_lag", "C_h", "H_h"), _no_node),
+    Effect("envelope_conductance", "one factor on the conductances of a zone's components to the outdoors "
+                                   "and to boundaries, their outside surface coefficients included",
+           (Parameter("factor", "-", 0.05, 20.0),), _envelope_targets,
+           *_zone_field("envelope_factor", "factor"), _no_node),
     Effect("daily_gain", "a heat gain to the air with a daily profile: its mean and harmonics of the local time",
            (Parameter("mean", "W", -5000.0, 5000.0), *(Parameter(t, "W", -5000.0, 5000.0) for t in DAY_TERMS)),
            _zones, _daily_read, _daily_write, _no_node),

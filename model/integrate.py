@@ -115,8 +115,10 @@ def initial_state(building, measured0, T_default=20.0):
     for z in building.zones:
         air = measured0[z.air_node - 1]
         fallback = air if np.isfinite(air) else T_default
-        T[z.air_node - 1] = fallback
-        T[z.radiant_node - 1] = fallback
+        # the nodes a zone effect adds (never measured) start with the zone's air
+        for i in (z.air_node, z.radiant_node, z.mass_node, z.heater_node):
+            if i is not None:
+                T[i - 1] = fallback
         for c in building.components:
             if c.inside.zone != z.name:
                 continue
@@ -143,7 +145,8 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     network : Network
     U : (N_t+1, n_inputs) inputs at t_0..t_N, columns in `network.input_names`
     dt : step (s), uniform
-    measured : (N_t+1, N) measured node temperatures (C), NaN where missing; None: nothing measured
+    measured : (N_t+1, N) measured node temperatures (C), NaN where missing; None: nothing measured;
+        fewer columns than N: those of the building's own nodes, the nodes its effects add unmeasured
     force : (N,) bool, nodes forced to their measurements for the whole run
     warmup_days : passes over the first day's inputs (rows 1..24h/dt) before the run
     T_default : C, the initial temperature of a node nothing informs
@@ -157,6 +160,8 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     n_rows, n = U.shape[0], network.n_nodes
     if measured is None:
         measured = np.full((n_rows, n), np.nan)
+    elif measured.shape[1] < n:  # a case of the building as declared: the nodes its effects add are never measured
+        measured = np.hstack([measured, np.full((n_rows, n - measured.shape[1]), np.nan)])
     if force is None:
         force = np.zeros(n, dtype=bool)
     sources = network.sources(U)

@@ -1,6 +1,7 @@
 """Assemble the nodal network `C dT/dt = A T + B u(t) + q + s(u)` (PHYSICS.md section 3, paper eq. 5).
 
-Node i of the building file is row i-1. The input vector u holds, in this order: `T_out`,
+Node i of the building file is row i-1, the nodes zone effects add (an internal mass, a
+heater's capacity, PHYSICS.md section 7) after the building's own. The input vector u holds, in this order: `T_out`,
 `T_sky` (C), the irradiance input of each exterior component (W/m2 on its outside face: its
 `irradiance` column, else `I_<component>`), then the building's other named input columns (heat
 inputs W, supply and boundary temperatures C, shading 0..1), then, where a zone declares a daily
@@ -116,21 +117,24 @@ def assemble(building, names=None):
 
     for c in building.components:
         idx = [i - 1 for i in c.node_ids]
+        e, out = idx[-1], c.outside
+        # a zone's envelope factor scales what separates it from the outdoors or a boundary
+        envelope = (building.zone(c.inside.zone).envelope_factor if isinstance(out, (Exterior, Boundary))
+                    else 1.0)
         C[idx] += c.area * capacities(c.layers, c.depths)
         for k, g in enumerate(conductances(c.layers, c.depths)):
-            link(idx[k], idx[k + 1], c.area * g * c.conductivity_factor)
+            link(idx[k], idx[k + 1], c.area * g * c.conductivity_factor * envelope)
         to_zone(idx[0], c.area, c.inside)
-        e, out = idx[-1], c.outside
         if isinstance(out, Exterior):
             F = sky_view_factor(c.tilt)
-            A[e, e] -= c.area * (out.h_conv + out.h_rad)
-            B[e, col["T_out"]] += c.area * (out.h_conv + out.h_rad * (1.0 - F))
-            B[e, col["T_sky"]] += c.area * out.h_rad * F
+            A[e, e] -= c.area * (out.h_conv + out.h_rad) * envelope
+            B[e, col["T_out"]] += c.area * (out.h_conv + out.h_rad * (1.0 - F)) * envelope
+            B[e, col["T_sky"]] += c.area * out.h_rad * F * envelope
             B[e, col[c.irradiance_input]] += c.area * out.solar_absorptance
         elif isinstance(out, Surface):
             to_zone(e, c.area, out)
         elif isinstance(out, Boundary):
-            to_temperature(e, c.area * out.h, out.temperature)
+            to_temperature(e, c.area * out.h * envelope, out.temperature)
         else:
             assert isinstance(out, Adiabatic)
         if c.solar_transmittance is not None:
@@ -158,7 +162,22 @@ def assemble(building, names=None):
             B[air, col[day_input(term)]] += W
         for column, k in z.proportional_gains:
             B[air, col[column]] += k
-        for name in z.heat_input:
-            B[air, col[name]] += 1.0 - z.heat_input_radiative_fraction
-            B[radiant, col[name]] += z.heat_input_radiative_fraction
+        if z.internal_mass is not None:
+            mass = z.mass_node - 1
+            C[mass] += z.internal_mass.capacity
+            link(air, mass, z.internal_mass.conductance)
+        f_r = z.heat_input_radiative_fraction
+        if z.heat_input_lag is not None:
+            # the heater's node takes the heat input and gives it to the air and the radiant node
+            # in the heat input's split (PHYSICS.md section 7)
+            heater = z.heater_node - 1
+            C[heater] += z.heat_input_lag.capacity
+            link(heater, air, (1.0 - f_r) * z.heat_input_lag.conductance)
+            link(heater, radiant, f_r * z.heat_input_lag.conductance)
+            for name in z.heat_input:
+                B[heater, col[name]] += 1.0
+        else:
+            for name in z.heat_input:
+                B[air, col[name]] += 1.0 - f_r
+                B[radiant, col[name]] += f_r
     return Network(C=C, A=A, B=B, q=q, input_names=names, products=tuple(products))

@@ -1,0 +1,198 @@
+"""The zone effects of PHYSICS.md section 7 (internal mass, heater lag, envelope factor) against
+independent calculations, and both FMUs against the direct model with each of them."""
+import copy
+
+import numpy as np
+import pytest
+from scipy.linalg import expm
+
+from nodeforce.cosim.fmi import FmuInstance
+from nodeforce.cosim.run import simulate_fmu
+from nodeforce.fmu_build.build import build_fmu
+from nodeforce.model.building import parse_building
+from nodeforce.model.case import Case
+from nodeforce.model.effects import EFFECTS
+from nodeforce.model.errors import InputError
+from nodeforce.model.hlc import heat_loss_coefficient
+from nodeforce.model.integrate import simulate
+from nodeforce.model.network import assemble
+
+from .test_hlc import layers_conductance, series
+from .test_standalone import two_zones as cell_and_annex
+
+RHO_C = 1.2 * 1005
+VOLUME = 40.0
+
+
+def light_room(**zone):
+    """One zone whose only wall has no capacity (density 0) and no outside radiation: the wall is
+    a conductance H_o from the air to the outdoor air, and the room's one capacity is its air."""
+    return {
+        "format": "nodal-building/1", "name": "light room", "site": {"latitude": 45.0, "longitude": 5.0},
+        "materials": {"foam": {"conductivity": 0.04, "density": 0.0, "specific_heat": 1000.0}},
+        "zones": [{"name": "room", "volume": VOLUME, "heat_input": "heater", **zone}],
+        "components": [{"name": "wall", "area": 20.0, "tilt": 90.0, "azimuth": 180.0, "layers": [["foam", 0.1]],
+                        "nodes": {"max_spacing": 1.0}, "inside": {"zone": "room", "h_conv": 3.0, "h_rad": 5.0},
+                        "outside": {"type": "exterior", "h_conv": 20.0, "h_rad": 0.0, "solar_absorptance": 0.0}}],
+    }
+
+
+H_O = series(20.0 * 3.0, 20.0 * 0.04 / 0.1, 20.0 * 20.0)  # W/K: inside h_c, the foam, outside h_c
+
+
+def run(building, Q, dt, n_steps, force_air=None):
+    """Every node (C) at t_1..t_n after a step of the heat input to Q (W) at t_0+, from 0 C, the
+    outdoors at 0 C; the air held at `force_air` (C) if given."""
+    net = assemble(building)
+    U = np.zeros((n_steps + 1, len(net.input_names)))
+    U[:, net.input_names.index("heater")] = Q
+    measured = np.full((n_steps + 1, net.n_nodes), np.nan)
+    measured[0, :building.n_nodes - len(building.added_nodes)] = 0.0
+    force = np.zeros(net.n_nodes, dtype=bool)
+    if force_air is not None:
+        air = building.zone("room").air_node - 1
+        measured[:, air], force[air] = force_air, True
+    return simulate(building, net, U, dt, measured, force, warmup_days=0)
+
+
+def test_internal_mass_and_a_heater_step_give_the_two_time_constant_response():
+    """Air C_a and mass C_m joined by H_m, the air losing H_o to 0 C: x' = K x + b, whose exact
+    solution from x(0) = 0 is x(t) = (I - e^(K t)) x_inf with x_inf = -K^-1 b (two time
+    constants, the eigenvalues of K). Backward Euler at 10 s steps is within 0.2 % of it."""
+    C_m, H_m, Q = 2e6, 150.0, 1000.0
+    b = parse_building(light_room(internal_mass={"capacity": C_m, "conductance": H_m}))
+    (mass,) = b.added_nodes
+    assert mass == b.n_nodes and b.added_nodes[mass] == ("room", "internal mass")
+    C_a = RHO_C * VOLUME
+    K = np.array([[-(H_O + H_m) / C_a, H_m / C_a], [H_m / C_m, -H_m / C_m]])
+    x_inf = -np.linalg.solve(K, [Q / C_a, 0.0])
+    assert x_inf[0] == pytest.approx(Q / H_O)  # in steady state the mass carries nothing
+    dt, n = 10.0, 6 * 360  # 6 h
+    T = run(b, Q, dt, n)
+    t = dt * np.arange(1, n + 1)
+    exact = np.array([(np.eye(2) - expm(K * s)) @ x_inf for s in t])
+    air = b.zone("room").air_node - 1
+    assert np.abs(T[:, air] - exact[:, 0]).max() < 2e-3 * x_inf[0]
+    assert np.abs(T[:, mass - 1] - exact[:, 1]).max() < 2e-3 * x_inf[0]
+    # both time constants show: the air's fast rise (tau ~ 3 min) then the mass's slow one (hours)
+    taus = sorted(-1 / np.linalg.eigvals(K).real)
+    assert taus[0] < 600 < 3600 < taus[1]
+
+
+def test_the_heaters_capacity_delivers_a_step_as_a_first_order_response():
+    """The air held at 0 C: C_h T_h' = Q - H_h T_h, so the heat delivered to the air,
+    H_h T_h, is Q (1 - e^(-t H_h / C_h))."""
+    C_h, H_h, Q = 4e4, 20.0, 800.0
+    b = parse_building(light_room(heat_input_lag={"capacity": C_h, "conductance": H_h}))
+    (heater,) = b.added_nodes
+    dt, n = 5.0, 720  # an hour; the time constant is 2000 s
+    T = run(b, Q, dt, n, force_air=0.0)
+    delivered = H_h * T[:, heater - 1]
+    t = dt * np.arange(1, n + 1)
+    assert np.abs(delivered - Q * (1 - np.exp(-t * H_h / C_h))).max() < 2e-3 * Q
+    # without the lag the air gets all of Q at once: the heater node is no longer in the way
+    without = assemble(parse_building(light_room()))
+    assert without.B[b.zone("room").air_node - 1, without.input_names.index("heater")] == 1.0
+
+
+def test_a_heater_with_no_capacity_and_an_undeclared_mass_change_nothing():
+    """The effects' neutral values (how a candidate's FMU starts) are the building as declared.
+    (With a radiative fraction, a heater node splits its heat by the temperatures it sees, as
+    PHYSICS.md section 7 says, which no capacity makes the declared fixed split.)"""
+    for effect, f_r in (("internal_mass", 0.3), ("heat_input_lag", 0.0)):
+        b = parse_building(light_room(heat_input_radiative_fraction=f_r))
+        neutral = EFFECTS[effect].apply(b, "room", {})
+        assert neutral.n_nodes == b.n_nodes + 1
+        T = run(neutral, 500.0, 900.0, 96)
+        assert np.abs(T[:, :b.n_nodes] - run(b, 500.0, 900.0, 96)).max() < 1e-9, effect
+
+
+def test_an_envelope_factor_of_one_is_the_building_and_the_hlc_scales_its_outward_conductances(testcell_data):
+    b = parse_building(testcell_data)
+    one = assemble(EFFECTS["envelope_conductance"].apply(b, "cell", {"factor": 1.0}))
+    declared = assemble(b)
+    for name in ("C", "A", "B", "q"):
+        assert np.array_equal(getattr(one, name), getattr(declared, name)), name
+    # by hand: each exterior component's path outward (its layers in series with its outside
+    # coefficients) scaled by f, in series with the inside coefficients, which are not: the
+    # lead's hand sum of the test cell (test_hlc) with g_o scaled
+    f = 1.7
+    data = copy.deepcopy(testcell_data)
+    data["zones"][0]["air_change_rate"] = 0.4
+    for c in data["components"]:
+        if c["outside"]["type"] == "exterior":
+            for layer in c["layers"]:
+                layer[0] = scaled_material(data, layer[0], f)
+            c["outside"]["h_conv"] *= f
+            c["outside"]["h_rad"] *= f
+    expected = heat_loss_coefficient(parse_building(data))
+    with_air_change = parse_building({**testcell_data, "zones": [dict(testcell_data["zones"][0], air_change_rate=0.4)]})
+    by_factor = EFFECTS["envelope_conductance"].apply(with_air_change, "cell", {"factor": f})
+    assert heat_loss_coefficient(by_factor) == pytest.approx(expected, rel=1e-12)
+    assert heat_loss_coefficient(by_factor) > heat_loss_coefficient(with_air_change)
+
+
+def scaled_material(data, name, f):
+    """The name of a copy of material `name` whose conductivity is f times (added to data)."""
+    scaled = f"{name}_x{f}"
+    data["materials"][scaled] = dict(data["materials"][name], conductivity=data["materials"][name]["conductivity"] * f)
+    return scaled
+
+
+def test_the_light_rooms_hlc_is_its_wall_and_the_envelope_factor_scales_the_wall_only():
+    """One wall: air -- A h_c -- foam -- A h_ce -- outdoors; the factor scales the last two."""
+    b = parse_building(light_room(internal_mass={"capacity": 1e6, "conductance": 80.0},
+                                  heat_input_lag={"capacity": 1e4, "conductance": 30.0}))
+    assert heat_loss_coefficient(b) == pytest.approx(H_O, rel=1e-12)  # the added nodes lose nothing
+    f = 0.6
+    scaled = EFFECTS["envelope_conductance"].apply(b, "room", {"factor": f})
+    assert heat_loss_coefficient(scaled) == pytest.approx(
+        series(20.0 * 3.0, f * 20.0 * 0.04 / 0.1, f * 20.0 * 20.0), rel=1e-12)
+
+
+def test_added_nodes_are_numbered_after_the_last_named_and_never_measured(testcell_data):
+    data = cell_and_annex(testcell_data)
+    data["zones"][1]["internal_mass"] = {"capacity": 1e5, "conductance": 10.0}
+    data["zones"][1]["heat_input_lag"] = {"capacity": 1e4, "conductance": 5.0}
+    data["zones"][0]["internal_mass"] = {"capacity": 1e5, "conductance": 10.0}
+    b = parse_building(data)
+    assert b.added_nodes == {31: ("cell", "internal mass"), 32: ("annex", "internal mass"), 33: ("annex", "heater")}
+    assert b.node_names()[33] == "annex heater"
+    with pytest.raises(InputError, match="heat_input_lag: the zone has no heat_input"):
+        parse_building({**data, "zones": [dict(data["zones"][0], heat_input_lag={"capacity": 1.0, "conductance": 1.0}),
+                                          data["zones"][1]]})
+    with pytest.raises(InputError, match=r"internal_mass\.conductance: must be > 0"):
+        parse_building({**data, "zones": [dict(data["zones"][0], internal_mass={"capacity": 1.0, "conductance": 0}),
+                                          data["zones"][1]]})
+
+
+EFFECT_VALUES = [("internal_mass", {"C_m": 3e5, "H_m": 40.0}), ("heat_input_lag", {"C_h": 5e4, "H_h": 15.0}),
+                 ("envelope_conductance", {"factor": 1.8})]
+
+
+@pytest.mark.slow  # three effects, two FMU kinds
+@pytest.mark.parametrize("kind", ["python", "standalone"])
+def test_both_fmus_with_a_zone_effect_equal_the_direct_model(testcell_data, real_case, tmp_path, kind):
+    """The annex (heated through Q_annex) with each effect at values other than its start: the
+    FMU, its parameters set, gives the direct model of the building declaring those values."""
+    b = parse_building(cell_and_annex(testcell_data))
+    net = assemble(b)
+    n_rows = 2 * 96 + 1
+    rng = np.random.default_rng(5)
+    U = np.column_stack([real_case.U[:n_rows, real_case.input_names.index(n)] if n in real_case.input_names
+                         else rng.choice([0.0, 600.0], n_rows) for n in net.input_names])
+    measured = np.full((n_rows, net.n_nodes), np.nan)
+    measured[0, b.zone("annex").air_node - 1] = 18.0
+    case = Case(real_case.times[:n_rows], 900.0, net.input_names, U, measured)
+    for effect, values in EFFECT_VALUES:
+        fmu = build_fmu(b, tmp_path / f"{effect}.fmu", effect=(effect, "annex"), kind=kind)
+        after = EFFECTS[effect].apply(b, "annex", values)
+        full = np.full((n_rows, after.n_nodes), np.nan)
+        full[:, :net.n_nodes] = measured
+        expected = simulate(after, assemble(after, net.input_names), U, 900.0, full)
+        with FmuInstance(fmu) as instance:
+            T = simulate_fmu(instance, case, output_ids=range(1, after.n_nodes + 1),
+                             parameters={f"{effect}.{k}": v for k, v in values.items()})
+        assert np.abs(T - expected).max() < 1e-9, effect
+        plain = simulate(b, net, U, 900.0, measured)
+        assert np.abs(expected[:, :net.n_nodes] - plain).max() > 0.05, effect  # the effect does something
