@@ -2,8 +2,12 @@
 
 Chooses the chromosome (every measured node but the objective's air nodes and, by default, the
 algebraic radiant nodes, which are no sub-model), builds the FMU, and runs the search with the
-sensors' noise given by the user or estimated from the measured air.
+sensors' noise given by the user or estimated from the measured air. A record that measures
+only the objective's air (a thermostat's) has nothing to force: its locate.json says so, with
+`best_nodes` [], and the diagnosis goes on to the air's own equation.
 """
+import time
+
 import numpy as np
 from scipy.sparse.csgraph import shortest_path
 
@@ -68,11 +72,11 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
     give the paper's search).
     """
     candidates = chromosome_nodes(building, case, objective, source, nodes, include_algebraic)
-    if not candidates:
-        raise InputError(source, "columns", "no measured node besides the objective's air: nothing to force")
     fmu = build_fmu(building, workdir / "model.fmu", kind=fmu_kind)
     measured = objective.measured(case)
     noise = Noise.of(measured, noise)
+    if not candidates:
+        return nothing_to_force(building, case, objective, FmuFitness(fmu, case, [], objective, warmup_days), noise)
     result = search(FmuFitness(fmu, case, candidates, objective, warmup_days), candidates,
                     population=population, generations=generations, pc=pc, pm=pm, seed=seed,
                     patience=patience, seeded=seeded,
@@ -83,6 +87,31 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
               "objective": list(objective.zones), "output_nodes": list(objective.air_nodes), **result,
               "noise": noise.to_json()}
     return {**result, "finding": finding(building, result)}
+
+
+def nothing_to_force(building, case, objective, fitness, noise):
+    """locate.json of a record with no measured node but the objective's air (a thermostat's
+    record): J unforced, `best_nodes` [], and a finding that says no forcing can be tested and
+    which sensors would let it."""
+    start = time.perf_counter()
+    evaluator = fitness()
+    try:
+        J = evaluator.J([])
+    finally:
+        evaluator.close()
+    facing = sorted((c for c in building.components if c.inside.zone in objective.zones), key=lambda c: -c.area)
+    largest = ", ".join(f"{c.name} (node {c.node_ids[0]})" for c in facing[:3])
+    said = ("No forcing can be tested: no node besides the objective's air is measured, so the search has "
+            "nothing to force and every effect is left to the diagnosis of the air's own equation; a "
+            "temperature measured on the inside surface of a component facing the objective's air"
+            + (f" (the largest: {largest})" if largest else "")
+            + ", or inside one, would let the search test that component's sub-model.")
+    return {"measured_nodes": case.measured_ids, "chromosome_nodes": [], "output_node": objective.air_nodes[0],
+            "objective": list(objective.zones), "output_nodes": list(objective.air_nodes),
+            "J_unforced": J, "best_nodes": [], "J_best": J, "node_scores": {}, "ranked_nodes": [],
+            "search": {"method": "none", "evaluations": 1, "unique_evaluations": 1,
+                       "seconds": time.perf_counter() - start},
+            "noise": noise.to_json(), "finding": said}
 
 
 def finding(building, result):

@@ -4,6 +4,7 @@ Measurements are never changed: an empty cell stays missing (NaN) and no value i
 filled; the model handles a missing measurement where it uses one (PHYSICS.md section 5).
 """
 
+from nodeforce.model.building import NODE_COLUMN
 from nodeforce.model.errors import InputError
 from .timetable import check_celsius, read_time_table
 
@@ -30,10 +31,12 @@ def read_measurements(path):
     InputError
         Naming the file and the column: the checks of `iotools.timetable.read_time_table` (time
         column, times, non-numeric cells), no measured column, kelvin-looking temperatures
-        (median above `iotools.timetable.KELVIN_MEDIAN`).
+        (median above `iotools.timetable.KELVIN_MEDIAN`) in a `T<id>` column. Another name is
+        checked once the building has said it is a sensor's (`model.case.measured_matrix`): a
+        column that names no node (a heat power put here) is told so, not that it looks like kelvin.
     """
     frame = read_time_table(path)
     if frame.columns.empty:
         raise InputError(path, "T<id>", "no measured column besides time")
-    check_celsius(frame, frame.columns)
+    check_celsius(frame, [c for c in frame.columns if NODE_COLUMN.match(str(c))])
     return frame

@@ -10,6 +10,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pandas as pd
 
+from nodeforce.iotools.timetable import check_celsius
+
 from .errors import InputError
 from .integrate import simulate
 from .building import DAY_TERMS
@@ -119,7 +121,7 @@ def measured_matrix(building, measurements, times):
 
     A column `T<id>` measures node id, a column named as one of the building's sensors measures
     that sensor's node; any other column is an InputError naming the measurement file and the
-    column.
+    column, as is a column whose temperatures look like kelvin.
     """
     source = measurements.attrs.get("source", "measurements")
     matrix = np.full((len(times), building.n_nodes), np.nan)
@@ -136,6 +138,7 @@ def measured_matrix(building, measurements, times):
             raise InputError(source, column, f"node {node} is the {what} of zone {zone} a model effect adds, "
                                              "which stands for no sensor's position and is never measured")
         matrix[:, node - 1] = on_grid[column].to_numpy(float)
+    check_celsius(measurements, measurements.columns)  # once every column is known to be a temperature
     return matrix
 
 

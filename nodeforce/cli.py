@@ -157,14 +157,20 @@ def cmd_locate(args):
 
 def locate_summary(result):
     """A short table of the single-node scores (the paper's Table 4) and the answer."""
-    lines = [f"J unforced: {result['J_unforced']:.3f} C2 on the air of {', '.join(result['objective'])}",
-             f"{'node':>6}{'J forced alone':>16}"]
-    for node in result["ranked_nodes"][:8]:
-        lines.append(f"{node:>6}{result['node_scores'][str(node)]:>16.3f}")
+    lines = [f"J unforced: {result['J_unforced']:.3f} C2 on the air of {', '.join(result['objective'])}"]
+    # every node scored, most helpful first (the ranked ones, then those that lower nothing)
+    scores = result["node_scores"]
+    order = [str(n) for n in result["ranked_nodes"]]
+    order += sorted((n for n in scores if n not in order), key=lambda n: (scores[n] is None, scores[n]))
+    if order:
+        lines.append(f"{'node':>6}{'J forced alone':>16}")
+        lines += [f"{node:>6}{'failed' if scores[node] is None else format(scores[node], '.3f'):>16}"
+                  for node in order[:8]]
     found = ", ".join(map(str, result["best_nodes"])) or "none"
     search = result["search"]
-    lines.append(f"best nodes: {found} (J = {result['J_best']:.3f}); {search['method']} search, "
-                 f"{search['unique_evaluations']} simulations in {search['seconds']:.1f} s")
+    how = ("nothing to force" if search["method"] == "none" else
+           f"{search['method']} search, {search['unique_evaluations']} simulations in {search['seconds']:.1f} s")
+    lines.append(f"best nodes: {found} (J = {result['J_best']:.3f}); {how}")
     lines.append(result["finding"])
     return "\n".join(lines)
 

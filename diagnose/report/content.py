@@ -85,3 +85,12 @@ def period_text(report, window):
     if not span or len(span) != 2:
         return NA
     return f"{time_text(span[0])} to {time_text(span[1])}"
+
+
+def window_text(report, window):
+    """A window's span and, for the calibration, where its scoring starts (after the burn-in):
+    the terminal and report.md say the same."""
+    period = report.get("period") or {}
+    scored = period.get("calibration_scored_from") if window == "calibration" else None
+    return period_text(report, window) + (f" (residuals scored from {time_text(scored)}, after the burn-in)"
+                                          if scored else "")

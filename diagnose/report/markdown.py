@@ -7,7 +7,7 @@ from pathlib import Path
 from . import content, tables
 from ..phases import WORSE
 from ...ga.parsimony import Z_NOISE
-from .formats import NA, fmt_search, fmt_sig, num, time_text
+from .formats import NA, fmt_search, fmt_sig, num
 
 
 def _relative(path, out_dir):
@@ -83,7 +83,6 @@ def write_markdown(out_dir, report, plots, notes):
             return [f"![{caption}]({_relative(plots[key], out_dir)})", ""]
         return [f"*{notes.get(key, '')}*", ""]
 
-    period = report.get("period") or {}
     search = (report.get("localization") or {}).get("search") or {}
     ref = tables.reference_text(report)
     md = ["# nodeforce diagnosis report", "",
@@ -94,10 +93,8 @@ def write_markdown(out_dir, report, plots, notes):
           "", "## Decision", "", *decision_lines(report), "",
           "## Period", "",
           f"- objective zones: {', '.join(content.zones(report)) or NA}",
-          f"- calibration: {content.period_text(report, 'calibration')}"
-          + (f" (residuals scored from {time_text(period['calibration_scored_from'])}, after the burn-in)"
-             if period.get("calibration_scored_from") else ""),
-          f"- validation: {content.period_text(report, 'validation')}"]
+          f"- calibration: {content.window_text(report, 'calibration')}",
+          f"- validation: {content.window_text(report, 'validation')}"]
     if (report.get("noise") or {}).get("sentence"):
         md.append(f"- {report['noise']['sentence']}")
     md += ["", "## Before and after", "",

@@ -58,7 +58,7 @@ def before_after_table(report: dict) -> str:
                     fmt_temp(m.get("rmse")), fmt_temp(m.get("mean"), signed=True), fmt_temp(m.get("sd")),
                     fmt_int(m.get("n")))))
             lines.append(f"{(window + ' ' + label).strip():<{first}} | {cells[0]} | {cells[1]}")
-    lines += [f"{window}: {content.period_text(report, window)}" for window in WINDOWS]
+    lines += [f"{window}: {content.window_text(report, window)}" for window in WINDOWS]
     ref = reference_text(report)
     return "\n".join(lines + ([f"for scale, {ref}"] if ref else []))
 
