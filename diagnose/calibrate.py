@@ -20,6 +20,7 @@ from nodeforce.fmu_build.build import build_fmu
 from nodeforce.diagnose.candidates import calibration_start
 from nodeforce.diagnose.significance import bandwidth, parameter_covariance
 from nodeforce.model.effects import EFFECTS
+from nodeforce.model.hlc import heat_loss_coefficient
 
 log = logging.getLogger("nodeforce.diagnose")
 
@@ -28,6 +29,10 @@ log = logging.getLogger("nodeforce.diagnose")
 IDENTIFIABLE_RELATIVE = 0.25
 IDENTIFIABLE_KELVIN = 1.0
 MORRIS_TRAJECTORIES = 4
+# The step of the heat loss coefficient's differences, as a fraction of a parameter's range: the
+# HLC is linear or smooth in every parameter (a conductance in series), so a small step is exact
+# to many digits.
+HLC_STEP = 1e-6
 
 
 class Candidate:
@@ -90,21 +95,50 @@ def calibrate(candidate, case, objective):
 
 
 def derived(candidate, case, x, cov):
-    """What the data fix when the parameters trade off against each other.
+    """What the data fix when the parameters trade off against each other, each with its
+    standard deviation by the delta method, sd^2 = g' cov g for its gradient g.
 
-    A ground coupling acts through its heat flux density q = U (T_ground - T_face) (W/m2, into
-    the component), and over weeks the face's temperature barely moves: many (U, T_ground) pairs
-    give the same flux. q is reported with its standard deviation by the delta method,
-    grad q = (T_ground - T_face, U), T_face its mean simulated over the window.
+    - The heat loss coefficient of the model with the effect (PHYSICS.md section 8), W/K: what a
+      record of the air and the heating power fixes well even where the effect's parameters, or
+      the split of the loss among effects, it does not (`hlc_gradient`).
+    - A ground coupling acts through its heat flux density q = U (T_ground - T_face) (W/m2, into
+      the component), and over weeks the face's temperature barely moves: many (U, T_ground)
+      pairs give the same flux. g = (T_ground - T_face, U), T_face its mean simulated over the
+      window.
     """
-    if candidate.effect != "ground_coupling":
-        return {}
-    U, T_ground = x
-    face = candidate.building.component(candidate.target).node_ids[-1]
-    T_face = float(np.mean(candidate.nodes(case, [face], x)))
-    gradient = np.array([T_ground - T_face, U])
-    return {"ground_heat_flux": {"value": float(U * (T_ground - T_face)),
-                                 "std": float(np.sqrt(max(gradient @ cov @ gradient, 0.0))), "unit": "W/m2"}}
+    def with_sd(value, gradient, unit):
+        return {"value": float(value), "std": float(np.sqrt(max(gradient @ cov @ gradient, 0.0))), "unit": unit}
+
+    hlc, gradient = hlc_gradient(candidate, x)
+    out = {"heat_loss_coefficient": with_sd(hlc, gradient, "W/K")}
+    if candidate.effect == "ground_coupling":
+        U, T_ground = x
+        face = candidate.building.component(candidate.target).node_ids[-1]
+        T_face = float(np.mean(candidate.nodes(case, [face], x)))
+        out["ground_heat_flux"] = with_sd(U * (T_ground - T_face), np.array([T_ground - T_face, U]), "W/m2")
+    return out
+
+
+def hlc_gradient(candidate, x):
+    """The heat loss coefficient (W/K) of the building with the effect at x, and its gradient over
+    the parameters (W/K per unit of each), by differences of HLC_STEP of each parameter's range,
+    taken inside the bounds."""
+    effect = EFFECTS[candidate.effect]
+
+    def hlc(values):
+        return heat_loss_coefficient(effect.apply(candidate.building, candidate.target,
+                                                  {p.name: float(v) for p, v in zip(candidate.parameters, values)}))
+
+    x = np.asarray(x, dtype=float)
+    at = hlc(x)
+    gradient = np.zeros(len(x))
+    for j, p in enumerate(candidate.parameters):
+        h = HLC_STEP * (p.high - p.low)
+        h = h if x[j] + h <= p.high else -h
+        moved = x.copy()
+        moved[j] += h
+        gradient[j] = (hlc(moved) - at) / h
+    return at, gradient
 
 
 def sensitivity(candidate, case, objective, seed=0):

@@ -27,9 +27,12 @@ def candidates(building, located_nodes, zones):
     outside conductance, reported as `thermal_bridge` where the zone has mechanical supply air
     (whose flow is known) and as `infiltration` otherwise (PHYSICS.md section 7), plus bridges to
     the boundary temperatures the zone's surfaces see. When nothing was located, a change of the
-    inside convection (no single node) is one as well.
+    inside convection (no single node) is one as well, and so is one factor on the objective zones'
+    envelope (`envelope_conductance`): with nothing localised, the level or slow error that no
+    forcing explains may be the whole envelope's conduction rather than the air change.
     """
     located = set(located_nodes)
+    envelope = EFFECTS["envelope_conductance"].targets(building)
     pairs = [(effect.id, target) for effect in EFFECTS.values() for target in effect.targets(building)
              if located & set(effect.points_at(building, target))]
     air_zones = list(zones) + [z.name for z in building.zones if z.air_node in located]
@@ -44,6 +47,7 @@ def candidates(building, located_nodes, zones):
                 pairs.append(("thermal_bridge", target))
     if not located:
         pairs += [("inside_convection", name) for name in zones]
+        pairs += [("envelope_conductance", name) for name in zones if name in envelope]
     return list(dict.fromkeys(pairs))
 
 
@@ -99,7 +103,42 @@ def follow_up(building, left, zones):
     # surfaces is wrong (how fast the air answers the heater)
     pairs += [("heat_input_split", zone) for zone in zones
               if set(named) & set(building.zone(zone).heat_input)]
+    pairs += zone_effects(building, left, zones)
     return list(dict.fromkeys(pairs))
+
+
+def zone_effects(building, left, zones):
+    """The zone effects of PHYSICS.md section 7 a structured residual points at.
+
+    A residual that follows a zone's own heat input at the same instant is the air answering the
+    heater faster in the model than in the building: the classic sign of furniture and internal
+    mass and of a heater with its own capacity (Bacher and Madsen 2011), so `internal_mass` and
+    `heat_input_lag` of that zone. A level (a mean the residual's own correlation cannot explain)
+    or a slow error that follows no input is what the envelope's conduction as a whole would
+    leave: `envelope_conductance`. An effect the model already declares is not offered again, so
+    after one is added the residual left asks, by the same rules, for the other.
+
+    Parameters
+    ----------
+    building : Building, the model the residual is of
+    left : `diagnose.residuals.diagnostics` of that residual
+    zones : names of the objective zones
+    """
+    instant = {f["input"] for f in left["follows"] if f["lag_hours"] == 0.0}
+    pairs = []
+    for name in zones:
+        zone = building.zone(name)
+        if instant & set(zone.heat_input):
+            if zone.internal_mass is None:
+                pairs.append(("internal_mass", name))
+            if zone.heat_input_lag is None:
+                pairs.append(("heat_input_lag", name))
+    slow = not left["follows"] and not (left["time_of_day"] or {}).get("significant", False)
+    if (left.get("level") or {}).get("significant") or slow:
+        pairs += [("envelope_conductance", name) for name in zones
+                  if name in EFFECTS["envelope_conductance"].targets(building)
+                  and building.zone(name).envelope_factor == 1.0]
+    return pairs
 
 
 def shaped_inputs(building):

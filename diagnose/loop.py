@@ -42,6 +42,7 @@ from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnose.calibrate import Candidate, calibrate, sensitivity
 from nodeforce.diagnose.candidates import candidates, follow_up, implausible, shaped_inputs
+from nodeforce.diagnose.loss import heat_loss
 from nodeforce.diagnose.report import write_report
 from nodeforce.diagnose.phases import phase_errors, worsened
 from nodeforce.diagnose.residuals import diagnostics as residual_diagnostics
@@ -291,6 +292,8 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
         "decision": decision,
         "effect": effect,
         "after": after,
+        "heat_loss_coefficient": heat_loss(building, after_building, added, results, decision),
+        "assumptions": list(case.assumptions),
         "residuals": residuals,
         "sensitivity": sensitivities,
         "noise_sigma": sigma,

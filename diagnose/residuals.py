@@ -110,6 +110,16 @@ def time_of_day(times, residual, regressors, max_order):
             "peak_hour": float(np.argmax(profile) / 12), "ar_order": int(order)}
 
 
+def level(r, rho):
+    """The residual's mean (K), its standard deviation as the residual's lag-one autocorrelation
+    rho makes it (an AR(1) residual's mean varies (1 + rho) / (1 - rho) times more than white
+    noise's), and whether it is significant at level ALPHA."""
+    rho = min(max(rho, 0.0), 0.999)
+    sd = float(np.std(r, ddof=1) / math.sqrt(len(r)) * math.sqrt((1 + rho) / (1 - rho)))
+    mean = float(np.mean(r))
+    return {"mean": mean, "sd": sd, "significant": bool(abs(mean) > norm.isf(ALPHA / 2) * sd)}
+
+
 def _lagged(x, lag, n):
     """x delayed by `lag` steps, the last n values (x[t - lag] for the last n t)."""
     return x[len(x) - n - lag:len(x) - lag]
@@ -129,7 +139,7 @@ def diagnostics(times, residual, inputs, max_lag_hours=24.0):
     -------
     dict, JSON-ready: "n" (steps used), "run" (where: start, end, n_total, n_finite), "step_hours",
     "ljung_box" {"lag", "statistic", "p_value"}, "white", "acf" (lags 0..max, per step) with
-    "acf_bound" (95 % band of white noise), "follows" [{"input", "lag_hours", "correlation"}]
+    "acf_bound" (95 % band of white noise), "level" {"mean", "sd", "significant"} (`level`), "follows" [{"input", "lag_hours", "correlation"}]
     strongest first (significant only), "strongest" (the largest prewhitened cross-correlation,
     significant or not, with its curve "ccf" over the lags and its "bound"), "skipped" {name:
     why}, "time_of_day" {"F", "p_value", "significant", "amplitude" (K), "peak_hour", ...} and
@@ -150,7 +160,8 @@ def diagnostics(times, residual, inputs, max_lag_hours=24.0):
                    "end": times[stop - 1].isoformat() if n else None,
                    "n_total": len(r), "n_finite": int(finite.sum()),
                    "rule": "longest run of consecutive steps where the residual and every input are measured"},
-           "ljung_box": None, "white": None, "acf": [], "acf_bound": None, "follows": [], "strongest": None,
+           "ljung_box": None, "white": None, "acf": [], "acf_bound": None, "level": None, "follows": [],
+           "strongest": None,
            "skipped": {}, "time_of_day": None}
     max_lag = min(int(round(max_lag_hours / dt)), n // 5)
     if n < MIN_STEPS or max_lag < 1:
@@ -167,6 +178,8 @@ def diagnostics(times, residual, inputs, max_lag_hours=24.0):
                           "p_value": p_white},
                white=bool(p_white >= ALPHA), acf=[float(v) for v in acf(r, nlags=max_lag, fft=True)],
                acf_bound=float(norm.isf(ALPHA / 2) / math.sqrt(n)))
+
+    out["level"] = level(r, out["acf"][1])
 
     varying = {name: x for name, x in xs.items() if np.ptp(x) > 0}
     out["skipped"] = {name: "constant over the run" for name in xs if name not in varying}

@@ -16,7 +16,8 @@ from .errors import InputError
 from .integrate import simulate
 from .building import DAY_TERMS
 from .network import assemble, clock_input_names, day_input, input_names
-from .solar import incident_irradiance, measured_irradiance, sky_temperature, solar_position
+from .solar import (DECOMPOSITIONS, complete_irradiance, incident_irradiance, measured_irradiance, sky_temperature,
+                    solar_position)
 from .weather import IRRADIANCE_COLUMNS, check_columns, weather_on_grid
 
 
@@ -28,6 +29,7 @@ class Case:
     U: np.ndarray  # (N_t+1, n_inputs) inputs at t_0..t_N
     measured: np.ndarray  # (N_t+1, N) node temperatures (C), NaN where not measured
     burn_in_steps: int = 0  # B: t_1..t_B force every measured node and are not scored
+    assumptions: tuple = ()  # sentences: what the case computed that the files did not give
 
     @property
     def measured_ids(self):
@@ -71,8 +73,8 @@ class Case:
         """The sub-case on rows start..stop (inclusive), t_start becoming its t_0; the burn-in
         stays with a window that starts at t_0 and is left behind by one that starts later."""
         rows = slice(start, stop + 1)
-        return Case(self.times[rows], self.dt, self.input_names, self.U[rows], self.measured[rows],
-                    self.burn_in_steps if start == 0 else 0)
+        return replace(self, times=self.times[rows], U=self.U[rows], measured=self.measured[rows],
+                       burn_in_steps=self.burn_in_steps if start == 0 else 0)
 
 
 def uniform_grid(times, source):
@@ -142,7 +144,7 @@ def measured_matrix(building, measurements, times):
     return matrix
 
 
-def prepare_case(building, weather, measurements=None):
+def prepare_case(building, weather, measurements=None, decomposition="erbs"):
     """The `Case` of a building under a weather, measured or not.
 
     Parameters
@@ -150,20 +152,23 @@ def prepare_case(building, weather, measurements=None):
     building : Building
     weather : DataFrame from `nodeforce.iotools.weather.read_weather`
     measurements : DataFrame from `nodeforce.iotools.measurements.read_measurements`, or None
+    decomposition : the pvlib model (`model.solar.DECOMPOSITIONS`) that splits `ghi` into `dni`
+        and `dhi` where the weather has only `ghi`
 
     Returns
     -------
     Case with inputs `T_out`, `T_sky` (C), `I_<component>` (W/m2, the weather's measured column
     if `model.solar.measured_irradiance` finds one, else pvlib's isotropic transposition of
-    `ghi`, `dni`, `dhi`), the building's named columns and, where a zone declares a daily gain,
+    `ghi`, `dni`, `dhi`, those the weather lacks from the others: `model.solar.complete_irradiance`,
+    stated in the case's `assumptions`), the building's named columns and, where a zone declares a daily gain,
     the time-of-day basis `day_cos1`, ... (`clock_inputs`).
 
     Raises
     ------
     InputError
         Naming the weather file and the column: a column the building has no use for
-        (`model.weather.check_columns`), `ghi`, `dni` or `dhi` missing where a face's irradiance
-        is computed (naming the face), a named column missing, a gap in an input; naming the
+        (`model.weather.check_columns`), `ghi` missing (and not both `dni` and `dhi` given) where
+        a face's irradiance is computed (naming the face), a named column missing, a gap in an input; naming the
         measurement file: times off a uniform grid, a column that measures no node; naming the
         building file: a site timezone that is none, where a daily gain needs the local time.
     """
@@ -191,15 +196,23 @@ def prepare_case(building, weather, measurements=None):
             computed.append(c)
         else:
             columns[c.irradiance_input] = w[measured_sun].to_numpy(float)
+    assumptions = []
     if computed:
-        for name in IRRADIANCE_COLUMNS:
-            if name not in w:
-                raise InputError(source, name, f"needed to compute the solar irradiance on {computed[0].name}, "
-                                                "which no weather column measures")
+        given = {name: w[name].to_numpy(float) for name in IRRADIANCE_COLUMNS if name in w}
+        if "ghi" not in given and len(given) < 2:
+            raise InputError(source, "ghi", f"needed to compute the solar irradiance on {computed[0].name}: the weather "
+                                            f"has no global horizontal irradiance (ghi) and no measured irradiance on "
+                                            f"that face (I_{computed[0].name}, or a column its outside names)")
+        if decomposition not in DECOMPOSITIONS:
+            raise InputError("--decomposition", decomposition, f"one of pvlib's {', '.join(DECOMPOSITIONS)}")
         position = solar_position(times, site["latitude"], site["longitude"], site["altitude"])
+        ghi, dni, dhi, said = complete_irradiance(position, **given, decomposition=decomposition)
+        if said:
+            assumptions.append(f"The weather {source} lacks {', '.join(n for n in IRRADIANCE_COLUMNS if n not in given)}: "
+                               f"{said}.")
         for c in computed:
-            columns[f"I_{c.name}"] = incident_irradiance(position, w["ghi"], w["dni"], w["dhi"],
-                                                         c.tilt, c.azimuth, site["ground_albedo"])
+            columns[f"I_{c.name}"] = incident_irradiance(position, ghi, dni, dhi, c.tilt, c.azimuth,
+                                                         site["ground_albedo"])
     columns.update(clock_inputs(building, times))
     names = input_names(building)
     U = np.column_stack([np.asarray(columns[n], dtype=float) for n in names])
@@ -210,7 +223,7 @@ def prepare_case(building, weather, measurements=None):
                                              "at every step, and a gap is not filled in")
     measured = (measured_matrix(building, measurements, times) if measurements is not None
                 else np.full((len(times), building.n_nodes), np.nan))
-    return Case(times=times, dt=dt, input_names=names, U=U, measured=measured)
+    return Case(times=times, dt=dt, input_names=names, U=U, measured=measured, assumptions=tuple(assumptions))
 
 
 def simulate_building(building, weather, measurements=None, force=(), warmup_days=2, burn_in_days=0):

@@ -6,6 +6,7 @@ by far the most expensive part and does not depend on the surface.
 """
 
 import numpy as np
+import pandas as pd
 import pvlib
 
 #: Stefan-Boltzmann constant, W/m2/K4 (CODATA 2018, exact as PHYSICS.md writes it).
@@ -125,3 +126,63 @@ def incident_irradiance(position, ghi, dni, dhi, tilt, azimuth, albedo):
     )["poa_global"]
     poa = np.asarray(poa, dtype=float)
     return np.where(np.isfinite(poa) & (poa > 0.0), poa, 0.0)
+
+
+#: pvlib's decompositions of the global horizontal irradiance into its direct and diffuse parts
+#: that need nothing but ghi, the sun's zenith and the time (Erbs the default, the classic one).
+DECOMPOSITIONS = ("erbs", "erbs_driesse", "boland", "orgill_hollands", "louche", "disc", "dirint")
+
+
+def complete_irradiance(position, ghi=None, dni=None, dhi=None, decomposition="erbs"):
+    """The three horizontal components (ghi, dni, dhi, W/m2) from those a weather file has.
+
+    Parameters
+    ----------
+    position : pandas.DataFrame
+        Output of `solar_position` at the samples' times; its `zenith` (true, degrees) is used.
+    ghi, dni, dhi : array_like or None
+        Global horizontal, direct normal, diffuse horizontal irradiance (W/m2) where measured.
+        ghi with at least one of the others, or dni and dhi, is needed.
+    decomposition : str
+        The pvlib model (one of `DECOMPOSITIONS`) that splits ghi when it is the only one.
+
+    Returns
+    -------
+    (ghi, dni, dhi) as numpy arrays (W/m2), and a sentence saying what was computed (None when
+    all three were given). Two components give the third by closure,
+    ghi = dhi + dni cos(zenith) (pvlib's `complete_irradiance`); ghi alone is split by
+    the pvlib decomposition, a modelling assumption.
+    """
+    given = {name: v for name, v in (("ghi", ghi), ("dni", dni), ("dhi", dhi)) if v is not None}
+    if len(given) == 3:
+        return ghi, dni, dhi, None
+    zenith = pd.Series(np.asarray(position["zenith"], dtype=float), index=position.index)
+    series = {name: pd.Series(np.asarray(v, dtype=float), index=position.index) for name, v in given.items()}
+    if len(given) == 2:
+        out = pvlib.irradiance.complete_irradiance(zenith, **series)
+        missing = next(name for name in ("ghi", "dni", "dhi") if name not in given)
+        said = (f"{missing} computed from {' and '.join(given)} by closure, ghi = dhi + dni cos(zenith) "
+                "(pvlib complete_irradiance)")
+    elif set(given) == {"ghi"}:
+        out = decompose(series["ghi"], zenith, decomposition)
+        said = (f"dni and dhi split from ghi by pvlib's {decomposition} decomposition (a modelling assumption: "
+                "measured direct or diffuse irradiance would replace it; --decomposition chooses among "
+                f"{', '.join(DECOMPOSITIONS)})")
+    else:
+        raise ValueError(f"the irradiance needs ghi, or two of ghi, dni and dhi; given: {', '.join(given) or 'none'}")
+    return tuple(np.asarray(out[name], dtype=float) for name in ("ghi", "dni", "dhi")) + (said,)
+
+
+def decompose(ghi, zenith, model="erbs"):
+    """{"ghi", "dni", "dhi"} (W/m2) from ghi (Series, W/m2, time index) and the true solar zenith
+    (Series, degrees) by one of pvlib's `DECOMPOSITIONS`; disc and dirint give dni alone, and
+    dhi follows by closure."""
+    function = getattr(pvlib.irradiance, model)
+    times = ghi.index
+    if model in ("disc", "dirint"):
+        dni = function(ghi, zenith, times)
+        dni = np.asarray(dni["dni"] if model == "disc" else dni, dtype=float)
+        return {"ghi": ghi, "dni": dni, "dhi": np.asarray(ghi, dtype=float) - dni * np.cos(np.radians(zenith))}
+    out = function(ghi, zenith, times)
+    return {"ghi": ghi, "dni": out["dni"], "dhi": out["dhi"]}
+

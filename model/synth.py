@@ -19,7 +19,7 @@ from .network import assemble
 
 
 def pseudo_measurements(building, weather, times, nodes, noise_sd=0.0, seed=0, history_days=0,
-                        spinup_days=365):
+                        spinup_days=365, decomposition="erbs"):
     """Node temperatures (C) at `times`, as a measurements frame with columns `T<id>`.
 
     Parameters
@@ -32,12 +32,13 @@ def pseudo_measurements(building, weather, times, nodes, noise_sd=0.0, seed=0, h
     seed : seed of the noise
     history_days : days of real weather simulated before the record
     spinup_days : passes over the first simulated day that make the start periodic
+    decomposition : pvlib's split of ghi where the weather has it alone (`model.case.prepare_case`)
     """
     dt = times[1] - times[0]
     grid = pd.date_range(times[0] - pd.Timedelta(days=history_days), times[-1], freq=dt, name="time")
     empty = pd.DataFrame(index=grid)
     empty.attrs["source"] = "pseudo-measurements"
-    case = prepare_case(building, weather, empty)
+    case = prepare_case(building, weather, empty, decomposition)
     T = simulate(building, assemble(building), case.U, case.dt, case.measured,
                  warmup_days=spinup_days, include_start=True)
     record = T[len(grid) - len(times):, np.array(nodes) - 1]

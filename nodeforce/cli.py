@@ -42,7 +42,9 @@ def load_inputs(args):
     building = load_building(args.building)
     weather = read_weather(args.weather)
     measurements = read_measurements(args.measurements) if getattr(args, "measurements", None) else None
-    case = prepare_case(building, weather, measurements)
+    case = prepare_case(building, weather, measurements, args.decomposition)
+    for said in case.assumptions:
+        print(f"assumed: {said}")
     check_warmup(case, args.measurements or args.weather)
     case = case.with_burn_in(args.burn_in_days)
     objective = Objective.of(building, zone_list(args.objective) if getattr(args, "objective", None) else None)
@@ -215,7 +217,8 @@ def cmd_synth(args):
     times = pd.date_range(start, periods=int(args.days * 86400 / args.step) + 1,
                           freq=pd.Timedelta(seconds=args.step), name="time")
     frame = pseudo_measurements(building, read_weather(args.weather), times, node_list("--sensors", args.sensors),
-                                noise_sd=args.noise, seed=args.seed, history_days=args.history_days)
+                                noise_sd=args.noise, seed=args.seed, history_days=args.history_days,
+                                decomposition=args.decomposition)
     frame.round(4).to_csv(args.output, date_format="%Y-%m-%dT%H:%M:%S%z")
     print(f"wrote {args.output}: nodes {args.sensors}, {len(times)} times from {times[0].isoformat()}, "
           f"noise {args.noise} C" + (f", with {args.effect} not in {args.building}" if args.effect else ""))
@@ -287,6 +290,14 @@ def case_arguments(s, measurements_required, output_help, output_default=None):
     s.add_argument("--weather", required=True)
     s.add_argument("--measurements", required=measurements_required)
     s.add_argument("-o", "--output", required=output_default is None, default=output_default, help=output_help)
+    decomposition_argument(s)
+
+
+def decomposition_argument(s):
+    from nodeforce.model.solar import DECOMPOSITIONS
+    s.add_argument("--decomposition", choices=DECOMPOSITIONS, default="erbs",
+                   help="the pvlib model that splits the global horizontal irradiance into direct and diffuse "
+                        "where the weather has ghi alone (default erbs)")
 
 
 def diagnosis_arguments(s):
@@ -389,6 +400,7 @@ def parser():
                    help="days of real weather simulated before the record")
     s.add_argument("--effect", help="EFFECT@TARGET:name=value,... added to the building, e.g. "
                                     "ground_coupling@floor:U=0.8,T_ground=24")
+    decomposition_argument(s)
     s.set_defaults(run=cmd_synth)
 
     s = sub.add_parser("table", help="columns of a Modelica CombiTimeTable text file as a weather or measurements CSV")

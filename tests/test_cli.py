@@ -92,8 +92,9 @@ def rewrite_csv(files, source, name, edit):
 def test_bad_weather_files(files, capsys):
     def run(path):
         return error_of(capsys, ["simulate", str(files["building"]), "--weather", path])
-    no_dni = rewrite_csv(files, "weather", "no_dni.csv", lambda f: f.drop(columns="dni"))
-    assert "no_dni.csv: dni" in run(no_dni)
+    # ghi with dhi is enough (dni by closure); without ghi and one of the others, nothing to work from
+    no_sun = rewrite_csv(files, "weather", "no_sun.csv", lambda f: f.drop(columns=["ghi", "dni"]))
+    assert "no_sun.csv: ghi" in run(no_sun)
     shuffled = rewrite_csv(files, "weather", "shuffled.csv", lambda f: f.iloc[[0, 2, 1, *range(3, len(f))]])
     assert "shuffled.csv: time" in run(shuffled)
     twice = rewrite_csv(files, "weather", "twice.csv", lambda f: pd.concat([f.iloc[:5], f.iloc[4:]]))

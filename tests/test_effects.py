@@ -106,7 +106,7 @@ def test_candidates_follow_the_located_nodes(testcell):
         ("ground_coupling", "floor"), ("conductivity", "floor"), ("solar_transmittance", "window"), *air]
     assert candidates(testcell, [9, 10], ["cell"]) == [
         ("solar_absorptance", "roof"), ("conductivity", "roof"), *air]
-    assert candidates(testcell, [], ["cell"]) == [*air, ("inside_convection", "cell")]
+    assert candidates(testcell, [], ["cell"]) == [*air, ("inside_convection", "cell"), ("envelope_conductance", "cell")]
 
 
 def test_a_zone_with_supply_air_gets_a_thermal_bridge_not_an_infiltration():
@@ -166,7 +166,8 @@ def test_a_residual_that_follows_a_heat_input_points_at_its_gain_and_split():
     b = multizone_with_everything()
     left = {"white": False, "time_of_day": {"significant": False},
             "follows": [{"input": "heater", "lag_hours": 0.0, "correlation": -0.7}]}
-    assert follow_up(b, left, ["B"]) == [("proportional_gain", "B->heater"), ("heat_input_split", "B")]
+    assert follow_up(b, left, ["B"]) == [("proportional_gain", "B->heater"), ("heat_input_split", "B"),
+                                         ("internal_mass", "B"), ("heat_input_lag", "B")]
     # the time of day points at a daily gain; a white residual at nothing
     assert follow_up(b, {**left, "follows": [], "time_of_day": {"significant": True}, "strongest": None},
                      ["A"])[0] == ("daily_gain", "A")

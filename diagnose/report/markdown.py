@@ -90,7 +90,8 @@ def write_markdown(out_dir, report, plots, notes):
           "effect the model lacks, added and calibrated on the calibration window; the validation "
           "window was not seen by the calibration.", "",
           "## Result", "", *[f"**{line.strip()}**  " for line in tables.effect_header(report, pm="±").splitlines()],
-          "", "## Decision", "", *decision_lines(report), "",
+          "", *[f"{line}  " for line in tables.hlc_lines(report, pm="±")], "",
+          *([f"Modelling assumptions: {' '.join(report['assumptions'])}", ""] if report.get("assumptions") else []), "## Decision", "", *decision_lines(report), "",
           "## Period", "",
           f"- objective zones: {', '.join(content.zones(report)) or NA}",
           f"- calibration: {content.window_text(report, 'calibration')}",

@@ -5,7 +5,8 @@ from __future__ import annotations
 
 from . import content
 from .content import STATES, WINDOWS, metrics
-from .formats import (NA, fmt_bic, fmt_derived, fmt_int, fmt_parameters, fmt_sig, fmt_temp, num, time_text)
+from .formats import (NA, fmt_bic, fmt_derived, fmt_int, fmt_parameters, fmt_sig, fmt_temp, fmt_value_std, num,
+                      time_text)
 from ..phases import is_worse
 from ..residuals import lag_text
 
@@ -18,7 +19,21 @@ def effect_header(report, pm="+-"):
     params = fmt_parameters(effect.get("effect"), effect.get("parameters"), pm)
     line = (f"Effect added: {content.effect_name(effect.get('effect'), effect.get('target'))}"
             + (f": {params}" if params else ""))
-    return "\n".join([line] + [f"  the data determine {d}" for d in fmt_derived(effect.get("derived"), pm)])
+    # the HLC has its own line (`hlc_lines`)
+    derived = {k: v for k, v in (effect.get("derived") or {}).items() if k != "heat_loss_coefficient"}
+    return "\n".join([line] + [f"  the data determine {d}" for d in fmt_derived(derived, pm)])
+
+
+def hlc_lines(report, pm="+-"):
+    """The heat loss coefficient as described and as corrected (W/K, PHYSICS.md section 8), and
+    the sentence saying the data do not fix its split among effects, where they do not."""
+    hlc = report.get("heat_loss_coefficient") or {}
+    if num(hlc.get("before")) is None:
+        return []
+    line = f"Heat loss coefficient: {hlc['before']:.1f} W/K as described"
+    if num(hlc.get("after")) is not None:
+        line += f", {fmt_value_std(hlc['after'], hlc.get('after_sd'), pm)} W/K as corrected"
+    return [line] + ([hlc["split"]] if hlc.get("split") else [])
 
 
 def reference_text(report):
@@ -59,6 +74,7 @@ def before_after_table(report: dict) -> str:
                     fmt_int(m.get("n")))))
             lines.append(f"{(window + ' ' + label).strip():<{first}} | {cells[0]} | {cells[1]}")
     lines += [f"{window}: {content.window_text(report, window)}" for window in WINDOWS]
+    lines += hlc_lines(report) + [f"assumed: {a}" for a in report.get("assumptions") or ()]
     ref = reference_text(report)
     return "\n".join(lines + ([f"for scale, {ref}"] if ref else []))
 
