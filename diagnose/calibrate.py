@@ -137,7 +137,9 @@ def hlc_gradient(candidate, x):
         h = h if x[j] + h <= p.high else -h
         moved = x.copy()
         moved[j] += h
-        gradient[j] = (hlc(moved) - at) / h
+        change = hlc(moved) - at
+        # a parameter the loss does not depend on (a capacity, a gain) moves it by rounding only
+        gradient[j] = change / h if abs(change) > 1e-12 * abs(at) else 0.0
     return at, gradient
 
 

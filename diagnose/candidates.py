@@ -4,11 +4,18 @@ Kept apart from the effect records (`nodeforce.model.effects`), which an FMU bun
 the policy changes no FMU and throws away no saved search.
 """
 from nodeforce.model.effects import EFFECTS, bridge_parts, bridge_target
+from nodeforce.model.network import RHO_C_AIR
 
 # Where the calibration of an effect the file does not declare starts (see calibration_start).
 ABSENT_START = {("ground_coupling", "U"): 1.0,  # W/m2/K
                 ("infiltration", "n"): 0.5,  # 1/h
                 ("thermal_bridge", "UA"): 5.0}  # W/K
+# ... and, for the nodes a zone effect adds, in multiples of the zone air's capacity (J/K): a
+# room's furniture and inner mass are several times its air's, an electric heater's about its
+# air's; their conductances start at `effects.neutral_conductance` (the air's capacity over
+# half an hour), so the mass's time constant starts at hours and the heater's at half an hour.
+ZONE_START = {("internal_mass", "C_m"): 10.0,
+              ("heat_input_lag", "C_h"): 1.0}
 
 
 def candidates(building, located_nodes, zones):
@@ -53,13 +60,16 @@ def candidates(building, located_nodes, zones):
 
 def calibration_start(building, effect, target):
     """Where a calibration starts: the declared values, except that an absent coupling (U = 0,
-    n = 0, UA = 0) starts at `ABSENT_START`: on its bound, a bounded trust-region step is scaled
-    to nothing and the fit stops where it began, and at U = 0 the ground temperature has no
-    influence to fit at all."""
+    n = 0, UA = 0) starts at `ABSENT_START` and an absent zone node (C = 0) at `ZONE_START`: on
+    its bound, a bounded trust-region step is scaled to nothing and the fit stops where it began,
+    and at U = 0 the ground temperature (at C = 0 the node's conductance) has no influence to
+    fit at all."""
     values = EFFECTS[effect].read(building, target)
     for name, value in values.items():
         if value == 0.0 and (effect, name) in ABSENT_START:
             values[name] = ABSENT_START[(effect, name)]
+        if value == 0.0 and (effect, name) in ZONE_START:
+            values[name] = ZONE_START[(effect, name)] * RHO_C_AIR * building.zone(target).volume
     return values
 
 
