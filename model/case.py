@@ -131,8 +131,11 @@ def measured_matrix(building, measurements, times):
     for column in measurements.columns:
         node = building.node_of(column)
         if node is None:
+            hint = (": the building reads it as an input, which belongs in the weather file"
+                    if column in building.input_columns else "")
             raise InputError(source, column, f"names no node: a measurement column is T<node id> or a sensor "
-                                             f"of {building.source} ({', '.join(building.sensors) or 'none declared'})")
+                                             f"of {building.source} ({', '.join(building.sensors) or 'none declared'})"
+                                             + hint)
         if not 1 <= node <= building.n_nodes:
             raise InputError(source, column, f"node {node} does not exist (the building has nodes 1..{building.n_nodes})")
         if node in building.added_nodes:

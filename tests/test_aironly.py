@@ -86,7 +86,7 @@ def test_a_heat_power_in_the_measurements_is_told_it_names_no_node(heated, heate
     times = case.times
     measured = pd.DataFrame({"T23": case.measured[:, 22], "Q_heat": HEATER}, index=times)
     measured.attrs["source"] = "measured.csv"
-    with pytest.raises(InputError, match="names no node") as caught:
+    with pytest.raises(InputError, match="names no node.*belongs in the weather file") as caught:
         prepare_case(heated, heated_weather, measured)
     assert caught.value.field == "Q_heat"
     # a sensor-named column still gets the kelvin check, once the building says it is a temperature
