@@ -292,7 +292,7 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
         "decision": decision,
         "effect": effect,
         "after": after,
-        "heat_loss_coefficient": heat_loss(building, after_building, added, results, decision),
+        "heat_loss_coefficient": heat_loss(building, after_building, added, results, sigma),
         "assumptions": list(case.assumptions),
         "residuals": residuals,
         "sensitivity": sensitivities,

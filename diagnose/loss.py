@@ -5,20 +5,23 @@ how the loss splits among effects.
 A record of the indoor air and the heating power fixes the building's total loss per kelvin far
 better than where the heat goes: an air change and a factor on the envelope's conduction give
 the same HLC and nearly the same air temperatures. When candidates that change the loss fit the
-validation window alike and agree on the HLC, the report says the split is not the record's.
+validation window alike (within what the noise could change) and agree on the HLC, the report
+says the split is not the record's.
 """
 import math
 
+from nodeforce.ga.parsimony import tolerance
 from nodeforce.model.hlc import heat_loss_coefficient
 
 HLC = "heat_loss_coefficient"
-# Two HLCs agree when they differ by less than this many standard deviations of the difference,
-# or by less than AGREE_RELATIVE of their mean (a calibration's sd may be tiny on a long record).
+# An HLC moves when it differs from where its round started by more than AGREE_Z standard
+# deviations; two HLCs agree when they differ by less than AGREE_RELATIVE of their mean and each
+# is known to that fraction.
 AGREE_Z = 2.0
 AGREE_RELATIVE = 0.05
 
 
-def heat_loss(before_building, after_building, added, results, decision):
+def heat_loss(before_building, after_building, added, results, sigma):
     """report.json's `heat_loss_coefficient`: {"before", "after", "after_sd"} (W/K) and "split",
     a sentence where the data fix the HLC but not how it splits among effects (else None).
 
@@ -28,16 +31,14 @@ def heat_loss(before_building, after_building, added, results, decision):
     added : the loop's chosen candidate records, in order (their "derived" holds the HLC of the
         model with the effect and its sd from the calibration's covariance)
     results : every candidate record; a follow-up's have "on_top_of"
-    decision : the loop's decision record (its candidates' validation margins, and its follow-up's)
+    sigma : the air sensors' noise sd (C), which sets the change of J no test can tell apart
     """
     out = {"before": heat_loss_coefficient(before_building), "after": heat_loss_coefficient(after_building),
            "after_sd": float(added[-1]["derived"][HLC]["std"]) if added else 0.0, "split": None}
-    rounds = [(decision, [r for r in results if "on_top_of" not in r])]
-    if decision.get("follow_up"):
-        rounds.append((decision["follow_up"], [r for r in results if "on_top_of" in r]))
+    rounds = [[r for r in results if "on_top_of" not in r], [r for r in results if "on_top_of" in r]]
     starts = [{"value": out["before"], "std": 0.0}] + [a["derived"][HLC] for a in added]
-    for chosen, start, (judged, tried) in zip(added, starts, rounds):
-        alike = same_loss(chosen, tried, judged, start)
+    for chosen, start, tried in zip(added, starts, rounds):
+        alike = same_loss(chosen, tried, start, sigma)
         if alike:
             hlc = chosen["derived"][HLC]
             out["split"] = (f"The data fix the heat loss coefficient ({hlc['value']:.1f} ± {hlc['std']:.1f} W/K) "
@@ -49,18 +50,20 @@ def heat_loss(before_building, after_building, added, results, decision):
     return out
 
 
-def same_loss(chosen, tried, judged, start):
+def same_loss(chosen, tried, start, sigma):
     """The other candidates of `chosen`'s round that change the loss from the round's `start`
-    ({"value", "std"}, W/K) as the chosen does: the same HLC, and a validation J within the
-    margin that judged the chosen. None when the chosen changes no loss (a gain, a mass)."""
+    ({"value", "std"}, W/K) as the chosen does: the same HLC, each well determined, and a
+    validation J the chosen's does not beat by more than the noise could (`ga.parsimony.tolerance`).
+    None when the chosen changes no loss (a gain, a mass)."""
     from nodeforce.diagnose.loop import label  # the decision's keys; loop imports this module
     hlc = chosen["derived"].get(HLC)
     if not hlc or not moves(hlc, start):
         return []
-    margin = judged["candidates"][label(chosen)]["validation_margin"]
+    J, n = chosen["validation"]["J"], chosen["validation"]["n"]
+    margin = tolerance(J, sigma, n)
     return [r for r in tried if label(r) != label(chosen) and r["derived"].get(HLC)
             and agree(hlc, r["derived"][HLC]) and moves(r["derived"][HLC], start)
-            and abs(r["validation"]["J"] - chosen["validation"]["J"]) <= margin]
+            and r["validation"]["J"] - J <= margin]
 
 
 def moves(a, start):
@@ -70,7 +73,8 @@ def moves(a, start):
 
 
 def agree(a, b):
-    """Whether two HLCs ({"value", "std"}, W/K) are the same within their uncertainty."""
-    difference = abs(a["value"] - b["value"])
-    return (difference <= AGREE_Z * math.hypot(a["std"], b["std"])
-            or difference <= AGREE_RELATIVE * (abs(a["value"]) + abs(b["value"])) / 2)
+    """Whether two HLCs ({"value", "std"}, W/K) are the same and each is fixed: within
+    AGREE_RELATIVE of their mean, and each with a standard deviation under that fraction."""
+    mean = (abs(a["value"]) + abs(b["value"])) / 2
+    return (abs(a["value"] - b["value"]) <= AGREE_RELATIVE * mean
+            and max(a["std"], b["std"]) <= AGREE_RELATIVE * mean)
