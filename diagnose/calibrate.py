@@ -41,6 +41,7 @@ class Candidate:
     def __init__(self, building, effect, target, workdir, fmu_kind="python"):
         self.building, self.effect, self.target = building, effect, target
         self.parameters = EFFECTS[effect].parameters
+        self.bounds = EFFECTS[effect].bounds(building, target)  # [(low, high)] a calibration explores
         self.declared = EFFECTS[effect].apply(building, target, {})  # what its FMU carries
         self.instance = FmuInstance(build_fmu(building, workdir / f"{self.label}.fmu", effect=(effect, target),
                                               kind=fmu_kind))
@@ -72,8 +73,7 @@ def calibrate(candidate, case, objective):
     """
     measured = objective.measured(case)
     have = np.isfinite(measured)
-    lows = np.array([p.low for p in candidate.parameters])
-    highs = np.array([p.high for p in candidate.parameters])
+    lows, highs = np.array(candidate.bounds).T
     start = calibration_start(candidate.building, candidate.effect, candidate.target)
     x0 = np.clip([start[p.name] for p in candidate.parameters], lows, highs)
 
@@ -132,9 +132,9 @@ def hlc_gradient(candidate, x):
     x = np.asarray(x, dtype=float)
     at = hlc(x)
     gradient = np.zeros(len(x))
-    for j, p in enumerate(candidate.parameters):
-        h = HLC_STEP * (p.high - p.low)
-        h = h if x[j] + h <= p.high else -h
+    for j, (low, high) in enumerate(candidate.bounds):
+        h = HLC_STEP * (high - low)
+        h = h if x[j] + h <= high else -h
         moved = x.copy()
         moved[j] += h
         change = hlc(moved) - at
@@ -151,7 +151,7 @@ def sensitivity(candidate, case, objective, seed=0):
     """
     measured = objective.measured(case)
     problem = {"num_vars": len(candidate.parameters), "names": [p.name for p in candidate.parameters],
-               "bounds": [[p.low, p.high] for p in candidate.parameters]}
+               "bounds": [list(b) for b in candidate.bounds]}
     X = morris_sample.sample(problem, MORRIS_TRAJECTORIES, num_levels=4, seed=seed)
     Y = np.array([objective.J(measured, candidate.nodes(case, objective.air_nodes, x)) for x in X])
     analysis = morris_analyze.analyze(problem, X, Y, num_levels=4, seed=seed)

@@ -38,9 +38,16 @@ class Effect:
     read: Callable  # (building, target) -> {name: value} declared now (neutral if not declared)
     write: Callable  # (JSON data, target, {name: value}) -> None: declare the values
     points_at: Callable  # (building, target) -> node ids whose forcing points at it; () none
+    limits: Callable | None = None  # (building, target) -> {name: (low, high)} narrower than the parameters'
 
     def applies(self, building, target):
         return target in self.targets(building)
+
+    def bounds(self, building, target):
+        """[(low, high)] of each parameter a calibration may explore on this target: the
+        parameter's range, narrowed where the target's own size sets a physical limit."""
+        narrowed = self.limits(building, target) if self.limits else {}
+        return [narrowed.get(p.name, (p.low, p.high)) for p in self.parameters]
 
     def apply(self, building, target, values):
         """A new Building with the effect declared at `values` ({name: value}; the others as
@@ -204,6 +211,19 @@ def _lumped_field(key, capacity, conductance):
     return read, write
 
 
+# A zone's furniture and inner mass, or its heater, hold at most this many times its air's heat
+# capacity (furnishing is 10 to 80 kg per m2 of floor, some 10 to 40 times the air's capacity; a
+# floor heating's screed about 50): more would be a reservoir at the record's first temperature,
+# a constant gain in disguise, not a mass.
+MAX_AIR_CAPACITIES = 100.0
+
+
+def _lumped_limits(capacity):
+    def limits(building, target):
+        return {capacity: (0.0, MAX_AIR_CAPACITIES * RHO_C_AIR * building.zone(target).volume)}
+    return limits
+
+
 def _envelope_targets(building):
     """Zones with a component to the outdoors or a boundary: what an envelope factor scales."""
     return [z.name for z in building.zones
@@ -243,11 +263,11 @@ EFFECTS = {e.id: e for e in (
            lambda b, t: b.facing(t)),
     Effect("internal_mass", "the zone's furniture and undeclared internal mass: a node coupled to its air",
            (Parameter("C_m", "J/K", 0.0, 1e9), Parameter("H_m", "W/K", 0.01, 1e5)), _zones,
-           *_lumped_field("internal_mass", "C_m", "H_m"), _no_node),
+           *_lumped_field("internal_mass", "C_m", "H_m"), _no_node, _lumped_limits("C_m")),
     Effect("heat_input_lag", "the heater's own capacity: a node between its measured heat input and the zone",
            (Parameter("C_h", "J/K", 0.0, 1e8), Parameter("H_h", "W/K", 0.01, 1e5)),
            lambda b: [z.name for z in b.zones if z.heat_input],
-           *_lumped_field("heat_input_lag", "C_h", "H_h"), _no_node),
+           *_lumped_field("heat_input_lag", "C_h", "H_h"), _no_node, _lumped_limits("C_h")),
     Effect("envelope_conductance", "one factor on the conductances of a zone's components to the outdoors "
                                    "and to boundaries, their outside surface coefficients included",
            (Parameter("factor", "-", 0.05, 20.0),), _envelope_targets,

@@ -196,3 +196,12 @@ def test_both_fmus_with_a_zone_effect_equal_the_direct_model(testcell_data, real
         assert np.abs(T - expected).max() < 1e-9, effect
         plain = simulate(b, net, U, 900.0, measured)
         assert np.abs(expected[:, :net.n_nodes] - plain).max() > 0.05, effect  # the effect does something
+
+
+def test_a_mass_or_a_heater_may_hold_at_most_a_hundred_times_the_zones_air(testcell):
+    """Beyond that a node is a reservoir at the record's first temperature, not a mass: the
+    calibration's bound on C scales with the zone (the test cell's 22.5 m3: 2.71 MJ/K)."""
+    (low, high), conductance = EFFECTS["internal_mass"].bounds(testcell, "cell")
+    assert (low, high) == (0.0, pytest.approx(100 * RHO_C * 22.5))
+    assert conductance == (EFFECTS["internal_mass"].parameter("H_m").low, EFFECTS["internal_mass"].parameter("H_m").high)
+    assert EFFECTS["envelope_conductance"].bounds(testcell, "cell") == [(0.05, 20.0)]
