@@ -186,6 +186,8 @@ def locate(building, case, objective=None, workdir=None, **search):
     **search
         `nodeforce.ga.locate.locate`'s settings: nodes, include_algebraic, population,
         generations, pc, pm, patience, seeded, seed, workers, scheduler, fmu_kind, noise, progress.
+        Worker processes (`workers`, default all cores) are spawned: a script that uses more
+        than one runs this under ``if __name__ == "__main__":``.
 
     Returns
     -------
@@ -212,7 +214,8 @@ def diagnose(building, case, workdir, objective=None, **options):
         Default: the building's first zone.
     **options
         `nodeforce.diagnose.loop.diagnose`'s: fraction, calibration_end (a pandas Timestamp),
-        seed, workers, fmu_kind, noise, phases (from `read_phases`), reference.
+        seed, workers, fmu_kind, noise, phases (from `read_phases`), reference. Worker
+        processes as for `locate`.
 
     Returns
     -------
