@@ -184,6 +184,7 @@ def cmd_synth(args):
                           freq=pd.Timedelta(seconds=args.step), name="time")
     frame = pseudo_measurements(building, read_weather(args.weather), times, node_list("--sensors", args.sensors),
                                 noise_sd=args.noise, seed=args.seed, history_days=args.history_days)
+    Path(args.output).parent.mkdir(parents=True, exist_ok=True)
     frame.round(4).to_csv(args.output, date_format="%Y-%m-%dT%H:%M:%S%z")
     print(f"wrote {args.output}: nodes {args.sensors}, {len(times)} times from {times[0].isoformat()}, "
           f"noise {args.noise} C" + (f", with {args.effect} not in {args.building}" if args.effect else ""))
