@@ -10,9 +10,8 @@ import numpy as np
 
 from nodeforce.ga.search import PAPER, PATIENCE
 from nodeforce.model.building import load_building
-from nodeforce.model.case import prepare_case
+from nodeforce.model.case import force_mask, measured_case, prepare_case
 from nodeforce.model.errors import InputError
-from nodeforce.model.integrate import steps_per_day
 from nodeforce.iotools.measurements import read_measurements
 from nodeforce.iotools.timetable import instant
 from nodeforce.iotools.weather import read_weather
@@ -42,9 +41,7 @@ def load_inputs(args):
     building = load_building(args.building)
     weather = read_weather(args.weather)
     measurements = read_measurements(args.measurements) if getattr(args, "measurements", None) else None
-    case = prepare_case(building, weather, measurements)
-    check_warmup(case, args.measurements or args.weather)
-    case = case.with_burn_in(args.burn_in_days)
+    case = measured_case(building, weather, measurements, args.burn_in_days)
     objective = Objective.of(building, zone_list(args.objective) if getattr(args, "objective", None) else None)
     return building, case, objective
 
@@ -55,29 +52,6 @@ def zone_list(text):
     if not names:
         raise InputError("--objective", text, "names no zone")
     return names
-
-
-def check_warmup(case, source):
-    """The warm-up replays the first day (PHYSICS.md section 5): the step must divide a day and
-    the record must hold one."""
-    try:
-        per_day = steps_per_day(case.dt)
-    except ValueError as e:
-        raise InputError(source, "time", f"{e}: the warm-up replays whole days") from None
-    if len(case.times) - 1 < per_day:
-        raise InputError(source, "time", f"{len(case.times) - 1} steps of {case.dt:g} s: the warm-up needs "
-                                          f"at least one day ({per_day} steps)")
-
-
-def force_mask(case, ids, source):
-    """Boolean mask of forced nodes; each must have a measurement to be forced to."""
-    mask = np.zeros(case.measured.shape[1], dtype=bool)
-    measured = set(case.measured_ids)
-    for i in ids:
-        if i not in measured:
-            raise InputError(source, f"T{i}", f"node {i} is to be forced but has no measurement column T{i}")
-        mask[i - 1] = True
-    return mask
 
 
 def cmd_fmu(args):
@@ -210,6 +184,7 @@ def cmd_synth(args):
                           freq=pd.Timedelta(seconds=args.step), name="time")
     frame = pseudo_measurements(building, read_weather(args.weather), times, node_list("--sensors", args.sensors),
                                 noise_sd=args.noise, seed=args.seed, history_days=args.history_days)
+    Path(args.output).parent.mkdir(parents=True, exist_ok=True)
     frame.round(4).to_csv(args.output, date_format="%Y-%m-%dT%H:%M:%S%z")
     print(f"wrote {args.output}: nodes {args.sensors}, {len(times)} times from {times[0].isoformat()}, "
           f"noise {args.noise} C" + (f", with {args.effect} not in {args.building}" if args.effect else ""))
