@@ -17,6 +17,9 @@ from nodeforce.model.network import clock_input_names
 
 
 DEFAULT_STEP = 900.0  # s, the step of the bundled data when a building declares none
+# s: an importer's default run (DefaultExperiment) is a day at that step, long enough for the
+# building to move and short enough for a first try; without stopTime every importer ran 1 s
+DEFAULT_SPAN = 86400.0
 # FMI 2.0 units: name -> (quantity, SI base-unit exponents and factor/offset to SI)
 UNITS = {
     "degC": ("ThermodynamicTemperature", {"K": "1", "offset": "273.15"}),
@@ -49,6 +52,9 @@ class Variable:
     start: object  # None for a calculated output
     unit: object  # a key of UNITS or None
     description: str
+    # An input an importer holds between the samples it is given (zero-order hold), never
+    # interpolates: a measurement, whose NaN (not measured) must not leak into its neighbours
+    discrete: bool = False
 
 
 def variables(layout, building, effect=None):
@@ -61,7 +67,8 @@ def variables(layout, building, effect=None):
     found += [Variable(name, "input", "Real", "0", *_input_meaning(building, name))
               for name in layout.input_names]
     found += [Variable(f"T_forced[{i}]", "input", "Real", "NaN", "degC",
-                       f"measured temperature of node {i}, NaN if none") for i in n]
+                       f"measured temperature of node {i}, NaN if none; held between samples, "
+                       "never interpolated", discrete=True) for i in n]
     found += [Variable(f"T[{i}]", "output", "Real", None, "degC", f"temperature of node {i}") for i in n]
     if effect is not None:
         effect_id, target, start = effect
@@ -116,7 +123,7 @@ def initial_dependencies(building, layout):
 
 
 def model_description(layout, building, guid, identifier, name, effect=None, standalone=False,
-                      source_files=(), step=DEFAULT_STEP):
+                      source_files=(), step=DEFAULT_STEP, span=DEFAULT_SPAN):
     """modelDescription.xml (bytes) of a model.
 
     Parameters
@@ -125,7 +132,7 @@ def model_description(layout, building, guid, identifier, name, effect=None, sta
     guid : the content hash (`content_guid`); identifier : the model identifier (binary name)
     name : model name; effect : (id, target, {name: start}) or None
     standalone : the FMU needs no Python; source_files : names under sources/
-    step : default communication step (s)
+    step, span : default communication step and stop time (s) of the DefaultExperiment
     """
     version, licence = nodeforce_version()
     root = Element("fmiModelDescription", {
@@ -152,7 +159,8 @@ def model_description(layout, building, guid, identifier, name, effect=None, sta
     categories = SubElement(root, "LogCategories")
     for category in LOG_CATEGORIES:
         SubElement(categories, "Category", {"name": category})
-    SubElement(root, "DefaultExperiment", {"startTime": "0", "stepSize": repr(float(step))})
+    SubElement(root, "DefaultExperiment", {"startTime": "0", "stopTime": repr(float(span)),
+                                           "stepSize": repr(float(step))})
     model_variables = SubElement(root, "ModelVariables")
     for vr, v in enumerate(declared):
         attributes = {"name": v.name, "valueReference": str(vr), "description": v.description,
@@ -161,6 +169,8 @@ def model_description(layout, building, guid, identifier, name, effect=None, sta
             attributes.update(variability="fixed", initial="exact")
         elif v.causality == "output":
             attributes["initial"] = "calculated"
+        if v.discrete:
+            attributes["variability"] = "discrete"
         element = SubElement(model_variables, "ScalarVariable", attributes)
         typed = {} if v.start is None else {"start": v.start}
         if v.unit:
@@ -250,4 +260,9 @@ def documentation(name, standalone, guarded=True, python_minimum="3.10"):
             "measurement); outputs <code>T[i]</code> (degC). Set the measurements at t_0 as "
             "<code>T_forced[i]</code> during initialisation: they set the initial state. One "
             "<code>fmi2DoStep</code> of h seconds is one backward-Euler step with the inputs set "
-            "before it (the inputs at the end of the step).</p>\n</body></html>\n").encode()
+            "before it (the inputs at the end of the step).</p>\n"
+            "<p><code>T_forced[i]</code> is a discrete input: an importer that reads an input file "
+            "holds each sample until the next one, NaN included, and never interpolates it, so a "
+            "gap means \"not measured\" over exactly the steps whose sample is NaN, in every importer. "
+            f"The default experiment is a day ({DEFAULT_SPAN:.0f} s) of {DEFAULT_STEP:.0f}-s steps, "
+            "the model's step.</p>\n</body></html>\n").encode()

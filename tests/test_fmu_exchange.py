@@ -1,0 +1,73 @@
+"""What an importer's own run of the FMU gives: its default run (DefaultExperiment), and an
+input file with gaps in a measurement, the same in FMPy and in a C host that applies input
+files as Reference-FMUs' fmusim does (tests/c_host/host.c)."""
+import numpy as np
+import pytest
+from fmpy import read_model_description, simulate_fmu
+
+from nodeforce.fmu_build.build import build_fmu
+from nodeforce.model.building import parse_building
+from nodeforce.model.integrate import simulate
+from nodeforce.model.network import assemble
+from tests.test_standalone import run_c_host
+
+DT = 900.0
+
+
+@pytest.fixture(scope="module")
+def fmus(tmp_path_factory, testcell_data):
+    folder = tmp_path_factory.mktemp("exchange")
+    building = parse_building(testcell_data)
+    return {kind: build_fmu(building, folder / f"{kind}.fmu", kind=kind) for kind in ("python", "standalone")}
+
+
+def test_the_default_run_is_a_day_of_backward_euler_steps_of_900_s(fmus, testcell, tmp_path):
+    fmu = fmus["standalone"]
+    experiment = read_model_description(str(fmu)).defaultExperiment
+    start, stop, step = (float(x) for x in (experiment.startTime, experiment.stopTime, experiment.stepSize))
+    assert (start, stop, step) == (0.0, 86400.0, DT)
+    outputs = [f"T[{i}]" for i in range(1, 24)]
+    result = simulate_fmu(str(fmu), output=outputs)  # FMPy with nothing but the FMU
+    assert np.array_equal(result["time"], np.arange(97) * DT)
+    T = np.column_stack([result[name] for name in outputs])[1:]
+    # the direct model: every input at its start value (0), nothing measured, 20 C everywhere
+    network = assemble(testcell)
+    direct = simulate(testcell, network, np.zeros((97, len(network.input_names))), DT, warmup_days=0)
+    assert np.abs(T - direct).max() < 1e-9
+    assert 20.0 - direct[-1, 22] > 5.0  # the day moves the model: a 1-s run would not
+    done, in_c = run_c_host(fmu, {}, {}, outputs, step, round((stop - start) / step), tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert np.abs(in_c - T).max() < 1e-9
+
+
+def gap_file(fmu):
+    """An input file of a day at 900 s: weather, and node 9's measurement with a gap of an
+    hour and a lone missing sample (NaN)."""
+    times = np.arange(97) * DT
+    day = np.sin(2 * np.pi * times / 86400)
+    names = [v.name for v in read_model_description(str(fmu)).modelVariables
+             if v.causality == "input" and not v.name.startswith("T_forced[")]
+    inputs = {name: np.maximum(0, 700 * day) if name.startswith("I_") else 24 + 6 * day - 8 * (name == "T_sky")
+              for name in names}
+    measured = 27 + 2 * np.cos(2 * np.pi * times / 86400)
+    measured[[30, 31, 32, 33, 60]] = np.nan
+    inputs["T_forced[9]"] = measured
+    return times, inputs
+
+
+def test_a_file_with_gaps_gives_the_same_outputs_in_fmpy_and_the_c_host(fmus, tmp_path):
+    times, inputs = gap_file(fmus["standalone"])
+    outputs = [f"T[{i}]" for i in range(1, 24)]
+    signals = np.array(list(zip(times, *inputs.values())),
+                       dtype=[("time", float)] + [(name, float) for name in inputs])
+    in_fmpy = simulate_fmu(str(fmus["python"]), input=signals, start_values={"force[9]": True}, output=outputs)
+    in_fmpy = np.column_stack([in_fmpy[name] for name in outputs])[1:]
+    done, in_c = run_c_host(fmus["standalone"], {"force[9]": True}, inputs, outputs, DT, 96, tmp_path, times=times)
+    assert done.returncode == 0, done.stderr
+    assert np.abs(in_c - in_fmpy).max() < 1e-9
+    # "not measured" is the held sample: the step from t_k takes the sample at t_k, and node 9
+    # is computed over exactly the steps whose sample is NaN
+    measured = inputs["T_forced[9]"][:96]
+    have = np.isfinite(measured)
+    assert np.array_equal(in_c[have, 8], measured[have])
+    assert np.isfinite(in_c).all() and not np.isin(in_c[~have, 8], measured[have]).any()
