@@ -15,6 +15,8 @@ from nodeforce.model.building import Boundary
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.network import clock_input_names
 
+from .guard import GUARD_GLIBC, PYTHONFMU_GLIBC
+
 
 DEFAULT_STEP = 900.0  # s, the step of the bundled data when a building declares none
 # s: an importer's default run (DefaultExperiment) is a day at that step, long enough for the
@@ -230,13 +232,17 @@ def documentation(name, standalone, guarded=True, python_minimum="3.10"):
         needs = (f"<p>This FMU runs Python code (pythonfmu): the importing machine needs Python "
                  f"{python_minimum} or newer with numpy. A Python host (FMPy, libcosimpy, ecospy) runs it as "
                  "is. In a process without Python, the FMU's binary (a guard in front of pythonfmu's, "
-                 "<code>binaries/linux64/*.pythonfmu.so</code>) loads the libpython named in "
-                 "<code>resources/guard.txt</code>, or the one the environment variable "
-                 "<code>NODEFORCE_LIBPYTHON</code> names; numpy must be importable there (e.g. on "
-                 "<code>PYTHONPATH</code>). Calls the FMI 2.0 standard forbids get fmi2Error, the reason "
-                 "logged. A call in which the model raises (an effect parameter it refuses, for example) "
-                 "gets fmi2Error too, not pythonfmu's fmi2Fatal: fmi2Reset then gives a new instance. "
-                 "pythonfmu's Linux binary needs glibc 2.32 and the C++ runtime of GCC 12; there "
+                 "<code>binaries/linux64/*.pythonfmu.so</code>) loads libpython: the one the environment "
+                 "variable <code>NODEFORCE_LIBPYTHON</code> names if it is set, else the first found of "
+                 "the exporting machine's (recorded in <code>resources/guard.txt</code>), the one of the "
+                 "<code>python3</code> on <code>PATH</code>, the exporting version's through the dynamic "
+                 "linker (a system Python), in <code>/usr/local/lib</code> and in "
+                 "<code>$CONDA_PREFIX/lib</code>; the logged error names each one tried. numpy must be "
+                 "importable there (e.g. on <code>PYTHONPATH</code>). Calls the FMI 2.0 standard forbids "
+                 "get fmi2Error, the reason logged. A call in which the model raises (an effect parameter "
+                 "it refuses, for example) gets fmi2Error too, not pythonfmu's fmi2Fatal: fmi2Reset then "
+                 f"gives a new instance. The guard needs glibc {GUARD_GLIBC}; pythonfmu's Linux binary "
+                 f"needs glibc {PYTHONFMU_GLIBC} and the C++ runtime of GCC 12; there "
                  "is no macOS binary, and the win64 one has no guard. Where that is not available, export "
                  "the standalone FMU: <code>nodeforce fmu BUILDING --standalone -o MODEL.fmu</code>.</p>")
     else:
@@ -249,7 +255,8 @@ def documentation(name, standalone, guarded=True, python_minimum="3.10"):
                  "with the reason logged, but reported as fmi2Discard (doStep) or fmi2Fatal (get/set). "
                  "pythonfmu's binary releases Python objects twice when the model raises and when the "
                  "process ends, which can corrupt the host's memory: do not call an instance again after "
-                 "fmi2Fatal. The Linux binary needs glibc 2.32 and the C++ runtime of GCC 12; there is no macOS "
+                 f"fmi2Fatal. The Linux binary needs glibc {PYTHONFMU_GLIBC} and the C++ runtime of GCC 12; there is "
+                 "no macOS "
                  "binary. Where that is not available, export the standalone FMU: "
                  "<code>nodeforce fmu BUILDING --standalone -o MODEL.fmu</code>.</p>")
     return (f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{name}</title></head><body>\n"

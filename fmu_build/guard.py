@@ -21,6 +21,10 @@ from .compiler import compile_library, find_compiler
 PLATFORM = "linux64"  # the guard's platform; pythonfmu's other binaries (win64) stay unguarded
 GUARD_FILE = "resources/guard.txt"
 LIBPYTHON_VARIABLE = "NODEFORCE_LIBPYTHON"  # the guard's override of the recorded libpython
+# The newest glibc symbol version each linux64 binary of the Python FMU needs (objdump -T): the
+# guard's, and pythonfmu 0.7.0's, which also needs the C++ runtime of GCC 12 (GLIBCXX_3.4.30)
+GUARD_GLIBC = "2.2.5"
+PYTHONFMU_GLIBC = "2.32"
 
 
 @functools.lru_cache(maxsize=1)
@@ -33,13 +37,19 @@ def guard_binary():
         return None
     with tempfile.TemporaryDirectory(prefix="nodeforce_guard_") as tmp:
         library = Path(tmp) / "guard.so"
-        compile_library("guard.c", library, libraries=("dl", "pthread"))
+        # libdl.so.2 by name and kept: where glibc is older than 2.34 the dl* functions the guard
+        # asks for (c/guard.c) are there; since, it is an empty compatibility library
+        compile_library("guard.c", library, libraries=(":libdl.so.2",), link_options=("-Wl,--no-as-needed",))
         return library.read_bytes()
 
 
 def libpython():
-    """Path of the shared libpython of this Python (sysconfig LIBDIR/LDLIBRARY)."""
-    return str(Path(sysconfig.get_config_var("LIBDIR")) / sysconfig.get_config_var("LDLIBRARY"))
+    """Path of the shared libpython of this Python: its run-time name (sysconfig INSTSONAME,
+    e.g. libpython3.11.so.1.0, which a machine without Python's development files has too, and
+    the name the guard gives the dynamic linker where this path does not exist), else LDLIBRARY."""
+    folder = Path(sysconfig.get_config_var("LIBDIR"))
+    runtime = folder / (sysconfig.get_config_var("INSTSONAME") or "")
+    return str(runtime if runtime.is_file() else folder / sysconfig.get_config_var("LDLIBRARY"))
 
 
 def guard_text(layout, binary):

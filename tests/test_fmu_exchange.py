@@ -1,15 +1,23 @@
 """What an importer's own run of the FMU gives: its default run (DefaultExperiment), and an
 input file with gaps in a measurement, the same in FMPy and in a C host that applies input
 files as Reference-FMUs' fmusim does (tests/c_host/host.c)."""
+import re
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
 import numpy as np
 import pytest
 from fmpy import read_model_description, simulate_fmu
 
+from nodeforce.fmu_build import guard
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.model.building import parse_building
 from nodeforce.model.integrate import simulate
 from nodeforce.model.network import assemble
-from tests.test_standalone import run_c_host
+from tests.importers import run_fmpy
+from tests.test_standalone import python_host_environment, run_c_host, scenario
 
 DT = 900.0
 
@@ -71,3 +79,61 @@ def test_a_file_with_gaps_gives_the_same_outputs_in_fmpy_and_the_c_host(fmus, tm
     have = np.isfinite(measured)
     assert np.array_equal(in_c[have, 8], measured[have])
     assert np.isfinite(in_c).all() and not np.isin(in_c[~have, 8], measured[have]).any()
+
+
+def with_recorded_libpython(fmu, path, destination):
+    """A copy of the Python FMU whose resources/guard.txt records `path` as the exporting
+    machine's libpython, as an FMU exported elsewhere does."""
+    with zipfile.ZipFile(fmu) as source, zipfile.ZipFile(destination, "w") as copied:
+        for item in source.infolist():
+            data = source.read(item)
+            if item.filename == "resources/guard.txt":
+                data = re.sub(rb"(?m)^libpython .*$", f"libpython {path}".encode(), data)
+            copied.writestr(item, data)
+    return destination
+
+
+@pytest.mark.parametrize("where", ["python3 on PATH", "dynamic linker", "nowhere"])
+def test_the_guard_finds_libpython_where_the_recorded_path_does_not_exist(fmus, tmp_path, where):
+    recorded = Path(guard.libpython())
+    name = "libpython3.99.so.1.0" if where != "dynamic linker" else recorded.name  # 3.99: no such Python
+    fmu = with_recorded_libpython(fmus["python"], f"/nonexistent/{name}", tmp_path / "elsewhere.fmu")
+    # PATH: the folder of this test's python3, or no folder at all
+    path = str(Path(sys.executable).parent) if where == "python3 on PATH" else "/nonexistent"
+    env = {k: v for k, v in python_host_environment().items() if k not in (guard.LIBPYTHON_VARIABLE, "CONDA_PREFIX")}
+    parameters, inputs, outputs, _ = scenario(fmu)
+    done, T = run_c_host(fmu, parameters, inputs, outputs, DT, 4, tmp_path, env=dict(env, PATH=path))
+    if where == "nowhere":
+        assert done.returncode == 1
+        logged = [line for line in done.stderr.splitlines() if "libpython" in line]
+        assert len(logged) == 1
+        for attempt in (guard.LIBPYTHON_VARIABLE, f"/nonexistent/{name}", "python3 on PATH", f"{name} (",
+                        f"/usr/local/lib/{name}"):
+            assert attempt in logged[0]
+    else:
+        assert done.returncode == 0, done.stderr
+        assert np.abs(T - run_fmpy(fmus["python"], parameters, inputs, outputs, DT, 4)).max() < 1e-9
+
+
+def glibc_versions(library):
+    """The glibc symbol versions (tuples) a shared library needs, read from `objdump -T`, and
+    the libraries it names as needed (`objdump -p`)."""
+    symbols = subprocess.run(["objdump", "-T", str(library)], capture_output=True, text=True, check=True).stdout
+    headers = subprocess.run(["objdump", "-p", str(library)], capture_output=True, text=True, check=True).stdout
+    versions = {tuple(int(x) for x in v.split(".")) for v in re.findall(r"\(GLIBC_([0-9.]+)\)", symbols)}
+    return versions, set(re.findall(r"NEEDED\s+(\S+)", headers))
+
+
+def test_the_python_fmu_needs_the_glibc_its_documentation_states(fmus, tmp_path):
+    with zipfile.ZipFile(fmus["python"]) as fmu:
+        page = fmu.read("documentation/index.html").decode()
+        for name in ("NodalBuilding.so", "NodalBuilding.pythonfmu.so"):
+            (tmp_path / name).write_bytes(fmu.read(f"binaries/linux64/{name}"))
+    as_tuple = lambda text: tuple(int(x) for x in text.split("."))
+    guard_needs, guard_libraries = glibc_versions(tmp_path / "NodalBuilding.so")
+    pythonfmu_needs, _ = glibc_versions(tmp_path / "NodalBuilding.pythonfmu.so")
+    # the guard asks for the dl* functions' first versions, which glibc older than 2.34 has in libdl
+    assert max(guard_needs) == as_tuple(guard.GUARD_GLIBC) == (2, 2, 5)
+    assert "libdl.so.2" in guard_libraries
+    assert max(pythonfmu_needs) == as_tuple(guard.PYTHONFMU_GLIBC)
+    assert f"glibc {guard.GUARD_GLIBC};" in page and f"needs glibc {guard.PYTHONFMU_GLIBC} " in page

@@ -8,7 +8,11 @@
 
    And: pythonfmu's binary does not link libpython, it expects Python in the host process. When
    the process has none (Py_IsInitialized not found), the guard loads libpython with RTLD_GLOBAL
-   first: $NODEFORCE_LIBPYTHON, else the path recorded at export in resources/guard.txt.
+   first: $NODEFORCE_LIBPYTHON if set (a user's choice, nothing else is tried), else the first
+   that loads of the path recorded at export in resources/guard.txt, the libpython of the
+   python3 on PATH (its sysconfig), the recorded file name through the dynamic linker's search
+   (LD_LIBRARY_PATH, ld.so.cache: a system Python of the exporting version), and that name in
+   /usr/local/lib and $CONDA_PREFIX/lib; the logged error names every one tried.
 
    The guard does not depend on the model: it reads the sizes of the layout from
    resources/guard.txt at instantiation, a file of four lines:
@@ -50,6 +54,21 @@
 #include "resources.h"
 #include "variables.h"
 
+/* glibc 2.34 moved the dl* functions into libc under a new version, GLIBC_2.34, which a guard
+   linked there would need; their first versions are still in every glibc (in libdl.so.2 before
+   2.34, which the guard links, as compatibility symbols of libc since), so it asks for those.
+   memcpy too (GLIBC_2.14 is its newer version). The guard then needs only glibc's first x86_64
+   version, GLIBC_2.2.5: objdump -T of the binary lists every version it needs
+   (tests/test_fmu_exchange.py reads them). After the includes, which define __GLIBC__. */
+#if defined(__x86_64__) && defined(__GLIBC__)
+__asm__(".symver dlopen,dlopen@GLIBC_2.2.5");
+__asm__(".symver dlsym,dlsym@GLIBC_2.2.5");
+__asm__(".symver dladdr,dladdr@GLIBC_2.2.5");
+__asm__(".symver dlclose,dlclose@GLIBC_2.2.5");
+__asm__(".symver dlerror,dlerror@GLIBC_2.2.5");
+__asm__(".symver memcpy,memcpy@GLIBC_2.2.5");
+#endif
+
 #define LIBPYTHON_VARIABLE "NODEFORCE_LIBPYTHON"
 
 #define FORWARDED(X)                                                                                          \
@@ -87,7 +106,7 @@ typedef struct {
 } GuardState;
 
 static void log_error(const fmi2CallbackFunctions *cb, const char *name, const char *format, ...) {
-    char message[1024];
+    char message[8192];
     va_list args;
     va_start(args, format);
     vsnprintf(message, sizeof message, format, args);
@@ -114,16 +133,73 @@ static int read_field(FILE *f, const char *word, char *value, size_t size) {
     return 1;
 }
 
+/* Three counts "N N_IN N_PAR" (strtol, not sscanf, whose C99 name needs GLIBC_2.7). */
+static int read_sizes(const char *text, Layout *l) {
+    int *counts[3] = {&l->n, &l->n_in, &l->n_par}, k;
+    char *end;
+    for (k = 0; k < 3; k++) {
+        long value = strtol(text, &end, 10);
+        if (end == text || value < 0 || value > 100000000L) return 0;
+        *counts[k] = (int)value;
+        text = end;
+    }
+    return 1;
+}
+
 static int read_guard_file(const char *path, GuardFile *g) {
     char header[64], sizes[64];
     FILE *f = fopen(path, "r");
     int ok = f && fgets(header, sizeof header, f) && strcmp(header, "nodeforce-guard/1\n") == 0
-             && read_field(f, "sizes", sizes, sizeof sizes)
-             && sscanf(sizes, "%d %d %d", &g->layout.n, &g->layout.n_in, &g->layout.n_par) == 3
+             && read_field(f, "sizes", sizes, sizeof sizes) && read_sizes(sizes, &g->layout)
              && read_field(f, "binary", g->binary, sizeof g->binary)
              && read_field(f, "libpython", g->libpython, sizeof g->libpython);
     if (f) fclose(f);
     return ok;
+}
+
+/* ------------------------------------------------------------------ finding libpython */
+/* Load `path` RTLD_GLOBAL; else add "path (why)" to the list of what was tried. */
+static int try_python(const char *path, char *tried, size_t size) {
+    size_t used = strlen(tried);
+    if (dlopen(path, RTLD_NOW | RTLD_GLOBAL)) return 1;
+    snprintf(tried + used, size - used, "%s%s (%s)", used ? "; " : "", path, dlerror());
+    return 0;
+}
+
+/* The libpython of the python3 on PATH, from its sysconfig, into `path`; 0 without one. */
+static int python_on_path(char *path, size_t size) {
+    FILE *p = popen("python3 -c \"import os, sysconfig as s; print(os.path.join(s.get_config_var('LIBDIR') or '', "
+                    "s.get_config_var('INSTSONAME') or ''))\" 2>/dev/null", "r");
+    int ok;
+    if (!p) return 0;
+    ok = fgets(path, (int)size, p) != NULL;
+    if (pclose(p) != 0) ok = 0;
+    path[strcspn(path, "\r\n")] = 0;
+    return ok && path[0] == '/';
+}
+
+/* libpython without $NODEFORCE_LIBPYTHON: the candidates of the top of this file, in turn. */
+static int load_python(const char *recorded, const fmi2CallbackFunctions *cb, const char *name) {
+    char tried[6144] = "", path[4352];
+    const char *slash = strrchr(recorded, '/'), *file = slash ? slash + 1 : recorded;
+    const char *folders[2] = {"/usr/local/lib", getenv("CONDA_PREFIX")};
+    size_t used, k;
+    if (try_python(recorded, tried, sizeof tried)) return 1;
+    if (python_on_path(path, sizeof path)) {
+        if (try_python(path, tried, sizeof tried)) return 1;
+    } else {
+        used = strlen(tried);
+        snprintf(tried + used, sizeof tried - used, "; python3 on PATH (none, or it gives no shared libpython)");
+    }
+    if (try_python(file, tried, sizeof tried)) return 1; /* the dynamic linker's search */
+    for (k = 0; k < 2; k++) {
+        if (!folders[k] || !*folders[k]) continue;
+        snprintf(path, sizeof path, "%s%s/%s", folders[k], k ? "/lib" : "", file);
+        if (try_python(path, tried, sizeof tried)) return 1;
+    }
+    log_error(cb, name, "this process has no Python and no libpython could be loaded; tried %s unset, then %s: set %s "
+              "to the libpython3 shared library of a Python with numpy", LIBPYTHON_VARIABLE, tried, LIBPYTHON_VARIABLE);
+    return 0;
 }
 
 /* ------------------------------------------------------------------ loading pythonfmu's binary */
@@ -141,10 +217,13 @@ static int load(const GuardFile *file, const fmi2CallbackFunctions *cb, const ch
     void *library;
     if (inner.library) return 1;
     if (!dlsym(RTLD_DEFAULT, "Py_IsInitialized")) {
-        if (!libpython || !*libpython) libpython = file->libpython;
-        if (!dlopen(libpython, RTLD_NOW | RTLD_GLOBAL)) {
-            log_error(cb, name, "this process has no Python and libpython cannot be loaded (%s): set %s to the "
-                      "libpython3 shared library of a Python with numpy", dlerror(), LIBPYTHON_VARIABLE);
+        if (libpython && *libpython) {
+            if (!dlopen(libpython, RTLD_NOW | RTLD_GLOBAL)) {
+                log_error(cb, name, "this process has no Python and libpython cannot be loaded (%s): set %s to the "
+                          "libpython3 shared library of a Python with numpy", dlerror(), LIBPYTHON_VARIABLE);
+                return 0;
+            }
+        } else if (!load_python(file->libpython, cb, name)) {
             return 0;
         }
     }
