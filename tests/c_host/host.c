@@ -10,13 +10,15 @@
      at t = 0 during initialisation, row r is the last with time <= t; a continuous (c) input
      gets v_r + (t - t_r) (v_r+1 - v_r) / (t_r+1 - t_r), a discrete (d) one v_r (held).
    Prints one row of P outputs (%.17g) after each step, read in one fmi2GetReal, or one call
-   per value with "one-by-one" (as the FMI Compliance Checker reads them).
+   per value with "one-by-one" (as the FMI Compliance Checker reads them), and, last on
+   stderr, "stepping S s": the time of the step loop (benchmarks/bench_fmu_calls.py).
    Exits 1 on any status other than fmi2OK, naming the call. */
 #include <dlfcn.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "fmi2.h"
 
@@ -98,6 +100,7 @@ int main(int argc, char **argv) {
     SetReal set_real;
     DoStep do_step;
     GetReal get_real;
+    struct timespec started, ended;
     int one_by_one = argc == 6 && !strcmp(argv[5], "one-by-one");
     Table table = {0, 0, NULL, NULL, NULL};
     if (argc != 5 && !one_by_one) {
@@ -158,6 +161,7 @@ int main(int argc, char **argv) {
     set_real = (SetReal)symbol(library, "fmi2SetReal"); /* looked up once: the loop times the FMU */
     do_step = (DoStep)symbol(library, "fmi2DoStep");
     get_real = (GetReal)symbol(library, "fmi2GetReal");
+    clock_gettime(CLOCK_MONOTONIC, &started);
     for (k = 0; k < n_steps; k++) {
         if (table.rows) {
             table_at(&table, k * dt, in);
@@ -175,11 +179,13 @@ int main(int argc, char **argv) {
         for (j = 0; j < n_out; j++) printf(j ? " %.17g" : "%.17g", out[j]);
         printf("\n");
     }
+    clock_gettime(CLOCK_MONOTONIC, &ended);
     CHECK(((Call)symbol(library, "fmi2Terminate"))(c));
     ((Free)symbol(library, "fmi2FreeInstance"))(c);
     dlclose(library);
     free(in_vr); free(in); free(out_vr); free(out);
     free(table.kind); free(table.time); free(table.values);
     fclose(scenario);
+    fprintf(stderr, "stepping %.6f s\n", (double)(ended.tv_sec - started.tv_sec) + 1e-9 * (ended.tv_nsec - started.tv_nsec));
     return 0;
 }
