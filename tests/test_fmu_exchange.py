@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from fmpy import read_model_description, simulate_fmu
 
+from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.fmu_build import guard
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.model.building import parse_building
@@ -137,3 +138,31 @@ def test_the_python_fmu_needs_the_glibc_its_documentation_states(fmus, tmp_path)
     assert "libdl.so.2" in guard_libraries
     assert max(pythonfmu_needs) == as_tuple(guard.PYTHONFMU_GLIBC)
     assert f"glibc {guard.GUARD_GLIBC};" in page and f"needs glibc {guard.PYTHONFMU_GLIBC} " in page
+
+
+def test_outputs_read_one_per_call_are_the_step_s_outputs(fmus, tmp_path):
+    """The guard answers reads of outputs from its copy of the step's outputs: read one per
+    call, after every step, in the C host, they are FMPy's (all in one call); restoring a state
+    gives that state's outputs before any step."""
+    fmu = fmus["python"]
+    parameters, inputs, outputs, _ = scenario(fmu)
+    reference = run_fmpy(fmu, parameters, inputs, outputs, DT, 24)
+    done, T = run_c_host(fmu, parameters, inputs, outputs, DT, 24, tmp_path, env=python_host_environment(),
+                         one_by_one=True)
+    assert done.returncode == 0, done.stderr
+    assert np.abs(T - reference).max() < 1e-9 and np.ptp(T[:, 22]) > 0.1
+    with FmuInstance(fmu) as instance:
+        slave, refs = instance.fmu, [instance.variables[name].valueReference for name in outputs]
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
+        slave.exitInitializationMode()
+        slave.setReal([instance.variables["T_out"].valueReference], [35.0])
+        slave.doStep(0.0, DT)
+        state, first = slave.getFMUstate(), slave.getReal(refs)
+        slave.doStep(DT, DT)
+        second = [slave.getReal([vr])[0] for vr in refs]
+        slave.setFMUstate(state)
+        restored = [slave.getReal([vr])[0] for vr in refs]
+        slave.freeFMUstate(state)
+        slave.terminate()
+    assert restored == first and second != first

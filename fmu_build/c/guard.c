@@ -41,7 +41,15 @@
      releases them again in the next call that touches them (fmi2Reset, fmi2FreeInstance). The
      guard sets that instance aside, never calls it again (its few bytes are left allocated),
      and answers fmi2Error, as for any failed call of this instance: fmi2Reset instantiates the
-     model anew, fmi2FreeInstance frees the rest. */
+     model anew, fmi2FreeInstance frees the rest.
+
+   Outputs: a host may read the N outputs one value per fmi2GetReal (the FMI Compliance Checker
+   does), and each call into pythonfmu costs tens of microseconds of Python. The outputs change
+   only in the calls that step or move the slave (fmi2DoStep, the state changes, fmi2Reset,
+   fmi2SetFMUstate; variables.h refuses setting them), so the guard reads all N in one call the
+   first time one is asked for after such a call, once initialisation has ended, and answers
+   every read of outputs only from that copy until the next such call
+   (benchmarks/bench_fmu_calls.py). */
 #define _GNU_SOURCE
 #include <dlfcn.h>
 #include <pthread.h>
@@ -92,6 +100,9 @@ typedef struct {
     fmi2Component inner;
     int lost; /* the model raised: `inner` is set aside (see the top of this file) */
     Layout layout;
+    int cached;                      /* `outputs` holds the outputs since the last step or state change */
+    fmi2Real *outputs;               /* T[1..N] */
+    fmi2ValueReference *output_refs; /* their value references */
     int state;
     char *name, *guid, *resources;
     fmi2Type type;
@@ -274,6 +285,7 @@ static fmi2Status answered(Guard *g, fmi2Status status) {
 
 /* A state change that happens when the slave accepts the call. */
 static fmi2Status moved(Guard *g, fmi2Status status, int state) {
+    g->cached = 0;
     if (status <= fmi2Warning) g->state = state;
     return status;
 }
@@ -297,6 +309,8 @@ static void free_guard(Guard *g) {
     free(g->name);
     free(g->guid);
     free(g->resources);
+    free(g->outputs);
+    free(g->output_refs);
     free(g);
 }
 
@@ -311,7 +325,7 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
     GuardFile file;
     Guard *g;
     char *path;
-    int ok;
+    int ok, k;
     if (!functions) return NULL; /* no logger to say why: the standard requires the callbacks */
     path = resources ? resource_path(resources, "guard.txt") : NULL;
     ok = path && read_guard_file(path, &file);
@@ -335,7 +349,10 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
     g->functions = functions;
     g->layout = file.layout;
     g->state = INSTANTIATED;
-    g->inner = g->name && g->guid && g->resources ? instantiate(g) : NULL;
+    g->outputs = malloc(sizeof(fmi2Real) * (size_t)(file.layout.n + 1));
+    g->output_refs = malloc(sizeof(fmi2ValueReference) * (size_t)(file.layout.n + 1));
+    for (k = 0; g->output_refs && k < file.layout.n; k++) g->output_refs[k] = (fmi2ValueReference)(vr_T(&g->layout) + k);
+    g->inner = g->name && g->guid && g->resources && g->outputs && g->output_refs ? instantiate(g) : NULL;
     if (!g->inner) {
         free_guard(g);
         return NULL;
@@ -377,6 +394,7 @@ FMI2_EXPORT fmi2Status fmi2Reset(fmi2Component c) {
     if (!fresh) return refuse(g, "fmi2Reset: the model cannot be instantiated again");
     g->inner = fresh;
     g->lost = 0;
+    g->cached = 0;
     g->state = INSTANTIATED;
     return fmi2OK;
 }
@@ -390,10 +408,27 @@ FMI2_EXPORT fmi2Status fmi2Reset(fmi2Component c) {
             return refuse(g, reason);                                                                         \
         return FORWARD(g, function(g->inner, vr, nvr, value));                                                \
     }
-GET_OR_SET(fmi2GetReal, fmi2Real value[], 1, 0)
 GET_OR_SET(fmi2SetReal, const fmi2Real value[], 1, 1)
 GET_OR_SET(fmi2GetBoolean, fmi2Boolean value[], 0, 0)
 GET_OR_SET(fmi2SetBoolean, const fmi2Boolean value[], 0, 1)
+
+/* Outputs only, once initialisation has ended: from the copy (the top of this file). */
+FMI2_EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
+    Guard *g = c;
+    char reason[256];
+    size_t k;
+    int outputs = (g->state == STEPPING || g->state == TERMINATED) && !g->lost;
+    if (refusal(&g->layout, vr, nvr, 1, 0, g->state, reason, sizeof reason)) return refuse(g, reason);
+    for (k = 0; outputs && k < nvr; k++) outputs = (int)vr[k] >= vr_T(&g->layout) && (int)vr[k] < vr_parameters(&g->layout);
+    if (!outputs) return FORWARD(g, fmi2GetReal(g->inner, vr, nvr, value));
+    if (!g->cached) {
+        fmi2Status status = FORWARD(g, fmi2GetReal(g->inner, g->output_refs, (size_t)g->layout.n, g->outputs));
+        if (status > fmi2Warning) return status;
+        g->cached = 1;
+    }
+    for (k = 0; k < nvr; k++) value[k] = g->outputs[vr[k] - (fmi2ValueReference)vr_T(&g->layout)];
+    return fmi2OK;
+}
 
 #define NO_SUCH_TYPE(function, value_type, type)                                                              \
     FMI2_EXPORT fmi2Status function(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, value_type) { \
@@ -501,6 +536,7 @@ FMI2_EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunication
     Guard *g = c;
     char reason[256];
     if (step_refusal(g->state, communicationStepSize, reason, sizeof reason)) return refuse(g, reason);
+    g->cached = 0;
     return FORWARD(g, fmi2DoStep(g->inner, currentCommunicationPoint, communicationStepSize,
                                  noSetFMUStatePriorToCurrentPoint));
 }
