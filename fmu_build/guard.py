@@ -27,9 +27,11 @@ GUARD_GLIBC = "2.2.5"
 PYTHONFMU_GLIBC = "2.32"
 
 
-@functools.lru_cache(maxsize=1)
-def guard_binary():
-    """The guard library (bytes), compiled once per process; None without a C compiler."""
+@functools.lru_cache(maxsize=2)
+def guard_binary(fmi=2):
+    """The guard library (bytes), compiled once per process; None without a C compiler. With
+    fmi=3, the FMI 3.0 interface (c/fmi3.c) over it, in one library whose own calls to its
+    fmi2* functions stay inside it (-Bsymbolic)."""
     if find_compiler() is None:
         print("nodeforce: warning: no C compiler (cc, gcc or $CC): the Python FMU is written without its "
               "guard, so forbidden calls get fmi2Discard or fmi2Fatal instead of fmi2Error and a C host "
@@ -39,7 +41,8 @@ def guard_binary():
         library = Path(tmp) / "guard.so"
         # libdl.so.2 by name and kept: where glibc is older than 2.34 the dl* functions the guard
         # asks for (c/guard.c) are there; since, it is an empty compatibility library
-        compile_library("guard.c", library, libraries=(":libdl.so.2",), link_options=("-Wl,--no-as-needed",))
+        compile_library(("guard.c", "fmi3.c") if fmi == 3 else "guard.c", library, libraries=(":libdl.so.2",),
+                        link_options=("-Wl,--no-as-needed", "-Wl,-Bsymbolic"))
         return library.read_bytes()
 
 

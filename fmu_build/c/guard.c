@@ -59,23 +59,10 @@
 #include <string.h>
 
 #include "fmi2.h"
+#include "glibc.h"
 #include "resources.h"
 #include "variables.h"
 
-/* glibc 2.34 moved the dl* functions into libc under a new version, GLIBC_2.34, which a guard
-   linked there would need; their first versions are still in every glibc (in libdl.so.2 before
-   2.34, which the guard links, as compatibility symbols of libc since), so it asks for those.
-   memcpy too (GLIBC_2.14 is its newer version). The guard then needs only glibc's first x86_64
-   version, GLIBC_2.2.5: objdump -T of the binary lists every version it needs
-   (tests/test_fmu_exchange.py reads them). After the includes, which define __GLIBC__. */
-#if defined(__x86_64__) && defined(__GLIBC__)
-__asm__(".symver dlopen,dlopen@GLIBC_2.2.5");
-__asm__(".symver dlsym,dlsym@GLIBC_2.2.5");
-__asm__(".symver dladdr,dladdr@GLIBC_2.2.5");
-__asm__(".symver dlclose,dlclose@GLIBC_2.2.5");
-__asm__(".symver dlerror,dlerror@GLIBC_2.2.5");
-__asm__(".symver memcpy,memcpy@GLIBC_2.2.5");
-#endif
 
 #define LIBPYTHON_VARIABLE "NODEFORCE_LIBPYTHON"
 
@@ -141,19 +128,6 @@ static int read_field(FILE *f, const char *word, char *value, size_t size) {
     if (length == 0 || length >= size) return 0;
     memcpy(value, line + n + 1, length);
     value[length] = 0;
-    return 1;
-}
-
-/* Three counts "N N_IN N_PAR" (strtol, not sscanf, whose C99 name needs GLIBC_2.7). */
-static int read_sizes(const char *text, Layout *l) {
-    int *counts[3] = {&l->n, &l->n_in, &l->n_par}, k;
-    char *end;
-    for (k = 0; k < 3; k++) {
-        long value = strtol(text, &end, 10);
-        if (end == text || value < 0 || value > 100000000L) return 0;
-        *counts[k] = (int)value;
-        text = end;
-    }
     return 1;
 }
 
