@@ -158,72 +158,59 @@ static void place_time(Adapter *a, const fmi3ValueReference vr[], size_t nvr, co
     }
 }
 
-FMI3_EXPORT fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
-                                      fmi3Float64 values[], size_t nValues) {
-    Adapter *a = instance;
-    size_t n;
-    fmi2ValueReference *refs = expand(a, vr, nvr, REAL, nValues, &n);
-    double *got;
+/* A get or set of Float64 (REAL) or Boolean values, through the FMI 2.0 instance: the values
+   in FMI 2.0's order (time aside), fmi3Boolean (bool) as fmi2Boolean (int). */
+static fmi3Status transfer(Adapter *a, const fmi3ValueReference vr[], size_t nvr, int type, size_t nValues,
+                           void *values, int setting) {
+    size_t n, k;
+    fmi2ValueReference *refs;
+    double *reals = NULL;
+    fmi2Boolean *booleans = NULL;
     fmi3Status status;
+    for (k = 0; setting && k < nvr; k++)
+        if (vr[k] == 0) return refuse(a, "time (value reference 0) is the independent variable: it cannot be set");
+    refs = expand(a, vr, nvr, type, nValues, &n);
     if (!refs) return fmi3Error;
-    got = malloc(sizeof *got * (n + 1));
-    status = got ? (fmi3Status)fmi2GetReal(a->inner, refs, n, got) : refuse(a, "out of memory");
-    if (status <= fmi3Warning) place_time(a, vr, nvr, got, values, 1);
-    free(got);
+    if (type == REAL) reals = malloc(sizeof *reals * (n + 1));
+    else booleans = malloc(sizeof *booleans * (n + 1));
+    if (!reals && !booleans) {
+        free(refs);
+        return refuse(a, "out of memory");
+    }
+    if (setting && reals) place_time(a, vr, nvr, values, reals, 0);
+    for (k = 0; setting && booleans && k < n; k++) booleans[k] = ((fmi3Boolean *)values)[k] ? fmi2True : fmi2False;
+    if (reals) status = (fmi3Status)(setting ? fmi2SetReal(a->inner, refs, n, reals) : fmi2GetReal(a->inner, refs, n, reals));
+    else status = (fmi3Status)(setting ? fmi2SetBoolean(a->inner, refs, n, booleans)
+                                       : fmi2GetBoolean(a->inner, refs, n, booleans));
+    if (!setting && status <= fmi3Warning) {
+        if (reals) place_time(a, vr, nvr, reals, values, 1);
+        for (k = 0; booleans && k < n; k++) ((fmi3Boolean *)values)[k] = booleans[k] != fmi2False;
+    }
+    free(reals);
+    free(booleans);
     free(refs);
     return status;
+}
+
+FMI3_EXPORT fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
+                                      fmi3Float64 values[], size_t nValues) {
+    return transfer(instance, vr, nvr, REAL, nValues, values, 0);
 }
 
 FMI3_EXPORT fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                                       const fmi3Float64 values[], size_t nValues) {
-    Adapter *a = instance;
-    size_t n, k;
-    fmi2ValueReference *refs;
-    double *set;
-    fmi3Status status;
-    for (k = 0; k < nvr; k++)
-        if (vr[k] == 0) return refuse(a, "time (value reference 0) is the independent variable: it cannot be set");
-    refs = expand(a, vr, nvr, REAL, nValues, &n);
-    if (!refs) return fmi3Error;
-    set = malloc(sizeof *set * (n + 1));
-    if (set) place_time(a, vr, nvr, values, set, 0);
-    status = set ? (fmi3Status)fmi2SetReal(a->inner, refs, n, set) : refuse(a, "out of memory");
-    free(set);
-    free(refs);
-    return status;
+    return transfer(instance, vr, nvr, REAL, nValues, (void *)values, 1);
 }
 
-/* fmi3Boolean (bool) to and from fmi2Boolean (int): force[N] is the only Boolean. */
+/* force[N] is the only Boolean. */
 FMI3_EXPORT fmi3Status fmi3GetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                                       fmi3Boolean values[], size_t nValues) {
-    Adapter *a = instance;
-    size_t n, k;
-    fmi2ValueReference *refs = expand(a, vr, nvr, BOOLEAN, nValues, &n);
-    fmi2Boolean *got;
-    fmi3Status status;
-    if (!refs) return fmi3Error;
-    got = malloc(sizeof *got * (n + 1));
-    status = got ? (fmi3Status)fmi2GetBoolean(a->inner, refs, n, got) : refuse(a, "out of memory");
-    for (k = 0; status <= fmi3Warning && k < n; k++) values[k] = got[k] != fmi2False;
-    free(got);
-    free(refs);
-    return status;
+    return transfer(instance, vr, nvr, BOOLEAN, nValues, values, 0);
 }
 
 FMI3_EXPORT fmi3Status fmi3SetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                                       const fmi3Boolean values[], size_t nValues) {
-    Adapter *a = instance;
-    size_t n, k;
-    fmi2ValueReference *refs = expand(a, vr, nvr, BOOLEAN, nValues, &n);
-    fmi2Boolean *set;
-    fmi3Status status;
-    if (!refs) return fmi3Error;
-    set = malloc(sizeof *set * (n + 1));
-    for (k = 0; set && k < n; k++) set[k] = values[k] ? fmi2True : fmi2False;
-    status = set ? (fmi3Status)fmi2SetBoolean(a->inner, refs, n, set) : refuse(a, "out of memory");
-    free(set);
-    free(refs);
-    return status;
+    return transfer(instance, vr, nvr, BOOLEAN, nValues, (void *)values, 1);
 }
 
 /* ------------------------------------------------------------------ instances */
