@@ -12,6 +12,7 @@ from nodeforce.cli import main
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnose.calibrate import Candidate, calibrate
+from nodeforce.fmu_build import guard
 from nodeforce.fmu_build.build import build_fmu, fmu_kind
 from nodeforce.model.building import parse_building
 from nodeforce.model.case import prepare_case
@@ -21,6 +22,7 @@ from nodeforce.model.network import assemble
 from nodeforce.model.score import Objective
 from nodeforce.model.synth import pseudo_measurements
 from tests.conftest import SENSORS, record_times
+from tests.test_fmu_exchange import glibc_versions
 from tests.test_fmu_processes import files  # noqa: F401 (the locate fixture)
 from tests.test_standalone import TWINHOUSE, scenario
 
@@ -52,6 +54,12 @@ def test_fmi3_declares_arrays_units_and_the_effect_and_passes_fmpy_validate(fmus
     assert declared["T_forced"].get("variability") == "discrete" and declared["T"].get("unit") == "degC"
     assert len(declared["T_forced"].get("start").split()) == 23
     assert declared["ground_coupling.U"].get("unit") == "W/m2/K"
+    if kind == "python":  # its binary, the FMI 3.0 interface and the guard, asks glibc for no more than the guard
+        with zipfile.ZipFile(fmu) as archive:
+            binary = archive.read(f"binaries/x86_64-linux/{root.find('CoSimulation').get('modelIdentifier')}.so")
+        (fmu.parent / "fmi3_guard.so").write_bytes(binary)
+        versions, _ = glibc_versions(fmu.parent / "fmi3_guard.so")
+        assert max(versions) == tuple(int(x) for x in guard.GUARD_GLIBC.split("."))
     # 3N scalars of FMI 2.0 became 3 arrays, with the independent time beside them
     with zipfile.ZipFile(fmus[(kind, 2)]) as archive:
         scalars = ElementTree.fromstring(archive.read("modelDescription.xml")).find("ModelVariables")
