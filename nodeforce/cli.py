@@ -55,22 +55,23 @@ def zone_list(text):
 
 
 def cmd_fmu(args):
-    from nodeforce.fmu_build.build import build_fmu
-    path = build_fmu(load_building(args.building), args.output, kind="standalone" if args.standalone else "python")
+    from nodeforce.fmu_build.build import build_fmu, fmu_kind
+    path = build_fmu(load_building(args.building), args.output,
+                     kind=fmu_kind("standalone" if args.standalone else "python", args.fmi))
     print(f"wrote {path}")
 
 
 def cmd_simulate(args):
     from nodeforce.cosim.fmi import FmuInstance
     from nodeforce.cosim.run import simulate_fmu
-    from nodeforce.fmu_build.build import build_fmu
+    from nodeforce.fmu_build.build import build_fmu, fmu_kind
     from nodeforce.model.report import write_node_names, write_node_temperatures
     if args.force and not args.measurements:
         raise InputError("--force", args.force, "forcing needs --measurements to force nodes to")
     building, case, objective = load_inputs(args)
     force = force_mask(case, node_list("--force", args.force), args.measurements) if args.force else None
     with tempfile.TemporaryDirectory(prefix="nodeforce_") as tmp:
-        with FmuInstance(build_fmu(building, Path(tmp) / "model.fmu")) as instance:
+        with FmuInstance(build_fmu(building, Path(tmp) / "model.fmu", kind=fmu_kind("python", args.fmi))) as instance:
             T = simulate_fmu(instance, case, force)
     write_node_temperatures(args.output, case.times[1:], T)
     names = write_node_names(args.output, building)
@@ -123,7 +124,7 @@ def cmd_locate(args):
     result = locate(building, case, objective, out, source=args.measurements,
                     nodes=node_list("--nodes", args.nodes) if args.nodes else None,
                     include_algebraic=args.include_algebraic, **strategy, seed=args.seed,
-                    workers=args.workers, scheduler=args.scheduler, fmu_kind=args.fmu, noise=noise(args))
+                    workers=args.workers, scheduler=args.scheduler, fmu_kind=kind_of(args), noise=noise(args))
     (out / "locate.json").write_text(json.dumps(result, indent=2) + "\n")
     print(locate_summary(result))
     print(f"wrote {out / 'locate.json'}")
@@ -200,7 +201,7 @@ def run_diagnosis(building, case, objective, out, source, args):
     check_workers(args)
     out.mkdir(parents=True, exist_ok=True)
     report = diagnose(building, case, objective, out, source=source, fraction=args.calibration_fraction,
-                      calibration_end=end, seed=args.seed, workers=args.workers, fmu_kind=args.fmu,
+                      calibration_end=end, seed=args.seed, workers=args.workers, fmu_kind=kind_of(args),
                       reference=read_reference(args.reference) if args.reference else None, noise=noise(args),
                       phases=read_phases(args.phases) if args.phases else None)
     print(before_after_table(report))
@@ -258,7 +259,18 @@ def case_arguments(s, measurements_required, output_help, output_default=None):
     s.add_argument("-o", "--output", required=output_default is None, default=output_default, help=output_help)
 
 
+def fmi_argument(s):
+    s.add_argument("--fmi", type=int, choices=(2, 3), default=2, help="the FMI version of the FMU (default 2)")
+
+
+def kind_of(args):
+    """The FMU kind of --fmu at --fmi (fmu_build.build.fmu_kind)."""
+    from nodeforce.fmu_build.build import fmu_kind
+    return fmu_kind(args.fmu, args.fmi)
+
+
 def diagnosis_arguments(s):
+    fmi_argument(s)
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--workers", type=int, help="processes (default: all cores)")
     s.add_argument("--fmu", choices=("python", "standalone"), default="python", help="the FMU kind to run")
@@ -305,11 +317,13 @@ def parser():
     s.add_argument("building")
     s.add_argument("-o", "--output", required=True, help="the .fmu to write")
     s.add_argument("--standalone", action="store_true", help="C, no Python at run time (needs a C compiler)")
+    fmi_argument(s)
     s.set_defaults(run=cmd_fmu)
 
     s = sub.add_parser("simulate", help="simulate a building through its FMU")
     case_arguments(s, False, "the CSV of node temperatures to write", output_default="sim.csv")
     s.add_argument("--force", help="node ids forced to their measurements, e.g. 1,7,9")
+    fmi_argument(s)
     burn_in_argument(s, 0.0)
     objective_argument(s)
     s.set_defaults(run=cmd_simulate)
@@ -333,6 +347,7 @@ def parser():
     s.add_argument("--workers", type=int, help="processes (default: all cores)")
     s.add_argument("--fmu", choices=("python", "standalone"), default="python", help="the FMU kind to run")
     s.add_argument("--scheduler", help="a Dask scheduler address, tcp://host:port")
+    fmi_argument(s)
     noise_argument(s)
     burn_in_argument(s, 0.0)
     objective_argument(s)
