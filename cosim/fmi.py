@@ -7,18 +7,19 @@ writes the inputs into preallocated ctypes arrays through numpy views and calls 
 
 The slave class follows the model description's fmiVersion, as FMPy's own `simulate_fmu` does;
 this layer knows nothing of how an FMU was made. Extracted FMUs live in temporary folders named
-`nodeforce_fmu_*`, removed when the instance closes, when instantiation fails, and at the latest
-when the interpreter exits: instances still open then are freed first, while Python still runs
-(a library's own exit handlers must not meet live instances after the interpreter has gone).
+`nodeforce_fmu_<owner>_*` (nodeforce.tempdirs), removed when the instance closes, when
+instantiation fails, and at the latest when the interpreter exits: instances still open then are
+freed first, while Python still runs (a library's own exit handlers must not meet live instances
+after the interpreter has gone); those of a process killed outright, by the next run.
 """
 import atexit
-import shutil
-import tempfile
 import weakref
 
 import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave, fmi2Boolean, fmi2Real, fmi2True, fmi2ValueReference
+
+from nodeforce import tempdirs
 
 SLAVES = {"2.0": FMU2Slave}
 _OPEN = weakref.WeakSet()
@@ -42,7 +43,7 @@ class FmuInstance:
         if self.description.coSimulation is None:
             raise ValueError(f"{self.path} is not a co-simulation FMU")
         self.variables = {v.name: v for v in self.description.modelVariables}
-        self._unzipdir = extract(self.path, unzipdir=tempfile.mkdtemp(prefix="nodeforce_fmu_"))
+        self._unzipdir = extract(self.path, unzipdir=tempdirs.make("fmu"))
         self.fmu = None
         try:
             self.fmu = slave_class(guid=self.description.guid, unzipDirectory=self._unzipdir,
@@ -131,7 +132,7 @@ class FmuInstance:
                 fmu.freeInstance()
             else:
                 fmu.freeLibrary()
-        shutil.rmtree(self._unzipdir, ignore_errors=True)
+        tempdirs.remove(self._unzipdir)
         _OPEN.discard(self)
 
     def __enter__(self):

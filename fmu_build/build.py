@@ -14,11 +14,10 @@ Both carry the model description of `description.py`, with a GUID that hashes th
 """
 import json
 import sys
-import tempfile
 import zipfile
 from pathlib import Path
 
-from nodeforce import model
+from nodeforce import model, tempdirs
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.network import input_names
 
@@ -78,7 +77,7 @@ def _build_python(building, destination, effect):
     module = "nodeforce_" + description.content_hash(building_text, effect_text, slave_text,
                                                      *sources.values())[:16]
 
-    with tempfile.TemporaryDirectory(prefix="nodeforce_fmu_") as tmp:
+    with tempdirs.folder("fmu") as tmp:
         tmp = Path(tmp)
         script = tmp / f"{module}.py"
         script.write_text(slave_text)

@@ -2,12 +2,13 @@
 import argparse
 import json
 import sys
-import tempfile
 from importlib.resources import files
 from pathlib import Path
 
 import numpy as np
 
+from nodeforce import lifetime, tempdirs
+from nodeforce.ga.checkpoint import NAME as CHECKPOINT, resume_hint
 from nodeforce.ga.search import PAPER, PATIENCE
 from nodeforce.model.building import load_building
 from nodeforce.model.case import prepare_case
@@ -95,7 +96,7 @@ def cmd_simulate(args):
         raise InputError("--force", args.force, "forcing needs --measurements to force nodes to")
     building, case, objective = load_inputs(args)
     force = force_mask(case, node_list("--force", args.force), args.measurements) if args.force else None
-    with tempfile.TemporaryDirectory(prefix="nodeforce_") as tmp:
+    with tempdirs.folder("simulate") as tmp:
         with FmuInstance(build_fmu(building, Path(tmp) / "model.fmu")) as instance:
             T = simulate_fmu(instance, case, force)
     write_node_temperatures(args.output, case.times[1:], T)
@@ -408,11 +409,22 @@ def parser():
 
 def main(argv=None):
     args = parser().parse_args(argv)
+    tempdirs.sweep()  # the folders of runs killed outright
     try:
-        args.run(args)
+        with lifetime.stop_on_signals():
+            args.run(args)
     except InputError as e:
         print(f"nodeforce: {e}", file=sys.stderr)
         return 2
+    except BaseException as e:
+        stop = lifetime.stopped(e)  # a signal or a lost cluster: one line, its own exit status
+        if stop is None:
+            raise
+        status, why = stop
+        searched = args.command in ("locate", "diagnose", "demo")
+        print(f"nodeforce: {why}; " + (resume_hint(Path(args.output) / CHECKPOINT) if searched else
+                                       "run the same command again"), file=sys.stderr)
+        return status
     return 0
 
 
