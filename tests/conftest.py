@@ -48,6 +48,17 @@ def real_case(testcell_data, testcell, weather):
     return prepare_case(testcell, weather, measurements)
 
 
+@pytest.fixture
+def private_tmp(tmp_path, monkeypatch):
+    """A temp directory of the test's own, for this process and every process it starts."""
+    folder = tmp_path / "tmp"
+    folder.mkdir()
+    monkeypatch.setenv("TMPDIR", str(folder))
+    monkeypatch.setattr(tempfile, "tempdir", None)
+    yield folder
+    tempfile.tempdir = None
+
+
 def pytest_sessionstart(session):
     """The session's own temp directory (TMPDIR reaches the processes tests start), so folders
     other runs on the machine make or leave in the shared one do not count, and parallel test
