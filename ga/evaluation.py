@@ -25,6 +25,7 @@ import math
 import multiprocessing.util
 import pickle
 import threading
+import warnings
 from typing import Iterable, Sequence
 
 from nodeforce import lifetime
@@ -176,18 +177,25 @@ def _dask_task(token: str, factory, masks):
     return evaluate_masks(_dask_evaluators[key], masks)
 
 
+def _held(factory):
+    return factory
+
+
 def _dask_close(token: str) -> None:
     """Run on every Dask worker when a search ends: its evaluators go, the cluster stays up."""
     for key in [key for key in _dask_evaluators if key[0] == token]:
         close_evaluator(_dask_evaluators.pop(key))
 
 
+CLIENT_LOGGERS = ("distributed.client", "distributed.batched")
+
+
 class DaskBackend(_Backend):
     """Chunks submitted to a dask.distributed scheduler at `address` ("tcp://host:port").
 
-    A worker lost mid-task costs nothing: the scheduler gives its tasks to another worker (and
-    the factory, scattered to every worker, is still on the others).  A lost scheduler stops the
-    search (lifetime.RunStopped); its checkpoint resumes it.
+    A worker lost mid-task costs nothing: the scheduler gives its tasks to another worker (or
+    to the same one, restarted by its nanny).  A lost scheduler stops the search
+    (lifetime.RunStopped); its checkpoint resumes it.
     """
 
     def __init__(self, factory, address: str):
@@ -199,8 +207,20 @@ class DaskBackend(_Backend):
         except (OSError, ValueError, TypeError) as e:
             raise InputError("--scheduler", address, f"cannot reach a Dask scheduler there ({e})") from None
         self._token = factory_token(factory)
-        # Ship the factory once; tasks refer to it instead of carrying it each time.
-        [self._factory] = self._client.scatter([factory], broadcast=True, hash=False)
+        # Ship the factory once, as the result of a task the chunks' tasks depend on: a worker
+        # fetches it from another, and if the workers holding it are lost the scheduler runs the
+        # task again (data scattered instead could not be made again: every task needing it
+        # would be cancelled, "lost dependencies").  Dask's warning that the task is large is
+        # for tasks sent again and again, not this one.
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)
+            self._factory = self._client.submit(_held, factory, pure=False)
+        # The client's own logs are silenced while it serves the search: every failure it meets
+        # reaches the search as a future's exception, said in one line (a lost scheduler), and
+        # they would repeat it as tracebacks (a closed connection, the attempts to reconnect).
+        self._log_levels = {name: logging.getLogger(name).level for name in CLIENT_LOGGERS}
+        for name in CLIENT_LOGGERS:
+            logging.getLogger(name).setLevel(logging.CRITICAL + 1)
 
     @property
     def slots(self) -> int:
@@ -227,7 +247,11 @@ class DaskBackend(_Backend):
             if not abort:  # the workers keep the evaluators of a stopped search, for its rerun
                 self._client.run(_dask_close, self._token)
         finally:
-            self._client.close()
+            try:
+                self._client.close()
+            finally:
+                for name, level in self._log_levels.items():
+                    logging.getLogger(name).setLevel(level)
 
 
 def open_backend(factory, workers: "int | None", scheduler: "str | None"):

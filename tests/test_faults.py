@@ -208,7 +208,7 @@ def arm_after(generation, armed):
 
 
 @contextmanager
-def dask_cluster(folder, n_workers):
+def dask_cluster(folder, n_workers, threads=1):
     """`dask scheduler` on 127.0.0.1 (a port the system picks) and `dask worker`s (with their
     nannies, which restart a killed worker); yields (address, scheduler process)."""
     from distributed import Client
@@ -222,7 +222,7 @@ def dask_cluster(folder, n_workers):
         for _ in range(n_workers):
             processes.append(subprocess.Popen(
                 [sys.executable, "-m", "distributed.cli.dask_worker", "--scheduler-file", str(file), "--host",
-                 "127.0.0.1", "--nthreads", "1", "--no-dashboard", "--death-timeout", "30"], **quiet))
+                 "127.0.0.1", "--nthreads", str(threads), "--no-dashboard", "--death-timeout", "30"], **quiet))
         address = json.loads(file.read_text())["address"]
         with Client(address, timeout="30s") as client:
             client.wait_for_workers(n_workers, timeout=60)
@@ -242,7 +242,10 @@ BUDGET = dict(population=20, generations=15)
 @pytest.mark.slow
 def test_a_dask_worker_killed_mid_search_costs_no_answer(tmp_path, caplog):
     spec = Killing(armed=str(tmp_path / "armed"), done=str(tmp_path / "killed"))
-    with dask_cluster(tmp_path, 2) as (address, _), caplog.at_level(logging.WARNING, "nodeforce.ga"):
+    # One worker process (two threads): the one killed is the one holding the evaluator factory
+    # too, so the search goes on only once its nanny has restarted it and the scheduler has made
+    # the factory again.
+    with dask_cluster(tmp_path, 1, threads=2) as (address, _), caplog.at_level(logging.WARNING, "nodeforce.ga"):
         result = search(spec, NODES12, scheduler=address, progress=arm_after(2, spec.armed), **BUDGET)
     assert Path(spec.done).exists()  # a worker was killed, in the middle of a generation
     print(f"Dask worker killed: the search took {result['search']['seconds']:.1f} s")
