@@ -25,7 +25,6 @@ import math
 import multiprocessing.util
 import pickle
 import threading
-import warnings
 from typing import Iterable, Sequence
 
 from nodeforce import lifetime
@@ -177,10 +176,6 @@ def _dask_task(token: str, factory, masks):
     return evaluate_masks(_dask_evaluators[key], masks)
 
 
-def _held(factory):
-    return factory
-
-
 def _dask_close(token: str) -> None:
     """Run on every Dask worker when a search ends: its evaluators go, the cluster stays up."""
     for key in [key for key in _dask_evaluators if key[0] == token]:
@@ -188,14 +183,17 @@ def _dask_close(token: str) -> None:
 
 
 CLIENT_LOGGERS = ("distributed.client", "distributed.batched")
+# Times a batch is submitted while the workers holding the evaluator factory are lost (a chunk
+# that kills every worker it runs on must not be retried for ever).
+FACTORY_LOSSES = 3
 
 
 class DaskBackend(_Backend):
     """Chunks submitted to a dask.distributed scheduler at `address` ("tcp://host:port").
 
     A worker lost mid-task costs nothing: the scheduler gives its tasks to another worker (or
-    to the same one, restarted by its nanny).  A lost scheduler stops the search
-    (lifetime.RunStopped); its checkpoint resumes it.
+    to the same one, restarted by its nanny), and if the factory was lost with it, it is shipped
+    again.  A lost scheduler stops the search (lifetime.RunStopped); its checkpoint resumes it.
     """
 
     def __init__(self, factory, address: str):
@@ -207,14 +205,8 @@ class DaskBackend(_Backend):
         except (OSError, ValueError, TypeError) as e:
             raise InputError("--scheduler", address, f"cannot reach a Dask scheduler there ({e})") from None
         self._token = factory_token(factory)
-        # Ship the factory once, as the result of a task the chunks' tasks depend on: a worker
-        # fetches it from another, and if the workers holding it are lost the scheduler runs the
-        # task again (data scattered instead could not be made again: every task needing it
-        # would be cancelled, "lost dependencies").  Dask's warning that the task is large is
-        # for tasks sent again and again, not this one.
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", UserWarning)
-            self._factory = self._client.submit(_held, factory, pure=False)
+        self._raw_factory = factory
+        self._ship_factory()
         # The client's own logs are silenced while it serves the search: every failure it meets
         # reaches the search as a future's exception, said in one line (a lost scheduler), and
         # they would repeat it as tracebacks (a closed connection, the attempts to reconnect).
@@ -222,24 +214,38 @@ class DaskBackend(_Backend):
         for name in CLIENT_LOGGERS:
             logging.getLogger(name).setLevel(logging.CRITICAL + 1)
 
+    def _ship_factory(self):
+        # Once to every worker; tasks refer to it instead of carrying it each time.
+        [self._factory] = self._client.scatter([self._raw_factory], broadcast=True, hash=False)
+
     @property
     def slots(self) -> int:
         return max(1, sum(self._client.nthreads().values()))
 
     def run(self, chunks):
-        futures = [self._client.submit(_dask_task, self._token, self._factory, chunk, pure=False)
-                   for chunk in chunks]
-        results = []
-        for future in futures:
-            try:
-                results.append(future.result())
-            except EvaluatorSetupError:
-                raise
-            except Exception as exc:  # KilledWorker and the like: the chunk was lost
-                if self._client.status != "running":  # ... unless the scheduler was
-                    raise lifetime.RunStopped(f"--scheduler: {self._address}: lost the Dask scheduler "
-                                              f"({type(exc).__name__})") from exc
-                results.append(exc)
+        results = [None] * len(chunks)
+        todo = range(len(chunks))
+        for _ in range(FACTORY_LOSSES):
+            futures = {i: self._client.submit(_dask_task, self._token, self._factory, chunks[i], pure=False)
+                       for i in todo}
+            todo = []
+            for i, future in futures.items():
+                try:
+                    results[i] = future.result()
+                except EvaluatorSetupError:
+                    raise
+                except Exception as exc:  # KilledWorker and the like: the chunk was lost
+                    if self._client.status != "running":  # ... unless the scheduler was
+                        raise lifetime.RunStopped(f"--scheduler: {self._address}: lost the Dask scheduler "
+                                                  f"({type(exc).__name__})") from exc
+                    results[i] = exc
+                    if self._factory.status != "finished":
+                        todo.append(i)
+            if not todo:
+                break
+            # The workers holding the factory were lost (scattered data cannot be made again)
+            # and with it every task that needed it: ship it again and submit those again.
+            self._ship_factory()
         return results
 
     def close(self, abort=False):
