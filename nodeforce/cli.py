@@ -1,4 +1,6 @@
-"""The `nodeforce` command line (INTERFACE.md). Bad input: one line on stderr, exit status 2."""
+"""The `nodeforce` command line (INTERFACE.md). Bad input: one line on stderr, exit status 2; stopped
+by SIGINT, SIGTERM or a lost Dask scheduler: one line saying how to resume, 130, 143 or 75
+(nodeforce.lifetime)."""
 import argparse
 import json
 import sys
@@ -409,15 +411,16 @@ def parser():
 
 def main(argv=None):
     args = parser().parse_args(argv)
-    tempdirs.sweep()  # the folders of runs killed outright
+    signals = lifetime.Signals()
     try:
-        with lifetime.stop_on_signals():
+        with lifetime.stop_on_signals() as signals:
+            tempdirs.sweep()  # the folders of runs killed outright
             args.run(args)
     except InputError as e:
         print(f"nodeforce: {e}", file=sys.stderr)
         return 2
     except BaseException as e:
-        stop = lifetime.stopped(e)  # a signal or a lost cluster: one line, its own exit status
+        stop = lifetime.stopped(e, signals)  # a signal or a lost cluster: one line, its own exit status
         if stop is None:
             raise
         status, why = stop

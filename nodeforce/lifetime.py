@@ -57,41 +57,48 @@ class RunStopped(RuntimeError):
     exit_status = 75
 
 
-_received: "int | None" = None
+class Signals:
+    """What `stop_on_signals` received: `signum`, the first signal (None: none came)."""
+
+    signum: "int | None" = None
+
+
+_current: "Signals | None" = None  # while a stop_on_signals block runs
 
 
 def _on_signal(signum, frame):
-    global _received
-    if _received is None:  # the first one stops the run; later ones must not break its cleanup
-        _received = signum
+    if _current.signum is None:  # the first one stops the run; later ones must not break its cleanup
+        _current.signum = signum
         raise Interrupted(signum)
 
 
 def raise_if_interrupted():
-    """Raise Interrupted if a signal stopped the run. For code that catches a failure: an FMU
+    """Raise Interrupted if a signal is stopping the run. For code that catches a failure: an FMU
     whose own Python code was running when the signal came reports an FMU error instead."""
-    if _received is not None:
-        raise Interrupted(_received)
+    if _current is not None and _current.signum is not None:
+        raise Interrupted(_current.signum)
 
 
 @contextmanager
 def stop_on_signals():
-    """Within the block (in the main thread), SIGINT and SIGTERM raise Interrupted."""
-    global _received
-    _received = None
+    """Within the block (in the main thread), SIGINT and SIGTERM raise Interrupted; yields the
+    `Signals` received, for `stopped` after the block."""
+    global _current
+    _current = Signals()
     previous = {s: signal.signal(s, _on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
     try:
-        yield
+        yield _current
     finally:
         for s, handler in previous.items():
             signal.signal(s, handler)
+        _current = None
 
 
-def stopped(exc: BaseException) -> "tuple[int, str] | None":
+def stopped(exc: BaseException, signals: Signals) -> "tuple[int, str] | None":
     """(exit status, what stopped the run) if `exc` ended a run stopped from outside, else None.
     Any exception counts once a signal came: it may be the signal's, reported by an FMU."""
-    if _received is not None:
-        return 128 + _received, f"stopped by {signal.Signals(_received).name}"
+    if signals.signum is not None:
+        return 128 + signals.signum, f"stopped by {signal.Signals(signals.signum).name}"
     if isinstance(exc, RunStopped):
         return exc.exit_status, str(exc)
     return None

@@ -170,6 +170,40 @@ def test_the_next_run_removes_the_folders_of_dead_processes_only(tmp_path, priva
     assert sorted(os.listdir(private_tmp)) == sorted([folders["alive"], folders["no_owner"]])
 
 
+@dataclass(frozen=True)
+class SignalledFmu:
+    """TWELVE's evaluator inside an FMU whose own code catches every exception and reports a
+    failed step, as pythonfmu's does: a SIGTERM coming at its `n`-th simulation raises there."""
+    n: int
+
+    def __call__(self):
+        return SignalledEvaluator(self.n)
+
+
+class SignalledEvaluator:
+    def __init__(self, n):
+        self.left, self.inner = n, TWELVE()
+
+    def J(self, mask):
+        self.left -= 1
+        try:
+            if self.left == 0:
+                os.kill(os.getpid(), signal.SIGTERM)
+            return self.inner.J(mask)
+        except BaseException as exc:
+            raise RuntimeError(f"fmi2DoStep failed: {exc!r}") from None
+
+
+def test_a_signal_the_fmu_reports_as_a_failed_step_stops_the_search_and_scores_nothing_unfit(tmp_path):
+    path = tmp_path / "search.json"
+    with pytest.raises(lifetime.Interrupted), lifetime.stop_on_signals() as signals:
+        search(SignalledFmu(n=100), NODES12, workers=1, checkpoint=path, **BUDGET)
+    saved = json.loads(path.read_text())
+    assert saved["generation"] >= 1 and None not in saved["cache"].values()
+    assert lifetime.stopped(RuntimeError(), signals) == (143, "stopped by SIGTERM")
+    lifetime.raise_if_interrupted()  # the block is over: a later failed simulation is one again
+
+
 # --- Dask: a loopback cluster of scheduler and worker processes started here (free ports)
 
 
