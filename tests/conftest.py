@@ -1,8 +1,6 @@
 """Shared fixtures: the reference test cell and a real-weather case (bundled Miami TMY2)."""
 import copy
 import json
-import os
-import shutil
 import tempfile
 from pathlib import Path
 
@@ -34,6 +32,17 @@ def weather():
     return read_weather(DATA / "miami_tmy2.csv")
 
 
+@pytest.fixture
+def private_tmp(tmp_path, monkeypatch):
+    """A temp directory of the test's own, for this process and every process it starts."""
+    folder = tmp_path / "tmp"
+    folder.mkdir()
+    monkeypatch.setenv("TMPDIR", str(folder))
+    monkeypatch.setattr(tempfile, "tempdir", None)
+    yield folder
+    tempfile.tempdir = None
+
+
 def record_times(days=5, start="2001-06-10 00:00"):
     return pd.date_range(start, periods=days * 96 + 1, freq="15min", tz="-05:00", name="time")
 
@@ -48,45 +57,19 @@ def real_case(testcell_data, testcell, weather):
     return prepare_case(testcell, weather, measurements)
 
 
-@pytest.fixture
-def private_tmp(tmp_path, monkeypatch):
-    """A temp directory of the test's own, for this process and every process it starts."""
-    folder = tmp_path / "tmp"
-    folder.mkdir()
-    monkeypatch.setenv("TMPDIR", str(folder))
-    monkeypatch.setattr(tempfile, "tempdir", None)
-    yield folder
-    tempfile.tempdir = None
+def _extracted():
+    """Folders nodeforce made in the temp directory (extracted or built FMUs, simulations)."""
+    import tempfile
+    return {p.name for p in Path(tempfile.gettempdir()).glob("nodeforce_*")}
 
 
 def pytest_sessionstart(session):
-    """The session's own temp directory (TMPDIR reaches the processes tests start), so folders
-    other runs on the machine make or leave in the shared one do not count, and parallel test
-    sessions (pytest-xdist's workers included) do not see each other's."""
-    folder = tempfile.mkdtemp(prefix="nodeforce-tests-")
-    session.config.nodeforce_tmp = (folder, os.environ.get("TMPDIR"))
-    os.environ["TMPDIR"] = folder
-    tempfile.tempdir = None  # gettempdir() reads TMPDIR again
+    session.config.nodeforce_extracted = _extracted()
 
 
 def pytest_sessionfinish(session, exitstatus):
     """The whole suite leaves nothing it extracted in the temp directory."""
-    folder, _ = session.config.nodeforce_tmp
-    left = sorted(p.name for p in Path(folder).glob("nodeforce_*"))
+    left = sorted(_extracted() - session.config.nodeforce_extracted)
     if left:
         print(f"\nthe test suite left {len(left)} nodeforce folders in the temp directory: {left[:5]}")
         session.exitstatus = 1
-
-
-def pytest_unconfigure(config):
-    """The session's temp directory goes after every plugin's end of session (pytest's own
-    tmp_path folders are in it)."""
-    if not hasattr(config, "nodeforce_tmp"):
-        return
-    folder, before = config.nodeforce_tmp
-    shutil.rmtree(folder, ignore_errors=True)
-    if before is None:
-        os.environ.pop("TMPDIR", None)
-    else:
-        os.environ["TMPDIR"] = before
-    tempfile.tempdir = None
