@@ -1,7 +1,6 @@
 """Shared fixtures: the reference test cell and a real-weather case (bundled Miami TMY2)."""
 import copy
 import json
-import tempfile
 from pathlib import Path
 
 import pandas as pd
@@ -38,9 +37,8 @@ def private_tmp(tmp_path, monkeypatch):
     folder = tmp_path / "tmp"
     folder.mkdir()
     monkeypatch.setenv("TMPDIR", str(folder))
-    monkeypatch.setattr(tempfile, "tempdir", None)
-    yield folder
-    tempfile.tempdir = None
+    monkeypatch.setattr("tempfile.tempdir", None)  # gettempdir() reads TMPDIR again; restored after
+    return folder
 
 
 def record_times(days=5, start="2001-06-10 00:00"):
