@@ -7,10 +7,9 @@ writes the inputs into preallocated ctypes arrays through numpy views and calls 
 
 The slave class follows the model description's fmiVersion, as FMPy's own `simulate_fmu` does;
 this layer knows nothing of how an FMU was made. Extracted FMUs live in temporary folders named
-`nodeforce_fmu_<owner>_*` (nodeforce.tempdirs), removed when the instance closes, when
-instantiation fails, and at the latest when the interpreter exits: instances still open then are
-freed first, while Python still runs (a library's own exit handlers must not meet live instances
-after the interpreter has gone); those of a process killed outright, by the next run.
+`nodeforce_fmu_*`, removed when the instance closes, when instantiation fails, and at the latest
+when the interpreter exits: instances still open then are freed first, while Python still runs
+(a library's own exit handlers must not meet live instances after the interpreter has gone).
 """
 import atexit
 import weakref
