@@ -14,8 +14,6 @@ when the interpreter exits: instances still open then are freed first, while Pyt
 (a library's own exit handlers must not meet live instances after the interpreter has gone).
 """
 import atexit
-import shutil
-import tempfile
 import weakref
 from ctypes import byref
 
@@ -23,6 +21,8 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave, fmi2Boolean, fmi2Real, fmi2True, fmi2ValueReference
 from fmpy.fmi3 import FMU3Slave, fmi3Boolean, fmi3Float64, fmi3ValueReference
+
+from nodeforce import tempdirs
 
 _OPEN = weakref.WeakSet()
 
@@ -182,7 +182,7 @@ class FmuInstance:
             raise ValueError(f"{self.path} is not a co-simulation FMU")
         self.calls = version(self.description)
         self.variables = self.calls.variables
-        self._unzipdir = extract(self.path, unzipdir=tempfile.mkdtemp(prefix="nodeforce_fmu_"))
+        self._unzipdir = extract(self.path, unzipdir=tempdirs.make("fmu"))
         self.fmu = None
         try:
             self.fmu = version.slave_class(guid=self.description.guid, unzipDirectory=self._unzipdir,
@@ -246,7 +246,7 @@ class FmuInstance:
                 fmu.freeInstance()
             else:
                 fmu.freeLibrary()
-        shutil.rmtree(self._unzipdir, ignore_errors=True)
+        tempdirs.remove(self._unzipdir)
         _OPEN.discard(self)
 
     def __enter__(self):

@@ -18,11 +18,10 @@ the same model, its FMI 3.0 interface (c/fmi3.c) compiled into the FMU's binary 
 """
 import json
 import sys
-import tempfile
 import zipfile
 from pathlib import Path
 
-from nodeforce import model
+from nodeforce import model, tempdirs
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.network import input_names
 
@@ -94,7 +93,7 @@ def _build_python(building, destination, effect, fmi):
     module = "nodeforce_" + description.content_hash(building_text, effect_text, slave_text,
                                                      *sources.values())[:16]
 
-    with tempfile.TemporaryDirectory(prefix="nodeforce_fmu_") as tmp:
+    with tempdirs.folder("fmu") as tmp:
         tmp = Path(tmp)
         script = tmp / f"{module}.py"
         script.write_text(slave_text)
@@ -161,7 +160,7 @@ def _build_standalone(building, destination, effect, fmi):
 
     files, identifier, source_files = standalone_files(building, effect)
     if fmi == 3:
-        with tempfile.TemporaryDirectory(prefix="nodeforce_fmu_") as tmp:
+        with tempdirs.folder("fmu") as tmp:
             library = Path(tmp) / f"{identifier}.so"
             compile_library((source_files[0], "fmi3.c"), library, libraries=("m",), link_options=("-Wl,-Bsymbolic",))
             binary = library.read_bytes()

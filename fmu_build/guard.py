@@ -13,9 +13,9 @@ a C host must preload libpython, and pythonfmu's double releases reach the host)
 import functools
 import sys
 import sysconfig
-import tempfile
 from pathlib import Path
 
+from nodeforce import tempdirs
 from .compiler import compile_library, find_compiler
 
 PLATFORM = "linux64"  # the guard's platform; pythonfmu's other binaries (win64) stay unguarded
@@ -37,7 +37,7 @@ def guard_binary(fmi=2):
               "guard, so forbidden calls get fmi2Discard or fmi2Fatal instead of fmi2Error and a C host "
               "must preload libpython", file=sys.stderr)
         return None
-    with tempfile.TemporaryDirectory(prefix="nodeforce_guard_") as tmp:
+    with tempdirs.folder("guard") as tmp:
         library = Path(tmp) / "guard.so"
         # libdl.so.2 by name and kept: where glibc is older than 2.34 the dl* functions the guard
         # asks for (c/guard.c) are there; since, it is an empty compatibility library

@@ -7,10 +7,15 @@ The Python API (`nodeforce.api`, docs/api.md) is available here: `nodeforce.read
 
 
 import importlib
+import importlib.util
 
 
 def __getattr__(name):
     if not name.startswith("__"):
+        # `from nodeforce import tempdirs` asks for the attribute before importing the submodule:
+        # a submodule is imported as such, not looked for in the API (which may be importing it).
+        if importlib.util.find_spec(f"{__name__}.{name}") is not None:
+            return importlib.import_module(f"{__name__}.{name}")
         api = importlib.import_module("nodeforce.api")
         if name in api.__all__:
             return getattr(api, name)

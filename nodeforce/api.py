@@ -6,10 +6,10 @@ re-exported by the package (`import nodeforce; nodeforce.read_building(...)`); d
 shows them at work. Bad input raises `InputError` (a ValueError) with the one-line message the
 command line prints.
 """
-import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 
+from nodeforce import tempdirs
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnose import loop as _loop
@@ -232,5 +232,5 @@ def _folder(workdir):
         Path(workdir).mkdir(parents=True, exist_ok=True)
         yield Path(workdir)
         return
-    with tempfile.TemporaryDirectory(prefix="nodeforce_") as tmp:
+    with tempdirs.folder("api") as tmp:
         yield Path(tmp)

@@ -1,13 +1,16 @@
-"""The `nodeforce` command line (INTERFACE.md). Bad input: one line on stderr, exit status 2."""
+"""The `nodeforce` command line (INTERFACE.md). Bad input: one line on stderr, exit status 2; stopped
+by SIGINT, SIGTERM or a lost Dask scheduler: one line saying how to resume, 130, 143 or 75
+(nodeforce.lifetime)."""
 import argparse
 import json
 import sys
-import tempfile
 from importlib.resources import files
 from pathlib import Path
 
 import numpy as np
 
+from nodeforce import lifetime, tempdirs
+from nodeforce.ga.checkpoint import NAME as CHECKPOINT, resume_hint
 from nodeforce.ga.search import PAPER, PATIENCE
 from nodeforce.model.building import load_building
 from nodeforce.model.case import force_mask, measured_case, prepare_case
@@ -70,7 +73,7 @@ def cmd_simulate(args):
         raise InputError("--force", args.force, "forcing needs --measurements to force nodes to")
     building, case, objective = load_inputs(args)
     force = force_mask(case, node_list("--force", args.force), args.measurements) if args.force else None
-    with tempfile.TemporaryDirectory(prefix="nodeforce_") as tmp:
+    with tempdirs.folder("simulate") as tmp:
         with FmuInstance(build_fmu(building, Path(tmp) / "model.fmu", kind=fmu_kind("python", args.fmi))) as instance:
             T = simulate_fmu(instance, case, force)
     write_node_temperatures(args.output, case.times[1:], T)
@@ -398,11 +401,23 @@ def parser():
 
 def main(argv=None):
     args = parser().parse_args(argv)
+    signals = lifetime.Signals()
     try:
-        args.run(args)
+        with lifetime.stop_on_signals() as signals:
+            tempdirs.sweep()  # the folders of runs killed outright
+            args.run(args)
     except InputError as e:
         print(f"nodeforce: {e}", file=sys.stderr)
         return 2
+    except BaseException as e:
+        stop = lifetime.stopped(e, signals)  # a signal or a lost cluster: one line, its own exit status
+        if stop is None:
+            raise
+        status, why = stop
+        searched = args.command in ("locate", "diagnose", "demo")
+        print(f"nodeforce: {why}; " + (resume_hint(Path(args.output) / CHECKPOINT) if searched else
+                                       "run the same command again"), file=sys.stderr)
+        return status
     return 0
 
 

@@ -34,6 +34,16 @@ def weather():
     return read_weather(DATA / "miami_tmy2.csv")
 
 
+@pytest.fixture
+def private_tmp(tmp_path, monkeypatch):
+    """A temp directory of the test's own, for this process and every process it starts."""
+    folder = tmp_path / "tmp"
+    folder.mkdir()
+    monkeypatch.setenv("TMPDIR", str(folder))
+    monkeypatch.setattr("tempfile.tempdir", None)  # gettempdir() reads TMPDIR again; restored after
+    return folder
+
+
 def record_times(days=5, start="2001-06-10 00:00"):
     return pd.date_range(start, periods=days * 96 + 1, freq="15min", tz="-05:00", name="time")
 
