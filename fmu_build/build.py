@@ -22,9 +22,7 @@ import tempfile
 import zipfile
 from pathlib import Path
 
-# not `from nodeforce import model`: that asks nodeforce's __getattr__ first, which imports the
-# API and so this module again, when this module is the first of nodeforce imported
-import nodeforce.model as model
+from nodeforce import model
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.network import input_names
 
