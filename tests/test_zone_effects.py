@@ -170,8 +170,8 @@ EFFECT_VALUES = [("internal_mass", {"C_m": 3e5, "H_m": 40.0}), ("heat_input_lag"
                  ("envelope_conductance", {"factor": 1.8})]
 
 
-@pytest.mark.slow  # three effects, two FMU kinds
-@pytest.mark.parametrize("kind", ["python", "standalone"])
+@pytest.mark.slow  # three effects, four FMU kinds
+@pytest.mark.parametrize("kind", ["python", "standalone", "python-fmi3", "standalone-fmi3"])
 def test_both_fmus_with_a_zone_effect_equal_the_direct_model(testcell_data, real_case, tmp_path, kind):
     """The annex (heated through Q_annex) with each effect at values other than its start: the
     FMU, its parameters set, gives the direct model of the building declaring those values."""
