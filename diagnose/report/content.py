@@ -48,7 +48,7 @@ def decision(report):
 
 
 def verdict(report, candidate):
-    """The loop's {'beats_bic', 'beats_validation', 'validation_margin'} for a candidate ({} if
+    """The loop's {'beats_bic', 'beats_selection', 'selection_margin'} for a candidate ({} if
     not recorded); one tried on top of a first choice is judged in the follow-up decision."""
     judged = decision(report)
     if candidate.get("on_top_of"):

@@ -308,7 +308,7 @@ def plot_candidates(path, report):
                     fontsize=8, color="tab:red")
             continue
         verdict = content.verdict(report, c)
-        key = (bool(verdict.get("beats_bic")), bool(verdict.get("beats_validation")))
+        key = (bool(verdict.get("beats_bic")), bool(verdict.get("beats_selection")))
         style = dict(facecolor="tab:blue") if content.is_chosen(report, c) else VERDICT_STYLES[key][0]
         used.add("chosen" if content.is_chosen(report, c) else key)
         ax.bar(xi, v, edgecolor="0.2", lw=0.5, **style)

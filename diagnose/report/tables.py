@@ -143,11 +143,11 @@ def candidates(report):
                      fmt_temp(metrics(report, c, "validation").get("rmse")),
                      fmt_temp(metrics(report, c, "validation").get("mean"), True),
                      fmt_bic(bic), f"{bic - base:+.1f}" if bic is not None and base is not None else NA,
-                     fmt_sig((c.get("validation_fall") or {}).get("J")), fmt_sig(verdict.get("validation_margin")),
-                     _yes_no(verdict.get("beats_bic")), _yes_no(verdict.get("beats_validation"))])
+                     fmt_sig((c.get("selection_fall") or {}).get("J")), fmt_sig(verdict.get("selection_margin")),
+                     _yes_no(verdict.get("beats_bic")), _yes_no(verdict.get("beats_selection"))])
     return markdown(["effect", "target", "parameters (value ± std)", "the data determine",
                      "calibration RMSE (C)", "validation RMSE (C)", "validation mean (C)", "BIC", "ΔBIC",
-                     "validation fall of J (C²)", "fall needed (C²)", "beats BIC", "beats validation"], rows)
+                     "selection fall of J (C²)", "fall needed (C²)", "beats BIC", "beats selection"], rows)
 
 
 def candidate_zones(report):
