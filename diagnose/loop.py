@@ -52,7 +52,7 @@ from nodeforce.diagnose.significance import bandwidth, change_of_J, worse
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.locate import check_measured, locate
 from nodeforce.ga.parsimony import Z_NOISE, tolerance
-from nodeforce.model.effects import EFFECTS
+from nodeforce.model.effects import EFFECTS, bridge_parts
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
 from nodeforce.model.score import Noise
@@ -170,9 +170,8 @@ def decide(building, results, before, sigma, selection_residuals, k_before=0):
                                                                    selection_residuals[label(best)]))
     rmse_before = before["selection"]["rmse"]
     if chosen:
-        what = (f"an unexplained heat source, acting {EFFECTS[chosen['effect']].adds.split(': ')[0].replace('a heat gain', 'as a gain')} "
-                f"({chosen['effect']} on {chosen['target']})" if is_shape(chosen["effect"])
-                else f"{chosen['effect']} on {chosen['target']}")
+        what = (f"an unexplained heat source, acting {acting(chosen)} ({chosen['effect']} on {chosen['target']})"
+                if is_shape(chosen["effect"]) else f"{chosen['effect']} on {chosen['target']}")
         passed = (f"of the {len(passing)} of {len(results)} candidates that beat the model without them on BIC "
                   f"({bic_before:.1f}) and lower the selection window's J ({J_before:.3g} C2) by more than the noise "
                   f"and the residuals' own correlated scatter could ({tests[label(chosen)]['selection_margin']:.3g} C2 "
@@ -203,6 +202,17 @@ def decide(building, results, before, sigma, selection_residuals, k_before=0):
     return chosen, {"chosen": label(chosen) if chosen else None, "reason": reason, "implausible": flag,
                     "bic_baseline": bic_before, "selection_J_before": J_before, "selection_margin": margin,
                     "suggestions": suggestions, "candidates": tests}
+
+
+def acting(result):
+    """How a shape's heat source acts, in words: with a daily profile, or in proportion to an input."""
+    values = {name: p["value"] for name, p in result["parameters"].items()}
+    if result["effect"] == "daily_gain":
+        amplitude = math.hypot(values.get("cos1", 0.0), values.get("sin1", 0.0))
+        return (f"with a daily profile (mean {values['mean']:.3g} W, first harmonic {amplitude:.3g} W) to the air "
+                f"of {result['target']}")
+    zone, column = bridge_parts(result["target"])
+    return f"in proportion to {column} (k = {values['k']:.3g}) to the air of {zone}"
 
 
 def candidate_objection(building, result):

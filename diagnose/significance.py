@@ -78,20 +78,21 @@ def automatic_lags(series):
 
 
 def critical_value(lags, n):
-    """Two-sided 5 % critical value of the paired statistic fall / sd when sd is the Bartlett HAC
+    """One-sided 5 % critical value of the paired statistic fall / sd when sd is the Bartlett HAC
     estimate over `lags` of n steps: Kiefer and Vogelsang's fixed-b value (2005, their
     polynomial for the Bartlett kernel, b = (lags + 1) / n). A bandwidth of a day on a record of
     a week or two is a large share of it, and the estimate of sd then scatters enough to make
-    1.96 reject a true equality about twice as often as it says (tests/test_paired.py)."""
+    the normal 1.645 reject a true equality far more often than it says (tests/test_significance.py)."""
     b = min((lags + 1) / n, 1.0)
-    return 1.96 + 2.9694 * b + 0.4160 * b ** 2 - 0.5324 * b ** 3
+    return 1.6449 + 2.1859 * b + 0.3142 * b ** 2 - 0.3427 * b ** 3
 
 
 def worse(first, second):
     """Whether the data show `first` (residuals, C, (n_t, n_zones), NaN where not scored) fitting
     worse than `second` on the same steps: J(first) - J(second) beyond `critical_value` HAC
-    standard deviations of that paired difference (a Diebold-Mariano test on squared errors, at
-    5 % two-sided, over the `automatic_lags` of that difference). Two models scored on one record share its noise, so their difference of J is
+    standard deviations of that paired difference (a Diebold-Mariano test on squared errors,
+    one-sided at 5 %, over the `automatic_lags` of that difference). One-sided: the question
+    is always whether the preferred one (nearer the zone, physical, fewer parameters) is worse. Two models scored on one record share its noise, so their difference of J is
     far better determined than either J: this, not the noise of one J, says whether they can be
     told apart."""
     first, second = np.asarray(first, dtype=float), np.asarray(second, dtype=float)
