@@ -131,6 +131,31 @@ def test_building_json_is_the_generator_output():
     assert BUILDING.read_text() == module.text(), "run examples/twinhouse_n2/make_building.py"
 
 
+def test_experiment_2_s_house_differs_only_by_its_protocol(data):
+    # exp2's README: ventilation about 60 m3/h (not 120), the blinds of W27 and W33 closed
+    spec = importlib.util.spec_from_file_location("make_building", EXAMPLE / "make_building.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    exp2 = module.building(2)
+    supply = sum(z.get("supply", {}).get("flow", 0.0) for z in exp2["zones"])
+    assert supply == 60.0
+    # every zone's inflow still equals its outflow: half of the supply extracted in each of bath and child
+    assert extract_flows(exp2) == pytest.approx({z["name"]: 30.0 if z["name"] in ("bath", "child") else 0.0
+                                                 for z in exp2["zones"]})
+    shaded = {c["name"]: c.get("shading") for c in exp2["components"] if c.get("shading")}
+    assert shaded == {"W27": "shading_W27", "W29": "shading_south", "W30": "shading_south",
+                      "W31": "shading_south", "W33": "shading_W33"}
+    changed = [c for c, d in zip(exp2["components"], data["components"]) if c != d]
+    assert [c["name"] for c in changed] == ["W27", "W33"]
+    assert exp2["materials"] == data["materials"] and exp2["sensors"] == data["sensors"]
+    # the column files name columns experiment 2's data has
+    names = set(pd.read_csv(DATA.parent / "twinhouse_n2_exp2" / "columns.csv")["name"])
+    for listing in ("weather_columns_exp2.txt", "measurement_columns_exp2.txt"):
+        for line in (EXAMPLE / listing).read_text().splitlines():
+            if line and not line.startswith("#"):
+                assert line.split("=", 1)[1] in names, line
+
+
 def test_zones_and_components_are_building_md_s(data, building_md):
     zones = {z["name"]: z for z in data["zones"]}
     for row in table_rows(building_md, "## Zones"):
