@@ -33,11 +33,13 @@ same record, so they share its noise, and the difference of their J is far bette
 than either J. The residuals of the two forcings are recomputed (`Paired`: a few simulations,
 only for the finalists) and their difference of J judged against its HAC standard deviation
 (`diagnose.significance.worse`, a Diebold-Mariano-type test allowing for the residuals'
-correlation in time). Where the evaluator keeps no residuals, the noise of one J
-(noise_tolerance) is the band instead. So the inside surface of a wrong roof wins over the
+correlation in time). Where the evaluator keeps no residuals, the noise of one J (noise_tolerance) is the band instead. So the inside surface of a wrong roof wins over the
 layer behind it (their residuals differ by noise), but a wall that merely compensates a wrong
 floor or door does not win over it because it comes first: its J is measurably worse on the
-same steps, even when the gap is inside the noise band of one J. Sets of up to EXACT_ANY nodes are searched over the whole chromosome, so
+same steps, even when the gap is inside the noise band of one J. With noisy sensors on every
+node the test also sees how much of a forced sensor's noise reaches the air: forcing the node
+behind a faulty wall's inside surface may then fit measurably better than the surface itself,
+and is named instead; both locate the same component. Sets of up to EXACT_ANY nodes are searched over the whole chromosome, so
 the answer for one or two faults does not depend on the path the search took. The empty set
 comes first, so best_nodes = [] exactly when J_unforced - J_min <= tolerance: no significant
 reduction. Larger subsets of the best chromosome are searched exhaustively, smallest first,
@@ -65,6 +67,7 @@ EXPLAINED = 0.5
 RELATIVE_FLOOR = 0.01
 EXACT_MAX_NODES = 8
 EXACT_ANY = 2
+ROUNDING = 1e-9  # of J_unforced: a difference of J below it is the simulation's rounding
 
 
 def tolerance(J_unforced: float, noise_sigma: "float | None", n_residuals: "int | None") -> float:
@@ -160,10 +163,14 @@ class Paired:
     only the few finalists of the parsimony rule need their series. Close it when done.
 
     factory: a fitness factory whose evaluators have residuals(mask) (`keeps_residuals`, ga.fitness).
+    J_many, floor: the search's scores and the difference of J (C2) that is rounding, whatever
+        the test says (ROUNDING of J_unforced): on a noise-free record two forcings that both
+        cut a fault off differ by nothing else.
     """
 
-    def __init__(self, factory):
+    def __init__(self, factory, J_many=None, floor=0.0):
         self._factory, self._evaluator, self._kept = factory, None, {}
+        self._J_many, self._floor = J_many, floor
 
     def residuals(self, mask):
         if mask not in self._kept:
@@ -174,6 +181,10 @@ class Paired:
 
     def worse(self, a, b) -> bool:
         """Whether forcing mask a fits the record measurably worse than mask b."""
+        if self._J_many is not None:
+            J_a, J_b = self._J_many([a, b])
+            if J_a - J_b <= self._floor:
+                return False
         return significance.worse(self.residuals(a), self.residuals(b))
 
     def close(self):

@@ -43,8 +43,8 @@ from tqdm import tqdm
 from nodeforce.ga import checkpoint as ckpt
 from nodeforce.ga.evaluation import FitnessCache, log, open_backend
 from nodeforce.ga.operators import bit_flip_mutation, one_point_crossover, roulette_selection
-from nodeforce.ga.parsimony import (Paired, explains, forward_backward, noise_floor, noise_tolerance, smallest_subset,
-                                    tolerance)
+from nodeforce.ga.parsimony import (ROUNDING, Paired, explains, forward_backward, noise_floor, noise_tolerance,
+                                    smallest_subset, tolerance)
 
 # Generations without a significant fall of the best J before the GA stops. Measured on the
 # paper's verification cases (benchmarks/bench_search.py --cases, README): successive falls of
@@ -321,7 +321,8 @@ def _answer(cache, nodes, noise_sigma, n_residuals, factory=None) -> dict:
     J_min = cache.J_of[best]
     tol = tolerance(J_unforced, noise_sigma, n_residuals)
     if explains(J_unforced, J_min, noise_sigma, n_residuals):
-        paired = Paired(factory) if getattr(factory, "keeps_residuals", False) else None
+        paired = (Paired(factory, cache.J_many, ROUNDING * J_unforced)
+                  if getattr(factory, "keeps_residuals", False) else None)
         try:
             chosen = smallest_subset(cache.J_many, best, J_min + tol, noise_tolerance(noise_sigma, n_residuals),
                                      worse=paired.worse if paired else None)

@@ -90,8 +90,8 @@ def write_markdown(out_dir, report, plots, notes):
     ref = tables.reference_text(report)
     md = ["# nodeforce diagnosis report", "",
           "From the residual of the indoor air, to the nodes whose forcing explains it, to a physical "
-          "effect the model lacks, added and calibrated on the calibration window; the validation "
-          "window was not seen by the calibration.", "",
+          "effect the model lacks, added and calibrated on the calibration window's first part and chosen on "
+          "its last (the selection window); the validation window played no part in any choice.", "",
           "## Result", "", *[f"**{line.strip()}**  " for line in tables.effect_header(report, pm="±").splitlines()],
           "", "## Decision", "", *decision_lines(report), "",
           "## Period", "",
