@@ -5,6 +5,8 @@ from __future__ import annotations
 from .formats import NA, time_text
 
 WINDOWS = ("calibration", "validation")
+# the windows whose METRICS report.json holds: the fits' ("calibration"), the choice's, the test's
+SCORED = ("calibration", "selection", "validation")
 STATES = ("before", "after")
 
 
@@ -78,6 +80,13 @@ def reference(report):
     if not ref or not ref.get("rmse"):
         return None
     return str(ref.get("label") or "reference"), dict(ref["rmse"])
+
+
+def scored_period_text(report, window):
+    """The span the METRICS of `window` cover: a report with a selection window scores
+    "calibration" on the fitting window, the calibration window's first part."""
+    period = report.get("period") or {}
+    return period_text(report, "fitting" if window == "calibration" and period.get("fitting") else window)
 
 
 def period_text(report, window):
