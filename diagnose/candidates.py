@@ -120,7 +120,8 @@ def objection(building, effect, target, parameters, derived=None):
     """Why a calibrated effect may not be added to the model, or None: a gain the building file's
     description rules out (`implausible`), a parameter on a bound of its search range or not
     identifiable from the data (for a ground coupling, whose U and T_ground trade off, the heat
-    flux they give must be determined instead), or a value outside physical limits.
+    flux they give must be determined instead, and then the pair is one of the many that give
+    it, wherever it ended), or a value outside physical limits.
 
     parameters : {name: {"value", "std", "identifiable", "on_bound"}} of `diagnose.calibrate`
     derived : what the data determine besides (`diagnose.calibrate.derived`)
@@ -131,9 +132,11 @@ def objection(building, effect, target, parameters, derived=None):
     for name in JUDGED.get(effect, [p.name for p in EFFECTS[effect].parameters]):
         p, unit = parameters[name], EFFECTS[effect].parameter(name).unit
         low, high = limits(building, effect, target, name)
-        if p.get("on_bound"):
+        if flux_known:
+            pass  # many (U, T_ground) give the flux the data fix: the pair is one of them, on a bound or not
+        elif p.get("on_bound"):
             reasons.append(f"{name} = {p['value']:.3g} {unit} ends on a bound of its range")
-        elif not p["identifiable"] and not flux_known:
+        elif not p["identifiable"]:
             reasons.append(f"{name} = {p['value']:.3g} +- {p['std']:.2g} {unit} is not identifiable from these data")
         if not low <= p["value"] <= high:
             what = "a negative gain (a heat sink)" if low == 0.0 and "gain" in effect else "outside physical limits"

@@ -56,6 +56,8 @@ def test_a_ground_coupling_is_judged_by_the_flux_the_data_fix(testcell):
     traded = {"U": parameter(0.8, 0.5, identifiable=False), "T_ground": parameter(24.0, 3.0, identifiable=False)}
     flux = {"ground_heat_flux": {"value": 4.0, "std": 0.3, "unit": "W/m2"}}
     assert objection(testcell, "ground_coupling", "floor", traded, flux) is None
+    on_bound = {**traded, "T_ground": parameter(-10.0, 3000.0, identifiable=False, on_bound=True)}
+    assert objection(testcell, "ground_coupling", "floor", on_bound, flux) is None
     assert "not identifiable" in objection(testcell, "ground_coupling", "floor", traded,
                                            {"ground_heat_flux": {"value": 4.0, "std": 3.0, "unit": "W/m2"}})
 

@@ -357,10 +357,11 @@ def test_diagnose_end_to_end_on_a_few_real_days(tmp_path):
     assert len(sensors) == 5
     assert main(["table", *table, "--select", ",".join(sensors), "-o", str(measurements)]) == 0
     phases = tmp_path / "phases.csv"
-    # the second phase is the validation window (the first holds the burn-in and the calibration)
-    phases.write_text("time,phase\n2013-09-09T00:00+01:00,first half\n2013-09-11T00:10+01:00,second half\n")
+    # the second phase is the validation window (the first holds the burn-in and the calibration:
+    # a day to fit and a day to choose on)
+    phases.write_text("time,phase\n2013-09-09T00:00+01:00,first part\n2013-09-12T00:10+01:00,last day\n")
     assert main(["diagnose", str(BUILDING), "--weather", str(weather), "--measurements", str(measurements),
-                 "-o", str(out), "--objective", "living", "--calibration-end", "2013-09-11T00:00+01:00",
+                 "-o", str(out), "--objective", "living", "--calibration-end", "2013-09-12T00:00+01:00",
                  "--burn-in-days", "1", "--seed", "0", "--phases", str(phases)]) == 0
     md = (out / "report.md").read_text()
     report = json.loads((out / "report.json").read_text())
@@ -378,7 +379,7 @@ def test_diagnose_end_to_end_on_a_few_real_days(tmp_path):
     for worse in report["decision"].get("worsened_phases", []):
         assert f"{worse['phase']} worse" in report["decision"]["reason"]
     assert report["objective"] == ["living"]
-    assert pd.Timestamp(report["period"]["calibration"][1]) == pd.Timestamp("2013-09-11T00:00+01:00")
+    assert pd.Timestamp(report["period"]["calibration"][1]) == pd.Timestamp("2013-09-12T00:00+01:00")
     for side in ("before", "after"):
         for window in ("calibration", "validation"):
             assert math.isfinite(report[side][window]["rmse"]) and report[side][window]["n"] > 0, (side, window)
