@@ -22,12 +22,16 @@ system-deps:
 demo: venv
 	$(BIN)/nodeforce demo -o out/demo
 
+# Two pytest-xdist workers, one per core; a test file stays on one worker, so its module fixtures
+# (a shared diagnosis, say) are computed once.
+PYTEST := $(BIN)/python -m pytest -q -n 2 --dist loadfile
+
 test: venv system-deps
-	$(BIN)/python -m pytest -q
+	$(PYTEST)
 
 # The edit-test loop: everything but the searches, diagnoses and importer runs (under a minute).
 check: venv
-	$(BIN)/python -m pytest -q -m "not slow"
+	$(PYTEST) -m "not slow"
 
 # Twin House N2, experiment 1 (examples/twinhouse_n2/README.md): the shared measurements converted,
 # then diagnosed on the living room; then experiment 2 (spring 2014, another protocol) converted

@@ -3,25 +3,164 @@
 An `FmuInstance` extracts and instantiates an FMU once; each `run` resets it, so a search can
 simulate thousands of forcing masks without unzipping or instantiating again. The step loop
 writes the inputs into preallocated ctypes arrays through numpy views and calls FMPy's
-`fmi2SetReal`, `fmi2DoStep` and `fmi2GetReal`, so a step allocates nothing in Python.
+low-level set, doStep and get functions, so a step allocates nothing in Python.
 
-The slave class follows the model description's fmiVersion, as FMPy's own `simulate_fmu` does;
-this layer knows nothing of how an FMU was made. Extracted FMUs live in temporary folders named
+The calls follow the model description's fmiVersion, as FMPy's own `simulate_fmu` does: one class
+per version (`Fmi2`, `Fmi3`) sets, steps and gets, and both speak in scalar names (`force[i]`,
+`T_forced[i]`, `T[i]`), which FMI 3.0 FMUs hold as elements of arrays; this layer knows nothing
+of how an FMU was made. Extracted FMUs live in temporary folders named
 `nodeforce_fmu_*`, removed when the instance closes, when instantiation fails, and at the latest
 when the interpreter exits: instances still open then are freed first, while Python still runs
 (a library's own exit handlers must not meet live instances after the interpreter has gone).
 """
 import atexit
-import shutil
-import tempfile
 import weakref
+from ctypes import byref
 
 import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave, fmi2Boolean, fmi2Real, fmi2True, fmi2ValueReference
+from fmpy.fmi3 import FMU3Slave, fmi3Boolean, fmi3Float64, fmi3ValueReference
 
-SLAVES = {"2.0": FMU2Slave}
+from nodeforce import tempdirs
+
 _OPEN = weakref.WeakSet()
+
+
+class Fmi2:
+    """FMI 2.0 calls: every value is a variable of its own."""
+
+    slave_class = FMU2Slave
+
+    def __init__(self, description):
+        self.variables = {v.name: v for v in description.modelVariables}
+
+    def names(self, causality):
+        return [name for name, v in self.variables.items() if v.causality == causality]
+
+    def refs(self, names):
+        try:
+            return [self.variables[n].valueReference for n in names]
+        except KeyError as e:
+            raise KeyError(f"no variable {e.args[0]}") from None
+
+    def is_boolean(self, name):
+        return self.variables[name].type == "Boolean"
+
+    def initialise(self, fmu, start_time, booleans, reals):
+        """Set up, set the parameters and start values ({name: value}), end initialisation."""
+        fmu.setupExperiment(startTime=start_time)
+        fmu.enterInitializationMode()
+        if booleans:
+            fmu.setBoolean(self.refs(booleans), [bool(v) for v in booleans.values()])
+        if reals:
+            fmu.setReal(self.refs(reals), [float(v) for v in reals.values()])
+        fmu.exitInitializationMode()
+
+    def stepper(self, fmu, input_names, output_names):
+        """step(time, dt, inputs row, outputs row or None): set the inputs, step, get the
+        outputs, through preallocated ctypes arrays (a step allocates nothing in Python)."""
+        n_in, n_out = len(input_names), len(output_names)
+        in_refs = (fmi2ValueReference * n_in)(*self.refs(input_names))
+        in_values = (fmi2Real * n_in)()
+        in_view = np.ctypeslib.as_array(in_values) if n_in else None
+        out_refs = (fmi2ValueReference * n_out)(*self.refs(output_names))
+        out_values = (fmi2Real * n_out)()
+        out_view = np.ctypeslib.as_array(out_values) if n_out else None
+        component = fmu.component
+        set_real, do_step, get_real = fmu.fmi2SetReal, fmu.fmi2DoStep, fmu.fmi2GetReal
+
+        def step(time, dt, row, out):
+            if n_in:
+                in_view[:] = row
+                set_real(component, in_refs, n_in, in_values)
+            do_step(component, time, dt, fmi2Boolean(fmi2True))
+            if out is not None:
+                get_real(component, out_refs, n_out, out_values)
+                out[:] = out_view
+        return step
+
+
+class Fmi3(Fmi2):
+    """FMI 3.0 calls: `force`, `T_forced` and `T` are arrays of N, whose element i-1 is the
+    scalar `name[i]`; a set or get names whole arrays, the elements not given at their start."""
+
+    slave_class = FMU3Slave
+
+    def __init__(self, description):
+        super().__init__(description)
+        self.elements = {}  # scalar name: (variable, index in its array or None)
+        for v in description.modelVariables:
+            if v.dimensions:
+                self.elements.update({f"{v.name}[{i + 1}]": (v, i) for i in range(int(v.dimensions[0].start))})
+            else:
+                self.elements[v.name] = (v, None)
+
+    def names(self, causality):
+        return [name for name, (v, _) in self.elements.items() if v.causality == causality]
+
+    def is_boolean(self, name):
+        return self.elements[name][0].type == "Boolean"
+
+    def layout(self, names):
+        """(value references, buffer of every value of their variables at the start values,
+        the position of each of `names` in the buffer)."""
+        try:
+            chosen = [self.elements[n] for n in names]
+        except KeyError as e:
+            raise KeyError(f"no variable {e.args[0]}") from None
+        variables = list({id(v): v for v, _ in chosen}.values())
+        size = lambda v: int(np.prod(v.shape or (1,)))
+        starts = [np.array([text.lower() in ("true", "1") if v.type == "Boolean" else float(text)
+                            for text in v.start.split()] if v.start else np.zeros(size(v)), dtype=float)
+                  for v in variables]
+        offsets = dict(zip((id(v) for v in variables), np.cumsum([0] + [len(x) for x in starts])))
+        buffer = np.concatenate(starts) if starts else np.empty(0)
+        positions = np.array([offsets[id(v)] + (i or 0) for v, i in chosen], dtype=np.intp)
+        return [v.valueReference for v in variables], buffer, positions
+
+    def _set(self, fmu, values, boolean):
+        if values:
+            refs, buffer, positions = self.layout(list(values))
+            buffer[positions] = [float(x) for x in values.values()]
+            if boolean:
+                fmu.setBoolean(refs, [bool(x) for x in buffer])
+            else:
+                fmu.setFloat64(refs, list(buffer))
+
+    def initialise(self, fmu, start_time, booleans, reals):
+        fmu.enterInitializationMode(startTime=start_time)
+        self._set(fmu, booleans, True)
+        self._set(fmu, reals, False)
+        fmu.exitInitializationMode()
+
+    def stepper(self, fmu, input_names, output_names):
+        in_refs, in_buffer, in_positions = self.layout(input_names)
+        out_refs, out_buffer, out_positions = self.layout(output_names)
+        n_in, n_out = len(in_buffer), len(out_buffer)
+        in_refs = (fmi3ValueReference * len(in_refs))(*in_refs)
+        in_values = (fmi3Float64 * n_in)(*in_buffer)
+        in_view = np.ctypeslib.as_array(in_values) if n_in else None
+        out_refs = (fmi3ValueReference * len(out_refs))(*out_refs)
+        out_values = (fmi3Float64 * n_out)()
+        out_view = np.ctypeslib.as_array(out_values) if n_out else None
+        component = fmu.component
+        set_float, do_step, get_float = fmu.fmi3SetFloat64, fmu.fmi3DoStep, fmu.fmi3GetFloat64
+        event, terminate, early, last = fmi3Boolean(), fmi3Boolean(), fmi3Boolean(), fmi3Float64()
+
+        def step(time, dt, row, out):
+            if n_in:
+                in_view[in_positions] = row
+                set_float(component, in_refs, len(in_refs), in_values, n_in)
+            do_step(component, time, dt, fmi3Boolean(True), byref(event), byref(terminate), byref(early),
+                    byref(last))
+            if out is not None:
+                get_float(component, out_refs, len(out_refs), out_values, n_out)
+                out[:] = out_view[out_positions]
+        return step
+
+
+VERSIONS = {"2.0": Fmi2, "3.0": Fmi3}
 
 
 def content_id(fmu_path):
@@ -35,17 +174,18 @@ class FmuInstance:
     def __init__(self, fmu_path, instance_name="nodeforce"):
         self.path = str(fmu_path)
         self.description = read_model_description(self.path)
-        slave_class = SLAVES.get(self.description.fmiVersion)
-        if slave_class is None:
+        version = VERSIONS.get(self.description.fmiVersion)
+        if version is None:
             raise ValueError(f"{self.path} is an FMI {self.description.fmiVersion} FMU; "
-                             f"nodeforce runs FMI {', '.join(SLAVES)}")
+                             f"nodeforce runs FMI {', '.join(VERSIONS)}")
         if self.description.coSimulation is None:
             raise ValueError(f"{self.path} is not a co-simulation FMU")
-        self.variables = {v.name: v for v in self.description.modelVariables}
-        self._unzipdir = extract(self.path, unzipdir=tempfile.mkdtemp(prefix="nodeforce_fmu_"))
+        self.calls = version(self.description)
+        self.variables = self.calls.variables
+        self._unzipdir = extract(self.path, unzipdir=tempdirs.make("fmu"))
         self.fmu = None
         try:
-            self.fmu = slave_class(guid=self.description.guid, unzipDirectory=self._unzipdir,
+            self.fmu = version.slave_class(guid=self.description.guid, unzipDirectory=self._unzipdir,
                                    modelIdentifier=self.description.coSimulation.modelIdentifier,
                                    instanceName=instance_name)
             self.fmu.instantiate()
@@ -56,14 +196,9 @@ class FmuInstance:
         self._used = False
 
     def names(self, causality):
-        """Names of the variables of a causality ("parameter", "input", "output")."""
-        return [v.name for v in self.description.modelVariables if v.causality == causality]
-
-    def _refs(self, names):
-        try:
-            return [self.variables[n].valueReference for n in names]
-        except KeyError as e:
-            raise KeyError(f"{self.path} has no variable {e.args[0]}") from None
+        """Names of the variables of a causality ("parameter", "input", "output"), array
+        elements by their scalar names (`T[3]`)."""
+        return self.calls.names(causality)
 
     def run(self, dt, parameters, start_inputs, input_names, inputs, output_names, start_time=0.0,
             skip=0):
@@ -87,36 +222,16 @@ class FmuInstance:
         if self._used:
             fmu.reset()
         self._used = True
-        fmu.setupExperiment(startTime=start_time)
-        fmu.enterInitializationMode()
-        booleans = {n: v for n, v in parameters.items() if self.variables[n].type == "Boolean"}
+        calls = self.calls
+        booleans = {n: v for n, v in parameters.items() if calls.is_boolean(n)}
         reals = {n: v for n, v in {**parameters, **start_inputs}.items() if n not in booleans}
-        if booleans:
-            fmu.setBoolean(self._refs(booleans), [bool(v) for v in booleans.values()])
-        if reals:
-            fmu.setReal(self._refs(reals), [float(v) for v in reals.values()])
-        fmu.exitInitializationMode()
-
+        calls.initialise(fmu, start_time, booleans, reals)
         inputs = np.asarray(inputs, dtype=float)
-        n_in, n_out = len(input_names), len(output_names)
-        in_refs = (fmi2ValueReference * n_in)(*self._refs(input_names))
-        in_values = (fmi2Real * n_in)()
-        in_view = np.ctypeslib.as_array(in_values)
-        out_refs = (fmi2ValueReference * n_out)(*self._refs(output_names))
-        out_values = (fmi2Real * n_out)()
-        out_view = np.ctypeslib.as_array(out_values)
-        component = fmu.component
-        set_real, do_step, get_real = fmu.fmi2SetReal, fmu.fmi2DoStep, fmu.fmi2GetReal
-        outputs = np.empty((len(inputs) - skip, n_out))
+        step = calls.stepper(fmu, list(input_names), list(output_names))
+        outputs = np.empty((len(inputs) - skip, len(output_names)))
         time = start_time
         for k, row in enumerate(inputs):
-            if n_in:
-                in_view[:] = row
-                set_real(component, in_refs, n_in, in_values)
-            do_step(component, time, dt, fmi2Boolean(fmi2True))
-            if k >= skip:
-                get_real(component, out_refs, n_out, out_values)
-                outputs[k - skip] = out_view
+            step(time, dt, row, outputs[k - skip] if k >= skip else None)
             time = start_time + (k + 1) * dt
         fmu.terminate()
         return outputs
@@ -131,7 +246,7 @@ class FmuInstance:
                 fmu.freeInstance()
             else:
                 fmu.freeLibrary()
-        shutil.rmtree(self._unzipdir, ignore_errors=True)
+        tempdirs.remove(self._unzipdir)
         _OPEN.discard(self)
 
     def __enter__(self):

@@ -30,16 +30,15 @@ on data the calibration did not see.
 """
 import json
 import math
-import multiprocessing
 import os
 import sys
-from concurrent.futures import ProcessPoolExecutor
 from contextlib import nullcontext
 from dataclasses import dataclass
 
 import numpy as np
 from tqdm import tqdm
 
+from nodeforce import lifetime
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnose.calibrate import Candidate, calibrate, sensitivity
@@ -237,13 +236,13 @@ class Model:
 
 def assess_all(model, pairs, calibration, case, objective, folder, seed, workers, fmu_kind, k):
     """Each (effect, target) added to `model`, calibrated on `calibration` (the fitting window,
-    t_0..t_j) and run, in parallel worker processes: the candidates' records, their `Model`s by
-    label, their Morris screenings, and their residuals on the selection window t_j+1..t_k."""
+    t_0..t_j) and run, in parallel worker processes (which end with this process:
+    nodeforce.lifetime): the candidates' records, their `Model`s by label, their Morris
+    screenings, and their residuals on the selection window t_j+1..t_k."""
     tasks = [(model.building, effect, target, folder, calibration, case, objective, seed, fmu_kind)
              for effect, target in pairs]
     n_workers = min(workers or os.cpu_count(), len(tasks))
-    with (ProcessPoolExecutor(n_workers, mp_context=multiprocessing.get_context("spawn"))
-          if n_workers > 1 else nullcontext()) as pool:
+    with (lifetime.worker_pool(n_workers) if n_workers > 1 else nullcontext()) as pool:
         assessed = list(tqdm((pool.map if pool else map)(assess, tasks), total=len(tasks),
                              desc="calibrating candidate effects", unit="candidate",
                              disable=not sys.stderr.isatty()))

@@ -11,19 +11,23 @@ Two kinds of FMU, with the same variables and the same numbers:
   Python at run time.
 
 Both carry the model description of `description.py`, with a GUID that hashes their content.
+
+Either as FMI 2.0 (the default) or FMI 3.0 (kind "python-fmi3", "standalone-fmi3"; `fmu_kind`):
+the same model, its FMI 3.0 interface (c/fmi3.c) compiled into the FMU's binary over its FMI
+2.0 one, with `force`, `T_forced` and `T` as arrays of N.
 """
 import json
 import sys
-import tempfile
 import zipfile
 from pathlib import Path
 
-from nodeforce import model
+from nodeforce import model, tempdirs
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.network import input_names
 
 from . import description
-from .guard import guarded
+from .compiler import C_DIR, compile_library
+from .guard import PLATFORM, guard_binary, guarded
 from .variables import Layout
 
 SLAVE = Path(__file__).with_name("slave.py")
@@ -31,6 +35,15 @@ VARIABLES = Path(__file__).with_name("variables.py")
 MODEL_DIR = Path(model.__file__).parent
 # The modules the FMU imports; weather and solar stay outside (their results are inputs).
 PHYSICS_MODULES = ("__init__", "errors", "building", "discretise", "effects", "network", "integrate")
+
+
+FMI3_PLATFORM = "x86_64-linux"  # FMI 3.0's name of FMI 2.0's linux64
+FMI3_SOURCES = ("fmi3.c", "fmi3.h", "glibc.h")
+
+
+def fmu_kind(kind, fmi):
+    """The `build_fmu` kind of an FMU kind ("python", "standalone") at an FMI version (2, 3)."""
+    return kind if int(fmi) == 2 else f"{kind}-fmi3"
 
 
 def build_fmu(building, destination, effect=None, kind="python"):
@@ -42,21 +55,23 @@ def build_fmu(building, destination, effect=None, kind="python"):
     destination : path of the .fmu to write
     effect : (effect id, target) of `model.effects` whose parameters the FMU exposes as
         `<effect>.<name>` (start: the values the building declares), or None
-    kind : "python" (pythonfmu) or "standalone" (C, no Python at run time)
+    kind : "python" (pythonfmu) or "standalone" (C, no Python at run time), FMI 2.0; with
+        "-fmi3", the same as FMI 3.0 (`fmu_kind`)
 
     Returns
     -------
     Path of the FMU written
     """
-    if kind not in KINDS:
-        raise ValueError(f"unknown FMU kind {kind!r}: one of {', '.join(KINDS)}")
+    kind, _, version = kind.partition("-fmi")
+    if kind not in KINDS or version not in ("", "3"):
+        raise ValueError(f"unknown FMU kind {kind!r}: one of {', '.join(KINDS)}, each optionally -fmi3")
     if effect is not None and not EFFECTS[effect[0]].applies(building, effect[1]):
         raise ValueError(f"effect {effect[0]} does not apply to {effect[1]!r}")
     if effect is not None:  # declared at its present values, so the FMU has every input the effect uses
         building = EFFECTS[effect[0]].apply(building, effect[1], {})
     destination = Path(destination).resolve()
     destination.parent.mkdir(parents=True, exist_ok=True)
-    return KINDS[kind](building, destination, effect)
+    return KINDS[kind](building, destination, effect, int(version or 2))
 
 
 def model_interface(building, effect):
@@ -66,7 +81,7 @@ def model_interface(building, effect):
     return layout, ((*effect, start) if effect else None)
 
 
-def _build_python(building, destination, effect):
+def _build_python(building, destination, effect, fmi):
     from pythonfmu.builder import FmuBuilder
     from pythonfmu.osutil import get_platform
 
@@ -78,7 +93,7 @@ def _build_python(building, destination, effect):
     module = "nodeforce_" + description.content_hash(building_text, effect_text, slave_text,
                                                      *sources.values())[:16]
 
-    with tempfile.TemporaryDirectory(prefix="nodeforce_fmu_") as tmp:
+    with tempdirs.folder("fmu") as tmp:
         tmp = Path(tmp)
         script = tmp / f"{module}.py"
         script.write_text(slave_text)
@@ -107,26 +122,51 @@ def _build_python(building, destination, effect):
                            f"from {FmuBuilder.build_FMU.__code__.co_filename} is a copy without one")
     # pythonfmu names the binaries after the slave class, and finds the module in slavemodule.txt
     identifier = Path(next(name for name in files if name.startswith("binaries/"))).stem
-    files, is_guarded = guarded(files, identifier, model_interface(building, effect)[0])
-    return _write(destination, files, building, effect, identifier, standalone=False, guarded=is_guarded)
+    layout = model_interface(building, effect)[0]
+    files, is_guarded = guarded(files, identifier, layout)
+    if fmi == 3:
+        if not is_guarded:
+            raise RuntimeError("the FMI 3.0 Python FMU's binary is its FMI 3.0 interface over the guard, compiled at "
+                               "export: it needs a C compiler (cc, gcc or $CC)")
+        files = _as_fmi3(files, identifier, layout, guard_binary(fmi=3))
+    return _write(destination, files, building, effect, identifier, standalone=False, guarded=is_guarded, fmi=fmi)
 
 
-def _write(destination, files, building, effect, identifier, standalone, source_files=(), guarded=True):
+def _as_fmi3(files, identifier, layout, binary):
+    """The files of an FMU as FMI 3.0: its linux64 binaries under FMI 3.0's platform name, the
+    model's `binary` (FMI 3.0 over FMI 2.0) for its own, no other platform (pythonfmu's win64
+    binary is FMI 2.0 only), and the sizes c/fmi3.c reads."""
+    moved = {name.replace(f"binaries/{PLATFORM}/", f"binaries/{FMI3_PLATFORM}/"): data
+             for name, data in files.items() if not name.startswith("binaries/") or f"/{PLATFORM}/" in name}
+    moved[f"binaries/{FMI3_PLATFORM}/{identifier}.so"] = binary
+    moved["resources/fmi3.txt"] = (f"nodeforce-fmi3/1\nsizes {layout.n_nodes} {len(layout.input_names)} "
+                                   f"{len(layout.parameter_names)}\n").encode()
+    return moved
+
+
+def _write(destination, files, building, effect, identifier, standalone, source_files=(), guarded=True, fmi=2):
     """Add the documentation and the model description (GUID: hash of every file) and write."""
     name = building.name or identifier
-    files = {**files, "documentation/index.html": description.documentation(name, standalone, guarded)}
+    files = {**files, "documentation/index.html": description.documentation(name, standalone, guarded, fmi=fmi)}
     guid = description.content_guid(*(part for item in sorted(files.items()) for part in item))
     layout, effect_spec = model_interface(building, effect)
     files["modelDescription.xml"] = description.model_description(
-        layout, building, guid, identifier, name, effect_spec, standalone, source_files)
+        layout, building, guid, identifier, name, effect_spec, standalone, source_files, fmi=fmi)
     return description.write_fmu(destination, files)
 
 
-def _build_standalone(building, destination, effect):
+def _build_standalone(building, destination, effect, fmi):
     from .standalone import standalone_files
 
     files, identifier, source_files = standalone_files(building, effect)
-    return _write(destination, files, building, effect, identifier, True, source_files)
+    if fmi == 3:
+        with tempdirs.folder("fmu") as tmp:
+            library = Path(tmp) / f"{identifier}.so"
+            compile_library((source_files[0], "fmi3.c"), library, libraries=("m",), link_options=("-Wl,-Bsymbolic",))
+            binary = library.read_bytes()
+        files = _as_fmi3(files, identifier, model_interface(building, effect)[0], binary)
+        files.update({f"sources/{name}": (C_DIR / name).read_bytes() for name in FMI3_SOURCES})
+    return _write(destination, files, building, effect, identifier, True, source_files, fmi=fmi)
 
 
 KINDS = {"python": _build_python, "standalone": _build_standalone}

@@ -16,11 +16,14 @@ def find_compiler():
     return command.split()
 
 
-def compile_library(source, output, libraries=()):
-    """Compile c/<source> (with the headers beside it) into the shared library `output`.
+def compile_library(source, output, libraries=(), link_options=()):
+    """Compile c/<source> (a file name, or several) with the headers beside it into the shared
+    library `output`.
 
     Compiled in c/ by relative name, without debug information: the bytes do not depend on
     where nodeforce is installed, so the same model gives the same FMU.
+
+    libraries : names given to -l; link_options : options for the linker (-Wl,...), before them
 
     Raises RuntimeError without a C compiler or when compiling fails.
     """
@@ -28,7 +31,7 @@ def compile_library(source, output, libraries=()):
     if compiler is None:
         raise RuntimeError("no C compiler found (cc, gcc or $CC): install one (e.g. apt-get install gcc)")
     command = [*compiler, "-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden",
-               "-o", str(output), source, *(f"-l{name}" for name in libraries)]
+               "-o", str(output), *([source] if isinstance(source, str) else source), *link_options, *(f"-l{name}" for name in libraries)]
     done = subprocess.run(command, cwd=C_DIR, capture_output=True, text=True)
     if done.returncode:
-        raise RuntimeError(f"compiling {source} failed: {' '.join(command)}\n{done.stderr}")
+        raise RuntimeError(f"compiling {source!r} failed: {' '.join(command)}\n{done.stderr}")

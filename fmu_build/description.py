@@ -15,8 +15,13 @@ from nodeforce.model.building import Boundary
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.network import clock_input_names
 
+from .guard import GUARD_GLIBC, PYTHONFMU_GLIBC
+
 
 DEFAULT_STEP = 900.0  # s, the step of the bundled data when a building declares none
+# s: an importer's default run (DefaultExperiment) is a day at that step, long enough for the
+# building to move and short enough for a first try; without stopTime every importer ran 1 s
+DEFAULT_SPAN = 86400.0
 # FMI 2.0 units: name -> (quantity, SI base-unit exponents and factor/offset to SI)
 UNITS = {
     "degC": ("ThermodynamicTemperature", {"K": "1", "offset": "273.15"}),
@@ -49,6 +54,9 @@ class Variable:
     start: object  # None for a calculated output
     unit: object  # a key of UNITS or None
     description: str
+    # An input an importer holds between the samples it is given (zero-order hold), never
+    # interpolates: a measurement, whose NaN (not measured) must not leak into its neighbours
+    discrete: bool = False
 
 
 def variables(layout, building, effect=None):
@@ -61,7 +69,8 @@ def variables(layout, building, effect=None):
     found += [Variable(name, "input", "Real", "0", *_input_meaning(building, name))
               for name in layout.input_names]
     found += [Variable(f"T_forced[{i}]", "input", "Real", "NaN", "degC",
-                       f"measured temperature of node {i}, NaN if none") for i in n]
+                       f"measured temperature of node {i}, NaN if none; held between samples, "
+                       "never interpolated", discrete=True) for i in n]
     found += [Variable(f"T[{i}]", "output", "Real", None, "degC", f"temperature of node {i}") for i in n]
     if effect is not None:
         effect_id, target, start = effect
@@ -116,7 +125,7 @@ def initial_dependencies(building, layout):
 
 
 def model_description(layout, building, guid, identifier, name, effect=None, standalone=False,
-                      source_files=(), step=DEFAULT_STEP):
+                      source_files=(), step=DEFAULT_STEP, span=DEFAULT_SPAN, fmi=2):
     """modelDescription.xml (bytes) of a model.
 
     Parameters
@@ -124,24 +133,32 @@ def model_description(layout, building, guid, identifier, name, effect=None, sta
     layout : variables.Layout; building : model.building.Building
     guid : the content hash (`content_guid`); identifier : the model identifier (binary name)
     name : model name; effect : (id, target, {name: start}) or None
-    standalone : the FMU needs no Python; source_files : names under sources/
-    step : default communication step (s)
+    standalone : the FMU needs no Python; source_files : names under sources/ (FMI 2.0)
+    step, span : default communication step and stop time (s) of the DefaultExperiment
+    fmi : 2 (scalars) or 3 (`force`, `T_forced` and `T` as arrays of N; c/fmi3.c)
     """
     version, licence = nodeforce_version()
+    header = {"fmiVersion": "2.0", "modelName": name, "guid": guid} if fmi == 2 else \
+        {"fmiVersion": "3.0", "modelName": name, "instantiationToken": guid}
     root = Element("fmiModelDescription", {
-        "fmiVersion": "2.0", "modelName": name, "guid": guid,
+        **header,
         "description": "Nodal (RC network) building thermal model with a forcing input per node",
         "author": "nodeforce", "version": version,
         "license": f"nodeforce: {licence or 'see the nodeforce distribution'}"
                    + ("" if standalone else "; pythonfmu runtime: MIT"),
         "generationTool": f"nodeforce {version}" + ("" if standalone else " with pythonfmu"),
-        "variableNamingConvention": "structured", "numberOfEventIndicators": "0"})
-    cosim = SubElement(root, "CoSimulation", {
-        "modelIdentifier": identifier, "needsExecutionTool": "false" if standalone else "true",
-        "canHandleVariableCommunicationStepSize": "true", "canInterpolateInputs": "false",
-        "canBeInstantiatedOnlyOncePerProcess": "false", "canNotUseMemoryManagementFunctions": "true",
-        "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true"})
-    if source_files:
+        "variableNamingConvention": "structured", **({"numberOfEventIndicators": "0"} if fmi == 2 else {})})
+    capabilities = {"modelIdentifier": identifier, "needsExecutionTool": "false" if standalone else "true",
+                    "canHandleVariableCommunicationStepSize": "true",
+                    "canBeInstantiatedOnlyOncePerProcess": "false"}
+    if fmi == 2:
+        capabilities.update({"canInterpolateInputs": "false", "canNotUseMemoryManagementFunctions": "true",
+                             "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true"})
+    else:
+        capabilities.update({"canGetAndSetFMUState": "true", "canSerializeFMUState": "true",
+                             "hasEventMode": "false", "providesIntermediateUpdate": "false"})
+    cosim = SubElement(root, "CoSimulation", capabilities)
+    if source_files and fmi == 2:
         files = SubElement(cosim, "SourceFiles")
         for file in source_files:
             SubElement(files, "File", {"name": file})
@@ -152,20 +169,40 @@ def model_description(layout, building, guid, identifier, name, effect=None, sta
     categories = SubElement(root, "LogCategories")
     for category in LOG_CATEGORIES:
         SubElement(categories, "Category", {"name": category})
-    SubElement(root, "DefaultExperiment", {"startTime": "0", "stepSize": repr(float(step))})
+    SubElement(root, "DefaultExperiment", {"startTime": "0", "stopTime": repr(float(span)),
+                                           "stepSize": repr(float(step))})
+    (_variables2 if fmi == 2 else _variables3)(root, declared, building, layout)
+    indent(root, "  ")
+    return tostring(root, encoding="UTF-8", xml_declaration=True) + b"\n"
+
+
+def _attributes(v):
+    """The attributes of a variable's element that both FMI versions spell alike."""
+    attributes = {"name": v.name, "description": v.description, "causality": v.causality}
+    if v.causality == "parameter":
+        attributes.update(variability="fixed", initial="exact")
+    if v.discrete:
+        attributes["variability"] = "discrete"
+    return attributes
+
+
+def _typed(v):
+    """start, quantity and unit of a variable."""
+    typed = {} if v.start is None else {"start": v.start}
+    if v.unit:
+        typed.update(quantity=UNITS[v.unit][0], unit=v.unit)
+    return typed
+
+
+def _variables2(root, declared, building, layout):
+    """FMI 2.0 ModelVariables (one ScalarVariable per value, value reference = layout index)
+    and ModelStructure."""
     model_variables = SubElement(root, "ModelVariables")
     for vr, v in enumerate(declared):
-        attributes = {"name": v.name, "valueReference": str(vr), "description": v.description,
-                      "causality": v.causality}
-        if v.causality == "parameter":
-            attributes.update(variability="fixed", initial="exact")
-        elif v.causality == "output":
+        attributes = {**_attributes(v), "valueReference": str(vr)}
+        if v.causality == "output":
             attributes["initial"] = "calculated"
-        element = SubElement(model_variables, "ScalarVariable", attributes)
-        typed = {} if v.start is None else {"start": v.start}
-        if v.unit:
-            typed.update(quantity=UNITS[v.unit][0], unit=v.unit)
-        SubElement(element, v.type, typed)
+        SubElement(SubElement(model_variables, "ScalarVariable", attributes), v.type, _typed(v))
     structure = SubElement(root, "ModelStructure")
     outputs = SubElement(structure, "Outputs")
     initial = SubElement(structure, "InitialUnknowns")
@@ -175,8 +212,41 @@ def model_description(layout, building, guid, identifier, name, effect=None, sta
         SubElement(outputs, "Unknown", {"index": str(vr + 1), "dependencies": ""})
         SubElement(initial, "Unknown", {"index": str(vr + 1),
                                         "dependencies": " ".join(str(d + 1) for d in depends[node])})
-    indent(root, "  ")
-    return tostring(root, encoding="UTF-8", xml_declaration=True) + b"\n"
+
+
+ARRAYS = {"force": "node i is forced to T_forced[i] where that is not NaN",
+          "T_forced": "measured temperature of node i, NaN if none; held between samples, never interpolated",
+          "T": "temperature of node i"}
+FMI3_TYPES = {"Real": "Float64", "Boolean": "Boolean"}
+
+
+def _variables3(root, declared, building, layout):
+    """FMI 3.0 ModelVariables: time (value reference 0), then the FMI 2.0 variables in their
+    order, `force[i]`, `T_forced[i]` and `T[i]` each one array of N (c/fmi3.c); and
+    ModelStructure, where T depends initially on T_start and T_forced."""
+    model_variables = SubElement(root, "ModelVariables")
+    SubElement(model_variables, "Float64", {"name": "time", "valueReference": "0", "causality": "independent",
+                                            "variability": "continuous", "description": "simulation time"})
+    refs, k = {}, 0
+    while k < len(declared):
+        v = declared[k]
+        array = v.name.split("[")[0] if "[" in v.name else None
+        n = layout.n_nodes if array else 1
+        vr = refs[array or v.name] = len(refs) + 1
+        attributes = {**_attributes(v), "name": array or v.name, "valueReference": str(vr)}
+        if array:
+            attributes["description"] = ARRAYS[array]
+        typed = _typed(v)
+        if "start" in typed and array:
+            typed["start"] = " ".join(variable.start for variable in declared[k:k + n])
+        element = SubElement(model_variables, FMI3_TYPES[v.type], {**attributes, **typed})
+        if array:
+            SubElement(element, "Dimension", {"start": str(n)})
+        k += n
+    structure = SubElement(root, "ModelStructure")
+    SubElement(structure, "Output", {"valueReference": str(refs["T"]), "dependencies": ""})
+    SubElement(structure, "InitialUnknown", {"valueReference": str(refs["T"]),
+                                             "dependencies": f"{refs['T_start']} {refs['T_forced']}"})
 
 
 def content_hash(*parts):
@@ -206,11 +276,11 @@ def write_fmu(destination, files):
     return destination
 
 
-def documentation(name, standalone, guarded=True, python_minimum="3.10"):
+def documentation(name, standalone, guarded=True, python_minimum="3.10", fmi=2):
     """documentation/index.html: what an importer needs to run this FMU.
 
     standalone : the C FMU; else the Python FMU, with its guard (guard.py) or, exported without a
-    C compiler, without it."""
+    C compiler, without it; fmi : 2 or 3 (the FMI 3.0 interface over the FMI 2.0 one)."""
     if standalone:
         needs = ("<p>This FMU needs no Python: <code>binaries/linux64</code> holds a C library "
                  "that links only the C library (symbols up to glibc 2.14). For another platform compile "
@@ -220,13 +290,17 @@ def documentation(name, standalone, guarded=True, python_minimum="3.10"):
         needs = (f"<p>This FMU runs Python code (pythonfmu): the importing machine needs Python "
                  f"{python_minimum} or newer with numpy. A Python host (FMPy, libcosimpy, ecospy) runs it as "
                  "is. In a process without Python, the FMU's binary (a guard in front of pythonfmu's, "
-                 "<code>binaries/linux64/*.pythonfmu.so</code>) loads the libpython named in "
-                 "<code>resources/guard.txt</code>, or the one the environment variable "
-                 "<code>NODEFORCE_LIBPYTHON</code> names; numpy must be importable there (e.g. on "
-                 "<code>PYTHONPATH</code>). Calls the FMI 2.0 standard forbids get fmi2Error, the reason "
-                 "logged. A call in which the model raises (an effect parameter it refuses, for example) "
-                 "gets fmi2Error too, not pythonfmu's fmi2Fatal: fmi2Reset then gives a new instance. "
-                 "pythonfmu's Linux binary needs glibc 2.32 and the C++ runtime of GCC 12; there "
+                 "<code>binaries/linux64/*.pythonfmu.so</code>) loads libpython: the one the environment "
+                 "variable <code>NODEFORCE_LIBPYTHON</code> names if it is set, else the first found of "
+                 "the exporting machine's (recorded in <code>resources/guard.txt</code>), the one of the "
+                 "<code>python3</code> on <code>PATH</code>, the exporting version's through the dynamic "
+                 "linker (a system Python), in <code>/usr/local/lib</code> and in "
+                 "<code>$CONDA_PREFIX/lib</code>; the logged error names each one tried. numpy must be "
+                 "importable there (e.g. on <code>PYTHONPATH</code>). Calls the FMI 2.0 standard forbids "
+                 "get fmi2Error, the reason logged. A call in which the model raises (an effect parameter "
+                 "it refuses, for example) gets fmi2Error too, not pythonfmu's fmi2Fatal: fmi2Reset then "
+                 f"gives a new instance. The guard needs glibc {GUARD_GLIBC}; pythonfmu's Linux binary "
+                 f"needs glibc {PYTHONFMU_GLIBC} and the C++ runtime of GCC 12; there "
                  "is no macOS binary, and the win64 one has no guard. Where that is not available, export "
                  "the standalone FMU: <code>nodeforce fmu BUILDING --standalone -o MODEL.fmu</code>.</p>")
     else:
@@ -239,9 +313,18 @@ def documentation(name, standalone, guarded=True, python_minimum="3.10"):
                  "with the reason logged, but reported as fmi2Discard (doStep) or fmi2Fatal (get/set). "
                  "pythonfmu's binary releases Python objects twice when the model raises and when the "
                  "process ends, which can corrupt the host's memory: do not call an instance again after "
-                 "fmi2Fatal. The Linux binary needs glibc 2.32 and the C++ runtime of GCC 12; there is no macOS "
+                 f"fmi2Fatal. The Linux binary needs glibc {PYTHONFMU_GLIBC} and the C++ runtime of GCC 12; there is "
+                 "no macOS "
                  "binary. Where that is not available, export the standalone FMU: "
                  "<code>nodeforce fmu BUILDING --standalone -o MODEL.fmu</code>.</p>")
+    if fmi == 3:  # the same binaries under FMI 3.0's platform name, the same answers in FMI 3.0's words
+        needs = (needs.replace("binaries/linux64", "binaries/x86_64-linux").replace("FMI 2.0", "FMI 3.0")
+                 .replace("fmi2Error", "fmi3Error").replace("fmi2Reset", "fmi3Reset")
+                 .replace(", and the win64 one has no guard", ""))
+        needs += ("<p>FMI 3.0: <code>force</code>, <code>T_forced</code> and <code>T</code> are arrays of N "
+                  "(element i is node i), and <code>time</code> is the independent variable; the binary is "
+                  "the FMU's FMI 3.0 interface over its FMI 2.0 one (<code>fmi3DoStep</code> is "
+                  "<code>fmi2DoStep</code>), so its numbers are the FMI 2.0 FMU's. No event mode.</p>")
     return (f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{name}</title></head><body>\n"
             f"<h1>{name}</h1>\n{needs}\n"
             "<p>Variables: parameters <code>force[i]</code> (node i is forced) and <code>T_start</code> "
@@ -250,4 +333,9 @@ def documentation(name, standalone, guarded=True, python_minimum="3.10"):
             "measurement); outputs <code>T[i]</code> (degC). Set the measurements at t_0 as "
             "<code>T_forced[i]</code> during initialisation: they set the initial state. One "
             "<code>fmi2DoStep</code> of h seconds is one backward-Euler step with the inputs set "
-            "before it (the inputs at the end of the step).</p>\n</body></html>\n").encode()
+            "before it (the inputs at the end of the step).</p>\n"
+            "<p><code>T_forced[i]</code> is a discrete input: an importer that reads an input file "
+            "holds each sample until the next one, NaN included, and never interpolates it, so a "
+            "gap means \"not measured\" over exactly the steps whose sample is NaN, in every importer. "
+            f"The default experiment is a day ({DEFAULT_SPAN:.0f} s) of {DEFAULT_STEP:.0f}-s steps, "
+            "the model's step.</p>\n</body></html>\n").encode()

@@ -13,33 +13,46 @@ a C host must preload libpython, and pythonfmu's double releases reach the host)
 import functools
 import sys
 import sysconfig
-import tempfile
 from pathlib import Path
 
+from nodeforce import tempdirs
 from .compiler import compile_library, find_compiler
 
 PLATFORM = "linux64"  # the guard's platform; pythonfmu's other binaries (win64) stay unguarded
 GUARD_FILE = "resources/guard.txt"
 LIBPYTHON_VARIABLE = "NODEFORCE_LIBPYTHON"  # the guard's override of the recorded libpython
+# The newest glibc symbol version each linux64 binary of the Python FMU needs (objdump -T): the
+# guard's, and pythonfmu 0.7.0's, which also needs the C++ runtime of GCC 12 (GLIBCXX_3.4.30)
+GUARD_GLIBC = "2.2.5"
+PYTHONFMU_GLIBC = "2.32"
 
 
-@functools.lru_cache(maxsize=1)
-def guard_binary():
-    """The guard library (bytes), compiled once per process; None without a C compiler."""
+@functools.lru_cache(maxsize=2)
+def guard_binary(fmi=2):
+    """The guard library (bytes), compiled once per process; None without a C compiler. With
+    fmi=3, the FMI 3.0 interface (c/fmi3.c) over it, in one library whose own calls to its
+    fmi2* functions stay inside it (-Bsymbolic)."""
     if find_compiler() is None:
         print("nodeforce: warning: no C compiler (cc, gcc or $CC): the Python FMU is written without its "
               "guard, so forbidden calls get fmi2Discard or fmi2Fatal instead of fmi2Error and a C host "
               "must preload libpython", file=sys.stderr)
         return None
-    with tempfile.TemporaryDirectory(prefix="nodeforce_guard_") as tmp:
+    with tempdirs.folder("guard") as tmp:
         library = Path(tmp) / "guard.so"
-        compile_library("guard.c", library, libraries=("dl", "pthread"))
+        # libdl.so.2 by name and kept: where glibc is older than 2.34 the dl* functions the guard
+        # asks for (c/guard.c) are there; since, it is an empty compatibility library
+        compile_library(("guard.c", "fmi3.c") if fmi == 3 else "guard.c", library, libraries=(":libdl.so.2",),
+                        link_options=("-Wl,--no-as-needed", "-Wl,-Bsymbolic"))
         return library.read_bytes()
 
 
 def libpython():
-    """Path of the shared libpython of this Python (sysconfig LIBDIR/LDLIBRARY)."""
-    return str(Path(sysconfig.get_config_var("LIBDIR")) / sysconfig.get_config_var("LDLIBRARY"))
+    """Path of the shared libpython of this Python: its run-time name (sysconfig INSTSONAME,
+    e.g. libpython3.11.so.1.0, which a machine without Python's development files has too, and
+    the name the guard gives the dynamic linker where this path does not exist), else LDLIBRARY."""
+    folder = Path(sysconfig.get_config_var("LIBDIR"))
+    runtime = folder / (sysconfig.get_config_var("INSTSONAME") or "")
+    return str(runtime if runtime.is_file() else folder / sysconfig.get_config_var("LDLIBRARY"))
 
 
 def guard_text(layout, binary):

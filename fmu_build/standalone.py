@@ -12,11 +12,11 @@ The export checks that form against a direct assembly elsewhere and refuses an e
 not fit it.
 """
 import itertools
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from nodeforce import tempdirs
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.network import assemble
 
@@ -118,7 +118,7 @@ def standalone_files(building, effect):
     """({archive name: bytes}, model identifier, source file names) of the standalone FMU."""
     files = {f"sources/{name}": (C_DIR / name).read_bytes() for name in SOURCES}
     files["resources/network.txt"] = network_text(building, effect).encode()
-    with tempfile.TemporaryDirectory(prefix="nodeforce_fmu_") as tmp:
+    with tempdirs.folder("fmu") as tmp:
         try:
             compile_library("nodeforce_fmu.c", Path(tmp) / f"{IDENTIFIER}.so", libraries=("m",))
         except RuntimeError as e:

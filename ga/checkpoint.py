@@ -24,6 +24,7 @@ from nodeforce.ga.evaluation import Mask, factory_token
 log = logging.getLogger("nodeforce.ga")
 
 FORMAT = "nodeforce-search-checkpoint/1"
+NAME = "locate.checkpoint.json"  # its name in the output folder of `locate` and `diagnose`
 
 
 def run_key(factory, nodes, **settings) -> str:
@@ -48,8 +49,11 @@ def save(path, key: str, state: dict) -> None:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(json.dumps({"format": FORMAT, "key": key, **state}))
-    os.replace(tmp, path)
+    try:
+        tmp.write_text(json.dumps({"format": FORMAT, "key": key, **state}))
+        os.replace(tmp, path)
+    finally:  # a run stopped while writing leaves no half-written file behind
+        tmp.unlink(missing_ok=True)
 
 
 def load(path, key: str) -> "dict | None":
@@ -66,6 +70,15 @@ def load(path, key: str) -> "dict | None":
         log.warning("checkpoint %s belongs to a run with other arguments; starting afresh", path)
         return None
     return state
+
+
+def resume_hint(path) -> str:
+    """What running a stopped search's command again does, in a clause for the user."""
+    try:
+        generation = json.loads(Path(path).read_text())["generation"]
+    except (OSError, ValueError, KeyError):
+        return "no checkpoint was written yet: run the same command again to start over"
+    return f"run the same command again to resume from {path} (generation {generation})"
 
 
 def rng_states(ga) -> dict:

@@ -22,13 +22,12 @@ from __future__ import annotations
 import hashlib
 import logging
 import math
-import multiprocessing
 import multiprocessing.util
 import pickle
 import threading
-from concurrent.futures import ProcessPoolExecutor
 from typing import Iterable, Sequence
 
+from nodeforce import lifetime
 from nodeforce.model.errors import InputError
 
 log = logging.getLogger("nodeforce.ga")
@@ -54,6 +53,7 @@ def evaluate_masks(evaluator, masks: Iterable[Mask]) -> list[Outcome]:
         try:
             J = float(evaluator.J(tuple(mask)))
         except Exception as exc:  # any failure of the simulation makes the chromosome unfit
+            lifetime.raise_if_interrupted()  # unless it was a signal, reported by the FMU
             outcomes.append((math.inf, f"{type(exc).__name__}: {exc}"))
             continue
         outcomes.append((J, None) if math.isfinite(J) else (math.inf, f"J is {J}"))
@@ -75,10 +75,20 @@ def _build(factory):
 
 
 # --- backends: each runs a list of chunks (lists of masks) and returns, per chunk, either its
-# outcomes or the exception that lost the whole chunk (a dead worker).
+# outcomes or the exception that lost the whole chunk (a dead worker).  Used as context managers:
+# a search ended by an exception (a signal's included) stops them without waiting for the work
+# in progress (close(abort=True)).
 
 
-class InProcessBackend:
+class _Backend:
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, *rest):
+        self.close(abort=kind is not None)
+
+
+class InProcessBackend(_Backend):
     """workers=1: one evaluator in this process, no pool."""
 
     slots = 1
@@ -89,7 +99,7 @@ class InProcessBackend:
     def run(self, chunks):
         return [evaluate_masks(self._evaluator, chunk) for chunk in chunks]
 
-    def close(self):
+    def close(self, abort=False):
         close_evaluator(self._evaluator)
 
 
@@ -119,12 +129,9 @@ def _pool_task(masks):
     return evaluate_masks(_process_evaluator, masks)
 
 
-class ProcessBackend:
-    """A pool of `workers` processes, each holding its own evaluator.
-
-    The pool uses the "spawn" start method: evaluators hold FMU / C-library state that must not
-    be inherited through fork.
-    """
+class ProcessBackend(_Backend):
+    """A pool of `workers` processes, each holding its own evaluator; they end with this process
+    (nodeforce.lifetime)."""
 
     def __init__(self, factory, workers: int):
         self._factory = factory
@@ -132,9 +139,7 @@ class ProcessBackend:
         self._pool = self._new_pool()
 
     def _new_pool(self):
-        return ProcessPoolExecutor(max_workers=self.slots,
-                                   mp_context=multiprocessing.get_context("spawn"),
-                                   initializer=_pool_initializer, initargs=(self._factory,))
+        return lifetime.new_pool(self.slots, _pool_initializer, (self._factory,))
 
     def run(self, chunks):
         futures = [self._pool.submit(_pool_task, chunk) for chunk in chunks]
@@ -152,8 +157,11 @@ class ProcessBackend:
             self._pool = self._new_pool()
         return results
 
-    def close(self):
-        self._pool.shutdown(wait=True, cancel_futures=True)
+    def close(self, abort=False):
+        if abort:
+            lifetime.stop_pool(self._pool)
+        else:
+            self._pool.shutdown(wait=True, cancel_futures=True)
 
 
 # Per Dask worker process: evaluators keyed by (factory token, thread), built on first use.
@@ -174,42 +182,82 @@ def _dask_close(token: str) -> None:
         close_evaluator(_dask_evaluators.pop(key))
 
 
-class DaskBackend:
-    """Chunks submitted to a dask.distributed scheduler at `address` ("tcp://host:port")."""
+CLIENT_LOGGERS = ("distributed.client", "distributed.batched")
+# Times a batch is submitted while the workers holding the evaluator factory are lost (a chunk
+# that kills every worker it runs on must not be retried for ever).
+FACTORY_LOSSES = 3
+
+
+class DaskBackend(_Backend):
+    """Chunks submitted to a dask.distributed scheduler at `address` ("tcp://host:port").
+
+    A worker lost mid-task costs nothing: the scheduler gives its tasks to another worker (or
+    to the same one, restarted by its nanny), and if the factory was lost with it, it is shipped
+    again.  A lost scheduler stops the search (lifetime.RunStopped); its checkpoint resumes it.
+    """
 
     def __init__(self, factory, address: str):
         from distributed import Client
 
         try:
             self._client = Client(address, set_as_default=False, timeout="10s")
+            self._address = address
         except (OSError, ValueError, TypeError) as e:
             raise InputError("--scheduler", address, f"cannot reach a Dask scheduler there ({e})") from None
         self._token = factory_token(factory)
-        # Ship the factory once; tasks refer to it instead of carrying it each time.
-        [self._factory] = self._client.scatter([factory], broadcast=True, hash=False)
+        self._raw_factory = factory
+        self._ship_factory()
+        # The client's own logs are silenced while it serves the search: every failure it meets
+        # reaches the search as a future's exception, said in one line (a lost scheduler), and
+        # they would repeat it as tracebacks (a closed connection, the attempts to reconnect).
+        self._log_levels = {name: logging.getLogger(name).level for name in CLIENT_LOGGERS}
+        for name in CLIENT_LOGGERS:
+            logging.getLogger(name).setLevel(logging.CRITICAL + 1)
+
+    def _ship_factory(self):
+        # Once to every worker; tasks refer to it instead of carrying it each time.
+        [self._factory] = self._client.scatter([self._raw_factory], broadcast=True, hash=False)
 
     @property
     def slots(self) -> int:
         return max(1, sum(self._client.nthreads().values()))
 
     def run(self, chunks):
-        futures = [self._client.submit(_dask_task, self._token, self._factory, chunk, pure=False)
-                   for chunk in chunks]
-        results = []
-        for future in futures:
-            try:
-                results.append(future.result())
-            except EvaluatorSetupError:
-                raise
-            except Exception as exc:  # KilledWorker and the like: the chunk was lost
-                results.append(exc)
+        results = [None] * len(chunks)
+        todo = range(len(chunks))
+        for _ in range(FACTORY_LOSSES):
+            futures = {i: self._client.submit(_dask_task, self._token, self._factory, chunks[i], pure=False)
+                       for i in todo}
+            todo = []
+            for i, future in futures.items():
+                try:
+                    results[i] = future.result()
+                except EvaluatorSetupError:
+                    raise
+                except Exception as exc:  # KilledWorker and the like: the chunk was lost
+                    if self._client.status != "running":  # ... unless the scheduler was
+                        raise lifetime.RunStopped(f"--scheduler: {self._address}: lost the Dask scheduler "
+                                                  f"({type(exc).__name__})") from exc
+                    results[i] = exc
+                    if self._factory.status != "finished":
+                        todo.append(i)
+            if not todo:
+                break
+            # The workers holding the factory were lost (scattered data cannot be made again)
+            # and with it every task that needed it: ship it again and submit those again.
+            self._ship_factory()
         return results
 
-    def close(self):
+    def close(self, abort=False):
         try:
-            self._client.run(_dask_close, self._token)
+            if not abort:  # the workers keep the evaluators of a stopped search, for its rerun
+                self._client.run(_dask_close, self._token)
         finally:
-            self._client.close()
+            try:
+                self._client.close()
+            finally:
+                for name, level in self._log_levels.items():
+                    logging.getLogger(name).setLevel(level)
 
 
 def open_backend(factory, workers: "int | None", scheduler: "str | None"):

@@ -8,6 +8,7 @@ import numpy as np
 from scipy.sparse.csgraph import shortest_path
 
 from nodeforce.fmu_build.build import build_fmu
+from nodeforce.ga.checkpoint import NAME as CHECKPOINT
 from nodeforce.ga.fitness import FmuFitness
 from nodeforce.ga.parsimony import EXPLAINED, removed
 from nodeforce.ga.search import PATIENCE, search
@@ -76,7 +77,7 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
     result = search(FmuFitness(fmu, case, candidates, objective, warmup_days), candidates,
                     population=population, generations=generations, pc=pc, pm=pm, seed=seed,
                     patience=patience, seeded=seeded,
-                    workers=workers, scheduler=scheduler, checkpoint=workdir / "locate.checkpoint.json",
+                    workers=workers, scheduler=scheduler, checkpoint=workdir / CHECKPOINT,
                     progress=progress, noise_sigma=noise.sigma,
                     n_residuals=int(np.isfinite(measured).sum()))
     result = {"measured_nodes": case.measured_ids, "output_node": objective.air_nodes[0],

@@ -105,8 +105,7 @@ def search(factory, chromosome_nodes, *, population=30, generations=400, pc=0.8,
     key = ckpt.run_key(factory, nodes, **settings) if checkpoint else None
     state = ckpt.load(checkpoint, key) if checkpoint else None
 
-    backend = open_backend(factory, workers or os.cpu_count(), scheduler)
-    try:
+    with open_backend(factory, workers or os.cpu_count(), scheduler) as backend:
         cache = FitnessCache(backend, ckpt.decode_cache(state["cache"]) if state else None, nodes)
         if state:
             cache.requests = state["requests"]
@@ -138,8 +137,6 @@ def search(factory, chromosome_nodes, *, population=30, generations=400, pc=0.8,
             # Keep the final scores too, so a rerun is instant; the counter stays at the end of
             # the search so the rerun counts the final steps exactly once, like this run.
             steps.save(steps.done, requests=search_requests)
-    finally:
-        backend.close()
     answer["search"].update(settings, evaluations=cache.requests, unique_evaluations=cache.unique,
                             seconds=round(time.monotonic() - started, 3), stopped=stopped,
                             stopped_at=steps.done, **extra)

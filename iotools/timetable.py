@@ -6,6 +6,7 @@ The weather and measurement readers are built on `read_time_table`; the typical-
 
 import csv
 import re
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -73,11 +74,12 @@ def write_time_table(frame, path, float_format=None):
     frame : pandas.DataFrame
         Indexed by tz-aware time; numeric columns, written in their order.
     path : str or Path
-        CSV file to write.
+        CSV file to write; its folder is made if absent.
     float_format : str, optional
         printf format of the numbers; by default each is written in full (its shortest exact
         decimal form), so nothing is rounded.
     """
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
     out = frame.copy()
     out.index = pd.Index([t.isoformat() for t in frame.index], name="time")
     out.to_csv(path, float_format=float_format, lineterminator="\n")

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import InputError
-from .integrate import simulate
+from .integrate import simulate, steps_per_day
 from .building import DAY_TERMS
 from .network import assemble, clock_input_names, day_input, input_names
 from .solar import incident_irradiance, measured_irradiance, sky_temperature, solar_position
@@ -206,6 +206,40 @@ def prepare_case(building, weather, measurements=None):
     return Case(times=times, dt=dt, input_names=names, U=U, measured=measured)
 
 
+def check_warmup(case, source):
+    """InputError naming `source` unless the warm-up can replay the case's first day (PHYSICS.md
+    section 5): the step must divide a day and the record must hold one."""
+    try:
+        per_day = steps_per_day(case.dt)
+    except ValueError as e:
+        raise InputError(source, "time", f"{e}: the warm-up replays whole days") from None
+    if len(case.times) - 1 < per_day:
+        raise InputError(source, "time", f"{len(case.times) - 1} steps of {case.dt:g} s: the warm-up needs "
+                                          f"at least one day ({per_day} steps)")
+
+
+def measured_case(building, weather, measurements=None, burn_in_days=0):
+    """The `Case` of `prepare_case`, checked to hold the warm-up's day (`check_warmup`), with its
+    first `burn_in_days` a burn-in (`Case.with_burn_in`); InputError naming the measurement file
+    (else the weather file) or the burn-in."""
+    case = prepare_case(building, weather, measurements)
+    timed = measurements if measurements is not None else weather
+    check_warmup(case, timed.attrs.get("source", "measurements" if measurements is not None else "weather"))
+    return case.with_burn_in(burn_in_days)
+
+
+def force_mask(case, ids, source):
+    """(N,) bool mask of the forced node `ids`; InputError naming `source` for a node without a
+    measurement to be forced to."""
+    mask = np.zeros(case.measured.shape[1], dtype=bool)
+    measured = set(case.measured_ids)
+    for i in ids:
+        if i not in measured:
+            raise InputError(source, f"T{i}", f"node {i} is to be forced but has no measurement column T{i}")
+        mask[i - 1] = True
+    return mask
+
+
 def simulate_building(building, weather, measurements=None, force=(), warmup_days=2, burn_in_days=0):
     """Every node's temperature (C) under a weather, with the direct model: the plain Python API.
 
@@ -223,9 +257,8 @@ def simulate_building(building, weather, measurements=None, force=(), warmup_day
     -------
     DataFrame indexed by time t_1..t_N, columns `T1..TN`
     """
-    case = prepare_case(building, weather, measurements).with_burn_in(burn_in_days)
-    mask = np.zeros(building.n_nodes, dtype=bool)
-    mask[np.asarray(force, dtype=int) - 1] = True
+    case = measured_case(building, weather, measurements, burn_in_days)
+    mask = force_mask(case, force, "force")
     T = simulate(building, assemble(building), case.U, case.dt, case.measured, mask, warmup_days,
                  burn_in_steps=case.burn_in_steps)
     return pd.DataFrame(T, index=case.times[1:], columns=[f"T{i}" for i in range(1, building.n_nodes + 1)])

@@ -3,12 +3,12 @@ from pathlib import Path
 
 import pandas as pd
 
+from nodeforce.iotools.timetable import write_time_table
+
 
 def write_node_temperatures(path, times, T):
-    """CSV with `time` (ISO 8601 with offset) and `T1..TN` (C), one row per time."""
-    frame = pd.DataFrame(T, columns=[f"T{i}" for i in range(1, T.shape[1] + 1)])
-    frame.insert(0, "time", [t.isoformat() for t in times])
-    frame.to_csv(path, index=False)
+    """CSV time table (`iotools.timetable.write_time_table`) of `T1..TN` (C), one row per time."""
+    write_time_table(pd.DataFrame(T, index=times, columns=[f"T{i}" for i in range(1, T.shape[1] + 1)]), path)
 
 
 def write_node_names(path, building):

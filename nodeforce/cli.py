@@ -1,18 +1,20 @@
-"""The `nodeforce` command line (INTERFACE.md). Bad input: one line on stderr, exit status 2."""
+"""The `nodeforce` command line (INTERFACE.md). Bad input: one line on stderr, exit status 2; stopped
+by SIGINT, SIGTERM or a lost Dask scheduler: one line saying how to resume, 130, 143 or 75
+(nodeforce.lifetime)."""
 import argparse
 import json
 import sys
-import tempfile
 from importlib.resources import files
 from pathlib import Path
 
 import numpy as np
 
+from nodeforce import lifetime, tempdirs
+from nodeforce.ga.checkpoint import NAME as CHECKPOINT, resume_hint
 from nodeforce.ga.search import PAPER, PATIENCE
 from nodeforce.model.building import load_building
-from nodeforce.model.case import prepare_case
+from nodeforce.model.case import force_mask, measured_case, prepare_case
 from nodeforce.model.errors import InputError
-from nodeforce.model.integrate import steps_per_day
 from nodeforce.iotools.measurements import read_measurements
 from nodeforce.iotools.timetable import instant
 from nodeforce.iotools.weather import read_weather
@@ -42,9 +44,7 @@ def load_inputs(args):
     building = load_building(args.building)
     weather = read_weather(args.weather)
     measurements = read_measurements(args.measurements) if getattr(args, "measurements", None) else None
-    case = prepare_case(building, weather, measurements)
-    check_warmup(case, args.measurements or args.weather)
-    case = case.with_burn_in(args.burn_in_days)
+    case = measured_case(building, weather, measurements, args.burn_in_days)
     objective = Objective.of(building, zone_list(args.objective) if getattr(args, "objective", None) else None)
     return building, case, objective
 
@@ -57,46 +57,24 @@ def zone_list(text):
     return names
 
 
-def check_warmup(case, source):
-    """The warm-up replays the first day (PHYSICS.md section 5): the step must divide a day and
-    the record must hold one."""
-    try:
-        per_day = steps_per_day(case.dt)
-    except ValueError as e:
-        raise InputError(source, "time", f"{e}: the warm-up replays whole days") from None
-    if len(case.times) - 1 < per_day:
-        raise InputError(source, "time", f"{len(case.times) - 1} steps of {case.dt:g} s: the warm-up needs "
-                                          f"at least one day ({per_day} steps)")
-
-
-def force_mask(case, ids, source):
-    """Boolean mask of forced nodes; each must have a measurement to be forced to."""
-    mask = np.zeros(case.measured.shape[1], dtype=bool)
-    measured = set(case.measured_ids)
-    for i in ids:
-        if i not in measured:
-            raise InputError(source, f"T{i}", f"node {i} is to be forced but has no measurement column T{i}")
-        mask[i - 1] = True
-    return mask
-
-
 def cmd_fmu(args):
-    from nodeforce.fmu_build.build import build_fmu
-    path = build_fmu(load_building(args.building), args.output, kind="standalone" if args.standalone else "python")
+    from nodeforce.fmu_build.build import build_fmu, fmu_kind
+    path = build_fmu(load_building(args.building), args.output,
+                     kind=fmu_kind("standalone" if args.standalone else "python", args.fmi))
     print(f"wrote {path}")
 
 
 def cmd_simulate(args):
     from nodeforce.cosim.fmi import FmuInstance
     from nodeforce.cosim.run import simulate_fmu
-    from nodeforce.fmu_build.build import build_fmu
+    from nodeforce.fmu_build.build import build_fmu, fmu_kind
     from nodeforce.model.report import write_node_names, write_node_temperatures
     if args.force and not args.measurements:
         raise InputError("--force", args.force, "forcing needs --measurements to force nodes to")
     building, case, objective = load_inputs(args)
     force = force_mask(case, node_list("--force", args.force), args.measurements) if args.force else None
-    with tempfile.TemporaryDirectory(prefix="nodeforce_") as tmp:
-        with FmuInstance(build_fmu(building, Path(tmp) / "model.fmu")) as instance:
+    with tempdirs.folder("simulate") as tmp:
+        with FmuInstance(build_fmu(building, Path(tmp) / "model.fmu", kind=fmu_kind("python", args.fmi))) as instance:
             T = simulate_fmu(instance, case, force)
     write_node_temperatures(args.output, case.times[1:], T)
     names = write_node_names(args.output, building)
@@ -149,7 +127,7 @@ def cmd_locate(args):
     result = locate(building, case, objective, out, source=args.measurements,
                     nodes=node_list("--nodes", args.nodes) if args.nodes else None,
                     include_algebraic=args.include_algebraic, **strategy, seed=args.seed,
-                    workers=args.workers, scheduler=args.scheduler, fmu_kind=args.fmu, noise=noise(args))
+                    workers=args.workers, scheduler=args.scheduler, fmu_kind=kind_of(args), noise=noise(args))
     (out / "locate.json").write_text(json.dumps(result, indent=2) + "\n")
     print(locate_summary(result))
     print(f"wrote {out / 'locate.json'}")
@@ -210,6 +188,7 @@ def cmd_synth(args):
                           freq=pd.Timedelta(seconds=args.step), name="time")
     frame = pseudo_measurements(building, read_weather(args.weather), times, node_list("--sensors", args.sensors),
                                 noise_sd=args.noise, seed=args.seed, history_days=args.history_days)
+    Path(args.output).parent.mkdir(parents=True, exist_ok=True)
     frame.round(4).to_csv(args.output, date_format="%Y-%m-%dT%H:%M:%S%z")
     print(f"wrote {args.output}: nodes {args.sensors}, {len(times)} times from {times[0].isoformat()}, "
           f"noise {args.noise} C" + (f", with {args.effect} not in {args.building}" if args.effect else ""))
@@ -225,7 +204,7 @@ def run_diagnosis(building, case, objective, out, source, args):
     check_workers(args)
     out.mkdir(parents=True, exist_ok=True)
     report = diagnose(building, case, objective, out, source=source, fraction=args.calibration_fraction,
-                      calibration_end=end, seed=args.seed, workers=args.workers, fmu_kind=args.fmu,
+                      calibration_end=end, seed=args.seed, workers=args.workers, fmu_kind=kind_of(args),
                       reference=read_reference(args.reference) if args.reference else None, noise=noise(args),
                       phases=read_phases(args.phases) if args.phases else None)
     print(before_after_table(report))
@@ -303,7 +282,18 @@ def case_arguments(s, measurements_required, output_help, output_default=None):
     s.add_argument("-o", "--output", required=output_default is None, default=output_default, help=output_help)
 
 
+def fmi_argument(s):
+    s.add_argument("--fmi", type=int, choices=(2, 3), default=2, help="the FMI version of the FMU (default 2)")
+
+
+def kind_of(args):
+    """The FMU kind of --fmu at --fmi (fmu_build.build.fmu_kind)."""
+    from nodeforce.fmu_build.build import fmu_kind
+    return fmu_kind(args.fmu, args.fmi)
+
+
 def diagnosis_arguments(s):
+    fmi_argument(s)
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--workers", type=int, help="processes (default: all cores)")
     s.add_argument("--fmu", choices=("python", "standalone"), default="python", help="the FMU kind to run")
@@ -350,11 +340,13 @@ def parser():
     s.add_argument("building")
     s.add_argument("-o", "--output", required=True, help="the .fmu to write")
     s.add_argument("--standalone", action="store_true", help="C, no Python at run time (needs a C compiler)")
+    fmi_argument(s)
     s.set_defaults(run=cmd_fmu)
 
     s = sub.add_parser("simulate", help="simulate a building through its FMU")
     case_arguments(s, False, "the CSV of node temperatures to write", output_default="sim.csv")
     s.add_argument("--force", help="node ids forced to their measurements, e.g. 1,7,9")
+    fmi_argument(s)
     burn_in_argument(s, 0.0)
     objective_argument(s)
     s.set_defaults(run=cmd_simulate)
@@ -378,6 +370,7 @@ def parser():
     s.add_argument("--workers", type=int, help="processes (default: all cores)")
     s.add_argument("--fmu", choices=("python", "standalone"), default="python", help="the FMU kind to run")
     s.add_argument("--scheduler", help="a Dask scheduler address, tcp://host:port")
+    fmi_argument(s)
     noise_argument(s)
     burn_in_argument(s, 0.0)
     objective_argument(s)
@@ -440,11 +433,23 @@ def parser():
 
 def main(argv=None):
     args = parser().parse_args(argv)
+    signals = lifetime.Signals()
     try:
-        args.run(args)
+        with lifetime.stop_on_signals() as signals:
+            tempdirs.sweep()  # the folders of runs killed outright
+            args.run(args)
     except InputError as e:
         print(f"nodeforce: {e}", file=sys.stderr)
         return 2
+    except BaseException as e:
+        stop = lifetime.stopped(e, signals)  # a signal or a lost cluster: one line, its own exit status
+        if stop is None:
+            raise
+        status, why = stop
+        searched = args.command in ("locate", "diagnose", "demo")
+        print(f"nodeforce: {why}; " + (resume_hint(Path(args.output) / CHECKPOINT) if searched else
+                                       "run the same command again"), file=sys.stderr)
+        return status
     return 0
 
 

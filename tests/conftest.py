@@ -1,6 +1,9 @@
 """Shared fixtures: the reference test cell and a real-weather case (bundled Miami TMY2)."""
 import copy
 import json
+import os
+import shutil
+import tempfile
 from pathlib import Path
 
 import pandas as pd
@@ -31,6 +34,16 @@ def weather():
     return read_weather(DATA / "miami_tmy2.csv")
 
 
+@pytest.fixture
+def private_tmp(tmp_path, monkeypatch):
+    """A temp directory of the test's own, for this process and every process it starts."""
+    folder = tmp_path / "tmp"
+    folder.mkdir()
+    monkeypatch.setenv("TMPDIR", str(folder))
+    monkeypatch.setattr("tempfile.tempdir", None)  # gettempdir() reads TMPDIR again; restored after
+    return folder
+
+
 def record_times(days=5, start="2001-06-10 00:00"):
     return pd.date_range(start, periods=days * 96 + 1, freq="15min", tz="-05:00", name="time")
 
@@ -45,19 +58,34 @@ def real_case(testcell_data, testcell, weather):
     return prepare_case(testcell, weather, measurements)
 
 
-def _extracted():
-    """Folders nodeforce made in the temp directory (extracted or built FMUs, simulations)."""
-    import tempfile
-    return {p.name for p in Path(tempfile.gettempdir()).glob("nodeforce_*")}
+def _extracted(root):
+    """Folders nodeforce made in the temp directory `root` of a test process and of the
+    pytest-xdist workers it started (extracted or built FMUs, simulations)."""
+    root = Path(root)
+    return sorted(str(p.relative_to(root)) for pattern in ("nodeforce_*", "pytest-nodeforce-*/nodeforce_*")
+                  for p in root.glob(pattern))
 
 
-def pytest_sessionstart(session):
-    session.config.nodeforce_extracted = _extracted()
+def pytest_configure(config):
+    """Each test process gets a temp directory of its own (a pytest-xdist worker one inside its
+    controller's), and so do the processes it starts, through TMPDIR: the check below then sees
+    only what this run's tests left, not another run's folders."""
+    config.nodeforce_tmp = tempfile.mkdtemp(prefix="pytest-nodeforce-")
+    os.environ["TMPDIR"] = config.nodeforce_tmp
+    tempfile.tempdir = None  # gettempdir() reads TMPDIR again
 
 
 def pytest_sessionfinish(session, exitstatus):
-    """The whole suite leaves nothing it extracted in the temp directory."""
-    left = sorted(_extracted() - session.config.nodeforce_extracted)
+    """The whole suite leaves nothing it extracted in the temp directory (checked by the process
+    that started the run, after its workers have finished)."""
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        return
+    left = _extracted(session.config.nodeforce_tmp)
     if left:
         print(f"\nthe test suite left {len(left)} nodeforce folders in the temp directory: {left[:5]}")
         session.exitstatus = 1
+
+
+def pytest_unconfigure(config):
+    if not os.environ.get("PYTEST_XDIST_WORKER"):  # a worker's folder is its controller's to check
+        shutil.rmtree(config.nodeforce_tmp, ignore_errors=True)

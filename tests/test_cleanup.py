@@ -1,7 +1,6 @@
 """Nothing is left behind: a search and a diagnosis, in worker processes too, remove every FMU
 they extracted and every temporary folder they made, when they succeed and when they fail."""
 import os
-import tempfile
 
 import pandas as pd
 import pytest
@@ -14,17 +13,6 @@ from nodeforce.model.synth import pseudo_measurements
 from tests.conftest import SENSORS
 
 pytestmark = pytest.mark.slow
-
-
-@pytest.fixture
-def private_tmp(tmp_path, monkeypatch):
-    """A temp directory of the test's own, for this process and the workers it spawns."""
-    folder = tmp_path / "tmp"
-    folder.mkdir()
-    monkeypatch.setenv("TMPDIR", str(folder))
-    monkeypatch.setattr(tempfile, "tempdir", None)
-    yield folder
-    tempfile.tempdir = None
 
 
 def test_a_diagnosis_with_workers_leaves_the_temp_directory_empty(tmp_path, private_tmp, testcell, weather):

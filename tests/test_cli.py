@@ -40,7 +40,7 @@ def error_of(capsys, argv):
 
 
 def test_simulate_writes_every_node_as_the_direct_model_computes(files, testcell, weather):
-    out = files["dir"] / "sim.csv"
+    out = files["dir"] / "not" / "yet" / "sim.csv"  # the output's folder is made, as README's out/ is
     assert main(["simulate", str(files["building"]), "--weather", str(files["weather"]),
                  "--measurements", str(files["measurements"]), "--force", "7,17", "-o", str(out)]) == 0
     sim = pd.read_csv(out)
@@ -53,6 +53,7 @@ def test_simulate_writes_every_node_as_the_direct_model_computes(files, testcell
     assert len(sim) == len(measurements) - 1  # t_1..t_N
     assert np.abs(sim.iloc[:, 1:].to_numpy() - direct).max() < 1e-9
     assert np.array_equal(sim["T7"].to_numpy(), measurements["T7"].to_numpy()[1:])
+    assert pd.read_csv(out.parent / "sim.nodes.csv")["column"].tolist() == list(sim.columns[1:])
 
 
 def test_fmu_command_writes_a_valid_fmu(files):

@@ -1,7 +1,8 @@
 """The Python FMU leaves its host's memory intact: when the model raises, and when the host
-exits. pythonfmu 0.7.0's binary releases Python objects twice in both cases (fmu_build/c/guard.c
-says how the guard keeps the host out of it). Each case runs in a process of its own, so that a
-corrupted heap ends that process, not the test session."""
+exits, as FMI 2.0 and as FMI 3.0 (its FMI 3.0 interface, fmu_build/c/fmi3.c, calls the guard).
+pythonfmu 0.7.0's binary releases Python objects twice in both cases (fmu_build/c/guard.c says
+how the guard keeps the host out of it), and so does pythonfmu3 0.3.4's (docs/fmu.md). Each case
+runs in a process of its own, so that a corrupted heap ends that process, not the test session."""
 import json
 import os
 import shutil
@@ -13,37 +14,37 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from nodeforce.fmu_build.build import build_fmu
+from nodeforce.fmu_build.build import build_fmu, fmu_kind
 from nodeforce.model.building import parse_building
 from tests.test_standalone import python_host_environment, run_c_host, scenario
 
-ERROR = 3  # fmi2Status
+ERROR = 3  # fmi2Error and fmi3Error
 ROOT = Path(__file__).parents[1]
 
-# Twelve times the model raising, each followed by fmi2Reset and a valid run. Without the guard's
-# care pythonfmu's instance loses one reference to the slave class at each, and the process ends
-# in a segmentation fault by the fourth.
+# Twelve times the model raising, each followed by Reset and a valid run, through
+# nodeforce's own FMI 2.0 or 3.0 calls (cosim/fmi.py). Without the guard's care pythonfmu's
+# instance loses one reference to the slave class at each, and the process ends in a
+# segmentation fault by the fourth.
 RAISES_AND_RECOVERS = textwrap.dedent("""
     import json, sys
+    import numpy as np
     from fmpy import extract, read_model_description
     from fmpy.fmi1 import FMICallException
-    from fmpy.fmi2 import FMU2Slave
+    from nodeforce.cosim.fmi import VERSIONS
 
     fmu, unzipped = sys.argv[1], sys.argv[2]
     md = read_model_description(fmu)
-    vr = {v.name: v.valueReference for v in md.modelVariables}
-    slave = FMU2Slave(guid=md.guid, unzipDirectory=extract(fmu, unzipdir=unzipped),
-                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="memory")
+    calls = VERSIONS[md.fmiVersion](md)
+    slave = calls.slave_class(guid=md.guid, unzipDirectory=extract(fmu, unzipdir=unzipped),
+                              modelIdentifier=md.coSimulation.modelIdentifier, instanceName="memory")
     slave.instantiate(loggingOn=True)
 
     def run(U):
-        slave.setupExperiment(startTime=0.0)
-        slave.enterInitializationMode()
-        slave.setReal([vr["ground_coupling.U"]], [U])
-        slave.exitInitializationMode()
+        calls.initialise(slave, 0.0, {}, {"ground_coupling.U": U})
+        step, T = calls.stepper(slave, [], ["T[23]"]), np.empty(1)
         for k in range(4):
-            slave.doStep(currentCommunicationPoint=900.0 * k, communicationStepSize=900.0)
-        return slave.getReal([vr["T[23]"]])[0]
+            step(900.0 * k, 900.0, np.empty(0), T)
+        return T[0]
 
     answers = []
     for attempt in range(12):
@@ -62,9 +63,11 @@ RAISES_AND_RECOVERS = textwrap.dedent("""
 
 @pytest.fixture(scope="module")
 def coupled_fmu(tmp_path_factory, testcell_data):
-    """The test cell's Python FMU with a ground coupling of the floor as parameters."""
-    return build_fmu(parse_building(testcell_data), tmp_path_factory.mktemp("memory") / "coupled.fmu",
-                     effect=("ground_coupling", "floor"))
+    """{FMI version: the test cell's Python FMU with a ground coupling of the floor as parameters}."""
+    folder = tmp_path_factory.mktemp("memory")
+    return {fmi: build_fmu(parse_building(testcell_data), folder / f"coupled{fmi}.fmu",
+                           effect=("ground_coupling", "floor"), kind=fmu_kind("python", fmi))
+            for fmi in (2, 3)}
 
 
 def python_process(script, *args, env=None, prefix=()):
@@ -74,11 +77,12 @@ def python_process(script, *args, env=None, prefix=()):
                           capture_output=True, text=True, timeout=600)
 
 
-def test_a_model_that_raises_gets_fmi2_error_and_reset_recovers_it(coupled_fmu, tmp_path):
+@pytest.mark.parametrize("fmi", (2, 3))
+def test_a_model_that_raises_gets_fmi_error_and_reset_recovers_it(coupled_fmu, tmp_path, fmi):
     """A negative ground conductance is refused by the model (an exception in Python): the call
-    is answered fmi2Error (not pythonfmu's fmi2Fatal, after which nothing may be called), the
-    reason is logged, and fmi2Reset gives an instance whose run is the same as the first one's."""
-    done = python_process(RAISES_AND_RECOVERS, coupled_fmu, tmp_path / "unzipped")
+    is answered Error (not pythonfmu's or pythonfmu3's Fatal, after which nothing may be called),
+    the reason is logged, and Reset gives an instance whose run is the same as the first one's."""
+    done = python_process(RAISES_AND_RECOVERS, coupled_fmu[fmi], tmp_path / "unzipped")
     assert done.returncode == 0, f"exit {done.returncode}\n{done.stdout[-2000:]}\n{done.stderr[-2000:]}"
     answers = json.loads(done.stdout.split("ANSWERS ")[1])
     refused, runs = answers[0::2], answers[1::2]
@@ -122,11 +126,12 @@ def valgrind_logs(tmp_path):
 
 
 @pytest.mark.slow  # valgrind: tens of seconds
-def test_a_python_host_ends_without_touching_freed_memory(tmp_path, testcell_data):
+@pytest.mark.parametrize("fmi", (2, 3))
+def test_a_python_host_ends_without_touching_freed_memory(tmp_path, testcell_data, fmi):
     """pythonfmu's binary stays loaded to the end of a process and, at exit, released its Python
     state a second time: freed memory written, which glibc reported now and then as "corrupted
     double-linked list". Valgrind sees each such access, whether or not glibc notices."""
-    fmu = build_fmu(parse_building(testcell_data), tmp_path / "model.fmu")
+    fmu = build_fmu(parse_building(testcell_data), tmp_path / "model.fmu", kind=fmu_kind("python", fmi))
     env = dict(os.environ, PYTHONMALLOC="malloc")  # Python's own allocator hides accesses from valgrind
     done = python_process(LIFECYCLE, fmu, env=env, prefix=valgrind(tmp_path))
     assert done.returncode == 0 and "RAN" in done.stdout, done.stderr[-2000:]

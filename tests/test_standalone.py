@@ -95,9 +95,14 @@ def scenario(fmu, n_steps=192, seed=0):
     return parameters, inputs, [f"T[{i}]" for i in range(1, n + 1)], n_steps
 
 
-def run_c_host(fmu, parameters, inputs, outputs, dt, n_steps, tmp_path, env=None, prefix=()):
+def run_c_host(fmu, parameters, inputs, outputs, dt, n_steps, tmp_path, env=None, prefix=(), times=None,
+               one_by_one=False):
     """Outputs of `fmu` run by the C host (compiled here with cc) in a process of its own,
-    started through `prefix` (a tool such as valgrind) if given."""
+    started through `prefix` (a tool such as valgrind) if given.
+
+    inputs : {name: values}, value k set before step k; or, with `times`, an input file (the
+    values at those times) the host applies as fmusim does, by each input's variability.
+    one_by_one : read each output in a call of its own."""
     compiler = shutil.which("cc") or pytest.fail("the C host test needs a C compiler (cc)")
     host = tmp_path / "host"
     if not host.exists():
@@ -109,14 +114,20 @@ def run_c_host(fmu, parameters, inputs, outputs, dt, n_steps, tmp_path, env=None
     lines = [f"{dt!r} {n_steps}", f"parameters {len(parameters)}"]
     lines += [f"{vr[name].valueReference} {'B' if vr[name].type == 'Boolean' else 'R'} {float(value)!r}"
               for name, value in parameters.items()]
-    lines.append("inputs " + " ".join(str(n) for n in [len(inputs)] + [vr[name].valueReference for name in inputs]))
+    columns = np.column_stack(list(inputs.values())) if inputs else np.empty((n_steps, 0))
+    if times is None:
+        lines.append("inputs " + " ".join(str(n) for n in [len(inputs)] + [vr[name].valueReference for name in inputs]))
+    else:
+        kinds = " ".join(f"{vr[name].valueReference} {vr[name].variability[0]}" for name in inputs)
+        lines.append(f"table {len(inputs)} {len(times)} {kinds}")
+        columns = np.column_stack([times, columns])
     lines.append("outputs " + " ".join(str(n) for n in [len(outputs)] + [vr[name].valueReference for name in outputs]))
-    columns = np.column_stack(list(inputs.values()))
-    lines += [" ".join(repr(float(x)) for x in row) for row in columns[:n_steps]]
+    lines += [" ".join(repr(float(x)) for x in row) for row in (columns if times is not None else columns[:n_steps])]
     (tmp_path / "scenario.txt").write_text("\n".join(lines) + "\n")
     library = unzipped / "binaries" / "linux64" / f"{md.coSimulation.modelIdentifier}.so"
     done = subprocess.run([*prefix, str(host), str(library), (unzipped / "resources").as_uri(), md.guid,
-                           str(tmp_path / "scenario.txt")], capture_output=True, text=True, env=env, timeout=600)
+                           str(tmp_path / "scenario.txt"), *(["one-by-one"] if one_by_one else [])],
+                          capture_output=True, text=True, env=env, timeout=600)
     shutil.rmtree(unzipped)
     return done, (np.loadtxt(done.stdout.splitlines(), ndmin=2) if done.returncode == 0 else None)
 

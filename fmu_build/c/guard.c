@@ -8,7 +8,11 @@
 
    And: pythonfmu's binary does not link libpython, it expects Python in the host process. When
    the process has none (Py_IsInitialized not found), the guard loads libpython with RTLD_GLOBAL
-   first: $NODEFORCE_LIBPYTHON, else the path recorded at export in resources/guard.txt.
+   first: $NODEFORCE_LIBPYTHON if set (a user's choice, nothing else is tried), else the first
+   that loads of the path recorded at export in resources/guard.txt, the libpython of the
+   python3 on PATH (its sysconfig), the recorded file name through the dynamic linker's search
+   (LD_LIBRARY_PATH, ld.so.cache: a system Python of the exporting version), and that name in
+   /usr/local/lib and $CONDA_PREFIX/lib; the logged error names every one tried.
 
    The guard does not depend on the model: it reads the sizes of the layout from
    resources/guard.txt at instantiation, a file of four lines:
@@ -37,7 +41,15 @@
      releases them again in the next call that touches them (fmi2Reset, fmi2FreeInstance). The
      guard sets that instance aside, never calls it again (its few bytes are left allocated),
      and answers fmi2Error, as for any failed call of this instance: fmi2Reset instantiates the
-     model anew, fmi2FreeInstance frees the rest. */
+     model anew, fmi2FreeInstance frees the rest.
+
+   Outputs: a host may read the N outputs one value per fmi2GetReal (the FMI Compliance Checker
+   does), and each call into pythonfmu costs tens of microseconds of Python. The outputs change
+   only in the calls that step or move the slave (fmi2DoStep, the state changes, fmi2Reset,
+   fmi2SetFMUstate; variables.h refuses setting them), so the guard reads all N in one call the
+   first time one is asked for after such a call, once initialisation has ended, and answers
+   every read of outputs only from that copy until the next such call
+   (benchmarks/bench_fmu_calls.py). */
 #define _GNU_SOURCE
 #include <dlfcn.h>
 #include <pthread.h>
@@ -47,8 +59,10 @@
 #include <string.h>
 
 #include "fmi2.h"
+#include "glibc.h"
 #include "resources.h"
 #include "variables.h"
+
 
 #define LIBPYTHON_VARIABLE "NODEFORCE_LIBPYTHON"
 
@@ -73,6 +87,9 @@ typedef struct {
     fmi2Component inner;
     int lost; /* the model raised: `inner` is set aside (see the top of this file) */
     Layout layout;
+    int cached;                      /* `outputs` holds the outputs since the last step or state change */
+    fmi2Real *outputs;               /* T[1..N] */
+    fmi2ValueReference *output_refs; /* their value references */
     int state;
     char *name, *guid, *resources;
     fmi2Type type;
@@ -87,7 +104,7 @@ typedef struct {
 } GuardState;
 
 static void log_error(const fmi2CallbackFunctions *cb, const char *name, const char *format, ...) {
-    char message[1024];
+    char message[8192];
     va_list args;
     va_start(args, format);
     vsnprintf(message, sizeof message, format, args);
@@ -118,12 +135,56 @@ static int read_guard_file(const char *path, GuardFile *g) {
     char header[64], sizes[64];
     FILE *f = fopen(path, "r");
     int ok = f && fgets(header, sizeof header, f) && strcmp(header, "nodeforce-guard/1\n") == 0
-             && read_field(f, "sizes", sizes, sizeof sizes)
-             && sscanf(sizes, "%d %d %d", &g->layout.n, &g->layout.n_in, &g->layout.n_par) == 3
+             && read_field(f, "sizes", sizes, sizeof sizes) && read_sizes(sizes, &g->layout)
              && read_field(f, "binary", g->binary, sizeof g->binary)
              && read_field(f, "libpython", g->libpython, sizeof g->libpython);
     if (f) fclose(f);
     return ok;
+}
+
+/* ------------------------------------------------------------------ finding libpython */
+/* Load `path` RTLD_GLOBAL; else add "path (why)" to the list of what was tried. */
+static int try_python(const char *path, char *tried, size_t size) {
+    size_t used = strlen(tried);
+    if (dlopen(path, RTLD_NOW | RTLD_GLOBAL)) return 1;
+    snprintf(tried + used, size - used, "%s%s (%s)", used ? "; " : "", path, dlerror());
+    return 0;
+}
+
+/* The libpython of the python3 on PATH, from its sysconfig, into `path`; 0 without one. */
+static int python_on_path(char *path, size_t size) {
+    FILE *p = popen("python3 -c \"import os, sysconfig as s; print(os.path.join(s.get_config_var('LIBDIR') or '', "
+                    "s.get_config_var('INSTSONAME') or ''))\" 2>/dev/null", "r");
+    int ok;
+    if (!p) return 0;
+    ok = fgets(path, (int)size, p) != NULL;
+    if (pclose(p) != 0) ok = 0;
+    path[strcspn(path, "\r\n")] = 0;
+    return ok && path[0] == '/';
+}
+
+/* libpython without $NODEFORCE_LIBPYTHON: the candidates of the top of this file, in turn. */
+static int load_python(const char *recorded, const fmi2CallbackFunctions *cb, const char *name) {
+    char tried[6144] = "", path[4352];
+    const char *slash = strrchr(recorded, '/'), *file = slash ? slash + 1 : recorded;
+    const char *folders[2] = {"/usr/local/lib", getenv("CONDA_PREFIX")};
+    size_t used, k;
+    if (try_python(recorded, tried, sizeof tried)) return 1;
+    if (python_on_path(path, sizeof path)) {
+        if (try_python(path, tried, sizeof tried)) return 1;
+    } else {
+        used = strlen(tried);
+        snprintf(tried + used, sizeof tried - used, "; python3 on PATH (none, or it gives no shared libpython)");
+    }
+    if (try_python(file, tried, sizeof tried)) return 1; /* the dynamic linker's search */
+    for (k = 0; k < 2; k++) {
+        if (!folders[k] || !*folders[k]) continue;
+        snprintf(path, sizeof path, "%s%s/%s", folders[k], k ? "/lib" : "", file);
+        if (try_python(path, tried, sizeof tried)) return 1;
+    }
+    log_error(cb, name, "this process has no Python and no libpython could be loaded; tried %s unset, then %s: set %s "
+              "to the libpython3 shared library of a Python with numpy", LIBPYTHON_VARIABLE, tried, LIBPYTHON_VARIABLE);
+    return 0;
 }
 
 /* ------------------------------------------------------------------ loading pythonfmu's binary */
@@ -141,10 +202,13 @@ static int load(const GuardFile *file, const fmi2CallbackFunctions *cb, const ch
     void *library;
     if (inner.library) return 1;
     if (!dlsym(RTLD_DEFAULT, "Py_IsInitialized")) {
-        if (!libpython || !*libpython) libpython = file->libpython;
-        if (!dlopen(libpython, RTLD_NOW | RTLD_GLOBAL)) {
-            log_error(cb, name, "this process has no Python and libpython cannot be loaded (%s): set %s to the "
-                      "libpython3 shared library of a Python with numpy", dlerror(), LIBPYTHON_VARIABLE);
+        if (libpython && *libpython) {
+            if (!dlopen(libpython, RTLD_NOW | RTLD_GLOBAL)) {
+                log_error(cb, name, "this process has no Python and libpython cannot be loaded (%s): set %s to the "
+                          "libpython3 shared library of a Python with numpy", dlerror(), LIBPYTHON_VARIABLE);
+                return 0;
+            }
+        } else if (!load_python(file->libpython, cb, name)) {
             return 0;
         }
     }
@@ -195,6 +259,7 @@ static fmi2Status answered(Guard *g, fmi2Status status) {
 
 /* A state change that happens when the slave accepts the call. */
 static fmi2Status moved(Guard *g, fmi2Status status, int state) {
+    g->cached = 0;
     if (status <= fmi2Warning) g->state = state;
     return status;
 }
@@ -218,6 +283,8 @@ static void free_guard(Guard *g) {
     free(g->name);
     free(g->guid);
     free(g->resources);
+    free(g->outputs);
+    free(g->output_refs);
     free(g);
 }
 
@@ -232,7 +299,7 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
     GuardFile file;
     Guard *g;
     char *path;
-    int ok;
+    int ok, k;
     if (!functions) return NULL; /* no logger to say why: the standard requires the callbacks */
     path = resources ? resource_path(resources, "guard.txt") : NULL;
     ok = path && read_guard_file(path, &file);
@@ -256,7 +323,10 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
     g->functions = functions;
     g->layout = file.layout;
     g->state = INSTANTIATED;
-    g->inner = g->name && g->guid && g->resources ? instantiate(g) : NULL;
+    g->outputs = malloc(sizeof(fmi2Real) * (size_t)(file.layout.n + 1));
+    g->output_refs = malloc(sizeof(fmi2ValueReference) * (size_t)(file.layout.n + 1));
+    for (k = 0; g->output_refs && k < file.layout.n; k++) g->output_refs[k] = (fmi2ValueReference)(vr_T(&g->layout) + k);
+    g->inner = g->name && g->guid && g->resources && g->outputs && g->output_refs ? instantiate(g) : NULL;
     if (!g->inner) {
         free_guard(g);
         return NULL;
@@ -298,6 +368,7 @@ FMI2_EXPORT fmi2Status fmi2Reset(fmi2Component c) {
     if (!fresh) return refuse(g, "fmi2Reset: the model cannot be instantiated again");
     g->inner = fresh;
     g->lost = 0;
+    g->cached = 0;
     g->state = INSTANTIATED;
     return fmi2OK;
 }
@@ -311,10 +382,27 @@ FMI2_EXPORT fmi2Status fmi2Reset(fmi2Component c) {
             return refuse(g, reason);                                                                         \
         return FORWARD(g, function(g->inner, vr, nvr, value));                                                \
     }
-GET_OR_SET(fmi2GetReal, fmi2Real value[], 1, 0)
 GET_OR_SET(fmi2SetReal, const fmi2Real value[], 1, 1)
 GET_OR_SET(fmi2GetBoolean, fmi2Boolean value[], 0, 0)
 GET_OR_SET(fmi2SetBoolean, const fmi2Boolean value[], 0, 1)
+
+/* Outputs only, once initialisation has ended: from the copy (the top of this file). */
+FMI2_EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
+    Guard *g = c;
+    char reason[256];
+    size_t k;
+    int outputs = (g->state == STEPPING || g->state == TERMINATED) && !g->lost;
+    if (refusal(&g->layout, vr, nvr, 1, 0, g->state, reason, sizeof reason)) return refuse(g, reason);
+    for (k = 0; outputs && k < nvr; k++) outputs = (int)vr[k] >= vr_T(&g->layout) && (int)vr[k] < vr_parameters(&g->layout);
+    if (!outputs) return FORWARD(g, fmi2GetReal(g->inner, vr, nvr, value));
+    if (!g->cached) {
+        fmi2Status status = FORWARD(g, fmi2GetReal(g->inner, g->output_refs, (size_t)g->layout.n, g->outputs));
+        if (status > fmi2Warning) return status;
+        g->cached = 1;
+    }
+    for (k = 0; k < nvr; k++) value[k] = g->outputs[vr[k] - (fmi2ValueReference)vr_T(&g->layout)];
+    return fmi2OK;
+}
 
 #define NO_SUCH_TYPE(function, value_type, type)                                                              \
     FMI2_EXPORT fmi2Status function(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, value_type) { \
@@ -422,6 +510,7 @@ FMI2_EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunication
     Guard *g = c;
     char reason[256];
     if (step_refusal(g->state, communicationStepSize, reason, sizeof reason)) return refuse(g, reason);
+    g->cached = 0;
     return FORWARD(g, fmi2DoStep(g->inner, currentCommunicationPoint, communicationStepSize,
                                  noSetFMUStatePriorToCurrentPoint));
 }

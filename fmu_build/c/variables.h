@@ -13,6 +13,7 @@
 #define NODEFORCE_VARIABLES_H
 
 #include <stdio.h>
+#include <stdlib.h>
 
 #include "fmi2.h"
 
@@ -30,6 +31,20 @@ static inline int vr_T_forced(const Layout *l) { return vr_inputs(l) + l->n_in; 
 static inline int vr_T(const Layout *l) { return vr_T_forced(l) + l->n; }
 static inline int vr_parameters(const Layout *l) { return vr_T(l) + l->n; }
 static inline int layout_size(const Layout *l) { return vr_parameters(l) + l->n_par; }
+
+/* The three counts "N N_IN N_PAR" of a layout; 0 if the text is not that (strtol, not
+   sscanf, whose C99 name needs GLIBC_2.7: see glibc.h). */
+static inline int read_sizes(const char *text, Layout *l) {
+    int *counts[3] = {&l->n, &l->n_in, &l->n_par}, k;
+    char *end;
+    for (k = 0; k < 3; k++) {
+        long value = strtol(text, &end, 10);
+        if (end == text || value < 0 || value > 100000000L) return 0;
+        *counts[k] = (int)value;
+        text = end;
+    }
+    return 1;
+}
 
 /* Why the standard forbids this get or set of a Real (real) or Boolean (!real), written into
    reason; 0 when every reference may be read (or, setting, written) in this state. */

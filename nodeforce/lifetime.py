@@ -1,0 +1,172 @@
+"""How a run ends when it is stopped: worker processes that end with their parent, SIGINT and
+SIGTERM turned into a clean stop, and a distinct exit status for each way of stopping.
+
+Worker pools (`new_pool`, `worker_pool`) start their processes with "spawn" (evaluators hold FMU
+and C-library state that must not be inherited through fork) and, in each worker, before the
+caller's initializer:
+
+- on Linux, the parent-death signal (prctl PR_SET_PDEATHSIG) is SIGTERM, then the parent's pid
+  is checked once more: a parent that died before the prctl would never send it. The kernel
+  sends the signal when the thread that started the worker ends; nodeforce starts workers from
+  the main thread, which lives as long as the process. Elsewhere a thread watches the parent;
+- SIGINT is ignored: a Ctrl-C reaches the whole process group, and the parent decides;
+- SIGTERM removes the worker's temporary folders (nodeforce.tempdirs) and ends it at once, with
+  status 143. An FMU it holds is not freed: the process ends, and the system takes its memory.
+
+So a parent killed outright (SIGKILL, the out-of-memory killer) takes its workers with it within
+the time they take to see the signal (a Python FMU step, milliseconds), and a pool stopped by an
+exception (`stop_pool`) does not wait for the work in progress.
+
+In the `nodeforce` command (`stop_on_signals`), SIGINT and SIGTERM raise `Interrupted` in the
+main thread, which unwinds the run like any exception (pools stopped, FMUs freed, temporary
+folders removed); a second signal during that cleanup is ignored. The command then prints one
+line and exits with 128 + the signal number, as shells report it: 130 for SIGINT, 143 for
+SIGTERM. A run stopped by a cause outside its inputs that a rerun may not meet (a lost Dask
+scheduler) raises `RunStopped` and exits with 75 (EX_TEMPFAIL of sysexits.h: try again).
+"""
+import ctypes
+import multiprocessing
+import os
+import signal
+import sys
+import threading
+import time
+from concurrent.futures import ProcessPoolExecutor
+from contextlib import contextmanager
+
+from nodeforce import tempdirs
+
+PR_SET_PDEATHSIG = 1  # linux/prctl.h
+# Seconds a stopped worker has to remove its folders and exit before it is killed.
+STOP_GRACE = 5.0
+
+
+class Interrupted(BaseException):
+    """SIGINT or SIGTERM reached the run. A BaseException, like KeyboardInterrupt, so that no
+    `except Exception` meant for a failed simulation takes it for one."""
+
+    def __init__(self, signum):
+        super().__init__(f"stopped by {signal.Signals(signum).name}")
+        self.signum = signum
+
+
+class RunStopped(RuntimeError):
+    """The run cannot go on for a cause outside its inputs (a lost Dask scheduler); its
+    checkpoint resumes it."""
+
+    exit_status = 75
+
+
+class Signals:
+    """What `stop_on_signals` received: `signum`, the first signal (None: none came)."""
+
+    signum: "int | None" = None
+
+
+_current: "Signals | None" = None  # while a stop_on_signals block runs
+
+
+def _on_signal(signum, frame):
+    if _current.signum is None:  # the first one stops the run; later ones must not break its cleanup
+        _current.signum = signum
+        raise Interrupted(signum)
+
+
+def raise_if_interrupted():
+    """Raise Interrupted if a signal is stopping the run. For code that catches a failure: an FMU
+    whose own Python code was running when the signal came reports an FMU error instead."""
+    if _current is not None and _current.signum is not None:
+        raise Interrupted(_current.signum)
+
+
+@contextmanager
+def stop_on_signals():
+    """Within the block (in the main thread), SIGINT and SIGTERM raise Interrupted; yields the
+    `Signals` received, for `stopped` after the block."""
+    global _current
+    _current = Signals()
+    previous = {s: signal.signal(s, _on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield _current
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+        _current = None
+
+
+def stopped(exc: BaseException, signals: Signals) -> "tuple[int, str] | None":
+    """(exit status, what stopped the run) if `exc` ended a run stopped from outside, else None.
+    Any exception counts once a signal came: it may be the signal's, reported by an FMU."""
+    if signals.signum is not None:
+        return 128 + signals.signum, f"stopped by {signal.Signals(signals.signum).name}"
+    if isinstance(exc, RunStopped):
+        return exc.exit_status, str(exc)
+    return None
+
+
+# --- worker processes
+
+
+def _worker_exit(signum, frame):
+    tempdirs.remove_held()
+    os._exit(128 + signum)
+
+
+def _watch_parent(parent):
+    while os.getppid() == parent:
+        time.sleep(1.0)
+    os.kill(os.getpid(), signal.SIGTERM)
+
+
+def _worker_start(parent, initializer, initargs):
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, _worker_exit)
+    if sys.platform.startswith("linux"):
+        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
+        if os.getppid() != parent:
+            _worker_exit(signal.SIGTERM, None)
+    else:
+        threading.Thread(target=_watch_parent, args=(parent,), daemon=True).start()
+    if initializer is not None:
+        initializer(*initargs)
+
+
+def new_pool(workers: int, initializer=None, initargs=()) -> ProcessPoolExecutor:
+    """A pool of `workers` spawned processes that end when this process ends (module docstring)."""
+    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
+                               initializer=_worker_start, initargs=(os.getpid(), initializer, initargs))
+
+
+def stop_pool(pool: ProcessPoolExecutor) -> None:
+    """Stop a pool now: work not started is cancelled, work in progress abandoned. Each worker gets
+    SIGTERM (it removes its folders and exits) and is killed if still there after STOP_GRACE;
+    then the folders of killed workers are swept."""
+    # The executor has no public way to end its workers before Python 3.14 (terminate_workers).
+    processes = list((pool._processes or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        if process.is_alive():
+            process.terminate()
+    deadline = time.monotonic() + STOP_GRACE
+    killed = False
+    for process in processes:
+        process.join(max(0.0, deadline - time.monotonic()))
+        if process.is_alive():
+            process.kill()
+            process.join()
+            killed = True
+    if killed:
+        tempdirs.sweep()
+
+
+@contextmanager
+def worker_pool(workers: int, initializer=None, initargs=()):
+    """new_pool for a `with` block: shut down normally at its end, stopped (stop_pool) when the
+    block raises, so an error or a signal does not wait for the work in progress."""
+    pool = new_pool(workers, initializer, initargs)
+    try:
+        yield pool
+    except BaseException:
+        stop_pool(pool)
+        raise
+    pool.shutdown(wait=True)

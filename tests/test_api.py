@@ -1,0 +1,56 @@
+"""The Python API (nodeforce.api): the FMU's score of a forcing equals the one computed by hand
+from the direct model, the search's candidates are the measured nodes but the air, and the API
+is loaded only when used."""
+import subprocess
+import sys
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import nodeforce
+from tests.conftest import DATA
+
+BURN_IN_STEPS = 96  # one day at 15 min
+
+
+@pytest.fixture(scope="module")
+def demo():
+    building = nodeforce.read_building(DATA / "testcell_miami.json")
+    weather = nodeforce.read_weather(DATA / "miami_tmy2.csv")
+    measured = nodeforce.read_measurements(DATA / "demo_measurements.csv")
+    return building, weather, measured, nodeforce.measured_case(building, weather, measured, burn_in_days=1)
+
+
+def test_score_through_the_fmu_equals_the_direct_models_sum_of_squares(demo, tmp_path):
+    building, weather, measured, case = demo
+    air = nodeforce.objective(building)
+    with nodeforce.open_fmu(nodeforce.write_fmu(building, tmp_path / "cell.fmu")) as fmu:
+        J = {nodes: nodeforce.score_forcing(fmu, case, nodes, air) for nodes in ((), (7,), (16,))}
+    for nodes, score in J.items():
+        T = nodeforce.simulate(building, weather, measured, force=nodes, burn_in_days=1)
+        # t_1..t_N against the file's rows 1..N, the burn-in's day left out
+        r = measured["T23"].to_numpy()[1 + BURN_IN_STEPS:] - T["T23"].to_numpy()[BURN_IN_STEPS:]
+        assert score == pytest.approx(float(np.sum(r ** 2)), rel=1e-9)
+    # the demo's undeclared effect is under the floor: forcing its sensor explains most of the air
+    assert J[(16,)] < 0.2 * J[()] < J[(7,)]
+
+
+def test_forcing_candidates_are_the_measured_nodes_but_the_air(demo):
+    building, _, measured, case = demo
+    ids = {int(c[1:]) for c in measured.columns}
+    assert set(nodeforce.forcing_candidates(building, case)) == ids - {building.zones[0].air_node}
+
+
+def test_forcing_an_unmeasured_node_is_refused(demo):
+    building, _, _, case = demo
+    with pytest.raises(nodeforce.InputError, match="node 5 is to be forced but has no measurement"):
+        nodeforce.score_forcing(None, case, [5], nodeforce.objective(building))
+
+
+@pytest.mark.slow
+def test_the_api_is_loaded_only_when_used():
+    code = ("import sys, nodeforce.model.case; print('nodeforce.api' in sys.modules); "
+            "nodeforce.read_building; print('nodeforce.api' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.split() == ["False", "True"]

@@ -1,0 +1,143 @@
+"""The same model as an FMI 3.0 co-simulation FMU, Python and standalone: arrays for force,
+T_forced and T, units, the effect's parameters; the FMI 2.0 FMU's numbers and answers."""
+import json
+import zipfile
+from xml.etree import ElementTree
+
+import numpy as np
+import pytest
+from fmpy.validation import validate_fmu
+
+from nodeforce.cli import main
+from nodeforce.cosim.fmi import FmuInstance
+from nodeforce.cosim.run import simulate_fmu
+from nodeforce.diagnose.calibrate import Candidate, calibrate
+from nodeforce.fmu_build import guard
+from nodeforce.fmu_build.build import build_fmu, fmu_kind
+from nodeforce.model.building import parse_building
+from nodeforce.model.case import prepare_case
+from nodeforce.model.effects import EFFECTS
+from nodeforce.model.integrate import simulate
+from nodeforce.model.network import assemble
+from nodeforce.model.score import Objective
+from nodeforce.model.synth import pseudo_measurements
+from tests.conftest import SENSORS, record_times
+from tests.test_fmu_exchange import glibc_versions
+from tests.test_fmu_processes import files  # noqa: F401 (the locate fixture)
+from tests.test_standalone import TWINHOUSE, scenario
+
+KINDS = ("python", "standalone")
+EFFECT = ("ground_coupling", "floor")
+
+
+@pytest.fixture(scope="module")
+def fmus(tmp_path_factory, testcell):
+    """{(kind, fmi): FMU} of the test cell with the ground coupling's parameters exposed."""
+    folder = tmp_path_factory.mktemp("fmi3")
+    return {(kind, fmi): build_fmu(testcell, folder / f"{kind}{fmi}.fmu", effect=EFFECT, kind=fmu_kind(kind, fmi))
+            for kind in KINDS for fmi in (2, 3)}
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_fmi3_declares_arrays_units_and_the_effect_and_passes_fmpy_validate(fmus, kind):
+    fmu = fmus[(kind, 3)]
+    assert validate_fmu(str(fmu)) == []
+    with zipfile.ZipFile(fmu) as archive:
+        root = ElementTree.fromstring(archive.read("modelDescription.xml"))
+        assert f"binaries/x86_64-linux/{root.find('CoSimulation').get('modelIdentifier')}.so" in archive.namelist()
+    assert root.get("fmiVersion") == "3.0"
+    declared = {v.get("name"): v for v in root.find("ModelVariables")}
+    for name, tag, causality in (("force", "Boolean", "parameter"), ("T_forced", "Float64", "input"),
+                                 ("T", "Float64", "output")):
+        v = declared[name]
+        assert (v.tag, v.get("causality"), v.find("Dimension").get("start")) == (tag, causality, "23")
+    assert declared["T_forced"].get("variability") == "discrete" and declared["T"].get("unit") == "degC"
+    assert len(declared["T_forced"].get("start").split()) == 23
+    assert declared["ground_coupling.U"].get("unit") == "W/m2/K"
+    if kind == "python":  # its binary, the FMI 3.0 interface and the guard, asks glibc for no more than the guard
+        with zipfile.ZipFile(fmu) as archive:
+            binary = archive.read(f"binaries/x86_64-linux/{root.find('CoSimulation').get('modelIdentifier')}.so")
+        (fmu.parent / "fmi3_guard.so").write_bytes(binary)
+        versions, _ = glibc_versions(fmu.parent / "fmi3_guard.so")
+        assert max(versions) == tuple(int(x) for x in guard.GUARD_GLIBC.split("."))
+    # 3N scalars of FMI 2.0 became 3 arrays, with the independent time beside them
+    with zipfile.ZipFile(fmus[(kind, 2)]) as archive:
+        scalars = ElementTree.fromstring(archive.read("modelDescription.xml")).find("ModelVariables")
+    assert len(scalars) - len(declared) == 3 * 22 - 1
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_fmi3_equals_fmi2_and_the_direct_model_with_forcing_and_effect(fmus, testcell, real_case, kind):
+    force = np.zeros(23, dtype=bool)
+    force[[0, 8, 16]] = True
+    values = {"U": 0.8, "T_ground": 24.0}
+    parameters = {f"{EFFECT[0]}.{k}": v for k, v in values.items()}
+    results = {}
+    for fmi in (2, 3):
+        with FmuInstance(fmus[(kind, fmi)]) as instance:
+            results[fmi] = simulate_fmu(instance, real_case, force, parameters=parameters)
+    coupled = EFFECTS[EFFECT[0]].apply(testcell, EFFECT[1], values)
+    direct = simulate(coupled, assemble(coupled), real_case.U, real_case.dt, real_case.measured, force)
+    assert np.abs(results[3] - results[2]).max() < 1e-9
+    assert np.abs(results[3] - direct).max() < 1e-9
+    measured = real_case.measured[1:, 8]
+    assert np.array_equal(results[3][:, 8], measured)  # forced through the T_forced array
+    uncoupled = simulate(testcell, assemble(testcell), real_case.U, real_case.dt, real_case.measured, force)
+    assert np.abs(direct - uncoupled).max() > 0.1  # the effect's parameters reached the model
+
+
+@pytest.mark.slow  # a search through four FMUs
+def test_a_search_through_fmi3_gives_the_fmi2_answer(files, tmp_path):  # noqa: F811
+    results = {}
+    for kind in KINDS:
+        for fmi in ("2", "3"):
+            out = tmp_path / f"{kind}{fmi}"
+            assert main(files + ["-o", str(out), "--fmu", kind, "--fmi", fmi, "--workers", "1"]) == 0
+            results[(kind, fmi)] = json.loads((out / "locate.json").read_text())
+    reference = results[("python", "2")]
+    assert reference["best_nodes"] == [7]
+    for found in results.values():
+        assert found["best_nodes"] == reference["best_nodes"]
+        for node, J in reference["node_scores"].items():
+            assert abs(found["node_scores"][node] - J) <= 1e-9 * max(1.0, J)
+
+
+@pytest.mark.slow  # two calibrations
+def test_a_diagnosis_s_calibration_through_fmi3_gives_the_fmi2_answer(tmp_path, testcell_data, testcell, weather):
+    """The diagnosis's step that runs FMUs: a candidate effect calibrated through its FMU (a whole
+    `diagnose --fmi 3` gave the --fmi 2 report's effect, values and RMSE too, in 108 s: too long
+    for the suite)."""
+    truth = EFFECTS["internal_gain"].apply(parse_building(testcell_data), "cell", {"Q": 100.0})
+    measured = pseudo_measurements(truth, weather, record_times(days=4), SENSORS, noise_sd=0.1, seed=5,
+                                   history_days=7)
+    case = prepare_case(testcell, weather, measured).with_burn_in(1)
+    objective = Objective.of(testcell)
+    found = {}
+    for fmi in (2, 3):
+        candidate = Candidate(testcell, "internal_gain", "cell", tmp_path, fmu_kind("standalone", fmi))
+        try:
+            found[fmi] = calibrate(candidate, case, objective)[0]["Q"]
+        finally:
+            candidate.close()
+    assert found[3]["value"] == pytest.approx(found[2]["value"], rel=1e-6)
+    assert found[3]["std"] == pytest.approx(found[2]["std"], rel=1e-6)
+    assert abs(found[3]["value"] - 100.0) < max(10.0, 3 * found[3]["std"])
+
+
+@pytest.mark.slow  # three FMUs of 267 nodes
+def test_fmi3_equals_fmi2_on_the_twin_house(tmp_path):
+    building = parse_building(json.loads(TWINHOUSE.read_text()))
+    built = {(kind, fmi): build_fmu(building, tmp_path / f"{kind}{fmi}.fmu", kind=fmu_kind(kind, fmi))
+             for kind, fmi in (("python", 2), ("python", 3), ("standalone", 3))}
+    parameters, inputs, outputs, n_steps = scenario(built[("python", 2)], n_steps=96)
+    start = {name: value for name, value in parameters.items() if name.startswith("T_forced[")}
+    fixed = {name: value for name, value in parameters.items() if name not in start}
+    results = {}
+    for key, fmu in built.items():
+        with FmuInstance(fmu) as instance:
+            results[key] = instance.run(900.0, fixed, start, list(inputs), np.column_stack(list(inputs.values())),
+                                        outputs)
+    reference = results[("python", 2)]
+    assert np.ptp(reference).max() > 1.0
+    for key in (("python", 3), ("standalone", 3)):
+        assert np.abs(results[key] - reference).max() < 1e-9, key
