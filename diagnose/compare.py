@@ -7,11 +7,11 @@ RMSE, mean and sd of each objective zone's air residual, overall and per phase o
 experiment, beside each model's heat loss coefficient (PHYSICS.md section 8).
 """
 import json
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from nodeforce import tempdirs
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnose.report.figures import plot_comparison
@@ -26,7 +26,7 @@ from nodeforce.model.hlc import heat_loss_coefficient
 def run_model(building, case, objective, fmu_kind="python"):
     """The objective's air (C) at t_1..t_N of `building` simulated on `case` through its FMU,
     built and removed in a temporary folder."""
-    with tempfile.TemporaryDirectory(prefix="nodeforce_") as tmp:
+    with tempdirs.folder("compare") as tmp:
         with FmuInstance(build_fmu(building, Path(tmp) / "model.fmu", kind=fmu_kind)) as instance:
             return simulate_fmu(instance, case, output_ids=objective.air_nodes)
 

@@ -238,9 +238,8 @@ def cmd_compare(args):
     models = []
     for path in args.buildings:
         building = load_building(path)
-        case = prepare_case(building, weather, measurements)
-        check_warmup(case, args.measurements)
-        models.append((path, building, case.with_burn_in(args.burn_in_days), Objective.of(building, names)))
+        case = measured_case(building, weather, measurements, args.burn_in_days)
+        models.append((path, building, case, Objective.of(building, names)))
     result, series = compare(models, read_phases(args.phases) if args.phases else (), fmu_kind=args.fmu)
     written = write_compare(Path(args.output), result, series)
     for m in result["models"]:
