@@ -34,18 +34,25 @@ check: venv
 	$(PYTEST) -m "not slow"
 
 # Twin House N2, experiment 1 (examples/twinhouse_n2/README.md): the shared measurements converted,
-# then diagnosed on the living room. The data are not in the repository (SOURCES.md of the data).
+# then diagnosed on the living room; then experiment 2 (spring 2014, another protocol) converted
+# and the house as written and as corrected on experiment 1 compared on it, a record the
+# correction never saw. The data are not in the repository (SOURCES.md of the data).
 TWINHOUSE_DATA ?= ../shared/data/twinhouse_n2_exp1
+TWINHOUSE_DATA2 ?= ../shared/data/twinhouse_n2_exp2
 TWINHOUSE_EXAMPLE := examples/twinhouse_n2
 TWINHOUSE_OUT := out/twinhouse
+TWINHOUSE_OUT2 := $(TWINHOUSE_OUT)/exp2
 TWINHOUSE_TABLE = $(BIN)/nodeforce table $(TWINHOUSE_DATA)/validationdataN2Exp1.txt \
 	--names $(TWINHOUSE_DATA)/columns.csv --origin 2013-01-01T00:00+01:00
+TWINHOUSE_TABLE2 = $(BIN)/nodeforce table $(TWINHOUSE_DATA2)/validationdataExp2.txt \
+	--names $(TWINHOUSE_DATA2)/columns.csv --origin 2014-01-01T00:00+01:00
 
 twinhouse: venv
-	@for f in validationdataN2Exp1.txt columns.csv; do test -f $(TWINHOUSE_DATA)/$$f || { \
-	  echo "twinhouse: $(TWINHOUSE_DATA)/$$f is missing: the Twin House N2 data folder (../shared/data/twinhouse_n2_exp1) is needed; validationdataN2Exp1.txt is IDEAS/Resources/measurements/validationdataN2Exp1.txt of github.com/open-ideas/IDEAS (commit 272d82aef8da5484b3ed729ba6d6cc1db9754f1e), columns.csv its column list (the data's SOURCES.md)" >&2; \
+	@for f in $(TWINHOUSE_DATA)/validationdataN2Exp1.txt $(TWINHOUSE_DATA)/columns.csv \
+	          $(TWINHOUSE_DATA2)/validationdataExp2.txt $(TWINHOUSE_DATA2)/columns.csv; do test -f $$f || { \
+	  echo "twinhouse: $$f is missing: the Twin House N2 data folders (../shared/data/twinhouse_n2_exp1 and _exp2) are needed; validationdataN2Exp1.txt is IDEAS/Resources/measurements/validationdataN2Exp1.txt of github.com/open-ideas/IDEAS (commit 272d82aef8da5484b3ed729ba6d6cc1db9754f1e), columns.csv its column list (each folder's SOURCES.md)" >&2; \
 	  exit 2; }; done
-	mkdir -p $(TWINHOUSE_OUT)
+	mkdir -p $(TWINHOUSE_OUT) $(TWINHOUSE_OUT2)
 	$(TWINHOUSE_TABLE) --select @$(TWINHOUSE_EXAMPLE)/weather_columns.txt --set shading_south=0 \
 		-o $(TWINHOUSE_OUT)/weather.csv
 	$(TWINHOUSE_TABLE) --select @$(TWINHOUSE_EXAMPLE)/measurement_columns.txt \
@@ -54,6 +61,25 @@ twinhouse: venv
 		--measurements $(TWINHOUSE_OUT)/measurements.csv -o $(TWINHOUSE_OUT) --objective living \
 		--calibration-end 2013-09-14T00:00+01:00 --burn-in-days 3 --seed 0 \
 		--reference $(TWINHOUSE_EXAMPLE)/reference.json --phases $(TWINHOUSE_EXAMPLE)/phases.csv
+	$(TWINHOUSE_TABLE2) --select @$(TWINHOUSE_EXAMPLE)/weather_columns_exp2.txt \
+		--set shading_south=1,shading_W27=0,shading_W33=0 -o $(TWINHOUSE_OUT2)/weather.csv
+	$(BIN)/python $(TWINHOUSE_EXAMPLE)/make_building.py --experiment 2 -o $(TWINHOUSE_OUT2)/building_as_written.json
+	$(BIN)/python $(TWINHOUSE_EXAMPLE)/make_building.py --experiment 2 --corrected-by $(TWINHOUSE_OUT)/report.json \
+		-o $(TWINHOUSE_OUT2)/building_corrected_on_exp1.json
+	@# experiment 2's record has two gaps (a row at 04-22 13:20, 6.5 h on 04-28): it is compared on the
+	@# two stretches between them, each with its own three days of burn-in
+	$(call twinhouse_exp2_part,early,2014-04-09T00:10+01:00,2014-04-22T13:10+01:00)
+	$(call twinhouse_exp2_part,late,2014-04-28T08:10+01:00,2014-05-19T23:20+01:00)
+
+# $(call twinhouse_exp2_part,NAME,START,END): experiment 2's measurements from START to END, and the
+# comparison of the two building files on them in out/twinhouse/exp2/NAME
+define twinhouse_exp2_part
+$(TWINHOUSE_TABLE2) --select @$(TWINHOUSE_EXAMPLE)/measurement_columns_exp2.txt --start $(2) --end $(3) \
+	-o $(TWINHOUSE_OUT2)/measurements_$(1).csv
+$(BIN)/nodeforce compare $(TWINHOUSE_OUT2)/building_as_written.json $(TWINHOUSE_OUT2)/building_corrected_on_exp1.json \
+	--weather $(TWINHOUSE_OUT2)/weather.csv --measurements $(TWINHOUSE_OUT2)/measurements_$(1).csv \
+	-o $(TWINHOUSE_OUT2)/$(1) --objective living --burn-in-days 3 --phases $(TWINHOUSE_EXAMPLE)/phases_exp2.csv
+endef
 
 benchmark: venv
 	$(BIN)/python benchmarks/bench_search.py

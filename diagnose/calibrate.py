@@ -17,16 +17,16 @@ from scipy.optimize import least_squares
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.fmu_build.build import build_fmu
-from nodeforce.diagnose.candidates import calibration_start
+from nodeforce.diagnose.candidates import IDENTIFIABLE_RELATIVE, calibration_start
 from nodeforce.diagnose.significance import bandwidth, parameter_covariance
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.hlc import heat_loss_coefficient
 
 log = logging.getLogger("nodeforce.diagnose")
 
-# A scale parameter is identifiable when its standard deviation is under this fraction of its
-# value; a temperature (T_ground) when its standard deviation is under this many kelvin.
-IDENTIFIABLE_RELATIVE = 0.25
+# A scale parameter is identifiable when its standard deviation is under IDENTIFIABLE_RELATIVE
+# of its value (candidates, which judges derived quantities by it too); a temperature (T_ground)
+# when its standard deviation is under this many kelvin.
 IDENTIFIABLE_KELVIN = 1.0
 MORRIS_TRAJECTORIES = 4
 # The step of the heat loss coefficient's differences, as a fraction of a parameter's range: the
@@ -90,7 +90,8 @@ def calibrate(candidate, case, objective):
         if not identifiable:
             log.warning("%s: %s = %.4g +- %.2g %s is not identifiable from these data%s", candidate.label,
                         p.name, value, sd, p.unit, " (it ended on a bound)" if bound else "")
-        result[p.name] = {"value": float(value), "std": float(sd), "identifiable": identifiable}
+        result[p.name] = {"value": float(value), "std": float(sd), "identifiable": identifiable,
+                          "on_bound": bool(bound != 0)}
     return result, derived(candidate, case, fit.x, cov)
 
 

@@ -3,7 +3,9 @@
 Kept apart from the effect records (`nodeforce.model.effects`), which an FMU bundles: changing
 the policy changes no FMU and throws away no saved search.
 """
-from nodeforce.model.effects import EFFECTS, bridge_parts, bridge_target
+import math
+
+from nodeforce.model.effects import BRIDGE_TO, EFFECTS, bridge_parts, bridge_target
 from nodeforce.model.network import RHO_C_AIR
 
 # Where the calibration of an effect the file does not declare starts (see calibration_start).
@@ -16,6 +18,11 @@ ABSENT_START = {("ground_coupling", "U"): 1.0,  # W/m2/K
 # half an hour), so the mass's time constant starts at hours and the heater's at half an hour.
 ZONE_START = {("internal_mass", "C_m"): 10.0,
               ("heat_input_lag", "C_h"): 1.0}
+
+
+# A scale parameter, or a derived quantity, is identifiable when its standard deviation is under
+# this fraction of its value (diagnose.calibrate).
+IDENTIFIABLE_RELATIVE = 0.25
 
 
 def candidates(building, located_nodes, zones):
@@ -81,6 +88,75 @@ def implausible(building, effect, target):
         return (f"{target} is declared unoccupied: the gain stands for a heat source the model lacks "
                 "(a heat input mis-measured, a flow of air or sun not modelled), not for occupants")
     return None
+
+
+# The shapes: a gain that follows the clock or an input column stands for a heat source the model
+# lacks, not for a physical effect of the building; it is chosen only when no physical effect
+# comes within the paired margin of it (diagnose.loop.decide).
+SHAPES = ("daily_gain", "proportional_gain")
+
+# Physical limits, tighter than the range a calibration explores (model.effects): a value
+# outside them is not a property of a building but a fit compensating something else. A gain to
+# the air is a source, not a sink (a heat sink would be a cooler the file would declare); scales
+# of conductances and convection within a factor of ten of what the file declares.
+PHYSICAL_LIMITS = {("internal_gain", "Q"): (0.0, math.inf),
+                   ("daily_gain", "mean"): (0.0, math.inf),
+                   ("conductivity", "factor"): (0.1, 10.0),
+                   ("envelope_conductance", "factor"): (0.1, 10.0),
+                   ("inside_convection", "factor"): (0.1, 10.0)}
+# The parameters whose identifiability decides for an effect (default: all of them): a daily
+# profile's harmonics may each be near zero, and small next to their uncertainty, while the
+# profile and its mean are determined.
+JUDGED = {"daily_gain": ("mean",)}
+
+
+def is_shape(effect):
+    return effect in SHAPES
+
+
+def preference(effect):
+    """Sort key of the candidates a decision prefers where the data cannot tell them apart: a
+    physical effect before a shape, then fewer parameters before more."""
+    return (is_shape(effect), len(EFFECTS[effect].parameters))
+
+
+def limits(building, effect, target, name):
+    """The physical (low, high) of a parameter: PHYSICAL_LIMITS, and for a proportional gain an
+    area of sun that cannot be negative (an irradiance column) or a share of a heat input that
+    cannot take away more than the input (k >= -1)."""
+    if effect == "proportional_gain":
+        zone, _, column = target.partition(BRIDGE_TO)
+        heat_inputs = {c for z in building.zones for c in z.heat_input}
+        return (-1.0 if column in heat_inputs else 0.0, math.inf)
+    return PHYSICAL_LIMITS.get((effect, name), (-math.inf, math.inf))
+
+
+def objection(building, effect, target, parameters, derived=None):
+    """Why a calibrated effect may not be added to the model, or None: a gain the building file's
+    description rules out (`implausible`), a parameter on a bound of its search range or not
+    identifiable from the data (for a ground coupling, whose U and T_ground trade off, the heat
+    flux they give must be determined instead, and then the pair is one of the many that give
+    it, wherever it ended), or a value outside physical limits.
+
+    parameters : {name: {"value", "std", "identifiable", "on_bound"}} of `diagnose.calibrate`
+    derived : what the data determine besides (`diagnose.calibrate.derived`)
+    """
+    reasons = [implausible(building, effect, target)]
+    flux = (derived or {}).get("ground_heat_flux")
+    flux_known = flux is not None and flux["std"] < IDENTIFIABLE_RELATIVE * abs(flux["value"])
+    for name in JUDGED.get(effect, [p.name for p in EFFECTS[effect].parameters]):
+        p, unit = parameters[name], EFFECTS[effect].parameter(name).unit
+        low, high = limits(building, effect, target, name)
+        if flux_known:
+            pass  # many (U, T_ground) give the flux the data fix: the pair is one of them, on a bound or not
+        elif p.get("on_bound"):
+            reasons.append(f"{name} = {p['value']:.3g} {unit} ends on a bound of its range")
+        elif not p["identifiable"]:
+            reasons.append(f"{name} = {p['value']:.3g} +- {p['std']:.2g} {unit} is not identifiable from these data")
+        if not low <= p["value"] <= high:
+            what = "a negative gain (a heat sink)" if low == 0.0 and "gain" in effect else "outside physical limits"
+            reasons.append(f"{name} = {p['value']:.3g} {unit} is {what} [{low:g}, {high:g}]")
+    return "; ".join(r for r in reasons if r) or None
 
 
 def follow_up(building, left, zones):

@@ -5,7 +5,7 @@ how the loss splits among effects.
 A record of the indoor air and the heating power fixes the building's total loss per kelvin far
 better than where the heat goes: an air change and a factor on the envelope's conduction give
 the same HLC and nearly the same air temperatures. When candidates that change the loss fit the
-validation window alike (within what the noise could change) and agree on the HLC, the report
+selection window alike (within what the noise could change) and agree on the HLC, the report
 says the split is not the record's.
 """
 import math
@@ -45,7 +45,7 @@ def heat_loss(before_building, after_building, added, results, sigma):
                             f"but not how it splits among effects: "
                             + ", ".join(f"{r['effect']} on {r['target']} ({r['derived'][HLC]['value']:.1f} W/K)"
                                         for r in alike)
-                            + f" fit the validation window as well as {chosen['effect']} on {chosen['target']} "
+                            + f" fit the selection window as well as {chosen['effect']} on {chosen['target']} "
                               "with the same loss, so the split is the building file's, not the record's.")
     return out
 
@@ -53,17 +53,17 @@ def heat_loss(before_building, after_building, added, results, sigma):
 def same_loss(chosen, tried, start, sigma):
     """The other candidates of `chosen`'s round that change the loss from the round's `start`
     ({"value", "std"}, W/K) as the chosen does: the same HLC, each well determined, and a
-    validation J the chosen's does not beat by more than the noise could (`ga.parsimony.tolerance`).
+    selection J the chosen's does not beat by more than the noise could (`ga.parsimony.tolerance`).
     None when the chosen changes no loss (a gain, a mass)."""
     from nodeforce.diagnose.loop import label  # the decision's keys; loop imports this module
     hlc = chosen["derived"].get(HLC)
     if not hlc or not moves(hlc, start):
         return []
-    J, n = chosen["validation"]["J"], chosen["validation"]["n"]
+    J, n = chosen["selection"]["J"], chosen["selection"]["n"]
     margin = tolerance(J, sigma, n)
     return [r for r in tried if label(r) != label(chosen) and r["derived"].get(HLC)
             and agree(hlc, r["derived"][HLC]) and moves(r["derived"][HLC], start)
-            and r["validation"]["J"] - J <= margin]
+            and r["selection"]["J"] - J <= margin]
 
 
 def moves(a, start):

@@ -59,3 +59,45 @@ def change_of_J(before, after, lags):
     d = np.nansum(np.square(before), axis=1) - np.nansum(np.square(after), axis=1)
     d = d[np.isfinite(before).any(axis=1)]
     return float(d.sum()), float(np.sqrt(S_hac_simple(d - d.mean(), nlags=lags)[0, 0]))
+
+
+
+
+def automatic_lags(series):
+    """Andrews' (1991) data-driven bandwidth (steps) of the Bartlett HAC estimate of a series'
+    long-run variance, from an AR(1) fitted to it: as many lags as its own autocorrelation asks
+    for, none where it is white, many where it remembers. The paired difference of two forcings'
+    squared residuals is often nearly white (the forcings remove the slow error and leave the
+    sensor noise), and a fixed day of lags would then only cost power."""
+    x = np.asarray(series, dtype=float)
+    x = x - x.mean()
+    n = len(x)
+    rho = float(np.clip(x[1:] @ x[:-1] / (x @ x), -0.97, 0.97)) if x @ x > 0 else 0.0
+    alpha = 4 * rho ** 2 / ((1 - rho) ** 2 * (1 + rho) ** 2)
+    return int(min(1.1447 * (alpha * n) ** (1 / 3), n - 1))
+
+
+def critical_value(lags, n):
+    """One-sided 5 % critical value of the paired statistic fall / sd when sd is the Bartlett HAC
+    estimate over `lags` of n steps: Kiefer and Vogelsang's fixed-b value (2005, their
+    polynomial for the Bartlett kernel, b = (lags + 1) / n). A bandwidth of a day on a record of
+    a week or two is a large share of it, and the estimate of sd then scatters enough to make
+    the normal 1.645 reject a true equality far more often than it says (tests/test_significance.py)."""
+    b = min((lags + 1) / n, 1.0)
+    return 1.6449 + 2.1859 * b + 0.3142 * b ** 2 - 0.3427 * b ** 3
+
+
+def worse(first, second):
+    """Whether the data show `first` (residuals, C, (n_t, n_zones), NaN where not scored) fitting
+    worse than `second` on the same steps: J(first) - J(second) beyond `critical_value` HAC
+    standard deviations of that paired difference (a Diebold-Mariano test on squared errors,
+    one-sided at 5 %, over the `automatic_lags` of that difference). One-sided: the question
+    is always whether the preferred one (nearer the zone, physical, fewer parameters) is worse. Two models scored on one record share its noise, so their difference of J is
+    far better determined than either J: this, not the noise of one J, says whether they can be
+    told apart."""
+    first, second = np.asarray(first, dtype=float), np.asarray(second, dtype=float)
+    d = np.nansum(np.square(first), axis=1) - np.nansum(np.square(second), axis=1)
+    d = d[np.isfinite(first).any(axis=1)]
+    lags = automatic_lags(d)
+    fall, sd = change_of_J(first, second, lags)
+    return fall > critical_value(lags, len(d)) * sd

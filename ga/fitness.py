@@ -27,6 +27,8 @@ class FmuFitness:
     warmup_days : warm-up passes (PHYSICS.md section 5)
     """
 
+    keeps_residuals = True  # its evaluators give residuals(mask): the paired test (ga.parsimony.Paired)
+
     def __init__(self, fmu_path, case, chromosome_nodes, objective, warmup_days=2):
         self.fmu_path = str(fmu_path)
         # The FMU's GUID hashes its content (fmu_build), so a checkpoint keyed on this factory is
@@ -50,6 +52,8 @@ class ModelFitness:
     case, chromosome_nodes, objective, warmup_days : as for FmuFitness
     """
 
+    keeps_residuals = True
+
     def __init__(self, building, case, chromosome_nodes, objective, warmup_days=2):
         self.building = building
         self.case = case
@@ -69,9 +73,17 @@ class _Evaluator:
         self.measured = spec.objective.measured(spec.case)
 
     def J(self, mask):
+        return self.spec.objective.J(self.measured, self.air(self._force(mask)))
+
+    def residuals(self, mask):
+        """(N_t, k) residuals (C) of the objective's air with the mask forced, NaN where not scored:
+        what J sums, kept per step for the paired comparison of two forcings."""
+        return self.measured - self.air(self._force(mask))
+
+    def _force(self, mask):
         force = np.zeros(self.spec.case.measured.shape[1], dtype=bool)
         force[self.spec.chromosome_nodes[np.asarray(mask, dtype=bool)] - 1] = True
-        return self.spec.objective.J(self.measured, self.air(force))
+        return force
 
     def close(self):
         """Free what the evaluator holds (nothing for the direct model)."""

@@ -24,13 +24,22 @@ otherwise best_nodes = [].
 
 Rule: best_nodes = the smallest set S with J(S) <= J_min + tolerance, looked for among the
 empty set, every set of at most EXACT_ANY nodes of the chromosome, and the subsets of the best
-chromosome. Among the smallest sets that fit, the one of lowest J wins, except that sets whose
-J is within the noise alone (noise_tolerance: the tolerance without its relative floor) of the
-lowest cannot be told apart, and among those the one earliest in the chromosome order wins: the
-caller orders the nodes by preference (nodes nearest the zone first, ga.locate). So the inside
-surface of a wrong roof wins over the layer behind it (their J differ by noise), but a wall
-that merely compensates a wrong door does not win over the door because it comes first: its J
-is measurably worse. Sets of up to EXACT_ANY nodes are searched over the whole chromosome, so
+chromosome. A larger set must buy more than the noise of one J: that is the size of a fall
+worth a sub-model. Among the smallest sets that fit, the one of lowest J wins, except where the
+data cannot tell a set from it, and among those the one earliest in the chromosome order wins:
+the caller orders the nodes by preference (nodes nearest the zone first, ga.locate). Whether
+two forcings can be told apart is a paired question: both are scored on the same steps of the
+same record, so they share its noise, and the difference of their J is far better determined
+than either J. The residuals of the two forcings are recomputed (`Paired`: a few simulations,
+only for the finalists) and their difference of J judged against its HAC standard deviation
+(`diagnose.significance.worse`, a Diebold-Mariano-type test allowing for the residuals'
+correlation in time). Where the evaluator keeps no residuals, the noise of one J (noise_tolerance) is the band instead. So the inside surface of a wrong roof wins over the
+layer behind it (their residuals differ by noise), but a wall that merely compensates a wrong
+floor or door does not win over it because it comes first: its J is measurably worse on the
+same steps, even when the gap is inside the noise band of one J. With noisy sensors on every
+node the test also sees how much of a forced sensor's noise reaches the air: forcing the node
+behind a faulty wall's inside surface may then fit measurably better than the surface itself,
+and is named instead; both locate the same component. Sets of up to EXACT_ANY nodes are searched over the whole chromosome, so
 the answer for one or two faults does not depend on the path the search took. The empty set
 comes first, so best_nodes = [] exactly when J_unforced - J_min <= tolerance: no significant
 reduction. Larger subsets of the best chromosome are searched exhaustively, smallest first,
@@ -51,11 +60,14 @@ import math
 from itertools import combinations
 from typing import Callable, Sequence
 
+from nodeforce.diagnose import significance
+
 Z_NOISE = 3.0
 EXPLAINED = 0.5
 RELATIVE_FLOOR = 0.01
 EXACT_MAX_NODES = 8
 EXACT_ANY = 2
+ROUNDING = 1e-9  # of J_unforced: a difference of J below it is the simulation's rounding
 
 
 def tolerance(J_unforced: float, noise_sigma: "float | None", n_residuals: "int | None") -> float:
@@ -88,12 +100,18 @@ def explains(J_unforced: float, J_min: float, noise_sigma: "float | None", n_res
 
 
 def smallest_subset(J_many: Callable[[Sequence[tuple]], list], best: tuple, limit: float,
-                    noise_tol: float = 0.0) -> tuple:
+                    noise_tol: float = 0.0, worse: "Callable[[tuple, tuple], bool] | None" = None) -> tuple:
     """The smallest mask whose J stays <= limit (J_min + tolerance), by the rule above.
 
     J_many scores a batch of masks (through the fitness cache, so a batch runs in parallel);
-    noise_tol (C2) is the noise_tolerance that sets of one size must differ by to be told apart.
+    worse(a, b) says whether the data show mask a fitting worse than mask b (`Paired.worse`);
+    without it, noise_tol (C2, the noise_tolerance) is what sets of one size must differ by to
+    be told apart.
     """
+    if worse is None:
+        def worse(a, b):
+            return J_many([a])[0] > J_many([b])[0] + noise_tol
+
     def mask(subset):
         chosen = set(subset)
         return tuple(i in chosen for i in range(len(best)))
@@ -101,28 +119,28 @@ def smallest_subset(J_many: Callable[[Sequence[tuple]], list], best: tuple, limi
     if J_many([mask(())])[0] <= limit:
         return mask(())
     for size in range(1, EXACT_ANY + 1):
-        chosen = _preferred(J_many, mask, list(combinations(range(len(best)), size)), limit, noise_tol)
+        chosen = _preferred(J_many, mask, list(combinations(range(len(best)), size)), limit, worse)
         if chosen is not None:
             return mask(chosen)
     members = [i for i, bit in enumerate(best) if bit]
     if len(members) <= EXACT_MAX_NODES:
-        return mask(_smallest_first(J_many, mask, members, limit, noise_tol))
+        return mask(_smallest_first(J_many, mask, members, limit, worse))
     return mask(_backward_elimination(J_many, mask, members, limit))
 
 
-def _preferred(J_many, mask, subsets, limit, noise_tol):
-    """Of the subsets (in preference order) whose J <= limit, the first within noise_tol of the
-    lowest; None if none fits."""
+def _preferred(J_many, mask, subsets, limit, worse):
+    """Of the subsets (in preference order) whose J <= limit, the first the data do not show
+    fitting worse than the lowest; None if none fits."""
     fits = [(J, s) for J, s in zip(J_many([mask(s) for s in subsets]), subsets) if J <= limit]
     if not fits:
         return None
-    lowest = min(J for J, _ in fits)
-    return next(s for J, s in fits if J <= lowest + noise_tol)
+    lowest = min(fits, key=lambda fit: fit[0])[1]
+    return next(s for _, s in fits if s == lowest or not worse(mask(s), mask(lowest)))
 
 
-def _smallest_first(J_many, mask, members, limit, noise_tol):
+def _smallest_first(J_many, mask, members, limit, worse):
     for size in range(EXACT_ANY + 1, len(members)):
-        chosen = _preferred(J_many, mask, list(combinations(members, size)), limit, noise_tol)
+        chosen = _preferred(J_many, mask, list(combinations(members, size)), limit, worse)
         if chosen is not None:
             return chosen
     return members
@@ -137,6 +155,44 @@ def _backward_elimination(J_many, mask, members, limit):
             break
         kept = candidates[i]
     return kept
+
+
+class Paired:
+    """The paired comparison of two forcings (`worse`), on residuals recomputed by one evaluator
+    of `factory` built in this process when first needed: the search's cache keeps only J, and
+    only the few finalists of the parsimony rule need their series. Close it when done.
+
+    factory: a fitness factory whose evaluators have residuals(mask) (`keeps_residuals`, ga.fitness).
+    J_many, floor: the search's scores and the difference of J (C2) that is rounding, whatever
+        the test says (ROUNDING of J_unforced): on a noise-free record two forcings that both
+        cut a fault off differ by nothing else.
+    """
+
+    def __init__(self, factory, J_many=None, floor=0.0):
+        self._factory, self._evaluator, self._kept = factory, None, {}
+        self._J_many, self._floor = J_many, floor
+
+    def residuals(self, mask):
+        if mask not in self._kept:
+            if self._evaluator is None:
+                self._evaluator = self._factory()
+            self._kept[mask] = self._evaluator.residuals(mask)
+        return self._kept[mask]
+
+    def worse(self, a, b) -> bool:
+        """Whether forcing mask a fits the record measurably worse than mask b."""
+        if self._J_many is not None:
+            J_a, J_b = self._J_many([a, b])
+            if J_a - J_b <= self._floor:
+                return False
+        return significance.worse(self.residuals(a), self.residuals(b))
+
+    def close(self):
+        if self._evaluator is not None:
+            close = getattr(self._evaluator, "close", None)
+            if close:
+                close()
+        self._evaluator, self._kept = None, {}
 
 
 def forward_backward(J_many: Callable[[Sequence[tuple]], list], k: int, tol: float) -> "tuple[tuple, float]":

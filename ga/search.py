@@ -43,8 +43,8 @@ from tqdm import tqdm
 from nodeforce.ga import checkpoint as ckpt
 from nodeforce.ga.evaluation import FitnessCache, log, open_backend
 from nodeforce.ga.operators import bit_flip_mutation, one_point_crossover, roulette_selection
-from nodeforce.ga.parsimony import (explains, forward_backward, noise_floor, noise_tolerance, smallest_subset,
-                                    tolerance)
+from nodeforce.ga.parsimony import (ROUNDING, Paired, explains, forward_backward, noise_floor, noise_tolerance,
+                                    smallest_subset, tolerance)
 
 # Generations without a significant fall of the best J before the GA stops. Measured on the
 # paper's verification cases (benchmarks/bench_search.py --cases, README): successive falls of
@@ -132,7 +132,7 @@ def search(factory, chromosome_nodes, *, population=30, generations=400, pc=0.8,
         finally:
             steps.close()
         search_requests = cache.requests
-        answer = _answer(cache, nodes, noise_sigma, n_residuals)
+        answer = _answer(cache, nodes, noise_sigma, n_residuals, factory)
         if checkpoint:
             # Keep the final scores too, so a rerun is instant; the counter stays at the end of
             # the search so the rerun counts the final steps exactly once, like this run.
@@ -307,8 +307,10 @@ def _evolve(cache, k, population, pc, pm, seed, state, steps, stop, initial):
     return why()
 
 
-def _answer(cache, nodes, noise_sigma, n_residuals) -> dict:
-    """The locate.json fields: unforced and single-node scores, best chromosome, best_nodes."""
+def _answer(cache, nodes, noise_sigma, n_residuals, factory=None) -> dict:
+    """The locate.json fields: unforced and single-node scores, best chromosome, best_nodes.
+    Sets of one size are told apart by the paired test on their residuals when the factory's
+    evaluators give them (`keeps_residuals`), else by the noise of one J (ga.parsimony)."""
     k = len(nodes)
     unforced = (False,) * k
     J_unforced, *J_single = cache.J_many([unforced] + _singles(k))
@@ -316,7 +318,14 @@ def _answer(cache, nodes, noise_sigma, n_residuals) -> dict:
     J_min = cache.J_of[best]
     tol = tolerance(J_unforced, noise_sigma, n_residuals)
     if explains(J_unforced, J_min, noise_sigma, n_residuals):
-        chosen = smallest_subset(cache.J_many, best, J_min + tol, noise_tolerance(noise_sigma, n_residuals))
+        paired = (Paired(factory, cache.J_many, ROUNDING * J_unforced)
+                  if getattr(factory, "keeps_residuals", False) else None)
+        try:
+            chosen = smallest_subset(cache.J_many, best, J_min + tol, noise_tolerance(noise_sigma, n_residuals),
+                                     worse=paired.worse if paired else None)
+        finally:
+            if paired:
+                paired.close()
     else:
         chosen = unforced
     return {

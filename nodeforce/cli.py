@@ -239,6 +239,25 @@ def cmd_diagnose(args):
     run_diagnosis(building, case, objective, Path(args.output), args.measurements, args)
 
 
+def cmd_compare(args):
+    from nodeforce.diagnose.compare import compare, write_compare
+    from nodeforce.iotools.phases import read_phases
+    weather, measurements = read_weather(args.weather), read_measurements(args.measurements)
+    names = zone_list(args.objective) if args.objective else None
+    models = []
+    for path in args.buildings:
+        building = load_building(path)
+        case = measured_case(building, weather, measurements, args.burn_in_days)
+        models.append((path, building, case, Objective.of(building, names)))
+    result, series = compare(models, read_phases(args.phases) if args.phases else (), fmu_kind=args.fmu)
+    written = write_compare(Path(args.output), result, series)
+    for m in result["models"]:
+        for zone, z in m["metrics"]["zones"].items():
+            print(f"{m['building']}: {zone} air RMSE {z['rmse']:.3f} C (mean {z['mean']:+.3f}, sd {z['sd']:.3f}); "
+                  f"heat loss coefficient {m['heat_loss_coefficient']:.1f} W/K")
+    print("wrote " + ", ".join(map(str, written)))
+
+
 def cmd_table(args):
     from nodeforce.iotools.table import column_names, constants, convert_table, selection
     written = convert_table(args.table_file, column_names(args.names, args.table_file), args.origin,
@@ -378,6 +397,18 @@ def parser():
     diagnosis_arguments(s)
     objective_argument(s)
     s.set_defaults(run=cmd_diagnose)
+
+    s = sub.add_parser("compare", help="building files run on one record none was fitted on: RMSE, mean, sd, "
+                                       "per phase, heat loss coefficient")
+    s.add_argument("buildings", metavar="BUILDING", nargs="+")
+    s.add_argument("--weather", required=True)
+    s.add_argument("--measurements", required=True)
+    s.add_argument("-o", "--output", required=True, help="folder for compare.json, compare.md and the plot")
+    s.add_argument("--phases", help="CSV time,phase: every model is scored on each phase")
+    s.add_argument("--fmu", choices=("python", "standalone"), default="python", help="the FMU kind to run")
+    burn_in_argument(s, 1.0)
+    objective_argument(s)
+    s.set_defaults(run=cmd_compare)
 
     s = sub.add_parser("synth", help="measurements of a building, optionally with an effect its file does not declare")
     s.add_argument("building")

@@ -130,7 +130,7 @@ def test_a_level_or_a_slow_error_with_nothing_localised_points_at_the_envelope(h
 
 def record(effect, hlc, sd, J):
     return {"effect": effect, "target": "cell", "derived": {"heat_loss_coefficient": {"value": hlc, "std": sd}},
-            "validation": {"J": J, "n": 100}}
+            "selection": {"J": J, "n": 100}}
 
 
 def test_the_report_says_when_the_data_fix_the_loss_but_not_its_split(heated):
@@ -151,9 +151,9 @@ def test_the_report_says_when_the_data_fix_the_loss_but_not_its_split(heated):
     assert "internal_gain" not in out["split"] and "inside_convection" not in out["split"]
     # an alternative that fits worse than the noise could make it, or loses differently, leaves
     # the split to the data
-    tried[1]["validation"]["J"] = 11.0
+    tried[1]["selection"]["J"] = 11.0
     assert heat_loss(heated, envelope, [chosen], tried, 0.1)["split"] is None
-    tried[1]["validation"]["J"], tried[1]["derived"]["heat_loss_coefficient"]["value"] = 10.3, hlc * 1.2
+    tried[1]["selection"]["J"], tried[1]["derived"]["heat_loss_coefficient"]["value"] = 10.3, hlc * 1.2
     assert heat_loss(heated, envelope, [chosen], tried, 0.1)["split"] is None
     report = {"effect": {"effect": "none"}, "before": {}, "after": {}, "objective": ["cell"],
               "heat_loss_coefficient": out, "assumptions": ["ghi split by erbs"]}

@@ -3,13 +3,16 @@ cell with one sub-model disturbed; the search over the FMU must point at that su
 import copy
 import json
 
+import numpy as np
 import pytest
 
+from nodeforce.ga import parsimony
 from nodeforce.ga.fitness import ModelFitness
 from nodeforce.ga.locate import chromosome_nodes, locate
 from nodeforce.ga.search import PAPER, search
 from nodeforce.model.building import parse_building
 from nodeforce.model.case import prepare_case
+from nodeforce.model.effects import EFFECTS
 from nodeforce.model.score import Objective, noise_level
 from nodeforce.model.synth import pseudo_measurements
 from nodeforce.cli import main
@@ -38,8 +41,17 @@ def disturbed(data, faults):
 # The nodes the paper's verification must find: the inside surface of each disturbed sub-model
 # (the node nearest the zone that cuts it off), nothing for the air node's own equation, which no
 # forcing reaches. benchmarks/bench_search.py --cases shows the paper's full 30 x 400 GA gives the
-# same best_nodes on each case; these tests run the default search, over all 21 nodes.
+# same best_nodes on each case; these tests run the default search, over all 21 nodes. With 0.1 C
+# of noise on every sensor, the paired test also sees how much of a forced sensor's noise reaches
+# the air: forcing the roof's next node (10) fits measurably better than its inside surface, and
+# is named; it locates the same component.
 EXPECTED = {"door": [7], "hci": [], "roof": [9], "door+roof": [7, 9]}
+NOISY = {"roof": [10], "door+roof": [7, 10]}
+
+
+def components(building, nodes):
+    """The names of the components the nodes (ids) belong to."""
+    return sorted({c.name for c in building.components for i in nodes if i in c.node_ids})
 
 
 def verification_case(testcell_data, testcell, weather, fault, noise):
@@ -58,7 +70,8 @@ def test_search_points_at_the_disturbed_sub_model(tmp_path, testcell_data, testc
     search = result["search"]
     assert search["method"] == "ga" and search["stopped"] == "converged"
     assert search["unique_evaluations"] <= 1200  # a tenth of the paper's 12,000
-    assert result["best_nodes"] == EXPECTED[fault]
+    assert result["best_nodes"] == (NOISY.get(fault, EXPECTED[fault]) if noise else EXPECTED[fault])
+    assert components(testcell, result["best_nodes"]) == components(testcell, EXPECTED[fault])
     if EXPECTED[fault]:
         assert result["ranked_nodes"][0] in EXPECTED[fault]
         # forcing them brings J down to what the noise alone gives (n sigma^2)
@@ -81,7 +94,8 @@ def test_default_search_gives_the_papers_answer_where_the_paper_is_exhaustive(te
     assert paper["search"]["method"] == "exhaustive"
     default = search(factory, nodes, generations=1023 // 30, workers=1, **noise)
     assert default["search"]["method"] == "ga" and default["search"]["stopped"] == "converged"
-    assert default["best_nodes"] == paper["best_nodes"] == [7, 9]
+    assert default["best_nodes"] == paper["best_nodes"]
+    assert components(testcell, default["best_nodes"]) == ["door", "roof"] and 7 in default["best_nodes"]
     assert default["search"]["unique_evaluations"] < paper["search"]["unique_evaluations"]
 
 
@@ -126,3 +140,27 @@ def test_locate_refuses_contradictory_search_options(tmp_path, capsys, options, 
     assert status == 2
     message = capsys.readouterr().err.strip()
     assert len(message.splitlines()) == 1 and field in message
+
+
+def test_a_paired_comparison_names_the_floor_where_the_noise_of_one_J_names_a_wall(testcell_data, testcell,
+                                                                                      weather):
+    # The paper's own finding: an undeclared ground coupling under the floor, the paper's sensors,
+    # 0.1 C noise, eight days of spring weather, located on the calibration window (60 %) as the
+    # diagnosis does. Forcing a floor node (16, 17) removes the error down to the noise; the east
+    # wall's inside surface (node 1, nearer the zone) removes less, by less than the noise band of
+    # one J, so that band could not tell them apart and gave the nearer node; the two forcings'
+    # residuals on the same steps can.
+    truth = EFFECTS["ground_coupling"].apply(testcell, "floor", {"U": 0.8, "T_ground": 18.0})
+    measurements = pseudo_measurements(truth, weather, record_times(8, "2001-04-10 00:00"), SENSORS,
+                                       noise_sd=0.1, seed=2, history_days=7)
+    case = prepare_case(testcell, weather, measurements).with_burn_in(1)
+    calibration = case.window(0, int(round(0.6 * (len(case.times) - 1))))
+    objective = Objective.of(testcell)
+    nodes = chromosome_nodes(testcell, calibration, objective, "m")
+    assert nodes.index(1) < nodes.index(16)  # the wall is preferred where the data cannot separate
+    n = int(np.isfinite(objective.measured(calibration)).sum())
+    result = search(ModelFitness(testcell, calibration, nodes, objective), nodes, workers=1, noise_sigma=0.1,
+                    n_residuals=n)
+    scores = result["node_scores"]
+    assert scores["1"] - scores["16"] < parsimony.noise_tolerance(0.1, n)
+    assert result["best_nodes"] in ([16], [17])

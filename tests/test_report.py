@@ -69,7 +69,7 @@ def synthetic():
         "candidates": [
             {"effect": "conductivity", "target": "door", "parameters": p_door, "derived": {},
              "calibration": metrics(0.1012, 0.001, 0.1011, 188), "validation": metrics(0.1234, 0.012, 0.1228, 190),
-             "validation_fall": {"J": 151.7, "sd": 4.1}, "bic": -412.3},
+             "selection_fall": {"J": 151.7, "sd": 4.1}, "bic": -412.3},
             {"effect": "ground_coupling", "target": "floor",
              "parameters": {"U": {"value": 0.52, "std": 0.9, "identifiable": False},
                             "T_ground": {"value": 24.3, "std": None, "identifiable": False}},
@@ -89,13 +89,13 @@ def synthetic():
         ],
         "decision": {"chosen": "conductivity@door",
                      "reason": "conductivity on door has the lowest validation RMSE of the 2 candidates that beat both tests.",
-                     "bic_baseline": -35.1, "validation_J_before": 154.6, "validation_margin": 7.25,
-                     "candidates": {"conductivity@door": {"beats_bic": True, "beats_validation": True,
-                                                          "validation_margin": 12.3},
-                                    "ground_coupling@floor": {"beats_bic": False, "beats_validation": True},
-                                    "infiltration@living": {"beats_bic": False, "beats_validation": False},
+                     "bic_baseline": -35.1, "selection_J_before": 154.6, "selection_margin": 7.25,
+                     "candidates": {"conductivity@door": {"beats_bic": True, "beats_selection": True,
+                                                          "selection_margin": 12.3},
+                                    "ground_coupling@floor": {"beats_bic": False, "beats_selection": True},
+                                    "infiltration@living": {"beats_bic": False, "beats_selection": False},
                                     # the loop's word, though its BIC is below the baseline's
-                                    "solar_absorptance@roof": {"beats_bic": False, "beats_validation": True}}},
+                                    "solar_absorptance@roof": {"beats_bic": False, "beats_selection": True}}},
         "effect": {"effect": "conductivity", "target": "door", "parameters": p_door, "derived": {}},
         "after": {"calibration": two_zones((0.1012, 0.001, 0.1011, 188), (0.1, 0.0, 0.1, 94), (0.1, 0.002, 0.1, 94)),
                   "validation": two_zones((0.1234, 0.012, 0.1228, 190), (0.11, 0.01, 0.1, 95), (0.13, 0.02, 0.13, 95))},
@@ -128,7 +128,7 @@ def no_effect(report, series):
     report["localization"]["best_nodes"] = []
     report["localization"]["J_best"] = report["localization"]["J_unforced"]
     report["decision"].update(chosen=None, reason="No candidate beats the model without an effect on both tests.",
-                              candidates={k: {"beats_bic": False, "beats_validation": False}
+                              candidates={k: {"beats_bic": False, "beats_selection": False}
                                           for k in report["decision"]["candidates"]})
     for zone in series["zones"].values():
         zone["after"] = zone["before"].copy()
@@ -295,8 +295,8 @@ def test_a_candidate_tried_again_on_top_is_judged_and_marked_in_its_own_round(tm
     report["effects"] = [{"effect": "conductivity", "target": "door"}, {"effect": "solar_absorptance", "target": "roof"}]
     report["decision"]["chosen"] = "solar_absorptance@roof"
     report["decision"]["follow_up"] = {"chosen": "solar_absorptance@roof", "candidates": {
-        "solar_absorptance@roof": {"beats_bic": True, "beats_validation": True, "validation_margin": 1.5}}}
+        "solar_absorptance@roof": {"beats_bic": True, "beats_selection": True, "selection_margin": 1.5}}}
     # the first round's roof: its own verdict, not chosen; the same label on top: chosen, its verdict
     assert content.verdict(report, roof) == report["decision"]["candidates"]["solar_absorptance@roof"]
     assert not content.is_chosen(report, roof) and content.is_chosen(report, first)
-    assert content.verdict(report, again)["validation_margin"] == 1.5 and content.is_chosen(report, again)
+    assert content.verdict(report, again)["selection_margin"] == 1.5 and content.is_chosen(report, again)

@@ -131,6 +131,31 @@ def test_building_json_is_the_generator_output():
     assert BUILDING.read_text() == module.text(), "run examples/twinhouse_n2/make_building.py"
 
 
+def test_experiment_2_s_house_differs_only_by_its_protocol(data):
+    # exp2's README: ventilation about 60 m3/h (not 120), the blinds of W27 and W33 closed
+    spec = importlib.util.spec_from_file_location("make_building", EXAMPLE / "make_building.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    exp2 = module.building(2)
+    supply = sum(z.get("supply", {}).get("flow", 0.0) for z in exp2["zones"])
+    assert supply == 60.0
+    # every zone's inflow still equals its outflow: half of the supply extracted in each of bath and child
+    assert extract_flows(exp2) == pytest.approx({z["name"]: 30.0 if z["name"] in ("bath", "child") else 0.0
+                                                 for z in exp2["zones"]})
+    shaded = {c["name"]: c.get("shading") for c in exp2["components"] if c.get("shading")}
+    assert shaded == {"W27": "shading_W27", "W29": "shading_south", "W30": "shading_south",
+                      "W31": "shading_south", "W33": "shading_W33"}
+    changed = [c for c, d in zip(exp2["components"], data["components"]) if c != d]
+    assert [c["name"] for c in changed] == ["W27", "W33"]
+    assert exp2["materials"] == data["materials"] and exp2["sensors"] == data["sensors"]
+    # the column files name columns experiment 2's data has
+    names = set(pd.read_csv(DATA.parent / "twinhouse_n2_exp2" / "columns.csv")["name"])
+    for listing in ("weather_columns_exp2.txt", "measurement_columns_exp2.txt"):
+        for line in (EXAMPLE / listing).read_text().splitlines():
+            if line and not line.startswith("#"):
+                assert line.split("=", 1)[1] in names, line
+
+
 def test_zones_and_components_are_building_md_s(data, building_md):
     zones = {z["name"]: z for z in data["zones"]}
     for row in table_rows(building_md, "## Zones"):
@@ -332,10 +357,11 @@ def test_diagnose_end_to_end_on_a_few_real_days(tmp_path):
     assert len(sensors) == 5
     assert main(["table", *table, "--select", ",".join(sensors), "-o", str(measurements)]) == 0
     phases = tmp_path / "phases.csv"
-    # the second phase is the validation window (the first holds the burn-in and the calibration)
-    phases.write_text("time,phase\n2013-09-09T00:00+01:00,first half\n2013-09-11T00:10+01:00,second half\n")
+    # the second phase is the validation window (the first holds the burn-in and the calibration:
+    # a day to fit and a day to choose on)
+    phases.write_text("time,phase\n2013-09-09T00:00+01:00,first part\n2013-09-12T00:10+01:00,last day\n")
     assert main(["diagnose", str(BUILDING), "--weather", str(weather), "--measurements", str(measurements),
-                 "-o", str(out), "--objective", "living", "--calibration-end", "2013-09-11T00:00+01:00",
+                 "-o", str(out), "--objective", "living", "--calibration-end", "2013-09-12T00:00+01:00",
                  "--burn-in-days", "1", "--seed", "0", "--phases", str(phases)]) == 0
     md = (out / "report.md").read_text()
     report = json.loads((out / "report.json").read_text())
@@ -353,7 +379,7 @@ def test_diagnose_end_to_end_on_a_few_real_days(tmp_path):
     for worse in report["decision"].get("worsened_phases", []):
         assert f"{worse['phase']} worse" in report["decision"]["reason"]
     assert report["objective"] == ["living"]
-    assert pd.Timestamp(report["period"]["calibration"][1]) == pd.Timestamp("2013-09-11T00:00+01:00")
+    assert pd.Timestamp(report["period"]["calibration"][1]) == pd.Timestamp("2013-09-12T00:00+01:00")
     for side in ("before", "after"):
         for window in ("calibration", "validation"):
             assert math.isfinite(report[side][window]["rmse"]) and report[side][window]["n"] > 0, (side, window)

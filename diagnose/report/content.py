@@ -5,6 +5,8 @@ from __future__ import annotations
 from .formats import NA, time_text
 
 WINDOWS = ("calibration", "validation")
+# the windows whose METRICS report.json holds: the fits' ("calibration"), the choice's, the test's
+SCORED = ("calibration", "selection", "validation")
 STATES = ("before", "after")
 
 
@@ -48,7 +50,7 @@ def decision(report):
 
 
 def verdict(report, candidate):
-    """The loop's {'beats_bic', 'beats_validation', 'validation_margin'} for a candidate ({} if
+    """The loop's {'beats_bic', 'beats_selection', 'selection_margin'} for a candidate ({} if
     not recorded); one tried on top of a first choice is judged in the follow-up decision."""
     judged = decision(report)
     if candidate.get("on_top_of"):
@@ -80,6 +82,13 @@ def reference(report):
     return str(ref.get("label") or "reference"), dict(ref["rmse"])
 
 
+def scored_period_text(report, window):
+    """The span the METRICS of `window` cover: a report with a selection window scores
+    "calibration" on the fitting window, the calibration window's first part."""
+    period = report.get("period") or {}
+    return period_text(report, "fitting" if window == "calibration" and period.get("fitting") else window)
+
+
 def period_text(report, window):
     span = (report.get("period") or {}).get(window)
     if not span or len(span) != 2:
@@ -87,10 +96,14 @@ def period_text(report, window):
     return f"{time_text(span[0])} to {time_text(span[1])}"
 
 
-def window_text(report, window):
-    """A window's span and, for the calibration, where its scoring starts (after the burn-in):
+def scored_from_note(report):
+    """Where the calibration's scoring starts, after the burn-in ("" when the report does not say):
     the terminal and report.md say the same."""
-    period = report.get("period") or {}
-    scored = period.get("calibration_scored_from") if window == "calibration" else None
-    return period_text(report, window) + (f" (residuals scored from {time_text(scored)}, after the burn-in)"
-                                          if scored else "")
+    scored = (report.get("period") or {}).get("calibration_scored_from")
+    return f" (residuals scored from {time_text(scored)}, after the burn-in)" if scored else ""
+
+
+def window_text(report, window):
+    """The span a window's metrics cover (`scored_period_text`) and, for the calibration, where its
+    scoring starts."""
+    return scored_period_text(report, window) + (scored_from_note(report) if window == "calibration" else "")

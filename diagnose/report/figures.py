@@ -7,6 +7,8 @@ matplotlib state (no pyplot, no backend switch). Missing numbers are left out of
 """
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 from matplotlib import dates as mdates
@@ -308,7 +310,7 @@ def plot_candidates(path, report):
                     fontsize=8, color="tab:red")
             continue
         verdict = content.verdict(report, c)
-        key = (bool(verdict.get("beats_bic")), bool(verdict.get("beats_validation")))
+        key = (bool(verdict.get("beats_bic")), bool(verdict.get("beats_selection")))
         style = dict(facecolor="tab:blue") if content.is_chosen(report, c) else VERDICT_STYLES[key][0]
         used.add("chosen" if content.is_chosen(report, c) else key)
         ax.bar(xi, v, edgecolor="0.2", lw=0.5, **style)
@@ -407,3 +409,40 @@ def draw(out_dir, report, series):
     else:
         notes["candidates"] = "No candidate effect was tried: no candidates plot."
     return {k: plots[k] for k in FILES if k in plots}, notes
+
+
+def plot_comparison(path, result, series):
+    """`nodeforce compare`: per objective zone, the measured air and each model's (top), and
+    each model's residual (below), the burn-in hatched; each model labelled by its file and its
+    RMSE over the scored steps."""
+    times, xlabel = _local_times(series["times"])
+    scored = _local_instant(series.get("scored_from"), series["times"])
+    zones = result["objective"]
+    fig = _new_figure(10.0, 1.6 + 4.4 * len(zones))
+    axes = fig.subplots(2 * len(zones), 1, sharex=True, squeeze=False)[:, 0]
+    colors = ["tab:red", "tab:blue", "tab:green", "tab:purple", "tab:orange", "tab:brown"]
+    for j, zone in enumerate(zones):
+        top, bottom = axes[2 * j], axes[2 * j + 1]
+        for ax in (top, bottom):
+            if scored is not None and scored > times[0]:
+                ax.axvspan(times[0], scored, facecolor="none", edgecolor="0.7", hatch="//", lw=0, zorder=0,
+                           label="burn-in (not scored)" if ax is axes[0] else None)
+            ax.grid(alpha=0.3)
+            ax.margins(x=0)
+        measured = series["measured"][:, j]
+        for k, (model, run) in enumerate(zip(result["models"], series["runs"])):
+            label = f"{Path(model['building']).name} (RMSE {fmt_temp(model['metrics']['zones'][zone]['rmse'])} C)"
+            top.plot(times, run[:, j], color=colors[k % len(colors)], lw=1.3, label=label if j == 0 else None)
+            bottom.plot(times, measured - run[:, j], color=colors[k % len(colors)], lw=1.0)
+        top.plot(times, measured, color=COLOR["measured"], lw=0, marker=".", ms=2.0, label="measured" if j == 0 else None)
+        bottom.axhline(0.0, color="0.3", lw=0.8)
+        top.set_title(zone, fontsize=10, loc="left")
+        top.set_ylabel("air temperature (C)")
+        bottom.set_ylabel("measured - simulated (C)")
+    locator = mdates.AutoDateLocator()
+    axes[-1].xaxis.set_major_locator(locator)
+    axes[-1].xaxis.set_major_formatter(mdates.ConciseDateFormatter(locator))
+    axes[-1].set_xlabel(xlabel)
+    fig.suptitle("Building files on a record none was fitted on")
+    fig.legend(loc="outside lower center", ncols=2, fontsize=9, frameon=False)
+    return _save(fig, path)

@@ -23,13 +23,15 @@ def decision_lines(report):
     if not d:
         return ["*The loop recorded no decision in this report.*"]
     lines = [d.get("reason") or NA, ""]
-    bic, J, margin = (num(d.get(k)) for k in ("bic_baseline", "validation_J_before", "validation_margin"))
-    lines.append(f"- BIC of the model without an effect (calibration window): {fmt_sig(bic)}; a candidate must "
+    bic, J, margin = (num(d.get(k)) for k in ("bic_baseline", "selection_J_before", "selection_margin"))
+    lines.append(f"- BIC of the model without an effect (fitting window): {fmt_sig(bic)}; a candidate must "
                  "have a lower BIC.")
-    lines.append(f"- validation J without an effect: {fmt_sig(J)} C²; a candidate must lower it by more than "
+    lines.append(f"- selection window's J without an effect: {fmt_sig(J)} C²; a candidate must lower it by more than "
                  f"the sensor noise could ({fmt_sig(margin)} C²) and by more than {Z_NOISE:g} standard deviations of "
                  "that fall as the residuals' correlation in time makes it (the fall needed, per candidate, "
                  "in the candidates table).")
+    for suggestion in d.get("suggestions") or []:
+        lines.append(f"- suggested, not added: {suggestion['candidate']}: {suggestion['reason']}")
     lines.append(f"- chosen: {d.get('chosen') or 'none'}")
     return lines
 
@@ -84,18 +86,23 @@ def write_markdown(out_dir, report, plots, notes):
         return [f"*{notes.get(key, '')}*", ""]
 
     search = (report.get("localization") or {}).get("search") or {}
+    period = report.get("period") or {}
     ref = tables.reference_text(report)
     md = ["# nodeforce diagnosis report", "",
           "From the residual of the indoor air, to the nodes whose forcing explains it, to a physical "
-          "effect the model lacks, added and calibrated on the calibration window; the validation "
-          "window was not seen by the calibration.", "",
+          "effect the model lacks, added and calibrated on the calibration window's first part and chosen on "
+          "its last (the selection window); the validation window played no part in any choice.", "",
           "## Result", "", *[f"**{line.strip()}**  " for line in tables.effect_header(report, pm="±").splitlines()],
           "", *[f"{line}  " for line in tables.hlc_lines(report, pm="±")], "",
-          *([f"Modelling assumptions: {' '.join(report['assumptions'])}", ""] if report.get("assumptions") else []), "## Decision", "", *decision_lines(report), "",
+          *([f"Modelling assumptions: {' '.join(report['assumptions'])}", ""] if report.get("assumptions") else []),
+          "## Decision", "", *decision_lines(report), "",
           "## Period", "",
           f"- objective zones: {', '.join(content.zones(report)) or NA}",
-          f"- calibration: {content.window_text(report, 'calibration')}",
-          f"- validation: {content.window_text(report, 'validation')}"]
+          f"- calibration: {content.period_text(report, 'calibration')}{content.scored_from_note(report)}",
+          *([f"- fitting (the forcing search and the candidates' fits): {content.period_text(report, 'fitting')}",
+             f"- selection (the choice among the candidates): {content.period_text(report, 'selection')}"]
+            if period.get("selection") else []),
+          f"- validation (before and after only, no part in any choice): {content.period_text(report, 'validation')}"]
     if (report.get("noise") or {}).get("sentence"):
         md.append(f"- {report['noise']['sentence']}")
     md += ["", "## Before and after", "",

@@ -4,7 +4,7 @@ candidates, the sensitivity, the residual diagnostics), each as a header and row
 from __future__ import annotations
 
 from . import content
-from .content import STATES, WINDOWS, metrics
+from .content import SCORED, STATES, metrics
 from .formats import (NA, fmt_bic, fmt_derived, fmt_int, fmt_parameters, fmt_sig, fmt_temp, fmt_value_std, num,
                       time_text)
 from ..phases import is_worse
@@ -57,14 +57,15 @@ def before_after_table(report: dict) -> str:
     width = 8
     group = len(cols) * (width + 1) - 1
     rows = _rows(report)
-    first = max([12] + [len(f"{w} {label}") for w in WINDOWS for label, _ in rows])
+    windows = _scored_windows(report)
+    first = max([12] + [len(f"{w} {label}") for w in windows for label, _ in rows])
     lines = effect_header(report, pm="+-").splitlines() + [
         "Air residual r = measured - simulated (C)",
         f"{'':<{first}} | {'before':^{group}} | {'after':^{group}}",
         f"{'window':<{first}} | " + " ".join(f"{c:>{width}}" for c in cols)
         + " | " + " ".join(f"{c:>{width}}" for c in cols)]
     lines.append("-" * len(lines[-1]))
-    for window in WINDOWS:
+    for window in windows:
         for label, zone in rows:
             cells = []
             for state in STATES:
@@ -73,7 +74,7 @@ def before_after_table(report: dict) -> str:
                     fmt_temp(m.get("rmse")), fmt_temp(m.get("mean"), signed=True), fmt_temp(m.get("sd")),
                     fmt_int(m.get("n")))))
             lines.append(f"{(window + ' ' + label).strip():<{first}} | {cells[0]} | {cells[1]}")
-    lines += [f"{window}: {content.window_text(report, window)}" for window in WINDOWS]
+    lines += [f"{window}: {content.window_text(report, window)}" for window in windows]
     lines += hlc_lines(report) + [f"assumed: {a}" for a in report.get("assumptions") or ()]
     ref = reference_text(report)
     return "\n".join(lines + ([f"for scale, {ref}"] if ref else []))
@@ -81,6 +82,11 @@ def before_after_table(report: dict) -> str:
 
 # ---------------------------------------------------------------------------------------------
 # report.md
+
+
+def _scored_windows(report):
+    """The windows the report has metrics for (a report without a selection window has two)."""
+    return [w for w in SCORED if w != "selection" or metrics(report, "before", w)]
 
 
 def markdown(header, rows):
@@ -98,9 +104,9 @@ def before_after(report):
     rmse_ref = ref[1] if ref else {}
     rows = []
     for label, zone in _rows(report):
-        for window in WINDOWS:
+        for window in _scored_windows(report):
             b, a = (metrics(report, state, window, zone) for state in STATES)
-            rows.append([label or "objective", window, content.period_text(report, window),
+            rows.append([label or "objective", window, content.scored_period_text(report, window),
                          fmt_temp(b.get("mean"), True), fmt_temp(a.get("mean"), True),
                          fmt_temp(b.get("sd")), fmt_temp(a.get("sd")),
                          fmt_temp(b.get("rmse")), fmt_temp(a.get("rmse"))]
@@ -159,11 +165,11 @@ def candidates(report):
                      fmt_temp(metrics(report, c, "validation").get("rmse")),
                      fmt_temp(metrics(report, c, "validation").get("mean"), True),
                      fmt_bic(bic), f"{bic - base:+.1f}" if bic is not None and base is not None else NA,
-                     fmt_sig((c.get("validation_fall") or {}).get("J")), fmt_sig(verdict.get("validation_margin")),
-                     _yes_no(verdict.get("beats_bic")), _yes_no(verdict.get("beats_validation"))])
+                     fmt_sig((c.get("selection_fall") or {}).get("J")), fmt_sig(verdict.get("selection_margin")),
+                     _yes_no(verdict.get("beats_bic")), _yes_no(verdict.get("beats_selection"))])
     return markdown(["effect", "target", "parameters (value ± std)", "the data determine",
                      "calibration RMSE (C)", "validation RMSE (C)", "validation mean (C)", "BIC", "ΔBIC",
-                     "validation fall of J (C²)", "fall needed (C²)", "beats BIC", "beats validation"], rows)
+                     "selection fall of J (C²)", "fall needed (C²)", "beats BIC", "beats selection"], rows)
 
 
 def candidate_zones(report):

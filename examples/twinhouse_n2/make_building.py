@@ -5,7 +5,14 @@ modelling assumption stated in README.md; this script is the one place they are 
 tests/test_twinhouse.py checks that building.json is its output. Run it from anywhere:
 
     python examples/twinhouse_n2/make_building.py
+
+The same house under experiment 2's protocol (60 m3/h of supply air, the blinds of W27 and W33
+closed: a shading column each), optionally with the effects a diagnosis added on experiment 1
+(report.json's "effects"), is written by
+
+    python examples/twinhouse_n2/make_building.py --experiment 2 -o FILE [--corrected-by REPORT]
 """
+import argparse
 import json
 import math
 from pathlib import Path
@@ -22,7 +29,6 @@ H_CONV_UPWARD_FLOW = 5.0  # EN ISO 6946, both faces of the ceiling
 H_CONV_DOWNWARD_FLOW = 0.7  # EN ISO 6946, both faces of the floor
 
 # --- Air flows (BUILDING.md "Ventilation", "Zones") ---------------------------------------
-SUPPLY_FLOW = 120.0  # m3/h into living, at vent_SUA_corr_AT
 N50 = 1.62  # 1/h, N2
 AIR_CHANGE_RATE = round(N50 / 20, 4)  # 1/h, the n50/20 rule of thumb, every zone alike
 
@@ -101,6 +107,12 @@ WINDOWS = {
 }
 SOUTH_SHADING = "shading_south"  # 1 blinds open, 0 closed (N2 Exp1: 0 throughout)
 
+# --- What differs between the experiments (the data's READMEs) ------------------------------
+# supply_flow: m3/h into living, at vent_SUA_corr_AT; shaded: windows whose blinds differ from
+# the others', each with its own shading column (1 open, 0 closed), besides the south windows'.
+EXPERIMENTS = {1: {"supply_flow": 120.0, "shaded": {}},
+               2: {"supply_flow": 60.0, "shaded": {"W27": "shading_W27", "W33": "shading_W33"}}}
+
 # --- Zones: IDEAS volumes (m3) and measured heat inputs (columns without the N2_ prefix) -----
 ZONES = {
     "living": (86.42, ["heat_elP_living_room"]),
@@ -113,8 +125,11 @@ ZONES = {
 }
 # Air leaves living for the corridor, which passes it on to bath and child (50/50), where it is
 # extracted: (receiving zone, sending zone, m3/h).
-AIRFLOWS = [("corridor", "living", SUPPLY_FLOW), ("bath", "corridor", SUPPLY_FLOW / 2),
-            ("child", "corridor", SUPPLY_FLOW / 2)]
+def airflows(supply_flow):
+    """(to, from, m3/h): the supply air on from living to the corridor, half of it to each of
+    bath and child, where it is extracted."""
+    return [("corridor", "living", supply_flow), ("bath", "corridor", supply_flow / 2),
+            ("child", "corridor", supply_flow / 2)]
 
 FACADE_IRRADIANCE = {0.0: "Solar_radiation_global_vertical_north",
                      90.0: "Solar_radiation_global_vertical_east",
@@ -212,7 +227,7 @@ def _component(name, area, tilt, azimuth, layers, nodes, inside, outside, **extr
             "inside": inside, "outside": outside, **extra}
 
 
-def components():
+def components(experiment=1):
     """Every component of the ground floor, in IDEAS id order."""
     out = []
     for name, (construction, area, azimuth, zone) in EXTERIOR_OPAQUE.items():
@@ -234,6 +249,8 @@ def components():
                  "transmitted_solar_to": FLOOR_OF[zone]}
         if azimuth == 180.0:
             extra["shading"] = SOUTH_SHADING
+        elif name in EXPERIMENTS[experiment]["shaded"]:
+            extra["shading"] = EXPERIMENTS[experiment]["shaded"][name]
         out.append(_component(name, area, 90.0, azimuth, [("glazing_equivalent", GLASS_THICKNESS)],
                               NODES["thin"], _surface(zone, H_CONV_HORIZONTAL_FLOW),
                               _exterior(FACADE_IRRADIANCE[azimuth], round(SOLAR_ABSORPTANCE_OUT * frame, 4)),
@@ -246,8 +263,9 @@ def components():
     return sorted(out, key=lambda c: int(c["name"][1:]))
 
 
-def zones():
+def zones(experiment=1):
     """The seven rooms: IDEAS volumes, no occupants, measured heat inputs, the ventilation path."""
+    supply_flow = EXPERIMENTS[experiment]["supply_flow"]
     out = []
     for name, (volume, heat_input) in ZONES.items():
         zone = {"name": name, "volume": volume, "air_change_rate": AIR_CHANGE_RATE,
@@ -256,8 +274,8 @@ def zones():
             zone["heat_input"] = heat_input[0] if len(heat_input) == 1 else heat_input
             zone["heat_input_radiative_fraction"] = HEATER_RADIATIVE_FRACTION
         if name == "living":
-            zone["supply"] = {"flow": SUPPLY_FLOW, "temperature": "vent_SUA_corr_AT"}
-        inflow = [{"zone": source, "flow": flow} for to, source, flow in AIRFLOWS if to == name]
+            zone["supply"] = {"flow": supply_flow, "temperature": "vent_SUA_corr_AT"}
+        inflow = [{"zone": source, "flow": flow} for to, source, flow in airflows(supply_flow) if to == name]
         if inflow:
             zone["airflow_from"] = inflow
         out.append(zone)
@@ -274,8 +292,8 @@ def sensors():
     return named
 
 
-def building():
-    """The whole building file as JSON data."""
+def building(experiment=1):
+    """The whole building file as JSON data, under the protocol of `experiment` (EXPERIMENTS)."""
     materials = {name: {"conductivity": k, "density": rho, "specific_heat": c}
                  for name, (k, rho, c) in MATERIALS.items()}
     materials["glazing_equivalent"] = {"conductivity": round(glazing_conductivity(), 6),
@@ -290,16 +308,34 @@ def building():
         "site": {"latitude": 47.874, "longitude": 11.728, "altitude": 690.0,
                  "timezone": "Etc/GMT-1", "ground_albedo": 0.23},
         "materials": materials,
-        "zones": zones(),
-        "components": components(),
+        "zones": zones(experiment),
+        "components": components(experiment),
         "sensors": sensors(),
     }
 
 
-def text():
-    """building.json's text: the data, indented, with a final newline."""
-    return json.dumps(building(), indent=1) + "\n"
+def text(data=None):
+    """building.json's text: the data (default: experiment 1's), indented, with a final newline."""
+    return json.dumps(building() if data is None else data, indent=1) + "\n"
+
+
+def corrected(data, report_path):
+    """The building data with the effects a diagnosis added (report.json's "effects", in order),
+    each declared at its calibrated values."""
+    from nodeforce.model.building import parse_building
+    from nodeforce.model.effects import EFFECTS
+    model = parse_building(data)
+    for added in json.loads(Path(report_path).read_text())["effects"]:
+        values = {name: p["value"] for name, p in added["parameters"].items()}
+        model = EFFECTS[added["effect"]].apply(model, added["target"], values)
+    return model.to_json()
 
 
 if __name__ == "__main__":
-    (HERE / "building.json").write_text(text())
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--experiment", type=int, choices=sorted(EXPERIMENTS), default=1)
+    parser.add_argument("-o", "--output", type=Path, default=HERE / "building.json")
+    parser.add_argument("--corrected-by", help="a diagnosis' report.json whose effects are added")
+    args = parser.parse_args()
+    data = building(args.experiment)
+    args.output.write_text(text(corrected(data, args.corrected_by) if args.corrected_by else data))

@@ -1,0 +1,109 @@
+"""`nodeforce compare`: building files run on one record none of them was fitted on.
+
+A correction found by `diagnose` on one experiment is only worth what it does on another: the
+house as written and as corrected are each simulated through their FMU on the same weather and
+measurements (each reads the columns its own file names), and scored on the same steps: the
+RMSE, mean and sd of each objective zone's air residual, overall and per phase of the
+experiment, beside each model's heat loss coefficient (PHYSICS.md section 8).
+"""
+import json
+from pathlib import Path
+
+import numpy as np
+
+from nodeforce import tempdirs
+from nodeforce.cosim.fmi import FmuInstance
+from nodeforce.cosim.run import simulate_fmu
+from nodeforce.diagnose.report.figures import plot_comparison
+from nodeforce.diagnose.report.formats import fmt_sig, fmt_temp
+from nodeforce.diagnose.report.tables import markdown
+from nodeforce.fmu_build.build import build_fmu
+from nodeforce.ga.locate import check_measured
+from nodeforce.model.errors import InputError
+from nodeforce.model.hlc import heat_loss_coefficient
+
+
+def run_model(building, case, objective, fmu_kind="python"):
+    """The objective's air (C) at t_1..t_N of `building` simulated on `case` through its FMU,
+    built and removed in a temporary folder."""
+    with tempdirs.folder("compare") as tmp:
+        with FmuInstance(build_fmu(building, Path(tmp) / "model.fmu", kind=fmu_kind)) as instance:
+            return simulate_fmu(instance, case, output_ids=objective.air_nodes)
+
+
+def compare(models, phases=(), fmu_kind="python"):
+    """Score each model on its record; return the content of compare.json and the series to plot.
+
+    Parameters
+    ----------
+    models : [(path, Building, Case, Objective)]: each building with the record prepared for it
+        (its burn-in set) and its objective; the records must share their times and the
+        objectives their zone names
+    phases : iotools.phases.Phase records, each model scored on each
+    """
+    path0, _, case0, objective0 = models[0]
+    for path, _, case, objective in models:
+        if objective.zones != objective0.zones:
+            raise InputError(path, "--objective", f"zones {', '.join(objective.zones)} differ from those of "
+                                                  f"{path0} ({', '.join(objective0.zones)})")
+        if not case.times.equals(case0.times) or case.burn_in_steps != case0.burn_in_steps:
+            raise InputError(path, "time", f"its record does not have the times of {path0}'s")
+        check_measured(objective, case, path)
+    times = case0.times[1:]
+    result = {"record": [case0.times[0].isoformat(), case0.times[-1].isoformat()],
+              "objective": list(objective0.zones),
+              "scored_from": case0.times[case0.burn_in_steps + 1].isoformat(), "models": []}
+    series = {"times": times, "scored_from": case0.times[case0.burn_in_steps + 1], "measured": None, "runs": []}
+    for path, building, case, objective in models:
+        measured = objective.measured(case)
+        simulated = run_model(building, case, objective, fmu_kind)
+        by_phase = {}
+        for phase in phases:
+            inside = np.asarray(phase.mask(times))
+            if np.isfinite(measured[inside]).any():
+                by_phase[phase.name] = objective.metrics(measured[inside], simulated[inside])
+        result["models"].append({"building": str(path), "heat_loss_coefficient": heat_loss_coefficient(building),
+                                 "metrics": objective.metrics(measured, simulated), "phases": by_phase})
+        series["measured"] = measured
+        series["runs"].append(simulated)
+    return result, series
+
+
+def write_compare(out, result, series):
+    """compare.json, the plot and compare.md in `out`; returns their paths."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    plot = plot_comparison(out / "compare.png", result, series)
+    (out / "compare.json").write_text(json.dumps(result, indent=2) + "\n")
+    (out / "compare.md").write_text(compare_markdown(result, plot.name))
+    return out / "compare.json", out / "compare.md", plot
+
+
+def compare_markdown(result, plot_name):
+    """The comparison as a human reads it: per model, its heat loss coefficient and its error per
+    objective zone, then the RMSE per phase."""
+    names = [Path(m["building"]).name for m in result["models"]]
+    zones = result["objective"]
+    rows = []
+    for name, m in zip(names, result["models"]):
+        for zone in zones:
+            z = m["metrics"]["zones"][zone]
+            rows.append([name, fmt_sig(m["heat_loss_coefficient"]), zone, fmt_temp(z["rmse"]),
+                         fmt_temp(z["mean"], True), fmt_temp(z["sd"]), z["n"]])
+        if len(zones) > 1:
+            a = m["metrics"]
+            rows.append([name, fmt_sig(m["heat_loss_coefficient"]), "all", fmt_temp(a["rmse"]),
+                         fmt_temp(a["mean"], True), fmt_temp(a["sd"]), a["n"]])
+    md = ["# nodeforce comparison", "",
+          f"Each building file simulated on the record {result['record'][0]} to {result['record'][1]}, none of "
+          f"them fitted on it; residuals (measured - simulated) scored from {result['scored_from']}, after the "
+          "burn-in.", "",
+          markdown(["building", "heat loss coefficient (W/K)", "zone", "RMSE (C)", "mean (C)", "sd (C)", "n"], rows),
+          ""]
+    phases = list(dict.fromkeys(p for m in result["models"] for p in m["phases"]))
+    if phases:
+        md += ["## RMSE per phase (C, all objective zones)", "",
+               markdown(["phase", *names], [[p, *(fmt_temp((m["phases"].get(p) or {}).get("rmse"))
+                                                    for m in result["models"])] for p in phases]), ""]
+    md += [f"![measured and simulated air]({plot_name})", ""]
+    return "\n".join(md)
