@@ -12,7 +12,7 @@ from pathlib import Path
 from nodeforce import tempdirs
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
-from nodeforce.diagnose import loop as _loop
+from nodeforce.diagnose import compare as _compare, loop as _loop
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga import locate as _locate
 from nodeforce.iotools.measurements import read_measurements
@@ -25,7 +25,7 @@ from nodeforce.model.score import Objective
 
 __all__ = ["InputError", "read_building", "read_weather", "read_measurements", "read_phases", "measured_case",
            "objective", "simulate", "write_fmu", "open_fmu", "simulate_fmu", "forcing_candidates",
-           "score_forcing", "locate", "diagnose"]
+           "score_forcing", "locate", "diagnose", "compare"]
 
 # The API's cases carry no file name: errors about their measurements say "measurements".
 SOURCE = "measurements"
@@ -223,6 +223,34 @@ def diagnose(building, case, workdir, objective=None, **options):
     """
     with _folder(workdir) as folder:
         return _loop.diagnose(building, case, objective or Objective.of(building), folder, source=SOURCE, **options)
+
+
+def compare(models, workdir=None, phases=(), fmu_kind="python"):
+    """`nodeforce compare`: building files scored on one record none of them was fitted on.
+
+    Parameters
+    ----------
+    models : list of (name, Building, Case, Objective)
+        Each building with the record prepared for it by `measured_case` (same times and burn-in
+        for all) and its objective (the same zone names for all); `name` labels it in the output.
+    workdir : str or Path, optional
+        Folder for compare.json, compare.md and the plot; None writes nothing.
+    phases : list of Phase, optional
+        From `read_phases`: every model is also scored on each.
+    fmu_kind : str
+        "python" or "standalone" (or their "-fmi3" forms): the FMU each model runs through.
+
+    Returns
+    -------
+    dict
+        compare.json's content: per model its heat loss coefficient (W/K) and the RMSE, mean and
+        sd (C) of each objective zone's air residual, overall and per phase.
+    """
+    result, series = _compare.compare(models, phases, fmu_kind=fmu_kind)
+    if workdir is not None:
+        Path(workdir).mkdir(parents=True, exist_ok=True)
+        _compare.write_compare(Path(workdir), result, series)
+    return result
 
 
 @contextmanager

@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 
 import nodeforce
+from nodeforce.model.effects import EFFECTS
 from tests.conftest import DATA
 
 BURN_IN_STEPS = 96  # one day at 15 min
@@ -54,3 +55,22 @@ def test_the_api_is_loaded_only_when_used():
             "nodeforce.read_building; print('nodeforce.api' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.split() == ["False", "True"]
+
+
+def test_compare_through_the_api_scores_each_model_as_its_own_fmu_run_does(demo, tmp_path):
+    """Two models on the demo record: each one's RMSE is that of the residual of its own air
+    simulated through its FMU and scored by hand from the burn-in's end."""
+    building, weather, measured, case = demo
+    coupled = EFFECTS["ground_coupling"].apply(building, "floor", {"U": 0.5, "T_ground": 24.0})
+    objective = nodeforce.objective(building)
+    models = [("written", building, case, objective),
+              ("coupled", coupled, nodeforce.measured_case(coupled, weather, measured, burn_in_days=1), objective)]
+    result = nodeforce.compare(models, workdir=tmp_path)
+    assert [m["building"] for m in result["models"]] == ["written", "coupled"]
+    for model, (_, b, c, _) in zip(result["models"], models):
+        with nodeforce.open_fmu(nodeforce.write_fmu(b, tmp_path / f"{model['building']}.fmu")) as fmu:
+            T = nodeforce.simulate_fmu(fmu, c)
+        r = (measured["T23"].to_numpy()[1:] - T[:, 22])[BURN_IN_STEPS:]
+        r = r[np.isfinite(r)]
+        assert model["metrics"]["rmse"] == pytest.approx(np.sqrt(np.mean(r ** 2)), rel=1e-9)
+    assert (tmp_path / "compare.json").exists() and (tmp_path / "compare.md").exists()
