@@ -192,8 +192,8 @@ def cmd_synth(args):
     from nodeforce.model.effects import EFFECTS
     from nodeforce.model.synth import pseudo_measurements
     building = load_building(args.building)
-    if args.effect:
-        effect, target, values = effect_spec(args.effect)
+    for text in args.effect or ():  # several faults at once: each applied in turn
+        effect, target, values = effect_spec(text)
         if not EFFECTS[effect].applies(building, target):
             raise InputError("--effect", f"{effect}@{target}", f"does not apply to {args.building}")
         building = EFFECTS[effect].apply(building, target, values)
@@ -212,7 +212,7 @@ def cmd_synth(args):
                                 noise_sd=args.noise, seed=args.seed, history_days=args.history_days)
     frame.round(4).to_csv(args.output, date_format="%Y-%m-%dT%H:%M:%S%z")
     print(f"wrote {args.output}: nodes {args.sensors}, {len(times)} times from {times[0].isoformat()}, "
-          f"noise {args.noise} C" + (f", with {args.effect} not in {args.building}" if args.effect else ""))
+          f"noise {args.noise} C" + (f", with {' and '.join(args.effect)} not in {args.building}" if args.effect else ""))
 
 
 def run_diagnosis(building, case, objective, out, source, args):
@@ -381,8 +381,9 @@ def parser():
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--history-days", type=float, default=7.0,
                    help="days of real weather simulated before the record")
-    s.add_argument("--effect", help="EFFECT@TARGET:name=value,... added to the building, e.g. "
-                                    "ground_coupling@floor:U=0.8,T_ground=24")
+    s.add_argument("--effect", action="append",
+                   help="EFFECT@TARGET:name=value,... added to the building, e.g. "
+                        "ground_coupling@floor:U=0.8,T_ground=24; repeat it for several at once")
     s.set_defaults(run=cmd_synth)
 
     s = sub.add_parser("table", help="columns of a Modelica CombiTimeTable text file as a weather or measurements CSV")
