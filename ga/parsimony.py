@@ -32,8 +32,8 @@ surface of a wrong roof wins over the layer behind it (their J differ by noise),
 that merely compensates a wrong door does not win over the door because it comes first: its J
 is measurably worse. Sets of up to EXACT_ANY nodes are searched over the whole chromosome, so
 the answer for one or two faults does not depend on the path the search took (above
-ALL_PAIRS_UP_TO genes, pairs among the best chromosome's nodes and the PAIR_POOL single nodes
-that lower J most, beyond the noise: a building's 100 sensors make 4,950 pairs). The empty set
+ALL_PAIRS_UP_TO genes, pairs among the PAIR_POOL single nodes that lower J most, beyond the
+noise: a building's 100 sensors make 4,950 pairs). The empty set
 comes first, so best_nodes = [] exactly when J_unforced - J_min <= tolerance: no significant
 reduction. Larger subsets of the best chromosome are searched exhaustively, smallest first,
 when it forces at most EXACT_MAX_NODES nodes; otherwise by backward elimination: repeatedly
@@ -59,10 +59,10 @@ RELATIVE_FLOOR = 0.01
 EXACT_MAX_NODES = 8
 EXACT_ANY = 2
 # Above this many genes, pairs are not all scored (100 genes make 4,950 pairs, most of a search's
-# budget): only pairs among the best chromosome's nodes and the PAIR_POOL single nodes that
-# lower J most, by more than the noise alone. Measured in benchmarks/bench_scale.py.
+# budget): only pairs among the PAIR_POOL single nodes that lower J most, by more than the noise
+# alone (larger sets come from the best chromosome). Measured in benchmarks/bench_scale.py.
 ALL_PAIRS_UP_TO = 25
-PAIR_POOL = 16
+PAIR_POOL = 10
 
 
 def tolerance(J_unforced: float, noise_sigma: "float | None", n_residuals: "int | None") -> float:
@@ -117,7 +117,7 @@ def smallest_subset(J_many: Callable[[Sequence[tuple]], list], best: tuple, limi
         if size == 1 and len(best) > ALL_PAIRS_UP_TO:
             J_single = J_many([mask((i,)) for i in pool])
             lowering = sorted((J, i) for i, J in enumerate(J_single) if J < J_none - noise_tol)
-            pool = sorted(set(members) | {i for _, i in lowering[:PAIR_POOL]})
+            pool = sorted(i for _, i in lowering[:PAIR_POOL])
     if len(members) <= EXACT_MAX_NODES:
         return mask(_smallest_first(J_many, mask, members, limit, noise_tol))
     return mask(_backward_elimination(J_many, mask, members, limit))

@@ -268,7 +268,7 @@ def initial_state(building, measured0, T_default=20.0):
 
 
 def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2, T_default=20.0,
-             include_start=False, burn_in_steps=0):
+             include_start=False, burn_in_steps=0, stepper=None):
     """Simulate the network over input samples t_0..t_N; return temperatures at t_1..t_N.
 
     Parameters
@@ -283,6 +283,8 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     T_default : C, the initial temperature of a node nothing informs
     include_start : also return the state at t_0 (after the warm-up) as the first row
     burn_in_steps : B, steps over which every measured node is forced (`forcing_schedule`)
+    stepper : the network's `ImplicitEuler` for dt, if one is kept between runs (its factors
+        per mask are then reused)
 
     Returns
     -------
@@ -295,7 +297,7 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
         force = np.zeros(n, dtype=bool)
     sources = network.sources(U)
     forced = forcing_schedule(force, measured, burn_in_steps)
-    stepper = ImplicitEuler(network, dt)
+    stepper = ImplicitEuler(network, dt) if stepper is None else stepper
     T = initial_state(building, measured[0], T_default)
     rows = warmup_rows(n_rows, dt, warmup_days)
     start = len(rows) - (n_rows - 1)  # the step that reaches t_1
