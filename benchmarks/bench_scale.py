@@ -268,7 +268,7 @@ def main(argv=None):
     parser.add_argument("--dask", action="store_true", help="item 3: 1 process, 2 processes, a Dask cluster")
     parser.add_argument("--repeats", type=int, default=3, help="timed simulations per evaluator and size")
     parser.add_argument("--plot", default="bench_scale.png", help="the plot of item 1")
-    parser.add_argument("--fmu", default="standalone", help="the evaluator of items 2 and 3")
+    parser.add_argument("--fmu", default="auto", help="the evaluator of items 2 and 3 (locate --fmu)")
     parser.add_argument("--paper-generations", type=int, default=0, help="also run the paper's GA that long")
     args = parser.parse_args(argv)
     print(f"{os.cpu_count()} cores, load {os.getloadavg()[0]:.1f}", flush=True)
