@@ -64,6 +64,7 @@ typedef struct {
     double *v, *work;
     unsigned char *imposed;
     Profile profile;
+    long *b_start; int *b_column; double *b_value; /* B's nonzeros by row: a node has few inputs */
     Factors cache[CACHED_PATTERNS];
 } Model;
 
@@ -158,11 +159,11 @@ static void free_network(Network *net) {
 }
 
 /* ------------------------------------------------------------------ the numbers */
-/* C, A, B, q at the effect parameters' current values. */
+/* C, A, B, q at the effect parameters' current values, and B's nonzeros by row. */
 static void network_at_parameters(Model *m) {
     const Network *net = &m->net;
     long size = term_size(net), k;
-    int t, j;
+    int t, i, j;
     double *out = m->C; /* C, A, B, q, P are one contiguous block */
     memset(out, 0, (size_t)size * sizeof(double));
     for (t = 0; t < net->n_terms; t++) {
@@ -172,6 +173,15 @@ static void network_at_parameters(Model *m) {
             if (net->term_mask[t] & (1 << j)) weight *= m->values[vr_parameters(&m->layout) + j] - net->p0[j];
         for (k = 0; k < size; k++) out[k] += weight * term[k];
     }
+    for (i = 0, k = 0; i < net->n; i++) {
+        m->b_start[i] = k;
+        for (j = 0; j < net->n_in; j++)
+            if (m->B[(long)i * net->n_in + j] != 0.0) {
+                m->b_column[k] = j;
+                m->b_value[k++] = m->B[(long)i * net->n_in + j];
+            }
+    }
+    m->b_start[net->n] = k;
 }
 
 /* np.interp(x, xp, fp) with xp increasing: the end values held beyond the range. */
@@ -382,7 +392,7 @@ static void forget_factors(Model *m) {
 
 static fmi2Status step(Model *m, double dt) {
     const Network *net = &m->net;
-    int n = net->n, i, j, k;
+    int n = net->n, i, k;
     const double *u = m->values + vr_inputs(&m->layout), *T_forced = m->values + vr_T_forced(&m->layout);
     double *T = m->values + vr_T(&m->layout);
     Factors *f;
@@ -393,8 +403,9 @@ static fmi2Status step(Model *m, double dt) {
         return fmi2Error;
     }
     for (i = 0; i < n; i++) { /* the sources */
+        long k_b;
         m->v[i] = m->q[i];
-        for (j = 0; j < net->n_in; j++) m->v[i] += m->B[i * net->n_in + j] * u[j];
+        for (k_b = m->b_start[i]; k_b < m->b_start[i + 1]; k_b++) m->v[i] += m->b_value[k_b] * u[m->b_column[k_b]];
     }
     for (k = 0; k < net->n_products; k++) {
         const int *p = net->product + 3 * k;
@@ -424,6 +435,7 @@ static void free_model(Model *m) {
     free_network(&m->net);
     free(m->name); free(m->values); free(m->start_values); free(m->C); free(m->v); free(m->work);
     free(m->imposed); free(m->profile.order); free(m->profile.first); free(m->profile.start);
+    free(m->b_start); free(m->b_column); free(m->b_value);
     free(m);
 }
 
@@ -469,8 +481,12 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
     m->P = m->q + m->net.n;
     m->v = calloc((size_t)m->net.n, sizeof(double));
     m->work = calloc((size_t)m->net.n, sizeof(double));
+    m->b_start = calloc((size_t)m->net.n + 1, sizeof(long));
+    m->b_column = calloc((size_t)m->net.n * m->net.n_in + 1, sizeof(int));
+    m->b_value = calloc((size_t)m->net.n * m->net.n_in + 1, sizeof(double));
     m->imposed = calloc((size_t)m->net.n, 1);
-    if (!m->values || !m->start_values || !m->C || !m->v || !m->work || !m->imposed || !order_network(m)) {
+    if (!m->values || !m->start_values || !m->C || !m->v || !m->work || !m->imposed || !m->b_start || !m->b_column
+        || !m->b_value || !order_network(m)) {
         free_model(m);
         return NULL;
     }
