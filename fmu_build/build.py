@@ -23,7 +23,6 @@ from nodeforce.model.effects import EFFECTS
 from nodeforce.model.network import input_names
 
 from . import description
-from .compiler import find_compiler
 from .guard import guarded
 from .variables import Layout
 
@@ -32,18 +31,6 @@ VARIABLES = Path(__file__).with_name("variables.py")
 MODEL_DIR = Path(model.__file__).parent
 # The modules the FMU imports; weather and solar stay outside (their results are inputs).
 PHYSICS_MODULES = ("__init__", "errors", "building", "discretise", "effects", "network", "integrate")
-
-
-# Below this many nodes the standalone FMU is the search's cheapest evaluator, from there on the
-# Python FMU, whose condensed solver is O(N) per step in fewer operations than the C FMU's
-# profile LU (benchmarks/bench_scale.py, docs/performance.md).
-STANDALONE_UP_TO = 1000  # nodes
-
-
-def evaluator_kind(building):
-    """The FMU kind a search should drive for this building ("auto"): the standalone FMU below
-    STANDALONE_UP_TO nodes where a C compiler is at hand, else the Python FMU."""
-    return "standalone" if building.n_nodes < STANDALONE_UP_TO and find_compiler() else "python"
 
 
 def build_fmu(building, destination, effect=None, kind="python"):
@@ -55,15 +42,12 @@ def build_fmu(building, destination, effect=None, kind="python"):
     destination : path of the .fmu to write
     effect : (effect id, target) of `model.effects` whose parameters the FMU exposes as
         `<effect>.<name>` (start: the values the building declares), or None
-    kind : "python" (pythonfmu), "standalone" (C, no Python at run time) or "auto"
-        (`evaluator_kind`: the faster of the two for the building's size)
+    kind : "python" (pythonfmu) or "standalone" (C, no Python at run time)
 
     Returns
     -------
     Path of the FMU written
     """
-    if kind == "auto":
-        kind = evaluator_kind(building)
     if kind not in KINDS:
         raise ValueError(f"unknown FMU kind {kind!r}: one of {', '.join(KINDS)}")
     if effect is not None and not EFFECTS[effect[0]].applies(building, effect[1]):

@@ -8,12 +8,25 @@ import numpy as np
 from scipy.sparse.csgraph import shortest_path
 
 from nodeforce.fmu_build.build import build_fmu
+from nodeforce.fmu_build.compiler import find_compiler
 from nodeforce.ga.fitness import FmuFitness
 from nodeforce.ga.parsimony import EXPLAINED, removed
 from nodeforce.ga.search import PATIENCE, search
 from nodeforce.model.errors import InputError
 from nodeforce.model.network import assemble
 from nodeforce.model.score import Noise
+
+
+# Below this many nodes the standalone FMU is the search's cheapest evaluator, from there on the
+# Python FMU (benchmarks/bench_scale.py, docs/performance.md).
+STANDALONE_UP_TO = 1000  # nodes
+
+
+def evaluator_kind(building):
+    """The FMU kind the search drives for `fmu_kind="auto"`: the standalone FMU below
+    STANDALONE_UP_TO nodes where a C compiler is at hand (it is compiled at export), else the
+    Python FMU."""
+    return "standalone" if building.n_nodes < STANDALONE_UP_TO and find_compiler() else "python"
 
 
 def check_measured(objective, case, source):
@@ -65,12 +78,13 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
     every generation with (generation, total, best J, unique evaluations). `noise` is the air
     sensors' noise sd (C) if the user knows it, else it is estimated (`model.score.Noise`). patience and seeded
     choose the search (ga.search: the defaults stop at convergence; ga.search.PAPER's values
-    give the paper's search).
+    give the paper's search). fmu_kind: "python", "standalone" or "auto" (`evaluator_kind`).
     """
     candidates = chromosome_nodes(building, case, objective, source, nodes, include_algebraic)
     if not candidates:
         raise InputError(source, "columns", "no measured node besides the objective's air: nothing to force")
-    fmu = build_fmu(building, workdir / "model.fmu", kind=fmu_kind)
+    kind = evaluator_kind(building) if fmu_kind == "auto" else fmu_kind
+    fmu = build_fmu(building, workdir / "model.fmu", kind=kind)
     measured = objective.measured(case)
     noise = Noise.of(measured, noise)
     result = search(FmuFitness(fmu, case, candidates, objective, warmup_days), candidates,
