@@ -16,13 +16,14 @@ Measures, in one run on one machine:
    (the seeded search; at the end of the run, with `--paper-generations`, the paper's GA for that
    many generations), which nodes it finds, how many unique simulations, and the wall time; the
    forward-backward pass's own answer (`stepwise_nodes`) is in the same locate.json.
-3. `--dask`: the small office with two faults located by 1 process, 2 processes and a Dask
-   cluster started here on 127.0.0.1 (`dask scheduler` and `dask worker` processes), the same
+3. `--dask small|full`: the small office with two faults, or the full one with its three,
+   located by 1 process, 2 processes and a Dask cluster started here on 127.0.0.1 (`dask scheduler` and `dask worker` processes), the same
    answer required, with the speed-up.
 
 Every FMU, record and checkpoint goes to a fresh temporary directory, removed at the end. Run:
 
-    nice -n 10 .venv/bin/python benchmarks/bench_scale.py --sizes --search --dask
+    nice -n 10 .venv/bin/python benchmarks/bench_scale.py --sizes --search --dask small --paper-generations 30
+    nice -n 10 .venv/bin/python benchmarks/bench_scale.py --dask full    # its "2 processes" is --search, standalone
 """
 import argparse
 import json
@@ -231,13 +232,15 @@ def free_port():
         return s.getsockname()[1]
 
 
-def bench_dask(tmp, fmu):
-    folder = tmp / "small"
-    objective = office_records(folder, office.SMALL, FAULTS_SMALL, 3)
+def bench_dask(tmp, fmu, which):
+    """1 process, 2 processes and a Dask cluster of 2 workers on the small or the full office."""
+    size, faults, days = (office.FULL, FAULTS_FULL, 4) if which == "full" else (office.SMALL, FAULTS_SMALL, 3)
+    folder = tmp / f"dask_{which}"
+    objective = office_records(folder, size, faults, days)
     names = load_building(folder / "building.json").node_names()
     runs = {}
     for label, extra in (("1 process", ["--workers", "1"]), ("2 processes", ["--workers", "2"])):
-        result, seconds = locate(folder, objective, tmp / label.replace(" ", "_"), "--fmu", fmu, *extra)
+        result, seconds = locate(folder, objective, folder / label.replace(" ", "_"), "--fmu", fmu, *extra)
         runs[label] = summary(result, seconds, names)
         print(label, json.dumps(runs[label]), flush=True)
     port = free_port()
@@ -249,11 +252,11 @@ def bench_dask(tmp, fmu):
         time.sleep(3)
         address = f"tcp://127.0.0.1:{port}"
         processes += [subprocess.Popen([str(bin_dir / "dask"), "worker", address, "--nworkers", "1", "--nthreads", "1",
-                                        "--host", "127.0.0.1", "--no-dashboard", "--local-directory", str(tmp / f"dw{i}")],
+                                        "--host", "127.0.0.1", "--no-dashboard", "--local-directory", str(folder / f"dw{i}")],
                                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
                       for i in range(2)]
         time.sleep(6)
-        result, seconds = locate(folder, objective, tmp / "dask", "--fmu", fmu, "--scheduler", address)
+        result, seconds = locate(folder, objective, folder / "dask", "--fmu", fmu, "--scheduler", address)
         runs["dask, 2 workers"] = summary(result, seconds, names)
         print("dask, 2 workers", json.dumps(runs["dask, 2 workers"]), flush=True)
     finally:
@@ -270,7 +273,8 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--sizes", action="store_true", help="item 1: cost against N")
     parser.add_argument("--search", action="store_true", help="item 2: the full office's three faults")
-    parser.add_argument("--dask", action="store_true", help="item 3: 1 process, 2 processes, a Dask cluster")
+    parser.add_argument("--dask", choices=("small", "full"), help="item 3 on this office: 1 process, 2 processes, "
+                                                                   "a Dask cluster")
     parser.add_argument("--repeats", type=int, default=3, help="timed simulations per evaluator and size")
     parser.add_argument("--plot", default="bench_scale.png", help="the plot of item 1")
     parser.add_argument("--fmu", default="auto", help="the evaluator of items 2 and 3 (locate --fmu)")
@@ -284,7 +288,7 @@ def main(argv=None):
         if args.search:
             bench_search(tmp, args.fmu, 0)
         if args.dask:
-            bench_dask(tmp, args.fmu)
+            bench_dask(tmp, args.fmu, args.dask)
         if args.paper_generations:  # last: the longest, and the least needed
             bench_search(tmp, args.fmu, args.paper_generations)
     finally:

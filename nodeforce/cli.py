@@ -357,8 +357,8 @@ def parser():
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--workers", type=int, help="processes (default: all cores)")
     s.add_argument("--fmu", choices=("auto", "python", "standalone"), default="auto",
-                   help="the FMU kind to run (auto: standalone below 1,000 nodes if a C compiler is "
-                        "found, else python: the faster, docs/performance.md)")
+                   help="the FMU kind to run (auto: standalone if a C compiler is found, else python; "
+                        "the standalone is the faster, docs/performance.md)")
     s.add_argument("--scheduler", help="a Dask scheduler address, tcp://host:port")
     noise_argument(s)
     burn_in_argument(s, 0.0)
