@@ -202,7 +202,7 @@ def locate(folder, objective, out, *extra):
 def summary(result, seconds, names):
     s = result["search"]
     return {"best_nodes": result["best_nodes"], "named": [names[i] for i in result["best_nodes"]],
-            "stepwise_nodes": s["stepwise_nodes"], "J_unforced": result["J_unforced"], "J_best": result["J_best"],
+            "stepwise_nodes": s.get("stepwise_nodes"), "J_unforced": result["J_unforced"], "J_best": result["J_best"],
             "J_noise": s["J_noise"], "unique_simulations": s["unique_evaluations"], "stopped_at": s["stopped_at"],
             "wall_s": round(seconds, 1)}
 
