@@ -89,29 +89,34 @@ class Partition:
 
 
 class CondensedSolve:
-    """M (forced rows made unit rows) solved by blocks and a Schur complement on the hubs of a
-    `Partition`: M_II x_I + M_IH x_H = v_I and M_HI x_I + M_HH x_H = v_H, with M_II block
+    """M (the `forced` rows made unit rows) solved by blocks and a Schur complement on the hubs of
+    a `Partition`: M_II x_I + M_IH x_H = v_I and M_HI x_I + M_HH x_H = v_H, with M_II block
     diagonal, give S x_H = v_H - M_HI M_II^-1 v_I, S = M_HH - M_HI M_II^-1 M_IH, then
     x_I = M_II^-1 (v_I - M_IH x_H). Every sparse product is one gather and one `np.bincount`.
+    Only the blocks and the couplings are read from the unforced M (left unchanged): O(N) per
+    mask, not a copy of M.
     """
 
-    def __init__(self, M, partition):
+    def __init__(self, M, partition, forced):
         p = self.partition = partition
         I, H = p.block_nodes, p.hubs
         rows, cols, values = [], [], []
         for start, count, size in p.groups:
             idx = I[start:start + count * size].reshape(count, size)
-            inverse = np.linalg.inv(M[idx[:, :, None], idx[:, None, :]])
+            blocks = unit_rows(M[idx[:, :, None], idx[:, None, :]], forced[idx])
+            inverse = np.linalg.inv(blocks)
             local = start + size * np.arange(count)[:, None, None]
             rows.append(np.broadcast_to(local + np.arange(size)[None, :, None], inverse.shape).ravel())
             cols.append(np.broadcast_to(local + np.arange(size)[None, None, :], inverse.shape).ravel())
             values.append(inverse.ravel())
         self.II = tuple(np.concatenate(x) for x in (rows, cols, values))  # M_II^-1, I-local indices
-        self.IH, self.HI = sparse(M[np.ix_(I, H)]), sparse(M[np.ix_(H, I)])
-        M_IH_dense = M[np.ix_(I, H)]
-        X = np.stack([self._product(self.II, column, len(I)) for column in M_IH_dense.T], axis=1) \
+        M_IH, M_HI = M[np.ix_(I, H)], M[np.ix_(H, I)]
+        M_IH[forced[I]] = 0.0
+        M_HI[forced[H]] = 0.0
+        self.IH, self.HI = sparse(M_IH), sparse(M_HI)
+        X = np.stack([self._product(self.II, column, len(I)) for column in M_IH.T], axis=1) \
             if len(H) else np.zeros((len(I), 0))
-        self.schur_inverse = np.linalg.inv(M[np.ix_(H, H)] - M[np.ix_(H, I)] @ X)
+        self.schur_inverse = np.linalg.inv(unit_rows(M[np.ix_(H, H)], forced[H]) - M_HI @ X)
 
     @staticmethod
     def _product(matrix, x, size):
@@ -129,6 +134,14 @@ class CondensedSolve:
         T[p.block_nodes] = x_I
         T[p.hubs] = x_H
         return T
+
+
+def unit_rows(blocks, forced):
+    """Square matrices (..., n, n) with the rows flagged in `forced` (..., n) made unit rows."""
+    where = np.nonzero(forced)
+    blocks[where] = 0.0
+    blocks[where + (where[-1],)] = 1.0
+    return blocks
 
 
 def sparse(matrix):
@@ -167,15 +180,12 @@ class ImplicitEuler:
         key = forced.tobytes()
         found = self._solvers.get(key)
         if found is None:
-            M = self._M.copy()
-            M[forced] = 0.0
-            M[forced, forced] = 1.0
             if self.condensed:
                 if self._partition is None:  # from the unforced pattern, which every mask shares
                     self._partition = Partition(self._M)
-                solve = CondensedSolve(M, self._partition)
+                solve = CondensedSolve(self._M, self._partition, forced)
             else:
-                solve = DenseSolve(M)
+                solve = DenseSolve(unit_rows(self._M.copy(), forced))
             found = self._solvers[key] = (solve, np.flatnonzero(forced))
             if len(self._solvers) > self.CACHED_MASKS:
                 self._solvers.popitem(last=False)
