@@ -247,7 +247,7 @@ def bench_dask(tmp, fmu, which):
     bin_dir = Path(sys.executable).parent
     processes = [subprocess.Popen([str(bin_dir / "dask"), "scheduler", "--host", "127.0.0.1", "--port", str(port),
                                    "--no-dashboard"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                                  start_new_session=True)]
+                                  start_new_session=True, env={**os.environ, "DASK_TEMPORARY_DIRECTORY": str(folder)})]
     try:
         time.sleep(3)
         address = f"tcp://127.0.0.1:{port}"
