@@ -20,7 +20,7 @@ from nodeforce.model.score import Noise
 def evaluator_kind(building):
     """The FMU kind the search drives for `fmu_kind="auto"`: the standalone FMU where a C compiler
     is at hand (it is compiled at export), else the Python FMU. Measured (benchmarks/bench_scale.py,
-    docs/performance.md): a simulation of a new mask costs 1.7 to 7 times less through the
+    docs/performance.md): a simulation of a new mask costs at least 1.7 times less through the
     standalone FMU than through the Python FMU, from the test cell's 23 nodes to 2,922."""
     return "standalone" if find_compiler() else "python"
 
