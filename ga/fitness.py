@@ -11,7 +11,7 @@ import numpy as np
 
 from nodeforce.cosim.fmi import FmuInstance, content_id
 from nodeforce.cosim.run import simulate_fmu
-from nodeforce.model.integrate import simulate
+from nodeforce.model.integrate import ImplicitEuler, simulate
 from nodeforce.model.network import assemble
 
 
@@ -108,10 +108,11 @@ class ModelEvaluator(_Evaluator):
     def __init__(self, spec):
         super().__init__(spec)
         self.network = assemble(spec.building)
+        self.stepper = ImplicitEuler(self.network, spec.case.dt)  # kept: its partition and factors
 
     def air(self, force):
         """Objective air temperatures (C) at t_1..t_N with the `force` (N,) bool nodes forced."""
         case = self.spec.case
         T = simulate(self.spec.building, self.network, case.U, case.dt, case.measured, force=force,
-                     warmup_days=self.spec.warmup_days, burn_in_steps=case.burn_in_steps)
+                     warmup_days=self.spec.warmup_days, burn_in_steps=case.burn_in_steps, stepper=self.stepper)
         return T[:, np.array(self.spec.objective.air_nodes) - 1]

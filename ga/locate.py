@@ -13,12 +13,21 @@ from scipy.sparse.csgraph import shortest_path
 
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.checkpoint import NAME as CHECKPOINT
+from nodeforce.fmu_build.compiler import find_compiler
 from nodeforce.ga.fitness import FmuFitness
 from nodeforce.ga.parsimony import EXPLAINED, removed
 from nodeforce.ga.search import PATIENCE, search
 from nodeforce.model.errors import InputError
 from nodeforce.model.network import assemble
 from nodeforce.model.score import Noise
+
+
+def evaluator_kind():
+    """The FMU kind the search drives for `fmu_kind="auto"`: the standalone FMU where a C compiler
+    is at hand (it is compiled at export), else the Python FMU. Measured (benchmarks/bench_scale.py,
+    docs/performance.md): a simulation of a new mask costs at least 1.7 times less through the
+    standalone FMU than through the Python FMU, from the test cell's 23 nodes to 2,922."""
+    return "standalone" if find_compiler() else "python"
 
 
 def check_measured(objective, case, source):
@@ -70,10 +79,12 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
     every generation with (generation, total, best J, unique evaluations). `noise` is the air
     sensors' noise sd (C) if the user knows it, else it is estimated (`model.score.Noise`). patience and seeded
     choose the search (ga.search: the defaults stop at convergence; ga.search.PAPER's values
-    give the paper's search).
+    give the paper's search). fmu_kind: "python", "standalone" (or their "-fmi3" kinds) or "auto"
+    (`evaluator_kind`, FMI 2.0).
     """
     candidates = chromosome_nodes(building, case, objective, source, nodes, include_algebraic)
-    fmu = build_fmu(building, workdir / "model.fmu", kind=fmu_kind)
+    kind = evaluator_kind() if fmu_kind == "auto" else fmu_kind
+    fmu = build_fmu(building, workdir / "model.fmu", kind=kind)
     measured = objective.measured(case)
     noise = Noise.of(measured, noise)
     if not candidates:

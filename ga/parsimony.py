@@ -40,7 +40,9 @@ same steps, even when the gap is inside the noise band of one J. With noisy sens
 node the test also sees how much of a forced sensor's noise reaches the air: forcing the node
 behind a faulty wall's inside surface may then fit measurably better than the surface itself,
 and is named instead; both locate the same component. Sets of up to EXACT_ANY nodes are searched over the whole chromosome, so
-the answer for one or two faults does not depend on the path the search took. The empty set
+the answer for one or two faults does not depend on the path the search took (above
+ALL_PAIRS_UP_TO genes, pairs among the PAIR_POOL single nodes that lower J most, beyond the
+noise: a building's 100 sensors make 4,950 pairs). The empty set
 comes first, so best_nodes = [] exactly when J_unforced - J_min <= tolerance: no significant
 reduction. Larger subsets of the best chromosome are searched exhaustively, smallest first,
 when it forces at most EXACT_MAX_NODES nodes; otherwise by backward elimination: repeatedly
@@ -68,6 +70,11 @@ RELATIVE_FLOOR = 0.01
 EXACT_MAX_NODES = 8
 EXACT_ANY = 2
 ROUNDING = 1e-9  # of J_unforced: a difference of J below it is the simulation's rounding
+# Above this many genes, pairs are not all scored (100 genes make 4,950 pairs, most of a search's
+# budget): only pairs among the PAIR_POOL single nodes that lower J most, by more than the noise
+# alone (larger sets come from the best chromosome). Measured in benchmarks/bench_scale.py.
+ALL_PAIRS_UP_TO = 25
+PAIR_POOL = 10
 
 
 def tolerance(J_unforced: float, noise_sigma: "float | None", n_residuals: "int | None") -> float:
@@ -116,13 +123,19 @@ def smallest_subset(J_many: Callable[[Sequence[tuple]], list], best: tuple, limi
         chosen = set(subset)
         return tuple(i in chosen for i in range(len(best)))
 
-    if J_many([mask(())])[0] <= limit:
+    [J_none] = J_many([mask(())])
+    if J_none <= limit:
         return mask(())
+    members = [i for i, bit in enumerate(best) if bit]
+    pool = list(range(len(best)))
     for size in range(1, EXACT_ANY + 1):
-        chosen = _preferred(J_many, mask, list(combinations(range(len(best)), size)), limit, worse)
+        chosen = _preferred(J_many, mask, list(combinations(pool, size)), limit, worse)
         if chosen is not None:
             return mask(chosen)
-    members = [i for i, bit in enumerate(best) if bit]
+        if size == 1 and len(best) > ALL_PAIRS_UP_TO:
+            J_single = J_many([mask((i,)) for i in pool])
+            lowering = sorted((J, i) for i, J in enumerate(J_single) if J < J_none - noise_tol)
+            pool = sorted(i for _, i in lowering[:PAIR_POOL])
     if len(members) <= EXACT_MAX_NODES:
         return mask(_smallest_first(J_many, mask, members, limit, worse))
     return mask(_backward_elimination(J_many, mask, members, limit))

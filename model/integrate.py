@@ -2,8 +2,9 @@
 
 One step from t_n to t_n+1 solves `M T^n+1 = V`, with `M = C/dt - A` and
 `V = (C/dt) T^n + B u^n+1 + q`. Forcing node i replaces row i of M by the unit row and v_i by
-the node's measured temperature: a Dirichlet condition. M is inverted once per forcing mask, so
-a step is one matrix-vector product.
+the node's measured temperature: a Dirichlet condition. M is factorised once per forcing mask
+(`ImplicitEuler`: inverted whole below a few hundred nodes, by blocks and a Schur complement on
+the zones' nodes above).
 
 The FMU's `doStep` and the direct model's `simulate` both call `ImplicitEuler.step`: one
 arithmetic for every path through the code.
@@ -15,38 +16,181 @@ import numpy as np
 DAY = 86400.0  # s
 
 
+class DenseSolve:
+    """M (forced rows made unit rows) inverted: a step is one matrix-vector product, O(N^2)."""
+
+    def __init__(self, M):
+        self.inverse = np.linalg.inv(M)
+
+    def __call__(self, v):
+        return self.inverse @ v
+
+
+def blocks_apart(n, rows, cols, hub):
+    """Label (n,) of the connected component of each node in the graph of the links
+    (rows[k], cols[k]) once the `hub` nodes (bool, (n,)) are removed; -1 on hubs."""
+    parent = list(range(n))
+
+    def root(i):
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for i, j in zip(rows.tolist(), cols.tolist()):
+        if not (hub[i] or hub[j]):
+            a, b = root(i), root(j)
+            if a != b:
+                parent[max(a, b)] = min(a, b)
+    return np.array([-1 if hub[i] else root(i) for i in range(n)])
+
+
+class Partition:
+    """The nodes split into hubs H (zone air and radiant nodes: those linked to more than three
+    others) and blocks of the rest, no two blocks linked except through H: a component's chain
+    of nodes (its surfaces' links go to hubs) is a block. The step matrix then factorises per
+    block (small dense inverses, applied in batches of blocks of equal size) and a dense Schur
+    complement on H: O(N) per step rather than O(N^2).
+
+    A block larger than `largest` nodes (a network that is not chains between zones) loses its
+    most linked node to the hubs, until none is.
+    """
+
+    def __init__(self, M, largest=64):
+        n = len(M)
+        rows, cols = np.nonzero(M)
+        off = rows != cols
+        r, c = rows[off], cols[off]
+        degree = np.bincount(np.concatenate([r, c]), minlength=n) // 2
+        hub = degree > 3
+        while True:
+            label = blocks_apart(n, r, c, hub)
+            sizes = np.bincount(label[~hub], minlength=n)
+            big = int(np.argmax(sizes))
+            if sizes[big] <= largest:
+                break
+            members = np.flatnonzero(label == big)
+            hub[members[np.argmax(degree[members])]] = True
+        self.n = n
+        self.hubs = np.flatnonzero(hub)
+        # the other nodes, ordered so that blocks of one size are contiguous
+        nodes = np.flatnonzero(~hub)
+        labels = label[nodes]
+        order = np.lexsort((nodes, labels, sizes[labels]))
+        self.block_nodes = nodes[order]
+        block_size = sizes[labels[order]]
+        self.groups = []  # (start in block_nodes, number of blocks, block size)
+        start = 0
+        while start < len(nodes):
+            size = int(block_size[start])
+            count = int(np.sum(block_size == size)) // size
+            self.groups.append((start, count, size))
+            start += count * size
+
+
+class CondensedSolve:
+    """M (the `forced` rows made unit rows) solved by blocks and a Schur complement on the hubs of
+    a `Partition`: M_II x_I + M_IH x_H = v_I and M_HI x_I + M_HH x_H = v_H, with M_II block
+    diagonal, give S x_H = v_H - M_HI M_II^-1 v_I, S = M_HH - M_HI M_II^-1 M_IH, then
+    x_I = M_II^-1 (v_I - M_IH x_H). Every sparse product is one gather and one `np.bincount`.
+    Only the blocks and the couplings are read from the unforced M (left unchanged): O(N) per
+    mask, not a copy of M.
+    """
+
+    def __init__(self, M, partition, forced):
+        p = self.partition = partition
+        I, H = p.block_nodes, p.hubs
+        rows, cols, values = [], [], []
+        for start, count, size in p.groups:
+            idx = I[start:start + count * size].reshape(count, size)
+            blocks = unit_rows(M[idx[:, :, None], idx[:, None, :]], forced[idx])
+            inverse = np.linalg.inv(blocks)
+            local = start + size * np.arange(count)[:, None, None]
+            rows.append(np.broadcast_to(local + np.arange(size)[None, :, None], inverse.shape).ravel())
+            cols.append(np.broadcast_to(local + np.arange(size)[None, None, :], inverse.shape).ravel())
+            values.append(inverse.ravel())
+        self.II = tuple(np.concatenate(x) for x in (rows, cols, values))  # M_II^-1, I-local indices
+        M_IH, M_HI = M[np.ix_(I, H)], M[np.ix_(H, I)]
+        M_IH[forced[I]] = 0.0
+        M_HI[forced[H]] = 0.0
+        self.IH, self.HI = sparse(M_IH), sparse(M_HI)
+        X = np.stack([self._product(self.II, column, len(I)) for column in M_IH.T], axis=1) \
+            if len(H) else np.zeros((len(I), 0))
+        self.schur_inverse = np.linalg.inv(unit_rows(M[np.ix_(H, H)], forced[H]) - M_HI @ X)
+
+    @staticmethod
+    def _product(matrix, x, size):
+        r, c, g = matrix
+        return np.bincount(r, g * x[c], minlength=size)
+
+    def __call__(self, v):
+        p = self.partition
+        n_I, n_H = len(p.block_nodes), len(p.hubs)
+        v_I = v[p.block_nodes]
+        y = self._product(self.II, v_I, n_I)
+        x_H = self.schur_inverse @ (v[p.hubs] - self._product(self.HI, y, n_H))
+        x_I = self._product(self.II, v_I - self._product(self.IH, x_H, n_I), n_I)
+        T = np.empty(p.n)
+        T[p.block_nodes] = x_I
+        T[p.hubs] = x_H
+        return T
+
+
+def unit_rows(blocks, forced):
+    """Square matrices (..., n, n) with the rows flagged in `forced` (..., n) made unit rows."""
+    where = np.nonzero(forced)
+    blocks[where] = 0.0
+    blocks[where + (where[-1],)] = 1.0
+    return blocks
+
+
+def sparse(matrix):
+    """(rows, columns, values) of a matrix's nonzeros."""
+    r, c = np.nonzero(matrix)
+    return r, c, matrix[r, c]
+
+
 class ImplicitEuler:
     """The step of a `Network` for a step size dt (s), with the step matrix kept per forcing mask.
 
-    M (with its forced rows made unit rows) is inverted once per mask, so that a step is one
-    matrix-vector product: numpy alone, no scipy (the Python FMU imports this class, and an FMU
-    that loads scipy corrupts memory when pythonfmu's host ends the interpreter). The most
-    recently used `CACHED_MASKS` inverses are kept: a search tries thousands of masks.
+    M (with its forced rows made unit rows) is factorised once per mask, with numpy alone, no
+    scipy (the Python FMU imports this class, and an FMU that loads scipy corrupts memory when
+    pythonfmu's host ends the interpreter): inverted whole below `CONDENSED_FROM` nodes
+    (`DenseSolve`, a step is one O(N^2) product), by blocks and a Schur complement on the zones'
+    nodes from there on (`CondensedSolve`, O(N) per step; the threshold is where it gets faster,
+    benchmarks/bench_scale.py). The most recently used `CACHED_MASKS` factors are kept: a search
+    tries thousands of masks.
     """
 
     CACHED_MASKS = 64
+    CONDENSED_FROM = 300  # nodes
 
-    def __init__(self, network, dt):
+    def __init__(self, network, dt, condensed=None):
         self.network = network
         self.dt = float(dt)
         self.c_dt = network.C / self.dt
         self._M = np.diag(self.c_dt) - network.A
-        self._inverses = OrderedDict()
+        self.condensed = network.n_nodes >= self.CONDENSED_FROM if condensed is None else condensed
+        self._partition = None
+        self._solvers = OrderedDict()
 
-    def inverse(self, forced):
-        """The inverse of M with the rows of the `forced` nodes (bool mask) replaced by unit
-        rows, and the indices of those nodes."""
+    def solver(self, forced):
+        """The solve of M with the rows of the `forced` nodes (bool mask) replaced by unit rows
+        (a callable v -> T), and the indices of those nodes."""
         key = forced.tobytes()
-        found = self._inverses.get(key)
+        found = self._solvers.get(key)
         if found is None:
-            M = self._M.copy()
-            M[forced] = 0.0
-            M[forced, forced] = 1.0
-            found = self._inverses[key] = (np.linalg.inv(M), np.flatnonzero(forced))
-            if len(self._inverses) > self.CACHED_MASKS:
-                self._inverses.popitem(last=False)
+            if self.condensed:
+                if self._partition is None:  # from the unforced pattern, which every mask shares
+                    self._partition = Partition(self._M)
+                solve = CondensedSolve(self._M, self._partition, forced)
+            else:
+                solve = DenseSolve(unit_rows(self._M.copy(), forced))
+            found = self._solvers[key] = (solve, np.flatnonzero(forced))
+            if len(self._solvers) > self.CACHED_MASKS:
+                self._solvers.popitem(last=False)
         else:
-            self._inverses.move_to_end(key)
+            self._solvers.move_to_end(key)
         return found
 
     def step(self, T, source, forced, T_forced):
@@ -61,12 +205,12 @@ class ImplicitEuler:
         """
         v = self.c_dt * T
         v += source
-        inverse, index = self.inverse(forced)
+        solve, index = self.solver(forced)
         if not len(index):
-            return inverse @ v
+            return solve(v)
         T_imposed = T_forced[index]
         v[index] = T_imposed
-        T_next = inverse @ v
+        T_next = solve(v)
         # The product returns the unit rows' values to rounding only; a Dirichlet node is exact.
         T_next[index] = T_imposed
         return T_next
@@ -136,7 +280,7 @@ def initial_state(building, measured0, T_default=20.0):
 
 
 def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2, T_default=20.0,
-             include_start=False, burn_in_steps=0):
+             include_start=False, burn_in_steps=0, stepper=None):
     """Simulate the network over input samples t_0..t_N; return temperatures at t_1..t_N.
 
     Parameters
@@ -152,6 +296,8 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     T_default : C, the initial temperature of a node nothing informs
     include_start : also return the state at t_0 (after the warm-up) as the first row
     burn_in_steps : B, steps over which every measured node is forced (`forcing_schedule`)
+    stepper : the network's `ImplicitEuler` for dt, if one is kept between runs (its factors
+        per mask are then reused)
 
     Returns
     -------
@@ -166,7 +312,7 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
         force = np.zeros(n, dtype=bool)
     sources = network.sources(U)
     forced = forcing_schedule(force, measured, burn_in_steps)
-    stepper = ImplicitEuler(network, dt)
+    stepper = ImplicitEuler(network, dt) if stepper is None else stepper
     T = initial_state(building, measured[0], T_default)
     rows = warmup_rows(n_rows, dt, warmup_days)
     start = len(rows) - (n_rows - 1)  # the step that reaches t_1

@@ -178,8 +178,8 @@ def cmd_synth(args):
     from nodeforce.model.effects import EFFECTS
     from nodeforce.model.synth import pseudo_measurements
     building = load_building(args.building)
-    if args.effect:
-        effect, target, values = effect_spec(args.effect)
+    for text in args.effect or ():  # several faults at once: each applied in turn
+        effect, target, values = effect_spec(text)
         if not EFFECTS[effect].applies(building, target):
             raise InputError("--effect", f"{effect}@{target}", f"does not apply to {args.building}")
         building = EFFECTS[effect].apply(building, target, values)
@@ -200,7 +200,7 @@ def cmd_synth(args):
     Path(args.output).parent.mkdir(parents=True, exist_ok=True)
     frame.round(4).to_csv(args.output, date_format="%Y-%m-%dT%H:%M:%S%z")
     print(f"wrote {args.output}: nodes {args.sensors}, {len(times)} times from {times[0].isoformat()}, "
-          f"noise {args.noise} C" + (f", with {args.effect} not in {args.building}" if args.effect else ""))
+          f"noise {args.noise} C" + (f", with {' and '.join(args.effect)} not in {args.building}" if args.effect else ""))
 
 
 def run_diagnosis(building, case, objective, out, source, args):
@@ -303,9 +303,11 @@ def fmi_argument(s):
 
 
 def kind_of(args):
-    """The FMU kind of --fmu at --fmi (fmu_build.build.fmu_kind)."""
+    """The FMU kind of --fmu at --fmi (fmu_build.build.fmu_kind); "auto" is the search's own
+    choice (ga.locate.evaluator_kind)."""
     from nodeforce.fmu_build.build import fmu_kind
-    return fmu_kind(args.fmu, args.fmi)
+    from nodeforce.ga.locate import evaluator_kind
+    return fmu_kind(evaluator_kind() if args.fmu == "auto" else args.fmu, args.fmi)
 
 
 def diagnosis_arguments(s):
@@ -384,7 +386,9 @@ def parser():
                         "convergence criterion (with the paper's 30 x 400, pc 0.8, pm 0.03 unless given)")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--workers", type=int, help="processes (default: all cores)")
-    s.add_argument("--fmu", choices=("python", "standalone"), default="python", help="the FMU kind to run")
+    s.add_argument("--fmu", choices=("auto", "python", "standalone"), default="auto",
+                   help="the FMU kind to run (auto: standalone if a C compiler is found, else python; "
+                        "the standalone is the faster, docs/performance.md)")
     s.add_argument("--scheduler", help="a Dask scheduler address, tcp://host:port")
     fmi_argument(s)
     noise_argument(s)
@@ -422,8 +426,9 @@ def parser():
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--history-days", type=float, default=7.0,
                    help="days of real weather simulated before the record")
-    s.add_argument("--effect", help="EFFECT@TARGET:name=value,... added to the building, e.g. "
-                                    "ground_coupling@floor:U=0.8,T_ground=24")
+    s.add_argument("--effect", action="append",
+                   help="EFFECT@TARGET:name=value,... added to the building, e.g. "
+                        "ground_coupling@floor:U=0.8,T_ground=24; repeat it for several at once")
     decomposition_argument(s)
     s.set_defaults(run=cmd_synth)
 

@@ -8,7 +8,8 @@
    This file only steps:
        (C/dt - A) T+ = (C/dt) T + B u + q + s(u),   s_i(u) = sum over products k on i of P_k u_a u_b,
    the rows of forced nodes (force[i] and T_forced[i] not NaN) replaced by T+_i = T_forced[i],
-   with M factorised (LU, partial pivoting) once per pattern of imposed nodes and step size.
+   with M factorised once per pattern of imposed nodes and step size: LU within the profile of
+   M reordered by reverse Cuthill-McKee (Profile below), O(N) per step on a building's network.
 
    Value references and the calls refused: variables.h (shared with the Python FMU's guard). */
 #include <math.h>
@@ -26,10 +27,20 @@
 typedef struct {
     double dt;
     unsigned char *imposed; /* N */
-    double *lu;             /* N x N, row major */
-    int *piv;               /* N */
+    double *lower, *upper;  /* the profile: row i of L and column i of U, from column first[i] */
+    double *diagonal;       /* N: U's */
     int used;
 } Factors;
+
+/* M in the reverse Cuthill-McKee order of the network's links, and its profile (envelope):
+   row and column i of the reordered M hold nonzeros from first[i] on only, so its LU factors
+   (without pivoting: M is an M-matrix, forced rows unit rows) fill nothing outside it. A zone's
+   chains of wall nodes keep the profile narrow: O(N) per step, not O(N^2). */
+typedef struct {
+    int *order;  /* N: old node at new position i */
+    int *first;  /* N: first column of row i (new numbering) */
+    long *start; /* N + 1: where row i begins in lower/upper */
+} Profile;
 
 typedef struct {
     int n, n_in, n_par, n_terms, n_zones, n_groups, n_products;
@@ -50,8 +61,10 @@ typedef struct {
     int state, size, clock;
     double *values, *start_values;
     double *C, *A, *B, *q, *P; /* at the parameters' values */
-    double *v, *T_next;
+    double *v, *work;
     unsigned char *imposed;
+    Profile profile;
+    long *b_start; int *b_column; double *b_value; /* B's nonzeros by row: a node has few inputs */
     Factors cache[CACHED_PATTERNS];
 } Model;
 
@@ -146,11 +159,11 @@ static void free_network(Network *net) {
 }
 
 /* ------------------------------------------------------------------ the numbers */
-/* C, A, B, q at the effect parameters' current values. */
+/* C, A, B, q at the effect parameters' current values, and B's nonzeros by row. */
 static void network_at_parameters(Model *m) {
     const Network *net = &m->net;
     long size = term_size(net), k;
-    int t, j;
+    int t, i, j;
     double *out = m->C; /* C, A, B, q, P are one contiguous block */
     memset(out, 0, (size_t)size * sizeof(double));
     for (t = 0; t < net->n_terms; t++) {
@@ -160,6 +173,15 @@ static void network_at_parameters(Model *m) {
             if (net->term_mask[t] & (1 << j)) weight *= m->values[vr_parameters(&m->layout) + j] - net->p0[j];
         for (k = 0; k < size; k++) out[k] += weight * term[k];
     }
+    for (i = 0, k = 0; i < net->n; i++) {
+        m->b_start[i] = k;
+        for (j = 0; j < net->n_in; j++)
+            if (m->B[(long)i * net->n_in + j] != 0.0) {
+                m->b_column[k] = j;
+                m->b_value[k++] = m->B[(long)i * net->n_in + j];
+            }
+    }
+    m->b_start[net->n] = k;
 }
 
 /* np.interp(x, xp, fp) with xp increasing: the end values held beyond the range. */
@@ -202,69 +224,157 @@ static void initial_state(Model *m) {
     free(fp);
 }
 
-static int lu_factor(double *a, int *piv, int n) {
-    int i, j, k;
-    for (k = 0; k < n; k++) {
-        int p = k;
-        for (i = k + 1; i < n; i++)
-            if (fabs(a[i * n + k]) > fabs(a[p * n + k])) p = i;
-        piv[k] = p;
-        if (a[p * n + k] == 0.0) return 0;
-        if (p != k)
-            for (j = 0; j < n; j++) {
-                double swap = a[k * n + j];
-                a[k * n + j] = a[p * n + j];
-                a[p * n + j] = swap;
-            }
-        for (i = k + 1; i < n; i++) {
-            double factor = a[i * n + k] /= a[k * n + k];
-            for (j = k + 1; j < n; j++) a[i * n + j] -= factor * a[k * n + j];
+/* Whether nodes a and b are linked (A_ab or A_ba nonzero) in any term. */
+static int linked(const Network *net, long size, int a, int b) {
+    int t, n = net->n;
+    for (t = 0; t < net->n_terms; t++) {
+        const double *A = net->terms + t * size + n;
+        if (A[(long)a * n + b] != 0.0 || A[(long)b * n + a] != 0.0) return 1;
+    }
+    return 0;
+}
+
+/* The profile of M's links in any term of the network (so in M at any parameter values):
+   reverse Cuthill-McKee from a node of least degree in each connected part. */
+static int order_network(Model *m) {
+    const Network *net = &m->net;
+    int n = net->n, i, j, head = 0, tail = 0, placed = 0;
+    long size = term_size(net), links = 0;
+    int *degree = calloc((size_t)n + 1, sizeof(int)), *seen = calloc((size_t)n + 1, sizeof(int));
+    int *position = calloc((size_t)n + 1, sizeof(int)), *queue = calloc((size_t)n + 1, sizeof(int));
+    long *at = calloc((size_t)n + 1, sizeof(long));
+    int *neighbour = NULL;
+    Profile *p = &m->profile;
+    p->order = calloc((size_t)n + 1, sizeof(int));
+    p->first = calloc((size_t)n + 1, sizeof(int));
+    p->start = calloc((size_t)n + 1, sizeof(long));
+    if (!degree || !seen || !position || !queue || !at || !p->order || !p->first || !p->start) goto fail;
+    for (i = 0; i < n; i++)
+        for (j = 0; j < n; j++)
+            if (i != j && linked(net, size, i, j)) degree[i]++;
+    for (i = 0; i < n; i++) { at[i + 1] = at[i] + degree[i]; links += degree[i]; }
+    neighbour = calloc((size_t)links + 1, sizeof(int));
+    if (!neighbour) goto fail;
+    for (i = 0; i < n; i++) {
+        long k = at[i];
+        for (j = 0; j < n; j++)
+            if (i != j && linked(net, size, i, j)) neighbour[k++] = j;
+    }
+    while (placed < n) {
+        int root = -1;
+        for (i = 0; i < n; i++)
+            if (!seen[i] && (root < 0 || degree[i] < degree[root])) root = i;
+        seen[root] = 1;
+        queue[tail++] = root;
+        while (head < tail) {
+            int node = queue[head++], from = tail;
+            long k;
+            for (k = at[node]; k < at[node + 1]; k++)
+                if (!seen[neighbour[k]]) { seen[neighbour[k]] = 1; queue[tail++] = neighbour[k]; }
+            for (i = from + 1; i < tail; i++) /* the new neighbours by increasing degree */
+                for (j = i; j > from && degree[queue[j]] < degree[queue[j - 1]]; j--) {
+                    int swap = queue[j]; queue[j] = queue[j - 1]; queue[j - 1] = swap;
+                }
         }
+        placed = tail;
+    }
+    for (i = 0; i < n; i++) { p->order[i] = queue[n - 1 - i]; position[queue[n - 1 - i]] = i; }
+    for (i = 0; i < n; i++) {
+        int node = p->order[i];
+        long k;
+        p->first[i] = i;
+        for (k = at[node]; k < at[node + 1]; k++)
+            if (position[neighbour[k]] < p->first[i]) p->first[i] = position[neighbour[k]];
+        p->start[i + 1] = p->start[i] + (i - p->first[i]);
+    }
+    free(degree); free(seen); free(position); free(queue); free(at); free(neighbour);
+    return 1;
+fail:
+    free(degree); free(seen); free(position); free(queue); free(at); free(neighbour);
+    return 0;
+}
+
+/* LU of the reordered M within its profile (Doolittle, L unit lower); 0 if a pivot is zero. */
+static int profile_factor(Factors *f, const Profile *p, int n) {
+    int i, j, k;
+    for (i = 0; i < n; i++) {
+        double *L_i = f->lower + p->start[i] - p->first[i], *U_i = f->upper + p->start[i] - p->first[i];
+        double d = f->diagonal[i];
+        for (j = p->first[i]; j < i; j++) {
+            const double *L_j = f->lower + p->start[j] - p->first[j], *U_j = f->upper + p->start[j] - p->first[j];
+            double l = L_i[j], u = U_i[j];
+            for (k = p->first[i] > p->first[j] ? p->first[i] : p->first[j]; k < j; k++) {
+                l -= L_i[k] * U_j[k];
+                u -= L_j[k] * U_i[k];
+            }
+            U_i[j] = u;
+            L_i[j] = l / f->diagonal[j];
+            d -= L_i[j] * U_i[j];
+        }
+        if (d == 0.0 || !isfinite(d)) return 0;
+        f->diagonal[i] = d;
     }
     return 1;
 }
 
-static void lu_solve(const double *a, const int *piv, double *b, int n) {
-    int i, j;
+/* Solve M x = b in place, b in the original numbering; y is scratch (N). */
+static void profile_solve(const Factors *f, const Profile *p, double *b, double *y, int n) {
+    int i, k;
     for (i = 0; i < n; i++) {
-        double swap = b[i];
-        b[i] = b[piv[i]];
-        b[piv[i]] = swap;
+        const double *L_i = f->lower + p->start[i] - p->first[i];
+        double s = b[p->order[i]];
+        for (k = p->first[i]; k < i; k++) s -= L_i[k] * y[k];
+        y[i] = s;
     }
-    for (i = 0; i < n; i++)
-        for (j = 0; j < i; j++) b[i] -= a[i * n + j] * b[j];
     for (i = n - 1; i >= 0; i--) {
-        for (j = i + 1; j < n; j++) b[i] -= a[i * n + j] * b[j];
-        b[i] /= a[i * n + i];
+        const double *U_i = f->upper + p->start[i] - p->first[i];
+        double x = y[i] /= f->diagonal[i];
+        for (k = p->first[i]; k < i; k++) y[k] -= U_i[k] * x;
     }
+    for (i = 0; i < n; i++) b[p->order[i]] = y[i];
+}
+
+/* M_rc: the step matrix, a forced row the unit row. */
+static double step_matrix(const Model *m, double dt, int r, int c) {
+    int n = m->net.n;
+    if (m->imposed[r]) return r == c;
+    return (r == c ? m->C[r] / dt : 0.0) - m->A[(long)r * n + c];
 }
 
 /* The factors of M for this step size and pattern of imposed nodes (cached). */
 static Factors *factors(Model *m, double dt) {
     int n = m->net.n, i, j, slot = 0;
+    const Profile *p = &m->profile;
     Factors *f;
     for (i = 0; i < CACHED_PATTERNS; i++) {
         f = &m->cache[i];
-        if (f->lu && f->dt == dt && memcmp(f->imposed, m->imposed, (size_t)n) == 0) {
+        if (f->lower && f->dt == dt && memcmp(f->imposed, m->imposed, (size_t)n) == 0) {
             f->used = ++m->clock;
             return f;
         }
         if (f->used < m->cache[slot].used) slot = i; /* the least recently used (unused: 0) */
     }
     f = &m->cache[slot];
-    if (!f->lu) {
-        f->lu = malloc((size_t)n * n * sizeof(double));
-        f->piv = malloc((size_t)n * sizeof(int));
+    if (!f->lower) {
+        f->lower = malloc(((size_t)p->start[n] + 1) * sizeof(double));
+        f->upper = malloc(((size_t)p->start[n] + 1) * sizeof(double));
+        f->diagonal = malloc((size_t)n * sizeof(double));
         f->imposed = malloc((size_t)n);
-        if (!f->lu || !f->piv || !f->imposed) return NULL;
+        if (!f->lower || !f->upper || !f->diagonal || !f->imposed) return NULL;
     }
-    for (i = 0; i < n; i++)
-        for (j = 0; j < n; j++)
-            f->lu[i * n + j] = m->imposed[i] ? (double)(i == j) : (i == j ? m->C[i] / dt : 0.0) - m->A[i * n + j];
+    for (i = 0; i < n; i++) {
+        int r = p->order[i];
+        double *L_i = f->lower + p->start[i] - p->first[i], *U_i = f->upper + p->start[i] - p->first[i];
+        for (j = p->first[i]; j < i; j++) {
+            L_i[j] = step_matrix(m, dt, r, p->order[j]);
+            U_i[j] = step_matrix(m, dt, p->order[j], r);
+        }
+        f->diagonal[i] = step_matrix(m, dt, r, r);
+    }
     f->dt = dt;
     memcpy(f->imposed, m->imposed, (size_t)n);
     f->used = ++m->clock;
-    if (!lu_factor(f->lu, f->piv, n)) {
+    if (!profile_factor(f, p, n)) {
         f->dt = -1.0; /* never matches again */
         f->used = 0;
         return NULL;
@@ -282,7 +392,7 @@ static void forget_factors(Model *m) {
 
 static fmi2Status step(Model *m, double dt) {
     const Network *net = &m->net;
-    int n = net->n, i, j, k;
+    int n = net->n, i, k;
     const double *u = m->values + vr_inputs(&m->layout), *T_forced = m->values + vr_T_forced(&m->layout);
     double *T = m->values + vr_T(&m->layout);
     Factors *f;
@@ -293,15 +403,16 @@ static fmi2Status step(Model *m, double dt) {
         return fmi2Error;
     }
     for (i = 0; i < n; i++) { /* the sources */
+        long k_b;
         m->v[i] = m->q[i];
-        for (j = 0; j < net->n_in; j++) m->v[i] += m->B[i * net->n_in + j] * u[j];
+        for (k_b = m->b_start[i]; k_b < m->b_start[i + 1]; k_b++) m->v[i] += m->b_value[k_b] * u[m->b_column[k_b]];
     }
     for (k = 0; k < net->n_products; k++) {
         const int *p = net->product + 3 * k;
         m->v[p[0]] += m->P[k] * u[p[1]] * u[p[2]];
     }
     for (i = 0; i < n; i++) m->v[i] = m->imposed[i] ? T_forced[i] : m->C[i] / dt * T[i] + m->v[i];
-    lu_solve(f->lu, f->piv, m->v, n);
+    profile_solve(f, &m->profile, m->v, m->work, n);
     for (i = 0; i < n; i++) T[i] = m->imposed[i] ? T_forced[i] : m->v[i];
     return fmi2OK;
 }
@@ -319,11 +430,12 @@ static void free_model(Model *m) {
     int i;
     if (!m) return;
     for (i = 0; i < CACHED_PATTERNS; i++) {
-        free(m->cache[i].lu); free(m->cache[i].piv); free(m->cache[i].imposed);
+        free(m->cache[i].lower); free(m->cache[i].upper); free(m->cache[i].diagonal); free(m->cache[i].imposed);
     }
     free_network(&m->net);
-    free(m->name); free(m->values); free(m->start_values); free(m->C); free(m->v); free(m->T_next);
-    free(m->imposed);
+    free(m->name); free(m->values); free(m->start_values); free(m->C); free(m->v); free(m->work);
+    free(m->imposed); free(m->profile.order); free(m->profile.first); free(m->profile.start);
+    free(m->b_start); free(m->b_column); free(m->b_value);
     free(m);
 }
 
@@ -368,9 +480,13 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
     m->q = m->B + m->net.n * m->net.n_in;
     m->P = m->q + m->net.n;
     m->v = calloc((size_t)m->net.n, sizeof(double));
-    m->T_next = calloc((size_t)m->net.n, sizeof(double));
+    m->work = calloc((size_t)m->net.n, sizeof(double));
+    m->b_start = calloc((size_t)m->net.n + 1, sizeof(long));
+    m->b_column = calloc((size_t)m->net.n * m->net.n_in + 1, sizeof(int));
+    m->b_value = calloc((size_t)m->net.n * m->net.n_in + 1, sizeof(double));
     m->imposed = calloc((size_t)m->net.n, 1);
-    if (!m->values || !m->start_values || !m->C || !m->v || !m->T_next || !m->imposed) {
+    if (!m->values || !m->start_values || !m->C || !m->v || !m->work || !m->imposed || !m->b_start || !m->b_column
+        || !m->b_value || !order_network(m)) {
         free_model(m);
         return NULL;
     }
