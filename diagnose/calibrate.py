@@ -95,6 +95,10 @@ def calibrate(candidate, case, objective):
     return result, derived(candidate, case, fit.x, cov)
 
 
+# The derived time constant (s) of the effects that add a node of capacity C and conductance H.
+TIME_CONSTANTS = {"internal_mass": "mass_time_constant", "heat_input_lag": "heater_time_constant"}
+
+
 def derived(candidate, case, x, cov):
     """What the data fix when the parameters trade off against each other, each with its
     standard deviation by the delta method, sd^2 = g' cov g for its gradient g.
@@ -106,6 +110,9 @@ def derived(candidate, case, x, cov):
       the component), and over weeks the face's temperature barely moves: many (U, T_ground)
       pairs give the same flux. g = (T_ground - T_face, U), T_face its mean simulated over the
       window.
+    - A zone's internal mass or heater node answers with its time constant tau = C / H (s): a
+      short record of the air fixes tau far better than C and H apart, which trade off along it.
+      g = (1 / H, -C / H^2).
     """
     def with_sd(value, gradient, unit):
         return {"value": float(value), "std": float(np.sqrt(max(gradient @ cov @ gradient, 0.0))), "unit": unit}
@@ -117,6 +124,9 @@ def derived(candidate, case, x, cov):
         face = candidate.building.component(candidate.target).node_ids[-1]
         T_face = float(np.mean(candidate.nodes(case, [face], x)))
         out["ground_heat_flux"] = with_sd(U * (T_ground - T_face), np.array([T_ground - T_face, U]), "W/m2")
+    if candidate.effect in TIME_CONSTANTS:
+        C, H = x
+        out[TIME_CONSTANTS[candidate.effect]] = with_sd(C / H, np.array([1.0 / H, -C / H ** 2]), "s")
     return out
 
 

@@ -131,27 +131,34 @@ def limits(building, effect, target, name):
     return PHYSICAL_LIMITS.get((effect, name), (-math.inf, math.inf))
 
 
+# What the data fix where an effect's parameters trade off (`diagnose.calibrate.derived`): when
+# it is determined, the parameters need not be one by one. A ground coupling's (U, T_ground) is
+# then one of the many pairs that give the flux, wherever it ended, a bound included; a node's
+# (C, H) must still be inside its range, where a bound means a node that is not there.
+TRADE_OFFS = {"ground_coupling": ("ground_heat_flux", True),
+              "heat_input_lag": ("heater_time_constant", False),
+              "internal_mass": ("mass_time_constant", False)}
+
+
 def objection(building, effect, target, parameters, derived=None):
     """Why a calibrated effect may not be added to the model, or None: a gain the building file's
     description rules out (`implausible`), a parameter on a bound of its search range or not
-    identifiable from the data (for a ground coupling, whose U and T_ground trade off, the heat
-    flux they give must be determined instead, and then the pair is one of the many that give
-    it, wherever it ended), or a value outside physical limits.
+    identifiable from the data (unless the quantity its parameters trade off along is, TRADE_OFFS),
+    or a value outside physical limits.
 
     parameters : {name: {"value", "std", "identifiable", "on_bound"}} of `diagnose.calibrate`
     derived : what the data determine besides (`diagnose.calibrate.derived`)
     """
     reasons = [implausible(building, effect, target)]
-    flux = (derived or {}).get("ground_heat_flux")
-    flux_known = flux is not None and flux["std"] < IDENTIFIABLE_RELATIVE * abs(flux["value"])
+    key, bounds_waived = TRADE_OFFS.get(effect, (None, False))
+    fixed = (derived or {}).get(key)
+    resolved = fixed is not None and fixed["std"] < IDENTIFIABLE_RELATIVE * abs(fixed["value"])
     for name in JUDGED.get(effect, [p.name for p in EFFECTS[effect].parameters]):
         p, unit = parameters[name], EFFECTS[effect].parameter(name).unit
         low, high = limits(building, effect, target, name)
-        if flux_known:
-            pass  # many (U, T_ground) give the flux the data fix: the pair is one of them, on a bound or not
-        elif p.get("on_bound"):
+        if p.get("on_bound") and not (resolved and bounds_waived):
             reasons.append(f"{name} = {p['value']:.3g} {unit} ends on a bound of its range")
-        elif not p["identifiable"]:
+        elif not p["identifiable"] and not resolved:
             reasons.append(f"{name} = {p['value']:.3g} +- {p['std']:.2g} {unit} is not identifiable from these data")
         if not low <= p["value"] <= high:
             what = "a negative gain (a heat sink)" if low == 0.0 and "gain" in effect else "outside physical limits"

@@ -62,6 +62,18 @@ def test_a_ground_coupling_is_judged_by_the_flux_the_data_fix(testcell):
                                            {"ground_heat_flux": {"value": 4.0, "std": 3.0, "unit": "W/m2"}})
 
 
+def test_a_heater_node_is_judged_by_the_time_constant_the_data_fix_but_must_stay_inside_its_range(testcell):
+    # C_h and H_h trade off along tau = C_h / H_h: neither is determined, tau is
+    traded = {"C_h": parameter(9.4e4, 4.8e4, identifiable=False), "H_h": parameter(59.0, 39.0, identifiable=False)}
+    tau = {"heater_time_constant": {"value": 1590.0, "std": 120.0, "unit": "s"}}
+    assert objection(testcell, "heat_input_lag", "cell", traded, tau) is None
+    assert "not identifiable" in objection(testcell, "heat_input_lag", "cell", traded,
+                                           {"heater_time_constant": {"value": 1590.0, "std": 900.0, "unit": "s"}})
+    # a conductance on its bound is a node that is not there, whatever tau says
+    on_bound = {**traded, "H_h": parameter(0.01, 0.0002, on_bound=True)}
+    assert "bound" in objection(testcell, "heat_input_lag", "cell", on_bound, tau)
+
+
 def test_physics_comes_before_shapes_and_fewer_parameters_before_more():
     assert preference("conductivity") < preference("proportional_gain") < preference("daily_gain")
     assert preference("infiltration") < preference("ground_coupling")
