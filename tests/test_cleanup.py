@@ -16,7 +16,7 @@ pytestmark = pytest.mark.slow
 
 
 def test_a_diagnosis_with_workers_leaves_the_temp_directory_empty(tmp_path, private_tmp, testcell, weather):
-    times = pd.date_range("2001-06-10 00:00", periods=4 * 96 + 1, freq="15min", tz="-05:00", name="time")
+    times = pd.date_range("2001-06-10 00:00", periods=6 * 96 + 1, freq="15min", tz="-05:00", name="time")
     measurements = pseudo_measurements(testcell, weather, times, SENSORS, noise_sd=0.1, seed=1)
     case = prepare_case(testcell, weather, measurements).with_burn_in(1)
     out = tmp_path / "out"
