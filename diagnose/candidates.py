@@ -5,7 +5,7 @@ the policy changes no FMU and throws away no saved search.
 """
 import math
 
-from nodeforce.model.effects import BRIDGE_TO, EFFECTS, bridge_parts, bridge_target
+from nodeforce.model.effects import EFFECTS, bridge_parts, bridge_target
 from nodeforce.model.network import RHO_C_AIR
 
 # Where the calibration of an effect the file does not declare starts (see calibration_start).
@@ -125,7 +125,7 @@ def limits(building, effect, target, name):
     area of sun that cannot be negative (an irradiance column) or a share of a heat input that
     cannot take away more than the input (k >= -1)."""
     if effect == "proportional_gain":
-        zone, _, column = target.partition(BRIDGE_TO)
+        _, column = bridge_parts(target)
         heat_inputs = {c for z in building.zones for c in z.heat_input}
         return (-1.0 if column in heat_inputs else 0.0, math.inf)
     return PHYSICAL_LIMITS.get((effect, name), (-math.inf, math.inf))

@@ -87,7 +87,7 @@ def split(case, source, fraction=None, end=None):
 SELECTION_SHARE = 1 / 3
 
 
-def selection_split(case, k):
+def selection_split(case, k, source):
     """Row index j of the last fitting time inside the calibration window t_0..t_k: the candidates
     are fitted on t_0..t_j and chosen on t_j+1..t_k (the selection window), a third of the scored
     calibration steps and at least a day, so that the window the report's "after" is measured on
@@ -96,7 +96,7 @@ def selection_split(case, k):
     scored = k - case.burn_in_steps
     held = max(int(round(SELECTION_SHARE * scored)), day)
     if scored - held < day:
-        raise InputError("measurements", "time", f"a calibration window of {scored} scored steps of {case.dt:g} s "
+        raise InputError(source, "time", f"a calibration window of {scored} scored steps of {case.dt:g} s "
                                                  "leaves no fitting window of a day beside a selection window of a "
                                                  "day: give a longer calibration window")
     return k - held
@@ -150,7 +150,7 @@ def decide(building, results, before, sigma, selection_residuals, k_before=0):
     bic_before = bic(before["calibration"]["J"], before["calibration"]["n"], k_before)
     J_before = before["selection"]["J"]
     margin = tolerance(J_before, sigma, before["selection"]["n"])
-    tests, by_label = {}, {label(r): r for r in results}
+    tests = {}
     for r in results:
         # the fall must beat the sensor noise and the residuals' own correlated scatter
         needed = max(margin, Z_NOISE * r["selection_fall"]["sd"])
@@ -279,7 +279,7 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
     `phases` (iotools.phases.Phase records) are the experiment's phases, each model scored on each."""
     check_measured(objective, case, source)
     k = split(case, source, fraction, calibration_end)
-    j = selection_split(case, k)
+    j = selection_split(case, k, source)
     # the forcing search and the candidates' fits read the calibration window's first part (the
     # fitting window), the choice its rest (the selection window); the validation window only reports
     fitting = case.window(0, j)

@@ -54,7 +54,7 @@ def same_loss(chosen, tried, start, sigma):
     """The other candidates of `chosen`'s round that change the loss from the round's `start`
     ({"value", "std"}, W/K) as the chosen does: the same HLC, each well determined, and a
     selection J the chosen's does not beat by more than the noise could (`ga.parsimony.tolerance`).
-    None when the chosen changes no loss (a gain, a mass)."""
+    None of them when the chosen changes no loss (a gain, a mass)."""
     from nodeforce.diagnose.loop import label  # the decision's keys; loop imports this module
     hlc = chosen["derived"].get(HLC)
     if not hlc or not moves(hlc, start):
