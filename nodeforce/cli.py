@@ -247,8 +247,10 @@ def cmd_compare(args):
     models = []
     for path in args.buildings:
         building = load_building(path)
-        case = measured_case(building, weather, measurements, args.burn_in_days)
+        case = measured_case(building, weather, measurements, args.burn_in_days, args.decomposition)
         models.append((path, building, case, Objective.of(building, names)))
+    for said in dict.fromkeys(a for _, _, case, _ in models for a in case.assumptions):
+        print(f"assumed: {said}")
     result, series = compare(models, read_phases(args.phases) if args.phases else (), fmu_kind=args.fmu)
     written = write_compare(Path(args.output), result, series)
     for m in result["models"]:
@@ -410,6 +412,7 @@ def parser():
     s.add_argument("-o", "--output", required=True, help="folder for compare.json, compare.md and the plot")
     s.add_argument("--phases", help="CSV time,phase: every model is scored on each phase")
     s.add_argument("--fmu", choices=("python", "standalone"), default="python", help="the FMU kind to run")
+    decomposition_argument(s)
     burn_in_argument(s, 1.0)
     objective_argument(s)
     s.set_defaults(run=cmd_compare)
