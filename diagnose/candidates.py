@@ -11,7 +11,8 @@ from nodeforce.model.network import RHO_C_AIR
 # Where the calibration of an effect the file does not declare starts (see calibration_start).
 ABSENT_START = {("ground_coupling", "U"): 1.0,  # W/m2/K
                 ("infiltration", "n"): 0.5,  # 1/h
-                ("thermal_bridge", "UA"): 5.0}  # W/K
+                ("thermal_bridge", "UA"): 5.0,  # W/K
+                ("shading_transmittance", "f"): 0.1}  # an external screen's openness and absorbed share
 # ... and, for the nodes a zone effect adds, in multiples of the zone air's capacity (J/K): a
 # room's furniture and inner mass are several times its air's, an electric heater's about its
 # air's; their conductances start at `effects.neutral_conductance` (the air's capacity over
@@ -43,7 +44,9 @@ def candidates(building, located_nodes, zones):
     the boundary temperatures the zone's surfaces see. When nothing was located, a change of the
     inside convection (no single node) is one as well, and so is one factor on the objective zones'
     envelope (`envelope_conductance`): with nothing localised, the level or slow error that no
-    forcing explains may be the whole envelope's conduction rather than the air change.
+    forcing explains may be the whole envelope's conduction rather than the air change. An
+    objective zone with shaded glazings is offered the sun its closed shadings let in
+    (`shading_leaks`).
     """
     located = set(located_nodes)
     envelope = EFFECTS["envelope_conductance"].targets(building)
@@ -59,6 +62,7 @@ def candidates(building, located_nodes, zones):
             zone, to = bridge_parts(target)
             if zone == name and (to != "outdoor" or supplied):
                 pairs.append(("thermal_bridge", target))
+    pairs += shading_leaks(building, zones)
     if not located:
         pairs += [("inside_convection", name) for name in zones]
         pairs += [("envelope_conductance", name) for name in zones if name in envelope]
@@ -67,7 +71,7 @@ def candidates(building, located_nodes, zones):
 
 def calibration_start(building, effect, target):
     """Where a calibration starts: the declared values, except that an absent coupling (U = 0,
-    n = 0, UA = 0) starts at `ABSENT_START` and an absent zone node (C = 0) at `ZONE_START`: on
+    n = 0, UA = 0, a closed shading's leak f = 0) starts at `ABSENT_START` and an absent zone node (C = 0) at `ZONE_START`: on
     its bound, a bounded trust-region step is scaled to nothing and the fit stops where it began,
     and at U = 0 the ground temperature (at C = 0 the node's conductance) has no influence to
     fit at all."""
@@ -197,7 +201,22 @@ def follow_up(building, left, zones):
     pairs += [("heat_input_split", zone) for zone in zones
               if set(named) & set(building.zone(zone).heat_input)]
     pairs += zone_effects(building, left, zones)
+    # sun on a facade whose glazings have shadings: the physical counterpart of a gain following it
+    pairs += shading_leaks(building, zones, set(named))
     return list(dict.fromkeys(pairs))
+
+
+def shading_leaks(building, zones, columns=None):
+    """("shading_transmittance", zone) for each objective zone whose glazings have a shading and
+    that declares no leak yet: a model whose closed blinds block all the sun (the usual
+    description, and IDEAS's) misses what a real screen lets through its weave and passes on from
+    the heat it absorbs, a gain that follows the sun on those facades only while they are shaded.
+    `columns`: only the zones whose shaded glazings read one of these irradiance columns."""
+    targets = EFFECTS["shading_transmittance"].targets(building)
+    return [("shading_transmittance", name) for name in zones
+            if name in targets and building.zone(name).shading_transmittance == 0.0
+            and (columns is None or columns & {c.irradiance_input for c in building.components
+                                               if c.shading and c.inside.zone == name})]
 
 
 def zone_effects(building, left, zones):

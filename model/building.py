@@ -113,6 +113,7 @@ class Zone:
     internal_mass: Lumped | None = None  # furniture and undeclared mass, coupled to the air
     heat_input_lag: Lumped | None = None  # the heater's own capacity, between heat input and zone
     envelope_factor: float = 1.0  # scale on the conductances of the zone's components to outside
+    shading_transmittance: float = 0.0  # part of its glazings' sun a closed shading still lets in
     mass_node: int | None = None  # ids of the nodes those two add (PHYSICS.md section 7)
     heater_node: int | None = None
 
@@ -480,6 +481,7 @@ def _zone(check, z, where, zone_names, explicit, next_id):
         daily_gain=daily or (),
         proportional_gains=proportional,
         envelope_factor=check.number(z, "envelope_factor", where, default=1.0, low=0, low_open=True),
+        shading_transmittance=check.number(z, "shading_transmittance", where, default=0.0, low=0, high=1),
         **lumped,
     )
 

@@ -230,6 +230,20 @@ def _envelope_targets(building):
             if any(c.inside.zone == z.name and isinstance(c.outside, (Exterior, Boundary)) for c in building.components)]
 
 
+def _shaded_glazings(building, zone):
+    return [c for c in building.components if c.shading and c.inside.zone == zone]
+
+
+def _shading_targets(building):
+    """Zones with a glazing whose sun a shading column scales: what a closed shading's leak acts on."""
+    return [z.name for z in building.zones if _shaded_glazings(building, z.name)]
+
+
+def _shading_receivers(building, target):
+    return tuple(i for c in _shaded_glazings(building, target)
+                 for i in building.component(c.transmitted_solar_to).node_ids)
+
+
 EFFECTS = {e.id: e for e in (
     Effect("ground_coupling", "a conductance from an adiabatic face to a ground temperature",
            (Parameter("U", "W/m2/K", 0.0, 20.0), Parameter("T_ground", "C", -10.0, 40.0)),
@@ -272,6 +286,10 @@ EFFECTS = {e.id: e for e in (
                                    "and to boundaries, their outside surface coefficients included",
            (Parameter("factor", "-", 0.05, 20.0),), _envelope_targets,
            *_zone_field("envelope_factor", "factor"), _no_node),
+    Effect("shading_transmittance", "the part of a glazing's sun that the zone's closed shading devices "
+                                    "still let in (a screen's openness, the heat a blind absorbs and passes on)",
+           (Parameter("f", "-", 0.0, 1.0),), _shading_targets,
+           *_zone_field("shading_transmittance", "f"), _shading_receivers),
     Effect("daily_gain", "a heat gain to the air with a daily profile: its mean and harmonics of the local time",
            (Parameter("mean", "W", -5000.0, 5000.0), *(Parameter(t, "W", -5000.0, 5000.0) for t in DAY_TERMS)),
            _zones, _daily_read, _daily_write, _no_node),

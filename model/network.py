@@ -141,7 +141,10 @@ def assemble(building, names=None):
             receiver = building.component(c.transmitted_solar_to).node_ids[0] - 1
             transmitted = c.solar_transmittance * c.area
             if c.shading:
-                products.append((receiver, col[c.irradiance_input], col[c.shading], transmitted))
+                # tau A I (s + f (1 - s)): a closed shading (s = 0) still lets in the part f
+                f = building.zone(c.inside.zone).shading_transmittance
+                products.append((receiver, col[c.irradiance_input], col[c.shading], transmitted * (1.0 - f)))
+                B[receiver, col[c.irradiance_input]] += transmitted * f
             else:
                 B[receiver, col[c.irradiance_input]] += transmitted
 

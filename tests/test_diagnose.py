@@ -1,5 +1,6 @@
 """Closing the loop on measurements that carry an effect the building file does not declare:
 real weather, 0.1 C of sensor noise, the paper's sensors, a history longer than the warm-up."""
+import copy
 import json
 
 import numpy as np
@@ -120,6 +121,28 @@ def test_the_residual_left_points_at_an_effect_of_the_right_shape(tmp_path, test
     assert report["after"]["validation"]["rmse"] <= 1.5 * NOISE
     # the residual the loop describes at the end
     assert report["decision"]["structure_left"]
+
+
+def test_the_sun_a_closed_blind_lets_in_is_named_as_the_blind_not_as_a_gain(tmp_path, testcell_data, weather):
+    """The test cell with a blind on its south window, drawn 09:00 to 17:00 every day, and a blind
+    that lets 30 % of the glazing's sun through where its file says none: the physical effect
+    (shading_transmittance) is named, not a gain that follows the sun (a shape of the same input)."""
+    data = copy.deepcopy(testcell_data)
+    next(c for c in data["components"] if "solar_transmittance" in c)["shading"] = "blind"
+    building = parse_building(data)
+    hour = weather.index.tz_convert("-05:00").hour
+    drawn = weather.assign(blind=np.where((hour >= 9) & (hour < 17), 0.0, 1.0))
+    drawn.attrs = weather.attrs
+    truth = EFFECTS["shading_transmittance"].apply(building, "cell", {"f": 0.3})
+    measurements = pseudo_measurements(truth, drawn, record(), SENSORS, noise_sd=NOISE, seed=5, history_days=7)
+    case = prepare_case(building, drawn, measurements).with_burn_in(1)
+    report = diagnose(building, case, Objective.of(building), tmp_path, seed=0, workers=2)
+    assert [(e["effect"], e["target"]) for e in report["effects"]] == [("shading_transmittance", "cell")], \
+        report["decision"]["reason"]
+    f = report["effect"]["parameters"]["f"]
+    assert f["identifiable"] and abs(f["value"] - 0.3) <= max(0.25 * 0.3, 3 * f["std"])
+    before, after = report["before"]["validation"]["rmse"], report["after"]["validation"]["rmse"]
+    assert after <= 1.5 * NOISE < before
 
 
 def test_no_undeclared_effect_changes_nothing(tmp_path, testcell_data, testcell, weather):

@@ -124,7 +124,8 @@ def boundary_heat_in(building, T, u):
             Q += c.area * out.h * (T_b - e)
         if c.solar_transmittance is not None:
             I = u[c.outside.irradiance or f"I_{c.name}"]
-            Q += c.solar_transmittance * c.area * I * (u[c.shading] if c.shading else 1.0)
+            s, f = (u[c.shading], building.zone(c.inside.zone).shading_transmittance) if c.shading else (1.0, 0.0)
+            Q += c.solar_transmittance * c.area * I * (s + f * (1 - s))
     # Air: what enters from outside at its temperature, what leaves at the zone's. The flows
     # between zones enter one zone at the other's temperature and leave it at the same.
     for z in building.zones:
@@ -165,6 +166,28 @@ def test_energy_balance_closes_every_step():
         heat_in = boundary_heat_in(b, T[n], u)  # implicit Euler: the fluxes at t_n+1
         scale = max(abs(stored), abs(heat_in), 1.0)
         assert abs(stored - heat_in) <= 1e-6 * scale, n
+
+
+@pytest.mark.parametrize("f", [0.0, 0.3, 1.0])
+def test_a_closed_shading_lets_in_its_part_f_of_the_glazings_sun(f):
+    """PHYSICS.md section 4's transmitted sun tau s A I, with the zone's shading_transmittance f:
+    tau A I (s + f (1 - s)), by hand at a blind open, half drawn and closed; it lands on the
+    receiving surface only, and f = 0 is the building as declared."""
+    data = copy.deepcopy(TESTCELL)
+    glazing = next(c for c in data["components"] if "solar_transmittance" in c)
+    glazing["shading"] = "blind"
+    data["zones"][0]["shading_transmittance"] = f
+    b = parse_building(data)
+    net = assemble(b)
+    c = b.component(glazing["name"])
+    receiver = b.component(c.transmitted_solar_to).node_ids[0] - 1
+    for s in (1.0, 0.5, 0.0):
+        u = dict.fromkeys(net.input_names, 0.0) | {c.irradiance_input: 500.0, "blind": s}
+        sources = net.sources(np.array([u[name] for name in net.input_names]))
+        hand = c.solar_transmittance * c.area * 500.0 * (s + f * (1 - s))
+        assert sources[receiver] == pytest.approx(hand, rel=1e-12, abs=1e-12)
+        others = np.delete(sources, [receiver, c.node_ids[-1] - 1])  # the glazing's own outside absorbs
+        assert np.all(others == 0.0)
 
 
 def test_forced_node_equals_its_measurement_exactly():

@@ -21,6 +21,7 @@ from fmpy.fmi2 import FMU2Slave
 from nodeforce.cosim.fmi import content_id
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.model.building import parse_building
+from nodeforce.model.effects import EFFECTS
 from tests.importers import fmpy_validate, fmutool_check, run_ecos, run_fmpy, run_libcosim
 
 HOST = Path(__file__).with_name("c_host") / "host.c"
@@ -162,6 +163,26 @@ def test_an_effect_on_a_shaded_glazing_is_carried_by_the_standalone_fmu(fmus, te
     parameters["solar_transmittance.tau"] = 0.3
     reference = run_fmpy(built["python"], parameters, inputs, outputs, 900.0, n_steps)
     assert np.abs(reference - at_declared).max() > 0.1  # tau matters
+    done, in_c = run_c_host(built["standalone"], parameters, inputs, outputs, 900.0, n_steps, tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert np.abs(in_c - reference).max() < 1e-9
+
+
+def test_a_closed_shadings_leak_is_carried_by_both_fmus(testcell_data, tmp_path):
+    """shading_transmittance scales the product of inputs and adds a term of the irradiance
+    alone: both FMUs at f = 0.4 agree, with each other and with the building declaring it."""
+    building = parse_building(shaded(testcell_data))
+    effect = ("shading_transmittance", "cell")
+    built = {kind: build_fmu(building, tmp_path / f"{kind}.fmu", effect=effect, kind=kind) for kind in KINDS}
+    parameters, inputs, outputs, n_steps = scenario(built["python"], n_steps=96)
+    at_declared = run_fmpy(built["python"], parameters, inputs, outputs, 900.0, n_steps)
+    parameters["shading_transmittance.f"] = 0.4
+    reference = run_fmpy(built["python"], parameters, inputs, outputs, 900.0, n_steps)
+    assert np.abs(reference - at_declared).max() > 0.1  # the leak matters while the blind is drawn
+    declared = build_fmu(EFFECTS["shading_transmittance"].apply(building, "cell", {"f": 0.4}), tmp_path / "f.fmu")
+    del parameters["shading_transmittance.f"]
+    assert np.abs(run_fmpy(declared, parameters, inputs, outputs, 900.0, n_steps) - reference).max() < 1e-9
+    parameters["shading_transmittance.f"] = 0.4
     done, in_c = run_c_host(built["standalone"], parameters, inputs, outputs, 900.0, n_steps, tmp_path)
     assert done.returncode == 0, done.stderr
     assert np.abs(in_c - reference).max() < 1e-9
