@@ -174,7 +174,9 @@ def follow_up(building, left, zones):
     """(effect, target) pairs that the structure left in a residual points at: a gain with a daily
     profile where the residual follows the time of day, a gain proportional to an input column it
     follows (a heat input mis-measured, sun through an opening the model lacks), for each
-    objective zone. None where the residual is white: nothing is left to explain.
+    objective zone, and where that column is the sun on a facade the zone has glazings on, their
+    transmittance and their shadings' leak. None where the residual is white: nothing is left to
+    explain.
 
     Parameters
     ----------
@@ -201,7 +203,10 @@ def follow_up(building, left, zones):
     pairs += [("heat_input_split", zone) for zone in zones
               if set(named) & set(building.zone(zone).heat_input)]
     pairs += zone_effects(building, left, zones)
-    # sun on a facade whose glazings have shadings: the physical counterpart of a gain following it
+    # sun on a facade with glazings: the physical counterparts of a gain following it, the
+    # glazings' transmittance and the sun their closed shadings let in
+    pairs += [("solar_transmittance", c.name) for c in building.components for zone in zones
+              if c.solar_transmittance is not None and c.inside.zone == zone and c.irradiance_input in named]
     pairs += shading_leaks(building, zones, set(named))
     return list(dict.fromkeys(pairs))
 

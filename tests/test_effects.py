@@ -172,3 +172,27 @@ def test_a_residual_that_follows_a_heat_input_points_at_its_gain_and_split():
     assert follow_up(b, {**left, "follows": [], "time_of_day": {"significant": True}, "strongest": None},
                      ["A"])[0] == ("daily_gain", "A")
     assert follow_up(b, {**left, "white": True}, ["B"]) == []
+
+
+def test_a_residual_that_follows_the_sun_on_a_glazed_facade_points_at_the_glazing_before_a_gain(testcell_data):
+    """Sun on the facade of a zone's glazing: its transmittance, and the leak of its shading, are
+    the physical counterparts of a gain following that sun, and are offered with it; sun on a
+    facade with no glazing of the zone offers only the gain; a declared leak is not offered again."""
+    from nodeforce.diagnose.candidates import candidates, follow_up
+    data = copy.deepcopy(testcell_data)
+    window = next(c for c in data["components"] if "solar_transmittance" in c)
+    window["shading"] = "blind"
+    b = parse_building(data)
+    column = b.component(window["name"]).irradiance_input
+    left = {"white": False, "time_of_day": {"significant": False},
+            "follows": [{"input": column, "lag_hours": 0.0, "correlation": 0.6}]}
+    pairs = follow_up(b, left, ["cell"])
+    assert ("proportional_gain", f"cell->{column}") in pairs
+    assert ("solar_transmittance", window["name"]) in pairs and ("shading_transmittance", "cell") in pairs
+    roof = {**left, "follows": [{"input": "I_roof", "lag_hours": 0.0, "correlation": 0.6}]}
+    assert not {"solar_transmittance", "shading_transmittance"} & {e for e, _ in follow_up(b, roof, ["cell"])}
+    leaking = EFFECTS["shading_transmittance"].apply(b, "cell", {"f": 0.2})
+    assert ("shading_transmittance", "cell") not in follow_up(leaking, left, ["cell"])
+    # a zone with a shaded glazing is offered the leak from the first round; one without is not
+    assert ("shading_transmittance", "cell") in candidates(b, [], ["cell"])
+    assert not any(e == "shading_transmittance" for e, _ in candidates(parse_building(testcell_data), [], ["cell"]))
