@@ -15,9 +15,10 @@ from nodeforce.model.errors import InputError
 DATA = Path(__file__).parents[1] / "model" / "data"
 SCHEMA = json.loads((DATA / "nodal-building.schema.json").read_text())
 TESTCELL = json.loads((DATA / "testcell.json").read_text())
-# the test cell with a measured heater, 30 % radiative
+# the test cell with a measured heater, 30 % radiative, and a blind on its window
 HEATED = copy.deepcopy(TESTCELL)
 HEATED["zones"][0].update(heat_input="heater", heat_input_radiative_fraction=0.3)
+next(c for c in HEATED["components"] if c["name"] == "window")["shading"] = "blind"
 
 # A sensible value for every effect, on the test cell element it fits.
 EFFECT_CASES = {
@@ -35,6 +36,7 @@ EFFECT_CASES = {
     "internal_mass": ("cell", {"C_m": 4e5, "H_m": 60.0}),
     "heat_input_lag": ("cell", {"C_h": 3e4, "H_h": 12.0}),
     "envelope_conductance": ("cell", {"factor": 1.4}),
+    "shading_transmittance": ("cell", {"f": 0.15}),
 }
 
 
@@ -168,6 +170,10 @@ def _glazing_without_target(d):
     del _component(d, "window")["transmitted_solar_to"]
 
 
+def _shading_leak_above_one(d):
+    d["zones"][0]["shading_transmittance"] = 1.2
+
+
 def _wrong_format(d):
     d["format"] = "nodal-building/2"
 
@@ -176,7 +182,7 @@ def _wrong_format(d):
     _unknown_outside_type, _negative_area, _tilt_200, _missing_layers, _absorptance_1_5,
     _zero_conductivity, _boundary_without_h, _exterior_without_absorptance,
     _negative_air_change_rate, _zero_convection_factor, _layer_without_thickness,
-    _latitude_100, _glazing_without_target, _wrong_format,
+    _latitude_100, _glazing_without_target, _shading_leak_above_one, _wrong_format,
 ], ids=lambda f: f.__name__.strip("_"))
 def test_wrong_file_is_refused_by_schema_and_parser(validator, mutate):
     data = copy.deepcopy(TESTCELL)
