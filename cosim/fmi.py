@@ -206,7 +206,7 @@ class FmuInstance:
 
         Parameters
         ----------
-        dt : communication step (s)
+        dt : communication step (s), or one per step (n_steps,)
         parameters : {name: value} for Boolean and Real parameters
         start_inputs : {name: value} inputs set during initialisation
         input_names : the inputs set before every step
@@ -229,10 +229,10 @@ class FmuInstance:
         inputs = np.asarray(inputs, dtype=float)
         step = calls.stepper(fmu, list(input_names), list(output_names))
         outputs = np.empty((len(inputs) - skip, len(output_names)))
-        time = start_time
+        steps = np.broadcast_to(np.asarray(dt, dtype=float), (len(inputs),))
+        times = start_time + np.concatenate([[0.0], np.cumsum(steps)])
         for k, row in enumerate(inputs):
-            step(time, dt, row, outputs[k - skip] if k >= skip else None)
-            time = start_time + (k + 1) * dt
+            step(times[k], steps[k], row, outputs[k - skip] if k >= skip else None)
         fmu.terminate()
         return outputs
 

@@ -5,7 +5,7 @@ driver's, and follow the same rules as `model.integrate.simulate`, so both give 
 """
 import numpy as np
 
-from nodeforce.model.integrate import forcing_schedule, warmup_rows
+from nodeforce.model.integrate import STEADY_STEP, forcing_schedule, steady_inputs, warmup_rows
 
 
 def node_names(prefix, ids):
@@ -47,6 +47,11 @@ def simulate_fmu(instance, case, force=None, warmup_days=2, output_ids=None, T_d
     columns = np.array(forced_ids, dtype=int) - 1
     imposed = np.where(schedule[:, columns], measured[:, columns], np.nan)
     inputs = np.hstack([case.U[rows], imposed[rows]])
-    return instance.run(case.dt, parameters, start_inputs,
+    steps = np.full(len(rows), case.dt)
+    if case.steady_start:
+        u, held, values = steady_inputs(case.U, measured, schedule, case.dt)
+        inputs = np.vstack([np.concatenate([u, np.where(held[columns], values[columns], np.nan)]), inputs])
+        steps = np.concatenate([[STEADY_STEP], steps])
+    return instance.run(steps, parameters, start_inputs,
                         list(case.input_names) + node_names("T_forced", forced_ids),
-                        inputs, node_names("T", output_ids), skip=len(rows) - (n_rows - 1))
+                        inputs, node_names("T", output_ids), skip=len(inputs) - (n_rows - 1))

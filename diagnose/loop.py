@@ -278,6 +278,10 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
     `noise` (C) is the air sensors' noise sd if the user knows it, else it is estimated;
     `phases` (iotools.phases.Phase records) are the experiment's phases, each model scored on each."""
     check_measured(objective, case, source)
+    # what no sensor sets (every wall of an air-only record) starts from the steady state of the
+    # first day, not at the air's temperature: a heavy component would carry that guess for weeks,
+    # and the candidates' slow parameters would fit it
+    case = case if case.steady_start else case.with_steady_start()
     k = split(case, source, fraction, calibration_end)
     j = selection_split(case, k, source)
     # the forcing search and the candidates' fits read the calibration window's first part (the

@@ -114,5 +114,6 @@ class ModelEvaluator(_Evaluator):
         """Objective air temperatures (C) at t_1..t_N with the `force` (N,) bool nodes forced."""
         case = self.spec.case
         T = simulate(self.spec.building, self.network, case.U, case.dt, case.measured, force=force,
-                     warmup_days=self.spec.warmup_days, burn_in_steps=case.burn_in_steps, stepper=self.stepper)
+                     warmup_days=self.spec.warmup_days, burn_in_steps=case.burn_in_steps, stepper=self.stepper,
+                     steady_start=case.steady_start)
         return T[:, np.array(self.spec.objective.air_nodes) - 1]

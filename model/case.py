@@ -21,6 +21,11 @@ from .solar import (DECOMPOSITIONS, complete_irradiance, incident_irradiance, me
 from .weather import IRRADIANCE_COLUMNS, check_columns, weather_on_grid
 
 
+STEADY_START = ("the nodes no measurement sets start from the steady state of the first day's mean conditions, "
+                "then the first day is replayed (PHYSICS.md section 5's warm-up): a heavy component starts with "
+                "the gradient those conditions give it, not at the air's temperature")
+
+
 @dataclass(frozen=True)
 class Case:
     times: pd.DatetimeIndex  # t_0..t_N, uniform
@@ -30,6 +35,7 @@ class Case:
     measured: np.ndarray  # (N_t+1, N) node temperatures (C), NaN where not measured
     burn_in_steps: int = 0  # B: t_1..t_B force every measured node and are not scored
     assumptions: tuple = ()  # sentences: what the case computed that the files did not give
+    steady_start: bool = False  # the warm-up starts from the first day's steady state (`with_steady_start`)
 
     @property
     def measured_ids(self):
@@ -48,6 +54,11 @@ class Case:
         if steps >= len(self.times) - 1:
             raise InputError(source, days, "the burn-in must be shorter than the record")
         return replace(self, burn_in_steps=steps)
+
+    def with_steady_start(self):
+        """The case whose runs take, before the replay warm-up, one long step at the first day's
+        mean conditions (`integrate.steady_inputs`), stated among its assumptions."""
+        return replace(self, steady_start=True, assumptions=self.assumptions + (STEADY_START,))
 
     def scored(self, columns):
         """(N_t, k) measurements of the node indices `columns` at t_1..t_N, NaN where missing and

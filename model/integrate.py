@@ -14,6 +14,11 @@ from collections import OrderedDict
 import numpy as np
 
 DAY = 86400.0  # s
+# The steady start's one backward-Euler step: a mode of time constant tau keeps 1 / (1 + STEADY_STEP
+# / tau) of its start (1e-4 for the 12 days of the test cell's floor over its air), and C / dt is
+# still far above rounding next to the conductances (an infinite step would be the steady state
+# itself, but no FMU takes one).
+STEADY_STEP = 1e10  # s
 
 
 class DenseSolve:
@@ -279,8 +284,41 @@ def initial_state(building, measured0, T_default=20.0):
     return T
 
 
+def steady_inputs(U, measured, forced, dt):
+    """The steady start's step: the first day's mean inputs, and the nodes imposed during that
+    day held at the mean of their imposed values.
+
+    Before the replay warm-up (PHYSICS.md section 5), a diagnosis may take one backward-Euler
+    step of `STEADY_STEP` with these: every mode faster than centuries reaches the steady state of
+    the first day's mean conditions, so a heavy, unmeasured component starts with the gradient
+    the conditions give it rather than at the air's temperature, a guess its slow time constant
+    would carry through a whole record (the replay alone needs some three time constants of
+    days: weeks for a heavy floor).
+
+    Parameters
+    ----------
+    U : (N_t+1, n_inputs) inputs at t_0..t_N
+    measured : (N_t+1, N) measured temperatures (C), NaN where missing
+    forced : (N_t+1, N) bool, the nodes imposed at each row (`forcing_schedule`)
+    dt : step (s)
+
+    Returns
+    -------
+    u : (n_inputs,) mean inputs of rows 1..M
+    imposed : (N,) bool, nodes imposed at some row of the first day
+    values : (N,) C, their mean imposed temperature (NaN elsewhere)
+    """
+    day = slice(1, steps_per_day(dt) + 1)
+    imposed = forced[day].any(axis=0)
+    held = np.where(forced[day], measured[day], 0.0)
+    counts = forced[day].sum(axis=0)
+    values = np.full(measured.shape[1], np.nan)
+    values[imposed] = held[:, imposed].sum(axis=0) / counts[imposed]
+    return U[day].mean(axis=0), imposed, values
+
+
 def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2, T_default=20.0,
-             include_start=False, burn_in_steps=0, stepper=None):
+             include_start=False, burn_in_steps=0, stepper=None, steady_start=False):
     """Simulate the network over input samples t_0..t_N; return temperatures at t_1..t_N.
 
     Parameters
@@ -298,6 +336,8 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     burn_in_steps : B, steps over which every measured node is forced (`forcing_schedule`)
     stepper : the network's `ImplicitEuler` for dt, if one is kept between runs (its factors
         per mask are then reused)
+    steady_start : before the warm-up, one step of `STEADY_STEP` at the first day's mean
+        conditions (`steady_inputs`)
 
     Returns
     -------
@@ -314,6 +354,9 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     forced = forcing_schedule(force, measured, burn_in_steps)
     stepper = ImplicitEuler(network, dt) if stepper is None else stepper
     T = initial_state(building, measured[0], T_default)
+    if steady_start:
+        u, held, values = steady_inputs(U, measured, forced, dt)
+        T = ImplicitEuler(network, STEADY_STEP).step(T, network.sources(u), held, values)
     rows = warmup_rows(n_rows, dt, warmup_days)
     start = len(rows) - (n_rows - 1)  # the step that reaches t_1
     out = np.empty((n_rows, n))

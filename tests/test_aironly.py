@@ -20,6 +20,8 @@ from nodeforce.model.case import prepare_case
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
 from nodeforce.model.hlc import heat_loss_coefficient
+from nodeforce.model.integrate import simulate
+from nodeforce.model.network import assemble
 from nodeforce.model.score import Objective
 from nodeforce.model.solar import DECOMPOSITIONS, solar_position
 from nodeforce.model.synth import pseudo_measurements
@@ -214,26 +216,43 @@ RECOVERY = [("internal_mass", {"C_m": 1e6, "H_m": 80.0}),
             ("envelope_conductance", {"factor": 1.5})]
 
 
+@pytest.mark.parametrize("effect,values", RECOVERY, ids=[e for e, _ in RECOVERY])
+def test_the_steady_start_finds_the_walls_state_the_replay_alone_misses(heated, heated_weather, effect, values):
+    """The records are made periodic by a year of replays of their first day (`pseudo_measurements`),
+    an independent way to the walls' state at t_0. With the air alone measured, the true model
+    started from the first day's steady state reproduces the record to the hundredth of a degree;
+    the two replays of PHYSICS.md section 5 alone leave the heavy floor at the air's temperature,
+    tenths of a degree off for the whole record."""
+    truth = EFFECTS[effect].apply(heated, "cell", values)
+    times = pd.date_range("2001-06-10T00:00-05:00", periods=5 * 48 + 1, freq="30min", name="time")
+    record = pseudo_measurements(truth, heated_weather, times, [23])
+    case = prepare_case(truth, heated_weather, record).with_burn_in(1)
+    network = assemble(truth)
+
+    def error(steady_start):
+        T = simulate(truth, network, case.U, case.dt, case.measured, burn_in_steps=case.burn_in_steps,
+                     steady_start=steady_start)
+        return np.abs(record["T23"].to_numpy()[1:] - T[:, 22])[case.burn_in_steps:].max()
+    assert error(True) < 0.01 < 0.1 < error(False)
+
+
 @pytest.mark.slow  # a diagnosis each
 @pytest.mark.parametrize("effect,values", RECOVERY, ids=[e for e, _ in RECOVERY])
 def test_an_air_only_record_names_the_undeclared_zone_effect(heated, heated_weather, tmp_path, effect, values):
     """The test cell with a declared, measured on/off heater, only its air measured (0.1 C): the
-    effect the file lacks is the one named, the validation error falls to the noise, and the
-    HLC as corrected is within 10 % of the truth's.
-
-    The parameters are checked within 3 standard deviations or 25 %: the record's first days
-    carry the unmeasured walls' initial state (the test cell's heavy floor, adiabatic below,
-    holds its start for weeks), a bias of about 0.1 C that no covariance of the noise knows, and
-    a slow node's parameters absorb part of it (the internal mass's C_m comes out 20 % high, 4.5
-    of its sd, when fitted on the first two thirds of the calibration window)."""
+    effect the file lacks is the one named, and nothing on top of it; the validation error falls
+    to the noise; its parameters are the truth's within 3 of their standard deviations; the HLC
+    as corrected is the truth's (the issue asks 10 %; the diagnosis starts the unmeasured walls
+    from the first day's steady state, so no initial-state bias is left for a slow parameter to
+    absorb)."""
     truth, case = air_only(heated, heated_weather, id=effect, values=values)
     report = diagnose(heated, case.with_burn_in(1), Objective.of(heated), tmp_path, workers=2, noise=NOISE)
+    assert [(e["effect"], e["target"]) for e in report["effects"]] == [(effect, "cell")], report["decision"]["reason"]
     first = report["effects"][0]
-    assert first["effect"] == effect and first["target"] == "cell"
-    assert report["after"]["validation"]["rmse"] < 2 * NOISE < report["before"]["validation"]["rmse"]
+    assert report["after"]["validation"]["rmse"] < 1.2 * NOISE < 2 * NOISE < report["before"]["validation"]["rmse"]
     for name, true in values.items():
         p = first["parameters"][name]
-        assert abs(p["value"] - true) < max(3 * p["std"], 0.25 * true), (name, p, true)
+        assert p["identifiable"] and abs(p["value"] - true) < 3 * p["std"], (name, p, true)
     hlc = report["heat_loss_coefficient"]
-    assert hlc["after"] == pytest.approx(heat_loss_coefficient(truth), rel=0.10)
+    assert hlc["after"] == pytest.approx(heat_loss_coefficient(truth), rel=0.02)
     assert hlc["before"] == pytest.approx(heat_loss_coefficient(heated))

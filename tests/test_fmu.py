@@ -1,6 +1,7 @@
 """The FMU gives the direct model's numbers and behaves as an FMI 2.0 co-simulation slave should."""
 import copy
 import sys
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -35,6 +36,22 @@ def test_fmu_equals_direct_model_on_real_weather(fmu, testcell, real_case, force
     assert np.abs(through_fmu - direct).max() < 1e-9
     # the comparison is not between two idle models: the air swings with the weather
     assert np.ptp(direct[:, 22]) > 2.0
+
+
+def test_a_steady_start_is_the_same_year_long_step_through_the_fmu(fmu, testcell, real_case):
+    """A diagnosis' steady start (one long step at the first day's means) is a doStep like any
+    other: the FMU gives the direct model's numbers, and they differ from the replay's alone."""
+    # the air alone measured: the walls' state is the warm-up's to set
+    air_only = np.where(np.arange(23) == 22, real_case.measured, np.nan)
+    case = replace(real_case, measured=air_only).with_burn_in(1).with_steady_start()
+    net = assemble(testcell)
+    direct = simulate(testcell, net, case.U, case.dt, case.measured, burn_in_steps=case.burn_in_steps,
+                      steady_start=True)
+    with FmuInstance(fmu) as instance:
+        through_fmu = simulate_fmu(instance, case)
+    assert np.abs(through_fmu - direct).max() < 1e-9
+    replay = simulate(testcell, net, case.U, case.dt, case.measured, burn_in_steps=case.burn_in_steps)
+    assert np.abs(replay - direct).max() > 0.01
 
 
 def test_fmpy_validate_finds_no_problem(fmu):

@@ -190,6 +190,21 @@ def test_a_closed_shading_lets_in_its_part_f_of_the_glazings_sun(f):
         assert np.all(others == 0.0)
 
 
+def test_a_steady_start_on_constant_conditions_is_the_steady_state():
+    """The steady start's long step on constant conditions lands on the steady state solved by
+    hand from the network (-A T = B u + q), whatever the start; the replay then keeps it."""
+    b = parse_building(two_wall_box({"type": "boundary", "temperature": 12.0, "h": 4.0}))
+    inputs = {"T_out": 0.0, "T_sky": -5.0, "I_wall": 200.0}
+    net, U, T = run_constant(b, inputs, days=2, T0=30.0)
+    steady = np.linalg.solve(-net.A, net.sources(U[0]))
+    measured = np.full((U.shape[0], net.n_nodes), np.nan)
+    measured[0, b.zones[0].air_node - 1] = 30.0  # a start far from it
+    T = simulate(b, net, U, 3600.0, measured, warmup_days=0, include_start=True, steady_start=True)
+    assert np.abs(T[0] - steady).max() < 1e-3
+    assert np.abs(T[-1] - steady).max() < 1e-3
+    assert np.abs(steady - 30.0).min() > 5.0  # and the start was not already there
+
+
 def test_forced_node_equals_its_measurement_exactly():
     b = parse_building(TESTCELL)
     net = assemble(b)

@@ -210,10 +210,11 @@ def test_standalone_fmu_equals_the_direct_model_on_the_generated_office(office, 
         instance.close()
 
 
-def test_standalone_fmu_equals_the_direct_model_on_the_twin_house(tmp_path):
+@pytest.mark.parametrize("steady_start", [False, True], ids=["replay", "steady_start"])
+def test_standalone_fmu_equals_the_direct_model_on_the_twin_house(tmp_path, steady_start):
     """The Twin House (267 nodes: the direct model's dense inverse) through the C FMU's profile LU,
     on two days of random inputs, a third of its nodes forced to random measurements, some of
-    them missing at three steps."""
+    them missing at three steps; with a diagnosis' steady start too (its one long step)."""
     from types import SimpleNamespace
 
     from nodeforce.cosim.fmi import FmuInstance
@@ -227,8 +228,10 @@ def test_standalone_fmu_equals_the_direct_model_on_the_twin_house(tmp_path):
     measured = rng.normal(20.0, 2.0, (n_rows, network.n_nodes))
     measured[[20, 100, 150]] = np.where(rng.random(network.n_nodes) < 0.5, np.nan, measured[[20, 100, 150]])
     force = rng.random(network.n_nodes) < 0.3
-    case = SimpleNamespace(measured=measured, dt=900.0, burn_in_steps=4, U=U, input_names=network.input_names)
-    expected = simulate(building, network, U, 900.0, measured, force=force, burn_in_steps=4)
+    case = SimpleNamespace(measured=measured, dt=900.0, burn_in_steps=4, U=U, input_names=network.input_names,
+                           steady_start=steady_start)
+    expected = simulate(building, network, U, 900.0, measured, force=force, burn_in_steps=4,
+                        steady_start=steady_start)
     instance = FmuInstance(build_fmu(building, tmp_path / "twinhouse.fmu", kind="standalone"))
     try:
         assert np.abs(simulate_fmu(instance, case, force) - expected).max() < 1e-9
