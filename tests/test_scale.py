@@ -183,9 +183,11 @@ def test_small_office_two_faults_located(office, tmp_path):
     assert sorted(names[i] for i in result["best_nodes"]) == ["s0_N1_wallN at 0.000 m", "s1_S0_wallS at 0.000 m"]
 
 
-def test_standalone_fmu_equals_the_direct_model_on_the_generated_office(office, tmp_path):
+@pytest.mark.parametrize("steady_start", [False, True], ids=["replay", "steady_start"])
+def test_standalone_fmu_equals_the_direct_model_on_the_generated_office(office, tmp_path, steady_start):
     """The C FMU's profile LU after reverse Cuthill-McKee gives the direct model's numbers (the
-    direct model steps the office with the condensed solver: two independent factorisations)."""
+    direct model steps the office with the condensed solver: two independent factorisations),
+    a diagnosis' steady start (one step of 1e10 s) included."""
     from nodeforce.cosim.fmi import FmuInstance
     from nodeforce.cosim.run import simulate_fmu
     from nodeforce.fmu_build.build import build_fmu
@@ -199,10 +201,11 @@ def test_standalone_fmu_equals_the_direct_model_on_the_generated_office(office, 
     sensors = [int(i) for i in (out / "sensors.txt").read_text().split(",")]
     measured = pseudo_measurements(building, weather, times, sensors, noise_sd=0.1, seed=1, spinup_days=2)
     case = prepare_case(building, weather, measured).with_burn_in(0.5)
+    case = case.with_steady_start() if steady_start else case
     force = np.zeros(building.n_nodes, dtype=bool)
     force[np.array(sensors[::3]) - 1] = True
     expected = simulate(building, assemble(building), case.U, case.dt, case.measured, force=force,
-                        burn_in_steps=case.burn_in_steps)
+                        burn_in_steps=case.burn_in_steps, steady_start=steady_start)
     instance = FmuInstance(build_fmu(building, tmp_path / "office.fmu", kind="standalone"))
     try:
         assert np.abs(simulate_fmu(instance, case, force) - expected).max() < 1e-9
