@@ -71,10 +71,10 @@ def candidates(building, located_nodes, zones):
 
 def calibration_start(building, effect, target):
     """Where a calibration starts: the declared values, except that an absent coupling (U = 0,
-    n = 0, UA = 0, a closed shading's leak f = 0) starts at `ABSENT_START` and an absent zone node (C = 0) at `ZONE_START`: on
-    its bound, a bounded trust-region step is scaled to nothing and the fit stops where it began,
-    and at U = 0 the ground temperature (at C = 0 the node's conductance) has no influence to
-    fit at all."""
+    n = 0, UA = 0, a closed shading's leak f = 0) starts at `ABSENT_START` and an absent zone node
+    (C = 0) at `ZONE_START`: on its bound, a bounded trust-region step is scaled to nothing and the
+    fit stops where it began, and at U = 0 the ground temperature (at C = 0 the node's
+    conductance) has no influence to fit at all."""
     values = EFFECTS[effect].read(building, target)
     for name, value in values.items():
         if value == 0.0 and (effect, name) in ABSENT_START:
