@@ -5,7 +5,7 @@ the policy changes no FMU and throws away no saved search.
 """
 import math
 
-from nodeforce.model.effects import EFFECTS, bridge_parts, bridge_target
+from nodeforce.model.effects import EFFECTS, bridge_parts, bridge_target, shaded_glazings
 from nodeforce.model.network import RHO_C_AIR
 
 # Where the calibration of an effect the file does not declare starts (see calibration_start).
@@ -217,11 +217,10 @@ def shading_leaks(building, zones, columns=None):
     description, and IDEAS's) misses what a real screen lets through its weave and passes on from
     the heat it absorbs, a gain that follows the sun on those facades only while they are shaded.
     `columns`: only the zones whose shaded glazings read one of these irradiance columns."""
-    targets = EFFECTS["shading_transmittance"].targets(building)
     return [("shading_transmittance", name) for name in zones
-            if name in targets and building.zone(name).shading_transmittance == 0.0
-            and (columns is None or columns & {c.irradiance_input for c in building.components
-                                               if c.shading and c.inside.zone == name})]
+            for glazings in [shaded_glazings(building, name)]
+            if glazings and building.zone(name).shading_transmittance == 0.0
+            and (columns is None or columns & {c.irradiance_input for c in glazings})]
 
 
 def zone_effects(building, left, zones):

@@ -11,7 +11,7 @@ import numpy as np
 
 from nodeforce.cosim.fmi import FmuInstance, content_id
 from nodeforce.cosim.run import simulate_fmu
-from nodeforce.model.integrate import ImplicitEuler, simulate
+from nodeforce.model.integrate import STEADY_STEP, ImplicitEuler, simulate
 from nodeforce.model.network import assemble
 
 
@@ -109,11 +109,12 @@ class ModelEvaluator(_Evaluator):
         super().__init__(spec)
         self.network = assemble(spec.building)
         self.stepper = ImplicitEuler(self.network, spec.case.dt)  # kept: its partition and factors
+        self.steady = ImplicitEuler(self.network, STEADY_STEP) if spec.case.steady_start else None
 
     def air(self, force):
         """Objective air temperatures (C) at t_1..t_N with the `force` (N,) bool nodes forced."""
         case = self.spec.case
         T = simulate(self.spec.building, self.network, case.U, case.dt, case.measured, force=force,
                      warmup_days=self.spec.warmup_days, burn_in_steps=case.burn_in_steps, stepper=self.stepper,
-                     steady_start=case.steady_start)
+                     steady_start=case.steady_start, steady_stepper=self.steady)
         return T[:, np.array(self.spec.objective.air_nodes) - 1]

@@ -230,17 +230,18 @@ def _envelope_targets(building):
             if any(c.inside.zone == z.name and isinstance(c.outside, (Exterior, Boundary)) for c in building.components)]
 
 
-def _shaded_glazings(building, zone):
+def shaded_glazings(building, zone):
+    """The glazed components of a zone whose sun a shading column scales."""
     return [c for c in building.components if c.shading and c.inside.zone == zone]
 
 
 def _shading_targets(building):
     """Zones with a glazing whose sun a shading column scales: what a closed shading's leak acts on."""
-    return [z.name for z in building.zones if _shaded_glazings(building, z.name)]
+    return [z.name for z in building.zones if shaded_glazings(building, z.name)]
 
 
 def _shading_receivers(building, target):
-    return tuple(i for c in _shaded_glazings(building, target)
+    return tuple(i for c in shaded_glazings(building, target)
                  for i in building.component(c.transmitted_solar_to).node_ids)
 
 

@@ -318,7 +318,7 @@ def steady_inputs(U, measured, forced, dt):
 
 
 def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2, T_default=20.0,
-             include_start=False, burn_in_steps=0, stepper=None, steady_start=False):
+             include_start=False, burn_in_steps=0, stepper=None, steady_start=False, steady_stepper=None):
     """Simulate the network over input samples t_0..t_N; return temperatures at t_1..t_N.
 
     Parameters
@@ -338,6 +338,7 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
         per mask are then reused)
     steady_start : before the warm-up, one step of `STEADY_STEP` at the first day's mean
         conditions (`steady_inputs`)
+    steady_stepper : the network's `ImplicitEuler` for `STEADY_STEP`, if one is kept between runs
 
     Returns
     -------
@@ -356,7 +357,8 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     T = initial_state(building, measured[0], T_default)
     if steady_start:
         u, held, values = steady_inputs(U, measured, forced, dt)
-        T = ImplicitEuler(network, STEADY_STEP).step(T, network.sources(u), held, values)
+        steady_stepper = ImplicitEuler(network, STEADY_STEP) if steady_stepper is None else steady_stepper
+        T = steady_stepper.step(T, network.sources(u), held, values)
     rows = warmup_rows(n_rows, dt, warmup_days)
     start = len(rows) - (n_rows - 1)  # the step that reaches t_1
     out = np.empty((n_rows, n))

@@ -164,3 +164,20 @@ def test_a_paired_comparison_names_the_floor_where_the_noise_of_one_J_names_a_wa
     scores = result["node_scores"]
     assert scores["1"] - scores["16"] < parsimony.noise_tolerance(0.1, n)
     assert result["best_nodes"] in ([16], [17])
+
+
+def test_the_direct_and_fmu_evaluators_agree_with_a_steady_start(tmp_path, testcell, weather):
+    """A diagnosis' case (its steady start) scored mask by mask by the direct model, which keeps
+    the long step's factors between masks, and through the FMU: the same J."""
+    from nodeforce.fmu_build.build import build_fmu
+    from nodeforce.ga.fitness import FmuFitness
+    measurements = pseudo_measurements(testcell, weather, record_times(days=2), list(SENSORS), noise_sd=0.1)
+    case = prepare_case(testcell, weather, measurements).with_burn_in(1).with_steady_start()
+    nodes, objective = [1, 7, 9], Objective.of(testcell)
+    direct = ModelFitness(testcell, case, nodes, objective)()
+    through_fmu = FmuFitness(build_fmu(testcell, tmp_path / "cell.fmu"), case, nodes, objective)()
+    try:
+        for mask in ([0, 0, 0], [1, 0, 0], [0, 1, 1], [0, 0, 0]):
+            assert direct.J(mask) == pytest.approx(through_fmu.J(mask), rel=1e-9, abs=1e-12)
+    finally:
+        through_fmu.close()
