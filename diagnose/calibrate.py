@@ -2,7 +2,7 @@
 
 Bounded least squares on the air-temperature residual of the calibration window (scipy's
 `least_squares`, trust region reflective). The covariance of the estimate is the linearised
-sandwich of `diagnose.significance`, which allows for the residual's correlation in time (the
+sandwich of `model.significance`, which allows for the residual's correlation in time (the
 textbook s^2 (J^T J)^-1 assumes independent residuals and, on real records, is several times
 too tight). A parameter is called identifiable from the data when that estimate
 is tight enough to act on (`IDENTIFIABLE_*` below) and it did not end on a bound.
@@ -18,7 +18,7 @@ from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.diagnose.candidates import IDENTIFIABLE_RELATIVE, calibration_start
-from nodeforce.diagnose.significance import bandwidth, parameter_covariance
+from nodeforce.model.significance import bandwidth, parameter_covariance
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.hlc import heat_loss_coefficient
 

@@ -48,7 +48,7 @@ from nodeforce.diagnose.loss import heat_loss
 from nodeforce.diagnose.report import write_report
 from nodeforce.diagnose.phases import phase_errors, worsened
 from nodeforce.diagnose.residuals import diagnostics as residual_diagnostics
-from nodeforce.diagnose.significance import bandwidth, change_of_J, worse
+from nodeforce.model.significance import bandwidth, change_of_J, worse
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.locate import check_measured, locate
 from nodeforce.ga.parsimony import Z_NOISE, tolerance

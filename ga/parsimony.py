@@ -32,7 +32,7 @@ two forcings can be told apart is a paired question: both are scored on the same
 same record, so they share its noise, and the difference of their J is far better determined
 than either J. The residuals of the two forcings are recomputed (`Paired`: a few simulations,
 only for the finalists) and their difference of J judged against its HAC standard deviation
-(`diagnose.significance.worse`, a Diebold-Mariano-type test allowing for the residuals'
+(`model.significance.worse`, a Diebold-Mariano-type test allowing for the residuals'
 correlation in time). Where the evaluator keeps no residuals, the noise of one J (noise_tolerance) is the band instead. So the inside surface of a wrong roof wins over the
 layer behind it (their residuals differ by noise), but a wall that merely compensates a wrong
 floor or door does not win over it because it comes first: its J is measurably worse on the
@@ -62,7 +62,7 @@ import math
 from itertools import combinations
 from typing import Callable, Sequence
 
-from nodeforce.diagnose import significance
+from nodeforce.model import significance
 
 Z_NOISE = 3.0
 EXPLAINED = 0.5

@@ -6,7 +6,7 @@ import pytest
 
 from nodeforce.diagnose.candidates import objection, preference
 from nodeforce.diagnose.loop import decide
-from nodeforce.diagnose.significance import change_of_J
+from nodeforce.model.significance import change_of_J
 from nodeforce.model.building import parse_building
 
 STEPS = 4 * 96  # four days of selection window at 15 min

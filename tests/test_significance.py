@@ -1,9 +1,9 @@
-"""diagnose.significance against Monte Carlo: the spread, over many records, of what one record
+"""model.significance against Monte Carlo: the spread, over many records, of what one record
 gives, for residuals correlated in time as a building model's are (AR(1), one day ~ 144 steps)."""
 import numpy as np
 import pytest
 
-from nodeforce.diagnose.significance import bandwidth, change_of_J, critical_value, parameter_covariance, worse
+from nodeforce.model.significance import bandwidth, change_of_J, critical_value, parameter_covariance, worse
 
 N, PHI, LAGS = 2000, 0.97, 144
 
