@@ -42,7 +42,7 @@ from nodeforce import lifetime
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnose.calibrate import Candidate, calibrate, sensitivity
-from nodeforce.diagnose.candidates import (candidates, follow_up, implausible, is_shape, objection, preference,
+from nodeforce.diagnose.candidates import (candidates, follow_up, is_shape, objection, preference,
                                            shaped_inputs)
 from nodeforce.diagnose.loss import heat_loss
 from nodeforce.diagnose.report import write_report
@@ -198,8 +198,7 @@ def decide(building, results, before, sigma, selection_residuals, k_before=0):
     if suggestions:
         reason += " Not added, though the data support them: " + "; ".join(
             f"{s['candidate']} ({s['reason']})" for s in suggestions) + "."
-    flag = implausible(building, chosen["effect"], chosen["target"]) if chosen else None
-    return chosen, {"chosen": label(chosen) if chosen else None, "reason": reason, "implausible": flag,
+    return chosen, {"chosen": label(chosen) if chosen else None, "reason": reason,
                     "bic_baseline": bic_before, "selection_J_before": J_before, "selection_margin": margin,
                     "suggestions": suggestions, "candidates": tests}
 
@@ -345,7 +344,6 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
             added.append(then)
             model = more_models[label(then)]
             decision["chosen"] = label(then)
-            decision["implausible"] = decision["implausible"] or follow_decision["implausible"]
 
     after_building, after_run, after = model.building, model.run, model.metrics
     effect = ({key: added[-1][key] for key in ("effect", "target", "parameters", "derived")} if added
