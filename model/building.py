@@ -76,8 +76,9 @@ class Boundary:
 
 @dataclass(frozen=True)
 class Supply:
-    flow: float  # m3/h
+    flow: float  # m3/h, as declared
     temperature: float | str  # C, or an input column
+    flow_factor: float = 1.0  # the flow the zone gets over the declared one (a fan off its setting)
 
 
 @dataclass(frozen=True)
@@ -114,6 +115,8 @@ class Zone:
     heat_input_lag: Lumped | None = None  # the heater's own capacity, between heat input and zone
     envelope_factor: float = 1.0  # scale on the conductances of the zone's components to outside
     shading_transmittance: float = 0.0  # part of its glazings' sun a closed shading still lets in
+    heat_input_factor: float = 1.0  # the heat its heat input columns deliver, per W they read
+    air_exchange: tuple = ()  # (other zone, m3/h each way): air through an open internal door
     mass_node: int | None = None  # ids of the nodes those two add (PHYSICS.md section 7)
     heater_node: int | None = None
 
@@ -155,6 +158,7 @@ class Building:
     zones: tuple
     components: tuple
     sensors: dict = field(default_factory=dict)  # sensor name -> node id
+    boundary_factors: dict = field(default_factory=dict)  # boundary column -> factor on its conductances
     source: str = field(default="<building>", compare=False)
     data: dict = field(default_factory=dict, compare=False, repr=False)  # the JSON it was read from
 
@@ -197,6 +201,16 @@ class Building:
             if c.shading:
                 names.append(c.shading)
         return tuple(dict.fromkeys(names))
+
+    @property
+    def boundary_columns(self):
+        """The input columns of boundary temperatures (attic, cellar, a neighbour): those a
+        component's outside face or a zone's thermal bridge sees, in order of appearance."""
+        return _boundary_columns(self.zones, self.components)
+
+    def boundary_factor(self, column):
+        """The factor on every conductance from the building to a boundary column (1 if not declared)."""
+        return self.boundary_factors.get(column, 1.0)
 
     def zone(self, name):
         return next(z for z in self.zones if z.name == name)
@@ -309,11 +323,13 @@ def parse_building(data, source="<building>"):
             check.fail(f"components[{i}].transmitted_solar_to",
                        f"names no component ({c.transmitted_solar_to!r})")
     _check_proportional_columns(check, zones, components)
+    _check_air_exchanges(check, zones)
+    boundary_factors = _boundary_factors(check, data, zones, components)
     _check_node_ids(check, zones, components)
     zones = _number_added_nodes(zones, sum(len(c.node_ids) for c in components) + 2 * len(zones))
     sensors = {name: _sensor_node(check, name, raw, zones, components) for name, raw in raw_sensors.items()}
     return Building(name=str(data.get("name", "")), site=site, zones=zones, components=components,
-                    sensors=sensors, source=source, data=copy.deepcopy(data))
+                    sensors=sensors, boundary_factors=boundary_factors, source=source, data=copy.deepcopy(data))
 
 
 class _Checker:
@@ -429,7 +445,8 @@ def _zone(check, z, where, zone_names, explicit, next_id):
     if z.get("supply") is not None:
         raw = check.mapping(z, "supply", where)
         supply = Supply(flow=check.number(raw, "flow", f"{where}.supply", low=0),
-                        temperature=check.temperature(raw, "temperature", f"{where}.supply"))
+                        temperature=check.temperature(raw, "temperature", f"{where}.supply"),
+                        flow_factor=check.number(raw, "flow_factor", f"{where}.supply", default=1.0, low=0))
     inflows = []
     for j, raw in enumerate(check.sequence(z, "airflow_from", where, optional=True)):
         fw = f"{where}.airflow_from[{j}]"
@@ -456,6 +473,17 @@ def _zone(check, z, where, zone_names, explicit, next_id):
     lumped = {key: _lumped(check, z, key, where) for key in ("internal_mass", "heat_input_lag")}
     if lumped["heat_input_lag"] is not None and not heat_input:
         check.fail(f"{where}.heat_input_lag", "the zone has no heat_input whose heater it would delay")
+    if "heat_input_factor" in z and not heat_input:
+        check.fail(f"{where}.heat_input_factor", "the zone has no heat_input whose reading it would scale")
+    exchange = z.get("air_exchange", {})
+    if not isinstance(exchange, dict):
+        check.fail(f"{where}.air_exchange", 'must be an object {"other zone": m3/h each way}')
+    for other in exchange:
+        if other not in zone_names:
+            check.fail(f"{where}.air_exchange.{other}", f"names no zone ({other!r})")
+        if other == z.get("name"):
+            check.fail(f"{where}.air_exchange.{other}", "a zone exchanges no air with itself")
+    exchange = tuple((other, check.number(exchange, other, f"{where}.air_exchange", low=0)) for other in exchange)
     occupied = z.get("occupied")
     if occupied is not None and not isinstance(occupied, bool):
         check.fail(f"{where}.occupied", f"must be true or false, found {occupied!r}")
@@ -482,6 +510,8 @@ def _zone(check, z, where, zone_names, explicit, next_id):
         proportional_gains=proportional,
         envelope_factor=check.number(z, "envelope_factor", where, default=1.0, low=0, low_open=True),
         shading_transmittance=check.number(z, "shading_transmittance", where, default=0.0, low=0, high=1),
+        heat_input_factor=check.number(z, "heat_input_factor", where, default=1.0, low=0),
+        air_exchange=exchange,
         **lumped,
     )
 
@@ -671,6 +701,37 @@ def _check_proportional_columns(check, zones, components):
             if column not in columns:
                 check.fail(f"zones[{i}].proportional_gains.{column}",
                            f"names no heat input or face irradiance of the building (one of: {', '.join(columns) or 'none'})")
+
+
+def _boundary_columns(zones, components):
+    names = [c.outside.temperature for c in components
+             if isinstance(c.outside, Boundary) and isinstance(c.outside.temperature, str)]
+    names += [to for z in zones for to, _ in z.thermal_bridges if to != "outdoor"]
+    return tuple(dict.fromkeys(names))
+
+
+def _boundary_factors(check, data, zones, components):
+    """{column: factor} of `boundary_conductance_factors`: each a boundary column of the building."""
+    raw = data.get("boundary_conductance_factors", {})
+    where = "boundary_conductance_factors"
+    if not isinstance(raw, dict):
+        check.fail(where, "must be an object {boundary temperature column: factor}")
+    columns = _boundary_columns(zones, components)
+    for column in raw:
+        if column not in columns:
+            check.fail(f"{where}.{column}", f"names no boundary temperature column of the building "
+                                            f"(one of: {', '.join(columns) or 'none'})")
+    return {column: check.number(raw, column, where, low=0) for column in raw}
+
+
+def _check_air_exchanges(check, zones):
+    """An exchange between two zones is declared on one of them only: declared on both, which
+    would be meant is not for the tool to guess."""
+    for i, z in enumerate(zones):
+        for other, _ in z.air_exchange:
+            if z.name in dict(next(o for o in zones if o.name == other).air_exchange):
+                check.fail(f"zones[{i}].air_exchange.{other}",
+                           f"the exchange between {z.name} and {other} is declared on both zones: declare it once")
 
 
 def _check_node_ids(check, zones, components):
