@@ -158,6 +158,7 @@ class Building:
     zones: tuple
     components: tuple
     sensors: dict = field(default_factory=dict)  # sensor name -> node id
+    flux_sensors: dict = field(default_factory=dict)  # sensor name -> (component, "inside" or "outside")
     boundary_factors: dict = field(default_factory=dict)  # boundary column -> factor on its conductances
     source: str = field(default="<building>", compare=False)
     data: dict = field(default_factory=dict, compare=False, repr=False)  # the JSON it was read from
@@ -327,9 +328,12 @@ def parse_building(data, source="<building>"):
     boundary_factors = _boundary_factors(check, data, zones, components)
     _check_node_ids(check, zones, components)
     zones = _number_added_nodes(zones, sum(len(c.node_ids) for c in components) + 2 * len(zones))
-    sensors = {name: _sensor_node(check, name, raw, zones, components) for name, raw in raw_sensors.items()}
+    flux_sensors = {name: (raw["component"], raw["face"]) for name, raw in raw_sensors.items()
+                    if raw.get("quantity") == "heat_flux"}
+    sensors = {name: _sensor_node(check, name, raw, zones, components) for name, raw in raw_sensors.items()
+               if name not in flux_sensors}
     return Building(name=str(data.get("name", "")), site=site, zones=zones, components=components,
-                    sensors=sensors, boundary_factors=boundary_factors, source=source, data=copy.deepcopy(data))
+                    sensors=sensors, flux_sensors=flux_sensors, boundary_factors=boundary_factors, source=source, data=copy.deepcopy(data))
 
 
 class _Checker:
@@ -658,8 +662,13 @@ def _explicit_ids(check, raw_zones, components):
     return all(given)
 
 
+FACES = ("inside", "outside")
+QUANTITIES = ("temperature", "heat_flux")
+
+
 def _sensor_depths(check, raw_sensors, raw_components):
-    """{component name: depths of the sensors declared on it}, for node generation."""
+    """{component name: depths of the sensors declared on it}, for node generation (a face
+    always has a node)."""
     names = {c.get("name") for c in raw_components if isinstance(c, dict)}
     depths = {}
     for name, raw in raw_sensors.items():
@@ -667,12 +676,23 @@ def _sensor_depths(check, raw_sensors, raw_components):
         if NODE_COLUMN.match(name):
             check.fail(where, "a sensor name must not look like a node column T<id>")
         if not isinstance(raw, dict) or ("zone" in raw) == ("component" in raw):
-            check.fail(where, 'must be {"zone": name} or {"component": name, "depth": m from the inside face}')
+            check.fail(where, 'must be {"zone": name}, {"component": name, "depth": m from the inside face} or '
+                              '{"component": name, "face": "inside" or "outside"}')
         if "component" in raw:
             component = check.text(raw, "component", where)
             if component not in names:
                 check.fail(f"{where}.component", f"names no component ({component!r})")
-            depths.setdefault(component, []).append(check.number(raw, "depth", where, low=0))
+            if ("depth" in raw) == ("face" in raw):
+                check.fail(where, "a component's sensor gives its depth (m from the inside face) or its face, one of them")
+            if "face" in raw and raw["face"] not in FACES:
+                check.fail(f"{where}.face", f"must be inside or outside, found {raw['face']!r}")
+            quantity = raw.get("quantity", "temperature")
+            if quantity not in QUANTITIES:
+                check.fail(f"{where}.quantity", f"must be temperature or heat_flux, found {quantity!r}")
+            if quantity == "heat_flux" and "face" not in raw:
+                check.fail(f"{where}.quantity", "a heat flux is measured at a face: give its face, not a depth")
+            if "depth" in raw:
+                depths.setdefault(component, []).append(check.number(raw, "depth", where, low=0))
     return depths
 
 
@@ -684,6 +704,8 @@ def _sensor_node(check, name, raw, zones, components):
             check.fail(f"{where}.zone", f"names no zone ({raw['zone']!r})")
         return zone.air_node
     c = next(c for c in components if c.name == raw["component"])
+    if "face" in raw:
+        return c.node_ids[0] if raw["face"] == "inside" else c.node_ids[-1]
     depth = raw["depth"]
     k = min(range(len(c.depths)), key=lambda k: abs(c.depths[k] - depth))
     if abs(c.depths[k] - depth) > SENSOR_TOLERANCE:

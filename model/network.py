@@ -190,3 +190,32 @@ def assemble(building, names=None):
                 B[air, col[name]] += gain * (1.0 - f_r)
                 B[radiant, col[name]] += gain * f_r
     return Network(C=C, A=A, B=B, q=q, input_names=names, products=tuple(products))
+
+
+def face_heat_flux(building, network, T, U, component, face):
+    """Heat flux density (W/m2) through a component's face into the component, as a heat flux
+    sensor on that face reads it.
+
+    It is what the face's node receives from outside the component: its net heat (A T + B u + q
+    + products, W) less what its neighbours in the component give it, over the area. On the
+    inside face that is the exchange with the zone's air and radiant node and the sun the face
+    absorbs; on an exterior face the outdoor air, sky and sun; on a boundary face the boundary.
+
+    Parameters
+    ----------
+    building : Building; network : its `Network`
+    T : (n_rows, N) node temperatures (C), all nodes
+    U : (n_rows, n_inputs) inputs at the same times, in `network.input_names` order
+    component : its name; face : "inside" or "outside"
+
+    Returns
+    -------
+    (n_rows,) W/m2, positive into the component
+    """
+    c = building.component(component)
+    own = [i - 1 for i in c.node_ids]
+    node = own[0] if face == "inside" else own[-1]
+    T = np.asarray(T, dtype=float)
+    net = T @ network.A[node] + network.sources(U)[:, node]
+    within = sum(network.A[node, j] * (T[:, j] - T[:, node]) for j in own if j != node)
+    return (net - within) / c.area
