@@ -333,7 +333,8 @@ def parse_building(data, source="<building>"):
     sensors = {name: _sensor_node(check, name, raw, zones, components) for name, raw in raw_sensors.items()
                if name not in flux_sensors}
     return Building(name=str(data.get("name", "")), site=site, zones=zones, components=components,
-                    sensors=sensors, flux_sensors=flux_sensors, boundary_factors=boundary_factors, source=source, data=copy.deepcopy(data))
+                    sensors=sensors, flux_sensors=flux_sensors, boundary_factors=boundary_factors,
+                    source=source, data=copy.deepcopy(data))
 
 
 class _Checker:
@@ -683,7 +684,8 @@ def _sensor_depths(check, raw_sensors, raw_components):
             if component not in names:
                 check.fail(f"{where}.component", f"names no component ({component!r})")
             if ("depth" in raw) == ("face" in raw):
-                check.fail(where, "a component's sensor gives its depth (m from the inside face) or its face, one of them")
+                check.fail(where, "a component's sensor gives its depth (m from the inside face) or its face, "
+                                  "one of them")
             if "face" in raw and raw["face"] not in FACES:
                 check.fail(f"{where}.face", f"must be inside or outside, found {raw['face']!r}")
             quantity = raw.get("quantity", "temperature")
@@ -726,6 +728,7 @@ def _check_proportional_columns(check, zones, components):
 
 
 def _boundary_columns(zones, components):
+    """`Building.boundary_columns` of these zones and components."""
     names = [c.outside.temperature for c in components
              if isinstance(c.outside, Boundary) and isinstance(c.outside.temperature, str)]
     names += [to for z in zones for to, _ in z.thermal_bridges if to != "outdoor"]
@@ -747,8 +750,8 @@ def _boundary_factors(check, data, zones, components):
 
 
 def _check_air_exchanges(check, zones):
-    """An exchange between two zones is declared on one of them only: declared on both, which
-    would be meant is not for the tool to guess."""
+    """An exchange between two zones is declared on one of them only: declared on both, whether
+    one exchange or two is meant is not the tool's to guess."""
     for i, z in enumerate(zones):
         for other, _ in z.air_exchange:
             if z.name in dict(next(o for o in zones if o.name == other).air_exchange):

@@ -85,10 +85,12 @@ NO_RAD = 1e-9  # W/m2/K: a radiant node with no coupling would be a singular row
 
 def test_an_open_door_couples_two_airs_by_rho_c_v():
     """Rooms a (heated) and b, each with a wall to the outdoors, share a partition (conductance
-    K_p from air to air, no radiation: h_rad 1e-9 W/m2/K, which moves nothing by 1e-6 K): with G = K_p + rho c V / 3600 and x = T_a - T_out,
-    Q = (H_a + G H_b / (H_b + G)) x and T_b - T_out = G x / (H_b + G)."""
+    K_p from air to air, no radiation: h_rad 1e-9 W/m2/K, which moves nothing by 1e-6 K): with
+    G = K_p + rho c V / 3600 and x = T_a - T_out, Q = (H_a + G H_b / (H_b + G)) x and
+    T_b - T_out = G x / (H_b + G)."""
     data = light_house([{"name": "a", "volume": 40.0, "heat_input": "heater"}, {"name": "b", "volume": 30.0}],
-                       [light_wall("wa", "a", OUTDOOR, h_rad=NO_RAD), light_wall("wb", "b", OUTDOOR, area=10.0, h_rad=NO_RAD),
+                       [light_wall("wa", "a", OUTDOOR, h_rad=NO_RAD),
+                        light_wall("wb", "b", OUTDOOR, area=10.0, h_rad=NO_RAD),
                         light_wall("door", "a", {"type": "zone", "zone": "b", "h_conv": 3.0, "h_rad": NO_RAD},
                                    area=2.0, h_rad=NO_RAD)])
     b = parse_building(data)
