@@ -5,14 +5,15 @@ the policy changes no FMU and throws away no saved search.
 """
 import math
 
-from nodeforce.model.effects import EFFECTS, bridge_parts, bridge_target, shaded_glazings
+from nodeforce.model.effects import EFFECTS, bridge_parts, bridge_target, pair_parts, shaded_glazings
 from nodeforce.model.network import RHO_C_AIR
 
 # Where the calibration of an effect the file does not declare starts (see calibration_start).
 ABSENT_START = {("ground_coupling", "U"): 1.0,  # W/m2/K
                 ("infiltration", "n"): 0.5,  # 1/h
                 ("thermal_bridge", "UA"): 5.0,  # W/K
-                ("shading_transmittance", "f"): 0.1}  # an external screen's openness and absorbed share
+                ("shading_transmittance", "f"): 0.1,  # an external screen's openness and absorbed share
+                ("interzone_air_exchange", "V"): 50.0}  # m3/h: a door ajar, or the gap under a closed one
 # ... and, for the nodes a zone effect adds, in multiples of the zone air's capacity (J/K): a
 # room's furniture and inner mass are several times its air's, an electric heater's about its
 # air's; their conductances start at `effects.neutral_conductance` (the air's capacity over
@@ -41,7 +42,8 @@ def candidates(building, located_nodes, zones):
     for the objective zones and any zone whose air was located: a constant gain, and an air-to-
     outside conductance, reported as `thermal_bridge` where the zone has mechanical supply air
     (whose flow is known) and as `infiltration` otherwise (PHYSICS.md section 7), plus bridges to
-    the boundary temperatures the zone's surfaces see. When nothing was located, a change of the
+    the boundary temperatures the zone's surfaces see, and the house-level effects on its air
+    (`house_effects`). When nothing was located, a change of the
     inside convection (no single node) is one as well, and so is one factor on the objective zones'
     envelope (`envelope_conductance`): with nothing localised, the level or slow error that no
     forcing explains may be the whole envelope's conduction rather than the air change. An
@@ -62,6 +64,7 @@ def candidates(building, located_nodes, zones):
             zone, to = bridge_parts(target)
             if zone == name and (to != "outdoor" or supplied):
                 pairs.append(("thermal_bridge", target))
+        pairs += house_effects(building, name)
     pairs += shading_leaks(building, zones)
     if not located:
         pairs += [("inside_convection", name) for name in zones]
@@ -69,12 +72,25 @@ def candidates(building, located_nodes, zones):
     return list(dict.fromkeys(pairs))
 
 
+def house_effects(building, zone):
+    """The house-level effects on a zone's air: its supply flow, its heat input's reading, the air
+    it exchanges with each zone it shares a component with, and the conductances to each boundary
+    column its surfaces or bridges see."""
+    pairs = [(effect, zone) for effect in ("supply_flow", "heat_input_factor")
+             if EFFECTS[effect].applies(building, zone)]
+    pairs += [("interzone_air_exchange", t) for t in EFFECTS["interzone_air_exchange"].targets(building)
+              if zone in pair_parts(t)]
+    seen = [to for t in EFFECTS["thermal_bridge"].targets(building) for z, to in [bridge_parts(t)] if z == zone]
+    pairs += [("boundary_conductance", c) for c in EFFECTS["boundary_conductance"].targets(building) if c in seen]
+    return pairs
+
+
 def calibration_start(building, effect, target):
     """Where a calibration starts: the declared values, except that an absent coupling (U = 0,
     n = 0, UA = 0, a closed shading's leak f = 0) starts at `ABSENT_START` and an absent zone node
     (C = 0) at `ZONE_START`: on its bound, a bounded trust-region step is scaled to nothing and the
     fit stops where it began, and at U = 0 the ground temperature (at C = 0 the node's
-    conductance) has no influence to fit at all."""
+    conductance) has no influence to fit at all; an absent door, V = 0, likewise."""
     values = EFFECTS[effect].read(building, target)
     for name, value in values.items():
         if value == 0.0 and (effect, name) in ABSENT_START:
@@ -107,7 +123,12 @@ PHYSICAL_LIMITS = {("internal_gain", "Q"): (0.0, math.inf),
                    ("daily_gain", "mean"): (0.0, math.inf),
                    ("conductivity", "factor"): (0.1, 10.0),
                    ("envelope_conductance", "factor"): (0.1, 10.0),
-                   ("inside_convection", "factor"): (0.1, 10.0)}
+                   ("inside_convection", "factor"): (0.1, 10.0),
+                   ("boundary_conductance", "factor"): (0.1, 10.0),
+                   ("supply_flow", "factor"): (0.1, 10.0),
+                   # a heater or meter off its reading by more than a factor of two is a fault
+                   # the building file should state, not a property to fit
+                   ("heat_input_factor", "factor"): (0.5, 2.0)}
 # The parameters whose identifiability decides for an effect (default: all of them): a daily
 # profile's harmonics may each be near zero, and small next to their uncertainty, while the
 # profile and its mean are determined.

@@ -4,7 +4,9 @@ A correction found by `diagnose` on one experiment is only worth what it does on
 house as written and as corrected are each simulated through their FMU on the same weather and
 measurements (each reads the columns its own file names), and scored on the same steps: the
 RMSE, mean and sd of each objective zone's air residual, overall and per phase of the
-experiment, beside each model's heat loss coefficient (PHYSICS.md section 8).
+experiment, beside each model's heat loss coefficient (PHYSICS.md section 8). Where the record
+measures heat fluxes at surfaces (the building's heat flux sensors), each model's flux through
+that face is reported beside the reading: a check the fit never saw.
 """
 import json
 from pathlib import Path
@@ -21,14 +23,38 @@ from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.locate import check_measured
 from nodeforce.model.errors import InputError
 from nodeforce.model.hlc import heat_loss_coefficient
+from nodeforce.model.network import assemble, face_heat_flux
+from nodeforce.model.score import metrics
 
 
-def run_model(building, case, objective, fmu_kind="python"):
-    """The objective's air (C) at t_1..t_N of `building` simulated on `case` through its FMU,
+def run_model(building, case, output_ids, fmu_kind="python"):
+    """The nodes `output_ids` (C) at t_1..t_N of `building` simulated on `case` through its FMU,
     built and removed in a temporary folder."""
     with tempdirs.folder("compare") as tmp:
         with FmuInstance(build_fmu(building, Path(tmp) / "model.fmu", kind=fmu_kind)) as instance:
-            return simulate_fmu(instance, case, output_ids=objective.air_nodes)
+            return simulate_fmu(instance, case, output_ids=output_ids)
+
+
+def surface_fluxes(building, case, T):
+    """Each heat flux sensor the record measures, its reading beside the model's: {sensor:
+    {"component", "face", "measured_mean", "model_mean" (W/m2, positive into the component),
+    and the residual's "rmse", "mean", "sd", "n"}} over the scored steps (after the burn-in).
+    A check the diagnosis did not fit: nothing it calibrates reads a flux.
+
+    T : (N_t, N) every node of `building` at t_1..t_N
+    """
+    network = assemble(building, case.input_names)
+    out = {}
+    for name, reading in case.fluxes.items():
+        component, face = building.flux_sensors[name]
+        model = face_heat_flux(building, network, T, case.U[1:], component, face)
+        measured = reading[1:].copy()
+        measured[:case.burn_in_steps] = np.nan
+        have = np.isfinite(measured)
+        if have.any():
+            out[name] = {"component": component, "face": face, "measured_mean": float(measured[have].mean()),
+                         "model_mean": float(model[have].mean()), **metrics(measured, model)}
+    return out
 
 
 def compare(models, phases=(), fmu_kind="python"):
@@ -56,14 +82,19 @@ def compare(models, phases=(), fmu_kind="python"):
     series = {"times": times, "scored_from": case0.times[case0.burn_in_steps + 1], "measured": None, "runs": []}
     for path, building, case, objective in models:
         measured = objective.measured(case)
-        simulated = run_model(building, case, objective, fmu_kind)
+        if case.fluxes:
+            T = run_model(building, case, range(1, building.n_nodes + 1), fmu_kind)
+            simulated = T[:, [i - 1 for i in objective.air_nodes]]
+        else:
+            simulated = run_model(building, case, objective.air_nodes, fmu_kind)
         by_phase = {}
         for phase in phases:
             inside = np.asarray(phase.mask(times))
             if np.isfinite(measured[inside]).any():
                 by_phase[phase.name] = objective.metrics(measured[inside], simulated[inside])
         result["models"].append({"building": str(path), "heat_loss_coefficient": heat_loss_coefficient(building),
-                                 "metrics": objective.metrics(measured, simulated), "phases": by_phase})
+                                 "metrics": objective.metrics(measured, simulated), "phases": by_phase,
+                                 "surface_heat_flux": surface_fluxes(building, case, T) if case.fluxes else {}})
         series["measured"] = measured
         series["runs"].append(simulated)
     return result, series
@@ -105,5 +136,14 @@ def compare_markdown(result, plot_name):
         md += ["## RMSE per phase (C, all objective zones)", "",
                markdown(["phase", *names], [[p, *(fmt_temp((m["phases"].get(p) or {}).get("rmse"))
                                                     for m in result["models"])] for p in phases]), ""]
+    fluxes = [(name, sensor, m["surface_heat_flux"][sensor]) for name, m in zip(names, result["models"])
+              for sensor in m.get("surface_heat_flux", {})]
+    if fluxes:
+        md += ["## Surface heat flux (W/m2, positive into the component): measured beside the model's", "",
+               "A check the diagnosis did not fit: no calibration reads a heat flux.", "",
+               markdown(["building", "sensor", "face", "measured mean", "model mean", "RMSE", "mean residual", "n"],
+                        [[name, sensor, f"{f['component']} {f['face']}", f"{f['measured_mean']:.2f}",
+                          f"{f['model_mean']:.2f}", f"{f['rmse']:.2f}", f"{f['mean']:+.2f}", f["n"]]
+                         for name, sensor, f in fluxes]), ""]
     md += [f"![measured and simulated air]({plot_name})", ""]
     return "\n".join(md)

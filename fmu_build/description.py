@@ -32,6 +32,7 @@ UNITS = {
     "J/K": ("HeatCapacity", {"kg": "1", "m": "2", "s": "-2", "K": "-1"}),
     "W/m2/K": ("CoefficientOfHeatTransfer", {"kg": "1", "s": "-3", "K": "-1"}),
     "1/h": ("AirChangeRate", {"s": "-1", "factor": str(1 / 3600)}),
+    "m3/h": ("VolumeFlowRate", {"m": "3", "s": "-1", "factor": str(1 / 3600)}),
 }
 EFFECT_UNITS = {"C": "degC", "-": None}  # effects.Parameter.unit spellings that differ from FMI's
 LOG_CATEGORIES = ("logStatusWarning", "logStatusDiscard", "logStatusError", "logStatusFatal", "logAll")

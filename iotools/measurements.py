@@ -18,7 +18,8 @@ def read_measurements(path):
         CSV with a `time` column (ISO 8601 with UTC offset, strictly increasing) and one column
         per measured temperature (degrees C): `T<id>` for node id (e.g. `T23`), or another name,
         which the building resolves to a node (`nodeforce.model.case.measured_matrix`, where an
-        unknown name is refused). An empty cell is a missing value.
+        unknown name is refused) or to a heat flux sensor on a face (W/m2,
+        `nodeforce.model.case.measured_fluxes`). An empty cell is a missing value.
 
     Returns
     -------

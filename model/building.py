@@ -76,8 +76,9 @@ class Boundary:
 
 @dataclass(frozen=True)
 class Supply:
-    flow: float  # m3/h
+    flow: float  # m3/h, as declared
     temperature: float | str  # C, or an input column
+    flow_factor: float = 1.0  # the flow the zone gets over the declared one (a fan off its setting)
 
 
 @dataclass(frozen=True)
@@ -114,6 +115,8 @@ class Zone:
     heat_input_lag: Lumped | None = None  # the heater's own capacity, between heat input and zone
     envelope_factor: float = 1.0  # scale on the conductances of the zone's components to outside
     shading_transmittance: float = 0.0  # part of its glazings' sun a closed shading still lets in
+    heat_input_factor: float = 1.0  # the heat its heat input columns deliver, per W they read
+    air_exchange: tuple = ()  # (other zone, m3/h each way): air through an open internal door
     mass_node: int | None = None  # ids of the nodes those two add (PHYSICS.md section 7)
     heater_node: int | None = None
 
@@ -155,6 +158,8 @@ class Building:
     zones: tuple
     components: tuple
     sensors: dict = field(default_factory=dict)  # sensor name -> node id
+    flux_sensors: dict = field(default_factory=dict)  # sensor name -> (component, "inside" or "outside")
+    boundary_factors: dict = field(default_factory=dict)  # boundary column -> factor on its conductances
     source: str = field(default="<building>", compare=False)
     data: dict = field(default_factory=dict, compare=False, repr=False)  # the JSON it was read from
 
@@ -197,6 +202,16 @@ class Building:
             if c.shading:
                 names.append(c.shading)
         return tuple(dict.fromkeys(names))
+
+    @property
+    def boundary_columns(self):
+        """The input columns of boundary temperatures (attic, cellar, a neighbour): those a
+        component's outside face or a zone's thermal bridge sees, in order of appearance."""
+        return _boundary_columns(self.zones, self.components)
+
+    def boundary_factor(self, column):
+        """The factor on every conductance from the building to a boundary column (1 if not declared)."""
+        return self.boundary_factors.get(column, 1.0)
 
     def zone(self, name):
         return next(z for z in self.zones if z.name == name)
@@ -309,11 +324,17 @@ def parse_building(data, source="<building>"):
             check.fail(f"components[{i}].transmitted_solar_to",
                        f"names no component ({c.transmitted_solar_to!r})")
     _check_proportional_columns(check, zones, components)
+    _check_air_exchanges(check, zones)
+    boundary_factors = _boundary_factors(check, data, zones, components)
     _check_node_ids(check, zones, components)
     zones = _number_added_nodes(zones, sum(len(c.node_ids) for c in components) + 2 * len(zones))
-    sensors = {name: _sensor_node(check, name, raw, zones, components) for name, raw in raw_sensors.items()}
+    flux_sensors = {name: (raw["component"], raw["face"]) for name, raw in raw_sensors.items()
+                    if raw.get("quantity") == "heat_flux"}
+    sensors = {name: _sensor_node(check, name, raw, zones, components) for name, raw in raw_sensors.items()
+               if name not in flux_sensors}
     return Building(name=str(data.get("name", "")), site=site, zones=zones, components=components,
-                    sensors=sensors, source=source, data=copy.deepcopy(data))
+                    sensors=sensors, flux_sensors=flux_sensors, boundary_factors=boundary_factors,
+                    source=source, data=copy.deepcopy(data))
 
 
 class _Checker:
@@ -429,7 +450,8 @@ def _zone(check, z, where, zone_names, explicit, next_id):
     if z.get("supply") is not None:
         raw = check.mapping(z, "supply", where)
         supply = Supply(flow=check.number(raw, "flow", f"{where}.supply", low=0),
-                        temperature=check.temperature(raw, "temperature", f"{where}.supply"))
+                        temperature=check.temperature(raw, "temperature", f"{where}.supply"),
+                        flow_factor=check.number(raw, "flow_factor", f"{where}.supply", default=1.0, low=0))
     inflows = []
     for j, raw in enumerate(check.sequence(z, "airflow_from", where, optional=True)):
         fw = f"{where}.airflow_from[{j}]"
@@ -456,6 +478,17 @@ def _zone(check, z, where, zone_names, explicit, next_id):
     lumped = {key: _lumped(check, z, key, where) for key in ("internal_mass", "heat_input_lag")}
     if lumped["heat_input_lag"] is not None and not heat_input:
         check.fail(f"{where}.heat_input_lag", "the zone has no heat_input whose heater it would delay")
+    if "heat_input_factor" in z and not heat_input:
+        check.fail(f"{where}.heat_input_factor", "the zone has no heat_input whose reading it would scale")
+    exchange = z.get("air_exchange", {})
+    if not isinstance(exchange, dict):
+        check.fail(f"{where}.air_exchange", 'must be an object {"other zone": m3/h each way}')
+    for other in exchange:
+        if other not in zone_names:
+            check.fail(f"{where}.air_exchange.{other}", f"names no zone ({other!r})")
+        if other == z.get("name"):
+            check.fail(f"{where}.air_exchange.{other}", "a zone exchanges no air with itself")
+    exchange = tuple((other, check.number(exchange, other, f"{where}.air_exchange", low=0)) for other in exchange)
     occupied = z.get("occupied")
     if occupied is not None and not isinstance(occupied, bool):
         check.fail(f"{where}.occupied", f"must be true or false, found {occupied!r}")
@@ -482,6 +515,8 @@ def _zone(check, z, where, zone_names, explicit, next_id):
         proportional_gains=proportional,
         envelope_factor=check.number(z, "envelope_factor", where, default=1.0, low=0, low_open=True),
         shading_transmittance=check.number(z, "shading_transmittance", where, default=0.0, low=0, high=1),
+        heat_input_factor=check.number(z, "heat_input_factor", where, default=1.0, low=0),
+        air_exchange=exchange,
         **lumped,
     )
 
@@ -628,8 +663,13 @@ def _explicit_ids(check, raw_zones, components):
     return all(given)
 
 
+FACES = ("inside", "outside")
+QUANTITIES = ("temperature", "heat_flux")
+
+
 def _sensor_depths(check, raw_sensors, raw_components):
-    """{component name: depths of the sensors declared on it}, for node generation."""
+    """{component name: depths of the sensors declared on it}, for node generation (a face
+    always has a node)."""
     names = {c.get("name") for c in raw_components if isinstance(c, dict)}
     depths = {}
     for name, raw in raw_sensors.items():
@@ -637,12 +677,24 @@ def _sensor_depths(check, raw_sensors, raw_components):
         if NODE_COLUMN.match(name):
             check.fail(where, "a sensor name must not look like a node column T<id>")
         if not isinstance(raw, dict) or ("zone" in raw) == ("component" in raw):
-            check.fail(where, 'must be {"zone": name} or {"component": name, "depth": m from the inside face}')
+            check.fail(where, 'must be {"zone": name}, {"component": name, "depth": m from the inside face} or '
+                              '{"component": name, "face": "inside" or "outside"}')
         if "component" in raw:
             component = check.text(raw, "component", where)
             if component not in names:
                 check.fail(f"{where}.component", f"names no component ({component!r})")
-            depths.setdefault(component, []).append(check.number(raw, "depth", where, low=0))
+            if ("depth" in raw) == ("face" in raw):
+                check.fail(where, "a component's sensor gives its depth (m from the inside face) or its face, "
+                                  "one of them")
+            if "face" in raw and raw["face"] not in FACES:
+                check.fail(f"{where}.face", f"must be inside or outside, found {raw['face']!r}")
+            quantity = raw.get("quantity", "temperature")
+            if quantity not in QUANTITIES:
+                check.fail(f"{where}.quantity", f"must be temperature or heat_flux, found {quantity!r}")
+            if quantity == "heat_flux" and "face" not in raw:
+                check.fail(f"{where}.quantity", "a heat flux is measured at a face: give its face, not a depth")
+            if "depth" in raw:
+                depths.setdefault(component, []).append(check.number(raw, "depth", where, low=0))
     return depths
 
 
@@ -654,6 +706,8 @@ def _sensor_node(check, name, raw, zones, components):
             check.fail(f"{where}.zone", f"names no zone ({raw['zone']!r})")
         return zone.air_node
     c = next(c for c in components if c.name == raw["component"])
+    if "face" in raw:
+        return c.node_ids[0] if raw["face"] == "inside" else c.node_ids[-1]
     depth = raw["depth"]
     k = min(range(len(c.depths)), key=lambda k: abs(c.depths[k] - depth))
     if abs(c.depths[k] - depth) > SENSOR_TOLERANCE:
@@ -671,6 +725,38 @@ def _check_proportional_columns(check, zones, components):
             if column not in columns:
                 check.fail(f"zones[{i}].proportional_gains.{column}",
                            f"names no heat input or face irradiance of the building (one of: {', '.join(columns) or 'none'})")
+
+
+def _boundary_columns(zones, components):
+    """`Building.boundary_columns` of these zones and components."""
+    names = [c.outside.temperature for c in components
+             if isinstance(c.outside, Boundary) and isinstance(c.outside.temperature, str)]
+    names += [to for z in zones for to, _ in z.thermal_bridges if to != "outdoor"]
+    return tuple(dict.fromkeys(names))
+
+
+def _boundary_factors(check, data, zones, components):
+    """{column: factor} of `boundary_conductance_factors`: each a boundary column of the building."""
+    raw = data.get("boundary_conductance_factors", {})
+    where = "boundary_conductance_factors"
+    if not isinstance(raw, dict):
+        check.fail(where, "must be an object {boundary temperature column: factor}")
+    columns = _boundary_columns(zones, components)
+    for column in raw:
+        if column not in columns:
+            check.fail(f"{where}.{column}", f"names no boundary temperature column of the building "
+                                            f"(one of: {', '.join(columns) or 'none'})")
+    return {column: check.number(raw, column, where, low=0) for column in raw}
+
+
+def _check_air_exchanges(check, zones):
+    """An exchange between two zones is declared on one of them only: declared on both, whether
+    one exchange or two is meant is not the tool's to guess."""
+    for i, z in enumerate(zones):
+        for other, _ in z.air_exchange:
+            if z.name in dict(next(o for o in zones if o.name == other).air_exchange):
+                check.fail(f"zones[{i}].air_exchange.{other}",
+                           f"the exchange between {z.name} and {other} is declared on both zones: declare it once")
 
 
 def _check_node_ids(check, zones, components):

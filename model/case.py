@@ -5,7 +5,7 @@ time grid: the measurement grid when there are measurements (weather interpolate
 else the weather's own. It never fills a gap: a missing measurement stays NaN (the node is then
 computed, PHYSICS.md section 5) and a missing input is refused.
 """
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
@@ -36,6 +36,7 @@ class Case:
     burn_in_steps: int = 0  # B: t_1..t_B force every measured node and are not scored
     assumptions: tuple = ()  # sentences: what the case computed that the files did not give
     steady_start: bool = False  # the warm-up starts from the first day's steady state (`with_steady_start`)
+    fluxes: dict = field(default_factory=dict)  # flux sensor -> (N_t+1,) W/m2 measured, NaN where missing
 
     @property
     def measured_ids(self):
@@ -85,7 +86,8 @@ class Case:
         stays with a window that starts at t_0 and is left behind by one that starts later."""
         rows = slice(start, stop + 1)
         return replace(self, times=self.times[rows], U=self.U[rows], measured=self.measured[rows],
-                       burn_in_steps=self.burn_in_steps if start == 0 else 0)
+                       burn_in_steps=self.burn_in_steps if start == 0 else 0,
+                       fluxes={name: values[rows] for name, values in self.fluxes.items()})
 
 
 def uniform_grid(times, source):
@@ -133,13 +135,15 @@ def measured_matrix(building, measurements, times):
     """(len(times), N) node temperatures (C) from the measurement columns, NaN where not measured.
 
     A column `T<id>` measures node id, a column named as one of the building's sensors measures
-    that sensor's node; any other column is an InputError naming the measurement file and the
-    column, as is a column whose temperatures look like kelvin.
+    that sensor's node; a heat flux sensor's column is not a temperature (`measured_fluxes`); any
+    other column is an InputError naming the measurement file and the column, as is a column
+    whose temperatures look like kelvin.
     """
     source = measurements.attrs.get("source", "measurements")
     matrix = np.full((len(times), building.n_nodes), np.nan)
     on_grid = measurements.reindex(times)
-    for column in measurements.columns:
+    temperatures = [c for c in measurements.columns if c not in building.flux_sensors]
+    for column in temperatures:
         node = building.node_of(column)
         if node is None:
             hint = (": the building reads it as an input, which belongs in the weather file"
@@ -154,8 +158,15 @@ def measured_matrix(building, measurements, times):
             raise InputError(source, column, f"node {node} is the {what} of zone {zone} a model effect adds, "
                                              "which stands for no sensor's position and is never measured")
         matrix[:, node - 1] = on_grid[column].to_numpy(float)
-    check_celsius(measurements, measurements.columns)  # once every column is known to be a temperature
+    check_celsius(measurements, temperatures)  # once every column is known to be a temperature
     return matrix
+
+
+def measured_fluxes(building, measurements, times):
+    """{flux sensor: (len(times),) heat flux density (W/m2) through its face, positive into the
+    component, NaN where not measured} of the columns that name the building's heat flux sensors."""
+    on_grid = measurements.reindex(times)
+    return {c: on_grid[c].to_numpy(float) for c in measurements.columns if c in building.flux_sensors}
 
 
 def prepare_case(building, weather, measurements=None, decomposition="erbs"):
@@ -237,7 +248,9 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs"):
                                              "at every step, and a gap is not filled in")
     measured = (measured_matrix(building, measurements, times) if measurements is not None
                 else np.full((len(times), building.n_nodes), np.nan))
-    return Case(times=times, dt=dt, input_names=names, U=U, measured=measured, assumptions=tuple(assumptions))
+    fluxes = measured_fluxes(building, measurements, times) if measurements is not None else {}
+    return Case(times=times, dt=dt, input_names=names, U=U, measured=measured, assumptions=tuple(assumptions),
+                fluxes=fluxes)
 
 
 def check_warmup(case, source):

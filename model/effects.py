@@ -10,15 +10,18 @@ is the diagnosis' policy (`nodeforce.diagnose.candidates`), not physics.
 
 A `thermal_bridge` target is a zone name for a bridge to the outdoor air, or `<zone>-><column>`
 for a bridge to a boundary temperature column (attic, cellar, neighbour); a `proportional_gain`
-target is `<zone>-><column>`, the column a heat input or a face's irradiance the building reads.
+target is `<zone>-><column>`, the column a heat input or a face's irradiance the building reads;
+a `boundary_conductance` target is a boundary temperature column; an `interzone_air_exchange`
+target is `<zone>|<zone>`, the two zones in the building file's order.
 """
 from dataclasses import dataclass
 from typing import Callable
 
-from .building import DAY_TERMS, Adiabatic, Boundary, Exterior
+from .building import DAY_TERMS, Adiabatic, Boundary, Exterior, Surface
 from .network import RHO_C_AIR
 
 BRIDGE_TO = "->"
+PAIR = "|"
 
 
 @dataclass(frozen=True)
@@ -245,6 +248,72 @@ def _shading_receivers(building, target):
                  for i in building.component(c.transmitted_solar_to).node_ids)
 
 
+# boundary conductance: one factor on every conductance from the building to a boundary column
+def _boundary_components(building, column):
+    return [c for c in building.components
+            if isinstance(c.outside, Boundary) and c.outside.temperature == column]
+
+
+def _boundary_read(building, target):
+    return {"factor": building.boundary_factor(target)}
+
+
+def _boundary_write(data, target, values):
+    data.setdefault("boundary_conductance_factors", {})[target] = float(values["factor"])
+
+
+def _boundary_nodes(building, target):
+    return tuple(i for c in _boundary_components(building, target) for i in c.node_ids)
+
+
+# supply flow: a factor on a zone's mechanical supply flow
+def _supply_targets(building):
+    return [z.name for z in building.zones if z.supply is not None and z.supply.flow > 0]
+
+
+def _supply_read(building, target):
+    return {"factor": building.zone(target).supply.flow_factor}
+
+
+def _supply_write(data, target, values):
+    _zone(data, target)["supply"]["flow_factor"] = float(values["factor"])
+
+
+# interzone air exchange: a flow V each way between two zones' air, through an open internal door
+def pair_target(a, b):
+    return f"{a}{PAIR}{b}"
+
+
+def pair_parts(target):
+    """(zone, zone) of an `interzone_air_exchange` target."""
+    a, _, b = target.partition(PAIR)
+    return a, b
+
+
+def _pair_targets(building):
+    """Each pair of zones that share a component (a partition, an internal door), and each pair
+    that declares an exchange, the two in the building file's order."""
+    order = {z.name: k for k, z in enumerate(building.zones)}
+    pairs = [(c.inside.zone, c.outside.zone) for c in building.components
+             if isinstance(c.outside, Surface) and c.outside.zone != c.inside.zone]
+    pairs += [(z.name, other) for z in building.zones for other, _ in z.air_exchange]
+    return list(dict.fromkeys(pair_target(*sorted(p, key=order.get)) for p in pairs))
+
+
+def _pair_read(building, target):
+    a, b = pair_parts(target)
+    declared = {**{(a, o): V for o, V in building.zone(a).air_exchange},
+                **{(b, o): V for o, V in building.zone(b).air_exchange}}
+    return {"V": float(declared.get((a, b), declared.get((b, a), 0.0)))}
+
+
+def _pair_write(data, target, values):
+    a, b = pair_parts(target)
+    # where the file declares it, else on the first of the two zones
+    owner = b if a in _zone(data, b).get("air_exchange", {}) else a
+    _zone(data, owner).setdefault("air_exchange", {})[b if owner == a else a] = float(values["V"])
+
+
 EFFECTS = {e.id: e for e in (
     Effect("ground_coupling", "a conductance from an adiabatic face to a ground temperature",
            (Parameter("U", "W/m2/K", 0.0, 20.0), Parameter("T_ground", "C", -10.0, 40.0)),
@@ -298,4 +367,16 @@ EFFECTS = {e.id: e for e in (
                                 "dimensionless for a heat input, m2 for an irradiance)",
            (Parameter("k", "-", -10.0, 10.0),), _proportional_targets, _proportional_read, _proportional_write,
            _no_node),
+    Effect("boundary_conductance", "one factor on every conductance from the building to a boundary temperature "
+                                   "column (attic, cellar, a neighbour): its components' layers and outside "
+                                   "coefficients, and the zones' thermal bridges to it",
+           (Parameter("factor", "-", 0.05, 20.0),), lambda b: list(b.boundary_columns),
+           _boundary_read, _boundary_write, _boundary_nodes),
+    Effect("supply_flow", "a factor on a zone's mechanical supply air flow",
+           (Parameter("factor", "-", 0.0, 10.0),), _supply_targets, _supply_read, _supply_write, _no_node),
+    Effect("interzone_air_exchange", "air exchanged between two zones, a flow each way (an open internal door)",
+           (Parameter("V", "m3/h", 0.0, 3000.0),), _pair_targets, _pair_read, _pair_write, _no_node),
+    Effect("heat_input_factor", "a factor on a zone's measured heat input: the heat its heater delivers per W read",
+           (Parameter("factor", "-", 0.0, 5.0),), lambda b: [z.name for z in b.zones if z.heat_input],
+           *_zone_field("heat_input_factor", "factor"), _no_node),
 )}

@@ -118,9 +118,12 @@ def assemble(building, names=None):
     for c in building.components:
         idx = [i - 1 for i in c.node_ids]
         e, out = idx[-1], c.outside
-        # a zone's envelope factor scales what separates it from the outdoors or a boundary
+        # a zone's envelope factor scales what separates it from the outdoors or a boundary, and a
+        # boundary column's factor what separates the building from that column
         envelope = (building.zone(c.inside.zone).envelope_factor if isinstance(out, (Exterior, Boundary))
                     else 1.0)
+        if isinstance(out, Boundary) and isinstance(out.temperature, str):
+            envelope *= building.boundary_factor(out.temperature)
         C[idx] += c.area * capacities(c.layers, c.depths)
         for k, g in enumerate(conductances(c.layers, c.depths)):
             link(idx[k], idx[k + 1], c.area * g * c.conductivity_factor * envelope)
@@ -153,13 +156,16 @@ def assemble(building, names=None):
         C[air] += RHO_C_AIR * z.volume
         to_temperature(air, air_conductance(z.volume * z.air_change_rate), "T_out")
         if z.supply is not None:
-            to_temperature(air, air_conductance(z.supply.flow), z.supply.temperature)
+            to_temperature(air, air_conductance(z.supply.flow * z.supply.flow_factor), z.supply.temperature)
         for inflow in z.airflow_from:
             g = air_conductance(inflow.flow)
             A[air, air] -= g
             A[air, building.zone(inflow.zone).air_node - 1] += g
+        for other, flow in z.air_exchange:
+            link(air, building.zone(other).air_node - 1, air_conductance(flow))
         for to, UA in z.thermal_bridges:
-            to_temperature(air, UA, "T_out" if to == "outdoor" else to)
+            to_temperature(air, UA if to == "outdoor" else UA * building.boundary_factor(to),
+                           "T_out" if to == "outdoor" else to)
         q[air] += z.internal_gain
         for term, W in z.daily_gain:
             B[air, col[day_input(term)]] += W
@@ -169,7 +175,7 @@ def assemble(building, names=None):
             mass = z.mass_node - 1
             C[mass] += z.internal_mass.capacity
             link(air, mass, z.internal_mass.conductance)
-        f_r = z.heat_input_radiative_fraction
+        f_r, gain = z.heat_input_radiative_fraction, z.heat_input_factor
         if z.heat_input_lag is not None:
             # the heater's node takes the heat input and gives it to the air and the radiant node
             # in the heat input's split (PHYSICS.md section 7)
@@ -178,9 +184,38 @@ def assemble(building, names=None):
             link(heater, air, (1.0 - f_r) * z.heat_input_lag.conductance)
             link(heater, radiant, f_r * z.heat_input_lag.conductance)
             for name in z.heat_input:
-                B[heater, col[name]] += 1.0
+                B[heater, col[name]] += gain
         else:
             for name in z.heat_input:
-                B[air, col[name]] += 1.0 - f_r
-                B[radiant, col[name]] += f_r
+                B[air, col[name]] += gain * (1.0 - f_r)
+                B[radiant, col[name]] += gain * f_r
     return Network(C=C, A=A, B=B, q=q, input_names=names, products=tuple(products))
+
+
+def face_heat_flux(building, network, T, U, component, face):
+    """Heat flux density (W/m2) through a component's face into the component, as a heat flux
+    sensor on that face reads it.
+
+    It is what the face's node receives from outside the component: its net heat (A T + B u + q
+    + products, W) less what its neighbours in the component give it, over the area. On the
+    inside face that is the exchange with the zone's air and radiant node and the sun the face
+    absorbs; on an exterior face the outdoor air, sky and sun; on a boundary face the boundary.
+
+    Parameters
+    ----------
+    building : Building; network : its `Network`
+    T : (n_rows, N) node temperatures (C), all nodes
+    U : (n_rows, n_inputs) inputs at the same times, in `network.input_names` order
+    component : its name; face : "inside" or "outside"
+
+    Returns
+    -------
+    (n_rows,) W/m2, positive into the component
+    """
+    c = building.component(component)
+    own = [i - 1 for i in c.node_ids]
+    node = own[0] if face == "inside" else own[-1]
+    T = np.asarray(T, dtype=float)
+    net = T @ network.A[node] + network.sources(U)[:, node]
+    within = sum(network.A[node, j] * (T[:, j] - T[:, node]) for j in own if j != node)
+    return (net - within) / c.area

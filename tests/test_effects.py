@@ -196,3 +196,13 @@ def test_a_residual_that_follows_the_sun_on_a_glazed_facade_points_at_the_glazin
     # a zone with a shaded glazing is offered the leak from the first round; one without is not
     assert ("shading_transmittance", "cell") in candidates(b, [], ["cell"])
     assert not any(e == "shading_transmittance" for e, _ in candidates(parse_building(testcell_data), [], ["cell"]))
+
+
+def test_every_effect_parameter_has_a_unit_the_fmus_declare():
+    """The FMU takes an effect's parameters from the registry: each unit must be one FMI is told
+    (a unit missing from fmu_build.description.UNITS would stop every export of the effect)."""
+    from nodeforce.fmu_build.description import EFFECT_UNITS, UNITS
+    for effect in EFFECTS.values():
+        for p in effect.parameters:
+            unit = EFFECT_UNITS.get(p.unit, p.unit)
+            assert unit is None or unit in UNITS, (effect.id, p.name, p.unit)

@@ -113,15 +113,17 @@ def boundary_heat_in(building, T, u):
     Q = 0.0
     for c in building.components:
         e, out = T[c.node_ids[-1] - 1], c.outside
+        envelope = building.zone(c.inside.zone).envelope_factor  # scales the outside coefficients
         if isinstance(out, Exterior):
             F = (1 + np.cos(np.radians(c.tilt))) / 2
             I = u[out.irradiance or f"I_{c.name}"]
-            Q += c.area * (out.h_conv * (u["T_out"] - e)
-                           + out.h_rad * (F * (u["T_sky"] - e) + (1 - F) * (u["T_out"] - e))
+            Q += c.area * (envelope * out.h_conv * (u["T_out"] - e)
+                           + envelope * out.h_rad * (F * (u["T_sky"] - e) + (1 - F) * (u["T_out"] - e))
                            + out.solar_absorptance * I)
         elif isinstance(out, Boundary):
             T_b = u[out.temperature] if isinstance(out.temperature, str) else out.temperature
-            Q += c.area * out.h * (T_b - e)
+            factor = building.boundary_factors.get(out.temperature, 1.0)
+            Q += c.area * envelope * factor * out.h * (T_b - e)
         if c.solar_transmittance is not None:
             I = u[c.outside.irradiance or f"I_{c.name}"]
             s, f = (u[c.shading], building.zone(c.inside.zone).shading_transmittance) if c.shading else (1.0, 0.0)
@@ -131,15 +133,18 @@ def boundary_heat_in(building, T, u):
     for z in building.zones:
         air = T[z.air_node - 1]
         Q += rho_c * z.volume * z.air_change_rate / 3600 * (u["T_out"] - air)
+        supplied = z.supply.flow * z.supply.flow_factor if z.supply else 0.0
         if z.supply is not None:
             T_sup = u[z.supply.temperature] if isinstance(z.supply.temperature, str) else z.supply.temperature
-            Q += rho_c * z.supply.flow / 3600 * T_sup
-        inflow = (z.supply.flow if z.supply else 0.0) + sum(f.flow for f in z.airflow_from)
+            Q += rho_c * supplied / 3600 * T_sup
+        inflow = supplied + sum(f.flow for f in z.airflow_from)
         outflow = sum(f.flow for other in building.zones for f in other.airflow_from if f.zone == z.name)
         Q -= rho_c * (inflow - outflow) / 3600 * air  # the balance leaves the building from here
+        # (an exchange both ways between two zones, air_exchange, moves heat inside the building only)
         for to, UA in z.thermal_bridges:
-            Q += UA * ((u["T_out"] if to == "outdoor" else u[to]) - air)
-        Q += z.internal_gain + sum(u[name] for name in z.heat_input)
+            factor = 1.0 if to == "outdoor" else building.boundary_factors.get(to, 1.0)
+            Q += factor * UA * ((u["T_out"] if to == "outdoor" else u[to]) - air)
+        Q += z.internal_gain + z.heat_input_factor * sum(u[name] for name in z.heat_input)
     return Q
 
 

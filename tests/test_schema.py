@@ -12,12 +12,16 @@ from nodeforce.model.building import Boundary, parse_building
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
 
+from .test_standalone import two_zones
+
 DATA = Path(__file__).parents[1] / "model" / "data"
 SCHEMA = json.loads((DATA / "nodal-building.schema.json").read_text())
 TESTCELL = json.loads((DATA / "testcell.json").read_text())
-# the test cell with a measured heater, 30 % radiative, and a blind on its window
-HEATED = copy.deepcopy(TESTCELL)
-HEATED["zones"][0].update(heat_input="heater", heat_input_radiative_fraction=0.3)
+# the test cell with a measured heater, 30 % radiative, supply air, a bridge to the attic and a
+# blind on its window, and an annex behind a partition: something for every effect to act on
+HEATED = two_zones(TESTCELL)
+HEATED["zones"][0].update(heat_input="heater", heat_input_radiative_fraction=0.3,
+                          supply={"flow": 30.0, "temperature": "T_supply"}, thermal_bridges={"T_attic": 1.0})
 next(c for c in HEATED["components"] if c["name"] == "window")["shading"] = "blind"
 
 # A sensible value for every effect, on the test cell element it fits.
@@ -37,6 +41,10 @@ EFFECT_CASES = {
     "heat_input_lag": ("cell", {"C_h": 3e4, "H_h": 12.0}),
     "envelope_conductance": ("cell", {"factor": 1.4}),
     "shading_transmittance": ("cell", {"f": 0.15}),
+    "boundary_conductance": ("T_attic", {"factor": 0.7}),
+    "supply_flow": ("cell", {"factor": 0.5}),
+    "interzone_air_exchange": ("cell|annex", {"V": 80.0}),
+    "heat_input_factor": ("cell", {"factor": 0.9}),
 }
 
 

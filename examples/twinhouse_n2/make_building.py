@@ -282,13 +282,27 @@ def zones(experiment=1):
     return out
 
 
+# The inside faces experiment 2 measures besides W9's, each a surface temperature `<prefix>_IS_T`
+# and a heat flux `<prefix>_IS_HF` (W/m2): the data's prefix read as room, w(indow) or f(acade),
+# orientation. lww, lws and cws are glazing (their flux swings to -200 W/m2 when the sun heats the
+# pane), cfs and cfe walls (a few W/m2 into the wall, as W9's). The data do not say which of the
+# living room's two south windows lws is: W31, the window, not the door-window W30.
+SURFACE_SENSORS = {"W32": "lww", "W31": "lws", "W29": "cws", "W7": "cfs", "W6": "cfe"}
+
+
 def sensors():
-    """Sensor names of the measured channels: each room's air, the three W9 nodes."""
+    """Sensor names of the measured channels: each room's air, the three W9 nodes, the inside
+    faces experiment 2 measures (`SURFACE_SENSORS` and W9's): `<component>_inside` their
+    temperature, `<component>_inside_flux` the heat flux through them (W/m2, into the component)."""
     named = {zone: {"zone": zone} for zone in ZONES}
     thickness = sum(t for _, t in CONSTRUCTIONS["extwall_Ws"])
     named.update({"W9_inside": {"component": "W9", "depth": 0.0},
                   "W9_BL1": {"component": "W9", "depth": W9_BL1_DEPTH},
-                  "W9_outside": {"component": "W9", "depth": round(thickness, 6)}})
+                  "W9_outside": {"component": "W9", "depth": round(thickness, 6)},
+                  "W9_inside_flux": {"component": "W9", "face": "inside", "quantity": "heat_flux"}})
+    for component in SURFACE_SENSORS:
+        named[f"{component}_inside"] = {"component": component, "face": "inside"}
+        named[f"{component}_inside_flux"] = {"component": component, "face": "inside", "quantity": "heat_flux"}
     return named
 
 
