@@ -48,7 +48,8 @@ def where_line(report):
         return f"Fault: in {', '.join(components)}: forcing {nodes}{share}"
     strongest, J_min = search.get("min_nodes"), num(search.get("J_min"))
     if strongest and J_unforced is not None and J_min is not None:
-        return (f"Fault: not located: the best forcing (node {', '.join(map(str, strongest))}) removes only "
+        return (f"Fault: not located: the best forcing (node{'s' if len(strongest) > 1 else ''} "
+                f"{', '.join(map(str, strongest))}) removes only "
                 f"{removed(J_unforced, J_min, J_noise):.0%} {of}")
     return "Fault: not located: no forcing the sensors allow lowers J beyond the noise"
 
