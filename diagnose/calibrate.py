@@ -103,7 +103,7 @@ def derived(candidate, case, x, cov):
     """What the data fix when the parameters trade off against each other, each with its
     standard deviation by the delta method, sd^2 = g' cov g for its gradient g.
 
-    - The heat loss coefficient of the model with the effect (PHYSICS.md section 8), W/K: what a
+    - The heat loss coefficient of the model with the effect (docs/model.md section 8), W/K: what a
       record of the air and the heating power fixes well even where the effect's parameters, or
       the split of the loss among effects, it does not (`hlc_gradient`).
     - A ground coupling acts through its heat flux density q = U (T_ground - T_face) (W/m2, into

@@ -1,5 +1,5 @@
 """`nodeforce table`: columns of a Modelica table picked, renamed and written as a weather or
-measurements CSV (INTERFACE.md, Files).
+measurements CSV (docs/guide.md, Modelica tables).
 
 Nothing is computed from the data: the values written are the table's, cut to the period asked
 for, and a constant column (`--set`) holds exactly the value the user states.

@@ -1,4 +1,4 @@
-"""The `nodeforce` command line (INTERFACE.md). Bad input: one line on stderr, exit status 2; stopped
+"""The `nodeforce` command line (docs/guide.md). Bad input: one line on stderr, exit status 2; stopped
 by SIGINT, SIGTERM or a lost Dask scheduler: one line saying how to resume, 130, 143 or 75
 (nodeforce.lifetime)."""
 import argparse
@@ -332,7 +332,7 @@ def diagnosis_arguments(s):
 def burn_in_argument(s, default):
     s.add_argument("--burn-in-days", type=float, default=default,
                    help=f"days after t_0 over which every measured node is forced and nothing is scored "
-                        f"(PHYSICS.md section 5; default {default:g})")
+                        f"(docs/model.md section 5; default {default:g})")
 
 
 def noise_argument(s):

@@ -25,7 +25,7 @@ def effect_header(report, pm="+-"):
 
 
 def hlc_lines(report, pm="+-"):
-    """The heat loss coefficient as described and as corrected (W/K, PHYSICS.md section 8), and
+    """The heat loss coefficient as described and as corrected (W/K, docs/model.md section 8), and
     the sentence saying the data do not fix its split among effects, where they do not."""
     hlc = report.get("heat_loss_coefficient") or {}
     if num(hlc.get("before")) is None:
