@@ -88,7 +88,9 @@ def calibrate(candidate, case, objective):
         tight = sd < (IDENTIFIABLE_KELVIN if p.unit == "C" else IDENTIFIABLE_RELATIVE * abs(value))
         identifiable = bool(tight and bound == 0)
         if not identifiable:
-            log.warning("%s: %s = %.4g +- %.2g %s is not identifiable from these data%s", candidate.label,
+            # the report's candidates table says it for every candidate; the terminal keeps its
+            # first screen for the result
+            log.info("%s: %s = %.4g +- %.2g %s is not identifiable from these data%s", candidate.label,
                         p.name, value, sd, p.unit, " (it ended on a bound)" if bound else "")
         result[p.name] = {"value": float(value), "std": float(sd), "identifiable": identifiable,
                           "on_bound": bool(bound != 0)}

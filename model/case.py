@@ -22,7 +22,7 @@ from .weather import IRRADIANCE_COLUMNS, check_columns, weather_on_grid
 
 
 STEADY_START = ("the nodes no measurement sets start from the steady state of the first day's mean conditions, "
-                "then the first day is replayed (the replay warm-up): a heavy component starts with "
+                "then the first day is replayed (the warm-up): a heavy component starts with "
                 "the gradient those conditions give it, not at the air's temperature")
 
 
