@@ -332,8 +332,8 @@ def test_the_first_screen_gives_what_the_data_fix_not_the_parameters_they_cannot
     screen = first_screen_of(md)
     assert len(screen) <= 10
     # (640.2 - 400.2) / (640.2 - 40.2) of the best forcing found, which did not locate the fault
-    assert screen[1] == ("**Fault:** not located: the best forcing (nodes 7, 16) removes only 40% of J above the "
-                         "noise floor.  ")
+    assert screen[1] == ("**Fault:** not located: the best forcing, nodes 7 (door, inside), 16 (floor, inside), "
+                         "removes only 40% of J above the noise floor.  ")
     assert screen[3] == ("**The data determine:** ground heat flux = -1.774 ± 0.047 W/m2 (U and T_ground each not "
                          "fixed by these data: candidates table).  ")
     assert not any("not identifiable" in line or "U = " in line for line in screen)

@@ -379,6 +379,13 @@ def test_diagnose_end_to_end_on_a_few_real_days(tmp_path):
                  "--burn-in-days", "1", "--seed", "0", "--phases", str(phases)]) == 0
     md = (out / "report.md").read_text()
     report = json.loads((out / "report.json").read_text())
+    # the first screen: at most ten lines, where (or that forcing cannot say), the validation error
+    # before and after as report.json has it, no parameter the data cannot fix
+    screen = md.split("\n\n")[1].splitlines()
+    assert len(screen) <= 9 and screen[0].startswith("**Fault:**")
+    assert not any("not identifiable" in line for line in screen)
+    before, after = (report[state]["validation"]["rmse"] for state in ("before", "after"))
+    assert any(f"RMSE {before:.3f} -> {after:.3f} C" in line for line in screen)
     # the report's claims, against the numbers they stand on
     loc = report["localization"]
     assert loc["finding"] in md

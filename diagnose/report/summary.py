@@ -30,6 +30,12 @@ def _component(node_name):
     return node_name.split(" at ", 1)[0]
 
 
+def _forcing(report, nodes):
+    """'node 16 (floor at 0.150 m)', 'nodes 70 (W9 at 0.000 m), 256 (corridor air)'."""
+    named = [f"{b}" + (f" ({content.node_name(report, b)})" if content.node_name(report, b) else "") for b in nodes]
+    return f"node{'s' if len(nodes) > 1 else ''} {', '.join(named)}"
+
+
 def where_line(report):
     """Where the fault is: the components behind the best forcing and the share of J it removes."""
     loc = report.get("localization") or {}
@@ -42,14 +48,12 @@ def where_line(report):
     if best:
         names = [content.node_name(report, b) for b in best]
         components = list(dict.fromkeys(_component(n) for n in names if n)) or [f"node {b}" for b in best]
-        nodes = ", ".join(f"node {b}" + (f" ({n})" if n else "") for b, n in zip(best, names))
         share = (f" removes {removed(J_unforced, loc['J_best'], J_noise):.0%} {of}"
                  if J_unforced is not None and num(loc.get("J_best")) is not None else "")
-        return f"Fault: in {', '.join(components)}: forcing {nodes}{share}"
+        return f"Fault: in {', '.join(components)}: forcing {_forcing(report, best)}{share}"
     strongest, J_min = search.get("min_nodes"), num(search.get("J_min"))
     if strongest and J_unforced is not None and J_min is not None:
-        return (f"Fault: not located: the best forcing (node{'s' if len(strongest) > 1 else ''} "
-                f"{', '.join(map(str, strongest))}) removes only "
+        return (f"Fault: not located: the best forcing, {_forcing(report, strongest)}, removes only "
                 f"{removed(J_unforced, J_min, J_noise):.0%} {of}")
     return "Fault: not located: no forcing the sensors allow lowers J beyond the noise"
 
