@@ -33,25 +33,21 @@ test: venv system-deps
 check: venv
 	$(PYTEST) -m "not slow"
 
-# Twin House N2, experiment 1 (examples/twinhouse_n2/README.md): the shared measurements converted,
-# then diagnosed on the living room; then experiment 2 (spring 2014, another protocol) converted
-# and the house as written and as corrected on experiment 1 compared on it, a record the
-# correction never saw. The data are not in the repository (SOURCES.md of the data).
-TWINHOUSE_DATA ?= ../shared/data/twinhouse_n2_exp1
-TWINHOUSE_DATA2 ?= ../shared/data/twinhouse_n2_exp2
+# Twin House N2, experiment 1 (examples/twinhouse_n2/README.md): the measurements the repository
+# carries (examples/twinhouse_n2/data/, read compressed) converted, then diagnosed on the living
+# room; then experiment 2 (spring 2014, another protocol) converted and the house as written and as
+# corrected on experiment 1 compared on it, a record the correction never saw.
 TWINHOUSE_EXAMPLE := examples/twinhouse_n2
+TWINHOUSE_DATA := $(TWINHOUSE_EXAMPLE)/data/exp1
+TWINHOUSE_DATA2 := $(TWINHOUSE_EXAMPLE)/data/exp2
 TWINHOUSE_OUT := out/twinhouse
 TWINHOUSE_OUT2 := $(TWINHOUSE_OUT)/exp2
-TWINHOUSE_TABLE = $(BIN)/nodeforce table $(TWINHOUSE_DATA)/validationdataN2Exp1.txt \
+TWINHOUSE_TABLE = $(BIN)/nodeforce table $(TWINHOUSE_DATA)/validationdataN2Exp1.txt.gz \
 	--names $(TWINHOUSE_DATA)/columns.csv --origin 2013-01-01T00:00+01:00
-TWINHOUSE_TABLE2 = $(BIN)/nodeforce table $(TWINHOUSE_DATA2)/validationdataExp2.txt \
+TWINHOUSE_TABLE2 = $(BIN)/nodeforce table $(TWINHOUSE_DATA2)/validationdataExp2.txt.gz \
 	--names $(TWINHOUSE_DATA2)/columns.csv --origin 2014-01-01T00:00+01:00
 
 twinhouse: venv
-	@for f in $(TWINHOUSE_DATA)/validationdataN2Exp1.txt $(TWINHOUSE_DATA)/columns.csv \
-	          $(TWINHOUSE_DATA2)/validationdataExp2.txt $(TWINHOUSE_DATA2)/columns.csv; do test -f $$f || { \
-	  echo "twinhouse: $$f is missing: the Twin House N2 data folders (../shared/data/twinhouse_n2_exp1 and _exp2) are needed; validationdataN2Exp1.txt is IDEAS/Resources/measurements/validationdataN2Exp1.txt of github.com/open-ideas/IDEAS (commit 272d82aef8da5484b3ed729ba6d6cc1db9754f1e), columns.csv its column list (each folder's SOURCES.md)" >&2; \
-	  exit 2; }; done
 	mkdir -p $(TWINHOUSE_OUT) $(TWINHOUSE_OUT2)
 	$(TWINHOUSE_TABLE) --select @$(TWINHOUSE_EXAMPLE)/weather_columns.txt --set shading_south=0 \
 		-o $(TWINHOUSE_OUT)/weather.csv

@@ -1,8 +1,8 @@
 """Speed on a real house: one simulation of the Twin House N2 ground floor (261 nodes, about 5000
 steps of 10 min) by the direct model, through the Python FMU and through the standalone FMU.
 
-Needs `make twinhouse` to have converted the shared data into out/twinhouse/ (weather.csv,
-measurements.csv). Run: `.venv/bin/python benchmarks/bench_twinhouse.py`.
+Needs `make twinhouse` to have converted the repository's data (examples/twinhouse_n2/data/) into
+out/twinhouse/ (weather.csv, measurements.csv). Run: `.venv/bin/python benchmarks/bench_twinhouse.py`.
 """
 import statistics
 import sys

@@ -1,4 +1,4 @@
-"""Simulate a measured case through the FMU, warm-up included (PHYSICS.md section 5).
+"""Simulate a measured case through the FMU, warm-up included (docs/model.md section 5).
 
 The FMU knows one step; the warm-up, the initial measurements and the forcing mask are the
 driver's, and follow the same rules as `model.integrate.simulate`, so both give the same numbers.

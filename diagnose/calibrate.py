@@ -88,7 +88,9 @@ def calibrate(candidate, case, objective):
         tight = sd < (IDENTIFIABLE_KELVIN if p.unit == "C" else IDENTIFIABLE_RELATIVE * abs(value))
         identifiable = bool(tight and bound == 0)
         if not identifiable:
-            log.warning("%s: %s = %.4g +- %.2g %s is not identifiable from these data%s", candidate.label,
+            # the report's candidates table says it for every candidate; the terminal keeps its
+            # first screen for the result
+            log.info("%s: %s = %.4g +- %.2g %s is not identifiable from these data%s", candidate.label,
                         p.name, value, sd, p.unit, " (it ended on a bound)" if bound else "")
         result[p.name] = {"value": float(value), "std": float(sd), "identifiable": identifiable,
                           "on_bound": bool(bound != 0)}
@@ -103,7 +105,7 @@ def derived(candidate, case, x, cov):
     """What the data fix when the parameters trade off against each other, each with its
     standard deviation by the delta method, sd^2 = g' cov g for its gradient g.
 
-    - The heat loss coefficient of the model with the effect (PHYSICS.md section 8), W/K: what a
+    - The heat loss coefficient of the model with the effect (docs/model.md section 8), W/K: what a
       record of the air and the heating power fixes well even where the effect's parameters, or
       the split of the loss among effects, it does not (`hlc_gradient`).
     - A ground coupling acts through its heat flux density q = U (T_ground - T_face) (W/m2, into

@@ -41,7 +41,7 @@ def candidates(building, located_nodes, zones):
     located). The air node's own equation is always a candidate, since no forcing can reveal it,
     for the objective zones and any zone whose air was located: a constant gain, and an air-to-
     outside conductance, reported as `thermal_bridge` where the zone has mechanical supply air
-    (whose flow is known) and as `infiltration` otherwise (PHYSICS.md section 7), plus bridges to
+    (whose flow is known) and as `infiltration` otherwise (docs/model.md section 7), plus bridges to
     the boundary temperatures the zone's surfaces see, and the house-level effects on its air
     (`house_effects`). When nothing was located, a change of the
     inside convection (no single node) is one as well, and so is one factor on the objective zones'
@@ -245,7 +245,7 @@ def shading_leaks(building, zones, columns=None):
 
 
 def zone_effects(building, left, zones):
-    """The zone effects of PHYSICS.md section 7 a structured residual points at.
+    """The zone effects of docs/model.md section 7 a structured residual points at.
 
     A residual that follows a zone's own heat input at the same instant is the air answering the
     heater faster in the model than in the building: the classic sign of furniture and internal

@@ -4,7 +4,7 @@ A correction found by `diagnose` on one experiment is only worth what it does on
 house as written and as corrected are each simulated through their FMU on the same weather and
 measurements (each reads the columns its own file names), and scored on the same steps: the
 RMSE, mean and sd of each objective zone's air residual, overall and per phase of the
-experiment, beside each model's heat loss coefficient (PHYSICS.md section 8). Where the record
+experiment, beside each model's heat loss coefficient (docs/model.md section 8). Where the record
 measures heat fluxes at surfaces (the building's heat flux sensors), each model's flux through
 that face is reported beside the reading: a check the fit never saw.
 """

@@ -3,7 +3,7 @@ on data the calibration did not see.
 
 1. The record is split by time into a calibration window and a later validation window, and the
    calibration window again into a fitting window and a selection window (its last third, at
-   least a day). The record's first days are a burn-in (PHYSICS.md section 5: every measured node
+   least a day). The record's first days are a burn-in (docs/model.md section 5: every measured node
    forced, not scored), so the walls start from what the sensors saw rather than from the
    warm-up's replay of the first day, which a record with real history does not match.
 2. Before: the building as described, simulated through its FMU; metrics on the three windows,

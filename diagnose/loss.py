@@ -1,4 +1,4 @@
-"""The heat loss coefficient in the diagnosis' report (PHYSICS.md section 8): as described, as
+"""The heat loss coefficient in the diagnosis' report (docs/model.md section 8): as described, as
 corrected with the standard deviation the calibration gives it, and whether the record fixes
 how the loss splits among effects.
 

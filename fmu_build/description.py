@@ -83,7 +83,7 @@ def variables(layout, building, effect=None):
 
 
 def _input_meaning(building, name):
-    """(unit, description) of an input of the network (PHYSICS.md sections 1 and 4)."""
+    """(unit, description) of an input of the network (docs/model.md sections 1 and 4)."""
     if name == "T_out":
         return "degC", "outdoor air temperature"
     if name == "T_sky":
@@ -112,7 +112,7 @@ def _input_meaning(building, name):
 
 def initial_dependencies(building, layout):
     """{node index (0-based): sorted value references} the initial T of each node depends on
-    (PHYSICS.md section 5): its own measurement, its component's, its zone's air, T_start."""
+    (docs/model.md section 5): its own measurement, its component's, its zone's air, T_start."""
     forced = range(layout.T_forced.start, layout.T_forced.stop)
     depends = {i: {forced[i], layout.T_start} for i in range(layout.n_nodes)}
     for zone in building.zones:

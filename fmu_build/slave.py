@@ -8,7 +8,7 @@ cache would otherwise run the first FMU's code for the second.
 Variables: `<module>_model/variables.py` (the layout the standalone FMU shares). One doStep of h
 seconds is one backward-Euler step with the inputs set before it. During initialisation, the
 `T_forced[i]` values set are the measurements at t_0, from which the initial state follows
-PHYSICS.md section 5 (`T_start` where nothing is measured). Calls the standard forbids are
+docs/model.md section 5 (`T_start` where nothing is measured). Calls the standard forbids are
 answered with fmi2Error and a logged reason, and change nothing.
 
 The step needs numpy only: an FMU that imports scipy corrupts memory when the host ends.

@@ -1,7 +1,7 @@
 """The standalone FMU: the assembled network as data, stepped by generic C code; no Python at
 run time (`nodeforce fmu BUILDING --standalone -o MODEL.fmu`).
 
-Python assembles (model.network), C only steps (c/nodeforce_fmu.c, PHYSICS.md section 5). A
+Python assembles (model.network), C only steps (c/nodeforce_fmu.c, docs/model.md section 5). A
 shaded glazing's transmitted sun, the product of two inputs, is data too: which node and inputs,
 and its coefficient in each term. An
 added effect's parameters stay FMU parameters: every effect of model.effects changes the network

@@ -2,7 +2,7 @@
 
 A chromosome (Lauret et al.) is a mask over the measured nodes: True = that node is forced to
 its measured temperature for the whole run.  Its score is J, the sum of squared residuals of
-indoor air temperature (PHYSICS.md section 6), computed by an *evaluator*:
+indoor air temperature (docs/model.md section 6), computed by an *evaluator*:
 
     factory = SomeFactory(...)      # picklable; shipped to every worker
     evaluator = factory()           # called once per worker process (or per Dask worker thread)

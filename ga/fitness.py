@@ -24,7 +24,7 @@ class FmuFitness:
     case : model.case.Case with the measurements
     chromosome_nodes : node ids, one bit each
     objective : model.score.Objective, the zones whose measured air J sums
-    warmup_days : warm-up passes (PHYSICS.md section 5)
+    warmup_days : warm-up passes (docs/model.md section 5)
     """
 
     keeps_residuals = True  # its evaluators give residuals(mask): the paired test (ga.parsimony.Paired)

@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 
 from nodeforce.model.errors import InputError
-from .timetable import check_column_names, instant, one_line
+from .timetable import check_column_names, instant, read_text
 
 _VERSION = re.compile(r"#1(?![0-9.])")
 _DECLARATION = re.compile(r"(?:double|float)\s+([A-Za-z_][A-Za-z0-9_]*)\s*\(\s*(\d+)\s*,\s*(\d+)\s*\)")
@@ -33,7 +33,7 @@ def read_combitimetable(path, names, origin, table=None):
     Parameters
     ----------
     path : str or Path
-        The text file.
+        The text file, or its gzip (`.gz`) or xz (`.xz`) compression, read as it is.
     names : sequence of str
         One name per column of the matrix, column 1 (time, s) included: `names[0]` names the time
         column and `names[1:]` the data columns, as a column list such as the Twin House
@@ -85,13 +85,7 @@ def read_combitimetable(path, names, origin, table=None):
 
 def _tables(source):
     """{name: (declaration line, rows, cols, [(line number, text without comment)])}."""
-    try:
-        with open(source, encoding="utf-8-sig") as handle:
-            text = handle.read().splitlines()
-    except FileNotFoundError:
-        raise InputError(source, "file", "not found") from None
-    except (OSError, UnicodeDecodeError) as error:
-        raise InputError(source, "file", one_line(error)) from None
+    text = read_text(source).splitlines()
     tables, current, version = {}, None, False
     for number, line in enumerate(text, start=1):
         if not version:

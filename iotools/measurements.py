@@ -1,7 +1,7 @@
-"""Measured temperatures: read and check the measurements CSV (INTERFACE.md, Files).
+"""Measured temperatures: read and check the measurements CSV (docs/guide.md, Measurements).
 
 Measurements are never changed: an empty cell stays missing (NaN) and no value is interpolated or
-filled; the model handles a missing measurement where it uses one (PHYSICS.md section 5).
+filled; the model handles a missing measurement where it uses one (docs/model.md section 5).
 """
 
 from nodeforce.model.building import NODE_COLUMN

@@ -1,5 +1,5 @@
 """`nodeforce table`: columns of a Modelica table picked, renamed and written as a weather or
-measurements CSV (INTERFACE.md, Files).
+measurements CSV (docs/guide.md, Modelica tables).
 
 Nothing is computed from the data: the values written are the table's, cut to the period asked
 for, and a constant column (`--set`) holds exactly the value the user states.
@@ -14,7 +14,7 @@ import pandas as pd
 
 from nodeforce.model.errors import InputError
 from .combitimetable import read_combitimetable
-from .timetable import instant, one_line, write_time_table
+from .timetable import instant, one_line, uncompressed_name, write_time_table
 
 
 class Selected(NamedTuple):
@@ -38,7 +38,7 @@ def column_names(text, table_path):
         together 1..COLS, each once) and `file` (rows naming another file than the table's are
         for that file and are not read).
     table_path : str or Path
-        The table file, whose name selects the rows of a `file` column.
+        The table file, whose name (less a `.gz` or `.xz`) selects the rows of a `file` column.
 
     Returns
     -------
@@ -51,9 +51,10 @@ def column_names(text, table_path):
     if not rows or "name" not in rows[0][1]:
         raise InputError(path, "name", "no 'name' column")
     if "file" in rows[0][1]:
-        rows = [(line, row) for line, row in rows if row["file"].strip() == Path(table_path).name]
+        table_name = uncompressed_name(table_path)
+        rows = [(line, row) for line, row in rows if row["file"].strip() == table_name]
         if not rows:
-            raise InputError(path, "file", f"no row for {Path(table_path).name}")
+            raise InputError(path, "file", f"no row for {table_name}")
     if "column_1based" not in rows[0][1]:
         return [row["name"].strip() for _, row in rows]
     by_column = {}

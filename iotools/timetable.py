@@ -5,6 +5,8 @@ The weather and measurement readers are built on `read_time_table`; the typical-
 """
 
 import csv
+import gzip
+import lzma
 import re
 from pathlib import Path
 
@@ -124,6 +126,36 @@ def instant(option, text):
     if time.tzinfo is None:
         raise InputError(option, text, "needs a UTC offset, e.g. 2013-01-01T00:00+01:00")
     return time
+
+
+#: Compressed text files read as they are, by the suffix of their name: nothing decompressed is
+#: written beside them.
+_OPENERS = {".gz": gzip.open, ".xz": lzma.open}
+
+
+def read_text(path):
+    """The text of a file, UTF-8 (a byte-order mark dropped), decompressed first when its name ends
+    in `.gz` (gzip) or `.xz` (xz).
+
+    Raises
+    ------
+    InputError
+        One line naming the file: not found, unreadable, not valid compressed data, not text.
+    """
+    opener = _OPENERS.get(Path(path).suffix.lower(), open)
+    try:
+        with opener(path, "rt", encoding="utf-8-sig") as handle:
+            return handle.read()
+    except FileNotFoundError:
+        raise InputError(path, "file", "not found") from None
+    except (OSError, EOFError, lzma.LZMAError, UnicodeDecodeError) as error:
+        raise InputError(path, "file", one_line(error)) from None
+
+
+def uncompressed_name(path):
+    """A file's name without the `.gz` or `.xz` that `read_text` decompresses."""
+    path = Path(path)
+    return path.stem if path.suffix.lower() in _OPENERS else path.name
 
 
 def one_line(error):

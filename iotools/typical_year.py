@@ -3,7 +3,8 @@
 The bundled Miami files are reproduced, from the repository root, with
 
     python -m nodeforce.iotools.typical_year convert \\
-        /work/venv/lib/python3.11/site-packages/pvlib/data/12839.tm2 model/data/miami_tmy2.csv \\
+        "$(python -c 'import pvlib, pathlib; print(pathlib.Path(pvlib.__file__).parent)')/data/12839.tm2" \\
+        model/data/miami_tmy2.csv \\
         --building model/data/testcell.json --building-out model/data/testcell_miami.json
 
 (the first path is pvlib's bundled TMY2 file for Miami, wherever pvlib is installed).

@@ -1,4 +1,4 @@
-"""Weather files: the weather CSV of PHYSICS.md section 4 or an EPW file, read and checked.
+"""Weather files: the weather CSV of docs/model.md section 4 or an EPW file, read and checked.
 
 Hourly sources (EPW) have their rows at the middle of the hour (`nodeforce.iotools.hourly`).
 """
@@ -19,7 +19,7 @@ IRRADIANCE_FLOOR = -50.0
 
 
 def read_weather(path):
-    """Read and check a weather file: the CSV of PHYSICS.md section 4, or an EPW file (by extension).
+    """Read and check a weather file: the CSV of docs/model.md section 4, or an EPW file (by extension).
 
     Parameters
     ----------

@@ -1,4 +1,4 @@
-"""Read and validate a building file (`"format": "nodal-building/1"`, PHYSICS.md section 1).
+"""Read and validate a building file (`"format": "nodal-building/1"`, docs/model.md section 1).
 
 Every check raises `InputError` naming the file and the field, so a user can fix the file
 without reading code. The result is one `Building`: a tree of frozen records the network is
@@ -55,7 +55,7 @@ class Surface:
 
 @dataclass(frozen=True)
 class Exterior:
-    """Outdoor air, sky and sun (PHYSICS.md section 3)."""
+    """Outdoor air, sky and sun (docs/model.md section 3)."""
     h_conv: float  # W/m2/K
     h_rad: float  # W/m2/K
     solar_absorptance: float  # -
@@ -89,7 +89,7 @@ class Inflow:
 
 @dataclass(frozen=True)
 class Lumped:
-    """A node a zone effect adds (PHYSICS.md section 7): its capacity and its conductance to the zone."""
+    """A node a zone effect adds (docs/model.md section 7): its capacity and its conductance to the zone."""
     capacity: float  # J/K; 0 makes the node algebraic
     conductance: float  # W/K, > 0
 
@@ -117,7 +117,7 @@ class Zone:
     shading_transmittance: float = 0.0  # part of its glazings' sun a closed shading still lets in
     heat_input_factor: float = 1.0  # the heat its heat input columns deliver, per W they read
     air_exchange: tuple = ()  # (other zone, m3/h each way): air through an open internal door
-    mass_node: int | None = None  # ids of the nodes those two add (PHYSICS.md section 7)
+    mass_node: int | None = None  # ids of the nodes those two add (docs/model.md section 7)
     heater_node: int | None = None
 
 
@@ -534,7 +534,7 @@ def _lumped(check, z, key, where):
 
 def _number_added_nodes(zones, last):
     """The zones with ids for the nodes their effects add: after the building's `last` node, zone
-    by zone in file order, its internal mass before its heater (PHYSICS.md section 7)."""
+    by zone in file order, its internal mass before its heater (docs/model.md section 7)."""
     ids = iter(range(last + 1, 10 ** 9))
     numbered = []
     for z in zones:

@@ -3,7 +3,7 @@
 `prepare_case` turns a building, its weather and its measurements into arrays on one uniform
 time grid: the measurement grid when there are measurements (weather interpolated onto it),
 else the weather's own. It never fills a gap: a missing measurement stays NaN (the node is then
-computed, PHYSICS.md section 5) and a missing input is refused.
+computed, docs/model.md section 5) and a missing input is refused.
 """
 from dataclasses import dataclass, field, replace
 
@@ -22,7 +22,7 @@ from .weather import IRRADIANCE_COLUMNS, check_columns, weather_on_grid
 
 
 STEADY_START = ("the nodes no measurement sets start from the steady state of the first day's mean conditions, "
-                "then the first day is replayed (PHYSICS.md section 5's warm-up): a heavy component starts with "
+                "then the first day is replayed (the warm-up): a heavy component starts with "
                 "the gradient those conditions give it, not at the air's temperature")
 
 
@@ -48,7 +48,7 @@ class Case:
         return int(round(days * 86400 / self.dt))
 
     def with_burn_in(self, days, source="--burn-in-days"):
-        """The case whose first `days` after t_0 are a burn-in (PHYSICS.md section 5)."""
+        """The case whose first `days` after t_0 are a burn-in (docs/model.md section 5)."""
         steps = self.steps(days)
         if days < 0 or abs(steps * self.dt - days * 86400) > 1e-6 * self.dt:
             raise InputError(source, days, f"must be a whole number of {self.dt:g} s steps, not negative")
@@ -254,7 +254,7 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs"):
 
 
 def check_warmup(case, source):
-    """InputError naming `source` unless the warm-up can replay the case's first day (PHYSICS.md
+    """InputError naming `source` unless the warm-up can replay the case's first day (docs/model.md
     section 5): the step must divide a day and the record must hold one."""
     try:
         per_day = steps_per_day(case.dt)
@@ -297,8 +297,8 @@ def simulate_building(building, weather, measurements=None, force=(), warmup_day
     measurements : DataFrame from `nodeforce.iotools.measurements.read_measurements`, or None; it sets the
         time grid, the initial state and the values forced nodes take
     force : node ids forced to their measurements for the whole run
-    warmup_days : passes over the first day before the run (PHYSICS.md section 5)
-    burn_in_days : days after t_0 over which every measured node is forced (PHYSICS.md section 5)
+    warmup_days : passes over the first day before the run (docs/model.md section 5)
+    burn_in_days : days after t_0 over which every measured node is forced (docs/model.md section 5)
 
     Returns
     -------

@@ -1,4 +1,4 @@
-"""Spatial discretisation of a multilayer component (PHYSICS.md section 2), per m2 of area.
+"""Spatial discretisation of a multilayer component (docs/model.md section 2), per m2 of area.
 
 Conductances are exact integrals of dx/lambda across layer boundaries, capacities exact
 integrals of rho*c over each node's control volume: with two nodes this is the R2C model

@@ -1,4 +1,4 @@
-"""The effects a diagnosis may add to a model (PHYSICS.md section 7): one record per effect.
+"""The effects a diagnosis may add to a model (docs/model.md section 7): one record per effect.
 
 Each effect is a change of declared fields of the building file, so a model with the effect is
 an ordinary building that every command loads, and its FMU exposes the effect's parameters as
@@ -189,7 +189,7 @@ def _proportional_write(data, target, values):
     _zone(data, zone).setdefault("proportional_gains", {})[column] = float(values["k"])
 
 
-# internal mass, heater lag: a node of capacity C coupled to the zone by H (PHYSICS.md section 7).
+# internal mass, heater lag: a node of capacity C coupled to the zone by H (docs/model.md section 7).
 # Not declared, the node is neutral: no capacity, so it holds the zone's temperature and carries
 # no heat (the heater passes its input on at once); its conductance is then any positive value,
 # the zone air's capacity over NEUTRAL_TIME, a magnitude a calibration may start from.

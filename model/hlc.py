@@ -1,4 +1,4 @@
-"""The heat loss coefficient of a model (PHYSICS.md section 8).
+"""The heat loss coefficient of a model (docs/model.md section 8).
 
 The HLC is the steady-state heat loss per kelvin of indoor-outdoor difference: no sun, every
 prescribed temperature (outdoor air, sky, boundary columns, supply air) at 0 C, the air of every

@@ -1,4 +1,4 @@
-"""Backward-Euler integration with forcing (PHYSICS.md section 5, paper eqs. 6 and 7).
+"""Backward-Euler integration with forcing (docs/model.md section 5, paper eqs. 6 and 7).
 
 One step from t_n to t_n+1 solves `M T^n+1 = V`, with `M = C/dt - A` and
 `V = (C/dt) T^n + B u^n+1 + q`. Forcing node i replaces row i of M by the unit row and v_i by
@@ -228,7 +228,7 @@ def imposed(force, measured):
 
 
 def forcing_schedule(force, measured, burn_in_steps=0):
-    """(N_t+1, N) bool: the nodes imposed at each input row t_0..t_N (PHYSICS.md section 5).
+    """(N_t+1, N) bool: the nodes imposed at each input row t_0..t_N (docs/model.md section 5).
 
     Over the burn-in, rows 1..B, every node measured there is forced (a state observer: the
     record, not a guess, sets the walls' state); from row B+1 on, the mask's nodes whose
@@ -288,7 +288,7 @@ def steady_inputs(U, measured, forced, dt):
     """The steady start's step: the first day's mean inputs, and the nodes imposed during that
     day held at the mean of their imposed values.
 
-    Before the replay warm-up (PHYSICS.md section 5), a diagnosis may take one backward-Euler
+    Before the replay warm-up (docs/model.md section 5), a diagnosis may take one backward-Euler
     step of `STEADY_STEP` with these: every mode faster than centuries reaches the steady state of
     the first day's mean conditions, so a heavy, unmeasured component starts with the gradient
     the conditions give it rather than at the air's temperature, a guess its slow time constant

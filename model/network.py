@@ -1,7 +1,7 @@
-"""Assemble the nodal network `C dT/dt = A T + B u(t) + q + s(u)` (PHYSICS.md section 3, paper eq. 5).
+"""Assemble the nodal network `C dT/dt = A T + B u(t) + q + s(u)` (docs/model.md section 3, paper eq. 5).
 
 Node i of the building file is row i-1, the nodes zone effects add (an internal mass, a
-heater's capacity, PHYSICS.md section 7) after the building's own. The input vector u holds, in this order: `T_out`,
+heater's capacity, docs/model.md section 7) after the building's own. The input vector u holds, in this order: `T_out`,
 `T_sky` (C), the irradiance input of each exterior component (W/m2 on its outside face: its
 `irradiance` column, else `I_<component>`), then the building's other named input columns (heat
 inputs W, supply and boundary temperatures C, shading 0..1), then, where a zone declares a daily
@@ -178,7 +178,7 @@ def assemble(building, names=None):
         f_r, gain = z.heat_input_radiative_fraction, z.heat_input_factor
         if z.heat_input_lag is not None:
             # the heater's node takes the heat input and gives it to the air and the radiant node
-            # in the heat input's split (PHYSICS.md section 7)
+            # in the heat input's split (docs/model.md section 7)
             heater = z.heater_node - 1
             C[heater] += z.heat_input_lag.capacity
             link(heater, air, (1.0 - f_r) * z.heat_input_lag.conductance)

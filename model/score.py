@@ -1,4 +1,4 @@
-"""The score of a simulation against the measured indoor air (PHYSICS.md section 6)."""
+"""The score of a simulation against the measured indoor air (docs/model.md section 6)."""
 from dataclasses import dataclass
 
 import numpy as np
@@ -110,7 +110,7 @@ class Noise:
 
 @dataclass(frozen=True)
 class Objective:
-    """The zones whose measured air J sums (PHYSICS.md section 6), and their air nodes."""
+    """The zones whose measured air J sums (docs/model.md section 6), and their air nodes."""
     zones: tuple  # zone names
     air_nodes: tuple  # their air node ids, in the same order
 

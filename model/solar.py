@@ -1,4 +1,4 @@
-"""Sky temperature and solar irradiance on the outside faces of a building (PHYSICS.md section 4).
+"""Sky temperature and solar irradiance on the outside faces of a building (docs/model.md section 4).
 
 Pure functions on numpy arrays and pandas indexes, no I/O. The sun position is computed once for
 a time grid (`solar_position`) and reused for every surface (`incident_irradiance`), because it is
@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 import pvlib
 
-#: Stefan-Boltzmann constant, W/m2/K4 (CODATA 2018, exact as PHYSICS.md writes it).
+#: Stefan-Boltzmann constant, W/m2/K4 (CODATA 2018, exact).
 STEFAN_BOLTZMANN = 5.670374419e-8
 
 #: Offset between degrees Celsius and kelvin, K.
@@ -111,7 +111,7 @@ def incident_irradiance(position, ghi, dni, dhi, tilt, azimuth, albedo):
     -------
     numpy.ndarray
         pvlib's isotropic `get_total_irradiance(...)["poa_global"]`, W/m2, with NaN and negative
-        values set to 0: a missing weather sample contributes no sun (PHYSICS.md section 4).
+        values set to 0: a missing weather sample contributes no sun (docs/model.md section 4).
     """
     poa = pvlib.irradiance.get_total_irradiance(
         tilt,

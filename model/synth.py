@@ -4,7 +4,7 @@ The paper verifies its method this way (Tables 2 and 3): measurements come from 
 one sub-model disturbed, and the search must point at it.
 
 The "real" building starts in the periodic regime of its first day: the model's own warm-up
-(PHYSICS.md section 5) carried on for `spinup_days` passes, as building simulation tools
+(docs/model.md section 5) carried on for `spinup_days` passes, as building simulation tools
 precondition a run. A record that starts there is a fixed point of the warm-up, so a model that
 is right everywhere reproduces it exactly, and what remains comes from the disturbed sub-model.
 `history_days` of real weather may follow before the record, for a building whose past was not

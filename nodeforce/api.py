@@ -54,7 +54,7 @@ def read_building(path):
 
 
 def objective(building, zones=None):
-    """The zones whose measured air J sums (PHYSICS.md section 6).
+    """The zones whose measured air J sums (docs/model.md section 6).
 
     Parameters
     ----------
@@ -82,7 +82,7 @@ def simulate(building, weather, measurements=None, force=(), burn_in_days=0):
     force : sequence of int
         Node ids forced to their measurements for the whole run.
     burn_in_days : float
-        Days after t_0 over which every measured node is forced (PHYSICS.md section 5).
+        Days after t_0 over which every measured node is forced (docs/model.md section 5).
 
     Returns
     -------
@@ -151,7 +151,7 @@ def forcing_candidates(building, case, objective=None, include_algebraic=False):
 
 def score_forcing(instance, case, nodes, objective):
     """J (C2): the sum of squared residuals of the objective's measured air with `nodes` forced to
-    their measurements, simulated through an open FMU, warm-up included (PHYSICS.md sections 5, 6).
+    their measurements, simulated through an open FMU, warm-up included (docs/model.md sections 5, 6).
 
     Parameters
     ----------

@@ -1,4 +1,4 @@
-"""The `nodeforce` command line (INTERFACE.md). Bad input: one line on stderr, exit status 2; stopped
+"""The `nodeforce` command line (docs/guide.md). Bad input: one line on stderr, exit status 2; stopped
 by SIGINT, SIGTERM or a lost Dask scheduler: one line saying how to resume, 130, 143 or 75
 (nodeforce.lifetime)."""
 import argparse
@@ -206,7 +206,7 @@ def cmd_synth(args):
 def run_diagnosis(building, case, objective, out, source, args):
     from nodeforce.diagnose.loop import diagnose
     from nodeforce.iotools.phases import read_phases
-    from nodeforce.diagnose.report import before_after_table
+    from nodeforce.diagnose.report import terminal_summary
     if not 0.0 < args.calibration_fraction < 1.0:
         raise InputError("--calibration-fraction", args.calibration_fraction, "a fraction between 0 and 1")
     end = instant("--calibration-end", args.calibration_end) if args.calibration_end else None
@@ -216,7 +216,7 @@ def run_diagnosis(building, case, objective, out, source, args):
                       calibration_end=end, seed=args.seed, workers=args.workers, fmu_kind=kind_of(args),
                       reference=read_reference(args.reference) if args.reference else None, noise=noise(args),
                       phases=read_phases(args.phases) if args.phases else None)
-    print(before_after_table(report))
+    print(terminal_summary(report))
     print(f"wrote {out / 'report.json'}, {out / 'report.md'}, {out / 'building_after.json'}, {out / 'model_after.fmu'}")
 
 
@@ -332,7 +332,7 @@ def diagnosis_arguments(s):
 def burn_in_argument(s, default):
     s.add_argument("--burn-in-days", type=float, default=default,
                    help=f"days after t_0 over which every measured node is forced and nothing is scored "
-                        f"(PHYSICS.md section 5; default {default:g})")
+                        f"(docs/model.md section 5; default {default:g})")
 
 
 def noise_argument(s):

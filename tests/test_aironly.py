@@ -1,7 +1,7 @@
 """Records with ordinary sensors (issue 17): the indoor air, the weather and the heating power.
 
 Every command takes them; `locate` says it has nothing to force; the candidate policy points at
-the zone effects of PHYSICS.md section 7 where the residual asks for them, and the diagnosis
+the zone effects of docs/model.md section 7 where the residual asks for them, and the diagnosis
 recovers each from an air-only synthetic record; the report gives the heat loss coefficient;
 weather with `ghi` alone is split by a pvlib decomposition."""
 import numpy as np
@@ -221,7 +221,7 @@ def test_the_steady_start_finds_the_walls_state_the_replay_alone_misses(heated, 
     """The records are made periodic by a year of replays of their first day (`pseudo_measurements`),
     an independent way to the walls' state at t_0. With the air alone measured, the true model
     started from the first day's steady state reproduces the record to the hundredth of a degree;
-    the two replays of PHYSICS.md section 5 alone leave the heavy floor at the air's temperature,
+    the two replays of docs/model.md section 5 alone leave the heavy floor at the air's temperature,
     tenths of a degree off for the whole record."""
     truth = EFFECTS[effect].apply(heated, "cell", values)
     times = pd.date_range("2001-06-10T00:00-05:00", periods=5 * 48 + 1, freq="30min", name="time")

@@ -178,9 +178,30 @@ def test_diagnose_refuses_a_fraction_outside_0_1(files, capsys):
 def test_demo_runs_the_whole_loop_and_finds_the_ground_coupling(tmp_path, capsys):
     assert main(["demo", "-o", str(tmp_path), "--workers", "1"]) == 0
     out = capsys.readouterr().out
-    assert "Effect added: ground_coupling on floor" in out
     assert "validation" in out and "calibration" in out
     report = json.loads((tmp_path / "report.json").read_text())
+    # the first screen, in the terminal (after the demo's line on its data) and atop report.md: where,
+    # what was added, what the data fix (the flux, not U and T_ground apart), before and after
+    screen = out.split("\n\n")[0].splitlines()[1:]
+    md = (tmp_path / "report.md").read_text()
+    top = md.split("\n\n")[:2]
+    assert top[0] == "# nodeforce diagnosis report" and len(top[1].splitlines()) == len(screen) <= 8
+    for lines in (screen, top[1].splitlines()):
+        assert lines[0].startswith(("Fault: in floor: forcing node 16", "Fault: in floor: forcing node 17",
+                                    "**Fault:** in floor: forcing node 16", "**Fault:** in floor: forcing node 17"))
+        assert "ground_coupling on floor" in lines[1]
+        assert "ground heat flux = -1.9" in lines[2]
+        assert not any("not identifiable" in line for line in lines)
+    flux = report["effect"]["derived"]["ground_heat_flux"]
+    assert f"{flux['value']:.3f}" in screen[2]
+    validation = [report[s]["validation"] for s in ("before", "after")]
+    assert f"RMSE {validation[0]['rmse']:.3f} -> {validation[1]['rmse']:.3f} C" in screen[3]
+    # the Decision gives each reason once: the refused gains grouped
+    decision = md.split("## Decision", 1)[1].split("\n## ", 1)[0]
+    refused = report["decision"]["suggestions"]
+    assert refused and decision.count("negative gain") == 1
+    assert f"{len(refused)} candidates the data support, not added: each is a negative gain" in decision
+    assert all(s["candidate"] in decision for s in refused)
     assert report["localization"]["best_nodes"] in ([16], [17])
     assert report["after"]["validation"]["rmse"] < 0.5 * report["before"]["validation"]["rmse"]
     for name in ("report.md", "building_after.json", "model_after.fmu", "air_temperature.png"):

@@ -13,7 +13,7 @@ from nodeforce.iotools.table import column_names
 from nodeforce.iotools.weather import read_weather
 from nodeforce.model.errors import InputError
 
-TWIN_HOUSE = Path(__file__).resolve().parents[2] / "shared" / "data" / "twinhouse_n2_exp1"
+TWIN_HOUSE = Path(__file__).resolve().parents[1] / "examples" / "twinhouse_n2" / "data" / "exp1"
 NAMES = ["time", "T_a", "T_b"]
 ORIGIN = "2024-06-01T00:00-05:00"
 # Three rows of three columns, every separator the format allows, comments anywhere.
@@ -52,6 +52,27 @@ def test_rows_may_span_lines_as_the_format_allows(tmp_path, body):
     frame = read_combitimetable(write(tmp_path, "#1\ndouble tab(3,3)\n" + body), NAMES, ORIGIN)
     expected = read_combitimetable(write(tmp_path, SMALL, "small.txt"), NAMES, ORIGIN)
     pd.testing.assert_frame_equal(frame, expected)
+
+
+@pytest.mark.parametrize("suffix, compress", [(".gz", "gzip"), (".xz", "lzma")])
+def test_a_compressed_table_reads_as_its_text_and_a_broken_one_is_one_line(tmp_path, suffix, compress):
+    import importlib
+    module = importlib.import_module(compress)
+    packed = tmp_path / f"table.txt{suffix}"
+    packed.write_bytes(module.compress(SMALL.encode()))
+    expected = read_combitimetable(write(tmp_path, SMALL), NAMES, ORIGIN)
+    pd.testing.assert_frame_equal(read_combitimetable(packed, NAMES, ORIGIN), expected)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["table.txt", packed.name]  # nothing unpacked beside it
+    # a names file's `file` column names the table uncompressed
+    names = tmp_path / "columns.csv"
+    names.write_text("file,column_1based,name\ntable.txt,1,time\ntable.txt,2,T_a\ntable.txt,3,T_b\n")
+    assert column_names(str(names), packed) == NAMES
+    broken = tmp_path / f"broken.txt{suffix}"
+    broken.write_bytes(SMALL.encode())  # plain text under a compressed name
+    with pytest.raises(InputError) as caught:
+        read_combitimetable(broken, NAMES, ORIGIN)
+    assert caught.value.source == str(broken) and caught.value.field == "file"
+    assert "\n" not in str(caught.value)
 
 
 def test_a_file_of_several_tables_reads_the_one_named(tmp_path):
@@ -161,10 +182,8 @@ def test_table_command_bad_input_is_one_line_exit_2(tmp_path, capsys, extra, sta
 
 @pytest.fixture(scope="module")
 def twin_house():
-    table, names = TWIN_HOUSE / "validationdataN2Exp1.txt", TWIN_HOUSE / "columns.csv"
-    if not (table.is_file() and names.is_file()):
-        pytest.skip(f"needs the Twin House data {table} and {names} (../shared relative to the repository)")
-    return table, names
+    """The repository's Twin House table, read compressed (columns.csv names it uncompressed)."""
+    return TWIN_HOUSE / "validationdataN2Exp1.txt.gz", TWIN_HOUSE / "columns.csv"
 
 
 def test_twin_house_first_row_is_21_august_cet_and_values_match_loadtxt(twin_house):

@@ -18,7 +18,7 @@ from tests.conftest import DATA, SENSORS, record_times
 def direct_rmse(building, weather, measurements, start, end):
     """RMSE (C) of the cell's air of `building` against the measurements over the steps from
     `start` to `end`, simulated by the direct model with the first day a burn-in (every measured
-    node forced, not scored), as PHYSICS.md section 5 says."""
+    node forced, not scored), as docs/model.md section 5 says."""
     case = prepare_case(building, weather, measurements).with_burn_in(1)
     T = simulate(building, assemble(building), case.U, case.dt, case.measured, burn_in_steps=case.burn_in_steps)
     rows = (case.times[1:] >= start) & (case.times[1:] <= end)

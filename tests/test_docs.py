@@ -1,5 +1,7 @@
-"""The documentation stays true: every relative link in README.md and docs/*.md resolves (the
-file, and a `#anchor` to a heading of a Markdown file), and every `nodeforce COMMAND` shown in a
+"""The documentation stays true: every relative link in README.md, docs/*.md and the examples'
+READMEs resolves (the file, and a `#anchor` to a heading of a Markdown file), every file and
+every name of the code they give in a code span exists, docs/model.md documents every effect the
+registry has, no file points outside the repository, and every `nodeforce COMMAND` shown in a
 code block is a command whose `--help` exists and lists each `--option` shown with it.
 
 The pages are parsed, not listed here, so a page or command added to the docs is checked too.
@@ -16,6 +18,7 @@ from nodeforce.cli import main
 
 ROOT = Path(__file__).parents[1]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+EXAMPLE_PAGES = sorted((ROOT / "examples").glob("*/README.md"))
 
 FENCE = re.compile(r"^\s*(```|~~~)")
 LINK = re.compile(r"!?\[[^\]]*\]\(([^)\s]+)(?:\s+\"[^\"]*\")?\)")
@@ -135,7 +138,7 @@ def test_the_docs_show_commands():
     assert {"demo", "diagnose", "simulate", "locate", "fmu", "table", "synth"} <= shown
 
 
-@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.relative_to(ROOT).as_posix())
+@pytest.mark.parametrize("page", PAGES + EXAMPLE_PAGES, ids=lambda p: p.relative_to(ROOT).as_posix())
 def test_relative_links_resolve(page):
     broken = []
     for target in links(page):
@@ -154,3 +157,99 @@ def test_documented_command_and_options_exist(page, command, options):
     assert status == 0, f"{page}: `nodeforce {command} --help` fails: {text.strip().splitlines()[-1:]}"
     listed = set(OPTION.findall(text))
     assert not set(options) - listed, f"{page}: nodeforce {command} has no {sorted(set(options) - listed)}"
+
+
+# A file path in a code span: a slash, and a known ending; placeholders, globs and outputs left out.
+PATH_SPAN = re.compile(r"`([A-Za-z0-9_.][A-Za-z0-9_./-]*/[A-Za-z0-9_.-]+\.(?:py|json|md|csv|txt|gz|c|h|toml|html|png|cfg))`")
+# A name of the code: `model.network.assemble`, `diagnose.calibrate.IDENTIFIABLE_KELVIN`, ...
+CODE_NAME = re.compile(r"`((?:model|diagnose|ga|cosim|iotools|fmu_build|nodeforce)(?:\.[A-Za-z_][A-Za-z0-9_]*)+)`")
+MODEL = ROOT / "docs" / "model.md"
+
+
+def named_files(page):
+    """The repository files a page names in code spans (`model/data/testcell.json`): paths whose
+    first folder is the repository's or the page's; outputs of a run (`out/...`), a user's folders
+    (`DIR/...`) and the inside of an FMU (`resources/...`) left out."""
+    text = re.sub(r"```.*?```", "", page.read_text(encoding="utf-8"), flags=re.S)
+    return sorted({p for p in PATH_SPAN.findall(text) if not p.startswith("out/")
+                   and ((ROOT / p.split("/")[0]).exists() or (page.parent / p.split("/")[0]).exists())})
+
+
+@pytest.mark.parametrize("page", PAGES + EXAMPLE_PAGES, ids=lambda p: p.relative_to(ROOT).as_posix())
+def test_every_file_the_docs_name_exists(page):
+    """A path is the repository's (from its root) or the page's own folder's."""
+    missing = [p for p in named_files(page) if not ((ROOT / p).exists() or (page.parent / p).exists())]
+    assert not missing, f"{page.relative_to(ROOT)} names files that do not exist: {missing}"
+
+
+def resolves(name):
+    """Whether a dotted name of the code is a module, or an attribute of one (a function, a class,
+    a method, a constant)."""
+    import importlib
+    parts = name.split(".")
+    for cut in range(len(parts), 0, -1):
+        module = "nodeforce" if parts[:cut] == ["nodeforce"] else "nodeforce." + ".".join(parts[:cut]).removeprefix("nodeforce.")
+        try:
+            found = importlib.import_module(module)
+        except ImportError:
+            continue
+        for attribute in parts[cut:]:
+            if not hasattr(found, attribute):
+                return False
+            found = getattr(found, attribute)
+        return True
+    return False
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.relative_to(ROOT).as_posix())
+def test_every_name_of_the_code_the_docs_give_exists(page):
+    text = page.read_text(encoding="utf-8")
+    names = {name for name in CODE_NAME.findall(text) if not re.search(r"\.(fmu|json|csv|md|py|png|txt)$", name)}
+    wrong = sorted(name for name in names if not resolves(name))
+    assert not wrong, f"{page.relative_to(ROOT)} names what the code does not have: {wrong}"
+
+
+def test_the_names_check_tells_a_wrong_name():
+    assert resolves("model.network.assemble") and resolves("model.case.Case.with_burn_in")
+    assert resolves("iotools.hourly") and resolves("diagnose.candidates.IDENTIFIABLE_RELATIVE")
+    assert not resolves("model.network.no_such_function") and not resolves("model.no_such_module")
+
+
+def documented_effects():
+    """The effect ids of docs/model.md: the `### id` headings of its Effects section."""
+    text = MODEL.read_text(encoding="utf-8")
+    section = re.search(r"^## \d+\. Effects\n(.*?)(?=^## )", text, re.M | re.S)
+    assert section, "docs/model.md has no '## N. Effects' section"
+    return [h.strip("` ") for h in re.findall(r"^### (.+)$", section.group(1), re.M)]
+
+
+def test_the_model_reference_documents_every_effect_of_the_registry():
+    """One `### id` section per effect `model.effects.EFFECTS` registers, and none it does not: an
+    effect added without its equations fails here."""
+    from nodeforce.model.effects import EFFECTS
+    documented = documented_effects()
+    assert len(documented) == len(set(documented)), "an effect documented twice"
+    assert set(documented) == set(EFFECTS), (f"undocumented: {sorted(set(EFFECTS) - set(documented))}; "
+                                             f"not registered: {sorted(set(documented) - set(EFFECTS))}")
+    # each section gives every parameter of the registry with its unit
+    text = MODEL.read_text(encoding="utf-8")
+    for effect_id, effect in EFFECTS.items():
+        body = text.split(f"\n### {effect_id}\n", 1)[1].split("\n#", 1)[0]
+        for p in effect.parameters:
+            assert p.name in body, f"docs/model.md, {effect_id}: no parameter {p.name}"
+            assert p.unit == "-" or p.unit in body, f"docs/model.md, {effect_id}: no unit {p.unit} of {p.name}"
+
+
+def test_no_page_or_file_points_outside_the_repository():
+    """The repository carries its own reference: no file names the specifications it grew from
+    or a folder beside the clone (the words are assembled here so that this file passes too)."""
+    words = ["PHYSICS" + ".md", "INTERFACE" + ".md", ".." + "/shared"]
+    tracked = __import__("subprocess").run(["git", "ls-files", "-z"], cwd=ROOT, capture_output=True, check=True)
+    found = []
+    for name in tracked.stdout.decode().split("\0"):
+        path = ROOT / name
+        if not name or not path.is_file() or path.suffix in (".gz", ".png", ".fmu"):
+            continue
+        text = path.read_text(encoding="utf-8", errors="replace")
+        found += [f"{name}: {w}" for w in words if w in text]
+    assert not found, found

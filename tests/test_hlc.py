@@ -1,4 +1,4 @@
-"""The heat loss coefficient (PHYSICS.md section 8) against hand-solved steady states."""
+"""The heat loss coefficient (docs/model.md section 8) against hand-solved steady states."""
 import copy
 
 import numpy as np

@@ -106,7 +106,7 @@ def test_steady_state_equals_hand_computed_conductance_network():
 
 def boundary_heat_in(building, T, u):
     """Heat entering the building (W) through its outside faces, the air flows, the transmitted
-    sun and the gains, written from PHYSICS.md section 3 term by term (flows between zones move
+    sun and the gains, written from docs/model.md section 3 term by term (flows between zones move
     heat inside the building and leave at the zone's temperature: only what enters from outside
     or leaves to it counts)."""
     rho_c = 1.2 * 1005
@@ -175,7 +175,7 @@ def test_energy_balance_closes_every_step():
 
 @pytest.mark.parametrize("f", [0.0, 0.3, 1.0])
 def test_a_closed_shading_lets_in_its_part_f_of_the_glazings_sun(f):
-    """PHYSICS.md section 4's transmitted sun tau s A I, with the zone's shading_transmittance f:
+    """docs/model.md section 4's transmitted sun tau s A I, with the zone's shading_transmittance f:
     tau A I (s + f (1 - s)), by hand at a blind open, half drawn and closed; it lands on the
     receiving surface only, and f = 0 is the building as declared."""
     data = copy.deepcopy(TESTCELL)

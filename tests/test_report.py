@@ -300,3 +300,68 @@ def test_a_candidate_tried_again_on_top_is_judged_and_marked_in_its_own_round(tm
     assert content.verdict(report, roof) == report["decision"]["candidates"]["solar_absorptance@roof"]
     assert not content.is_chosen(report, roof) and content.is_chosen(report, first)
     assert content.verdict(report, again)["selection_margin"] == 1.5 and content.is_chosen(report, again)
+
+
+def first_screen_of(md):
+    """report.md's title and the block under it (the first screen)."""
+    title, block = md.split("\n\n")[:2]
+    return [title] + block.splitlines()
+
+
+def test_the_first_screen_says_where_what_how_sure_and_what_is_left_in_ten_lines(tmp_path):
+    report, series = synthetic()
+    report["heat_loss_coefficient"] = {"before": 60.04, "after": 64.1, "after_sd": 1.23, "split": None}
+    write_report(tmp_path, report, series)
+    screen = first_screen_of((tmp_path / "report.md").read_text(encoding="utf-8"))
+    assert len(screen) <= 10 and screen[0] == "# nodeforce diagnosis report"
+    # share of J above the noise the forcing removes, by hand: no noise floor here, (640.2 - 12.5) / 640.2
+    assert screen[1] == "**Fault:** in door, inside: forcing node 7 (door, inside) removes 98% of J.  "
+    assert screen[2] == "**Added:** conductivity on door.  "
+    assert screen[3] == "**The data determine:** factor = 1.873 ± 0.031.  "
+    assert screen[4].startswith("**Validation:** RMSE 0.902 -> 0.123 C, mean error +0.701 -> +0.012 C")
+    assert screen[5] == "**Heat loss coefficient:** 60.0 W/K as described, 64.1 ± 1.2 W/K as corrected.  "
+    assert screen[6].startswith("**Left:** ") and report["residuals"]["after"]["sentence"][1:-1] in screen[6]
+
+
+def test_the_first_screen_gives_what_the_data_fix_not_the_parameters_they_cannot(tmp_path):
+    report, series = synthetic()
+    report["effect"] = copy.deepcopy({k: report["candidates"][1][k] for k in ("effect", "target", "parameters", "derived")})
+    report["localization"].update(best_nodes=[], search={**report["localization"]["search"], "J_noise": 40.2, "J_min": 400.2})
+    write_report(tmp_path, report, series)
+    md = (tmp_path / "report.md").read_text(encoding="utf-8")
+    screen = first_screen_of(md)
+    assert len(screen) <= 10
+    # (640.2 - 400.2) / (640.2 - 40.2) of the best forcing found, which did not locate the fault
+    assert screen[1] == ("**Fault:** not located: the best forcing, nodes 7 (door, inside), 16 (floor, inside), "
+                         "removes only 40% of J above the noise floor.  ")
+    assert screen[3] == ("**The data determine:** ground heat flux = -1.774 ± 0.047 W/m2 (U and T_ground each not "
+                         "fixed by these data: candidates table).  ")
+    assert not any("not identifiable" in line or "U = " in line for line in screen)
+    assert "U = 0.52 ± 0.90 W/m2/K (not identifiable)" in md  # below, in the result and the candidates
+
+
+def test_the_decision_says_each_refusal_reason_once(tmp_path):
+    from nodeforce.diagnose.report.summary import chosen_sentence
+    report, series = synthetic()
+    gains = [("internal_gain@living", "Q = -2.81 W is a negative gain (a heat sink) [0, inf]"),
+             ("daily_gain@living", "mean = -2.82 W is a negative gain (a heat sink) [0, inf]"),
+             ("proportional_gain@living->I_S", "k = -0.0245 - is a negative gain (a heat sink) [0, inf]")]
+    other = [("ground_coupling@floor", "U = 0.52 +- 0.9 W/m2/K is not identifiable from these data; "
+                                       "T_ground = 24.3 C ends on a bound of its range")]
+    suggestions = [{"candidate": c, "reason": r, "selection_rmse": 0.2} for c, r in gains + other]
+    first = "Conductivity on door fits the selection window best."
+    # the loop's reason lists every refused candidate; the report says them grouped instead
+    report["decision"].update(suggestions=suggestions, reason=first + " Not added, though the data support them: "
+                              + "; ".join(f"{c} ({r})" for c, r in gains + other) + ".")
+    assert chosen_sentence(report) == first
+    write_report(tmp_path, report, series)
+    md = (tmp_path / "report.md").read_text(encoding="utf-8")
+    decision = md.split("## Decision", 1)[1].split("\n## ", 1)[0]
+    assert decision.count("negative gain") == 1 and decision.count("not identifiable") == 1
+    assert ("- 3 candidates the data support, not added: each is a negative gain (a heat sink): "
+            "internal_gain@living (Q = -2.81 W), daily_gain@living (mean = -2.82 W), "
+            "proportional_gain@living->I_S (k = -0.0245)") in decision
+    assert ("- 1 candidate the data support, not added: it is not identifiable from these data; and ends on a bound "
+            "of its range: ground_coupling@floor (U = 0.52 +- 0.9 W/m2/K; T_ground = 24.3 C)") in decision
+    for candidate, _ in gains + other:
+        assert decision.count(candidate) == 1

@@ -1,7 +1,7 @@
 """A building at scale (issue 20): the generated office and the solver that steps it.
 
 The condensed solver (blocks and a Schur complement on the zones' nodes) must give the dense
-inverse's numbers, and forcing must be the Dirichlet condition PHYSICS.md section 5 states,
+inverse's numbers, and forcing must be the Dirichlet condition docs/model.md section 5 states,
 checked against an independent formulation: the free nodes' own system with the forced
 temperatures moved to the right-hand side. The generated office must pass the schema, close its
 energy balance every step, and have the heat loss coefficient a hand calculation brackets.

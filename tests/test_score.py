@@ -49,8 +49,8 @@ def test_white_noise_is_seen_and_an_averaging_sensor_hides_it():
 
 def test_the_twin_house_air_sensors_are_smooth_at_their_step():
     # 10-minute means of the living room's air: second differences dominated by the signal
-    from .test_twinhouse import shared
-    data = np.loadtxt(shared("validationdataN2Exp1.txt"), comments="#", skiprows=2)
+    from .test_twinhouse import TABLE
+    data = np.loadtxt(TABLE, comments="#", skiprows=2)
     noise = Noise.of(data[:, [5]])  # N2_living_AT_h125cm
     assert not noise.visible and noise.lag1 > -0.3
 

@@ -1,4 +1,4 @@
-"""Sky temperature and incident solar against hand calculations (PHYSICS.md section 4)."""
+"""Sky temperature and incident solar against hand calculations (docs/model.md section 4)."""
 
 import numpy as np
 import pandas as pd

@@ -2,8 +2,8 @@
 heat-loss budget and the measured steady state by hand formulas, its air mass balance, and the
 model on the real data (energy balance every step, an end-to-end diagnosis of a few days).
 
-The real data are read from ../shared (never copied into the repository); where they are absent
-a test fails and names the file it needs."""
+The real data are the repository's own (examples/twinhouse_n2/data/, gzip-compressed tables);
+a test checks that they are, byte for byte, the files their SOURCES.md cites."""
 import importlib.util
 import json
 import math
@@ -18,22 +18,14 @@ import pytest
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLE = REPO / "examples" / "twinhouse_n2"
 BUILDING = EXAMPLE / "building.json"
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "twinhouse_n2_exp1"
+DATA = EXAMPLE / "data" / "exp1"  # the measurements, as the repository carries them (their SOURCES.md)
+DATA2 = EXAMPLE / "data" / "exp2"
+TABLE = DATA / "validationdataN2Exp1.txt.gz"
 ORIGIN = pd.Timestamp("2013-01-01T00:00+01:00")  # the data's clock (README.md of the data)
-RHO_C_AIR = 1.2 * 1005.0  # J/m3/K, PHYSICS.md section 3
+RHO_C_AIR = 1.2 * 1005.0  # J/m3/K, docs/model.md
 SIGMA = 5.670374419e-8  # W/m2/K4
 FACING = {"N": 0.0, "E": 90.0, "S": 180.0, "W": 270.0}
 BOUNDARY_OF = {"outdoor": None, "cellar": "cellar_AT", "attic": "attic_east_AT"}
-
-
-def shared(name):
-    """Path of a file of the shared Twin House data; fails, naming it, where it is absent."""
-    path = DATA / name
-    if not path.is_file():
-        pytest.fail(f"{path} is needed and absent: the shared Twin House N2 data (validationdataN2Exp1.txt "
-                    "is IDEAS/Resources/measurements/validationdataN2Exp1.txt of github.com/open-ideas/IDEAS, "
-                    "commit 272d82ae; BUILDING.md and columns.csv come with it, see its SOURCES.md)")
-    return path
 
 
 @pytest.fixture(scope="module")
@@ -43,17 +35,39 @@ def data():
 
 @pytest.fixture(scope="module")
 def building_md():
-    return shared("BUILDING.md").read_text()
+    return (DATA / "BUILDING.md").read_text()
 
 
 @pytest.fixture(scope="module")
 def measured():
     """The whole record, columns by columns.csv's names, indexed by time."""
-    names = pd.read_csv(shared("columns.csv"))["name"].tolist()
-    table = np.loadtxt(shared("validationdataN2Exp1.txt"), comments="#", skiprows=2)
+    names = pd.read_csv(DATA / "columns.csv")["name"].tolist()
+    table = np.loadtxt(TABLE, comments="#", skiprows=2)  # numpy reads the gzip itself
     frame = pd.DataFrame(table, columns=names)
     frame.index = ORIGIN + pd.to_timedelta(frame.pop("time"), unit="s")
     return frame
+
+
+@pytest.mark.parametrize("folder", [DATA, DATA2])
+def test_the_data_are_the_files_their_sources_cite(folder):
+    """Each file SOURCES.md lists is, byte for byte, the IDEAS file it cites, by git blob id (sha1
+    of "blob <size>\\0" + content): the tables once decompressed (no decompressed copy kept beside
+    them), and the licence notice that travels with them."""
+    import gzip
+    import hashlib
+    sources = (folder / "SOURCES.md").read_text()
+    rows = [[cell.strip(" `") for cell in line.strip("|").split("|")] for line in sources.splitlines()
+            if line.startswith("| ") and not line.startswith("| here")]
+    assert sorted(path.rsplit("/", 1)[-1] for _, path, _ in rows) == sorted(
+        ["legal.html", "validationdataN2Exp1.txt" if folder == DATA else "validationdataExp2.txt"])
+    for here, _, blob in rows:
+        if here.endswith(".txt"):
+            content = gzip.decompress((folder / f"{here}.gz").read_bytes())
+            assert not (folder / here).exists()
+        else:
+            content = (folder / here).read_bytes()
+        assert hashlib.sha1(b"blob %d\0" % len(content) + content).hexdigest() == blob, here
+    assert "Strachan" in sources and "272d82aef8da5484b3ed729ba6d6cc1db9754f1e" in sources
 
 
 def table_rows(text, heading):
@@ -149,7 +163,7 @@ def test_experiment_2_s_house_differs_only_by_its_protocol(data):
     assert [c["name"] for c in changed] == ["W27", "W33"]
     assert exp2["materials"] == data["materials"] and exp2["sensors"] == data["sensors"]
     # the column files name columns experiment 2's data has
-    names = set(pd.read_csv(DATA.parent / "twinhouse_n2_exp2" / "columns.csv")["name"])
+    names = set(pd.read_csv(DATA2 / "columns.csv")["name"])
     for listing in ("weather_columns_exp2.txt", "measurement_columns_exp2.txt"):
         for line in (EXAMPLE / listing).read_text().splitlines():
             if line and not line.startswith("#"):
@@ -347,7 +361,7 @@ def test_diagnose_end_to_end_on_a_few_real_days(tmp_path):
     Of the nine forcing candidates, the corridor's air and W9's three nodes only: 16 forcing
     patterns rather than 512 keep the test to a small budget."""
     from nodeforce.cli import main
-    table = [str(shared("validationdataN2Exp1.txt")), "--names", str(shared("columns.csv")),
+    table = [str(TABLE), "--names", str(DATA / "columns.csv"),
              "--origin", "2013-01-01T00:00+01:00", "--start", "2013-09-09T00:00+01:00",
              "--end", "2013-09-13T00:00+01:00"]
     weather, measurements, out = tmp_path / "weather.csv", tmp_path / "measurements.csv", tmp_path / "out"
@@ -365,6 +379,13 @@ def test_diagnose_end_to_end_on_a_few_real_days(tmp_path):
                  "--burn-in-days", "1", "--seed", "0", "--phases", str(phases)]) == 0
     md = (out / "report.md").read_text()
     report = json.loads((out / "report.json").read_text())
+    # the first screen: at most ten lines, where (or that forcing cannot say), the validation error
+    # before and after as report.json has it, no parameter the data cannot fix
+    screen = md.split("\n\n")[1].splitlines()
+    assert len(screen) <= 9 and screen[0].startswith("**Fault:**")
+    assert not any("not identifiable" in line for line in screen)
+    before, after = (report[state]["validation"]["rmse"] for state in ("before", "after"))
+    assert any(f"RMSE {before:.3f} -> {after:.3f} C" in line for line in screen)
     # the report's claims, against the numbers they stand on
     loc = report["localization"]
     assert loc["finding"] in md

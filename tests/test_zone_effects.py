@@ -1,4 +1,4 @@
-"""The zone effects of PHYSICS.md section 7 (internal mass, heater lag, envelope factor) against
+"""The zone effects of docs/model.md section 7 (internal mass, heater lag, envelope factor) against
 independent calculations, and both FMUs against the direct model with each of them."""
 import copy
 
@@ -98,7 +98,7 @@ def test_the_heaters_capacity_delivers_a_step_as_a_first_order_response():
 def test_a_heater_with_no_capacity_and_an_undeclared_mass_change_nothing():
     """The effects' neutral values (how a candidate's FMU starts) are the building as declared.
     (With a radiative fraction, a heater node splits its heat by the temperatures it sees, as
-    PHYSICS.md section 7 says, which no capacity makes the declared fixed split.)"""
+    docs/model.md section 7 says, which no capacity makes the declared fixed split.)"""
     for effect, f_r in (("internal_mass", 0.3), ("heat_input_lag", 0.0)):
         b = parse_building(light_room(heat_input_radiative_fraction=f_r))
         neutral = EFFECTS[effect].apply(b, "room", {})

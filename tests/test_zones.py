@@ -1,4 +1,4 @@
-"""The zone terms of PHYSICS.md sections 1, 3 and 5 against independent calculations: air flows
+"""The zone terms of docs/model.md sections 1, 3 and 5 against independent calculations: air flows
 between zones and supply air, radiative heat input, shading, thermal bridges, measured
 irradiance columns and the burn-in."""
 import numpy as np

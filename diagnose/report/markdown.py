@@ -1,10 +1,10 @@
-"""report.md: the diagnosis told in order (result, decision, period, before and after, residual
+"""report.md: the diagnosis told in order (the first screen, result, decision, period, before and after, residual
 diagnostics, localisation, candidates, sensitivity, files), with the tables and figures."""
 from __future__ import annotations
 
 from pathlib import Path
 
-from . import content, tables
+from . import content, summary, tables
 from ..phases import WORSE
 from ...ga.parsimony import Z_NOISE
 from .formats import NA, fmt_search, fmt_sig, num
@@ -17,12 +17,21 @@ def _relative(path, out_dir):
         return str(path)
 
 
+def _bold_label(line):
+    """'**Fault:** in floor: ...' of 'Fault: in floor: ...'."""
+    label, _, rest = line.partition(": ")
+    return f"**{label}:** {rest}"
+
+
 def decision_lines(report):
-    """The loop's decision and its reason, and the margins it applied, as it recorded them."""
+    """The loop's decision and its reason, the candidates physics refused (grouped by reason, each
+    reason said once), and the margins it applied, as it recorded them."""
     d = content.decision(report)
     if not d:
         return ["*The loop recorded no decision in this report.*"]
-    lines = [d.get("reason") or NA, ""]
+    lines = [summary.chosen_sentence(report), ""]
+    refused = summary.refusals(report)
+    lines += refused + ([""] if refused else [])
     bic, J, margin = (num(d.get(k)) for k in ("bic_baseline", "selection_J_before", "selection_margin"))
     lines.append(f"- BIC of the model without an effect (fitting window): {fmt_sig(bic)}; a candidate must "
                  "have a lower BIC.")
@@ -30,8 +39,6 @@ def decision_lines(report):
                  f"the sensor noise could ({fmt_sig(margin)} C²) and by more than {Z_NOISE:g} standard deviations of "
                  "that fall as the residuals' correlation in time makes it (the fall needed, per candidate, "
                  "in the candidates table).")
-    for suggestion in d.get("suggestions") or []:
-        lines.append(f"- suggested, not added: {suggestion['candidate']}: {suggestion['reason']}")
     lines.append(f"- chosen: {d.get('chosen') or 'none'}")
     return lines
 
@@ -88,8 +95,8 @@ def write_markdown(out_dir, report, plots, notes):
     search = (report.get("localization") or {}).get("search") or {}
     period = report.get("period") or {}
     ref = tables.reference_text(report)
-    md = ["# nodeforce diagnosis report", "",
-          "From the residual of the indoor air, to the nodes whose forcing explains it, to a physical "
+    md = ["# nodeforce diagnosis report", "", *[_bold_label(line) + "  " for line in summary.first_screen(report, pm="±")],
+          "", "From the residual of the indoor air, to the nodes whose forcing explains it, to a physical "
           "effect the model lacks, added and calibrated on the calibration window's first part and chosen on "
           "its last (the selection window); the validation window played no part in any choice.", "",
           "## Result", "", *[f"**{line.strip()}**  " for line in tables.effect_header(report, pm="±").splitlines()],

@@ -25,7 +25,7 @@ def effect_header(report, pm="+-"):
 
 
 def hlc_lines(report, pm="+-"):
-    """The heat loss coefficient as described and as corrected (W/K, PHYSICS.md section 8), and
+    """The heat loss coefficient as described and as corrected (W/K, docs/model.md section 8), and
     the sentence saying the data do not fix its split among effects, where they do not."""
     hlc = report.get("heat_loss_coefficient") or {}
     if num(hlc.get("before")) is None:
@@ -51,15 +51,20 @@ def _rows(report):
     return [("all zones" if len(names) > 1 else "", None)] + ([(z, z) for z in names] if len(names) > 1 else [])
 
 
-def before_after_table(report: dict) -> str:
-    """The before/after table printed by `nodeforce demo`/`diagnose`: rows calibration and validation windows (and each zone's, when the objective has several), columns RMSE, mean, sd of the air residual (C) and n, before and after; a header line naming the chosen effect, target and its parameters (value +- std, 'not identifiable' flagged), or 'none: no effect improves the validation error'; the reference model's RMSE when the report has one."""
+def before_after_table(report: dict, header: bool = True) -> str:
+    """The before/after table: rows calibration and validation windows (and each zone's, when the
+    objective has several), columns RMSE, mean, sd of the air residual (C) and n, before and after;
+    with `header`, a line naming the chosen effect, target and its parameters (value +- std, 'not
+    identifiable' flagged), or 'none: no effect improves the validation error', and the heat loss
+    coefficient (`nodeforce diagnose` prints the first screen instead, `terminal_summary`); the
+    reference model's RMSE when the report has one."""
     cols = ("RMSE", "mean", "sd", "n")
     width = 8
     group = len(cols) * (width + 1) - 1
     rows = _rows(report)
     windows = _scored_windows(report)
     first = max([12] + [len(f"{w} {label}") for w in windows for label, _ in rows])
-    lines = effect_header(report, pm="+-").splitlines() + [
+    lines = (effect_header(report, pm="+-").splitlines() if header else []) + [
         "Air residual r = measured - simulated (C)",
         f"{'':<{first}} | {'before':^{group}} | {'after':^{group}}",
         f"{'window':<{first}} | " + " ".join(f"{c:>{width}}" for c in cols)
@@ -75,7 +80,7 @@ def before_after_table(report: dict) -> str:
                     fmt_int(m.get("n")))))
             lines.append(f"{(window + ' ' + label).strip():<{first}} | {cells[0]} | {cells[1]}")
     lines += [f"{window}: {content.window_text(report, window)}" for window in windows]
-    lines += hlc_lines(report) + [f"assumed: {a}" for a in report.get("assumptions") or ()]
+    lines += (hlc_lines(report) if header else []) + [f"assumed: {a}" for a in report.get("assumptions") or ()]
     ref = reference_text(report)
     return "\n".join(lines + ([f"for scale, {ref}"] if ref else []))
 

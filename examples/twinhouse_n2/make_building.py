@@ -316,8 +316,8 @@ def building(experiment=1):
         "format": "nodal-building/1",
         "name": "Twin House N2, ground floor (IEA EBC Annex 58)",
         "description": ("The instrumented ground floor of Twin House N2, Holzkirchen, from "
-                        "BUILDING.md of the shared data (IDEAS values, IDEAS areas on external "
-                        "dimensions); written by examples/twinhouse_n2/make_building.py, every "
+                        "examples/twinhouse_n2/data/exp1/BUILDING.md (IDEAS values, IDEAS areas on "
+                        "external dimensions); written by examples/twinhouse_n2/make_building.py, every "
                         "choice stated in examples/twinhouse_n2/README.md."),
         "site": {"latitude": 47.874, "longitude": 11.728, "altitude": 690.0,
                  "timezone": "Etc/GMT-1", "ground_albedo": 0.23},

@@ -1,4 +1,4 @@
-/* A generic FMI 2.0 co-simulation slave stepping a nodal network (PHYSICS.md section 5).
+/* A generic FMI 2.0 co-simulation slave stepping a nodal network (docs/model.md section 5).
 
    The network is data, assembled by nodeforce in Python and shipped as resources/network.txt:
    C (J/K), A (W/K), B, q (W) and the coefficients P (W) of the products of two inputs (a shaded
@@ -193,7 +193,7 @@ static double interp(double x, const double *xp, const double *fp, int count) {
     return (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j]) * (x - xp[j]) + fp[j];
 }
 
-/* PHYSICS.md section 5: the initial state from the measurements at t_0 and T_start. */
+/* docs/model.md section 5: the initial state from the measurements at t_0 and T_start. */
 static void initial_state(Model *m) {
     const Network *net = &m->net;
     const double *measured = m->values + vr_T_forced(&m->layout);

@@ -1,0 +1,202 @@
+"""The report's first screen, and the Decision's refusals said once per reason.
+
+The first screen answers, in at most ten lines, what a modeller asks first: where the fault is
+(with the forcing's evidence), what was added, what the data determine about it (the quantities
+they fix; parameters they cannot fix are in the candidates table, never here), the error before
+and after on the validation window, the heat loss coefficient as described and as corrected,
+and what is left. It reads report.json and decides nothing.
+"""
+from __future__ import annotations
+
+import re
+
+from . import content
+from .content import metrics
+from .formats import NA, fmt_derived, fmt_parameters, fmt_temp, num
+from .tables import before_after_table, hlc_lines
+from ...ga.parsimony import removed
+
+#: The most lines the first screen may take (the title included in report.md).
+FIRST_SCREEN_LINES = 10
+
+# One clause of a physical objection (`diagnose.candidates.objection`): "NAME = VALUE [+- STD] UNIT
+# is WHAT [LOW, HIGH]" or "... ends on WHAT"; anything else is kept whole as its own reason.
+_CLAUSE = re.compile(r"^(?P<value>\w+ = \S+(?: \+- \S+)?(?: (?!is\b|ends\b)\S+)?) "
+                     r"(?P<why>(?:is|ends on) .*?)(?: \[[^\]]*\])?$")
+
+
+def _component(node_name):
+    """'floor' of 'floor at 0.150 m'; a name without a depth ('living air') is kept whole."""
+    return node_name.split(" at ", 1)[0]
+
+
+def _forcing(report, nodes):
+    """'node 16 (floor at 0.150 m)', 'nodes 70 (W9 at 0.000 m), 256 (corridor air)'."""
+    named = [f"{b}" + (f" ({content.node_name(report, b)})" if content.node_name(report, b) else "") for b in nodes]
+    return f"node{'s' if len(nodes) > 1 else ''} {', '.join(named)}"
+
+
+def where_line(report):
+    """Where the fault is: the components behind the best forcing and the share of J it removes."""
+    loc = report.get("localization") or {}
+    best = loc.get("best_nodes")
+    search = loc.get("search") or {}
+    J_unforced, J_noise = num(loc.get("J_unforced")), num(search.get("J_noise")) or 0.0
+    of = "of J above the noise floor" if J_noise else "of J"
+    if not loc:
+        return "Fault: not searched for (no localisation in this report)"
+    if best:
+        names = [content.node_name(report, b) for b in best]
+        components = list(dict.fromkeys(_component(n) for n in names if n)) or [f"node {b}" for b in best]
+        share = (f" removes {removed(J_unforced, loc['J_best'], J_noise):.0%} {of}"
+                 if J_unforced is not None and num(loc.get("J_best")) is not None else "")
+        return f"Fault: in {', '.join(components)}: forcing {_forcing(report, best)}{share}"
+    strongest, J_min = search.get("min_nodes"), num(search.get("J_min"))
+    if strongest and J_unforced is not None and J_min is not None:
+        return (f"Fault: not located: the best forcing, {_forcing(report, strongest)}, removes only "
+                f"{removed(J_unforced, J_min, J_noise):.0%} {of}")
+    return "Fault: not located: no forcing the sensors allow lowers J beyond the noise"
+
+
+def added_effects(report):
+    """The effects the loop added, in order, each with its parameters and what the data determine."""
+    last = report.get("effect") or {}
+    if content.is_none_effect(last):
+        return []
+    added = report.get("effects") or [last]
+    rounds = []
+    for i, e in enumerate(added):
+        if i == len(added) - 1 and (e.get("effect"), e.get("target")) == (last.get("effect"), last.get("target")):
+            rounds.append(last)
+            continue
+        tried = next((c for c in report.get("candidates") or [] if content.candidate_key(c) == content.candidate_key(e)
+                      and bool(c.get("on_top_of")) == (i > 0)), {})
+        rounds.append({**e, "derived": e.get("derived", tried.get("derived"))})
+    return rounds
+
+
+def determined(effect, pm):
+    """What the data fix about an added effect: its identifiable parameters and the quantities its
+    parameters trade off along (the heat loss coefficient has its own line); the parameters the
+    data leave free are named as such, their values left to the candidates table."""
+    parameters = effect.get("parameters") or {}
+    fixed = {k: p for k, p in parameters.items() if p.get("identifiable") is not False}
+    free = [k for k, p in parameters.items() if p.get("identifiable") is False]
+    derived = {k: v for k, v in (effect.get("derived") or {}).items() if k != "heat_loss_coefficient"}
+    said = [t for t in [fmt_parameters(effect.get("effect"), fixed, pm)] + fmt_derived(derived, pm) if t]
+    text = ", ".join(said) if said else "nothing"
+    if free:
+        text += (f" ({' and '.join(free)} {'each' if len(free) > 1 else 'alone'} not fixed by these data: "
+                 "candidates table)")
+    return text
+
+
+def _change(before, after, signed=False):
+    return f"{fmt_temp(before, signed)} -> {fmt_temp(after, signed)} C"
+
+
+def error_line(report):
+    """RMSE and mean error of the objective's air before and after, on the validation window."""
+    b, a = (metrics(report, state, "validation") for state in content.STATES)
+    return (f"Validation: RMSE {_change(b.get('rmse'), a.get('rmse'))}, mean error "
+            f"{_change(b.get('mean'), a.get('mean'), signed=True)} (measured - simulated, "
+            f"{content.period_text(report, 'validation')})")
+
+
+def hlc_line(report, pm):
+    """`tables.hlc_lines`' first line, the split's sentence shortened to a clause; None without an HLC."""
+    lines = hlc_lines(report, pm)
+    if not lines:
+        return None
+    return lines[0] + (" (the data do not fix its split among the effects)" if len(lines) > 1 else "")
+
+
+def left_line(report):
+    """One sentence on what the corrected model still leaves: the structure of its residual on the
+    validation window, and a phase the correction made worse."""
+    after = (report.get("residuals") or {}).get("after") or {}
+    sentence = after.get("sentence") or (content.decision(report).get("structure_left")) or ""
+    worse = content.decision(report).get("worsened_phases") or []
+    sentence = sentence[:1].lower() + sentence[1:].rstrip(".")
+    text = f"Left: {sentence}" if sentence else "Left: no diagnostics of the residual in this report"
+    if worse:
+        text += "; made worse: " + ", ".join(
+            f"{w['phase']} ({fmt_temp(w.get('before'))} -> {fmt_temp(w.get('after'))} C)" for w in worse)
+    return text + "."
+
+
+def first_screen(report, pm="+-"):
+    """The first screen's lines (at most FIRST_SCREEN_LINES - 2: report.md adds its title and a
+    blank line), each opening with its label ('Fault:', 'Added:', ...)."""
+    effects = added_effects(report)
+    lines = [where_line(report) + "."]
+    if effects:
+        lines.append("Added: " + ", then ".join(content.effect_name(e.get("effect"), e.get("target"))
+                                                for e in effects) + ".")
+        for e in effects:
+            of = f" for {e.get('effect')}" if len(effects) > 1 else ""
+            lines.append(f"The data determine{of}: {determined(e, pm)}.")
+    else:
+        lines.append("Added: nothing: " + chosen_sentence(report))
+    lines.append(error_line(report) + ".")
+    hlc = hlc_line(report, pm)
+    lines += [hlc + "."] if hlc else []
+    return lines + [left_line(report)]
+
+
+def terminal_summary(report):
+    """What `nodeforce diagnose` and `demo` print: the first screen, then the before/after table
+    of every scored window (`tables.before_after_table` without its header, which the first screen
+    says)."""
+    return "\n".join(first_screen(report)) + "\n\n" + before_after_table(report, header=False)
+
+
+# ---------------------------------------------------------------------------------------------
+# the Decision
+
+
+def _suggestion_text(decision):
+    """The list of refused candidates as the loop appends it to its reason (`diagnose.loop.decide`)."""
+    suggestions = decision.get("suggestions") or []
+    return (" Not added, though the data support them: "
+            + "; ".join(f"{s['candidate']} ({s['reason']})" for s in suggestions) + ".") if suggestions else ""
+
+
+def chosen_sentence(report):
+    """The loop's reason without its list of refused candidates, which `refusals` says grouped."""
+    d = content.decision(report)
+    reason = d.get("reason") or NA
+    for decision in (d, d.get("follow_up") or {}):
+        listed = _suggestion_text(decision)
+        if listed:
+            reason = reason.replace(listed, "")
+    return reason
+
+
+def _clauses(objection):
+    """[(why, value)] of an objection: why it is refused ('is a negative gain (a heat sink)') and the
+    value that shows it ('Q = -2.81 W'); a clause of another form is its own why."""
+    out = []
+    for clause in (c.strip() for c in str(objection).split("; ")):
+        match = _CLAUSE.match(clause)
+        out.append((match["why"], match["value"].removesuffix(" -")) if match else (clause, ""))
+    return out
+
+
+def refusals(report):
+    """The candidates the data support but physics refused, one line per reason: 'N candidates ...
+    each is a negative gain (a heat sink): a (Q = -2.81 W), b (...)'."""
+    d = content.decision(report)
+    suggestions = list(d.get("suggestions") or []) + list((d.get("follow_up") or {}).get("suggestions") or [])
+    groups = {}
+    for s in suggestions:
+        clauses = _clauses(s.get("reason", ""))
+        why = "; and ".join(w for w, _ in clauses)
+        values = "; ".join(v for _, v in clauses if v)
+        groups.setdefault(why, []).append(s["candidate"] + (f" ({values})" if values else ""))
+    lines = []
+    for why, names in groups.items():
+        n = len(names)
+        said = f"{'each' if n > 1 else 'it'} {why}" if why.startswith(("is ", "ends on ")) else why
+        lines.append(f"- {n} candidate{'s' if n > 1 else ''} the data support, not added: {said}: {', '.join(names)}")
+    return lines
