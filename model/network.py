@@ -121,7 +121,7 @@ def assemble(building, names=None):
         # a zone's envelope factor scales what separates it from the outdoors or a boundary
         envelope = (building.zone(c.inside.zone).envelope_factor if isinstance(out, (Exterior, Boundary))
                     else 1.0)
-        C[idx] += c.area * capacities(c.layers, c.depths)
+        C[idx] += c.area * capacities(c.layers, c.depths) * c.capacity_factor
         for k, g in enumerate(conductances(c.layers, c.depths)):
             link(idx[k], idx[k + 1], c.area * g * c.conductivity_factor * envelope)
         to_zone(idx[0], c.area, c.inside)
