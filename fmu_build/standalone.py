@@ -12,9 +12,10 @@ zone's surface links, an air change rate a conductance to T_out, an absorptance,
 transmittance or a gain a column of B or q; ground coupling's q = A U T_ground is bilinear), so
 it is exported as its value at the declared parameters p0 plus, per set S of parameters that
 act together, a term weighted by prod_{j in S} (p_j - p0_j), found from assemblies at the
-corners p0 + delta_S: every set of the effect's parameters, each property alone, and a property
-with a set of the effect's where both change the same entries (a conductivity factor under an
-envelope factor). Each term keeps only its nonzeros, so the file grows with the parameters'
+corners p0 + delta_S: every set of the effect's parameters, each property alone (in batches of
+properties that change different nodes' rows, one assembly a batch), and a property with a set
+of the effect's where both change the same entries (a conductivity factor under an envelope
+factor). Each term keeps only its nonzeros, so the file grows with the parameters'
 reach, not with N^2 per parameter. The export checks that form against a direct assembly with
 every parameter moved at once, and refuses a network that does not fit it.
 """
@@ -24,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from nodeforce import tempdirs
-from nodeforce.model.effects import fmu_parameters, with_fmu_parameters
+from nodeforce.model.effects import fmu_parameters, properties, with_fmu_parameters
 from nodeforce.model.network import assemble
 
 from .compiler import C_DIR, compile_library
@@ -49,10 +50,39 @@ def _block(network, keys):
     return np.concatenate([network.C, network.A.ravel(), network.B.ravel(), network.q, P])
 
 
+def _rows(network, keys):
+    """The node (0-based) of each entry of `_block`: a property changes the rows of its nodes."""
+    n, n_in = network.n_nodes, network.B.shape[1]
+    nodes = np.arange(n)
+    return np.concatenate([nodes, np.repeat(nodes, n), np.repeat(nodes, n_in), nodes,
+                           np.array([node for node, _, _ in keys], dtype=int)])
+
+
+def _batches(reaches):
+    """Parameters (indices into `reaches`, sets of rows) in batches whose rows are disjoint:
+    greedily, each into the first batch it does not meet."""
+    batches, used = [], []
+    for j, rows in enumerate(reaches):
+        k = next((k for k, taken in enumerate(used) if not taken & rows), None)
+        if k is None:
+            batches.append([])
+            used.append(set())
+            k = len(batches) - 1
+        batches[k].append(j)
+        used[k] |= rows
+    return batches
+
+
 def network_terms(building, effect):
-    """(p0, product keys, [(parameter indices, flat term)]) of the network as a function of the
-    FMU's parameters (`fmu_parameters`), multi-affine as the top of this file says; flat terms
-    are C, A, B, q, P (`_block`) and the first is the network at p0.
+    """(p0, product keys, [(parameter indices, entries, values)]) of the network as a function
+    of the FMU's parameters (`fmu_parameters`), multi-affine as the top of this file says: each
+    term's nonzeros, at their index in the flat C, A, B, q, P (`_block`); the first term is
+    the network at p0.
+
+    The effect's parameters take every corner of theirs. The properties, hundreds on a large
+    building, go in batches of properties whose nodes (`Property.reach`) are apart: one assembly
+    moves a batch, each property taking the rows of its nodes, and a second, each property moved
+    by a different fraction, checks that split.
 
     Raises ValueError if the network is not of that form (to 1e-9 relative)."""
     start = fmu_parameters(building, effect)
@@ -61,51 +91,80 @@ def network_terms(building, effect):
     delta = np.where(p0 != 0.0, -p0 / 2, 1.0)
     base_network = assemble(building)
     inputs, keys = base_network.input_names, product_keys([base_network])
-    corners = {}
+    reach = {name: {i - 1 for i in p.reach(building, target)} for name, p, target in properties(building)}
+    own = [j for j, n in enumerate(names) if n not in reach]  # the effect's parameters
 
-    def corner(subset, fraction=1.0):
-        """The flat network with the parameters of `subset` moved by fraction * delta."""
-        if fraction == 1.0 and subset in corners:
-            return corners[subset]
-        values = {names[j]: p0[j] + fraction * delta[j] for j in subset}
-        block = _block(assemble(with_fmu_parameters(building, effect, values), inputs), keys)
-        return block
+    def corner(fractions):
+        """The flat network with parameter j moved by fractions[j] * delta_j."""
+        values = {names[j]: p0[j] + f * delta[j] for j, f in fractions.items()}
+        return _block(assemble(with_fmu_parameters(building, effect, values), inputs), keys)
+
+    def close(value, exact):
+        return np.abs(value - exact).max(initial=0.0) <= 1e-9 * max(1.0, np.abs(exact).max(initial=0.0))
+
+    base = corner({})
+    scale = max(1.0, np.abs(base).max(initial=0.0))
+    corners = {(): base}
 
     def term(subset):
         """The coefficient of prod_{j in subset} (p_j - p0_j), by inclusion-exclusion."""
-        total = sum((-1) ** (len(subset) - r) * corner(inner) for r in range(len(subset) + 1)
-                    for inner in itertools.combinations(subset, r))
+        total = 0.0
+        for r in range(len(subset) + 1):
+            for inner in itertools.combinations(subset, r):
+                if inner not in corners:
+                    corners[inner] = corner(dict.fromkeys(inner, 1.0))
+                total = total + (-1) ** (len(subset) - r) * corners[inner]
         return total / np.prod(delta[list(subset)])
 
-    base = corners[()] = corner(())
-    scale = max(1.0, np.abs(base).max(initial=0.0))
-    own = [j for j, n in enumerate(names) if effect is not None and n.startswith(f"{effect[0]}.")
-           and n not in dict.fromkeys(fmu_parameters(building))]
-    terms = [((), base)]
+    def sparse(t):
+        index = np.flatnonzero(t)
+        return index, t[index]
+
+    terms = [((), *sparse(base))]  # (parameter indices, entries, values)
     effect_reach = np.zeros(len(base), dtype=bool)
-    for subset in (s for r in range(1, len(own) + 1) for s in itertools.combinations(own, r)):
-        for inner in (s for r in range(len(subset) + 1) for s in itertools.combinations(subset, r)):
-            if inner not in corners:
-                corners[inner] = corner(inner)
+    subsets = [s for r in range(1, len(own) + 1) for s in itertools.combinations(own, r)]
+    for subset in subsets:
         t = term(subset)
         if np.abs(t).max(initial=0.0) > 1e-12 * scale:  # parameters that do act together
-            terms.append((subset, t))
+            terms.append((subset, *sparse(t)))
             effect_reach |= t != 0.0
-    for j in (j for j in range(len(names)) if j not in own):
-        single = term((j,))
-        if np.abs(single).max(initial=0.0) > 1e-12 * scale:
-            terms.append(((j,), single))
-        if effect_reach[single != 0.0].any():  # with the effect's parameters on the same entries
-            for subset in (s for r in range(1, len(own) + 1) for s in itertools.combinations(own, r)):
-                both = tuple(sorted((j, *subset)))
-                t = term(both)
-                if np.abs(t).max(initial=0.0) > 1e-12 * scale:
-                    terms.append((both, t))
-        corners.pop((j,), None)
-    moved = tuple(range(len(names)))
-    exact = corner(moved, 0.7)
-    value = sum(np.prod(0.7 * delta[list(subset)]) * t for subset, t in terms)
-    if np.abs(value - exact).max(initial=0.0) > 1e-9 * max(1.0, np.abs(exact).max(initial=0.0)):
+    rows = _rows(base_network, keys)
+    properties_of = [j for j in range(len(names)) if j not in own]
+    for batch in _batches([reach[names[j]] for j in properties_of]):
+        batch = [properties_of[k] for k in batch]
+        index, change = sparse(corner(dict.fromkeys(batch, 1.0)) - base)
+        owner = np.full(len(base_network.C), -1)
+        for j in batch:
+            owner[list(reach[names[j]])] = j
+        who = owner[rows[index]]
+        if (who < 0).any():
+            raise ValueError("a property changes the network beyond its nodes: no standalone export")
+        singles = {j: (index[who == j], change[who == j] / delta[j]) for j in batch}
+        fractions = {j: 0.3 + 0.6 * k / len(batch) for k, j in enumerate(batch)}
+        split = base.copy()
+        for j, f in fractions.items():
+            split[singles[j][0]] += f * delta[j] * singles[j][1]
+        if not close(split, corner(fractions)):
+            raise ValueError("the network is not affine in each of the building's properties apart: "
+                             "no standalone export")
+        for j in batch:
+            entries, values = singles[j]
+            if np.abs(values).max(initial=0.0) > 1e-12 * scale:
+                terms.append(((j,), entries, values))
+            if effect_reach[entries].any():  # with the effect's parameters on the same entries
+                corners[(j,)] = base.copy()
+                corners[(j,)][entries] += delta[j] * values
+                for subset in subsets:
+                    both = tuple(sorted((j, *subset)))
+                    t = term(both)
+                    if np.abs(t).max(initial=0.0) > 1e-12 * scale:
+                        terms.append((both, *sparse(t)))
+                corners = {key: value for key, value in corners.items() if j not in key}
+    exact = corner(dict.fromkeys(range(len(names)), 0.7))
+    value = np.zeros(len(base))
+    for subset, entries, values in terms:
+        value[entries] += np.prod(0.7 * delta[list(subset)]) * values
+    if not close(value, exact):
         raise ValueError("the network is not affine in each of the FMU's parameters: no standalone export")
     return p0, keys, terms
 
@@ -115,15 +174,14 @@ def network_text(building, effect):
     p0, keys, terms = network_terms(building, effect)
     n, n_in = building.n_nodes, len(assemble(building).input_names)
     numbers = lambda values: " ".join(repr(float(v)) for v in np.ravel(values))
-    sparse = [(subset, np.flatnonzero(t)) for subset, t in terms]
     lines = ["nodeforce-network/3",
-             f"sizes {n} {n_in} {len(p0)} {len(terms)} {len(keys)} {sum(len(s) for s, _ in sparse)} "
-             f"{sum(len(k) for _, k in sparse)}",
+             f"sizes {n} {n_in} {len(p0)} {len(terms)} {len(keys)} {sum(len(s) for s, _, _ in terms)} "
+             f"{sum(len(k) for _, k, _ in terms)}",
              f"p0 {numbers(p0)}",
              "products " + " ".join(f"{node} {a} {b}" for node, a, b in keys)]
-    for (subset, t), (_, index) in zip(terms, sparse):
-        lines.append(f"term {len(subset)} {' '.join(map(str, subset))} {len(index)}".replace("  ", " "))
-        lines += [f"{k} {float(v)!r}" for k, v in zip(index.tolist(), t[index].tolist())]
+    for subset, index, values in terms:
+        lines.append(" ".join(map(str, ["term", len(subset), *subset, len(index)])))
+        lines += [f"{k} {v!r}" for k, v in zip(index.tolist(), values.tolist())]
     lines.append("end")
     return "\n".join(lines) + "\n"
 

@@ -313,17 +313,26 @@ class Property:
     targets: Callable  # building -> the component or zone names it applies to
     read: Callable  # (building, target) -> value declared now
     write: Callable  # (JSON data, target, value) -> None
+    reach: Callable  # (building, target) -> ids of the nodes whose rows of the network it changes
 
     def bounds(self, start):
         """(min, max) an FMU declares: the parameter's range, widened to hold the declared value."""
         return min(self.parameter.low, start), max(self.parameter.high, start)
 
 
-def _effect_property(name, of, effect_id):
+def _effect_property(name, of, effect_id, reach):
     effect = EFFECTS[effect_id]
     parameter, = effect.parameters
     return Property(name, of, parameter, effect.targets, lambda b, t: float(effect.read(b, t)[parameter.name]),
-                    lambda data, t, value: effect.write(data, t, {parameter.name: value}))
+                    lambda data, t, value: effect.write(data, t, {parameter.name: value}), reach)
+
+
+def _air_node(building, target):
+    return (building.zone(target).air_node,)
+
+
+def _zone_surfaces(building, target):
+    return (building.zone(target).air_node, *building.facing(target))
 
 
 def _capacity_write(data, target, value):
@@ -331,14 +340,14 @@ def _capacity_write(data, target, value):
 
 
 PROPERTIES = (
-    _effect_property("conductivity_factor", "component", "conductivity"),
+    _effect_property("conductivity_factor", "component", "conductivity", _own_nodes),
     Property("capacity_factor", "component", Parameter("factor", "-", 0.05, 20.0), lambda b: [c.name for c in b.components],
-             lambda b, t: float(b.component(t).capacity_factor), _capacity_write),
-    _effect_property("solar_absorptance", "component", "solar_absorptance"),
-    _effect_property("solar_transmittance", "component", "solar_transmittance"),
-    _effect_property("air_change_rate", "zone", "infiltration"),
-    _effect_property("internal_gain", "zone", "internal_gain"),
-    _effect_property("h_conv_factor", "zone", "inside_convection"),
+             lambda b, t: float(b.component(t).capacity_factor), _capacity_write, _own_nodes),
+    _effect_property("solar_absorptance", "component", "solar_absorptance", _own_nodes),
+    _effect_property("solar_transmittance", "component", "solar_transmittance", _receiver_nodes),
+    _effect_property("air_change_rate", "zone", "infiltration", _air_node),
+    _effect_property("internal_gain", "zone", "internal_gain", _air_node),
+    _effect_property("h_conv_factor", "zone", "inside_convection", _zone_surfaces),
 )
 
 
