@@ -122,9 +122,9 @@ class NodalBuilding(Fmi2Slave):
         values = np.asarray(values, dtype=float)
         if real and not np.isfinite(values).all():  # a NaN is refused but in a measurement (layout)
             for vr, value in zip(index.tolist(), values.tolist()):
-                reason = self.layout.refusal(vr, real, True, self._state, value)
+                reason = self.layout.refusal(vr, real, True, self._state, value, self._time)
                 if reason:
-                    raise ValueError(f"{reason} (t = {self._time!r} s)")
+                    raise ValueError(reason)
         self._values[index] = values
 
     def get_real(self, vrs):

@@ -59,25 +59,28 @@ class Layout:
         """A parameter: settable only before initialisation ends."""
         return vr < self.T_start.stop or vr >= self.parameters.start
 
-    def refusal(self, vr, real, setting, state, value=0.0):
+    def refusal(self, vr, real, setting, state, value=0.0, time=0.0):
         """Why the standard forbids this get or set (None when it is allowed), or why the
-        value set is refused (a Real that is not finite, but a measurement's NaN).
+        value set is refused (a Real that is not finite, but a measurement's NaN): the messages
+        of c/variables.h.
 
         vr : value reference; real : a Real call (else Boolean); setting : a set call;
-        state : INSTANTIATED, INITIALISATION, STEPPING or TERMINATED; value : the value set
+        state : INSTANTIATED, INITIALISATION, STEPPING or TERMINATED; value : the value set;
+        time : the communication point (s)
         """
         if not 0 <= vr < self.size:
-            return f"value reference {vr} does not exist (0..{self.size - 1})"
+            return f"value reference {vr} (none) does not exist (0..{self.size - 1})"
+        reason = None
         if self.is_boolean(vr) == real:
-            return f"value reference {vr} is {'Boolean' if real else 'Real'}, not {'Real' if real else 'Boolean'}"
-        if not setting:
+            reason = f"is {'Boolean' if real else 'Real'}, not {'Real' if real else 'Boolean'}"
+        elif not setting:
             return None
-        if self.is_output(vr):
-            return f"value reference {vr} is an output, which cannot be set"
-        if self.is_fixed(vr) and state not in (INSTANTIATED, INITIALISATION):
-            return f"value reference {vr} is a fixed parameter, which cannot change after initialisation"
-        if state == TERMINATED:
-            return "the slave is terminated"
-        if real and value - value != 0.0 and not (self.T_forced.start <= vr < self.T_forced.stop):
-            return f"value reference {vr} ({self.names()[vr]}) set to {value}: it must be finite"
-        return None
+        elif self.is_output(vr):
+            reason = "is an output, which cannot be set"
+        elif self.is_fixed(vr) and state not in (INSTANTIATED, INITIALISATION):
+            reason = "is a fixed parameter, which cannot change after initialisation"
+        elif state == TERMINATED:
+            reason = "cannot be set: the slave is terminated"
+        elif real and value - value != 0.0 and not (self.T_forced.start <= vr < self.T_forced.stop):
+            reason = f"set to {value} at t = {time:.17g} s: it must be finite (NaN means \"not measured\" on T_forced only)"
+        return reason and f"value reference {vr} ({self.names()[vr]}) {reason}"
