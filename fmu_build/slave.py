@@ -65,6 +65,12 @@ def _model(resources, values=()):
     return building, _physics["network"].assemble(building, inputs), {}
 
 
+@functools.lru_cache(maxsize=8)
+def _parameter_start(resources):
+    """{name: declared value} of the FMU's parameters but forcing and start values."""
+    return _physics["effects"].fmu_parameters(_model(resources)[0], _read(resources)[1])
+
+
 class NodalBuilding(Fmi2Slave):
 
     def __init__(self, **kwargs):
@@ -76,7 +82,7 @@ class NodalBuilding(Fmi2Slave):
             sys.path.remove(self.resources)
         _, self._effect = _read(self.resources)
         self.building, self.network, self._steppers = _model(self.resources)
-        start = _physics["effects"].fmu_parameters(self.building, self._effect)
+        start = _parameter_start(self.resources)
         self._parameter_start = np.array(list(start.values()), dtype=float)
         layout = self.layout = _variables.Layout(self.network.n_nodes, self.network.input_names, start)
         self._values = np.zeros(layout.size)
