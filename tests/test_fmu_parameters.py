@@ -17,7 +17,6 @@ from fmpy.fmi3 import FMU3Slave
 
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.fmu_build.build import build_fmu
-from nodeforce.model.building import parse_building
 from nodeforce.model.effects import fmu_parameters
 from nodeforce.model.integrate import simulate
 from nodeforce.model.network import assemble
