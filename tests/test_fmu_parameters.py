@@ -263,3 +263,29 @@ def test_the_linux_binaries_find_their_neighbours_by_rpath_origin(fmus, tmp_path
         (tmp_path / "lib.so").write_bytes(archive.read(f"binaries/{folder}/{identifier}.so"))
     dynamic = subprocess.run(["readelf", "-d", str(tmp_path / "lib.so")], capture_output=True, text=True).stdout
     assert re.search(r"\(RPATH\)\s+Library rpath: \[\$ORIGIN\]", dynamic), dynamic
+
+
+def test_the_twin_houses_properties_through_the_standalone_fmu(tmp_path):
+    """Every property of a real house at once, and one zone's alone, at values drawn within
+    their bounds: the standalone FMU (its properties found in batches of nodes apart) against
+    the direct model of the building with those values (267 nodes, shaded glazings)."""
+    from nodeforce.model.building import load_building
+    from nodeforce.model.effects import properties, with_fmu_parameters
+    from tests.test_standalone import TWINHOUSE
+    building = load_building(TWINHOUSE)
+    network = assemble(building)
+    rng = np.random.default_rng(3)
+    U = rng.uniform(0.0, 30.0, (97, len(network.input_names)))
+    drawn = {}
+    for name, p, target in properties(building):
+        low, high = p.bounds(p.read(building, target))
+        gain = p.parameter.unit == "W"
+        drawn[name] = float(rng.uniform(-300.0, 300.0) if gain else rng.uniform(max(low, 0.3), min(high, 3.0)))
+    zone = building.zones[0].name
+    alone = {name: value for name, value in drawn.items() if name.startswith(f"{zone}.")}
+    fmu = build_fmu(building, tmp_path / "twinhouse.fmu", kind="standalone")
+    with FmuInstance(fmu) as instance:
+        for values in (drawn, alone):
+            edited = with_fmu_parameters(building, None, values)
+            expected = simulate(edited, assemble(edited), U, 900.0, warmup_days=0)
+            assert np.abs(run(instance, building, U, values) - expected).max() < 1e-9
