@@ -33,7 +33,7 @@ def stepping(fmu, folder, one_by_one, repeats=3):
     outputs = [v.name for v in md.modelVariables if v.causality == "output"]
     times = []
     for _ in range(repeats):
-        done, _ = run_c_host(fmu, {"T_start": 20.0}, {}, outputs, step, round(stop / step), folder,
+        done, _ = run_c_host(fmu, {"T_start[1]": 20.0}, {}, outputs, step, round(stop / step), folder,
                              env=python_host_environment(), one_by_one=one_by_one)
         if done.returncode:
             raise RuntimeError(done.stderr)

@@ -19,12 +19,12 @@ def simulate_fmu(instance, case, force=None, warmup_days=2, output_ids=None, T_d
     Parameters
     ----------
     instance : cosim.fmi.FmuInstance
-    case : model.case.Case (inputs and measurements on the simulation grid)
+    case : model.case.Case (inputs and measurements on the simulation grid) of the FMU's building
     force : (N,) bool, nodes forced to their measurements; None: no forcing (the case's burn-in
         forces every measured node over its first steps all the same)
     warmup_days : passes over the first day before the run
     output_ids : node ids to return (default: all)
-    T_default : C, the initial temperature of a node nothing informs (the FMU's T_start)
+    T_default : C, the initial temperature of a node nothing informs
     parameters : {name: value} of other FMU parameters (an added effect's `<effect>.<name>`)
 
     Returns
@@ -39,10 +39,11 @@ def simulate_fmu(instance, case, force=None, warmup_days=2, output_ids=None, T_d
                                 case.burn_in_steps)
     forced_ids = [i + 1 for i in np.flatnonzero(schedule[1:].any(axis=0))]
     output_ids = list(range(1, n + 1)) if output_ids is None else list(output_ids)
-    parameters = {"T_start": T_default, **{name: True for name in node_names("force", forced_ids)},
-                  **(parameters or {})}
-    measured0 = np.flatnonzero(np.isfinite(measured[0]))
-    start_inputs = {f"T_forced[{i + 1}]": measured[0, i] for i in measured0}
+    # the state at t_0 is the FMU's T_start: the measured nodes at their value, the others by the
+    # rule of the direct model (model.integrate.initial_state)
+    start = case.start_state(T_default)
+    parameters = {**dict(zip(node_names("T_start", range(1, len(start) + 1)), start.tolist())),
+                  **{name: True for name in node_names("force", forced_ids)}, **(parameters or {})}
     rows = warmup_rows(n_rows, case.dt, warmup_days)
     columns = np.array(forced_ids, dtype=int) - 1
     imposed = np.where(schedule[:, columns], measured[:, columns], np.nan)
@@ -52,6 +53,6 @@ def simulate_fmu(instance, case, force=None, warmup_days=2, output_ids=None, T_d
         u, held, values = steady_inputs(case.U, measured, schedule, case.dt)
         inputs = np.vstack([np.concatenate([u, np.where(held[columns], values[columns], np.nan)]), inputs])
         steps = np.concatenate([[STEADY_STEP], steps])
-    return instance.run(steps, parameters, start_inputs,
+    return instance.run(steps, parameters, {},
                         list(case.input_names) + node_names("T_forced", forced_ids),
                         inputs, node_names("T", output_ids), skip=len(inputs) - (n_rows - 1))

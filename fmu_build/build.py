@@ -22,7 +22,7 @@ import zipfile
 from pathlib import Path
 
 from nodeforce import model, tempdirs
-from nodeforce.model.effects import EFFECTS
+from nodeforce.model.effects import EFFECTS, fmu_parameters
 from nodeforce.model.network import input_names
 
 from . import description
@@ -39,6 +39,9 @@ PHYSICS_MODULES = ("__init__", "errors", "building", "discretise", "effects", "n
 
 FMI3_PLATFORM = "x86_64-linux"  # FMI 3.0's name of FMI 2.0's linux64
 FMI3_SOURCES = ("fmi3.c", "fmi3.h", "glibc.h")
+# The FMI 3.0 standalone binary: (C files, libraries, preprocessor definitions), which
+# sources/buildDescription.xml says too, so that an importer builds the same library
+FMI3_BUILD = (("nodeforce_fmu.c", "fmi3.c"), ("m",), ("NODEFORCE_FMI3",))
 
 
 def fmu_kind(kind, fmi):
@@ -75,10 +78,8 @@ def build_fmu(building, destination, effect=None, kind="python"):
 
 
 def model_interface(building, effect):
-    """(Layout, effect for `description.model_description`) of a building with its effect."""
-    start = EFFECTS[effect[0]].read(building, effect[1]) if effect else {}
-    layout = Layout(building.n_nodes, input_names(building), [f"{effect[0]}.{n}" for n in start])
-    return layout, ((*effect, start) if effect else None)
+    """The `Layout` of the FMU of a building with its effect ((id, target) or None)."""
+    return Layout(building.n_nodes, input_names(building), fmu_parameters(building, effect))
 
 
 def _build_python(building, destination, effect, fmi):
@@ -122,8 +123,10 @@ def _build_python(building, destination, effect, fmi):
                            f"from {FmuBuilder.build_FMU.__code__.co_filename} is a copy without one")
     # pythonfmu names the binaries after the slave class, and finds the module in slavemodule.txt
     identifier = Path(next(name for name in files if name.startswith("binaries/"))).stem
-    layout = model_interface(building, effect)[0]
+    layout = model_interface(building, effect)
     files, is_guarded = guarded(files, identifier, layout)
+    if is_guarded:
+        files["resources/names.txt"] = layout.names_file().encode()
     if fmi == 3:
         if not is_guarded:
             raise RuntimeError("the FMI 3.0 Python FMU's binary is its FMI 3.0 interface over the guard, compiled at "
@@ -149,23 +152,24 @@ def _write(destination, files, building, effect, identifier, standalone, source_
     name = building.name or identifier
     files = {**files, "documentation/index.html": description.documentation(name, standalone, guarded, fmi=fmi)}
     guid = description.content_guid(*(part for item in sorted(files.items()) for part in item))
-    layout, effect_spec = model_interface(building, effect)
     files["modelDescription.xml"] = description.model_description(
-        layout, building, guid, identifier, name, effect_spec, standalone, source_files, fmi=fmi)
+        model_interface(building, effect), building, guid, identifier, name, effect, standalone, source_files,
+        fmi=fmi)
     return description.write_fmu(destination, files)
 
 
 def _build_standalone(building, destination, effect, fmi):
     from .standalone import standalone_files
 
-    files, identifier, source_files = standalone_files(building, effect)
+    files, identifier, source_files = standalone_files(building, effect, model_interface(building, effect))
     if fmi == 3:
         with tempdirs.folder("fmu") as tmp:
             library = Path(tmp) / f"{identifier}.so"
-            compile_library((source_files[0], "fmi3.c"), library, libraries=("m",), link_options=("-Wl,-Bsymbolic",))
+            compile_library(FMI3_BUILD[0], library, libraries=FMI3_BUILD[1], defines=FMI3_BUILD[2])
             binary = library.read_bytes()
-        files = _as_fmi3(files, identifier, model_interface(building, effect)[0], binary)
+        files = _as_fmi3(files, identifier, model_interface(building, effect), binary)
         files.update({f"sources/{name}": (C_DIR / name).read_bytes() for name in FMI3_SOURCES})
+        files["sources/buildDescription.xml"] = description.build_description(identifier, *FMI3_BUILD)
     return _write(destination, files, building, effect, identifier, True, source_files, fmi=fmi)
 
 

@@ -16,22 +16,29 @@ def find_compiler():
     return command.split()
 
 
-def compile_library(source, output, libraries=(), link_options=()):
+# The libraries an FMU's binary loads beside it are found in its own folder (the FMU's
+# binaries/<platform>), whatever the host's working directory: DT_RPATH $ORIGIN.
+RPATH = ("-Wl,--disable-new-dtags", "-Wl,-rpath,$ORIGIN")
+
+
+def compile_library(source, output, libraries=(), link_options=(), defines=()):
     """Compile c/<source> (a file name, or several) with the headers beside it into the shared
     library `output`.
 
     Compiled in c/ by relative name, without debug information: the bytes do not depend on
     where nodeforce is installed, so the same model gives the same FMU.
 
-    libraries : names given to -l; link_options : options for the linker (-Wl,...), before them
+    libraries : names given to -l; link_options : options for the linker (-Wl,...), before them;
+    defines : preprocessor names given to -D
 
     Raises RuntimeError without a C compiler or when compiling fails.
     """
     compiler = find_compiler()
     if compiler is None:
         raise RuntimeError("no C compiler found (cc, gcc or $CC): install one (e.g. apt-get install gcc)")
-    command = [*compiler, "-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden",
-               "-o", str(output), *([source] if isinstance(source, str) else source), *link_options, *(f"-l{name}" for name in libraries)]
+    command = [*compiler, "-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden", *(f"-D{d}" for d in defines),
+               "-o", str(output), *([source] if isinstance(source, str) else source), *RPATH, *link_options,
+               *(f"-l{name}" for name in libraries)]
     done = subprocess.run(command, cwd=C_DIR, capture_output=True, text=True)
     if done.returncode:
         raise RuntimeError(f"compiling {source!r} failed: {' '.join(command)}\n{done.stderr}")

@@ -12,7 +12,7 @@ from importlib.metadata import PackageNotFoundError, metadata
 from xml.etree.ElementTree import Element, SubElement, indent, tostring
 
 from nodeforce.model.building import Boundary
-from nodeforce.model.effects import EFFECTS
+from nodeforce.model.effects import EFFECTS, fmu_parameters, properties
 from nodeforce.model.network import clock_input_names
 
 from .guard import GUARD_GLIBC, PYTHONFMU_GLIBC
@@ -59,27 +59,45 @@ class Variable:
     # An input an importer holds between the samples it is given (zero-order hold), never
     # interpolates: a measurement, whose NaN (not measured) must not leak into its neighbours
     discrete: bool = False
+    bounds: tuple = ()  # (min, max) of a parameter an importer may set, or none
 
 
 def variables(layout, building, effect=None):
-    """The `Variable`s of a model, in value-reference order."""
+    """The `Variable`s of a model, in value-reference order; effect: (id, target) or None."""
     n = range(1, layout.n_nodes + 1)
     found = [Variable(f"force[{i}]", "parameter", "Boolean", "false", None,
                       f"node {i} is forced to T_forced[{i}] where that is not NaN") for i in n]
-    found.append(Variable("T_start", "parameter", "Real", "20", "degC",
-                          "initial temperature of a node no measurement at t_0 informs"))
+    found += [Variable(f"T_start[{i}]", "parameter", "Real", "20", "degC",
+                       f"temperature of node {i} at the start (a measured node: its measurement)") for i in n]
     found += [Variable(name, "input", "Real", "0", *_input_meaning(building, name))
               for name in layout.input_names]
     found += [Variable(f"T_forced[{i}]", "input", "Real", "NaN", "degC",
                        f"measured temperature of node {i}, NaN if none; held between samples, "
                        "never interpolated", discrete=True) for i in n]
     found += [Variable(f"T[{i}]", "output", "Real", None, "degC", f"temperature of node {i}") for i in n]
+    return found + parameter_variables(building, effect)
+
+
+def parameter_variables(building, effect=None):
+    """The `Variable`s of the building's properties and of the effect's parameters
+    (`model.effects.fmu_parameters`), with their units and the bounds an importer may set."""
+    start = fmu_parameters(building, effect)
+    meaning = {}
+    for name, p, target in properties(building):
+        meaning[name] = (p.parameter.unit, p.bounds(start.get(name, 0.0)),
+                         f"{p.name.replace('_', ' ')} of {p.of} {target} (declared: {start.get(name)!r})")
     if effect is not None:
-        effect_id, target, start = effect
-        units = {p.name: EFFECT_UNITS.get(p.unit, p.unit) for p in EFFECTS[effect_id].parameters}
-        found += [Variable(f"{effect_id}.{name}", "parameter", "Real", repr(float(value)), units[name],
-                           f"{effect_id} of {target}: {name}") for name, value in start.items()]
-    return found
+        record = EFFECTS[effect[0]]
+        for p, (low, high) in zip(record.parameters, record.bounds(building, effect[1])):
+            name = f"{effect[0]}.{p.name}"
+            meaning[name] = (p.unit, (min(low, start[name]), max(high, start[name])),
+                             f"{effect[0]} of {effect[1]}: {p.name}")
+    variables = []
+    for name, value in start.items():
+        unit, bounds, description = meaning[name]
+        variables.append(Variable(name, "parameter", "Real", repr(float(value)), EFFECT_UNITS.get(unit, unit),
+                                  description, bounds=tuple(float(b) for b in bounds)))
+    return variables
 
 
 def _input_meaning(building, name):
@@ -110,20 +128,10 @@ def _input_meaning(building, name):
     return None, f"measured input column {name}"
 
 
-def initial_dependencies(building, layout):
-    """{node index (0-based): sorted value references} the initial T of each node depends on
-    (docs/model.md section 5): its own measurement, its component's, its zone's air, T_start."""
-    forced = range(layout.T_forced.start, layout.T_forced.stop)
-    depends = {i: {forced[i], layout.T_start} for i in range(layout.n_nodes)}
-    for zone in building.zones:
-        air = zone.air_node - 1
-        for node in (air, zone.radiant_node - 1):
-            depends[node].add(forced[air])
-        for c in building.components:
-            if c.inside.zone == zone.name:
-                for node in c.node_ids:
-                    depends[node - 1] |= {forced[air]} | {forced[j - 1] for j in c.node_ids}
-    return {i: sorted(vrs) for i, vrs in depends.items()}
+def initial_dependencies(layout):
+    """{node index (0-based): value references} the initial T of each node depends on: its
+    T_start, nothing else (the start values alone set the state)."""
+    return {i: [layout.T_start.start + i] for i in range(layout.n_nodes)}
 
 
 def model_description(layout, building, guid, identifier, name, effect=None, standalone=False,
@@ -134,7 +142,7 @@ def model_description(layout, building, guid, identifier, name, effect=None, sta
     ----------
     layout : variables.Layout; building : model.building.Building
     guid : the content hash (`content_guid`); identifier : the model identifier (binary name)
-    name : model name; effect : (id, target, {name: start}) or None
+    name : model name; effect : (id, target) of the added effect, or None
     standalone : the FMU needs no Python; source_files : names under sources/ (FMI 2.0)
     step, span : default communication step and stop time (s) of the DefaultExperiment
     fmi : 2 (scalars) or 3 (`force`, `T_forced` and `T` as arrays of N; c/fmi3.c)
@@ -193,6 +201,8 @@ def _typed(v):
     typed = {} if v.start is None else {"start": v.start}
     if v.unit:
         typed.update(quantity=UNITS[v.unit][0], unit=v.unit)
+    if v.bounds:
+        typed.update(min=repr(v.bounds[0]), max=repr(v.bounds[1]))
     return typed
 
 
@@ -208,7 +218,7 @@ def _variables2(root, declared, building, layout):
     structure = SubElement(root, "ModelStructure")
     outputs = SubElement(structure, "Outputs")
     initial = SubElement(structure, "InitialUnknowns")
-    depends = initial_dependencies(building, layout)
+    depends = initial_dependencies(layout)
     for node, vr in enumerate(range(layout.T.start, layout.T.stop)):
         # A co-simulation output is the state after doStep: no direct feed-through from inputs.
         SubElement(outputs, "Unknown", {"index": str(vr + 1), "dependencies": ""})
@@ -217,6 +227,7 @@ def _variables2(root, declared, building, layout):
 
 
 ARRAYS = {"force": "node i is forced to T_forced[i] where that is not NaN",
+          "T_start": "temperature of node i at the start (a measured node: its measurement)",
           "T_forced": "measured temperature of node i, NaN if none; held between samples, never interpolated",
           "T": "temperature of node i"}
 FMI3_TYPES = {"Real": "Float64", "Boolean": "Boolean"}
@@ -224,8 +235,8 @@ FMI3_TYPES = {"Real": "Float64", "Boolean": "Boolean"}
 
 def _variables3(root, declared, building, layout):
     """FMI 3.0 ModelVariables: time (value reference 0), then the FMI 2.0 variables in their
-    order, `force[i]`, `T_forced[i]` and `T[i]` each one array of N (c/fmi3.c); and
-    ModelStructure, where T depends initially on T_start and T_forced."""
+    order, `force[i]`, `T_start[i]`, `T_forced[i]` and `T[i]` each one array of N (c/fmi3.c); and
+    ModelStructure, where T depends initially on T_start alone."""
     model_variables = SubElement(root, "ModelVariables")
     SubElement(model_variables, "Float64", {"name": "time", "valueReference": "0", "causality": "independent",
                                             "variability": "continuous", "description": "simulation time"})
@@ -248,7 +259,23 @@ def _variables3(root, declared, building, layout):
     structure = SubElement(root, "ModelStructure")
     SubElement(structure, "Output", {"valueReference": str(refs["T"]), "dependencies": ""})
     SubElement(structure, "InitialUnknown", {"valueReference": str(refs["T"]),
-                                             "dependencies": f"{refs['T_start']} {refs['T_forced']}"})
+                                             "dependencies": f"{refs['T_start']}"})
+
+
+def build_description(identifier, sources, libraries, defines):
+    """sources/buildDescription.xml of an FMI 3.0 source FMU (bytes): one C99 build of the
+    model identifier's library from `sources` (in sources/), with `defines` and `libraries`."""
+    root = Element("fmiBuildDescription", {"fmiVersion": "3.0"})
+    configuration = SubElement(root, "BuildConfiguration", {"modelIdentifier": identifier})
+    files = SubElement(configuration, "SourceFileSet", {"language": "C99"})
+    for name in sources:
+        SubElement(files, "SourceFile", {"name": name})
+    for name in defines:
+        SubElement(files, "PreprocessorDefinition", {"name": name})
+    for name in libraries:
+        SubElement(configuration, "Library", {"name": name})
+    indent(root, "  ")
+    return tostring(root, encoding="UTF-8", xml_declaration=True) + b"\n"
 
 
 def content_hash(*parts):
@@ -323,17 +350,25 @@ def documentation(name, standalone, guarded=True, python_minimum="3.10", fmi=2):
         needs = (needs.replace("binaries/linux64", "binaries/x86_64-linux").replace("FMI 2.0", "FMI 3.0")
                  .replace("fmi2Error", "fmi3Error").replace("fmi2Reset", "fmi3Reset")
                  .replace(", and the win64 one has no guard", ""))
-        needs += ("<p>FMI 3.0: <code>force</code>, <code>T_forced</code> and <code>T</code> are arrays of N "
+        needs += ("<p>FMI 3.0: <code>force</code>, <code>T_start</code>, <code>T_forced</code> and <code>T</code> are arrays of N "
                   "(element i is node i), and <code>time</code> is the independent variable; the binary is "
                   "the FMU's FMI 3.0 interface over its FMI 2.0 one (<code>fmi3DoStep</code> is "
                   "<code>fmi2DoStep</code>), so its numbers are the FMI 2.0 FMU's. No event mode.</p>")
     return (f"<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{name}</title></head><body>\n"
             f"<h1>{name}</h1>\n{needs}\n"
-            "<p>Variables: parameters <code>force[i]</code> (node i is forced) and <code>T_start</code> "
-            "(degC); inputs <code>T_out</code>, <code>T_sky</code> (degC), <code>I_&lt;component&gt;</code> "
+            "<p>Variables: parameters <code>force[i]</code> (node i is forced), <code>T_start[i]</code> "
+            "(degC, node i's temperature at the start) and the building's properties "
+            "<code>&lt;component&gt;.conductivity_factor</code>, <code>.capacity_factor</code>, "
+            "<code>.solar_absorptance</code>, <code>.solar_transmittance</code>, "
+            "<code>&lt;zone&gt;.air_change_rate</code> (1/h), <code>.internal_gain</code> (W), "
+            "<code>.h_conv_factor</code>, each at the building file's value, within its min and max: set "
+            "before initialisation ends, they give the model of the building file edited the same way; "
+            "inputs <code>T_out</code>, <code>T_sky</code> (degC), <code>I_&lt;component&gt;</code> "
             "(W/m2), the building's named columns and <code>T_forced[i]</code> (degC, NaN: no "
-            "measurement); outputs <code>T[i]</code> (degC). Set the measurements at t_0 as "
-            "<code>T_forced[i]</code> during initialisation: they set the initial state. One "
+            "measurement); outputs <code>T[i]</code> (degC). The start values alone set the state at "
+            "the start: give a measured node its measurement at t_0 as <code>T_start[i]</code>; no input "
+            "applied at t_0 changes it. A Real set that is not finite is refused (Error, the variable and "
+            "the time logged), but <code>T_forced</code>'s NaN. One "
             "<code>fmi2DoStep</code> of h seconds is one backward-Euler step with the inputs set "
             "before it (the inputs at the end of the step).</p>\n"
             "<p><code>T_forced[i]</code> is a discrete input: an importer that reads an input file "

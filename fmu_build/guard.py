@@ -42,7 +42,7 @@ def guard_binary(fmi=2):
         # libdl.so.2 by name and kept: where glibc is older than 2.34 the dl* functions the guard
         # asks for (c/guard.c) are there; since, it is an empty compatibility library
         compile_library(("guard.c", "fmi3.c") if fmi == 3 else "guard.c", library, libraries=(":libdl.so.2",),
-                        link_options=("-Wl,--no-as-needed", "-Wl,-Bsymbolic"))
+                        link_options=("-Wl,--no-as-needed",), defines=("NODEFORCE_FMI3",) if fmi == 3 else ())
         return library.read_bytes()
 
 

@@ -6,10 +6,11 @@ to the FMU's content, because pythonfmu imports the slave by module name and Pyt
 cache would otherwise run the first FMU's code for the second.
 
 Variables: `<module>_model/variables.py` (the layout the standalone FMU shares). One doStep of h
-seconds is one backward-Euler step with the inputs set before it. During initialisation, the
-`T_forced[i]` values set are the measurements at t_0, from which the initial state follows
-docs/model.md section 5 (`T_start` where nothing is measured). Calls the standard forbids are
-answered with fmi2Error and a logged reason, and change nothing.
+seconds is one backward-Euler step with the inputs set before it. The state at the start is
+`T_start[i]`, with the model of the parameters set before initialisation ends (the building's
+properties and an added effect's: `model.effects.fmu_parameters`). Calls the standard forbids,
+and a value set that is not finite (but a measurement's NaN), are refused with a logged reason,
+and change nothing.
 
 The step needs numpy only: an FMU that imports scipy corrupts memory when the host ends.
 """
@@ -48,10 +49,11 @@ def _read(resources):
 
 
 # Reset re-constructs the slave: keep per process what depends only on the model's description,
-# for the few sets of effect parameter values last used (a calibration tries many, in turn).
+# for the few sets of parameter values last used (a calibration tries many, in turn).
 @functools.lru_cache(maxsize=8)
 def _model(resources, values=()):
-    """(building, network, steppers by dt) of the FMU's building with its effect at `values`."""
+    """(building, network, steppers by dt) of the FMU's building with the parameters of `values`
+    ((name, value) pairs, those that differ from the declared ones) set."""
     data, effect = _read(resources)
     building = _physics["building"].parse_building(data, source="building.json")
     if not values:
@@ -59,8 +61,14 @@ def _model(resources, values=()):
     # the FMU's inputs are those of the building as declared, in its order: the effect's network
     # takes its columns in that order (a bridge to a column moves the column in the building's own)
     inputs = _model(resources)[1].input_names
-    building = _physics["effects"].EFFECTS[effect[0]].apply(building, effect[1], dict(values))
+    building = _physics["effects"].with_fmu_parameters(building, effect, dict(values))
     return building, _physics["network"].assemble(building, inputs), {}
+
+
+@functools.lru_cache(maxsize=8)
+def _parameter_start(resources):
+    """{name: declared value} of the FMU's parameters but forcing and start values."""
+    return _physics["effects"].fmu_parameters(_model(resources)[0], _read(resources)[1])
 
 
 class NodalBuilding(Fmi2Slave):
@@ -74,17 +82,15 @@ class NodalBuilding(Fmi2Slave):
             sys.path.remove(self.resources)
         _, self._effect = _read(self.resources)
         self.building, self.network, self._steppers = _model(self.resources)
-        effect_start = (_physics["effects"].EFFECTS[self._effect[0]].read(self.building, self._effect[1])
-                        if self._effect else {})
-        self._effect_names = tuple(effect_start)
-        layout = self.layout = _variables.Layout(
-            self.network.n_nodes, self.network.input_names,
-            [f"{self._effect[0]}.{name}" for name in effect_start])
+        start = _parameter_start(self.resources)
+        self._parameter_start = np.array(list(start.values()), dtype=float)
+        layout = self.layout = _variables.Layout(self.network.n_nodes, self.network.input_names, start)
         self._values = np.zeros(layout.size)
         self._values[layout.T_start] = 20.0
         self._values[layout.T_forced] = np.nan
         self._values[layout.T] = 20.0
-        self._values[layout.parameters] = list(effect_start.values())
+        self._values[layout.parameters] = self._parameter_start
+        self._time = 0.0
         self._force = np.zeros(layout.n_nodes, dtype=bool)
         self._any_forced = False
         self._checked = OrderedDict()
@@ -119,6 +125,12 @@ class NodalBuilding(Fmi2Slave):
         index = self._index(vrs, real, True)
         if isinstance(index, str):
             raise ValueError(index)
+        values = np.asarray(values, dtype=float)
+        if real and not np.isfinite(values).all():  # a NaN is refused but in a measurement (layout)
+            for vr, value in zip(index.tolist(), values.tolist()):
+                reason = self.layout.refusal(vr, real, True, self._state, value, self._time)
+                if reason:
+                    raise ValueError(reason)
         self._values[index] = values
 
     def get_real(self, vrs):
@@ -133,22 +145,27 @@ class NodalBuilding(Fmi2Slave):
     def set_boolean(self, vrs, values):
         self._set(vrs, values, False)
 
+    def setup_experiment(self, start_time, stop_time=None, tolerance=None):
+        self._time = float(start_time)
+
     def enter_initialization_mode(self):
         self._state = _variables.INITIALISATION
 
     def _fix_parameters(self):
-        """force[i] and the effect parameters are fixed once initialised: read them once."""
+        """force[i] and the other parameters are fixed once initialised: read them once; the
+        model is the building with those that differ from the declared values set."""
         layout = self.layout
         self._force = self._values[layout.force] != 0.0
         self._any_forced = bool(self._force.any())
-        if self._effect_names:
-            values = tuple(zip(self._effect_names, self._values[layout.parameters].tolist()))
-            self.building, self.network, self._steppers = _model(self.resources, values)
+        values = self._values[layout.parameters]
+        changed = np.flatnonzero(values != self._parameter_start)
+        self.building, self.network, self._steppers = _model(
+            self.resources, tuple((layout.parameter_names[k], float(values[k])) for k in changed))
 
     def exit_initialization_mode(self):
+        # the start values alone set the state: what an importer applies as inputs at t_0 does not
         self._fix_parameters()
-        self._values[self.layout.T] = _physics["integrate"].initial_state(
-            self.building, self._values[self.layout.T_forced], self._values[self.layout.T_start])
+        self._values[self.layout.T] = self._values[self.layout.T_start]
         self._state = _variables.STEPPING
 
     def do_step(self, current_time, step_size):
@@ -164,6 +181,7 @@ class NodalBuilding(Fmi2Slave):
         if stepper is None:
             stepper = self._steppers[step_size] = _physics["integrate"].ImplicitEuler(self.network, step_size)
         values[layout.T] = stepper.step(values[layout.T], source, forced, T_forced)
+        self._time = current_time + step_size
         return True
 
     def terminate(self):

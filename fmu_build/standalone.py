@@ -1,15 +1,23 @@
 """The standalone FMU: the assembled network as data, stepped by generic C code; no Python at
 run time (`nodeforce fmu BUILDING --standalone -o MODEL.fmu`).
 
-Python assembles (model.network), C only steps (c/nodeforce_fmu.c, docs/model.md section 5). A
-shaded glazing's transmitted sun, the product of two inputs, is data too: which node and inputs,
-and its coefficient in each term. An
-added effect's parameters stay FMU parameters: every effect of model.effects changes the network
-affinely in each of its parameters (ground coupling's q = A U T_ground is bilinear), so the
-network is exported as its value at the declared parameters p0 plus, per set S of parameters, a
-term weighted by prod_{j in S} (p_j - p0_j), found from assemblies at the corners p0 + delta_S.
-The export checks that form against a direct assembly elsewhere and refuses an effect that does
-not fit it.
+Python assembles (model.network), C only steps (c/nodeforce_fmu.c, docs/model.md). A shaded
+glazing's transmitted sun, the product of two inputs, is data too: which node and inputs, and
+its coefficient in each term.
+
+Every parameter stays an FMU parameter: the building's properties and an added effect's
+(`model.effects.fmu_parameters`). The network is affine in each of them (a conductivity or
+capacity factor scales its component's conductances or capacities, a convection factor its
+zone's surface links, an air change rate a conductance to T_out, an absorptance, a
+transmittance or a gain a column of B or q; ground coupling's q = A U T_ground is bilinear), so
+it is exported as its value at the declared parameters p0 plus, per set S of parameters that
+act together, a term weighted by prod_{j in S} (p_j - p0_j), found from assemblies at the
+corners p0 + delta_S: every set of the effect's parameters, each property alone (in batches of
+properties that change different nodes' rows, one assembly a batch), and a property with a set
+of the effect's where both change the same entries (a conductivity factor under an envelope
+factor). Each term keeps only its nonzeros, so the file grows with the parameters'
+reach, not with N^2 per parameter. The export checks that form against a direct assembly with
+every parameter moved at once, and refuses a network that does not fit it.
 """
 import itertools
 from pathlib import Path
@@ -17,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from nodeforce import tempdirs
-from nodeforce.model.effects import EFFECTS
+from nodeforce.model.effects import fmu_parameters, properties, with_fmu_parameters
 from nodeforce.model.network import assemble
 
 from .compiler import C_DIR, compile_library
@@ -32,95 +40,157 @@ def product_keys(networks):
     return sorted({(node, a, b) for network in networks for node, a, b, _ in network.products})
 
 
-def _arrays(network, keys):
-    """(C, A, B, q, P) of a network; P the coefficients (W) of its products at `keys`."""
+def _block(network, keys):
+    """C, A, B, q and P (the coefficients, W, of its products at `keys`) of a network, flat."""
     P = np.zeros(len(keys))
     for node, a, b, coefficient in network.products:
         if (node, a, b) not in keys:
-            raise ValueError("the effect adds a product of inputs its declared network lacks: no standalone export")
+            raise ValueError("a parameter adds a product of inputs the declared network lacks: no standalone export")
         P[keys.index((node, a, b))] += coefficient
-    return (network.C, network.A, network.B, network.q, P)
+    return np.concatenate([network.C, network.A.ravel(), network.B.ravel(), network.q, P])
+
+
+def _rows(network, keys):
+    """The node (0-based) of each entry of `_block`: a property changes the rows of its nodes."""
+    n, n_in = network.n_nodes, network.B.shape[1]
+    nodes = np.arange(n)
+    return np.concatenate([nodes, np.repeat(nodes, n), np.repeat(nodes, n_in), nodes,
+                           np.array([node for node, _, _ in keys], dtype=int)])
+
+
+def _batches(reaches):
+    """Parameters (indices into `reaches`, sets of rows) in batches whose rows are disjoint:
+    greedily, each into the first batch it does not meet."""
+    batches, used = [], []
+    for j, rows in enumerate(reaches):
+        k = next((k for k, taken in enumerate(used) if not taken & rows), None)
+        if k is None:
+            batches.append([])
+            used.append(set())
+            k = len(batches) - 1
+        batches[k].append(j)
+        used[k] |= rows
+    return batches
 
 
 def network_terms(building, effect):
-    """(p0, product keys, [(set of parameter indices, (C, A, B, q, P))]) of the network as a
-    multi-affine function of the effect's parameters; one term (the network) without an effect.
-    P holds the coefficients of the products of inputs at the keys (`product_keys`).
+    """(p0, product keys, [(parameter indices, entries, values)]) of the network as a function
+    of the FMU's parameters (`fmu_parameters`), multi-affine as the top of this file says: each
+    term's nonzeros, at their index in the flat C, A, B, q, P (`_block`); the first term is
+    the network at p0.
 
-    Raises ValueError if the effect's network is not of that form (to 1e-9 relative)."""
-    if effect is None:
-        network = assemble(building)
-        keys = product_keys([network])
-        return [], keys, [((), _arrays(network, keys))]
-    p0 = EFFECTS[effect[0]].read(building, effect[1])
-    names = list(p0)
-    delta = {name: -value / 2 if value else 1.0 for name, value in p0.items()}
+    The effect's parameters take every corner of theirs. The properties, hundreds on a large
+    building, go in batches of properties whose nodes (`Property.reach`) are apart: one assembly
+    moves a batch, each property taking the rows of its nodes, and a second, each property moved
+    by a different fraction, checks that split.
 
-    inputs = assemble(building).input_names  # the FMU's inputs, in the declared building's order
+    Raises ValueError if the network is not of that form (to 1e-9 relative)."""
+    start = fmu_parameters(building, effect)
+    names = list(start)
+    p0 = np.array([start[n] for n in names], dtype=float)
+    delta = np.where(p0 != 0.0, -p0 / 2, 1.0)
+    base_network = assemble(building)
+    inputs, keys = base_network.input_names, product_keys([base_network])
+    reach = {name: {i - 1 for i in p.reach(building, target)} for name, p, target in properties(building)}
+    own = [j for j, n in enumerate(names) if n not in reach]  # the effect's parameters
 
-    def at(values):
-        return assemble(EFFECTS[effect[0]].apply(building, effect[1], values), inputs)
+    def corner(fractions):
+        """The flat network with parameter j moved by fractions[j] * delta_j."""
+        values = {names[j]: p0[j] + f * delta[j] for j, f in fractions.items()}
+        return _block(assemble(with_fmu_parameters(building, effect, values), inputs), keys)
 
-    networks = {}
-    for r in range(len(names) + 1):
-        for subset in itertools.combinations(range(len(names)), r):
-            networks[subset] = at({n: p0[n] + (delta[n] if j in subset else 0.0) for j, n in enumerate(names)})
-    keys = product_keys(networks.values())
-    corners = {subset: _arrays(network, keys) for subset, network in networks.items()}
-    terms = []
-    for subset in corners:  # inclusion-exclusion over the corners of the subset
-        scale = np.prod([delta[names[j]] for j in subset])
-        arrays = [sum((-1) ** (len(subset) - len(inner)) * corners[inner][k]
-                      for r in range(len(subset) + 1) for inner in itertools.combinations(subset, r)) / scale
-                  for k in range(5)]
-        if subset and all(np.abs(a).max(initial=0.0) <= 1e-12 * max(1.0, np.abs(c).max(initial=0.0))
-                          for a, c in zip(arrays, corners[()])):
-            continue  # parameters that do not act together (a daily gain's terms): nothing to carry
-        terms.append((subset, tuple(arrays)))
-    check = {n: p0[n] + 0.7 * delta[n] for n in names}
-    expected = _arrays(at(check), keys)
-    for k, exact in enumerate(expected):
-        value = sum(np.prod([check[names[j]] - p0[names[j]] for j in subset]) * arrays[k]
-                    for subset, arrays in terms)
-        if np.abs(value - exact).max(initial=0.0) > 1e-9 * max(1.0, np.abs(exact).max(initial=0.0)):
-            raise ValueError(f"effect {effect[0]} does not change the network affinely in each parameter: "
+    def close(value, exact):
+        return np.abs(value - exact).max(initial=0.0) <= 1e-9 * max(1.0, np.abs(exact).max(initial=0.0))
+
+    base = corner({})
+    scale = max(1.0, np.abs(base).max(initial=0.0))
+    corners = {(): base}
+
+    def term(subset):
+        """The coefficient of prod_{j in subset} (p_j - p0_j), by inclusion-exclusion."""
+        total = 0.0
+        for r in range(len(subset) + 1):
+            for inner in itertools.combinations(subset, r):
+                if inner not in corners:
+                    corners[inner] = corner(dict.fromkeys(inner, 1.0))
+                total = total + (-1) ** (len(subset) - r) * corners[inner]
+        return total / np.prod(delta[list(subset)])
+
+    def sparse(t):
+        index = np.flatnonzero(t)
+        return index, t[index]
+
+    terms = [((), *sparse(base))]  # (parameter indices, entries, values)
+    effect_reach = np.zeros(len(base), dtype=bool)
+    subsets = [s for r in range(1, len(own) + 1) for s in itertools.combinations(own, r)]
+    for subset in subsets:
+        t = term(subset)
+        if np.abs(t).max(initial=0.0) > 1e-12 * scale:  # parameters that do act together
+            terms.append((subset, *sparse(t)))
+            effect_reach |= t != 0.0
+    rows = _rows(base_network, keys)
+    properties_of = [j for j in range(len(names)) if j not in own]
+    for batch in _batches([reach[names[j]] for j in properties_of]):
+        batch = [properties_of[k] for k in batch]
+        index, change = sparse(corner(dict.fromkeys(batch, 1.0)) - base)
+        owner = np.full(len(base_network.C), -1)
+        for j in batch:
+            owner[list(reach[names[j]])] = j
+        who = owner[rows[index]]
+        if (who < 0).any():
+            raise ValueError("a property changes the network beyond its nodes: no standalone export")
+        singles = {j: (index[who == j], change[who == j] / delta[j]) for j in batch}
+        fractions = {j: 0.3 + 0.6 * k / len(batch) for k, j in enumerate(batch)}
+        split = base.copy()
+        for j, f in fractions.items():
+            split[singles[j][0]] += f * delta[j] * singles[j][1]
+        if not close(split, corner(fractions)):
+            raise ValueError("the network is not affine in each of the building's properties apart: "
                              "no standalone export")
-    return [p0[n] for n in names], keys, terms
+        for j in batch:
+            entries, values = singles[j]
+            if np.abs(values).max(initial=0.0) > 1e-12 * scale:
+                terms.append(((j,), entries, values))
+            if effect_reach[entries].any():  # with the effect's parameters on the same entries
+                corners[(j,)] = base.copy()
+                corners[(j,)][entries] += delta[j] * values
+                for subset in subsets:
+                    both = tuple(sorted((j, *subset)))
+                    t = term(both)
+                    if np.abs(t).max(initial=0.0) > 1e-12 * scale:
+                        terms.append((both, *sparse(t)))
+                corners = {key: value for key, value in corners.items() if j not in key}
+    exact = corner(dict.fromkeys(range(len(names)), 0.7))
+    value = np.zeros(len(base))
+    for subset, entries, values in terms:
+        value[entries] += np.prod(0.7 * delta[list(subset)]) * values
+    if not close(value, exact):
+        raise ValueError("the network is not affine in each of the FMU's parameters: no standalone export")
+    return p0, keys, terms
 
 
 def network_text(building, effect):
     """resources/network.txt: the format c/nodeforce_fmu.c reads (numbers that round-trip)."""
     p0, keys, terms = network_terms(building, effect)
-    n = building.n_nodes
-    groups = []
-    for c in building.components:
-        if any(b <= a for a, b in zip(c.depths, c.depths[1:])):
-            raise ValueError(f"component {c.name}: node depths must increase for the initial state")
-        zone = next(k for k, z in enumerate(building.zones) if z.name == c.inside.zone)
-        groups.append((zone, list(zip(c.node_ids, c.depths))))
-    # a node a zone effect adds is a group of one, never measured: it starts with the zone's air
-    zone_index = {z.name: k for k, z in enumerate(building.zones)}
-    groups += [(zone_index[zone], [(i, 0.0)]) for i, (zone, _) in building.added_nodes.items()]
+    n, n_in = building.n_nodes, len(assemble(building).input_names)
     numbers = lambda values: " ".join(repr(float(v)) for v in np.ravel(values))
-    lines = ["nodeforce-network/2",
-             f"sizes {n} {terms[0][1][2].shape[1]} {len(p0)} {len(terms)} {len(building.zones)} {len(groups)} "
-             f"{len(keys)}",
+    lines = ["nodeforce-network/3",
+             f"sizes {n} {n_in} {len(p0)} {len(terms)} {len(keys)} {sum(len(s) for s, _, _ in terms)} "
+             f"{sum(len(k) for _, k, _ in terms)}",
              f"p0 {numbers(p0)}",
              "products " + " ".join(f"{node} {a} {b}" for node, a, b in keys)]
-    for subset, arrays in terms:
-        lines.append(f"term {sum(1 << j for j in subset)}")
-        lines += [numbers(a) for a in arrays]
-    lines.append("zones " + " ".join(f"{z.air_node - 1} {z.radiant_node - 1}" for z in building.zones))
-    lines.append("components")
-    lines += [f"{zone} {len(nodes)} " + " ".join(f"{i - 1} {float(d)!r}" for i, d in nodes) for zone, nodes in groups]
+    for subset, index, values in terms:
+        lines.append(" ".join(map(str, ["term", len(subset), *subset, len(index)])))
+        lines += [f"{k} {v!r}" for k, v in zip(index.tolist(), values.tolist())]
     lines.append("end")
     return "\n".join(lines) + "\n"
 
 
-def standalone_files(building, effect):
+def standalone_files(building, effect, layout):
     """({archive name: bytes}, model identifier, source file names) of the standalone FMU."""
     files = {f"sources/{name}": (C_DIR / name).read_bytes() for name in SOURCES}
     files["resources/network.txt"] = network_text(building, effect).encode()
+    files["resources/names.txt"] = layout.names_file().encode()
     with tempdirs.folder("fmu") as tmp:
         try:
             compile_library("nodeforce_fmu.c", Path(tmp) / f"{IDENTIFIER}.so", libraries=("m",))

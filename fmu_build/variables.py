@@ -5,11 +5,14 @@ the same counts) and the model description: every value lives in one array index
 reference, in this order:
 
     force[1..N]      Boolean parameter, fixed      node i is forced to T_forced[i]
-    T_start          Real parameter, fixed (C)     initial temperature nothing measured informs
+    T_start[1..N]    Real parameters, fixed (C)    node i's temperature at the start
     <inputs>         Real inputs                   network.input_names, in order
     T_forced[1..N]   Real inputs (C)               measurement of node i, NaN where none
     T[1..N]          Real outputs (C)              node temperatures
-    <effect>.<name>  Real parameters, fixed        an added effect's parameters
+    <parameters>     Real parameters, fixed        the building's properties and an added effect's
+                                                   parameters (model.effects.fmu_parameters)
+
+A Real set must be finite, but T_forced's NaN ("not measured").
 
 This file is copied into the Python FMU: standard library only, syntax of Python 3.6.
 """
@@ -19,8 +22,8 @@ INSTANTIATED, INITIALISATION, STEPPING, TERMINATED = range(4)
 
 
 class Layout:
-    """Value references of a model with `n_nodes` nodes, its input names and its effect
-    parameters' full names (`<effect>.<name>`)."""
+    """Value references of a model with `n_nodes` nodes, its input names and its other
+    parameters' names (`<component>.<property>`, `<effect>.<name>`)."""
 
     def __init__(self, n_nodes, input_names, parameter_names=()):
         n = int(n_nodes)
@@ -28,8 +31,8 @@ class Layout:
         self.input_names = tuple(input_names)
         self.parameter_names = tuple(parameter_names)
         self.force = slice(0, n)
-        self.T_start = n
-        self.inputs = slice(n + 1, n + 1 + len(self.input_names))
+        self.T_start = slice(n, 2 * n)
+        self.inputs = slice(2 * n, 2 * n + len(self.input_names))
         self.T_forced = slice(self.inputs.stop, self.inputs.stop + n)
         self.T = slice(self.T_forced.stop, self.T_forced.stop + n)
         self.parameters = slice(self.T.stop, self.T.stop + len(self.parameter_names))
@@ -38,8 +41,13 @@ class Layout:
     def names(self):
         """Variable names in value-reference order."""
         n = range(1, self.n_nodes + 1)
-        return ([f"force[{i}]" for i in n] + ["T_start"] + list(self.input_names)
+        return ([f"force[{i}]" for i in n] + [f"T_start[{i}]" for i in n] + list(self.input_names)
                 + [f"T_forced[{i}]" for i in n] + [f"T[{i}]" for i in n] + list(self.parameter_names))
+
+    def names_file(self):
+        """resources/names.txt: the inputs' and parameters' names, one a line, which the C code
+        names them by in its messages (c/variables.h)."""
+        return "".join(f"{name}\n" for name in (*self.input_names, *self.parameter_names))
 
     def is_boolean(self, vr):
         return vr < self.n_nodes
@@ -49,24 +57,30 @@ class Layout:
 
     def is_fixed(self, vr):
         """A parameter: settable only before initialisation ends."""
-        return vr <= self.T_start or vr >= self.parameters.start
+        return vr < self.T_start.stop or vr >= self.parameters.start
 
-    def refusal(self, vr, real, setting, state):
-        """Why the standard forbids this get or set (None when it is allowed).
+    def refusal(self, vr, real, setting, state, value=0.0, time=0.0):
+        """Why the standard forbids this get or set (None when it is allowed), or why the
+        value set is refused (a Real that is not finite, but a measurement's NaN): the messages
+        of c/variables.h.
 
         vr : value reference; real : a Real call (else Boolean); setting : a set call;
-        state : INSTANTIATED, INITIALISATION, STEPPING or TERMINATED
+        state : INSTANTIATED, INITIALISATION, STEPPING or TERMINATED; value : the value set;
+        time : the communication point (s)
         """
         if not 0 <= vr < self.size:
-            return f"value reference {vr} does not exist (0..{self.size - 1})"
+            return f"value reference {vr} (none) does not exist (0..{self.size - 1})"
+        reason = None
         if self.is_boolean(vr) == real:
-            return f"value reference {vr} is {'Boolean' if real else 'Real'}, not {'Real' if real else 'Boolean'}"
-        if not setting:
+            reason = f"is {'Boolean' if real else 'Real'}, not {'Real' if real else 'Boolean'}"
+        elif not setting:
             return None
-        if self.is_output(vr):
-            return f"value reference {vr} is an output, which cannot be set"
-        if self.is_fixed(vr) and state not in (INSTANTIATED, INITIALISATION):
-            return f"value reference {vr} is a fixed parameter, which cannot change after initialisation"
-        if state == TERMINATED:
-            return "the slave is terminated"
-        return None
+        elif self.is_output(vr):
+            reason = "is an output, which cannot be set"
+        elif self.is_fixed(vr) and state not in (INSTANTIATED, INITIALISATION):
+            reason = "is a fixed parameter, which cannot change after initialisation"
+        elif state == TERMINATED:
+            reason = "cannot be set: the slave is terminated"
+        elif real and value - value != 0.0 and not (self.T_forced.start <= vr < self.T_forced.stop):
+            reason = f"set to {value} at t = {time:.17g} s: it must be finite (NaN means \"not measured\" on T_forced only)"
+        return reason and f"value reference {vr} ({self.names()[vr]}) {reason}"

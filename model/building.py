@@ -136,6 +136,7 @@ class Component:
     transmitted_solar_to: str | None = None
     shading: str | None = None  # input column in 0..1 multiplying the transmittance
     conductivity_factor: float = 1.0  # scale on the conductances between its nodes
+    capacity_factor: float = 1.0  # scale on the heat capacities of its nodes
 
     @property
     def thickness(self):
@@ -650,6 +651,7 @@ def _component(check, c, where, materials, zone_names, sensor_depths):
         transmitted_solar_to=c.get("transmitted_solar_to") if tau is not None else None,
         shading=shading,
         conductivity_factor=check.number(c, "conductivity_factor", where, default=1.0, low=0, low_open=True),
+        capacity_factor=check.number(c, "capacity_factor", where, default=1.0, low=0),
     )
 
 

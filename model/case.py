@@ -13,7 +13,7 @@ import pandas as pd
 from nodeforce.iotools.timetable import check_celsius
 
 from .errors import InputError
-from .integrate import simulate, steps_per_day
+from .integrate import initial_state, simulate, steps_per_day
 from .building import DAY_TERMS
 from .network import assemble, clock_input_names, day_input, input_names
 from .solar import (DECOMPOSITIONS, complete_irradiance, incident_irradiance, measured_irradiance, sky_temperature,
@@ -37,6 +37,17 @@ class Case:
     assumptions: tuple = ()  # sentences: what the case computed that the files did not give
     steady_start: bool = False  # the warm-up starts from the first day's steady state (`with_steady_start`)
     fluxes: dict = field(default_factory=dict)  # flux sensor -> (N_t+1,) W/m2 measured, NaN where missing
+    building: object = None  # the Building whose nodes `measured` holds (its state at t_0: `start_state`)
+
+    def start_state(self, T_default=20.0):
+        """(N,) node temperatures (C) at t_0 of the case's building, N its nodes (those its
+        effects add included): the measured ones at their value, the others by the rule of
+        `integrate.initial_state`."""
+        if self.building is None:
+            raise ValueError("a case without its building has no state at t_0 (Case(..., building=...))")
+        n = self.building.n_nodes
+        measured0 = np.concatenate([self.measured[0], np.full(n - self.measured.shape[1], np.nan)])
+        return initial_state(self.building, measured0, T_default)
 
     @property
     def measured_ids(self):
@@ -69,7 +80,7 @@ class Case:
         return measured
 
     def with_inputs(self, building):
-        """The case with the inputs `building` reads (`model.network.input_names`): its own
+        """The case of `building`, with the inputs it reads (`model.network.input_names`): its own
         columns, and the time-of-day basis computed from its times, for a building that differs
         from the case's by an effect (a daily gain adds the basis; no effect adds a measured column).
         """
@@ -79,7 +90,7 @@ class Case:
         absent = [n for n in names if n not in columns]
         if absent:
             raise InputError(building.source, absent[0], "an input column the case was not prepared with")
-        return replace(self, input_names=names, U=np.column_stack([columns[n] for n in names]))
+        return replace(self, input_names=names, U=np.column_stack([columns[n] for n in names]), building=building)
 
     def window(self, start, stop):
         """The sub-case on rows start..stop (inclusive), t_start becoming its t_0; the burn-in
@@ -250,7 +261,7 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs"):
                 else np.full((len(times), building.n_nodes), np.nan))
     fluxes = measured_fluxes(building, measurements, times) if measurements is not None else {}
     return Case(times=times, dt=dt, input_names=names, U=U, measured=measured, assumptions=tuple(assumptions),
-                fluxes=fluxes)
+                fluxes=fluxes, building=building)
 
 
 def check_warmup(case, source):

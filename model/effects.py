@@ -14,6 +14,7 @@ target is `<zone>-><column>`, the column a heat input or a face's irradiance the
 a `boundary_conductance` target is a boundary temperature column; an `interzone_air_exchange`
 target is `<zone>|<zone>`, the two zones in the building file's order.
 """
+import re
 from dataclasses import dataclass
 from typing import Callable
 
@@ -380,3 +381,124 @@ EFFECTS = {e.id: e for e in (
            (Parameter("factor", "-", 0.0, 5.0),), lambda b: [z.name for z in b.zones if z.heat_input],
            *_zone_field("heat_input_factor", "factor"), _no_node),
 )}
+
+
+@dataclass(frozen=True)
+class Property:
+    """A number of the building file that every FMU exposes as the parameter `<target>.<name>`
+    (its start the declared value): what another tool may calibrate. Where an effect of the
+    registry already reads and writes that number, the property is that effect's parameter."""
+    name: str
+    of: str  # "component" or "zone"
+    parameter: Parameter  # its unit and the range an FMU declares (min, max)
+    targets: Callable  # building -> the component or zone names it applies to
+    read: Callable  # (building, target) -> value declared now
+    write: Callable  # (JSON data, target, value) -> None
+    reach: Callable  # (building, target) -> ids of the nodes whose rows of the network it changes
+
+    def bounds(self, start):
+        """(min, max) an FMU declares: the parameter's range, widened to hold the declared value."""
+        return min(self.parameter.low, start), max(self.parameter.high, start)
+
+
+def _effect_property(name, of, effect_id, reach):
+    effect = EFFECTS[effect_id]
+    parameter, = effect.parameters
+    return Property(name, of, parameter, effect.targets, lambda b, t: float(effect.read(b, t)[parameter.name]),
+                    lambda data, t, value: effect.write(data, t, {parameter.name: value}), reach)
+
+
+def _air_node(building, target):
+    return (building.zone(target).air_node,)
+
+
+def _zone_surfaces(building, target):
+    return (building.zone(target).air_node, *building.facing(target))
+
+
+def _capacity_write(data, target, value):
+    _component(data, target)["capacity_factor"] = float(value)
+
+
+PROPERTIES = (
+    _effect_property("conductivity_factor", "component", "conductivity", _own_nodes),
+    Property("capacity_factor", "component", Parameter("factor", "-", 0.05, 20.0), lambda b: [c.name for c in b.components],
+             lambda b, t: float(b.component(t).capacity_factor), _capacity_write, _own_nodes),
+    _effect_property("solar_absorptance", "component", "solar_absorptance", _own_nodes),
+    _effect_property("solar_transmittance", "component", "solar_transmittance", _receiver_nodes),
+    _effect_property("air_change_rate", "zone", "infiltration", _air_node),
+    _effect_property("internal_gain", "zone", "internal_gain", _air_node),
+    _effect_property("h_conv_factor", "zone", "inside_convection", _zone_surfaces),
+)
+
+
+def properties(building):
+    """[(FMU parameter name, Property, target)] of a building, components' then zones', in the
+    building's order."""
+    targets = [set(p.targets(building)) for p in PROPERTIES]
+    names = {"component": [c.name for c in building.components], "zone": [z.name for z in building.zones]}
+    return [(f"{structured_name(name)}.{p.name}", p, name) for of in ("component", "zone") for name in names[of]
+            for p, applies in zip(PROPERTIES, targets) if p.of == of and name in applies]
+
+
+def structured_name(name):
+    """A component's or zone's name as one part of an FMI structured name: itself where it is an
+    identifier, else quoted (FMI's q-name: between single quotes, ' and \\ escaped)."""
+    if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
+        return name
+    return "'" + name.replace("\\", "\\\\").replace("'", "\\'") + "'"
+
+
+def with_properties(building, values):
+    """A new Building with the properties of `values` ({FMU parameter name: value}) declared;
+    the building itself when there are none."""
+    if not values:
+        return building
+    found = {name: (p, target) for name, p, target in properties(building)}
+
+    def write(data):
+        for name, value in values.items():
+            p, target = found[name]
+            p.write(data, target, value)
+    return building.edited(write)
+
+
+def fmu_parameters(building, effect=None):
+    """{name: declared value} of every parameter an FMU of the building exposes besides forcing
+    and start values: its properties (`properties`), then the added effect's `<effect>.<name>`
+    (effect: (id, target) or None). A property the effect sets too (the door's
+    `conductivity_factor` beside `conductivity.factor` on the door, a zone's `internal_gain` beside
+    its daily gain's mean) is declared once, as the effect's parameter: two names for one number
+    would leave the model undefined when both are set."""
+    found = {name: p.read(building, target) for name, p, target in properties(building)}
+    if effect is None:
+        return found
+    record = EFFECTS[effect[0]]
+    own = record.read(building, effect[1])
+    # the properties that move when the effect's parameters do are the effect's (two moves, so
+    # that no value the effect happens to be at can hide one)
+    for scale, shift in ((0.5, 0.1234567), (0.6, 0.0345678)):
+        moved = record.apply(building, effect[1], {n: scale * v + shift for n, v in own.items()})
+        for name, p, target in properties(building):
+            if name in found and p.read(moved, target) != found[name]:
+                del found[name]
+    return {**found, **{f"{effect[0]}.{n}": float(v) for n, v in own.items()}}
+
+
+def with_fmu_parameters(building, effect, values):
+    """The building as an FMU of it (`fmu_parameters`) simulates with the parameters of `values`
+    ({name: value}) set: the building file edited the same way, in one validated step."""
+    names = {name: (p, target) for name, p, target in properties(building)}
+    effect_values = {n.partition(".")[2]: v for n, v in values.items() if n not in names}
+    unknown = [n for n in values if n not in names and (effect is None or not n.startswith(f"{effect[0]}."))]
+    if unknown:
+        raise KeyError(f"no FMU parameter {unknown[0]}")
+
+    def write(data):
+        for name, value in values.items():
+            if name in names:
+                names[name][0].write(data, names[name][1], value)
+        if effect_values:
+            record = EFFECTS[effect[0]]
+            record.write(data, effect[1], {**record.read(building, effect[1]), **effect_values})
+    return building.edited(write) if values else building

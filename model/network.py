@@ -124,7 +124,7 @@ def assemble(building, names=None):
                     else 1.0)
         if isinstance(out, Boundary) and isinstance(out.temperature, str):
             envelope *= building.boundary_factor(out.temperature)
-        C[idx] += c.area * capacities(c.layers, c.depths)
+        C[idx] += c.area * capacities(c.layers, c.depths) * c.capacity_factor
         for k, g in enumerate(conductances(c.layers, c.depths)):
             link(idx[k], idx[k + 1], c.area * g * c.conductivity_factor * envelope)
         to_zone(idx[0], c.area, c.inside)

@@ -9,7 +9,7 @@ Every runner has the same contract::
 
 - ``parameters`` {name: value} is applied once, before initialisation ends; the Python type is
   ignored, the variable's type in modelDescription.xml decides (``force[1]`` -> Boolean,
-  ``T_start`` -> Real), so ``{"force[1]": 1, "T_start": 20}`` works everywhere.
+  ``T_start[1]`` -> Real), so ``{"force[1]": 1, "T_start[1]": 20}`` works everywhere.
 - ``inputs`` {name: array}: ``inputs[name][k]`` is set before step k (k = 0..n_steps-1), step k
   goes from k*dt to (k+1)*dt. Inputs not given keep their start value. NaN is passed through.
 - row k of the result holds ``outputs`` read after step k.

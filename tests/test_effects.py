@@ -143,7 +143,7 @@ def test_an_effect_that_moves_an_input_column_keeps_the_fmu_inputs(tmp_path, rea
     U = rng.uniform(0, 30, (n_rows, len(net.input_names)))
     U[:, net.input_names.index("blind")] = 1.0
     times = real_case.times[:n_rows]
-    case = Case(times, 900.0, net.input_names, U, np.full((n_rows, net.n_nodes), np.nan))
+    case = Case(times, 900.0, net.input_names, U, np.full((n_rows, net.n_nodes), np.nan), building=b)
     fmu = build_fmu(b, tmp_path / "m.fmu", effect=("thermal_bridge", target))
     with FmuInstance(fmu) as instance:
         changed = simulate_fmu(instance, case, parameters={"thermal_bridge.UA": 6.0})

@@ -87,7 +87,7 @@ def instantiate(path, name):
 def start(slave, refs, T_start, forced=()):
     slave.setupExperiment(startTime=0.0)
     slave.enterInitializationMode()
-    slave.setReal([refs["T_start"]], [T_start])
+    slave.setReal([refs[f"T_start[{i}]"] for i in range(1, 24)], [T_start] * 23)
     if forced:
         slave.setBoolean([refs[f"force[{i}]"] for i in forced], [True] * len(forced))
     slave.exitInitializationMode()

@@ -47,8 +47,8 @@ def test_fmi3_declares_arrays_units_and_the_effect_and_passes_fmpy_validate(fmus
         assert f"binaries/x86_64-linux/{root.find('CoSimulation').get('modelIdentifier')}.so" in archive.namelist()
     assert root.get("fmiVersion") == "3.0"
     declared = {v.get("name"): v for v in root.find("ModelVariables")}
-    for name, tag, causality in (("force", "Boolean", "parameter"), ("T_forced", "Float64", "input"),
-                                 ("T", "Float64", "output")):
+    for name, tag, causality in (("force", "Boolean", "parameter"), ("T_start", "Float64", "parameter"),
+                                 ("T_forced", "Float64", "input"), ("T", "Float64", "output")):
         v = declared[name]
         assert (v.tag, v.get("causality"), v.find("Dimension").get("start")) == (tag, causality, "23")
     assert declared["T_forced"].get("variability") == "discrete" and declared["T"].get("unit") == "degC"
@@ -60,10 +60,10 @@ def test_fmi3_declares_arrays_units_and_the_effect_and_passes_fmpy_validate(fmus
         (fmu.parent / "fmi3_guard.so").write_bytes(binary)
         versions, _ = glibc_versions(fmu.parent / "fmi3_guard.so")
         assert max(versions) == tuple(int(x) for x in guard.GUARD_GLIBC.split("."))
-    # 3N scalars of FMI 2.0 became 3 arrays, with the independent time beside them
+    # 4N scalars of FMI 2.0 became 4 arrays, with the independent time beside them
     with zipfile.ZipFile(fmus[(kind, 2)]) as archive:
         scalars = ElementTree.fromstring(archive.read("modelDescription.xml")).find("ModelVariables")
-    assert len(scalars) - len(declared) == 3 * 22 - 1
+    assert len(scalars) - len(declared) == 4 * 22 - 1
 
 
 @pytest.mark.parametrize("kind", KINDS)

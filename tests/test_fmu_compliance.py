@@ -25,7 +25,7 @@ def scenario(real_case):
     measured_9 = real_case.measured[rows, 8].copy()
     measured_9[30:34] = np.nan
     inputs["T_forced[9]"] = measured_9
-    parameters = {"force[9]": True, "T_start": 24.0}
+    parameters = {"force[9]": True, **{f"T_start[{i}]": 24.0 for i in range(1, 24)}}
     outputs = [f"T[{i}]" for i in range(1, 24)]
     return parameters, inputs, outputs
 

@@ -23,10 +23,13 @@ def test_one_guard_binary_for_every_model(testcell_data, tmp_path):
             sizes = fmu.read("resources/guard.txt").decode().splitlines()[1]
             assert "binaries/linux64/NodalBuilding.pythonfmu.so" in fmu.namelist()
     assert binaries[0] == binaries[1] == guard.guard_binary()
-    # the sizes the guard reads are the model description's: nodes, other inputs, no effect parameter
-    inputs = [v.name for v in read_model_description(str(path)).modelVariables if v.causality == "input"]
+    # the sizes the guard reads are the model description's: nodes, other inputs, the Real
+    # parameters but the N start values (the building's properties)
+    variables = read_model_description(str(path)).modelVariables
+    inputs = [v.name for v in variables if v.causality == "input"]
     n = sum(name.startswith("T_forced[") for name in inputs)
-    assert sizes == f"sizes {n} {len(inputs) - n} 0" and n == 23
+    reals = sum(v.causality == "parameter" and v.type == "Real" for v in variables)
+    assert sizes == f"sizes {n} {len(inputs) - n} {reals - n}" and n == 23 and reals - n == 27
 
 
 def test_without_a_c_compiler_the_python_fmu_is_written_unguarded(testcell_data, tmp_path, monkeypatch, capsys):
@@ -44,5 +47,5 @@ def test_without_a_c_compiler_the_python_fmu_is_written_unguarded(testcell_data,
     assert "resources/guard.txt" not in names and not any(n.endswith(".pythonfmu.so") for n in names)
     assert "without its guard" in page
     # pythonfmu's own binary runs it as before
-    T = run_fmpy(fmu, {"T_start": 22.0}, {}, ["T[23]"], 900.0, 4)
+    T = run_fmpy(fmu, {"T_start[23]": 22.0}, {}, ["T[23]"], 900.0, 4)
     assert np.isfinite(T).all()

@@ -218,11 +218,10 @@ def test_standalone_fmu_equals_the_direct_model_on_the_twin_house(tmp_path, stea
     """The Twin House (267 nodes: the direct model's dense inverse) through the C FMU's profile LU,
     on two days of random inputs, a third of its nodes forced to random measurements, some of
     them missing at three steps; with a diagnosis' steady start too (its one long step)."""
-    from types import SimpleNamespace
-
     from nodeforce.cosim.fmi import FmuInstance
     from nodeforce.cosim.run import simulate_fmu
     from nodeforce.fmu_build.build import build_fmu
+    from nodeforce.model.case import Case
     building = load_building(BUILDINGS[1])
     network = assemble(building)
     rng = np.random.default_rng(6)
@@ -231,8 +230,8 @@ def test_standalone_fmu_equals_the_direct_model_on_the_twin_house(tmp_path, stea
     measured = rng.normal(20.0, 2.0, (n_rows, network.n_nodes))
     measured[[20, 100, 150]] = np.where(rng.random(network.n_nodes) < 0.5, np.nan, measured[[20, 100, 150]])
     force = rng.random(network.n_nodes) < 0.3
-    case = SimpleNamespace(measured=measured, dt=900.0, burn_in_steps=4, U=U, input_names=network.input_names,
-                           steady_start=steady_start)
+    case = Case(times=None, dt=900.0, input_names=network.input_names, U=U, measured=measured, burn_in_steps=4,
+                steady_start=steady_start, building=building)
     expected = simulate(building, network, U, 900.0, measured, force=force, burn_in_steps=4,
                         steady_start=steady_start)
     instance = FmuInstance(build_fmu(building, tmp_path / "twinhouse.fmu", kind="standalone"))

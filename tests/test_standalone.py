@@ -69,7 +69,7 @@ def fmus(tmp_path_factory, testcell_data):
 
 def scenario(fmu, n_steps=192, seed=0):
     """Parameters, inputs and outputs of a two-day run: a sinusoidal day, the forced nodes'
-    measurements with gaps (NaN), the initial measurements set during initialisation."""
+    measurements with gaps (NaN), the state at the start (T_start, a measured node's its own)."""
     rng = np.random.default_rng(seed)
     variables = [v for v in read_model_description(str(fmu)).modelVariables if v.causality == "input"]
     n = sum(v.name.startswith("T_forced[") for v in variables)
@@ -92,7 +92,8 @@ def scenario(fmu, n_steps=192, seed=0):
         measured = 27 + 2 * day + rng.normal(0, 0.1, n_steps)
         measured[rng.random(n_steps) < 0.1] = np.nan
         inputs[f"T_forced[{i}]"] = measured
-    parameters = {"T_start": 23.0, **{f"force[{i}]": True for i in forced}, "T_forced[23]": 25.5}
+    parameters = {**{f"T_start[{i}]": 23.0 for i in range(1, n + 1)}, "T_start[23]": 25.5,
+                  **{f"force[{i}]": True for i in forced}}
     return parameters, inputs, [f"T[{i}]" for i in range(1, n + 1)], n_steps
 
 
@@ -221,7 +222,6 @@ def test_checkers_and_importers_agree(fmus, kind):
     ok, output = fmutool_check(fmu)
     assert ok, output
     parameters, inputs, outputs, _ = scenario(fmu)
-    parameters.pop("T_forced[23]")  # libcosim and ecos set parameters only before initialisation
     reference = run_fmpy(fmus[("testcell", "python")], parameters, inputs, outputs, 900.0, 96)
     for runner in (run_fmpy, run_libcosim, run_ecos):
         assert np.abs(runner(fmu, parameters, inputs, outputs, 900.0, 96) - reference).max() < 1e-9
@@ -237,7 +237,7 @@ def test_model_description_declares_units_initial_and_dependencies(fmus, kind):
     variables = root.find("ModelVariables").findall("ScalarVariable")
     by_name = {v.get("name"): (index, v) for index, v in enumerate(variables, start=1)}
     unit = lambda name: by_name[name][1][0].get("unit")
-    assert [unit(n) for n in ("T[1]", "T_out", "I_roof", "Q_annex", "T_forced[3]", "T_start")] == \
+    assert [unit(n) for n in ("T[1]", "T_out", "I_roof", "Q_annex", "T_forced[3]", "T_start[3]")] == \
         ["degC", "degC", "W/m2", "W", "degC", "degC"]
     assert float(root.find("DefaultExperiment").get("stepSize")) == 900.0
     assert root.get("version") and root.get("license")
@@ -248,11 +248,8 @@ def test_model_description_declares_units_initial_and_dependencies(fmus, kind):
     initial = {int(u.get("index")): {int(d) for d in u.get("dependencies").split()}
                for u in structure.find("InitialUnknowns")}
     index = lambda name: by_name[name][0]
-    # node 27, inside the partition: its own and its component's measurements, the cell's air
-    # (the fallback) and T_start; nothing of the annex, which it does not face from inside
-    assert initial[index("T[27]")] == {index(n) for n in ("T_forced[26]", "T_forced[27]", "T_forced[28]",
-                                                          "T_forced[23]", "T_start")}
-    assert initial[index("T[25]")] == {index(n) for n in ("T_forced[24]", "T_forced[25]", "T_start")}
+    # the start values alone set the state: node i's T_start, no input an importer applies at t_0
+    assert initial == {index(f"T[{i}]"): {index(f"T_start[{i}]")} for i in range(1, 31)}
 
 
 @pytest.mark.parametrize("kind", KINDS)
@@ -295,10 +292,10 @@ def test_forbidden_calls_get_fmi2_error_and_change_nothing(fmus, tmp_path, kind)
     assert status(slave.doStep, 0.0, 0.0) == ERROR
     assert status(slave.doStep, 0.0, -900.0) == ERROR
     assert status(slave.setReal, [vr["T[23]"]], [99.0]) == ERROR  # an output
-    assert status(slave.setReal, [vr["T_start"]], [99.0]) == ERROR  # fixed, after initialisation
+    assert status(slave.setReal, [vr["T_start[3]"]], [99.0]) == ERROR  # fixed, after initialisation
     assert status(slave.setBoolean, [vr["force[9]"]], [True]) == ERROR
     assert status(slave.getReal, [vr["force[9]"]]) == ERROR  # a Boolean
-    assert status(slave.getBoolean, [vr["T_start"]]) == ERROR  # a Real
+    assert status(slave.getBoolean, [vr["T_start[3]"]]) == ERROR  # a Real
     assert status(slave.getReal, [10 ** 6]) == ERROR
     assert status(slave.getInteger, [0]) == ERROR  # no Integer variables
     # nothing refused changed anything, and the slave steps on
@@ -318,9 +315,9 @@ def test_the_guard_keeps_the_slave_state_across_fmu_states(fmus, tmp_path):
     slave.enterInitializationMode()
     during = slave.getFMUstate()
     slave.exitInitializationMode()
-    assert status(slave.setReal, [vr["T_start"]], [25.0]) == ERROR
+    assert status(slave.setReal, [vr["T_start[3]"]], [25.0]) == ERROR
     slave.setFMUstate(during)
-    slave.setReal([vr["T_start"]], [25.0])  # allowed again
+    slave.setReal([vr["T_start[3]"]], [25.0])  # allowed again
     slave.exitInitializationMode()
     stepping = slave.getFMUstate()
     restored = slave.deSerializeFMUstate(slave.serializeFMUstate(stepping))

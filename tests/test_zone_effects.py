@@ -1,6 +1,7 @@
 """The zone effects of docs/model.md section 7 (internal mass, heater lag, envelope factor) against
 independent calculations, and both FMUs against the direct model with each of them."""
 import copy
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -190,8 +191,8 @@ def test_both_fmus_with_a_zone_effect_equal_the_direct_model(testcell_data, real
         full = np.full((n_rows, after.n_nodes), np.nan)
         full[:, :net.n_nodes] = measured
         expected = simulate(after, assemble(after, net.input_names), U, 900.0, full)
-        with FmuInstance(fmu) as instance:
-            T = simulate_fmu(instance, case, output_ids=range(1, after.n_nodes + 1),
+        with FmuInstance(fmu) as instance:  # the case of the FMU's building, the effect's node in it
+            T = simulate_fmu(instance, replace(case, building=after), output_ids=range(1, after.n_nodes + 1),
                              parameters={f"{effect}.{k}": v for k, v in values.items()})
         assert np.abs(T - expected).max() < 1e-9, effect
         plain = simulate(b, net, U, 900.0, measured)

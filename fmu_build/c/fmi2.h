@@ -76,7 +76,14 @@ typedef fmi2Status fmi2GetIntegerStatusTYPE(fmi2Component, const fmi2StatusKind,
 typedef fmi2Status fmi2GetBooleanStatusTYPE(fmi2Component, const fmi2StatusKind, fmi2Boolean *);
 typedef fmi2Status fmi2GetStringStatusTYPE(fmi2Component, const fmi2StatusKind, fmi2String *);
 
-#if defined(_WIN32)
+/* NODEFORCE_FMI3: the FMI 2.0 functions are the library's own, under its FMI 3.0 interface
+   (fmi3.c): not exported, so that fmi3.c's calls bind inside the library with no linker option
+   (buildDescription.xml of the FMI 3.0 FMU defines it). */
+#if defined(NODEFORCE_FMI3) && defined(_WIN32)
+#define FMI2_EXPORT
+#elif defined(NODEFORCE_FMI3)
+#define FMI2_EXPORT __attribute__((visibility("hidden")))
+#elif defined(_WIN32)
 #define FMI2_EXPORT __declspec(dllexport)
 #else
 #define FMI2_EXPORT __attribute__((visibility("default")))

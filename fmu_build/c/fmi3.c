@@ -7,14 +7,16 @@
    Variables (FMI 3.0 value references), over the FMI 2.0 layout of variables.h:
        0                 time            independent
        1                 force[N]        Boolean parameter, fixed      FMI 2.0: force[1..N]
-       2                 T_start         Float64 parameter, fixed
+       2                 T_start[N]      Float64 parameter, fixed      FMI 2.0: T_start[1..N]
        3 .. 2+N_IN       the inputs      Float64 inputs
        3+N_IN            T_forced[N]     Float64 input, discrete       FMI 2.0: T_forced[1..N]
        4+N_IN            T[N]            Float64 output                FMI 2.0: T[1..N]
-       5+N_IN ..         the effect's parameters, Float64, fixed
-   The sizes come from resources/fmi3.txt ("nodeforce-fmi3/1", then "sizes N N_IN N_PAR"). No
-   event mode, no intermediate update: the functions of those (and of model exchange and
-   scheduled execution) answer fmi3Error, with the reason logged. */
+       5+N_IN ..         the other parameters (properties, an effect's), Float64, fixed
+   The sizes come from resources/fmi3.txt ("nodeforce-fmi3/1", then "sizes N N_IN N_PAR"), the
+   names from resources/names.txt. A get or set is checked here, by the FMI 2.0 rules of
+   variables.h, so that a refusal names the FMI 3.0 value reference. No event mode, no
+   intermediate update: the functions of those (and of model exchange and scheduled execution)
+   answer fmi3Error, with the reason logged. */
 #define _GNU_SOURCE
 #include <stdarg.h>
 #include <stdio.h>
@@ -49,6 +51,7 @@ FMI2_EXPORT fmi2DoStepTYPE fmi2DoStep;
 typedef struct {
     fmi2Component inner; /* the FMI 2.0 instance */
     Layout layout;
+    int state; /* variables.h's, as the FMI 2.0 instance's */
     double time;
     char *name;
     fmi3InstanceEnvironment environment;
@@ -56,8 +59,9 @@ typedef struct {
     fmi2CallbackFunctions callbacks; /* the FMI 2.0 instance's, which log through `log` */
 } Adapter;
 
-/* An FMU state: the time beside the FMI 2.0 state. */
+/* An FMU state: the state and time beside the FMI 2.0 state. */
 typedef struct {
+    int state;
     double time;
     fmi2FMUstate inner;
 } AdapterState;
@@ -98,8 +102,10 @@ static int variable(const Layout *l, fmi3ValueReference vr, int *first, int *cou
         *count = l->n;
         return BOOLEAN;
     }
-    if (r == 2) *first = vr_T_start(l);
-    else if (r < T_forced) *first = vr_inputs(l) + (int)(r - inputs);
+    if (r == 2) {
+        *first = vr_T_start(l);
+        *count = l->n;
+    } else if (r < T_forced) *first = vr_inputs(l) + (int)(r - inputs);
     else if (r == T_forced || r == T_forced + 1) {
         *first = r == T_forced ? vr_T_forced(l) : vr_T(l);
         *count = l->n;
@@ -138,6 +144,29 @@ static fmi2ValueReference *expand(Adapter *a, const fmi3ValueReference vr[], siz
         for (j = 0; j < count; j++) refs[(*n)++] = (fmi2ValueReference)(first + j);
     }
     return refs;
+}
+
+/* Why the FMI 2.0 rules refuse this get or set of n references (expanded from vr; reals: the
+   values set or NULL), said of the FMI 3.0 variable: 1 with the reason logged, else 0. */
+static int refused3(Adapter *a, const fmi3ValueReference vr[], size_t nvr, const fmi2ValueReference refs[], size_t n,
+                    const double *reals, int real, int setting) {
+    char reason[256], name[128], element[32] = "";
+    long at = refusal(&a->layout, refs, n, reals, real, setting, a->state, a->time, reason, sizeof reason);
+    size_t k;
+    int first, count;
+    if (at < 0) return 0;
+    for (k = 0; k < nvr; k++) { /* the FMI 3.0 variable and element of position `at` */
+        if (variable(&a->layout, vr[k], &first, &count) == TIME) continue;
+        if (at < count) break;
+        at -= count;
+    }
+    variable_name(&a->layout, first + (int)at, name, sizeof name);
+    if (count > 1) {
+        snprintf(element, sizeof element, ", element %ld", at + 1);
+        *strchr(name, '[') = 0; /* the array's name */
+    }
+    refuse(a, "value reference %u (%s%s) %s", vr[k], name, element, reason);
+    return 1;
 }
 
 /* Values of the FMI 2.0 list (time aside) to or from the FMI 3.0 one, time at its places. */
@@ -179,7 +208,8 @@ static fmi3Status transfer(Adapter *a, const fmi3ValueReference vr[], size_t nvr
     }
     if (setting && reals) place_time(a, vr, nvr, values, reals, 0);
     for (k = 0; setting && booleans && k < n; k++) booleans[k] = ((fmi3Boolean *)values)[k] ? fmi2True : fmi2False;
-    if (reals) status = (fmi3Status)(setting ? fmi2SetReal(a->inner, refs, n, reals) : fmi2GetReal(a->inner, refs, n, reals));
+    if (refused3(a, vr, nvr, refs, n, setting ? reals : NULL, type == REAL, setting)) status = fmi3Error;
+    else if (reals) status = (fmi3Status)(setting ? fmi2SetReal(a->inner, refs, n, reals) : fmi2GetReal(a->inner, refs, n, reals));
     else status = (fmi3Status)(setting ? fmi2SetBoolean(a->inner, refs, n, booleans)
                                        : fmi2GetBoolean(a->inner, refs, n, booleans));
     if (!setting && status <= fmi3Warning) {
@@ -214,6 +244,12 @@ FMI3_EXPORT fmi3Status fmi3SetBoolean(fmi3Instance instance, const fmi3ValueRefe
 }
 
 /* ------------------------------------------------------------------ instances */
+/* A call that moves the instance to `state` when it succeeds. */
+static fmi3Status moved(Adapter *a, fmi3Status status, int state) {
+    if (status <= fmi3Warning) a->state = state;
+    return status;
+}
+
 FMI3_EXPORT const char *fmi3GetVersion(void) { return "3.0"; }
 
 FMI3_EXPORT fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean loggingOn, size_t nCategories,
@@ -263,6 +299,14 @@ FMI3_EXPORT fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fm
         free(a);
         return NULL;
     }
+    uri = malloc(strlen(resourcePath) + 16);
+    if (uri) {
+        sprintf(uri, "%s%snames.txt", resourcePath,
+                resourcePath[0] && resourcePath[strlen(resourcePath) - 1] == '/' ? "" : "/");
+        if (!read_names(&a->layout, uri)) free_names(&a->layout); /* messages then say "an input" */
+        free(uri);
+    }
+    a->state = INSTANTIATED;
     {   /* the FMI 2.0 instance logs to this one; its callbacks stay here, where it may keep them */
         const fmi2CallbackFunctions callbacks = {forward_log, calloc, free, NULL, a};
         memcpy(&a->callbacks, &callbacks, sizeof callbacks);
@@ -277,6 +321,7 @@ FMI3_EXPORT fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fm
     }
     free(uri);
     if (!a->inner) {
+        free_names(&a->layout);
         free(a->name);
         free(a);
         return NULL;
@@ -288,6 +333,7 @@ FMI3_EXPORT void fmi3FreeInstance(fmi3Instance instance) {
     Adapter *a = instance;
     if (!a) return;
     fmi2FreeInstance(a->inner);
+    free_names(&a->layout);
     free(a->name);
     free(a);
 }
@@ -300,22 +346,22 @@ FMI3_EXPORT fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Bo
                                                         stopTimeDefined, stopTime);
     if (status > fmi3Warning) return status;
     a->time = startTime;
-    return (fmi3Status)fmi2EnterInitializationMode(a->inner);
+    return moved(a, (fmi3Status)fmi2EnterInitializationMode(a->inner), INITIALISATION);
 }
 
 FMI3_EXPORT fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
     Adapter *a = instance;
-    return (fmi3Status)fmi2ExitInitializationMode(a->inner);
+    return moved(a, (fmi3Status)fmi2ExitInitializationMode(a->inner), STEPPING);
 }
 
 FMI3_EXPORT fmi3Status fmi3Terminate(fmi3Instance instance) {
     Adapter *a = instance;
-    return (fmi3Status)fmi2Terminate(a->inner);
+    return moved(a, (fmi3Status)fmi2Terminate(a->inner), TERMINATED);
 }
 
 FMI3_EXPORT fmi3Status fmi3Reset(fmi3Instance instance) {
     Adapter *a = instance;
-    fmi3Status status = (fmi3Status)fmi2Reset(a->inner);
+    fmi3Status status = moved(a, (fmi3Status)fmi2Reset(a->inner), INSTANTIATED);
     if (status <= fmi3Warning) a->time = 0.0;
     return status;
 }
@@ -347,6 +393,7 @@ FMI3_EXPORT fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState *stat
         return status;
     }
     s->time = a->time;
+    s->state = a->state;
     *state = s;
     return status;
 }
@@ -356,7 +403,7 @@ FMI3_EXPORT fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState state
     AdapterState *s = state;
     fmi3Status status;
     if (!s) return refuse(a, "fmi3SetFMUState without a state");
-    status = (fmi3Status)fmi2SetFMUstate(a->inner, s->inner);
+    status = moved(a, (fmi3Status)fmi2SetFMUstate(a->inner, s->inner), s->state);
     if (status <= fmi3Warning) a->time = s->time;
     return status;
 }
@@ -372,11 +419,12 @@ FMI3_EXPORT fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState *sta
     return status;
 }
 
-/* A serialized state: the time's bytes, then the FMI 2.0 state's. */
+/* A serialized state: the time's bytes and the state's (a double each), then the FMI 2.0 state's. */
+#define HEAD (2 * sizeof(double))
 FMI3_EXPORT fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState state, size_t *size) {
     Adapter *a = instance;
     fmi3Status status = (fmi3Status)fmi2SerializedFMUstateSize(a->inner, ((AdapterState *)state)->inner, size);
-    if (status <= fmi3Warning) *size += sizeof(double);
+    if (status <= fmi3Warning) *size += HEAD;
     return status;
 }
 
@@ -384,10 +432,12 @@ FMI3_EXPORT fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState
                                              size_t size) {
     Adapter *a = instance;
     AdapterState *s = state;
-    if (size < sizeof(double)) return refuse(a, "fmi3SerializeFMUState: no room for the state");
-    memcpy(serializedState, &s->time, sizeof(double));
-    return (fmi3Status)fmi2SerializeFMUstate(a->inner, s->inner, (fmi2Byte *)serializedState + sizeof(double),
-                                             size - sizeof(double));
+    double head[2];
+    if (size < HEAD) return refuse(a, "fmi3SerializeFMUState: no room for the state");
+    head[0] = s->time;
+    head[1] = s->state;
+    memcpy(serializedState, head, HEAD);
+    return (fmi3Status)fmi2SerializeFMUstate(a->inner, s->inner, (fmi2Byte *)serializedState + HEAD, size - HEAD);
 }
 
 FMI3_EXPORT fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte serializedState[], size_t size,
@@ -395,12 +445,17 @@ FMI3_EXPORT fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3
     Adapter *a = instance;
     AdapterState *s;
     fmi3Status status;
-    if (size < sizeof(double)) return refuse(a, "these bytes are not a serialized state of this FMU");
+    double head[2];
+    if (size < HEAD) return refuse(a, "these bytes are not a serialized state of this FMU");
+    memcpy(head, serializedState, HEAD);
+    if (!(head[1] >= INSTANTIATED && head[1] <= TERMINATED))
+        return refuse(a, "these bytes are not a serialized state of this FMU");
     s = calloc(1, sizeof(AdapterState));
     if (!s) return refuse(a, "out of memory for a state");
-    memcpy(&s->time, serializedState, sizeof(double));
-    status = (fmi3Status)fmi2DeSerializeFMUstate(a->inner, (const fmi2Byte *)serializedState + sizeof(double),
-                                                 size - sizeof(double), &s->inner);
+    s->time = head[0];
+    s->state = (int)head[1];
+    status = (fmi3Status)fmi2DeSerializeFMUstate(a->inner, (const fmi2Byte *)serializedState + HEAD, size - HEAD,
+                                                 &s->inner);
     if (status > fmi3Warning) {
         free(s);
         return status;

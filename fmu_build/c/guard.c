@@ -15,7 +15,8 @@
    /usr/local/lib and $CONDA_PREFIX/lib; the logged error names every one tried.
 
    The guard does not depend on the model: it reads the sizes of the layout from
-   resources/guard.txt at instantiation, a file of four lines:
+   resources/guard.txt at instantiation (and the variables' names from resources/names.txt, for
+   its messages), a file of four lines:
        nodeforce-guard/1
        sizes N N_IN N_PAR
        binary FILE_NAME         pythonfmu's binary, in this library's folder
@@ -91,15 +92,17 @@ typedef struct {
     fmi2Real *outputs;               /* T[1..N] */
     fmi2ValueReference *output_refs; /* their value references */
     int state;
+    double time; /* the current communication point (s), for the messages */
     char *name, *guid, *resources;
     fmi2Type type;
     fmi2Boolean visible, logging;
     const fmi2CallbackFunctions *functions; /* the host's: valid until fmi2FreeInstance (FMI 2.0) */
 } Guard;
 
-/* A state of the slave: the guard's state beside pythonfmu's. */
+/* A state of the slave: the guard's state and time beside pythonfmu's. */
 typedef struct {
     int state;
+    double time;
     fmi2FMUstate inner;
 } GuardState;
 
@@ -285,6 +288,7 @@ static void free_guard(Guard *g) {
     free(g->resources);
     free(g->outputs);
     free(g->output_refs);
+    free_names(&g->layout);
     free(g);
 }
 
@@ -323,6 +327,9 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
     g->functions = functions;
     g->layout = file.layout;
     g->state = INSTANTIATED;
+    path = resource_path(resources, "names.txt");
+    if (!read_names(&g->layout, path)) free_names(&g->layout); /* messages then say "an input" */
+    free(path);
     g->outputs = malloc(sizeof(fmi2Real) * (size_t)(file.layout.n + 1));
     g->output_refs = malloc(sizeof(fmi2ValueReference) * (size_t)(file.layout.n + 1));
     for (k = 0; g->output_refs && k < file.layout.n; k++) g->output_refs[k] = (fmi2ValueReference)(vr_T(&g->layout) + k);
@@ -344,8 +351,10 @@ FMI2_EXPORT void fmi2FreeInstance(fmi2Component c) {
 FMI2_EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
                                            fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
     Guard *g = c;
-    return FORWARD(g, fmi2SetupExperiment(g->inner, toleranceDefined, tolerance, startTime, stopTimeDefined,
-                                          stopTime));
+    fmi2Status status = FORWARD(g, fmi2SetupExperiment(g->inner, toleranceDefined, tolerance, startTime,
+                                                       stopTimeDefined, stopTime));
+    if (status <= fmi2Warning) g->time = startTime;
+    return status;
 }
 
 /* The calls that move the instance to another state: forwarded, the state kept if they succeed. */
@@ -363,6 +372,7 @@ MOVES_TO(fmi2Terminate, TERMINATED)
 FMI2_EXPORT fmi2Status fmi2Reset(fmi2Component c) {
     Guard *g = c;
     fmi2Component fresh;
+    g->time = 0.0;
     if (!g->lost) return moved(g, answered(g, inner.fmi2Reset(g->inner)), INSTANTIATED);
     fresh = instantiate(g);
     if (!fresh) return refuse(g, "fmi2Reset: the model cannot be instantiated again");
@@ -374,25 +384,26 @@ FMI2_EXPORT fmi2Status fmi2Reset(fmi2Component c) {
 }
 
 /* The get and set calls: refused here (variables.h), or forwarded. */
-#define GET_OR_SET(function, value_type, real, setting)                                                       \
+#define GET_OR_SET(function, value_type, reals, real, setting)                                                \
     FMI2_EXPORT fmi2Status function(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, value_type) { \
         Guard *g = c;                                                                                         \
-        char reason[256];                                                                                     \
-        if (refusal(&g->layout, vr, nvr, real, setting, g->state, reason, sizeof reason))                    \
-            return refuse(g, reason);                                                                         \
+        char message[512];                                                                                    \
+        if (refused2(&g->layout, vr, nvr, reals, real, setting, g->state, g->time, message, sizeof message)) \
+            return refuse(g, message);                                                                        \
         return FORWARD(g, function(g->inner, vr, nvr, value));                                                \
     }
-GET_OR_SET(fmi2SetReal, const fmi2Real value[], 1, 1)
-GET_OR_SET(fmi2GetBoolean, fmi2Boolean value[], 0, 0)
-GET_OR_SET(fmi2SetBoolean, const fmi2Boolean value[], 0, 1)
+GET_OR_SET(fmi2SetReal, const fmi2Real value[], value, 1, 1)
+GET_OR_SET(fmi2GetBoolean, fmi2Boolean value[], NULL, 0, 0)
+GET_OR_SET(fmi2SetBoolean, const fmi2Boolean value[], NULL, 0, 1)
 
 /* Outputs only, once initialisation has ended: from the copy (the top of this file). */
 FMI2_EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
     Guard *g = c;
-    char reason[256];
+    char message[512];
     size_t k;
     int outputs = (g->state == STEPPING || g->state == TERMINATED) && !g->lost;
-    if (refusal(&g->layout, vr, nvr, 1, 0, g->state, reason, sizeof reason)) return refuse(g, reason);
+    if (refused2(&g->layout, vr, nvr, NULL, 1, 0, g->state, g->time, message, sizeof message))
+        return refuse(g, message);
     for (k = 0; outputs && k < nvr; k++) outputs = (int)vr[k] >= vr_T(&g->layout) && (int)vr[k] < vr_parameters(&g->layout);
     if (!outputs) return FORWARD(g, fmi2GetReal(g->inner, vr, nvr, value));
     if (!g->cached) {
@@ -427,6 +438,7 @@ FMI2_EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *state) {
         return status;
     }
     s->state = g->state;
+    s->time = g->time;
     *state = s;
     return status;
 }
@@ -434,8 +446,11 @@ FMI2_EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *state) {
 FMI2_EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state) {
     Guard *g = c;
     GuardState *s = state;
+    fmi2Status status;
     if (!s) return refuse(g, "fmi2SetFMUstate without a state");
-    return moved(g, FORWARD(g, fmi2SetFMUstate(g->inner, s->inner)), s->state);
+    status = moved(g, FORWARD(g, fmi2SetFMUstate(g->inner, s->inner)), s->state);
+    if (status <= fmi2Warning) g->time = s->time;
+    return status;
 }
 
 /* Allowed on an instance set aside too: pythonfmu's fmi2FreeFMUstate releases the state's own
@@ -509,10 +524,13 @@ FMI2_EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunication
                                   fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
     Guard *g = c;
     char reason[256];
+    fmi2Status status;
     if (step_refusal(g->state, communicationStepSize, reason, sizeof reason)) return refuse(g, reason);
     g->cached = 0;
-    return FORWARD(g, fmi2DoStep(g->inner, currentCommunicationPoint, communicationStepSize,
-                                 noSetFMUStatePriorToCurrentPoint));
+    status = FORWARD(g, fmi2DoStep(g->inner, currentCommunicationPoint, communicationStepSize,
+                                   noSetFMUStatePriorToCurrentPoint));
+    if (status <= fmi2Warning) g->time = currentCommunicationPoint + communicationStepSize;
+    return status;
 }
 
 FMI2_EXPORT fmi2Status fmi2CancelStep(fmi2Component c) {

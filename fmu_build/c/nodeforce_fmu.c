@@ -1,15 +1,16 @@
-/* A generic FMI 2.0 co-simulation slave stepping a nodal network (docs/model.md section 5).
+/* A generic FMI 2.0 co-simulation slave stepping a nodal network (docs/model.md).
 
    The network is data, assembled by nodeforce in Python and shipped as resources/network.txt:
    C (J/K), A (W/K), B, q (W) and the coefficients P (W) of the products of two inputs (a shaded
-   glazing's transmitted sun, P_k u_a u_b on node i) at the declared effect parameters p0 and,
-   per set S of effect parameters, a term multiplied by prod_{j in S} (p_j - p0_j); the zones'
-   air and radiant nodes and each component's nodes with their depths (for the initial state).
-   This file only steps:
+   glazing's transmitted sun, P_k u_a u_b on node i) at the declared parameters p0 and, per set S
+   of parameters that act together, a term multiplied by prod_{j in S} (p_j - p0_j): the
+   network is affine in each parameter (the building's properties, an added effect's). Each
+   term keeps its nonzeros only. This file only steps:
        (C/dt - A) T+ = (C/dt) T + B u + q + s(u),   s_i(u) = sum over products k on i of P_k u_a u_b,
    the rows of forced nodes (force[i] and T_forced[i] not NaN) replaced by T+_i = T_forced[i],
    with M factorised once per pattern of imposed nodes and step size: LU within the profile of
    M reordered by reverse Cuthill-McKee (Profile below), O(N) per step on a building's network.
+   The state at the start is T_start.
 
    Value references and the calls refused: variables.h (shared with the Python FMU's guard). */
 #include <math.h>
@@ -43,14 +44,14 @@ typedef struct {
 } Profile;
 
 typedef struct {
-    int n, n_in, n_par, n_terms, n_zones, n_groups, n_products;
-    double *p0;     /* n_par */
-    int *product;   /* n_products x 3: node, input a, input b */
-    int *term_mask; /* n_terms: bit j = parameter j multiplies the term */
-    double *terms;  /* n_terms x (n + n*n + n*n_in + n + n_products): C, A, B, q, P */
-    int *air, *radiant;                 /* n_zones, 0-based nodes */
-    int *group_zone, *group_start, *group_len; /* n_groups */
-    int *group_node; double *group_depth;      /* concatenated */
+    int n, n_in, n_par, n_terms, n_products;
+    double *p0;       /* n_par */
+    int *product;     /* n_products x 3: node, input a, input b */
+    long *term_start; /* n_terms + 1: where each term's nonzeros begin */
+    long *par_start;  /* n_terms + 1: where each term's parameters begin */
+    int *term_par;    /* the parameters multiplying each term, concatenated */
+    long *index;      /* each term's nonzeros: index in the block C, A, B, q, P ... */
+    double *value;    /* ... and value, concatenated */
 } Network;
 
 typedef struct {
@@ -59,6 +60,7 @@ typedef struct {
     char *name;
     fmi2CallbackFunctions cb;
     int state, size, clock;
+    double time; /* the current communication point (s) */
     double *values, *start_values;
     double *C, *A, *B, *q, *P; /* at the parameters' values */
     double *v, *work;
@@ -78,10 +80,10 @@ static void log_error(Model *m, const char *format, ...) {
 }
 
 /* A get or set the standard forbids (variables.h), its reason logged: 1 when refused. */
-static int refused(Model *m, const fmi2ValueReference vr[], size_t nvr, int real, int setting) {
-    char reason[256];
-    if (!refusal(&m->layout, vr, nvr, real, setting, m->state, reason, sizeof reason)) return 0;
-    log_error(m, "%s", reason);
+static int refused(Model *m, const fmi2ValueReference vr[], size_t nvr, const double *values, int real, int setting) {
+    char message[512];
+    if (!refused2(&m->layout, vr, nvr, values, real, setting, m->state, m->time, message, sizeof message)) return 0;
+    log_error(m, "%s", message);
     return 1;
 }
 
@@ -105,27 +107,38 @@ static int read_doubles(FILE *f, double *x, long count) {
     return 1;
 }
 
+static int read_longs(FILE *f, long *x, long count) {
+    long k;
+    for (k = 0; k < count; k++)
+        if (fscanf(f, "%ld", &x[k]) != 1) return 0;
+    return 1;
+}
+
+/* The size of the block C, A, B, q, P. */
 static long term_size(const Network *net) { return (long)net->n * (2 + net->n + net->n_in) + net->n_products; }
 
+/* resources/network.txt: "nodeforce-network/3", "sizes N N_IN N_PAR N_TERMS N_PRODUCTS
+   N_PARAMETER_REFS N_NONZEROS", "p0 ...", "products (node a b) ...", then per term "term K
+   j_1 .. j_K COUNT" and COUNT pairs "index value" (index into the block C, A, B, q, P), "end". */
 static int read_network(Network *net, FILE *f) {
-    int k, total = 0;
-    if (!expect(f, "nodeforce-network/2") || !expect(f, "sizes") || !read_ints(f, &net->n, 1)
+    long refs, nonzeros, k, count, at = 0, at_par = 0, size;
+    int t, j;
+    if (!expect(f, "nodeforce-network/3") || !expect(f, "sizes") || !read_ints(f, &net->n, 1)
         || !read_ints(f, &net->n_in, 1) || !read_ints(f, &net->n_par, 1) || !read_ints(f, &net->n_terms, 1)
-        || !read_ints(f, &net->n_zones, 1) || !read_ints(f, &net->n_groups, 1) || !read_ints(f, &net->n_products, 1))
+        || !read_ints(f, &net->n_products, 1) || !read_longs(f, &refs, 1) || !read_longs(f, &nonzeros, 1)
+        || net->n <= 0 || net->n_in < 0 || net->n_par < 0 || net->n_terms < 1 || net->n_products < 0 || refs < 0
+        || nonzeros < 0)
         return 0;
+    size = term_size(net);
     net->p0 = calloc((size_t)net->n_par + 1, sizeof(double));
     net->product = calloc((size_t)net->n_products * 3 + 1, sizeof(int));
-    net->term_mask = calloc((size_t)net->n_terms, sizeof(int));
-    net->terms = calloc((size_t)(net->n_terms * term_size(net)), sizeof(double));
-    net->air = calloc((size_t)net->n_zones, sizeof(int));
-    net->radiant = calloc((size_t)net->n_zones, sizeof(int));
-    net->group_zone = calloc((size_t)net->n_groups, sizeof(int));
-    net->group_start = calloc((size_t)net->n_groups, sizeof(int));
-    net->group_len = calloc((size_t)net->n_groups, sizeof(int));
-    net->group_node = calloc((size_t)net->n, sizeof(int));
-    net->group_depth = calloc((size_t)net->n, sizeof(double));
-    if (!net->p0 || !net->product || !net->term_mask || !net->terms || !net->air || !net->radiant || !net->group_zone
-        || !net->group_start || !net->group_len || !net->group_node || !net->group_depth)
+    net->term_start = calloc((size_t)net->n_terms + 1, sizeof(long));
+    net->par_start = calloc((size_t)net->n_terms + 1, sizeof(long));
+    net->term_par = calloc((size_t)refs + 1, sizeof(int));
+    net->index = calloc((size_t)nonzeros + 1, sizeof(long));
+    net->value = calloc((size_t)nonzeros + 1, sizeof(double));
+    if (!net->p0 || !net->product || !net->term_start || !net->par_start || !net->term_par || !net->index
+        || !net->value)
         return 0;
     if (!expect(f, "p0") || !read_doubles(f, net->p0, net->n_par)) return 0;
     if (!expect(f, "products") || !read_ints(f, net->product, net->n_products * 3)) return 0;
@@ -133,33 +146,34 @@ static int read_network(Network *net, FILE *f) {
         const int *p = net->product + 3 * k;
         if (p[0] < 0 || p[0] >= net->n || p[1] < 0 || p[1] >= net->n_in || p[2] < 0 || p[2] >= net->n_in) return 0;
     }
-    for (k = 0; k < net->n_terms; k++)
-        if (!expect(f, "term") || !read_ints(f, &net->term_mask[k], 1)
-            || !read_doubles(f, net->terms + k * term_size(net), term_size(net)))
+    for (t = 0; t < net->n_terms; t++) {
+        int n_par;
+        net->term_start[t] = at;
+        net->par_start[t] = at_par;
+        if (!expect(f, "term") || !read_ints(f, &n_par, 1) || n_par < 0 || at_par + n_par > refs
+            || !read_ints(f, net->term_par + at_par, n_par) || !read_longs(f, &count, 1) || count < 0
+            || at + count > nonzeros)
             return 0;
-    if (!expect(f, "zones")) return 0;
-    for (k = 0; k < net->n_zones; k++)
-        if (!read_ints(f, &net->air[k], 1) || !read_ints(f, &net->radiant[k], 1)) return 0;
-    if (!expect(f, "components")) return 0;
-    for (k = 0; k < net->n_groups; k++) {
-        int j;
-        if (!read_ints(f, &net->group_zone[k], 1) || !read_ints(f, &net->group_len[k], 1)) return 0;
-        net->group_start[k] = total;
-        if (total + net->group_len[k] > net->n) return 0;
-        for (j = 0; j < net->group_len[k]; j++, total++)
-            if (!read_ints(f, &net->group_node[total], 1) || !read_doubles(f, &net->group_depth[total], 1)) return 0;
+        for (j = 0; j < n_par; j++)
+            if (net->term_par[at_par + j] < 0 || net->term_par[at_par + j] >= net->n_par) return 0;
+        at_par += n_par;
+        for (k = 0; k < count; k++, at++)
+            if (!read_longs(f, &net->index[at], 1) || !read_doubles(f, &net->value[at], 1) || net->index[at] < 0
+                || net->index[at] >= size)
+                return 0;
     }
-    return expect(f, "end");
+    net->term_start[net->n_terms] = at;
+    net->par_start[net->n_terms] = at_par;
+    return at == nonzeros && at_par == refs && expect(f, "end");
 }
 
 static void free_network(Network *net) {
-    free(net->p0); free(net->product); free(net->term_mask); free(net->terms); free(net->air); free(net->radiant);
-    free(net->group_zone); free(net->group_start); free(net->group_len); free(net->group_node);
-    free(net->group_depth);
+    free(net->p0); free(net->product); free(net->term_start); free(net->par_start); free(net->term_par);
+    free(net->index); free(net->value);
 }
 
 /* ------------------------------------------------------------------ the numbers */
-/* C, A, B, q at the effect parameters' current values, and B's nonzeros by row. */
+/* C, A, B, q, P at the parameters' current values, and B's nonzeros by row. */
 static void network_at_parameters(Model *m) {
     const Network *net = &m->net;
     long size = term_size(net), k;
@@ -168,10 +182,9 @@ static void network_at_parameters(Model *m) {
     memset(out, 0, (size_t)size * sizeof(double));
     for (t = 0; t < net->n_terms; t++) {
         double weight = 1.0;
-        const double *term = net->terms + t * size;
-        for (j = 0; j < net->n_par; j++)
-            if (net->term_mask[t] & (1 << j)) weight *= m->values[vr_parameters(&m->layout) + j] - net->p0[j];
-        for (k = 0; k < size; k++) out[k] += weight * term[k];
+        for (k = net->par_start[t]; k < net->par_start[t + 1]; k++)
+            weight *= m->values[vr_parameters(&m->layout) + net->term_par[k]] - net->p0[net->term_par[k]];
+        for (k = net->term_start[t]; k < net->term_start[t + 1]; k++) out[net->index[k]] += weight * net->value[k];
     }
     for (i = 0, k = 0; i < net->n; i++) {
         m->b_start[i] = k;
@@ -184,81 +197,38 @@ static void network_at_parameters(Model *m) {
     m->b_start[net->n] = k;
 }
 
-/* np.interp(x, xp, fp) with xp increasing: the end values held beyond the range. */
-static double interp(double x, const double *xp, const double *fp, int count) {
-    int j;
-    if (x <= xp[0]) return fp[0];
-    if (x >= xp[count - 1]) return fp[count - 1];
-    for (j = 0; xp[j + 1] <= x; j++) {}
-    return (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j]) * (x - xp[j]) + fp[j];
-}
-
-/* docs/model.md section 5: the initial state from the measurements at t_0 and T_start. */
-static void initial_state(Model *m) {
-    const Network *net = &m->net;
-    const double *measured = m->values + vr_T_forced(&m->layout);
-    double *T = m->values + vr_T(&m->layout), T_start = m->values[vr_T_start(&m->layout)];
-    double *xp = malloc((size_t)net->n * sizeof(double)), *fp = malloc((size_t)net->n * sizeof(double));
-    int z, g, i;
-    for (z = 0; z < net->n_zones; z++) {
-        double air = measured[net->air[z]];
-        double fallback = isfinite(air) ? air : T_start;
-        T[net->air[z]] = T[net->radiant[z]] = fallback;
-        for (g = 0; g < net->n_groups; g++) {
-            const int *node = net->group_node + net->group_start[g];
-            const double *depth = net->group_depth + net->group_start[g];
-            int count = 0;
-            if (net->group_zone[g] != z) continue;
-            for (i = 0; i < net->group_len[g]; i++)
-                if (isfinite(measured[node[i]])) {
-                    xp[count] = depth[i];
-                    fp[count++] = measured[node[i]];
-                }
-            for (i = 0; i < net->group_len[g]; i++)
-                T[node[i]] = count ? interp(depth[i], xp, fp, count) : fallback;
-        }
-    }
-    for (i = 0; i < net->n; i++)
-        if (isfinite(measured[i])) T[i] = measured[i];
-    free(xp);
-    free(fp);
-}
-
-/* Whether nodes a and b are linked (A_ab or A_ba nonzero) in any term. */
-static int linked(const Network *net, long size, int a, int b) {
-    int t, n = net->n;
-    for (t = 0; t < net->n_terms; t++) {
-        const double *A = net->terms + t * size + n;
-        if (A[(long)a * n + b] != 0.0 || A[(long)b * n + a] != 0.0) return 1;
-    }
-    return 0;
-}
-
 /* The profile of M's links in any term of the network (so in M at any parameter values):
    reverse Cuthill-McKee from a node of least degree in each connected part. */
 static int order_network(Model *m) {
     const Network *net = &m->net;
     int n = net->n, i, j, head = 0, tail = 0, placed = 0;
-    long size = term_size(net), links = 0;
+    long k, e, pairs = 0, nonzeros = net->term_start[net->n_terms];
     int *degree = calloc((size_t)n + 1, sizeof(int)), *seen = calloc((size_t)n + 1, sizeof(int));
     int *position = calloc((size_t)n + 1, sizeof(int)), *queue = calloc((size_t)n + 1, sizeof(int));
     long *at = calloc((size_t)n + 1, sizeof(long));
+    int *a = calloc((size_t)2 * nonzeros + 1, sizeof(int)), *b = calloc((size_t)2 * nonzeros + 1, sizeof(int));
     int *neighbour = NULL;
     Profile *p = &m->profile;
     p->order = calloc((size_t)n + 1, sizeof(int));
     p->first = calloc((size_t)n + 1, sizeof(int));
     p->start = calloc((size_t)n + 1, sizeof(long));
-    if (!degree || !seen || !position || !queue || !at || !p->order || !p->first || !p->start) goto fail;
-    for (i = 0; i < n; i++)
-        for (j = 0; j < n; j++)
-            if (i != j && linked(net, size, i, j)) degree[i]++;
-    for (i = 0; i < n; i++) { at[i + 1] = at[i] + degree[i]; links += degree[i]; }
-    neighbour = calloc((size_t)links + 1, sizeof(int));
+    if (!degree || !seen || !position || !queue || !at || !a || !b || !p->order || !p->first || !p->start) goto fail;
+    /* the links: A's off-diagonal nonzeros in any term, both ways */
+    for (k = 0; k < nonzeros; k++) {
+        long offset = net->index[k] - n;
+        if (offset < 0 || offset >= (long)n * n || offset / n == offset % n) continue;
+        a[pairs] = (int)(offset / n); b[pairs++] = (int)(offset % n);
+        a[pairs] = (int)(offset % n); b[pairs++] = (int)(offset / n);
+    }
+    for (e = 0; e < pairs; e++) degree[a[e]]++;
+    for (i = 0; i < n; i++) at[i + 1] = at[i] + degree[i];
+    neighbour = calloc((size_t)at[n] + 1, sizeof(int));
     if (!neighbour) goto fail;
-    for (i = 0; i < n; i++) {
-        long k = at[i];
-        for (j = 0; j < n; j++)
-            if (i != j && linked(net, size, i, j)) neighbour[k++] = j;
+    memset(degree, 0, (size_t)n * sizeof(int));
+    for (e = 0; e < pairs; e++) { /* each neighbour once (a node has few) */
+        long q;
+        for (q = at[a[e]]; q < at[a[e]] + degree[a[e]] && neighbour[q] != b[e]; q++) {}
+        if (q == at[a[e]] + degree[a[e]]) neighbour[at[a[e]] + degree[a[e]]++] = b[e];
     }
     while (placed < n) {
         int root = -1;
@@ -269,7 +239,7 @@ static int order_network(Model *m) {
         while (head < tail) {
             int node = queue[head++], from = tail;
             long k;
-            for (k = at[node]; k < at[node + 1]; k++)
+            for (k = at[node]; k < at[node] + degree[node]; k++)
                 if (!seen[neighbour[k]]) { seen[neighbour[k]] = 1; queue[tail++] = neighbour[k]; }
             for (i = from + 1; i < tail; i++) /* the new neighbours by increasing degree */
                 for (j = i; j > from && degree[queue[j]] < degree[queue[j - 1]]; j--) {
@@ -283,14 +253,14 @@ static int order_network(Model *m) {
         int node = p->order[i];
         long k;
         p->first[i] = i;
-        for (k = at[node]; k < at[node + 1]; k++)
+        for (k = at[node]; k < at[node] + degree[node]; k++)
             if (position[neighbour[k]] < p->first[i]) p->first[i] = position[neighbour[k]];
         p->start[i + 1] = p->start[i] + (i - p->first[i]);
     }
-    free(degree); free(seen); free(position); free(queue); free(at); free(neighbour);
+    free(degree); free(seen); free(position); free(queue); free(at); free(neighbour); free(a); free(b);
     return 1;
 fail:
-    free(degree); free(seen); free(position); free(queue); free(at); free(neighbour);
+    free(degree); free(seen); free(position); free(queue); free(at); free(neighbour); free(a); free(b);
     return 0;
 }
 
@@ -433,6 +403,7 @@ static void free_model(Model *m) {
         free(m->cache[i].lower); free(m->cache[i].upper); free(m->cache[i].diagonal); free(m->cache[i].imposed);
     }
     free_network(&m->net);
+    free_names(&m->layout);
     free(m->name); free(m->values); free(m->start_values); free(m->C); free(m->v); free(m->work);
     free(m->imposed); free(m->profile.order); free(m->profile.first); free(m->profile.start);
     free(m->b_start); free(m->b_column); free(m->b_value);
@@ -471,6 +442,10 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
     m->layout.n = m->net.n;
     m->layout.n_in = m->net.n_in;
     m->layout.n_par = m->net.n_par;
+    path = resource_path(resources, "names.txt");
+    ok = read_names(&m->layout, path);
+    free(path);
+    if (!ok) free_names(&m->layout); /* messages then say "an input" */
     m->size = layout_size(&m->layout);
     m->values = calloc((size_t)m->size, sizeof(double));
     m->start_values = calloc((size_t)m->size, sizeof(double));
@@ -490,8 +465,8 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
         free_model(m);
         return NULL;
     }
-    m->start_values[vr_T_start(&m->layout)] = 20.0;
     for (i = 0; i < m->net.n; i++) {
+        m->start_values[vr_T_start(&m->layout) + i] = 20.0;
         m->start_values[vr_T_forced(&m->layout) + i] = NAN;
         m->start_values[vr_T(&m->layout) + i] = 20.0;
     }
@@ -507,11 +482,12 @@ FMI2_EXPORT void fmi2FreeInstance(fmi2Component c) { free_model((Model *)c); }
 FMI2_EXPORT fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
                                            fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
     Model *m = c;
-    (void)toleranceDefined; (void)tolerance; (void)startTime; (void)stopTimeDefined; (void)stopTime;
+    (void)toleranceDefined; (void)tolerance; (void)stopTimeDefined; (void)stopTime;
     if (m->state != INSTANTIATED) {
         log_error(m, "fmi2SetupExperiment is allowed only after instantiation");
         return fmi2Error;
     }
+    m->time = startTime;
     return fmi2OK;
 }
 
@@ -533,7 +509,8 @@ FMI2_EXPORT fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
     }
     network_at_parameters(m);
     forget_factors(m);
-    initial_state(m);
+    /* the start values alone set the state: what an importer applies as inputs at t_0 does not */
+    memcpy(m->values + vr_T(&m->layout), m->values + vr_T_start(&m->layout), (size_t)m->net.n * sizeof(double));
     m->state = STEPPING;
     return fmi2OK;
 }
@@ -547,13 +524,14 @@ FMI2_EXPORT fmi2Status fmi2Reset(fmi2Component c) {
     Model *m = c;
     memcpy(m->values, m->start_values, (size_t)m->size * sizeof(double));
     m->state = INSTANTIATED;
+    m->time = 0.0;
     return fmi2OK;
 }
 
 FMI2_EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
     Model *m = c;
     size_t k;
-    if (refused(m, vr, nvr, 1, 0)) return fmi2Error;
+    if (refused(m, vr, nvr, NULL, 1, 0)) return fmi2Error;
     for (k = 0; k < nvr; k++) value[k] = m->values[vr[k]];
     return fmi2OK;
 }
@@ -561,7 +539,7 @@ FMI2_EXPORT fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[
 FMI2_EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
     Model *m = c;
     size_t k;
-    if (refused(m, vr, nvr, 1, 1)) return fmi2Error;
+    if (refused(m, vr, nvr, value, 1, 1)) return fmi2Error;
     for (k = 0; k < nvr; k++) m->values[vr[k]] = value[k];
     return fmi2OK;
 }
@@ -569,7 +547,7 @@ FMI2_EXPORT fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[
 FMI2_EXPORT fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[]) {
     Model *m = c;
     size_t k;
-    if (refused(m, vr, nvr, 0, 0)) return fmi2Error;
+    if (refused(m, vr, nvr, NULL, 0, 0)) return fmi2Error;
     for (k = 0; k < nvr; k++) value[k] = m->values[vr[k]] != 0.0;
     return fmi2OK;
 }
@@ -577,7 +555,7 @@ FMI2_EXPORT fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference 
 FMI2_EXPORT fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean value[]) {
     Model *m = c;
     size_t k;
-    if (refused(m, vr, nvr, 0, 1)) return fmi2Error;
+    if (refused(m, vr, nvr, NULL, 0, 1)) return fmi2Error;
     for (k = 0; k < nvr; k++) m->values[vr[k]] = value[k] ? 1.0 : 0.0;
     return fmi2OK;
 }
@@ -606,13 +584,15 @@ FMI2_EXPORT fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference v
     return no_such(c, "String", nvr);
 }
 
-/* A state: the state of the slave, then every value. */
+/* A state: the state of the slave, its time, then every value. */
+#define STATE_HEAD 2
 FMI2_EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *state) {
     Model *m = c;
-    double *copy = *state ? *state : malloc((size_t)(m->size + 1) * sizeof(double));
+    double *copy = *state ? *state : malloc((size_t)(m->size + STATE_HEAD) * sizeof(double));
     if (!copy) return fmi2Error;
     copy[0] = m->state;
-    memcpy(copy + 1, m->values, (size_t)m->size * sizeof(double));
+    copy[1] = m->time;
+    memcpy(copy + STATE_HEAD, m->values, (size_t)m->size * sizeof(double));
     *state = copy;
     return fmi2OK;
 }
@@ -622,7 +602,8 @@ FMI2_EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state) {
     const double *copy = state;
     if (!copy) return fmi2Error;
     m->state = (int)copy[0];
-    memcpy(m->values, copy + 1, (size_t)m->size * sizeof(double));
+    m->time = copy[1];
+    memcpy(m->values, copy + STATE_HEAD, (size_t)m->size * sizeof(double));
     if (m->state == STEPPING) { /* the network at the restored parameters */
         network_at_parameters(m);
         forget_factors(m);
@@ -639,19 +620,19 @@ FMI2_EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state) {
 
 FMI2_EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate state, size_t *size) {
     (void)state;
-    *size = (size_t)(((Model *)c)->size + 1) * sizeof(double);
+    *size = (size_t)(((Model *)c)->size + STATE_HEAD) * sizeof(double);
     return fmi2OK;
 }
 
 FMI2_EXPORT fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate state, fmi2Byte bytes[], size_t size) {
-    if (size < (size_t)(((Model *)c)->size + 1) * sizeof(double)) return fmi2Error;
-    memcpy(bytes, state, (size_t)(((Model *)c)->size + 1) * sizeof(double));
+    if (size < (size_t)(((Model *)c)->size + STATE_HEAD) * sizeof(double)) return fmi2Error;
+    memcpy(bytes, state, (size_t)(((Model *)c)->size + STATE_HEAD) * sizeof(double));
     return fmi2OK;
 }
 
 FMI2_EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[], size_t size, fmi2FMUstate *state) {
     Model *m = c;
-    size_t need = (size_t)(m->size + 1) * sizeof(double);
+    size_t need = (size_t)(m->size + STATE_HEAD) * sizeof(double);
     if (size != need) {
         log_error(m, "a serialized state of %lu bytes is not one of this FMU's (%lu)", (unsigned long)size, (unsigned long)need);
         return fmi2Error;
@@ -688,12 +669,15 @@ FMI2_EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunication
                                   fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
     Model *m = c;
     char reason[256];
-    (void)currentCommunicationPoint; (void)noSetFMUStatePriorToCurrentPoint;
+    fmi2Status status;
+    (void)noSetFMUStatePriorToCurrentPoint;
     if (step_refusal(m->state, communicationStepSize, reason, sizeof reason)) {
         log_error(m, "%s", reason);
         return fmi2Error;
     }
-    return step(m, communicationStepSize);
+    status = step(m, communicationStepSize);
+    if (status == fmi2OK) m->time = currentCommunicationPoint + communicationStepSize;
+    return status;
 }
 
 FMI2_EXPORT fmi2Status fmi2CancelStep(fmi2Component c) {

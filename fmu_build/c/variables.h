@@ -4,16 +4,19 @@
 
    Every value lives in one array indexed by value reference, in this order:
        force[1..N]      Boolean parameter, fixed
-       T_start          Real parameter, fixed
+       T_start[1..N]    Real parameters, fixed: the state at the start
        <inputs>         Real inputs (n_in)
        T_forced[1..N]   Real inputs
        T[1..N]          Real outputs
-       <effect>.<name>  Real parameters, fixed (n_par) */
+       <parameters>     Real parameters, fixed (n_par): the building's properties, an effect's
+   The names of the inputs and parameters, one a line, are resources/names.txt. A Real set must
+   be finite, but T_forced's NaN ("not measured"). */
 #ifndef NODEFORCE_VARIABLES_H
 #define NODEFORCE_VARIABLES_H
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "fmi2.h"
 
@@ -21,12 +24,13 @@
 enum { INSTANTIATED, INITIALISATION, STEPPING, TERMINATED };
 
 typedef struct {
-    int n, n_in, n_par; /* nodes, inputs before T_forced, effect parameters */
+    int n, n_in, n_par; /* nodes, inputs before T_forced, other parameters */
+    char **names;       /* n_in + n_par: the inputs' and parameters' names (NULL: not read) */
 } Layout;
 
 static inline int vr_force(const Layout *l) { (void)l; return 0; }
 static inline int vr_T_start(const Layout *l) { return l->n; }
-static inline int vr_inputs(const Layout *l) { return l->n + 1; }
+static inline int vr_inputs(const Layout *l) { return 2 * l->n; }
 static inline int vr_T_forced(const Layout *l) { return vr_inputs(l) + l->n_in; }
 static inline int vr_T(const Layout *l) { return vr_T_forced(l) + l->n; }
 static inline int vr_parameters(const Layout *l) { return vr_T(l) + l->n; }
@@ -46,40 +50,94 @@ static inline int read_sizes(const char *text, Layout *l) {
     return 1;
 }
 
-/* Why the standard forbids this get or set of a Real (real) or Boolean (!real), written into
-   reason; 0 when every reference may be read (or, setting, written) in this state. */
-static inline int refusal(const Layout *l, const fmi2ValueReference vr[], size_t nvr, int real, int setting, int state,
-                   char *reason, size_t size) {
+/* The names of resources/names.txt (path) into l->names; 0 if it cannot be read. */
+static inline int read_names(Layout *l, const char *path) {
+    char line[4096];
+    int k, count = l->n_in + l->n_par;
+    FILE *f = path ? fopen(path, "r") : NULL;
+    if (!f) return 0;
+    l->names = calloc((size_t)count + 1, sizeof(char *));
+    for (k = 0; l->names && k < count && fgets(line, sizeof line, f); k++) {
+        size_t length = strcspn(line, "\r\n");
+        if (!(l->names[k] = malloc(length + 1))) break;
+        memcpy(l->names[k], line, length);
+        l->names[k][length] = 0;
+    }
+    fclose(f);
+    return l->names && k == count;
+}
+
+static inline void free_names(Layout *l) {
+    int k;
+    for (k = 0; l->names && k < l->n_in + l->n_par; k++) free(l->names[k]);
+    free(l->names);
+    l->names = NULL;
+}
+
+/* The name of an FMI 2.0 value reference, in `name`. */
+static inline void variable_name(const Layout *l, int r, char *name, size_t size) {
+    const char *named = NULL;
+    if (r >= vr_inputs(l) && r < vr_T_forced(l)) named = l->names ? l->names[r - vr_inputs(l)] : "an input";
+    else if (r >= vr_parameters(l)) named = l->names ? l->names[l->n_in + r - vr_parameters(l)] : "a parameter";
+    if (named) snprintf(name, size, "%s", named);
+    else if (r < vr_T_start(l)) snprintf(name, size, "force[%d]", r + 1);
+    else if (r < vr_inputs(l)) snprintf(name, size, "T_start[%d]", r - vr_T_start(l) + 1);
+    else if (r < vr_T(l)) snprintf(name, size, "T_forced[%d]", r - vr_T_forced(l) + 1);
+    else snprintf(name, size, "T[%d]", r - vr_T(l) + 1);
+}
+
+/* Whether the standard forbids this get or set of Reals (real) or Booleans (!real) in this
+   state, or refuses a value set (a Real not finite, but T_forced's NaN; values: the Reals set,
+   or NULL): -1 when every reference may be read (or written); else the position k of the first
+   refused, and in `reason` why, said of the variable (the caller names it: "value reference
+   <vr> (<name>) " + reason). time : the communication point, for the message. */
+static inline long refusal(const Layout *l, const fmi2ValueReference vr[], size_t nvr, const double *values, int real,
+                           int setting, int state, double time, char *reason, size_t size) {
     size_t k;
     for (k = 0; k < nvr; k++) {
         int r = (int)vr[k];
         int boolean = r < l->n;
-        int fixed = r <= vr_T_start(l) || r >= vr_parameters(l);
+        int fixed = r < vr_inputs(l) || r >= vr_parameters(l);
         if (vr[k] >= (fmi2ValueReference)layout_size(l)) {
-            snprintf(reason, size, "value reference %u does not exist (0..%d)", vr[k], layout_size(l) - 1);
-            return 1;
+            snprintf(reason, size, "does not exist (0..%d)", layout_size(l) - 1);
+            return (long)k;
         }
         if (boolean == real) {
-            snprintf(reason, size, "value reference %d is %s, not %s", r, real ? "Boolean" : "Real",
-                     real ? "Real" : "Boolean");
-            return 1;
+            snprintf(reason, size, "is %s, not %s", real ? "Boolean" : "Real", real ? "Real" : "Boolean");
+            return (long)k;
         }
         if (!setting) continue;
         if (r >= vr_T(l) && r < vr_parameters(l)) {
-            snprintf(reason, size, "value reference %d is an output, which cannot be set", r);
-            return 1;
+            snprintf(reason, size, "is an output, which cannot be set");
+            return (long)k;
         }
         if (fixed && state != INSTANTIATED && state != INITIALISATION) {
-            snprintf(reason, size, "value reference %d is a fixed parameter, which cannot change after initialisation",
-                     r);
-            return 1;
+            snprintf(reason, size, "is a fixed parameter, which cannot change after initialisation");
+            return (long)k;
         }
         if (state == TERMINATED) {
-            snprintf(reason, size, "the slave is terminated");
-            return 1;
+            snprintf(reason, size, "cannot be set: the slave is terminated");
+            return (long)k;
+        }
+        if (values && values[k] - values[k] != 0.0 && !(r >= vr_T_forced(l) && r < vr_T(l))) {
+            snprintf(reason, size, "set to %g at t = %.17g s: it must be finite (NaN means \"not measured\" "
+                     "on T_forced only)", values[k], time);
+            return (long)k;
         }
     }
-    return 0;
+    return -1;
+}
+
+/* refusal's full message for an FMI 2.0 call, into `message`; 0 when nothing is refused. */
+static inline int refused2(const Layout *l, const fmi2ValueReference vr[], size_t nvr, const double *values, int real,
+                           int setting, int state, double time, char *message, size_t size) {
+    char reason[256], name[128];
+    long k = refusal(l, vr, nvr, values, real, setting, state, time, reason, sizeof reason);
+    if (k < 0) return 0;
+    if ((int)vr[k] < layout_size(l)) variable_name(l, (int)vr[k], name, sizeof name);
+    else snprintf(name, sizeof name, "none");
+    snprintf(message, size, "value reference %u (%s) %s", vr[k], name, reason);
+    return 1;
 }
 
 /* Why the standard forbids this doStep, written into reason; 0 when it may step. */
