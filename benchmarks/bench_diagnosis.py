@@ -24,7 +24,9 @@ Run:
     python benchmarks/bench_diagnosis.py --report       # the tables from the records already run
 """
 import argparse
+import contextlib
 import fnmatch
+import io
 import json
 import math
 import os
@@ -63,7 +65,8 @@ def diagnose_one(task):
         case = r.case()
         generated = time.time() - started
         t = time.time()
-        with tempdirs.folder("bench-diagnosis") as tmp:
+        # the loop's own lines (its findings, the candidates' fits) would bury the progress bar
+        with tempdirs.folder("bench-diagnosis") as tmp, contextlib.redirect_stdout(io.StringIO()):
             report = api.diagnose(r.building, case, tmp, objective=api.objective(r.building, r.zones), workers=1,
                                   population=population, generations=generations, noise=r.spec.noise, seed=0)
         seconds = time.time() - t

@@ -25,8 +25,6 @@ to judge the answer. `SPECS` lists the benchmark's records; `quick_specs()` a su
 """
 import functools
 import math
-import shutil
-import tempfile
 from dataclasses import asdict, dataclass, field, replace
 from itertools import count
 from pathlib import Path
@@ -35,6 +33,7 @@ import numpy as np
 import pandas as pd
 import pvlib
 
+from nodeforce import tempdirs
 from nodeforce.iotools.typical_year import convert_typical_year, relocate
 from nodeforce.iotools.weather import read_weather
 from nodeforce.model.building import load_building, parse_building
@@ -143,14 +142,14 @@ def refined(building, cells=CELLS):
     own = sum(len(c.node_ids) for c in building.components) + 2 * len(building.zones)
     ids = count(own + 1)
     for raw, c in zip(data["components"], building.components):
-        bounds = np.concatenate(([0.0], np.cumsum([t for _, t in c.layers])))
-        depths = sorted(set(np.round(np.concatenate((c.depths, bounds)), 12)))
-        given = dict(zip(np.round(c.depths, 12), c.node_ids))
+        bounds = np.cumsum([t for _, t in c.layers])[:-1]
+        points = sorted([(d, i) for i, d in zip(c.node_ids, c.depths)]
+                        + [(float(d), None) for d in bounds if np.abs(np.array(c.depths) - d).min() > 1e-9])
         nodes = []
-        for a, b in zip(depths, depths[1:]):
-            nodes.append({"id": given.get(a) or next(ids), "depth": float(a)})
-            nodes += [{"id": next(ids), "depth": float(a + (b - a) * k / cells)} for k in range(1, cells)]
-        nodes.append({"id": given[depths[-1]], "depth": float(c.thickness)})
+        for (a, i), (b, _) in zip(points, points[1:]):
+            nodes.append({"id": i or next(ids), "depth": a})
+            nodes += [{"id": next(ids), "depth": a + (b - a) * k / cells} for k in range(1, cells)]
+        nodes.append({"id": points[-1][1], "depth": points[-1][0]})
         raw["nodes"] = nodes
     for raw, z in zip(data["zones"], building.zones):
         raw["air_node"], raw["radiant_node"] = z.air_node, z.radiant_node
@@ -160,7 +159,7 @@ def refined(building, cells=CELLS):
 @functools.lru_cache(maxsize=None)
 def climate(name):
     """(site {latitude, longitude, altitude, timezone}, hourly weather) of a typical year pvlib bundles."""
-    with tempfile.TemporaryDirectory(prefix="nodeforce-bench-") as tmp:
+    with tempdirs.folder("bench-weather") as tmp:
         csv = Path(tmp) / f"{name}.csv"
         site = convert_typical_year(PVLIB_DATA / CLIMATES[name], csv)
         weather = read_weather(csv)
