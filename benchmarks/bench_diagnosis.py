@@ -80,7 +80,8 @@ def diagnose_one(task):
         generated = time.time() - started
         t = time.time()
         # the loop's own lines (its findings, the candidates' fits) would bury the progress bar
-        with tempdirs.folder("bench-diagnosis") as tmp, contextlib.redirect_stdout(io.StringIO()):
+        with tempdirs.folder("bench-diagnosis") as tmp, contextlib.redirect_stdout(io.StringIO()), \
+                contextlib.redirect_stderr(io.StringIO()):
             report = api.diagnose(r.building, case, tmp, objective=api.objective(r.building, r.zones), workers=1,
                                   population=population, generations=generations, noise=r.spec.noise, seed=0)
         seconds = time.time() - t

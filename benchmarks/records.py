@@ -472,7 +472,8 @@ FAULTS = {  # name: (effect, target, parameters at scale 1, the answers counted 
     "infiltration": ("infiltration", "cell", {"n": 2.0}, AIR_OUT),
     "bridge": ("thermal_bridge", "cell", {"UA": 15.0}, AIR_OUT),
     "envelope": ("envelope_conductance", "cell", {"factor": 2.0}, ()),
-    "convection": ("inside_convection", "cell", {"factor": 2.0}, ()),
+    # weaker inside convection: a factor up to the registry's 20 never makes a strong error in the cell
+    "convection": ("inside_convection", "cell", {"factor": 0.4}, ()),
     "door": ("conductivity", "door", {"factor": 3.0}, ()),
     "wall": ("conductivity", "east_wall", {"factor": 3.0}, ()),
     "roof-alpha": ("solar_absorptance", "roof", {"alpha": 0.9}, ()),
@@ -491,20 +492,23 @@ FAULTS = {  # name: (effect, target, parameters at scale 1, the answers counted 
     "shading": ("shading_transmittance", "living", {"f": 0.3}, ()),
     "living-mass": ("internal_mass", "living", {"C_m": 1.5e6, "H_m": 150.0}, ()),
 }
-GROUND = {"miami": 24.0, "greensboro": 12.0, "sandpoint": 5.0}  # C, below the cell in each climate
+GROUND = {"mia-jun": 24.0, "mia-dec": 15.0, "sdp-jul": 5.0}  # C, the ground below the cell, away from its air
 PLAN = {  # scenario: [fault or "none", size "s" subtle / "L" strong]
     "mia-jun": ["none", "infiltration s", "bridge s", "envelope s", "convection s", "door s", "wall s",
                 "ground s", "schedule s", "opening s"],
-    "gso-jan": ["none", "infiltration L", "bridge L", "envelope L", "convection L", "door L", "wall L",
+    # every node measured in winter: the door (1.6 m2) 20 times as conductive, or the inside convection
+    # a twentieth, stay subtle here
+    "gso-jan": ["none", "infiltration L", "bridge L", "envelope L", "convection s", "door s", "wall L",
                 "roof-alpha s", "window-tau s", "mass s"],
     "sdp-jul": ["none", "ground L", "roof-alpha L", "window-tau L", "gain s", "daily s", "east-sun s",
                 "schedule L", "opening L"],
     "gso-apr": ["none", "gain L", "daily L", "east-sun L", "mass L", "infiltration s", "envelope s", "convection s"],
     "mia-dec": ["none", "door s", "wall s", "ground s", "bridge s", "opening s", "schedule s"],
-    "sdp-feb-air": ["none", "lag s", "split s", "mass s", "envelope L", "infiltration L", "convection L", "gain s"],
-    "mia-jan-air": ["none", "lag L", "split L", "mass L", "envelope s", "schedule L"],
+    "sdp-feb-air": ["none", "lag s", "split L", "mass s", "envelope L", "infiltration L", "convection L", "gain s"],
+    "mia-jan-air": ["none", "lag L", "split s", "mass L", "envelope s", "schedule L"],
     # a Twin House diagnosis takes some 20 times a test cell's (docs/benchmark_diagnosis.md): four records
-    "twin-gso-feb": ["none", "W8 L", "shading s", "living-mass L"],
+    # (and 100 air capacities of furniture, the registry's bound, stay subtle)
+    "twin-gso-feb": ["none", "W8 L", "shading s", "living-mass s"],
 }
 
 
@@ -522,7 +526,7 @@ def make_specs():
                 continue
             effect, target, full, expected = FAULTS[fault]
             if "T_ground" in full:
-                full = {**full, "T_ground": GROUND[where]}
+                full = {**full, "T_ground": GROUND[scenario]}
             specs.append(Spec(name=f"{scenario}/{fault}-{size}", effect=effect, target=target, full=full,
                               size={"s": "subtle", "L": "strong"}[size], expected=expected, **common))
     return specs
