@@ -56,9 +56,27 @@ def result_path(out, name, draw):
     return out / "records" / f"{name.replace('/', '__')}__draw{draw}.json"
 
 
-def spec_digest(name):
-    """A digest of everything that makes a record: a result is reused only for the same spec."""
-    return hashlib.sha1(repr(SPECS_BY_NAME[name]).encode()).hexdigest()[:12]
+# The code and data a result depends on: the package (the loop), the records, the baseline, the Twin House.
+CODE = ("nodeforce", "model", "fmu_build", "cosim", "ga", "diagnose", "iotools", "benchmarks", "examples")
+
+
+def code_digest():
+    """A digest of the source files in `CODE` (their paths and contents)."""
+    digest = hashlib.sha1()
+    for path in sorted(p for folder in CODE for p in (ROOT / folder).rglob("*") if p.suffix in (".py", ".c", ".h", ".json")):
+        if path.name != "bench_diagnosis.py":  # its tables and options make no result
+            digest.update(str(path.relative_to(ROOT)).encode() + path.read_bytes())
+    return digest.hexdigest()
+
+
+def spec_digest(name, code=None):
+    """A digest of everything that makes a result: the record's spec and the code that made and
+    diagnosed it. A result is reused only when both are the same: a change of the loop runs every
+    record again."""
+    return hashlib.sha1((repr(SPECS_BY_NAME[name]) + (code or CODE_DIGEST)).encode()).hexdigest()[:12]
+
+
+CODE_DIGEST = code_digest()
 
 
 def finished(path, name):
@@ -257,6 +275,18 @@ def summary(results, draws):
     return lines, numbers
 
 
+# What one diagnosis costs, measured on the loop of 2026-11 (the quick subset, one draw, on 2 cores
+# shared with other work): the whole run is sized from it.
+BUDGET = ("The budget: a test-cell diagnosis took 8 to 16 s and its baseline 1 to 3 s, a Twin House "
+          "diagnosis 250 s and its baseline 120 s (the loop of November 2026, measured on the `--quick` "
+          "subset); 58 test-cell records and 4 Twin House records, 3 draws each, are then about 110 "
+          "processor-minutes, some 55 min on 2 workers. The GA and the calibrations keep the command "
+          "line's defaults; the four Twin House records are what the hour affords. Finished records are "
+          "kept in out/bench_diagnosis/records, each with a digest of its spec and of the code (the "
+          "package, the records, the baseline): a rerun skips what is unchanged, a changed loop runs "
+          "everything again.")
+
+
 def scenarios_table():
     """Markdown: the records' scenarios, with the file's error on each one's record without a fault."""
     lines = ["| scenario | building | climate (typical year) | start | days | step | noise | sensors | faults |",
@@ -281,6 +311,7 @@ def write_docs(path, lines, args, elapsed):
         f"settings: GA population {args.population}, at most {args.generations} generations (stopped at "
         "convergence), its own calibrations, seed 0, one worker per diagnosis, the sensors' noise given as "
         "a user states it.", "",
+        BUDGET, "",
         "## The records", "",
         "Made by `benchmarks/records.py` (read its docstring for why each choice): the truth is the "
         "building file discretised finer (every stretch between two of its nodes or layer boundaries cut "

@@ -25,7 +25,7 @@ to judge the answer. `SPECS` lists the benchmark's records; `quick_specs()` a su
 """
 import functools
 import math
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field
 from itertools import count
 from pathlib import Path
 

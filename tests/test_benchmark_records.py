@@ -5,7 +5,6 @@ fault's size gives the error it claims; a record is the same for the same name a
 A few small records (5 to 7 days, 30 to 60 min) stand here; `record(spec, draw)` gives a test
 everything to diagnose one and judge the answer."""
 import math
-from dataclasses import replace
 
 import numpy as np
 import pandas as pd
