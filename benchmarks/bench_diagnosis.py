@@ -277,14 +277,16 @@ def summary(results, draws):
 
 # What one diagnosis costs, measured on the loop of 2026-11 (the quick subset, one draw, on 2 cores
 # shared with other work): the whole run is sized from it.
-BUDGET = ("The budget: a test-cell diagnosis took 8 to 16 s and its baseline 1 to 3 s, a Twin House "
-          "diagnosis 250 s and its baseline 120 s (the loop of November 2026, measured on the `--quick` "
-          "subset); 58 test-cell records and 4 Twin House records, 3 draws each, are then about 110 "
-          "processor-minutes, some 55 min on 2 workers. The GA and the calibrations keep the command "
+BUDGET = ("The budget: on the loop of November 2026 (the `--quick` subset, one draw, 2 cores less loaded "
+          "than the last run's), a test-cell record took some 15 s in all (the loop 8 to 16 s, the baseline "
+          "1 to 3 s, the record 1 to 3 s) and a Twin House record some 6 min (the loop 250 s, the baseline "
+          "120 s); 58 test-cell and 4 Twin House records, 3 draws each, are then about 120 "
+          "processor-minutes: an hour on 2 workers, on 2 cores of its own (the times below were measured "
+          "with the cores shared, at a load of 10). The GA and the calibrations keep the command "
           "line's defaults; the four Twin House records are what the hour affords. Finished records are "
           "kept in out/bench_diagnosis/records, each with a digest of its spec and of the code (the "
-          "package, the records, the baseline): a rerun skips what is unchanged, a changed loop runs "
-          "everything again.")
+          "package, the records, the baseline, the examples): a rerun skips what is unchanged, a changed "
+          "loop runs everything again.")
 
 
 def scenarios_table():
@@ -301,13 +303,21 @@ def scenarios_table():
 
 
 def write_docs(path, lines, args, elapsed):
-    command = (COMMAND if not (args.quick or args.only) else
-               f"python benchmarks/bench_diagnosis.py {' '.join(sys.argv[1:])}")
+    subset = args.quick or args.only
+    # the command that made the results: --report and --docs only write them again
+    argv, skip = [], False
+    for a in sys.argv[1:]:
+        if skip or a in ("--report", "--docs") or a.startswith("--docs="):
+            skip = a == "--docs"
+            continue
+        argv.append(a)
+    command = COMMAND if not subset else f"python benchmarks/bench_diagnosis.py {' '.join(argv)}"
+    timing = ("" if args.report else f": {elapsed / 60:.0f} min for the diagnoses run this time")
     header = [
         "# The diagnosis on many records (issue 27)", "",
+        *(["A subset of the records; `make benchmark` writes the whole benchmark's tables here.", ""] if subset else []),
         "Made by", "", f"    {command}", "",
-        f"on {os.cpu_count()} cores, {args.workers} workers: {elapsed / 60:.0f} min for the diagnoses run this "
-        f"time. The loop runs through the public API (`nodeforce.api.diagnose`) with the command line's "
+        f"on {os.cpu_count()} cores, {args.workers} workers{timing}. The loop runs through the public API (`nodeforce.api.diagnose`) with the command line's "
         f"settings: GA population {args.population}, at most {args.generations} generations (stopped at "
         "convergence), its own calibrations, seed 0, one worker per diagnosis, the sensors' noise given as "
         "a user states it.", "",
