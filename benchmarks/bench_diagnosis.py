@@ -226,21 +226,22 @@ def summary(results, draws):
         "baseline_seconds_mean": statistics.mean(r["baseline"]["seconds"] for r in ok) if ok else float("nan"),
     }
     pct = lambda x: "n/a" if math.isnan(x) else f"{100 * x:.0f} %"  # noqa: E731
-    mark = lambda ok_: "PASS" if ok_ else "FAIL"  # noqa: E731
+    def mark(value, least):
+        return "n/a" if math.isnan(value) else "PASS" if value >= least else "FAIL"
     criteria = [
-        f"- {mark(numbers['right'] >= CRITERIA['right'])}: first effect right (target included) on "
+        f"- {mark(numbers['right'], CRITERIA['right'])}: first effect right (target included) on "
         f"{pct(numbers['right'])} of the diagnoses of faulty records (>= 90 %); the baseline {pct(numbers['baseline_right'])}",
-        f"- {mark(numbers['right_subtle'] >= CRITERIA['right_subtle'])}: on {pct(numbers['right_subtle'])} of the "
+        f"- {mark(numbers['right_subtle'], CRITERIA['right_subtle'])}: on {pct(numbers['right_subtle'])} of the "
         f"subtle ones (>= 80 %); the baseline {pct(numbers['baseline_right_subtle'])}",
-        f"- {mark(numbers['clean_untouched'] == 1)}: nothing added to {pct(numbers['clean_untouched'])} of the "
+        f"- {mark(numbers['clean_untouched'], 1)}: nothing added to {pct(numbers['clean_untouched'])} of the "
         f"diagnoses of records without a fault (100 %); the baseline {pct(numbers['baseline_clean_untouched'])}",
-        f"- {mark(numbers['within'] >= CRITERIA['within'])}: validation RMSE after within {WITHIN} x the noise on "
+        f"- {mark(numbers['within'], CRITERIA['within'])}: validation RMSE after within {WITHIN} x the noise on "
         f"{pct(numbers['within'])} (>= 90 %)",
-        f"- {mark(numbers['baseline_right_loop_wrong'] == 0)}: the loop wrong where the baseline is right on "
+        f"- {'PASS' if numbers['baseline_right_loop_wrong'] == 0 else 'FAIL'}: the loop wrong where the baseline is right on "
         f"{numbers['baseline_right_loop_wrong']} diagnoses (0)"
         + "".join(f"\n  - {r['name']} draw {r['draw']}: baseline {first(r, 'baseline')}, loop {first(r, 'loop')}"
                   for r in missed),
-        (f"- {mark(numbers['stable'] >= CRITERIA['stable'])}: the same first effect under {draws} noise draws on "
+        (f"- {mark(numbers['stable'], CRITERIA['stable'])}: the same first effect under {draws} noise draws on "
          f"{pct(numbers['stable'])} of {numbers['stable_records']} records (>= 90 %)") if draws > 1 else
         "- n/a: stability needs more than one draw (--draws)",
     ]
