@@ -77,8 +77,12 @@ $(BIN)/nodeforce compare $(TWINHOUSE_OUT2)/building_as_written.json $(TWINHOUSE_
 	-o $(TWINHOUSE_OUT2)/$(1) --objective living --burn-in-days 3 --phases $(TWINHOUSE_EXAMPLE)/phases_exp2.csv
 endef
 
+# The forcing search's speed, then the diagnosis on 62 records x 3 noise draws (about an hour on
+# 2 cores; finished records are kept in out/bench_diagnosis and skipped by a rerun):
+# docs/performance.md, docs/benchmark_diagnosis.md
 benchmark: venv
 	$(BIN)/python benchmarks/bench_search.py
+	$(BIN)/python benchmarks/bench_diagnosis.py
 
 clean:
 	rm -rf $(VENV) out

@@ -1,0 +1,152 @@
+"""The diagnosis benchmark's records (benchmarks/records.py): the truth is the file's building,
+only finer in space and time, so that it converges to the file's model as its fault vanishes; the
+fault's size gives the error it claims; a record is the same for the same name and draw.
+
+A few small records (5 to 7 days, 30 to 60 min) stand here; `record(spec, draw)` gives a test
+everything to diagnose one and judge the answer."""
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from benchmarks.baseline import fit_one
+from benchmarks.records import (CELLS, FAULTS, FINE_STEP, STRONG_BAND, SUBTLE_BAND, Spec, before_error,
+                                file_building, record, refined)
+from nodeforce.model.building import load_building
+from nodeforce.model.hlc import heat_loss_coefficient
+from nodeforce.model.network import assemble
+
+pytestmark = pytest.mark.slow  # each record is simulated at 1 min, and a few tuned
+
+
+def small(fault="none", size="subtle", **changes):
+    """A small record of the test cell in Miami's June (6 days at 30 min, the paper's sensors)."""
+    fields = dict(name=f"test/{fault}-{size}", building="testcell", climate="miami", start="06-03", days=6,
+                  step_min=30, noise=0.1, sensors="paper")
+    if fault != "none":
+        effect, target, full, expected = FAULTS[fault]
+        fields.update(effect=effect, target=target, full={**full, **({"T_ground": 24.0} if "T_ground" in full else {})},
+                      size=size, expected=expected)
+    return Spec(**{**fields, **changes})
+
+
+def test_the_truth_is_finer_and_has_the_files_conductances_and_capacities():
+    """Every cell of the truth lies in one layer and in one of the file's cells and is at most
+    1/CELLS of it; each component's total resistance (sum of dx/lambda over its layers, by hand)
+    and capacity (sum of rho c dx) are the file's; the file's nodes keep their ids and depths."""
+    for path in ("model/data/testcell.json", "examples/twinhouse_n2/building.json"):
+        building = load_building(path)
+        truth = refined(building)
+        for c, f in zip(truth.components, building.components):
+            assert dict(zip(f.node_ids, f.depths)).items() <= dict(zip(c.node_ids, c.depths)).items()
+            bounds = np.cumsum([0.0] + [t for _, t in c.layers])
+            for a, b in zip(c.depths, c.depths[1:]):
+                assert not np.any((bounds > a + 1e-12) & (bounds < b - 1e-12))  # no layer boundary inside
+                k = np.searchsorted(f.depths, a, side="right") - 1
+                assert b - a <= (f.depths[k + 1] - f.depths[k]) / CELLS + 1e-12
+            by_hand_R = sum(t / m.conductivity for m, t in c.layers)
+            by_hand_C = sum(t * m.density * m.specific_heat for m, t in c.layers)
+            for b_ in (building, truth):
+                n = assemble(b_)
+                ids = np.array(b_.component(c.name).node_ids) - 1
+                G = [n.A[i, j] for i, j in zip(ids, ids[1:])]
+                assert sum(1 / g for g in G) * c.area == pytest.approx(by_hand_R, rel=1e-9)
+                assert n.C[ids].sum() == pytest.approx(by_hand_C * c.area, rel=1e-9)
+        assert heat_loss_coefficient(truth) == pytest.approx(heat_loss_coefficient(building), rel=1e-9)
+
+
+def test_the_no_fault_truth_tends_to_the_files_model_and_a_vanishing_fault_vanishes():
+    """The finer truth without fault leaves the file's model a validation error that shrinks with
+    the record's step (the model's backward Euler at the step against the truth's minute: first
+    order) to under 0.1 C at 10 min, what the finer walls and the truth's real history leave;
+    a fault scaled towards zero makes a record that tends to it (the gap linear in the scale)."""
+    errors = {}
+    for step in (10, 30):
+        r = record(small(step_min=step), 0)
+        air = r.building.zones[0].air_node
+        errors[step] = before_error(r.building, r.weather, r.noiseless, air)
+        assert math.hypot(errors[step], 0.1) / 0.1 == pytest.approx(r.before_ratio, rel=1e-9)
+    assert errors[10] < 0.1 and 1.3 * errors[10] < errors[30] < 0.2
+    none = record(small(), 0)
+    spec = small("infiltration")
+    gaps = []
+    for scale in (1e-2, 1e-3):
+        faint = record(spec, 0, scale=scale)
+        gaps.append(np.abs(faint.noiseless.to_numpy() - none.noiseless.to_numpy()).max())
+    assert gaps[1] < 0.01 and gaps[1] == pytest.approx(gaps[0] / 10, rel=0.05)
+
+
+def test_a_finer_step_changes_the_truth_little():
+    """At 1 min the truth's time discretisation is converged: the file's own building simulated
+    at 1 min (the truth's way) and at 5 min (the same inputs): backward Euler's error is first
+    order in the step, so the 1-min run's error is about a quarter of their difference (Richardson),
+    under a hundredth of a degree."""
+    import benchmarks.records as records
+    spec = small(days=5)
+    building = file_building(spec)
+    times = records.record_times(spec)
+    weather = records.fine_weather(spec, building, times, {})
+    at_1 = records.truth_record(building, weather, times, [23])
+    coarse = weather.iloc[::5]
+    coarse.attrs["source"] = "5 min"
+    at_5 = records.truth_record(building, coarse, times, [23])
+    assert FINE_STEP == 60 and np.abs(at_1 - at_5).max() / 4 < 0.01
+
+
+@pytest.mark.parametrize("fault,size", [("door", "subtle"), ("mass", "strong"), ("schedule", "subtle")])
+def test_an_effects_size_gives_the_before_error_it_claims(fault, size):
+    """The file's validation RMSE on the noisy record (the diagnosis' "before") over the noise
+    lies in the size's band, for each of three draws."""
+    spec = small(fault, size, step_min=60, days=7)
+    band = SUBTLE_BAND if size == "subtle" else STRONG_BAND
+    for draw in range(3):
+        r = record(spec, draw)
+        air = r.building.zones[0].air_node
+        ratio = before_error(r.building, r.weather, r.measurements, air) / spec.noise
+        assert band[0] <= ratio <= band[1], (draw, ratio, r.scale)
+
+
+def test_a_record_is_its_name_and_draw():
+    """Same draw: the same numbers; another draw: the same truth, other noise of the stated sd."""
+    spec = small("wall", "strong", days=5)
+    a, b, c = record(spec, 1), record(spec, 1), record(spec, 2)
+    assert a.measurements.equals(b.measurements) and a.scale == c.scale
+    noise = (a.measurements - a.noiseless).to_numpy()
+    assert not np.allclose(noise, (c.measurements - c.noiseless).to_numpy())
+    n = noise.size
+    assert abs(noise.std() - spec.noise) < 4 * spec.noise / math.sqrt(2 * n)
+    assert list(a.measurements.columns) == ["T1", "T7", "T9", "T16", "T17", "T23"]
+
+
+def test_the_heater_is_held_over_each_record_step_and_the_schedule_is_its_hours():
+    """The air-only record's PRBS heater, read at 1 min, is over (t_k-1, t_k] the value at t_k,
+    which is what the file's model at the record's step reads; the scheduled gain gives its
+    power for its 10 hours of each local day and nothing else."""
+    r = record(small("schedule", "strong", sensors="air"), 0)
+    q = r.weather["Q_heat"]
+    times = r.measurements.index
+    assert set(np.unique(q)) == {0.0, 300.0}
+    for t0, t1 in zip(times[:-1], times[1:]):
+        inside = q[(q.index > t0) & (q.index <= t1)]
+        assert (inside == q[t1]).all()
+    # the schedule is the truth's, not the file's
+    assert "Q_schedule" not in r.weather and "Q_schedule" in r.truth.input_columns
+    import benchmarks.records as records
+    _, extra = records.faulty(refined(r.building), r.spec, r.values)
+    day = pd.date_range(times[0], periods=1440, freq="1min")
+    power = extra["Q_schedule"](day)
+    assert power.sum() * 60 == pytest.approx(r.values["Q"] * 10 * 3600)
+
+
+def test_the_baseline_fits_a_strong_air_change_to_its_size():
+    """On a strong infiltration record read by every node, the baseline's least squares of the air
+    change alone finds the truth's rate within 5 % (the finer walls and step leave the rest), and
+    lowers the calibration window's J to near the noise's n sigma^2."""
+    r = record(small("infiltration", "strong", sensors="all", days=7, step_min=30), 0)
+    case = r.case().with_steady_start()
+    n_steps = len(case.times) - 1
+    rows = np.arange(case.burn_in_steps, int(round(0.6 * n_steps)))
+    values, J, _ = fit_one(r.building, case, "infiltration", "cell", [23], rows)
+    assert values["n"] == pytest.approx(r.values["n"], rel=0.05)
+    assert J < 2 * rows.size * r.spec.noise ** 2
