@@ -58,7 +58,9 @@ def physical(building, evidence, zones, measured_ids, located_nodes=()):
     pairs = [pair for name in dict.fromkeys(air_zones) for pair in zone_effects(building, name)]
     ranked = [e["component"] for i, e in enumerate(evidence) if i < TOP_COMPONENTS or e["share"] >= EVIDENT]
     measured = set(measured_ids)
-    unsensed = [c.name for c in building.components if c.inside.zone in zones and not measured & set(c.node_ids)]
+    # a component of an objective zone: one of its faces faces the zone (a partition's either side)
+    facing = {i for zone in zones for i in building.facing(zone)}
+    unsensed = [c.name for c in building.components if facing & set(c.node_ids) and not measured & set(c.node_ids)]
     for name in dict.fromkeys(ranked + unsensed):
         pairs += component_effects(building, name)
     return list(dict.fromkeys(pairs))

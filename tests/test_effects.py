@@ -141,6 +141,9 @@ def test_a_zone_with_supply_air_gets_a_thermal_bridge_not_an_infiltration():
     assert ("thermal_bridge", "A->T_cellar") in pairs
     # a zone with a heat input: the heater's lag and the input's split; with shaded glazing: their leak
     assert {("heat_input_lag", "B"), ("heat_input_split", "B"), ("shading_transmittance", "A")} <= set(pairs)
+    # a partition is a component of the zones on both its sides: unmeasured, B's calibrates it too
+    assert ("conductivity", "partition") in physical(b, [], ["B"], [])
+    assert ("conductivity", "partition") not in physical(b, [], ["B"], b.component("partition").node_ids[:1])
     after = EFFECTS["heat_input_split"].apply(b, "B", {"f_r": 0.8})
     assert after.zone("B").heat_input_radiative_fraction == 0.8
     after = EFFECTS["thermal_bridge"].apply(b, "A->T_cellar", {"UA": 2.5})
