@@ -42,7 +42,7 @@ from nodeforce import lifetime
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnose.calibrate import Candidate, calibrate, sensitivity
-from nodeforce.diagnose.candidates import physical, shaped_inputs, shapes
+from nodeforce.diagnose.candidates import objection, physical, shaped_inputs, shapes
 from nodeforce.diagnose.loss import heat_loss
 from nodeforce.diagnose.report import write_report
 from nodeforce.diagnose.phases import phase_errors, worsened
@@ -202,9 +202,10 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
         pairs = [p for p in physical(model.building, localization["components"], objective.zones,
                                      case.measured_ids, localization["best_nodes"]) if "@".join(p) not in done]
         tried, models, screened, simulations = assessed(model, pairs)
-        # shapes only where no physical candidate brings the error left to the noise; the
-        # residual's statistics then choose which
-        if not any(at_noise(r["cv"]["J"], n, sigma) for r in tried):
+        # shapes only where no physical candidate physics admits brings the error left to the
+        # noise; the residual's statistics then choose which
+        if not any(at_noise(r["cv"]["J"], n, sigma) and not objection(model.building, r["effect"], r["target"],
+                                                                      r["parameters"], r["derived"]) for r in tried):
             pairs = [p for p in shapes(model.building, left_by(model), objective.zones) if "@".join(p) not in done]
             more, more_models, more_screened, more_simulations = assessed(model, pairs)
             tried, simulations = tried + more, simulations + more_simulations

@@ -150,8 +150,8 @@ def _reason(chosen, alike, results, passing, base, n, tests, margin, components)
     if not chosen:
         return (f"None of the {len(results)} candidates lowers the cross-validated J ({base.sum():.3g} C2 over "
                 f"{B} days) by more than the noise could ({margin:.3g} C2) and {STANDARD_ERRORS:g} standard error of "
-                f"its fall from day to day, on more days than one ({len(passing)} do, none that physics admits): "
-                "no effect is added.")
+                f"its fall from day to day, on more days than one"
+                + (f" ({len(passing)} do, and physics refuses each)" if passing else "") + ": no effect is added.")
     what = (f"an unexplained heat source, acting {acting(chosen)} ({chosen['effect']} on {chosen['target']})"
             if is_shape(chosen["effect"]) else f"{chosen['effect']} on {chosen['target']}")
     test = tests[label(chosen)]
