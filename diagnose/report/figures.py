@@ -299,9 +299,18 @@ def verdict_key(verdict):
     return "refused" if verdict.get("objection") else "passes"
 
 
+PLOTTED_CANDIDATES = 24
+
+
 def plot_candidates(path, report):
-    """Validation RMSE of each candidate against the baseline's, coloured by the loop's verdict."""
-    candidates = report.get("candidates") or []
+    """Validation RMSE of the candidates against the baseline's, coloured by the loop's verdict:
+    every chosen one and the others of lowest cross-validated error, PLOTTED_CANDIDATES in all
+    (a round calibrates tens)."""
+    tried = report.get("candidates") or []
+    kept = sorted(tried, key=lambda c: (not content.is_chosen(report, c),
+                                        num((c.get("cv") or {}).get("J")) if num((c.get("cv") or {}).get("J"))
+                                        is not None else np.inf))[:PLOTTED_CANDIDATES]
+    candidates = [c for c in tried if any(c is k for k in kept)]
     base = num(metrics(report, "before", "validation").get("rmse"))
     fig = _new_figure(max(7.0, 1.1 * len(candidates) + 3), 5.0)
     ax = fig.add_subplot()
@@ -339,7 +348,9 @@ def plot_candidates(path, report):
             if v is not None]
     if tops:
         ax.set_ylim(0, 1.18 * max(tops))
-    ax.set_title("Candidate effects: validation RMSE after calibration")
+    ax.set_title("Candidate effects: validation RMSE after calibration"
+                 + (f" (the {len(candidates)} of {len(tried)} of lowest cross-validated error)"
+                    if len(candidates) < len(tried) else ""))
     ax.grid(axis="y", alpha=0.3)
     fig.legend(handles=handles, loc="outside lower center", ncols=2, fontsize=9, frameon=False)
     return _save(fig, path)
