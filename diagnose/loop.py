@@ -22,7 +22,8 @@ on data the calibration did not see.
    any choice: its before and after are an honest estimate. The decision of every round, its
    margins, its cost and its reason go into report.json, which the report reads.
 5. The chosen model is built as an FMU and written (`model_after.fmu`, `building_after.json`);
-   every candidate's building file is written declaring its calibrated effect.
+   every candidate's building file is written declaring its calibrated effect
+   (`candidates/<effect>@<target>.json`, a later round's in `candidates/round<n>/`).
 6. The residual of the first objective zone on the validation window, before and after, is
    described (`diagnose.residuals`): is it white, and which input or time of day does it follow.
 7. Given the experiment's phases, every model is scored on each (`diagnose.phases`), and an
@@ -189,8 +190,11 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
         inputs = {name: values for name, values in zip(case.input_names, case.U[1:k + 1].T) if name in shaped}
         return residual_diagnostics(calibration.times[1:], scored[:, 0] - model.run[:k, 0], inputs)
 
-    def assessed(model, pairs):
-        return assess_all(model, pairs, calibration, case, objective, folder, seed, workers, masks)
+    def assessed(model, pairs, number):
+        # a later round's candidates, on top of the earlier choices, are building files of their own
+        into = folder / f"round{number + 1}" if number else folder
+        into.mkdir(exist_ok=True)
+        return assess_all(model, pairs, calibration, case, objective, into, seed, workers, masks)
 
     added, rounds, results, runs, sensitivities = [], [], [], {}, {}
     for number in range(MAX_ROUNDS):
@@ -201,13 +205,13 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
         started = time.perf_counter()
         pairs = [p for p in physical(model.building, localization["components"], objective.zones,
                                      case.measured_ids, localization["best_nodes"]) if "@".join(p) not in done]
-        tried, models, screened, simulations = assessed(model, pairs)
+        tried, models, screened, simulations = assessed(model, pairs, number)
         # shapes only where no physical candidate physics admits brings the error left to the
         # noise; the residual's statistics then choose which
         if not any(at_noise(r["cv"]["J"], n, sigma) and not objection(model.building, r["effect"], r["target"],
                                                                       r["parameters"], r["derived"]) for r in tried):
             pairs = [p for p in shapes(model.building, left_by(model), objective.zones) if "@".join(p) not in done]
-            more, more_models, more_screened, more_simulations = assessed(model, pairs)
+            more, more_models, more_screened, more_simulations = assessed(model, pairs, number)
             tried, simulations = tried + more, simulations + more_simulations
             models.update(more_models)
             screened.update(more_screened)
