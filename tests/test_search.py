@@ -460,3 +460,15 @@ def test_the_finding_names_the_rule_that_decided(testcell):
     shares = evidence(testcell, result)
     assert [(e["component"], e["node"]) for e in shares] == [("floor", 16), ("roof", 9), ("door", 7)]
     assert [e["share"] for e in shares] == pytest.approx([0.8, 0.5, -0.1])
+
+
+def test_the_terminal_marks_the_nodes_the_noise_cannot_separate():
+    from nodeforce.cli import locate_summary
+    result = {"J_unforced": 3.0, "objective": ["cell"], "node_scores": {"7": 1.0, "9": 1.1, "16": 2.0},
+              "ranked_nodes": [7, 9, 16], "tied_nodes": [[7, 9]], "best_nodes": [7], "J_best": 1.0,
+              "finding": "forcing node 7 ...", "search": {"method": "exhaustive", "unique_evaluations": 8,
+                                                          "seconds": 0.1}}
+    lines = locate_summary(result).splitlines()
+    header = next(i for i, line in enumerate(lines) if "J forced alone" in line)
+    assert [line.split() for line in lines[header + 1:header + 4]] == [["7", "1.000", "a"], ["9", "1.100", "a"],
+                                                                      ["16", "2.000"]]
