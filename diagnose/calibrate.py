@@ -1,11 +1,17 @@
-"""Calibrate an effect's parameters through its FMU, with their uncertainty and identifiability.
+"""Calibrate an effect's parameters on the direct model, with their uncertainty and identifiability.
 
 Bounded least squares on the air-temperature residual of the calibration window (scipy's
-`least_squares`, trust region reflective). The covariance of the estimate is the linearised
-sandwich of `model.significance`, which allows for the residual's correlation in time (the
-textbook s^2 (J^T J)^-1 assumes independent residuals and, on real records, is several times
-too tight). A parameter is called identifiable from the data when that estimate
-is tight enough to act on (`IDENTIFIABLE_*` below) and it did not end on a bound.
+`least_squares`, trust region reflective), simulated by the direct model (`model.integrate`):
+the FMUs carry the same equations and are tested equal to it (tests/test_fmu3.py), and a
+diagnosis calibrates tens of candidates, each once on the whole calibration window and once per
+cross-validation block left out (`diagnose.selection`, each fold one Gauss-Newton step from the
+whole window's optimum), so a simulation without an FMU's per-step calls is what makes that
+affordable. The chosen effect's FMU is built and written all
+the same (`diagnose.loop`). The covariance of the estimate is the linearised sandwich of
+`model.significance`, which allows for the residual's correlation in time (the textbook
+s^2 (J^T J)^-1 assumes independent residuals and, on real records, is several times too tight).
+A parameter is called identifiable from the data when that estimate is tight enough to act on
+(`IDENTIFIABLE_*` below) and it did not end on a bound.
 """
 import logging
 
@@ -14,13 +20,12 @@ from SALib.analyze import morris as morris_analyze
 from SALib.sample import morris as morris_sample
 from scipy.optimize import least_squares
 
-from nodeforce.cosim.fmi import FmuInstance
-from nodeforce.cosim.run import simulate_fmu
-from nodeforce.fmu_build.build import build_fmu
 from nodeforce.diagnose.candidates import IDENTIFIABLE_RELATIVE, calibration_start
 from nodeforce.model.significance import bandwidth, parameter_covariance
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.hlc import heat_loss_coefficient
+from nodeforce.model.integrate import simulate
+from nodeforce.model.network import assemble
 
 log = logging.getLogger("nodeforce.diagnose")
 
@@ -33,43 +38,66 @@ MORRIS_TRAJECTORIES = 4
 # HLC is linear or smooth in every parameter (a conductance in series), so a small step is exact
 # to many digits.
 HLC_STEP = 1e-6
+# Simulations a candidate keeps, by parameter values and window: the runs the report needs at the
+# calibrated values are then simulations already made.
+KEPT_RUNS = 64
 
 
 class Candidate:
-    """The model with one added effect: its own FMU, one instance reused for every run."""
+    """The model with one added effect, simulated by the direct model at any parameter values."""
 
-    def __init__(self, building, effect, target, workdir, fmu_kind="python"):
+    def __init__(self, building, effect, target):
         self.building, self.effect, self.target = building, effect, target
         self.parameters = EFFECTS[effect].parameters
         self.bounds = EFFECTS[effect].bounds(building, target)  # [(low, high)] a calibration explores
-        self.declared = EFFECTS[effect].apply(building, target, {})  # what its FMU carries
-        self.instance = FmuInstance(build_fmu(building, workdir / f"{self.label}.fmu", effect=(effect, target),
-                                              kind=fmu_kind))
+        self.declared = EFFECTS[effect].apply(building, target, {})  # the inputs it reads
+        self._runs, self._inputs = {}, {}
+        self.simulations = 0  # simulations run (kept ones not counted again): a round's cost
 
     @property
     def label(self):
         return f"{self.effect}@{self.target}"
 
+    def built(self, values):
+        """The building with the effect at `values` (sequence, in `parameters` order)."""
+        return EFFECTS[self.effect].apply(self.building, self.target,
+                                          {p.name: float(v) for p, v in zip(self.parameters, values)})
+
     def nodes(self, case, node_ids, values):
         """Simulated temperatures (C) of nodes at t_1..t_N, (N_t, len(node_ids)), with the effect
         at `values` (sequence)."""
-        parameters = {f"{self.effect}.{p.name}": float(v) for p, v in zip(self.parameters, values)}
-        # the effect may read inputs the building as declared does not (a daily gain, the clock)
-        return simulate_fmu(self.instance, case.with_inputs(self.declared), output_ids=node_ids,
-                            parameters=parameters)
+        key = (id(case), tuple(node_ids), tuple(float(v) for v in values))
+        if key not in self._runs:
+            if id(case) not in self._inputs:
+                # the effect may read inputs the building as declared does not (a daily gain, the clock)
+                self._inputs[id(case)] = (case, case.with_inputs(self.declared))
+            _, inputs = self._inputs[id(case)]
+            building = self.built(values)
+            self.simulations += 1
+            T = simulate(building, assemble(building), inputs.U, inputs.dt, inputs.measured,
+                         burn_in_steps=inputs.burn_in_steps, steady_start=inputs.steady_start)
+            if len(self._runs) >= KEPT_RUNS:
+                self._runs.pop(next(iter(self._runs)))
+            self._runs[key] = T[:, np.asarray(node_ids) - 1]
+        return self._runs[key]
 
-    def close(self):
-        self.instance.close()
 
-
-def calibrate(candidate, case, objective):
+def calibrate(candidate, case, objective, blocks=()):
     """Least-squares values of the candidate's parameters on `case` (the calibration window), on
-    the residuals of every objective zone.
+    the residuals of every objective zone, and the same fit with each block of steps left out.
+
+    Parameters
+    ----------
+    candidate : Candidate
+    case : Case, the calibration window
+    objective : model.score.Objective
+    blocks : (N_t,) bool masks of the steps of each cross-validation block (`diagnose.selection`)
 
     Returns
     -------
-    dict {name: {"value", "std", "identifiable"}}, and the quantities the data determine even
-    where the parameters are not (see `derived`)
+    dict {name: {"value", "std", "identifiable", "on_bound"}}; the quantities the data determine
+    even where the parameters are not (see `derived`); and per block the parameter values fitted
+    without it (`fold`) and the residuals (C, (N_t, zones), NaN off the block) they leave on it
     """
     measured = objective.measured(case)
     have = np.isfinite(measured)
@@ -88,13 +116,35 @@ def calibrate(candidate, case, objective):
         tight = sd < (IDENTIFIABLE_KELVIN if p.unit == "C" else IDENTIFIABLE_RELATIVE * abs(value))
         identifiable = bool(tight and bound == 0)
         if not identifiable:
-            # the report's candidates table says it for every candidate; the terminal keeps its
-            # first screen for the result
             log.info("%s: %s = %.4g +- %.2g %s is not identifiable from these data%s", candidate.label,
-                        p.name, value, sd, p.unit, " (it ended on a bound)" if bound else "")
+                     p.name, value, sd, p.unit, " (it ended on a bound)" if bound else "")
         result[p.name] = {"value": float(value), "std": float(sd), "identifiable": identifiable,
                           "on_bound": bool(bound != 0)}
-    return result, derived(candidate, case, fit.x, cov)
+    folds = []
+    for block in blocks:
+        train = ~np.broadcast_to(block[:, None], have.shape)[have]
+        x = fold(fit, train, lows, highs)
+        left = np.where(have & block[:, None], measured - candidate.nodes(case, objective.air_nodes, x), np.nan)
+        folds.append({"values": [float(v) for v in x], "residuals": left})
+    return result, derived(candidate, case, fit.x, cov), folds
+
+
+def fold(fit, train, lows, highs):
+    """The parameters fitted without a block: one Gauss-Newton step from the whole window's
+    optimum on the `train` rows of its residuals and Jacobian, kept inside the bounds.
+
+    Leaving one day out of several moves the optimum by little, and the step from the optimum
+    is exact to first order in that move (for a model linear in its parameters, exact): a fold
+    costs the one simulation that scores its left-out day, where a fit of its own would cost
+    tens; on the Twin House's eighteen days a candidate's fifteen folds would otherwise be most
+    of a diagnosis's time."""
+    # a parameter the whole window's fit left on a bound stays there: its step would leave the
+    # range, and clipping it alone would break the trade-off the others made with it
+    free = fit.active_mask == 0
+    x = fit.x.copy()
+    if free.any():
+        x[free] += np.linalg.lstsq(fit.jac[train][:, free], -fit.fun[train], rcond=None)[0]
+    return np.clip(x, lows, highs)
 
 
 # The derived time constant (s) of the effects that add a node of capacity C and conductance H.

@@ -5,7 +5,7 @@ the policy changes no FMU and throws away no saved search.
 """
 import math
 
-from nodeforce.model.effects import EFFECTS, bridge_parts, bridge_target, pair_parts, shaded_glazings
+from nodeforce.model.effects import EFFECTS, bridge_parts, bridge_target, pair_parts
 from nodeforce.model.network import RHO_C_AIR
 
 # Where the calibration of an effect the file does not declare starts (see calibration_start).
@@ -27,49 +27,64 @@ ZONE_START = {("internal_mass", "C_m"): 10.0,
 IDENTIFIABLE_RELATIVE = 0.25
 
 
-def candidates(building, located_nodes, zones):
-    """(effect, target) pairs a diagnosis should try.
+# The components whose effects every round calibrates besides the unmeasured ones: at least the
+# TOP_COMPONENTS whose forcing removes most of J above the noise, and any that removes EVIDENT of
+# it or more (ga.locate's `components`), whether or not the localisation calls a fault.
+TOP_COMPONENTS = 3
+EVIDENT = 0.25
+
+
+def physical(building, evidence, zones, measured_ids, located_nodes=()):
+    """(effect, target) pairs every round calibrates, whatever the residual's statistics say: a
+    building physicist's list of what could be wrong, which the cross-validated choice
+    (`diagnose.selection`) then judges.
+
+    - Every zone effect of each objective zone (`zone_effects`), and of any zone whose air the
+      forcing search located.
+    - The component effects (`component_effects`) of the components the forcing evidence ranks
+      highest (at least TOP_COMPONENTS, and any removing EVIDENT of J above the noise), and of
+      every component of an objective zone that no sensor sits in: forcing cannot point at a
+      component without a sensor; a calibration can.
 
     Parameters
     ----------
     building : Building
-    located_nodes : node ids the forcing search located
+    evidence : ga.locate's `components`: [{"component", "share", ...}], most evident first
     zones : names of the objective zones
-
-    The effects whose forcing points at a located node come first (those of the located
-    components, a glazing whose sun they receive, a zone's heat input split when its surfaces are
-    located). The air node's own equation is always a candidate, since no forcing can reveal it,
-    for the objective zones and any zone whose air was located: a constant gain, and an air-to-
-    outside conductance, reported as `thermal_bridge` where the zone has mechanical supply air
-    (whose flow is known) and as `infiltration` otherwise (docs/model.md section 7), plus bridges to
-    the boundary temperatures the zone's surfaces see, and the house-level effects on its air
-    (`house_effects`). When nothing was located, a change of the
-    inside convection (no single node) is one as well, and so is one factor on the objective zones'
-    envelope (`envelope_conductance`): with nothing localised, the level or slow error that no
-    forcing explains may be the whole envelope's conduction rather than the air change. An
-    objective zone with shaded glazings is offered the sun its closed shadings let in
-    (`shading_leaks`).
+    measured_ids : node ids with a measurement column
+    located_nodes : node ids the forcing search located
     """
     located = set(located_nodes)
-    envelope = EFFECTS["envelope_conductance"].targets(building)
-    pairs = [(effect.id, target) for effect in EFFECTS.values() for target in effect.targets(building)
-             if located & set(effect.points_at(building, target))]
     air_zones = list(zones) + [z.name for z in building.zones if z.air_node in located]
-    for name in dict.fromkeys(air_zones):
-        supplied = building.zone(name).supply is not None
-        if not supplied:
-            pairs.append(("infiltration", name))
-        pairs.append(("internal_gain", name))
-        for target in EFFECTS["thermal_bridge"].targets(building):
-            zone, to = bridge_parts(target)
-            if zone == name and (to != "outdoor" or supplied):
-                pairs.append(("thermal_bridge", target))
-        pairs += house_effects(building, name)
-    pairs += shading_leaks(building, zones)
-    if not located:
-        pairs += [("inside_convection", name) for name in zones]
-        pairs += [("envelope_conductance", name) for name in zones if name in envelope]
+    pairs = [pair for name in dict.fromkeys(air_zones) for pair in zone_effects(building, name)]
+    ranked = [e["component"] for i, e in enumerate(evidence) if i < TOP_COMPONENTS or e["share"] >= EVIDENT]
+    measured = set(measured_ids)
+    # a component of an objective zone: one of its faces faces the zone (a partition's either side)
+    facing = {i for zone in zones for i in building.facing(zone)}
+    unsensed = [c.name for c in building.components if facing & set(c.node_ids) and not measured & set(c.node_ids)]
+    for name in dict.fromkeys(ranked + unsensed):
+        pairs += component_effects(building, name)
     return list(dict.fromkeys(pairs))
+
+
+def zone_effects(building, name):
+    """The zone effects of the catalogue for one zone: its air change with the outside
+    (`thermal_bridge` where the zone has supply air, whose flow is known, `infiltration`
+    otherwise) and bridges to the boundary temperatures its surfaces see, a constant gain, inside
+    convection, one factor on its envelope, an internal mass, and where it has a heat input the
+    heater's lag and the input's split, and where it has shaded glazings their shadings' leak."""
+    zone = building.zone(name)
+    supplied = zone.supply is not None
+    pairs = [] if supplied else [("infiltration", name)]
+    for target in EFFECTS["thermal_bridge"].targets(building):
+        owner, to = bridge_parts(target)
+        if owner == name and (to != "outdoor" or supplied):
+            pairs.append(("thermal_bridge", target))
+    pairs += [(effect, name) for effect in ("internal_gain", "inside_convection", "envelope_conductance",
+                                            "internal_mass", "heat_input_lag", "heat_input_split",
+                                            "shading_transmittance")
+              if EFFECTS[effect].applies(building, name)]
+    return pairs + house_effects(building, name)
 
 
 def house_effects(building, zone):
@@ -80,9 +95,21 @@ def house_effects(building, zone):
              if EFFECTS[effect].applies(building, zone)]
     pairs += [("interzone_air_exchange", t) for t in EFFECTS["interzone_air_exchange"].targets(building)
               if zone in pair_parts(t)]
-    seen = [to for t in EFFECTS["thermal_bridge"].targets(building) for z, to in [bridge_parts(t)] if z == zone]
+    seen = {to for t in EFFECTS["thermal_bridge"].targets(building) for z, to in [bridge_parts(t)] if z == zone}
+    seen |= {getattr(c.outside, "temperature", None) for c in building.components if c.inside.zone == zone}
     pairs += [("boundary_conductance", c) for c in EFFECTS["boundary_conductance"].targets(building) if c in seen]
     return pairs
+
+
+def component_effects(building, name):
+    """The effects of one component: those whose target it is (a ground coupling under an
+    adiabatic face, its outside absorptance, its conductivity, a glazing's transmittance), and
+    a glazing's transmittance where the component receives its sun."""
+    nodes = set(building.component(name).node_ids)
+    components = {c.name for c in building.components}
+    return [(effect.id, target) for effect in EFFECTS.values() if not is_shape(effect.id)
+            for target in effect.targets(building) if target in components
+            and (target == name or nodes & set(effect.points_at(building, target)))]
 
 
 def calibration_start(building, effect, target):
@@ -111,8 +138,8 @@ def implausible(building, effect, target):
 
 
 # The shapes: a gain that follows the clock or an input column stands for a heat source the model
-# lacks, not for a physical effect of the building; it is chosen only when no physical effect
-# comes within the paired margin of it (diagnose.loop.decide).
+# lacks, not for a physical effect of the building; tried only where no physical effect brings the
+# error to the noise, and chosen only where none fits as well (diagnose.selection.decide).
 SHAPES = ("daily_gain", "proportional_gain")
 
 # Physical limits, tighter than the range a calibration explores (model.effects): a value
@@ -191,13 +218,12 @@ def objection(building, effect, target, parameters, derived=None):
     return "; ".join(r for r in reasons if r) or None
 
 
-def follow_up(building, left, zones):
-    """(effect, target) pairs that the structure left in a residual points at: a gain with a daily
-    profile where the residual follows the time of day, a gain proportional to an input column it
-    follows (a heat input mis-measured, sun through an opening the model lacks), for each
-    objective zone, and where that column is the sun on a facade the zone has glazings on, their
-    transmittance and their shadings' leak. None where the residual is white: nothing is left to
-    explain.
+def shapes(building, left, zones):
+    """The shapes (effect, target) the residual's statistics point at: a gain with a daily
+    profile where the residual follows the time of day, a gain proportional to each input column
+    it follows (a heat input mis-measured, sun through an opening the model lacks), for each
+    objective zone. None where the residual is white: nothing is left to explain. A round tries
+    them only where no physical candidate brings the error to the noise (`diagnose.loop`).
 
     Parameters
     ----------
@@ -209,8 +235,7 @@ def follow_up(building, left, zones):
         return []
     # A residual that is structured but follows no input significantly (inputs of one kind, such
     # as the irradiances of several faces, are nearly collinear) still points at that kind: every
-    # input a gain may follow is tried, and the clock. The decision's rules (BIC, validation)
-    # judge what is tried, so trying more costs time, never a wrong answer.
+    # input a gain may follow is tried, and the clock; the cross-validated choice judges them.
     named = [follows["input"] for follows in left["follows"]]
     clock = (left["time_of_day"] or {}).get("significant", False)
     if not named:
@@ -219,63 +244,7 @@ def follow_up(building, left, zones):
     targets = EFFECTS["proportional_gain"].targets(building)
     pairs += [("proportional_gain", target) for name in named for zone in zones
               for target in [bridge_target(zone, name)] if target in targets]
-    # a residual that follows a zone's own heat input may also mean its split between air and
-    # surfaces is wrong (how fast the air answers the heater)
-    pairs += [("heat_input_split", zone) for zone in zones
-              if set(named) & set(building.zone(zone).heat_input)]
-    pairs += zone_effects(building, left, zones)
-    # sun on a facade with glazings: the physical counterparts of a gain following it, the
-    # glazings' transmittance and the sun their closed shadings let in
-    pairs += [("solar_transmittance", c.name) for c in building.components for zone in zones
-              if c.solar_transmittance is not None and c.inside.zone == zone and c.irradiance_input in named]
-    pairs += shading_leaks(building, zones, set(named))
     return list(dict.fromkeys(pairs))
-
-
-def shading_leaks(building, zones, columns=None):
-    """("shading_transmittance", zone) for each objective zone whose glazings have a shading and
-    that declares no leak yet: a model whose closed blinds block all the sun (the usual
-    description, and IDEAS's) misses what a real screen lets through its weave and passes on from
-    the heat it absorbs, a gain that follows the sun on those facades only while they are shaded.
-    `columns`: only the zones whose shaded glazings read one of these irradiance columns."""
-    return [("shading_transmittance", name) for name in zones
-            for glazings in [shaded_glazings(building, name)]
-            if glazings and building.zone(name).shading_transmittance == 0.0
-            and (columns is None or columns & {c.irradiance_input for c in glazings})]
-
-
-def zone_effects(building, left, zones):
-    """The zone effects of docs/model.md section 7 a structured residual points at.
-
-    A residual that follows a zone's own heat input at the same instant is the air answering the
-    heater faster in the model than in the building: the classic sign of furniture and internal
-    mass and of a heater with its own capacity (Bacher and Madsen 2011), so `internal_mass` and
-    `heat_input_lag` of that zone. A level (a mean the residual's own correlation cannot explain)
-    or a slow error that follows no input is what the envelope's conduction as a whole would
-    leave: `envelope_conductance`. An effect the model already declares is not offered again, so
-    after one is added the residual left asks, by the same rules, for the other.
-
-    Parameters
-    ----------
-    building : Building, the model the residual is of
-    left : `diagnose.residuals.diagnostics` of that residual
-    zones : names of the objective zones
-    """
-    instant = {f["input"] for f in left["follows"] if f["lag_hours"] == 0.0}
-    pairs = []
-    for name in zones:
-        zone = building.zone(name)
-        if instant & set(zone.heat_input):
-            if zone.internal_mass is None:
-                pairs.append(("internal_mass", name))
-            if zone.heat_input_lag is None:
-                pairs.append(("heat_input_lag", name))
-    slow = not left["follows"] and not (left["time_of_day"] or {}).get("significant", False)
-    if (left.get("level") or {}).get("significant") or slow:
-        pairs += [("envelope_conductance", name) for name in zones
-                  if name in EFFECTS["envelope_conductance"].targets(building)
-                  and building.zone(name).envelope_factor == 1.0]
-    return pairs
 
 
 def shaped_inputs(building):

@@ -4,12 +4,13 @@ how the loss splits among effects.
 
 A record of the indoor air and the heating power fixes the building's total loss per kelvin far
 better than where the heat goes: an air change and a factor on the envelope's conduction give
-the same HLC and nearly the same air temperatures. When candidates that change the loss fit the
-selection window alike (within what the noise could change) and agree on the HLC, the report
-says the split is not the record's.
+the same HLC and nearly the same air temperatures. When candidates that change the loss predict
+the calibration window's days alike (cross-validated J within what the noise could change) and
+agree on the HLC, the report says the split is not the record's.
 """
 import math
 
+from nodeforce.diagnose.selection import label
 from nodeforce.ga.parsimony import tolerance
 from nodeforce.model.hlc import heat_loss_coefficient
 
@@ -30,12 +31,12 @@ def heat_loss(before_building, after_building, added, results, sigma):
     before_building, after_building : Building as described and as corrected
     added : the loop's chosen candidate records, in order (their "derived" holds the HLC of the
         model with the effect and its sd from the calibration's covariance)
-    results : every candidate record; a follow-up's have "on_top_of"
+    results : every candidate record, each with the "round" it was tried in
     sigma : the air sensors' noise sd (C), which sets the change of J no test can tell apart
     """
     out = {"before": heat_loss_coefficient(before_building), "after": heat_loss_coefficient(after_building),
            "after_sd": float(added[-1]["derived"][HLC]["std"]) if added else 0.0, "split": None}
-    rounds = [[r for r in results if "on_top_of" not in r], [r for r in results if "on_top_of" in r]]
+    rounds = [[r for r in results if r["round"] == number] for number in range(1, len(added) + 1)]
     starts = [{"value": out["before"], "std": 0.0}] + [a["derived"][HLC] for a in added]
     for chosen, start, tried in zip(added, starts, rounds):
         alike = same_loss(chosen, tried, start, sigma)
@@ -45,7 +46,7 @@ def heat_loss(before_building, after_building, added, results, sigma):
                             f"but not how it splits among effects: "
                             + ", ".join(f"{r['effect']} on {r['target']} ({r['derived'][HLC]['value']:.1f} W/K)"
                                         for r in alike)
-                            + f" fit the selection window as well as {chosen['effect']} on {chosen['target']} "
+                            + f" predict the left-out days as well as {chosen['effect']} on {chosen['target']} "
                               "with the same loss, so the split is the building file's, not the record's.")
     return out
 
@@ -53,17 +54,17 @@ def heat_loss(before_building, after_building, added, results, sigma):
 def same_loss(chosen, tried, start, sigma):
     """The other candidates of `chosen`'s round that change the loss from the round's `start`
     ({"value", "std"}, W/K) as the chosen does: the same HLC, each well determined, and a
-    selection J the chosen's does not beat by more than the noise could (`ga.parsimony.tolerance`).
+    cross-validated J the chosen's does not beat by more than the noise could
+    (`ga.parsimony.tolerance`).
     None of them when the chosen changes no loss (a gain, a mass)."""
-    from nodeforce.diagnose.loop import label  # the decision's keys; loop imports this module
     hlc = chosen["derived"].get(HLC)
     if not hlc or not moves(hlc, start):
         return []
-    J, n = chosen["selection"]["J"], chosen["selection"]["n"]
+    J, n = chosen["cv"]["J"], chosen["cv"]["n"]
     margin = tolerance(J, sigma, n)
     return [r for r in tried if label(r) != label(chosen) and r["derived"].get(HLC)
             and agree(hlc, r["derived"][HLC]) and moves(r["derived"][HLC], start)
-            and r["selection"]["J"] - J <= margin]
+            and r["cv"]["J"] - J <= margin]
 
 
 def moves(a, start):

@@ -98,7 +98,28 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
     result = {"measured_nodes": case.measured_ids, "output_node": objective.air_nodes[0],
               "objective": list(objective.zones), "output_nodes": list(objective.air_nodes), **result,
               "noise": noise.to_json()}
+    result["components"] = evidence(building, result)
     return {**result, "finding": finding(building, result)}
+
+
+def evidence(building, result):
+    """The forcing evidence per component: the share of J above the noise that forcing its
+    best-scoring measured node alone removes (`ga.parsimony.removed`), most first. A diagnosis
+    calibrates the effects of the components it ranks highest, whether or not a fault is
+    located (`diagnose.candidates.physical`).
+
+    Returns [{"component", "node", "J", "share"}]; components without a node the search forced
+    are absent."""
+    J_unforced, J_noise = result["J_unforced"], result["search"]["J_noise"] or 0.0
+    scores = {int(i): J for i, J in result["node_scores"].items() if J is not None}
+    out = []
+    for c in building.components:
+        scored = [i for i in c.node_ids if i in scores]
+        if scored:
+            node = min(scored, key=lambda i: (scores[i], i))
+            out.append({"component": c.name, "node": node, "J": scores[node],
+                        "share": removed(J_unforced, scores[node], J_noise)})
+    return sorted(out, key=lambda e: (e["J"], e["component"]))
 
 
 def nothing_to_force(building, case, objective, fitness, noise):
@@ -121,6 +142,7 @@ def nothing_to_force(building, case, objective, fitness, noise):
     return {"measured_nodes": case.measured_ids, "chromosome_nodes": [], "output_node": objective.air_nodes[0],
             "objective": list(objective.zones), "output_nodes": list(objective.air_nodes),
             "J_unforced": J, "best_nodes": [], "J_best": J, "node_scores": {}, "ranked_nodes": [],
+            "tied_nodes": [], "components": [],
             "search": {"method": "none", "evaluations": 1, "unique_evaluations": 1,
                        "seconds": time.perf_counter() - start},
             "noise": noise.to_json(), "finding": said}
@@ -141,13 +163,24 @@ def finding(building, result):
     if best:
         share = removed(J_unforced, result["J_best"], J_noise)
         said = f"{forcing(best)} removes {share:.0%} {of}: the fault is in the sub-model behind it."
+        # a single node that removes more, which the parsimony rule could not tell from it
+        # (the nearer the zone was preferred), is named: the numbers say both
+        first = (result["ranked_nodes"] or [None])[0]
+        if first is not None and first not in best and result["node_scores"][str(first)] < result["J_best"]:
+            more = removed(J_unforced, result["node_scores"][str(first)], J_noise)
+            said = said[:-1] + (f"; {forcing([first])} alone removes more ({more:.0%}), by a margin the data "
+                                "cannot tell from the noise, and the nearer the zone is preferred.")
     elif strongest and result["ranked_nodes"]:
         share = removed(J_unforced, result["search"]["J_min"], J_noise)
         first = result["ranked_nodes"][0]
         alone = removed(J_unforced, result["node_scores"][str(first)], J_noise)
+        # the rule that decided: too small a share of the error (ga.parsimony.explains), or a fall
+        # of J the noise could make (smallest_subset keeps no node)
+        why = (f"below the {1 - EXPLAINED:.0%} needed to call it the fault" if not result["search"]["explains"]
+               else f"but its fall of J, {J_unforced - result['search']['J_min']:.3g} C2, is within the "
+                    f"{result['search']['tolerance']:.3g} C2 the noise could make")
         said = (f"No forcing locates the fault: the best, {forcing(strongest)}, removes {share:.0%} {of}, "
-                f"below the {1 - EXPLAINED:.0%} needed to call it the fault; {forcing([first])} alone "
-                f"removes {alone:.0%}.")
+                f"{why}; {forcing([first])} alone removes {alone:.0%}.")
     else:
         said = "No forcing lowers J by more than the noise tolerance."
     tested = [c.name for c in building.components if set(c.node_ids) & set(result["chromosome_nodes"])]

@@ -82,8 +82,9 @@ def search(factory, chromosome_nodes, *, population=30, generations=400, pc=0.8,
     Returns the locate.json fields it knows, J values as floats (None: the simulation failed):
       chromosome_nodes; J_unforced (no node forced);
       node_scores {str(id): J with only that node forced};
-      ranked_nodes: the nodes whose forcing alone lowers J below J_unforced, lowest J first
-        (ties: chromosome order); nodes that do not help are left out;
+      ranked_nodes: the nodes whose forcing alone lowers J below J_unforced, lowest J first;
+        nodes that do not help are left out; tied_nodes: the groups of ranked nodes whose
+        scores the noise tolerance cannot separate (`ties`);
       best_nodes: the smallest set of nodes that keeps the best chromosome's reduction of J
         (ga.parsimony), [] when no reduction is significant; J_best: J with best_nodes forced;
       search: {method "ga" | "exhaustive", population, generations, pc, pm, seed, patience,
@@ -91,7 +92,9 @@ def search(factory, chromosome_nodes, *, population=30, generations=400, pc=0.8,
         unique_evaluations (simulations run), seconds, stopped ("converged": by the patience
         rule; "generations": every generation ran, or every batch of an exhaustive search),
         stopped_at (the generation it stopped at), J_min and min_nodes (the lowest J found and
-        its chromosome; parsimony starts from `parsimonious_best`), tolerance (the change of J deemed noise), and when
+        its chromosome; parsimony starts from `parsimonious_best`), tolerance (the change of J deemed noise),
+        explains (whether the best forcing removes enough of J above the noise to locate a
+        fault, ga.parsimony.explains), and when
         seeded stepwise_nodes and J_stepwise (the forward-backward pass's result)}.
     """
     started = time.monotonic()
@@ -248,7 +251,7 @@ def _seeded_population(start, population, k, seed):
     """Initial population: the pass's result, then the significant single nodes, best first,
     each followed by the union of it and the better ones; at most half the population, so the
     random rest keeps the GA free to find interactions the single scores do not show."""
-    helpful = [i for i in rank(start.J_single, start.J_unforced, start.tolerance)
+    helpful = [i for i in rank(start.J_single, start.J_unforced)
                if start.J_single[i] < start.J_unforced - start.tolerance]
     seeds = [start.mask]
     for m, i in enumerate(helpful):
@@ -317,7 +320,8 @@ def _answer(cache, nodes, noise_sigma, n_residuals, factory=None) -> dict:
     tol = tolerance(J_unforced, noise_sigma, n_residuals)
     best = cache.best()
     J_min = cache.J_of[best]
-    if explains(J_unforced, J_min, noise_sigma, n_residuals):
+    explained = explains(J_unforced, J_min, noise_sigma, n_residuals)
+    if explained:
         start = parsimonious_best(cache.J_of, tol)
         paired = (Paired(factory, cache.J_many, ROUNDING * J_unforced)
                   if getattr(factory, "keeps_residuals", False) else None)
@@ -335,9 +339,10 @@ def _answer(cache, nodes, noise_sigma, n_residuals, factory=None) -> dict:
         "best_nodes": cache.describe(chosen),
         "J_best": _json(cache.J_of[chosen]),
         "node_scores": {str(n): _json(J) for n, J in zip(nodes, J_single)},
-        "ranked_nodes": [nodes[i] for i in rank(J_single, J_unforced, tol)],
+        "ranked_nodes": [nodes[i] for i in rank(J_single, J_unforced)],
+        "tied_nodes": [[nodes[i] for i in group] for group in ties(J_single, J_unforced, tol)],
         "search": {"J_min": _json(J_min), "min_nodes": cache.describe(best),
-                   "tolerance": _json(tol),
+                   "tolerance": _json(tol), "explains": explained,
                    "J_noise": _json(noise_floor(noise_sigma, n_residuals))},
     }
 
@@ -353,20 +358,23 @@ def parsimonious_best(J_of, tol):
     return min(J_of, key=lambda m: (J_of[m] + tol * sum(m), sum(m), m))
 
 
-def rank(J_single, J_unforced, tol):
-    """Indices of the nodes whose forcing alone lowers J, most helpful first.
+def rank(J_single, J_unforced):
+    """Indices of the nodes whose forcing alone lowers J, lowest J first (the order of their
+    scores, whatever the noise can separate: `ties` says which it cannot)."""
+    return sorted((i for i, J in enumerate(J_single) if J < J_unforced), key=lambda i: (J_single[i], i))
 
-    Scores closer than `tol` cannot be told apart from the noise: among them the node earlier in
-    the chromosome order (the caller's preference) comes first.
-    """
-    left = [i for i, J in enumerate(J_single) if J < J_unforced]
-    order = []
-    while left:
-        lowest = min(J_single[i] for i in left)
-        first = min(i for i in left if J_single[i] <= lowest + tol)
-        order.append(first)
-        left.remove(first)
-    return order
+
+def ties(J_single, J_unforced, tol):
+    """The groups (indices, lowest J first) of ranked nodes whose single scores the noise cannot
+    separate: each group the nodes within `tol` of its first; only groups of two or more."""
+    groups, group = [], []
+    for i in rank(J_single, J_unforced):
+        if group and J_single[i] <= J_single[group[0]] + tol:
+            group.append(i)
+        else:
+            groups.append(group)
+            group = [i]
+    return [g for g in groups + [group] if len(g) > 1]
 
 
 def _json(J: float) -> "float | None":

@@ -142,10 +142,12 @@ def locate_summary(result):
     scores = result["node_scores"]
     order = [str(n) for n in result["ranked_nodes"]]
     order += sorted((n for n in scores if n not in order), key=lambda n: (scores[n] is None, scores[n]))
+    # nodes the noise cannot separate share a tie mark (a, b, ...): ranked by J, not reordered
+    tied = {str(n): chr(ord("a") + k) for k, group in enumerate(result.get("tied_nodes") or []) for n in group}
     if order:
-        lines.append(f"{'node':>6}{'J forced alone':>16}")
-        lines += [f"{node:>6}{'failed' if scores[node] is None else format(scores[node], '.3f'):>16}"
-                  for node in order[:8]]
+        lines.append(f"{'node':>6}{'J forced alone':>16}  tie")
+        lines += [f"{node:>6}{'failed' if scores[node] is None else format(scores[node], '.3f'):>16}  "
+                  f"{tied.get(node, '')}".rstrip() for node in order[:8]]
     found = ", ".join(map(str, result["best_nodes"])) or "none"
     search = result["search"]
     how = ("nothing to force" if search["method"] == "none" else

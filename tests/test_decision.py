@@ -1,15 +1,14 @@
-"""The decision's rules, on candidates built by hand (no simulation): physics refuses what the
-data cannot pin down or the building's description rules out, and prefers a physical effect
-with few parameters to a shape unless the data show it worse, pair by pair."""
+"""The decision's rules, on candidates built by hand (no simulation): the cross-validated fall of
+J must beat the noise and the days' disagreement; physics refuses what the data cannot pin down
+or the building's description rules out; among the candidates one standard error cannot tell
+apart, a physical effect with few parameters before a shape."""
 import numpy as np
 import pytest
 
 from nodeforce.diagnose.candidates import objection, preference
-from nodeforce.diagnose.loop import decide
-from nodeforce.model.significance import change_of_J
+from nodeforce.diagnose.selection import blocks, decide
 from nodeforce.model.building import parse_building
-
-STEPS = 4 * 96  # four days of selection window at 15 min
+from nodeforce.model.errors import InputError
 
 
 def parameter(value, std, identifiable=True, on_bound=False):
@@ -79,62 +78,93 @@ def test_physics_comes_before_shapes_and_fewer_parameters_before_more():
     assert preference("infiltration") < preference("ground_coupling")
 
 
-# --- decide() on hand-made candidates: the model without them leaves a daily wave of 0.5 C plus
-# white noise of 0.1 C on the selection window; each candidate leaves part of it
+# --- decide() on hand-made candidates: the model without them predicts each of four left-out days
+# with J = 10 C2; a candidate is the J it leaves on each day, fitted without it (0.1 C of noise on
+# 192 residuals: the noise alone could move J by 3 x 0.01 x sqrt(384) = 0.59 C2)
 
-def _window(rng):
-    t = np.arange(STEPS)
-    wave = 0.5 * np.sin(2 * np.pi * t / 96)
-    return wave, rng.normal(0.0, 0.1, STEPS)
+N, SIGMA = 192, 0.1
+BASE = [10.0, 10.0, 10.0, 10.0]
 
 
-def candidate(effect, target, parameters, left, n_fit=1000, J_fit=10.0):
-    """A calibrated candidate's record as diagnose.loop.assess_all makes it, leaving residual
-    `left` (C) on the selection window of the model without it `before` (module docstring)."""
-    residual = left[:, None]
+def candidate(effect, target, parameters, days):
+    """A calibrated candidate's record as diagnose.loop.assess_all makes it, leaving J `days`
+    (C2) on each left-out day."""
     return {"effect": effect, "target": target, "parameters": parameters, "derived": {},
-            "selection": {"J": float(left @ left), "rmse": float(np.sqrt(np.mean(left ** 2))), "n": STEPS},
-            "bic": n_fit * np.log(J_fit / n_fit) + len(parameters) * np.log(n_fit)}, residual
+            "cv": {"blocks": list(days), "J": float(sum(days)), "n": N, "rmse": float(np.sqrt(sum(days) / N))}}
 
 
-def judge(building, made, before_left):
-    results, residuals = [], {}
-    for record, residual in made:
-        results.append(record)
-        before = before_left[:, None]
-        record["selection_fall"] = dict(zip(("J", "sd"), change_of_J(before, residual, 96)))
-        residuals[f"{record['effect']}@{record['target']}"] = residual
-    before = {"calibration": {"J": 100.0, "n": 1000},
-              "selection": {"J": float(before_left @ before_left), "n": STEPS,
-                            "rmse": float(np.sqrt(np.mean(before_left ** 2)))}}
-    return decide(building, results, before, 0.1, residuals)
+def door(days, factor=3.0):
+    return candidate("conductivity", "door", {"factor": parameter(factor, 0.2)}, days)
+
+
+def daily(days):
+    return candidate("daily_gain", "cell", {"mean": parameter(40.0, 3.0), **{
+        t: parameter(1.0, 5.0, identifiable=False) for t in ("cos1", "sin1", "cos2", "sin2", "cos3", "sin3",
+                                                             "cos4", "sin4")}}, days)
+
+
+def test_blocks_are_whole_days_of_the_scored_steps(testcell):
+    masks = blocks(4 * 96 + 30, 96, 900.0)
+    assert masks.shape == (3, 4 * 96 + 30) and not masks[:, :96].any()
+    assert (masks.sum(axis=0)[96:] == 1).all()  # every scored step in one block
+    assert [m.sum() for m in masks] == [96, 96, 96 + 30]  # the part day joins the last
+    with pytest.raises(InputError, match="2 whole days"):
+        blocks(2 * 96 + 50, 96, 900.0)
 
 
 def test_a_physical_effect_wins_over_a_shape_the_data_cannot_tell_from_it(testcell):
-    rng = np.random.default_rng(1)
-    wave, noise = _window(rng)
-    physical = candidate("conductivity", "door", {"factor": parameter(3.0, 0.2)}, noise + 0.02 * wave)
-    shape = candidate("daily_gain", "cell", {"mean": parameter(40.0, 3.0), **{
-        t: parameter(1.0, 5.0, identifiable=False) for t in ("cos1", "sin1", "cos2", "sin2", "cos3", "sin3",
-                                                             "cos4", "sin4")}}, noise + 0.01 * wave)
-    chosen, decision = judge(testcell, [shape, physical], noise + wave)
+    physical, shape = door([2.0, 2.4, 1.9, 2.3]), daily([1.9, 2.2, 2.1, 2.0])
+    chosen, decision = decide(testcell, [shape, physical], BASE, SIGMA, N)
     assert chosen["effect"] == "conductivity", decision["reason"]
-    # where the shape fits measurably better, it is chosen, and told as a heat source the model lacks
-    far = candidate("conductivity", "door", {"factor": parameter(3.0, 0.2)}, noise + 0.4 * wave)
-    chosen, decision = judge(testcell, [shape, far], noise + wave)
+    assert decision["indistinct"] == ["daily_gain@cell"]
+    # where the shape predicts every day measurably better, it is chosen, and told as a heat source
+    far = door([5.0, 5.5, 4.8, 5.2])
+    chosen, decision = decide(testcell, [shape, far], BASE, SIGMA, N)
     assert chosen["effect"] == "daily_gain"
     assert "an unexplained heat source, acting with a daily profile" in decision["reason"].lower()
 
 
 def test_a_candidate_physics_refuses_is_never_added_but_suggested(testcell):
-    rng = np.random.default_rng(2)
-    wave, noise = _window(rng)
-    sink = candidate("internal_gain", "cell", {"Q": parameter(-545.0, 16.0)}, noise)
-    weaker = candidate("conductivity", "door", {"factor": parameter(3.0, 0.2)}, noise + 0.3 * wave)
-    chosen, decision = judge(testcell, [sink, weaker], noise + wave)
+    sink = candidate("internal_gain", "cell", {"Q": parameter(-545.0, 16.0)}, [1.0, 1.0, 1.0, 1.0])
+    weaker = door([4.0, 4.2, 3.9, 4.1])
+    chosen, decision = decide(testcell, [sink, weaker], BASE, SIGMA, N)
     assert chosen["effect"] == "conductivity"
     assert [s["candidate"] for s in decision["suggestions"]] == ["internal_gain@cell"]
-    assert "negative gain" in decision["suggestions"][0]["reason"] and "Not added" in decision["reason"]
+    # the reason says the choice; the refused candidate is in the suggestions, said once by the report
+    assert "negative gain" in decision["suggestions"][0]["reason"] and "internal_gain" not in decision["reason"]
     # alone, it leaves the model as it is
-    chosen, decision = judge(testcell, [sink], noise + wave)
+    chosen, decision = decide(testcell, [sink], BASE, SIGMA, N)
     assert chosen is None and decision["chosen"] is None
+
+
+def test_noise_alone_never_passes(testcell):
+    """A candidate fitted to the noise of a right model predicts the left-out days as the model
+    does, give or take what the noise makes: over many draws, none passes."""
+    rng = np.random.default_rng(3)
+    base = N / 4 * SIGMA ** 2 * np.ones(4)
+    for _ in range(200):
+        # a one-parameter fit to noise: each day's J moves by about 2 sigma^2 either way
+        days = base + rng.normal(0.0, 2 * SIGMA ** 2, 4)
+        chosen, decision = decide(testcell, [door(days)], base, SIGMA, N)
+        assert chosen is None, decision["reason"]
+
+
+def test_a_fall_from_one_day_alone_or_that_the_days_disagree_on_does_not_pass(testcell):
+    one_day = door([1.0, 10.0, 10.0, 10.0])  # 9 C2 of fall, far beyond the noise, all on one day
+    chosen, decision = decide(testcell, [one_day], BASE, SIGMA, N)
+    assert chosen is None and decision["candidates"]["conductivity@door"]["other_days"] <= 0
+    # a fall of 12 C2 that three days give and one takes back: within one standard error of itself
+    disagree = door([2.0, 2.0, 2.0, 22.0])
+    chosen, decision = decide(testcell, [disagree], BASE, SIGMA, N)
+    test = decision["candidates"]["conductivity@door"]
+    assert chosen is None and test["cv_fall"] > decision["noise_margin"] and test["cv_fall"] < test["needed"]
+    # the same fall, every day alike: chosen
+    chosen, _ = decide(testcell, [door([7.0, 7.0, 7.0, 7.0])], BASE, SIGMA, N)
+    assert chosen["effect"] == "conductivity"
+
+
+def test_two_components_the_data_cannot_tell_apart_are_both_named(testcell):
+    wall = candidate("conductivity", "west_wall", {"factor": parameter(2.0, 0.2)}, [2.1, 2.0, 2.3, 2.2])
+    chosen, decision = decide(testcell, [door([2.0, 2.2, 2.1, 2.2]), wall], BASE, SIGMA, N)
+    assert chosen["target"] == "door"
+    assert "cannot be told from that of west_wall" in decision["reason"]

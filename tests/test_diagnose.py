@@ -150,8 +150,8 @@ def test_no_undeclared_effect_changes_nothing(tmp_path, testcell_data, testcell,
     report = run(tmp_path, testcell_data, testcell, weather, measured_with(testcell_data, weather), workers=2)
     assert report["effect"]["effect"] == "none"
     assert report["after"] == report["before"]
-    # and nothing is left for a second round: the residual is white
-    assert report["residuals"]["after"]["white"] and "follow_up" not in report["decision"]
+    # one round, whose candidates none passes; the residual left is white
+    assert report["residuals"]["after"]["white"] and len(report["decision"]["rounds"]) == 1
     assert json.loads((tmp_path / "building_after.json").read_text()) == testcell_data
 
 
@@ -161,12 +161,13 @@ def test_gaps_stay_gaps_and_short_records_are_refused(tmp_path, testcell_data, t
     measurements.iloc[500:520, measurements.columns.get_loc("T16")] = np.nan
     report = run(tmp_path, testcell_data, testcell, weather, measurements)
     # the residual counts only measured times: 40 missing air values are not scored
-    # (the three windows: fitting, selection, validation)
-    n = sum(report["before"][window]["n"] for window in ("calibration", "selection", "validation"))
+    # (the two windows: calibration, validation)
+    n = sum(report["before"][window]["n"] for window in ("calibration", "validation"))
     assert n == len(measurements) - 1 - 96 - 40
     assert report["effect"]["effect"] == "internal_gain"
 
-    short = measured_with(testcell_data, weather).iloc[: 2 * 96 + 1]
+    # a calibration window of the burn-in and less than two days: no cross-validation
+    short = measured_with(testcell_data, weather).iloc[: 4 * 96 + 1]
     with pytest.raises(InputError, match="leaves no calibration window"):
         run(tmp_path, testcell_data, testcell, weather, short)
     no_air = measured_with(testcell_data, weather).drop(columns="T23")

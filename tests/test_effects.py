@@ -7,7 +7,7 @@ import pytest
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.fmu_build.build import build_fmu
-from nodeforce.diagnose.candidates import candidates
+from nodeforce.diagnose.candidates import physical
 from nodeforce.model.building import Boundary, parse_building
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
@@ -99,28 +99,51 @@ def test_every_effect_reads_back_what_it_writes(testcell):
         assert EFFECTS[effect].read(after, target) == pytest.approx(values), effect
 
 
-def test_candidates_follow_the_located_nodes(testcell):
-    air = [("infiltration", "cell"), ("internal_gain", "cell")]
-    # node 17 is in the floor: adiabatic below, and it receives the window's sun
-    assert candidates(testcell, [17], ["cell"]) == [
-        ("ground_coupling", "floor"), ("conductivity", "floor"), ("solar_transmittance", "window"), *air]
-    assert candidates(testcell, [9, 10], ["cell"]) == [
-        ("solar_absorptance", "roof"), ("conductivity", "roof"), *air]
-    assert candidates(testcell, [], ["cell"]) == [*air, ("inside_convection", "cell"), ("envelope_conductance", "cell")]
+def evidence(*components):
+    """ga.locate's `components`, most evident first, with made-up shares."""
+    return [{"component": c, "node": 0, "J": float(i), "share": 0.2 - 0.01 * i} for i, c in enumerate(components)]
+
+
+def test_every_round_calibrates_every_zone_effect_and_the_evident_and_unmeasured_components(testcell):
+    """The physics a round calibrates, whatever the residual says: every zone effect of the
+    objective zone, the component effects of the three most evident components and of those no
+    sensor sits in (the paper's sensors: nodes 1, 7, 9, 16, 17 and the air)."""
+    zone = [("infiltration", "cell"), ("internal_gain", "cell"), ("inside_convection", "cell"),
+            ("envelope_conductance", "cell"), ("internal_mass", "cell")]
+    sensors = [1, 7, 9, 16, 17, 23]
+    pairs = physical(testcell, evidence("floor", "roof", "door", "east_wall"), ["cell"], sensors)
+    assert pairs[:len(zone)] == zone
+    # the floor: adiabatic below, and it receives the window's sun
+    for pair in [("ground_coupling", "floor"), ("conductivity", "floor"), ("solar_transmittance", "window"),
+                 ("solar_absorptance", "roof"), ("conductivity", "door"),
+                 # no sensor: the walls but the east one, the window
+                 ("conductivity", "west_wall"), ("solar_absorptance", "north_wall"), ("conductivity", "window")]:
+        assert pair in pairs, pair
+    # the fourth most evident component, measured, removing less than a quarter: not calibrated
+    assert ("conductivity", "east_wall") not in pairs
+    evident = [*evidence("floor", "roof", "door"), {"component": "east_wall", "node": 1, "J": 3.0, "share": 0.3}]
+    assert ("conductivity", "east_wall") in physical(testcell, evident, ["cell"], sensors)
+    # no shape in the physics; a zone without a heat input has no heater lag or split
+    assert not {"daily_gain", "proportional_gain", "heat_input_lag", "heat_input_split"} & {e for e, _ in pairs}
+    # the air alone measured: every component is calibrated
+    alone = physical(testcell, [], ["cell"], [23])
+    assert {t for e, t in alone if e == "conductivity"} == {c.name for c in testcell.components}
 
 
 def test_a_zone_with_supply_air_gets_a_thermal_bridge_not_an_infiltration():
     from .test_zones import multizone_with_everything
     b = multizone_with_everything()
     # zone A has supply air (flow known): its air-to-outside term is a bridge; zone B has none
-    pairs = candidates(b, [], ["A", "B"])
+    pairs = physical(b, [], ["A", "B"], [])
     assert ("thermal_bridge", "A") in pairs and ("infiltration", "A") not in pairs
     assert ("infiltration", "B") in pairs
     # bridges to the boundary columns the zone's surfaces see (A's floor sees T_cellar)
     assert ("thermal_bridge", "A->T_cellar") in pairs
-    # forcing B's surfaces points at its heat input's radiative split
-    wall_B = b.component("wB").node_ids[0]
-    assert ("heat_input_split", "B") in candidates(b, [wall_B], ["A"])
+    # a zone with a heat input: the heater's lag and the input's split; with shaded glazing: their leak
+    assert {("heat_input_lag", "B"), ("heat_input_split", "B"), ("shading_transmittance", "A")} <= set(pairs)
+    # a partition is a component of the zones on both its sides: unmeasured, B's calibrates it too
+    assert ("conductivity", "partition") in physical(b, [], ["B"], [])
+    assert ("conductivity", "partition") not in physical(b, [], ["B"], b.component("partition").node_ids[:1])
     after = EFFECTS["heat_input_split"].apply(b, "B", {"f_r": 0.8})
     assert after.zone("B").heat_input_radiative_fraction == 0.8
     after = EFFECTS["thermal_bridge"].apply(b, "A->T_cellar", {"UA": 2.5})
@@ -160,42 +183,20 @@ def test_a_gain_in_a_zone_declared_unoccupied_is_implausible(testcell):
     assert implausible(empty, "infiltration", "cell") is None
 
 
-def test_a_residual_that_follows_a_heat_input_points_at_its_gain_and_split():
-    from nodeforce.diagnose.candidates import follow_up
+def test_the_residual_left_chooses_the_shapes():
+    """Shapes are the residual's to choose: a gain following each input it follows, a daily gain
+    where it follows the clock, every input and the clock where it is structured but follows none
+    (inputs of one kind are nearly collinear), nothing where it is white."""
+    from nodeforce.diagnose.candidates import shapes
     from .test_zones import multizone_with_everything
     b = multizone_with_everything()
     left = {"white": False, "time_of_day": {"significant": False},
             "follows": [{"input": "heater", "lag_hours": 0.0, "correlation": -0.7}]}
-    assert follow_up(b, left, ["B"]) == [("proportional_gain", "B->heater"), ("heat_input_split", "B"),
-                                         ("internal_mass", "B"), ("heat_input_lag", "B")]
-    # the time of day points at a daily gain; a white residual at nothing
-    assert follow_up(b, {**left, "follows": [], "time_of_day": {"significant": True}, "strongest": None},
-                     ["A"])[0] == ("daily_gain", "A")
-    assert follow_up(b, {**left, "white": True}, ["B"]) == []
-
-
-def test_a_residual_that_follows_the_sun_on_a_glazed_facade_points_at_the_glazing_before_a_gain(testcell_data):
-    """Sun on the facade of a zone's glazing: its transmittance, and the leak of its shading, are
-    the physical counterparts of a gain following that sun, and are offered with it; sun on a
-    facade with no glazing of the zone offers only the gain; a declared leak is not offered again."""
-    from nodeforce.diagnose.candidates import candidates, follow_up
-    data = copy.deepcopy(testcell_data)
-    window = next(c for c in data["components"] if "solar_transmittance" in c)
-    window["shading"] = "blind"
-    b = parse_building(data)
-    column = b.component(window["name"]).irradiance_input
-    left = {"white": False, "time_of_day": {"significant": False},
-            "follows": [{"input": column, "lag_hours": 0.0, "correlation": 0.6}]}
-    pairs = follow_up(b, left, ["cell"])
-    assert ("proportional_gain", f"cell->{column}") in pairs
-    assert ("solar_transmittance", window["name"]) in pairs and ("shading_transmittance", "cell") in pairs
-    roof = {**left, "follows": [{"input": "I_roof", "lag_hours": 0.0, "correlation": 0.6}]}
-    assert not {"solar_transmittance", "shading_transmittance"} & {e for e, _ in follow_up(b, roof, ["cell"])}
-    leaking = EFFECTS["shading_transmittance"].apply(b, "cell", {"f": 0.2})
-    assert ("shading_transmittance", "cell") not in follow_up(leaking, left, ["cell"])
-    # a zone with a shaded glazing is offered the leak from the first round; one without is not
-    assert ("shading_transmittance", "cell") in candidates(b, [], ["cell"])
-    assert not any(e == "shading_transmittance" for e, _ in candidates(parse_building(testcell_data), [], ["cell"]))
+    assert shapes(b, left, ["B"]) == [("proportional_gain", "B->heater")]
+    clock = {**left, "follows": []}
+    structured = shapes(b, clock, ["A"])
+    assert structured[0] == ("daily_gain", "A") and ("proportional_gain", "A->I_south") in structured
+    assert shapes(b, {**left, "white": True}, ["B"]) == []
 
 
 def test_every_effect_parameter_has_a_unit_the_fmus_declare():

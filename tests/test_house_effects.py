@@ -12,7 +12,7 @@ import pytest
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnose.calibrate import Candidate, calibrate
-from nodeforce.diagnose.candidates import calibration_start, candidates, limits
+from nodeforce.diagnose.candidates import calibration_start, limits, physical
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.model.building import load_building, parse_building
 from nodeforce.model.case import Case
@@ -208,13 +208,13 @@ def test_a_building_file_that_declares_them_round_trips_and_bad_ones_are_refused
 
 def test_each_is_offered_where_the_building_has_what_it_acts_on(testcell):
     b = multizone_with_everything()
-    pairs = candidates(b, [], ["A", "B"])
+    pairs = physical(b, [], ["A", "B"], [])
     for effect in HOUSE_EFFECTS:
         assert (effect, VALUES[effect][0]) in pairs, effect
-    # located floor nodes (its outside is the cellar column) point at the cellar's conductances
-    assert ("boundary_conductance", "T_cellar") in candidates(b, [b.component("floor").node_ids[-1]], ["B"])
+    # a zone whose floor's outside is the cellar column is offered the cellar's conductances
+    assert ("boundary_conductance", "T_cellar") in physical(b, [], [b.component("floor").inside.zone], [])
     # the test cell has one zone, no supply, no boundary column and no heat input
-    assert not {e for e, _ in candidates(testcell, [], ["cell"])} & set(HOUSE_EFFECTS)
+    assert not {e for e, _ in physical(testcell, [], ["cell"], [])} & set(HOUSE_EFFECTS)
     # an open door starts where it carries something; the physical limits of the factors
     assert calibration_start(b, "interzone_air_exchange", "A|B")["V"] > 0
     assert limits(b, "heat_input_factor", "B", "factor") == (0.5, 2.0)

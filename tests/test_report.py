@@ -69,33 +69,36 @@ def synthetic():
         "candidates": [
             {"effect": "conductivity", "target": "door", "parameters": p_door, "derived": {},
              "calibration": metrics(0.1012, 0.001, 0.1011, 188), "validation": metrics(0.1234, 0.012, 0.1228, 190),
-             "selection_fall": {"J": 151.7, "sd": 4.1}, "bic": -412.3},
+             "cv": {"blocks": [1.1, 0.9], "J": 2.0, "n": 188, "rmse": 0.1031}},
             {"effect": "ground_coupling", "target": "floor",
              "parameters": {"U": {"value": 0.52, "std": 0.9, "identifiable": False},
                             "T_ground": {"value": 24.3, "std": None, "identifiable": False}},
              "derived": {"ground_heat_flux": {"value": -1.7741, "std": 0.047, "unit": "W/m2"}},
              "calibration": metrics(0.7011, 0.4, 0.57, 188), "validation": metrics(0.8544, 0.6, 0.6, 190),
-             "bic": -20.0},
+             "cv": {"blocks": [50.0, 45.0], "J": 95.0, "n": 188, "rmse": 0.7109}},
             {"effect": "infiltration", "target": "living",
              "parameters": {"n": {"value": 0.3, "std": 0.05, "identifiable": True}}, "derived": {},
              "calibration": {"J": None, "rmse": None, "mean": None, "sd": None, "n": 188},
              "validation": {"J": None, "rmse": None, "mean": None, "sd": None, "n": 190},
-             "bic": None},
+             "cv": {"blocks": [], "J": None, "n": 188, "rmse": None}},
             {"effect": "solar_absorptance", "target": "roof",
              "parameters": {"alpha": {"value": 0.71, "std": 0.02, "identifiable": True}}, "derived": {},
              "calibration": metrics(0.4011, 0.2, 0.35, 188),
              "validation": two_zones((0.5544, 0.3, 0.47, 190), (0.4321, 0.2, 0.4, 95), (0.6543, 0.4, 0.5, 95)),
-             "bic": -150.0},
+             "cv": {"blocks": [16.0, 14.0], "J": 30.0, "n": 188, "rmse": 0.3995}},
         ],
         "decision": {"chosen": "conductivity@door",
-                     "reason": "conductivity on door has the lowest validation RMSE of the 2 candidates that beat both tests.",
-                     "bic_baseline": -35.1, "selection_J_before": 154.6, "selection_margin": 7.25,
-                     "candidates": {"conductivity@door": {"beats_bic": True, "beats_selection": True,
-                                                          "selection_margin": 12.3},
-                                    "ground_coupling@floor": {"beats_bic": False, "beats_selection": True},
-                                    "infiltration@living": {"beats_bic": False, "beats_selection": False},
-                                    # the loop's word, though its BIC is below the baseline's
-                                    "solar_absorptance@roof": {"beats_bic": False, "beats_selection": True}}},
+                     "reason": "conductivity on door lowers the cross-validated J the most of the 2 candidates that pass.",
+                     "cv_J_before": 154.6, "blocks": 2, "noise_margin": 7.25, "standard_errors": 1.0,
+                     "cost": {"candidates": 4, "simulations": 310, "seconds": 12.5},
+                     "candidates": {"conductivity@door": {"cv_fall": 152.6, "cv_se": 12.3, "needed": 12.3,
+                                                          "passes": True, "objection": None},
+                                    "ground_coupling@floor": {"cv_fall": 59.6, "cv_se": 1.0, "needed": 7.25,
+                                                              "passes": True,
+                                                              "objection": "U = 0.52 is not identifiable"},
+                                    "infiltration@living": {"passes": False, "objection": None},
+                                    "solar_absorptance@roof": {"cv_fall": 124.6, "cv_se": 2.0, "needed": 7.25,
+                                                               "passes": True, "objection": None}}},
         "effect": {"effect": "conductivity", "target": "door", "parameters": p_door, "derived": {}},
         "after": {"calibration": two_zones((0.1012, 0.001, 0.1011, 188), (0.1, 0.0, 0.1, 94), (0.1, 0.002, 0.1, 94)),
                   "validation": two_zones((0.1234, 0.012, 0.1228, 190), (0.11, 0.01, 0.1, 95), (0.13, 0.02, 0.13, 95))},
@@ -128,7 +131,7 @@ def no_effect(report, series):
     report["localization"]["best_nodes"] = []
     report["localization"]["J_best"] = report["localization"]["J_unforced"]
     report["decision"].update(chosen=None, reason="No candidate beats the model without an effect on both tests.",
-                              candidates={k: {"beats_bic": False, "beats_selection": False}
+                              candidates={k: {"passes": False, "objection": None}
                                           for k in report["decision"]["candidates"]})
     for zone in series["zones"].values():
         zone["after"] = zone["before"].copy()
@@ -214,9 +217,11 @@ def test_write_report_with_an_effect(tmp_path):
     assert "For scale, the IDEAS detailed model: RMSE 0.400 C (validation), 0.600 C (free float)." in md
     # the decision as the loop wrote it, with its margins; the verdicts are read, not re-derived
     assert report["decision"]["reason"] in md
-    assert "the sensor noise could (7.250 C²)" in md and "-35.10" in md
-    assert "| solar_absorptance | roof |" in md and "| -150.0 | -114.9 | n/a | n/a | no | yes |" in md
-    assert "| 151.7 | 12.30 | yes | yes |" in md  # the fall of J and the fall it needed
+    assert "sensor noise could (7.250 C²)" in md and "4 candidates, 310 simulations, 12.5 s" in md
+    # the cross-validated fall of J, the fall it needed, the verdict and physics' objection
+    assert "| solar_absorptance | roof |" in md and "| 124.6 | 7.250 | yes |  |" in md
+    assert "| 152.6 | 12.30 | yes |  |" in md
+    assert "| 59.60 | 7.250 | yes | U = 0.52 is not identifiable |" in md
     # each phase, before, every candidate and after; the phase made worse is marked
     assert "| held at 30 C | 2001-06-10 00:00 UTC-05:00 | 96 | 0.570 | 0.750 ▲ | 0.750 ▲ |" in md
     assert "| free float | 2001-06-11 00:00 UTC-05:00 | 95 | 0.900 | 0.120 | 0.120 |" in md
@@ -294,12 +299,13 @@ def test_a_candidate_tried_again_on_top_is_judged_and_marked_in_its_own_round(tm
     report["candidates"].append(again)
     report["effects"] = [{"effect": "conductivity", "target": "door"}, {"effect": "solar_absorptance", "target": "roof"}]
     report["decision"]["chosen"] = "solar_absorptance@roof"
-    report["decision"]["follow_up"] = {"chosen": "solar_absorptance@roof", "candidates": {
-        "solar_absorptance@roof": {"beats_bic": True, "beats_selection": True, "selection_margin": 1.5}}}
+    first_round = {**report["decision"], "chosen": "conductivity@door"}
+    report["decision"]["rounds"] = [first_round, {"chosen": "solar_absorptance@roof", "candidates": {
+        "solar_absorptance@roof": {"cv_fall": 3.0, "passes": True, "needed": 1.5, "objection": None}}}]
     # the first round's roof: its own verdict, not chosen; the same label on top: chosen, its verdict
-    assert content.verdict(report, roof) == report["decision"]["candidates"]["solar_absorptance@roof"]
+    assert content.verdict(report, roof) == first_round["candidates"]["solar_absorptance@roof"]
     assert not content.is_chosen(report, roof) and content.is_chosen(report, first)
-    assert content.verdict(report, again)["selection_margin"] == 1.5 and content.is_chosen(report, again)
+    assert content.verdict(report, again)["needed"] == 1.5 and content.is_chosen(report, again)
 
 
 def first_screen_of(md):
@@ -348,11 +354,12 @@ def test_the_decision_says_each_refusal_reason_once(tmp_path):
              ("proportional_gain@living->I_S", "k = -0.0245 - is a negative gain (a heat sink) [0, inf]")]
     other = [("ground_coupling@floor", "U = 0.52 +- 0.9 W/m2/K is not identifiable from these data; "
                                        "T_ground = 24.3 C ends on a bound of its range")]
-    suggestions = [{"candidate": c, "reason": r, "selection_rmse": 0.2} for c, r in gains + other]
-    first = "Conductivity on door fits the selection window best."
-    # the loop's reason lists every refused candidate; the report says them grouped instead
-    report["decision"].update(suggestions=suggestions, reason=first + " Not added, though the data support them: "
-                              + "; ".join(f"{c} ({r})" for c, r in gains + other) + ".")
+    suggestions = [{"candidate": c, "reason": r, "cv_rmse": 0.2} for c, r in gains[:2]]
+    first = "Conductivity on door predicts the left-out days best."
+    # refused candidates of two rounds: the report says them grouped by reason, across rounds
+    report["decision"].update(suggestions=suggestions, reason=first)
+    report["decision"]["rounds"] = [dict(report["decision"]), {
+        "chosen": None, "suggestions": [{"candidate": c, "reason": r, "cv_rmse": 0.2} for c, r in gains[2:] + other]}]
     assert chosen_sentence(report) == first
     write_report(tmp_path, report, series)
     md = (tmp_path / "report.md").read_text(encoding="utf-8")

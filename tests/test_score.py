@@ -6,7 +6,6 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from nodeforce.diagnose.loop import bic
 from nodeforce.model.building import parse_building
 from nodeforce.model.case import Case
 from nodeforce.model.integrate import initial_state
@@ -53,12 +52,6 @@ def test_the_twin_house_air_sensors_are_smooth_at_their_step():
     data = np.loadtxt(TABLE, comments="#", skiprows=2)
     noise = Noise.of(data[:, [5]])  # N2_living_AT_h125cm
     assert not noise.visible and noise.lag1 > -0.3
-
-
-def test_bic_by_hand_and_the_price_of_a_parameter():
-    assert bic(2.0, 10, 1) == pytest.approx(10 * math.log(0.2) + math.log(10))
-    # a parameter that does not lower J costs ln n
-    assert bic(2.0, 10, 2) - bic(2.0, 10, 1) == pytest.approx(math.log(10))
 
 
 def test_objective_sums_zones_and_reports_each():

@@ -429,3 +429,46 @@ def test_the_finding_says_what_the_best_forcing_removes_and_what_the_sensors_cov
     located = finding(testcell, search(linear(6, {2: 90.0}, base=100.0), [1, 2, 3, 4, 5, 6], workers=1,
                                        noise_sigma=0.05, n_residuals=400))
     assert located.startswith("forcing node 3 (west_wall at 0.000 m) removes 91% of J above the noise floor")
+
+
+def test_nodes_are_ranked_by_their_score_and_the_ones_the_noise_cannot_separate_are_tied():
+    """Issue 27: the nodes were "ranked" in chromosome order when all lay within the tolerance.
+    They are ranked by J; ties are marked, not reordered."""
+    from nodeforce.ga.search import rank, ties
+    J_single = [5.0, 3.0, 3.2, 9.0, 1.0, 12.0]
+    assert rank(J_single, 10.0) == [4, 1, 2, 0, 3]  # node 5 (12.0) lowers nothing
+    assert ties(J_single, 10.0, 0.5) == [[1, 2]]
+    assert ties(J_single, 10.0, 2.5) == [[4, 1, 2]]  # 3.0 and 3.2 within 2.5 of 1.0; 5.0 and 9.0 alone
+
+
+def test_the_finding_names_the_rule_that_decided(testcell):
+    """A forcing that removes 80 % of the error above the noise but whose fall of J the noise could
+    make is not called "below the 50 % needed"; one below half is; a node that removes more than
+    the one the parsimony preferred is named with it; the evidence per component is its best node's
+    share, most first."""
+    from nodeforce.ga.locate import evidence, finding
+    result = {"J_unforced": 2.0, "J_best": 2.0, "best_nodes": [], "ranked_nodes": [16, 9],
+              "node_scores": {"16": 1.2, "9": 1.5, "17": 1.3, "7": 2.1}, "chromosome_nodes": [7, 9, 16, 17],
+              "search": {"J_noise": 1.0, "J_min": 1.2, "min_nodes": [16], "tolerance": 0.9, "explains": True}}
+    said = finding(testcell, result)
+    assert "removes 80% of J above the noise floor" in said and "below the 50%" not in said
+    assert "its fall of J, 0.8 C2, is within the 0.9 C2 the noise could make" in said
+    weak = {**result, "search": {**result["search"], "J_min": 1.7, "explains": False}}
+    assert "removes 30% of J above the noise floor, below the 50% needed" in finding(testcell, weak)
+    located = {**result, "best_nodes": [9], "J_best": 1.5}
+    assert "node 16 (floor at 0.150 m) alone removes more (80%)" in finding(testcell, located)
+    shares = evidence(testcell, result)
+    assert [(e["component"], e["node"]) for e in shares] == [("floor", 16), ("roof", 9), ("door", 7)]
+    assert [e["share"] for e in shares] == pytest.approx([0.8, 0.5, -0.1])
+
+
+def test_the_terminal_marks_the_nodes_the_noise_cannot_separate():
+    from nodeforce.cli import locate_summary
+    result = {"J_unforced": 3.0, "objective": ["cell"], "node_scores": {"7": 1.0, "9": 1.1, "16": 2.0},
+              "ranked_nodes": [7, 9, 16], "tied_nodes": [[7, 9]], "best_nodes": [7], "J_best": 1.0,
+              "finding": "forcing node 7 ...", "search": {"method": "exhaustive", "unique_evaluations": 8,
+                                                          "seconds": 0.1}}
+    lines = locate_summary(result).splitlines()
+    header = next(i for i, line in enumerate(lines) if "J forced alone" in line)
+    assert [line.split() for line in lines[header + 1:header + 4]] == [["7", "1.000", "a"], ["9", "1.100", "a"],
+                                                                      ["16", "2.000"]]

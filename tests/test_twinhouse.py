@@ -372,7 +372,7 @@ def test_diagnose_end_to_end_on_a_few_real_days(tmp_path):
     assert main(["table", *table, "--select", ",".join(sensors), "-o", str(measurements)]) == 0
     phases = tmp_path / "phases.csv"
     # the second phase is the validation window (the first holds the burn-in and the calibration:
-    # a day to fit and a day to choose on)
+    # two days, each predicted by a fit to the other)
     phases.write_text("time,phase\n2013-09-09T00:00+01:00,first part\n2013-09-12T00:10+01:00,last day\n")
     assert main(["diagnose", str(BUILDING), "--weather", str(weather), "--measurements", str(measurements),
                  "-o", str(out), "--objective", "living", "--calibration-end", "2013-09-12T00:00+01:00",

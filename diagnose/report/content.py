@@ -5,8 +5,8 @@ from __future__ import annotations
 from .formats import NA, time_text
 
 WINDOWS = ("calibration", "validation")
-# the windows whose METRICS report.json holds: the fits' ("calibration"), the choice's, the test's
-SCORED = ("calibration", "selection", "validation")
+# the windows whose METRICS report.json holds: the fits' and the choice's ("calibration"), the test's
+SCORED = ("calibration", "validation")
 STATES = ("before", "after")
 
 
@@ -49,24 +49,28 @@ def decision(report):
     return report.get("decision") or {}
 
 
+def round_decision(report, candidate):
+    """The decision of the round a candidate was tried in (one tried on top of n effects: round
+    n + 1), {} if not recorded."""
+    d = decision(report)
+    rounds = d.get("rounds") or [d]
+    number = len(candidate.get("on_top_of") or [])
+    return rounds[number] if number < len(rounds) else {}
+
+
 def verdict(report, candidate):
-    """The loop's {'beats_bic', 'beats_selection', 'selection_margin'} for a candidate ({} if
-    not recorded); one tried on top of a first choice is judged in the follow-up decision."""
-    judged = decision(report)
-    if candidate.get("on_top_of"):
-        judged = judged.get("follow_up") or {}
-    return (judged.get("candidates") or {}).get(candidate_key(candidate)) or {}
+    """The loop's {'cv_fall', 'cv_se', 'needed', 'passes', 'objection'} for a candidate ({} if not
+    recorded), in the round it was tried in."""
+    return (round_decision(report, candidate).get("candidates") or {}).get(candidate_key(candidate)) or {}
 
 
 def is_chosen(report, candidate):
-    """Whether the loop added this candidate, in the round it was tried in (the first round's
-    choice is the first of `effects`; one tried on top is the follow-up decision's)."""
-    d = decision(report)
-    if candidate.get("on_top_of"):
-        return (d.get("follow_up") or {}).get("chosen") == candidate_key(candidate)
-    if report.get("effects"):
-        return candidate_key(report["effects"][0]) == candidate_key(candidate)
-    return d.get("chosen") == candidate_key(candidate)
+    """Whether the loop added this candidate, in the round it was tried in: the effect added in
+    round n + 1 is the (n + 1)-th of `effects`."""
+    number = len(candidate.get("on_top_of") or [])
+    effect = report.get("effect")
+    effects = report.get("effects") or ([] if is_none_effect(effect) else [effect])
+    return number < len(effects) and candidate_key(effects[number]) == candidate_key(candidate)
 
 
 def node_name(report, node):
@@ -83,10 +87,8 @@ def reference(report):
 
 
 def scored_period_text(report, window):
-    """The span the METRICS of `window` cover: a report with a selection window scores
-    "calibration" on the fitting window, the calibration window's first part."""
-    period = report.get("period") or {}
-    return period_text(report, "fitting" if window == "calibration" and period.get("fitting") else window)
+    """The span the METRICS of `window` cover."""
+    return period_text(report, window)
 
 
 def period_text(report, window):

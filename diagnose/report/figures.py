@@ -285,20 +285,33 @@ def plot_convergence(path, report, series):
     return _save(fig, path)
 
 
-# the loop's verdict on a candidate, as drawn: (beats BIC, beats validation) -> style and legend
+# the loop's verdict on a candidate, as drawn: its cross-validation test, and physics' objection
 VERDICT_STYLES = {
-    (True, True): (dict(facecolor="tab:cyan"), "beats BIC and the validation margin"),
-    (True, False): (dict(facecolor="lightcyan", hatch=".."), "beats BIC only"),
-    (False, True): (dict(facecolor="0.8", hatch=".."), "beats the validation margin only"),
-    (False, False): (dict(facecolor="0.8", hatch="//"), "beats neither"),
+    "passes": (dict(facecolor="tab:cyan"), "passes the cross-validation"),
+    "refused": (dict(facecolor="lightcyan", hatch=".."), "passes, refused by physics (a suggestion)"),
+    "fails": (dict(facecolor="0.8", hatch="//"), "does not pass"),
 }
 
 
+def verdict_key(verdict):
+    if not verdict.get("passes"):
+        return "fails"
+    return "refused" if verdict.get("objection") else "passes"
+
+
+PLOTTED_CANDIDATES = 24
+
+
 def plot_candidates(path, report):
-    """Validation RMSE of each candidate against the baseline's, coloured by the loop's verdict."""
-    candidates = report.get("candidates") or []
+    """Validation RMSE of the candidates against the baseline's, coloured by the loop's verdict:
+    every chosen one and the others of lowest cross-validated error, PLOTTED_CANDIDATES in all
+    (a round calibrates tens)."""
+    tried = report.get("candidates") or []
+    kept = sorted(tried, key=lambda c: (not content.is_chosen(report, c),
+                                        num((c.get("cv") or {}).get("J")) if num((c.get("cv") or {}).get("J"))
+                                        is not None else np.inf))[:PLOTTED_CANDIDATES]
+    candidates = [c for c in tried if any(c is k for k in kept)]
     base = num(metrics(report, "before", "validation").get("rmse"))
-    base_bic = num(content.decision(report).get("bic_baseline"))
     fig = _new_figure(max(7.0, 1.1 * len(candidates) + 3), 5.0)
     ax = fig.add_subplot()
     x = np.arange(len(candidates))
@@ -310,13 +323,12 @@ def plot_candidates(path, report):
                     fontsize=8, color="tab:red")
             continue
         verdict = content.verdict(report, c)
-        key = (bool(verdict.get("beats_bic")), bool(verdict.get("beats_selection")))
+        key = verdict_key(verdict)
         style = dict(facecolor="tab:blue") if content.is_chosen(report, c) else VERDICT_STYLES[key][0]
         used.add("chosen" if content.is_chosen(report, c) else key)
         ax.bar(xi, v, edgecolor="0.2", lw=0.5, **style)
-        bic = num(c.get("bic"))
-        dbic = f"\nΔBIC {bic - base_bic:+.1f}" if bic is not None and base_bic is not None else ""
-        ax.annotate(fmt_temp(v) + dbic, (xi, v), xytext=(0, 3), textcoords="offset points", ha="center",
+        cv = num((c.get("cv") or {}).get("rmse"))
+        ax.annotate(fmt_temp(v) + (f"\nCV {fmt_temp(cv)}" if cv is not None else ""), (xi, v), xytext=(0, 3), textcoords="offset points", ha="center",
                     va="bottom", fontsize=8, bbox=dict(facecolor="white", edgecolor="none", alpha=0.8, pad=0.5))
     if base is not None:
         ax.axhline(base, color=COLOR["before"], ls="--", lw=1.2, label=f"baseline (no effect) = {fmt_temp(base)} C")
@@ -336,7 +348,9 @@ def plot_candidates(path, report):
             if v is not None]
     if tops:
         ax.set_ylim(0, 1.18 * max(tops))
-    ax.set_title("Candidate effects: validation RMSE after calibration")
+    ax.set_title("Candidate effects: validation RMSE after calibration"
+                 + (f" (the {len(candidates)} of {len(tried)} of lowest cross-validated error)"
+                    if len(candidates) < len(tried) else ""))
     ax.grid(axis="y", alpha=0.3)
     fig.legend(handles=handles, loc="outside lower center", ncols=2, fontsize=9, frameon=False)
     return _save(fig, path)

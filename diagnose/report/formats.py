@@ -52,11 +52,6 @@ def fmt_int(x):
     return NA if v is None else str(int(round(v)))
 
 
-def fmt_bic(x):
-    v = num(x)
-    return NA if v is None else f"{v:.1f}"
-
-
 def fmt_search(v):
     return f"{v:g}" if isinstance(v, float) else str(v)
 

@@ -6,7 +6,6 @@ from pathlib import Path
 
 from . import content, summary, tables
 from ..phases import WORSE
-from ...ga.parsimony import Z_NOISE
 from .formats import NA, fmt_search, fmt_sig, num
 
 
@@ -32,13 +31,15 @@ def decision_lines(report):
     lines = [summary.chosen_sentence(report), ""]
     refused = summary.refusals(report)
     lines += refused + ([""] if refused else [])
-    bic, J, margin = (num(d.get(k)) for k in ("bic_baseline", "selection_J_before", "selection_margin"))
-    lines.append(f"- BIC of the model without an effect (fitting window): {fmt_sig(bic)}; a candidate must "
-                 "have a lower BIC.")
-    lines.append(f"- selection window's J without an effect: {fmt_sig(J)} C²; a candidate must lower it by more than "
-                 f"the sensor noise could ({fmt_sig(margin)} C²) and by more than {Z_NOISE:g} standard deviations of "
-                 "that fall as the residuals' correlation in time makes it (the fall needed, per candidate, "
-                 "in the candidates table).")
+    for number, r in enumerate(d.get("rounds") or [d], start=1):
+        cost = r.get("cost") or {}
+        lines.append(f"- round {number}: cross-validated J of the model it starts from {fmt_sig(r.get('cv_J_before'))} C² "
+                     f"over {r.get('blocks', NA)} days left out in turn; a candidate must lower it by more than the "
+                     f"sensor noise could ({fmt_sig(r.get('noise_margin'))} C²) and by more than "
+                     f"{fmt_sig(r.get('standard_errors'), 3)} standard error of its fall from day to day, on more "
+                     f"days than its best (the fall needed, per candidate, in the candidates table); {cost.get('candidates', NA)} candidates, "
+                     f"{cost.get('simulations', NA)} simulations, {cost.get('seconds', NA)} s; "
+                     f"chosen: {r.get('chosen') or 'none'}")
     lines.append(f"- chosen: {d.get('chosen') or 'none'}")
     return lines
 
@@ -56,7 +57,10 @@ def localization_lines(report):
            + (f": {', '.join(content.node_name(report, b) for b in best)}"
               if best and report.get("node_names") else ""),
            *([f"- {loc['finding']}"] if loc.get("finding") else []),
-           f"- ranked nodes (most helpful first): {loc.get('ranked_nodes', NA)}"]
+           f"- ranked nodes (lowest J first): {loc.get('ranked_nodes', NA)}"
+           + (f"; the noise cannot separate {', '.join(map(str, loc['tied_nodes']))}" if loc.get("tied_nodes") else ""),
+           *([f"- evidence per component (share of J above the noise its forcing removes): " + ", ".join(
+               f"{e['component']} {e['share']:.0%}" for e in loc["components"])] if loc.get("components") else [])]
     search = loc.get("search") or {}
     if search:
         keys = ("population", "generations", "pc", "pm", "seed") if search.get("method") != "exhaustive" else ()
@@ -97,8 +101,8 @@ def write_markdown(out_dir, report, plots, notes):
     ref = tables.reference_text(report)
     md = ["# nodeforce diagnosis report", "", *[_bold_label(line) + "  " for line in summary.first_screen(report, pm="±")],
           "", "From the residual of the indoor air, to the nodes whose forcing explains it, to a physical "
-          "effect the model lacks, added and calibrated on the calibration window's first part and chosen on "
-          "its last (the selection window); the validation window played no part in any choice.", "",
+          "effect the model lacks, added and calibrated on the calibration window and chosen by "
+          "cross-validation over its days; the validation window played no part in any choice.", "",
           "## Result", "", *[f"**{line.strip()}**  " for line in tables.effect_header(report, pm="±").splitlines()],
           "", *[f"{line}  " for line in tables.hlc_lines(report, pm="±")], "",
           *([f"Modelling assumptions: {' '.join(report['assumptions'])}", ""] if report.get("assumptions") else []),
@@ -106,9 +110,8 @@ def write_markdown(out_dir, report, plots, notes):
           "## Period", "",
           f"- objective zones: {', '.join(content.zones(report)) or NA}",
           f"- calibration: {content.period_text(report, 'calibration')}{content.scored_from_note(report)}",
-          *([f"- fitting (the forcing search and the candidates' fits): {content.period_text(report, 'fitting')}",
-             f"- selection (the choice among the candidates): {content.period_text(report, 'selection')}"]
-            if period.get("selection") else []),
+          *([f"- cross-validation blocks (each left out of a fit in turn): {len(period['blocks'])} whole days"]
+            if period.get("blocks") else []),
           f"- validation (before and after only, no part in any choice): {content.period_text(report, 'validation')}"]
     if (report.get("noise") or {}).get("sentence"):
         md.append(f"- {report['noise']['sentence']}")

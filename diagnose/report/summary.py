@@ -155,22 +155,9 @@ def terminal_summary(report):
 # the Decision
 
 
-def _suggestion_text(decision):
-    """The list of refused candidates as the loop appends it to its reason (`diagnose.loop.decide`)."""
-    suggestions = decision.get("suggestions") or []
-    return (" Not added, though the data support them: "
-            + "; ".join(f"{s['candidate']} ({s['reason']})" for s in suggestions) + ".") if suggestions else ""
-
-
 def chosen_sentence(report):
-    """The loop's reason without its list of refused candidates, which `refusals` says grouped."""
-    d = content.decision(report)
-    reason = d.get("reason") or NA
-    for decision in (d, d.get("follow_up") or {}):
-        listed = _suggestion_text(decision)
-        if listed:
-            reason = reason.replace(listed, "")
-    return reason
+    """The loop's reason: the refused candidates are not in it, `refusals` says them grouped."""
+    return content.decision(report).get("reason") or NA
 
 
 def _clauses(objection):
@@ -187,7 +174,7 @@ def refusals(report):
     """The candidates the data support but physics refused, one line per reason: 'N candidates ...
     each is a negative gain (a heat sink): a (Q = -2.81 W), b (...)'."""
     d = content.decision(report)
-    suggestions = list(d.get("suggestions") or []) + list((d.get("follow_up") or {}).get("suggestions") or [])
+    suggestions = [s for r in (d.get("rounds") or [d]) for s in r.get("suggestions") or []]
     groups = {}
     for s in suggestions:
         clauses = _clauses(s.get("reason", ""))

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from . import content
 from .content import SCORED, STATES, metrics
-from .formats import (NA, fmt_bic, fmt_derived, fmt_int, fmt_parameters, fmt_sig, fmt_temp, fmt_value_std, num,
+from .formats import (NA, fmt_derived, fmt_int, fmt_parameters, fmt_sig, fmt_temp, fmt_value_std, num,
                       time_text)
 from ..phases import is_worse
 from ..residuals import lag_text
@@ -90,8 +90,8 @@ def before_after_table(report: dict, header: bool = True) -> str:
 
 
 def _scored_windows(report):
-    """The windows the report has metrics for (a report without a selection window has two)."""
-    return [w for w in SCORED if w != "selection" or metrics(report, "before", w)]
+    """The windows the report has metrics for."""
+    return list(SCORED)
 
 
 def markdown(header, rows):
@@ -159,22 +159,22 @@ def candidates(report):
     rows = []
     for c in report.get("candidates") or []:
         chosen = content.is_chosen(report, c)
-        bic, base = num(c.get("bic")), num(content.decision(report).get("bic_baseline"))
         verdict = content.verdict(report, c)
         name = str(c.get("effect"))
+        cv = c.get("cv") or {}
         rows.append([f"**{name} (chosen)**" if chosen else name,
                      c.get("target") if c.get("target") is not None else "",
                      fmt_parameters(c.get("effect"), c.get("parameters")) or "-",
                      "; ".join(fmt_derived(c.get("derived"))) or "-",
-                     fmt_temp(metrics(report, c, "calibration").get("rmse")),
+                     fmt_temp(metrics(report, c, "calibration").get("rmse")), fmt_temp(cv.get("rmse")),
                      fmt_temp(metrics(report, c, "validation").get("rmse")),
                      fmt_temp(metrics(report, c, "validation").get("mean"), True),
-                     fmt_bic(bic), f"{bic - base:+.1f}" if bic is not None and base is not None else NA,
-                     fmt_sig((c.get("selection_fall") or {}).get("J")), fmt_sig(verdict.get("selection_margin")),
-                     _yes_no(verdict.get("beats_bic")), _yes_no(verdict.get("beats_selection"))])
+                     fmt_sig(verdict.get("cv_fall")), fmt_sig(verdict.get("needed")),
+                     _yes_no(verdict.get("passes")), verdict.get("objection") or ""])
     return markdown(["effect", "target", "parameters (value ± std)", "the data determine",
-                     "calibration RMSE (C)", "validation RMSE (C)", "validation mean (C)", "BIC", "ΔBIC",
-                     "selection fall of J (C²)", "fall needed (C²)", "beats BIC", "beats selection"], rows)
+                     "calibration RMSE (C)", "cross-validated RMSE (C)", "validation RMSE (C)",
+                     "validation mean (C)", "cross-validated fall of J (C²)", "fall needed (C²)", "passes",
+                     "objection"], rows)
 
 
 def candidate_zones(report):

@@ -1,0 +1,182 @@
+"""The one rule that chooses an effect: blocked cross-validation over whole days.
+
+The calibration window's scored steps (after the burn-in) are cut into blocks of whole days
+(`blocks`). Each candidate is fitted on all blocks but one and scored on the block left out, every
+block in turn (`diagnose.calibrate`): the simulation runs through the whole window, the left-out
+block's residuals are only left out of the least squares, so every block is predicted from the
+state the days before it left, as the validation window is. A day is the unit because a
+building's residual is correlated over hours and repeats with the sun: within a day, steps are
+not independent pieces of evidence, and days nearly are.
+
+`decide` judges each candidate by its fall of cross-validated J from the model it would be added
+to, block by block:
+
+1. It passes when that fall beats what noise alone gives, the change of J the sensors' noise
+   could make (`ga.parsimony.tolerance`), and what the days' disagreement gives: one standard
+   error of the fall computed from the per-block falls, blocks as the unit, so that residuals
+   correlated within a day cannot fake significance; and when it does not come from one day
+   alone (the other days together must gain too). A calibration window holds two to five days:
+   a Student t quantile on B - 1 degrees of freedom (6.3 for two days, 2.9 for three) would ask
+   the falls to be nearly equal from day to day, while a real effect's size follows the weather
+   (a ground coupling's drift shows on some days and hardly on others); the sensor noise is
+   judged by its own yardstick instead, and the days by their consistency.
+2. Physics may still refuse it (`diagnose.candidates.objection`: a gain in a zone declared
+   unoccupied, a parameter on its bound or not identifiable, a negative gain): then it is a
+   suggestion, with its reason, never added.
+3. Among the admissible candidates that pass, the one-standard-error rule: the candidates whose
+   cross-validated J exceeds the best's by no more than one standard error of that paired
+   difference (per block) cannot be told apart from it, and among them a physical effect
+   before a shape, then fewer parameters before more, then the lower J. Components whose
+   corrections cannot be told apart are named together in the reason.
+
+The validation window plays no part. A model built by earlier rounds is the baseline a later
+round's candidate must pass against (its parameters held).
+
+Several records of one building would add their days to the blocks and their residuals to the
+sums; nothing here depends on the blocks coming from one record.
+"""
+import math
+
+import numpy as np
+
+from nodeforce.diagnose.candidates import is_shape, objection, preference
+from nodeforce.ga.parsimony import ROUNDING, noise_floor, noise_tolerance, tolerance
+from nodeforce.model.effects import bridge_parts
+from nodeforce.model.errors import InputError
+from nodeforce.model.integrate import steps_per_day
+
+# Standard errors of its day-to-day scatter a cross-validated fall must exceed, and that the one-
+# standard-error rule allows between candidates it cannot tell apart.
+STANDARD_ERRORS = 1.0
+MIN_BLOCKS = 2
+
+
+def blocks(n_steps, scored_from, dt, source="measurements"):
+    """(B, n_steps) bool: the steps of each block, whole days of the scored steps
+    `scored_from`..n_steps-1 (the steps t_1..t_N of a window), the part day left at the end joined
+    to the last block."""
+    day = steps_per_day(dt)
+    n_blocks = (n_steps - scored_from) // day
+    if n_blocks < MIN_BLOCKS:
+        raise InputError(source, "time", f"a calibration window of {n_steps - scored_from} scored steps of {dt:g} s "
+                                         f"leaves no calibration window of {MIN_BLOCKS} whole days after the burn-in "
+                                         "for the cross-validation: give a longer calibration window")
+    index = np.arange(n_steps)
+    starts = scored_from + day * np.arange(n_blocks)
+    ends = np.append(starts[1:], n_steps)
+    return np.array([(index >= a) & (index < b) for a, b in zip(starts, ends)])
+
+
+def block_J(residuals, masks):
+    """J (C2) of residuals ((N_t, zones), NaN where not scored) on each block."""
+    return np.array([np.nansum(np.square(residuals[m])) for m in masks])
+
+
+def at_noise(J, n, sigma):
+    """Whether an error J (C2) on n residuals is what sensor noise of sd sigma alone leaves: within
+    the noise tolerance of n sigma^2."""
+    return J <= noise_floor(sigma, n) + noise_tolerance(sigma, n)
+
+
+def label(result):
+    return f"{result['effect']}@{result['target']}"
+
+
+def fall(base, scores):
+    """The fall of J from per-block J `base` to `scores` (C2) and its standard error from the
+    per-block falls (blocks as the unit)."""
+    d = np.asarray(base, dtype=float) - np.asarray(scores, dtype=float)
+    return float(d.sum()), float(math.sqrt(len(d)) * d.std(ddof=1))
+
+
+def decide(building, results, base, sigma, n):
+    """The decision record of one round (module docstring): the chosen candidate (or None), each
+    candidate's test, the candidates the data support but physics refuses (suggestions), those
+    the data cannot tell from the chosen, and the reason in words.
+
+    Parameters
+    ----------
+    building : Building the candidates are added to
+    results : candidate records, each with "cv": {"blocks": per-block J (C2) fitted without it}
+    base : per-block J (C2) of the model without them
+    sigma : the air sensors' noise sd (C)
+    n : residuals the blocks score
+    """
+    base = np.asarray(base, dtype=float)
+    margin = tolerance(float(base.sum()), sigma, n)
+    tests = {}
+    for r in results:
+        down, se = fall(base, r["cv"]["blocks"])
+        needed = max(margin, STANDARD_ERRORS * se)
+        # the other days than its best must gain too: one day alone is no evidence
+        others = down - float(np.max(base - np.asarray(r["cv"]["blocks"])))
+        tests[label(r)] = {"cv_fall": down, "cv_se": se, "needed": needed, "other_days": others,
+                           "passes": bool(down > needed and others > 0),
+                           "objection": objection(building, r["effect"], r["target"], r["parameters"],
+                                                  r.get("derived"))}
+    passing = [r for r in results if tests[label(r)]["passes"]]
+    admissible = [r for r in passing if not tests[label(r)]["objection"]]
+    suggestions = [{"candidate": label(r), "reason": tests[label(r)]["objection"], "cv_rmse": r["cv"]["rmse"]}
+                   for r in passing if tests[label(r)]["objection"]]
+    chosen, alike = None, []
+    if admissible:
+        best = min(admissible, key=lambda r: r["cv"]["J"])
+        floor = ROUNDING * float(base.sum())
+
+        def close(r):
+            # how much worse than the best it predicts the left-out days, and the scatter of that
+            worse, se = fall(r["cv"]["blocks"], best["cv"]["blocks"])
+            return worse <= max(STANDARD_ERRORS * se, floor)
+        near = [r for r in admissible if close(r)]
+        chosen = min(near, key=lambda r: (preference(r["effect"]), r["cv"]["J"]))
+        alike = [r for r in near if r is not chosen]
+    components = {c.name for c in building.components}
+    # the candidates physics refused are in `suggestions`; the report says them grouped by reason
+    reason = _reason(chosen, alike, results, passing, base, n, tests, margin, components)
+    return chosen, {"chosen": label(chosen) if chosen else None, "reason": reason,
+                    "cv_J_before": float(base.sum()), "blocks": len(base), "noise_margin": margin,
+                    "standard_errors": STANDARD_ERRORS, "suggestions": suggestions,
+                    "indistinct": [label(r) for r in alike], "candidates": tests}
+
+
+def _reason(chosen, alike, results, passing, base, n, tests, margin, components):
+    """The decision in words; `components` the building's component names."""
+    B = len(base)
+    rmse_before = math.sqrt(base.sum() / n)
+    if not results:
+        return "No candidate effect was tried, so the model is left as it is."
+    if not chosen:
+        return (f"None of the {len(results)} candidates lowers the cross-validated J ({base.sum():.3g} C2 over "
+                f"{B} days) by more than the noise could ({margin:.3g} C2) and {STANDARD_ERRORS:g} standard error of "
+                f"its fall from day to day, on more days than one"
+                + (f" ({len(passing)} do, and physics refuses each)" if passing else "") + ": no effect is added.")
+    what = (f"an unexplained heat source, acting {acting(chosen)} ({chosen['effect']} on {chosen['target']})"
+            if is_shape(chosen["effect"]) else f"{chosen['effect']} on {chosen['target']}")
+    test = tests[label(chosen)]
+    said = (f"{what[0].upper() + what[1:]} lowers the cross-validated J from {base.sum():.3g} to "
+            f"{chosen['cv']['J']:.3g} C2 ({rmse_before:.3f} -> {chosen['cv']['rmse']:.3f} C; each of {B} days "
+            f"predicted by a fit to the others), beyond the {test['needed']:.3g} C2 that the noise and its day-to-day "
+            f"scatter could make; {len(passing)} of {len(results)} candidates pass")
+    if alike:
+        said += ("; within one standard error of the best, and so not told apart by these data: "
+                 + ", ".join(f"{r['effect']} on {r['target']} ({r['cv']['J']:.3g} C2)" for r in alike)
+                 + (" (a physical effect, then fewer parameters, is preferred)" if any(
+                     r["cv"]["J"] < chosen["cv"]["J"] for r in alike) else ""))
+    others = [r["target"] for r in alike if r["target"] != chosen["target"] and r["target"] in components]
+    if others and chosen["target"] in components:
+        said += (f". The correction of {chosen['target']} cannot be told from that of "
+                 f"{', '.join(dict.fromkeys(others))}: the fault may be in either")
+    if is_shape(chosen["effect"]):
+        said += "; no physical effect comes within one standard error of it"
+    return said + "."
+
+
+def acting(result):
+    """How a shape's heat source acts, in words: with a daily profile, or in proportion to an input."""
+    values = {name: p["value"] for name, p in result["parameters"].items()}
+    if result["effect"] == "daily_gain":
+        amplitude = math.hypot(values.get("cos1", 0.0), values.get("sin1", 0.0))
+        return (f"with a daily profile (mean {values['mean']:.3g} W, first harmonic {amplitude:.3g} W) to the air "
+                f"of {result['target']}")
+    zone, column = bridge_parts(result["target"])
+    return f"in proportion to {column} (k = {values['k']:.3g}) to the air of {zone}"
