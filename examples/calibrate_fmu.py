@@ -24,7 +24,7 @@ writes OUT/testcell.fmu, OUT/inputs.csv and OUT/measurements.csv, fits the recor
 (default: all of it), prints the estimate with its standard deviation and writes
 OUT/estimate.json. `nodeforce diagnose model/data/testcell_miami.json --weather
 model/data/miami_tmy2.csv --measurements OUT/measurements.csv --burn-in-days 1 -o DIAGNOSIS`
-finds the same effect; fitted up to the end of that report's fitting window (the part of the
+finds the same effect; fitted up to the end of that report's calibration window (the part of the
 record its calibration reads), this script gives its value within its uncertainty
 (tests/test_calibrate_fmu.py).
 """

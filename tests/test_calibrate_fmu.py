@@ -30,8 +30,8 @@ def test_an_outside_calibration_through_the_fmu_finds_what_diagnose_finds(tmp_pa
     report = json.loads((tmp_path / "diagnosis" / "report.json").read_text())
     assert (report["effect"]["effect"], report["effect"]["target"]) == ("conductivity", "door")
     found = report["effect"]["parameters"]["factor"]
-    # on the record the diagnosis calibrated on (its fitting window), within its uncertainty
-    same = outside(tmp_path, "--fit-until", report["period"]["fitting"][1])
+    # on the record the diagnosis calibrated on (its calibration window), within its uncertainty
+    same = outside(tmp_path, "--fit-until", report["period"]["calibration"][1])
     assert abs(same["value"] - found["value"]) <= found["std"]
     # both near the real door's 0.78 / 0.23, within the bounds the FMU declares
     for estimate in (same, found):

@@ -115,9 +115,9 @@ def test_a_locate_killed_outright_takes_its_workers_with_it(cell, tmp_path, priv
 def test_a_diagnosis_killed_while_calibrating_takes_its_workers_with_it(cell, tmp_path, private_tmp):
     out = tmp_path / "out"
     run = start(cell["diagnose"] + ["-o", str(out), "--workers", "2"])
-    # the calibration workers build the candidates' FMUs: they are at work once one is there
+    # the candidates' folder comes after the search: two workers then are the calibration's
     status, _, seconds = stop(run, signal.SIGKILL,
-                              lambda: any((out / "candidates").glob("*.fmu")) and workers_running(run, 2))
+                              lambda: (out / "candidates").is_dir() and workers_running(run, 2))
     assert status == -signal.SIGKILL
     print(f"SIGKILL of diagnose --workers 2 while calibrating: its processes gone {seconds:.2f} s later")
     # a process killed outright cannot remove its own folders (the parent's extracted FMU, or a

@@ -73,7 +73,9 @@ def test_search_points_at_the_disturbed_sub_model(tmp_path, testcell_data, testc
     assert result["best_nodes"] == (NOISY.get(fault, EXPECTED[fault]) if noise else EXPECTED[fault])
     assert components(testcell, result["best_nodes"]) == components(testcell, EXPECTED[fault])
     if EXPECTED[fault]:
-        assert result["ranked_nodes"][0] in EXPECTED[fault]
+        # ranked by J: the first is a node of a disturbed component (with noise, the roof's
+        # next node scores below its inside surface, and is first)
+        assert set(components(testcell, result["ranked_nodes"][:1])) <= set(components(testcell, EXPECTED[fault]))
         # forcing them brings J down to what the noise alone gives (n sigma^2)
         J_noise = (len(case.times) - 1) * noise ** 2
         assert result["J_best"] - J_noise < 0.1 * (result["J_unforced"] - J_noise)

@@ -179,7 +179,7 @@ def refusals(report):
     for s in suggestions:
         clauses = _clauses(s.get("reason", ""))
         why = "; and ".join(w for w, _ in clauses)
-        values = "; ".join(v for _, v in clauses if v)
+        values = "; ".join(dict.fromkeys(v for _, v in clauses if v))
         groups.setdefault(why, []).append(s["candidate"] + (f" ({values})" if values else ""))
     lines = []
     for why, names in groups.items():
