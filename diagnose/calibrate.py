@@ -44,13 +44,18 @@ KEPT_RUNS = 64
 
 
 class Candidate:
-    """The model with one added effect, simulated by the direct model at any parameter values."""
+    """The model with one added effect, simulated by the direct model at any parameter values.
 
-    def __init__(self, building, effect, target):
+    `protocols` ({id(case): Building}) gives, for a case of a record run under another protocol
+    (its own supply flows, its own blinds), that record's building as the model stands; the effect
+    is added to it there. Other cases run `building`."""
+
+    def __init__(self, building, effect, target, protocols=None):
         self.building, self.effect, self.target = building, effect, target
+        self.protocols = protocols or {}
+        self.declared = EFFECTS[effect].apply(building, target, {})  # the inputs it reads
         self.parameters = EFFECTS[effect].parameters
         self.bounds = EFFECTS[effect].bounds(building, target)  # [(low, high)] a calibration explores
-        self.declared = EFFECTS[effect].apply(building, target, {})  # the inputs it reads
         self._runs, self._inputs = {}, {}
         self.simulations = 0  # simulations run (kept ones not counted again): a round's cost
 
@@ -58,9 +63,10 @@ class Candidate:
     def label(self):
         return f"{self.effect}@{self.target}"
 
-    def built(self, values):
-        """The building with the effect at `values` (sequence, in `parameters` order)."""
-        return EFFECTS[self.effect].apply(self.building, self.target,
+    def built(self, values, base=None):
+        """The building (`base`, default the candidate's) with the effect at `values` (sequence, in
+        `parameters` order)."""
+        return EFFECTS[self.effect].apply(self.building if base is None else base, self.target,
                                           {p.name: float(v) for p, v in zip(self.parameters, values)})
 
     def nodes(self, case, node_ids, values):
@@ -68,11 +74,13 @@ class Candidate:
         at `values` (sequence)."""
         key = (id(case), tuple(node_ids), tuple(float(v) for v in values))
         if key not in self._runs:
+            base = self.protocols.get(id(case), self.building)
             if id(case) not in self._inputs:
                 # the effect may read inputs the building as declared does not (a daily gain, the clock)
-                self._inputs[id(case)] = (case, case.with_inputs(self.declared))
+                declared = EFFECTS[self.effect].apply(base, self.target, {})
+                self._inputs[id(case)] = (case, case.with_inputs(declared))
             _, inputs = self._inputs[id(case)]
-            building = self.built(values)
+            building = self.built(values, base)
             self.simulations += 1
             T = simulate(building, assemble(building), inputs.U, inputs.dt, inputs.measured,
                          burn_in_steps=inputs.burn_in_steps, steady_start=inputs.steady_start)

@@ -94,8 +94,9 @@ def assess(task):
     each whole record, the Morris screening, the folds and the simulations it took; writes the
     candidate's building file, declared at the calibrated values, in `folder`.
     """
-    building, effect, target, folder, calibrations, cases, objective, blocks, seed = task
-    candidate = Candidate(building, effect, target)
+    building, bases, effect, target, folder, calibrations, cases, objective, blocks, seed = task
+    protocols = {id(c): base for windows in (calibrations, cases) for c, base in zip(windows, bases) if base is not None}
+    candidate = Candidate(building, effect, target, protocols)
     parameters, determined, folds = calibrate(candidate, calibrations, objective, blocks)
     values = [parameters[p.name]["value"] for p in candidate.parameters]
     runs = [candidate.nodes(case, objective.air_nodes, values) for case in cases]
@@ -109,13 +110,17 @@ def assess(task):
 class Record:
     """One record of the building: its case (burn-in set), the measurement file it came from (for
     errors), its name in the report, where its calibration window ends (`calibration_end`, a
-    pandas Timestamp, else the `fraction` of it by time) and its phases (iotools.phases.Phase)."""
+    pandas Timestamp, else the `fraction` of it by time), its phases (iotools.phases.Phase) and,
+    for a record run under another protocol than the building file's (other supply flows, other
+    blinds), the building as written for that protocol (`building`, the case's): the same house,
+    node for node, to which every correction is added as to the building file."""
     case: object
     source: str = "measurements"
     name: str = None
     fraction: float = 0.6
     calibration_end: object = None
     phases: tuple = ()
+    building: object = None
 
 
 @dataclass
@@ -174,10 +179,17 @@ class Windows:
 @dataclass
 class Model:
     """A model of the loop: its building, its objective air simulated over each whole record
-    (`runs`) and its metrics on every record's windows together."""
+    (`runs`), its metrics on every record's windows together, and per record the building it
+    runs under that record's protocol (None: `building`)."""
     building: object
     runs: list
     metrics: dict
+    bases: list
+
+    def adding(self, effect, target, values, runs, metrics):
+        """The model with the effect at `values` added to its building and to every record's."""
+        return Model(EFFECTS[effect].apply(self.building, target, values), runs, metrics,
+                     [None if b is None else EFFECTS[effect].apply(b, target, values) for b in self.bases])
 
 
 def assess_all(model, pairs, windows, objective, folder, seed, workers):
@@ -185,7 +197,7 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers):
     (t_0..t_k) with a fold per block, and run over each record, in parallel worker processes
     (which end with this process: nodeforce.lifetime): the candidates' records, their `Model`s by
     label, their Morris screenings, and the simulations they took."""
-    tasks = [(model.building, effect, target, folder, windows.calibrations, windows.cases, objective,
+    tasks = [(model.building, model.bases, effect, target, folder, windows.calibrations, windows.cases, objective,
               windows.blocks, seed) for effect, target in pairs]
     n_workers = min(workers or os.cpu_count(), len(tasks))
     with (lifetime.worker_pool(n_workers) if n_workers > 1 else nullcontext()) as pool:
@@ -202,7 +214,7 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers):
                   "cv": {"blocks": scores, "J": sum(scores), "n": n, "rmse": float(np.sqrt(sum(scores) / n)),
                          "folds": [f["values"] for f in folds]}}
         values = {name: p["value"] for name, p in parameters.items()}
-        models[label(result)] = Model(EFFECTS[effect].apply(model.building, target, values), runs, metrics)
+        models[label(result)] = model.adding(effect, target, values, runs, metrics)
         results.append(result)
         sensitivities[label(result)] = screening
         simulations += count
@@ -237,10 +249,14 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
     noise = Noise.of(np.concatenate([x for m in windows.measured for x in (m, gap)][:-1]), noise)
     sigma = noise.sigma
 
-    with FmuInstance(build_fmu(building, workdir / "model_before.fmu", kind=fmu_kind)) as base:
-        before_runs = [simulate_fmu(base, case, output_ids=objective.air_nodes) for case in windows.cases]
+    bases = [protocol(building, r) for r in records]
+    before_runs = []
+    for i, (case, base) in enumerate(zip(windows.cases, bases)):
+        name = "model_before.fmu" if base is None else f"model_before_{i + 1}.fmu"
+        with FmuInstance(build_fmu(base or building, workdir / name, kind=fmu_kind)) as fmu:
+            before_runs.append(simulate_fmu(fmu, case, output_ids=objective.air_nodes))
     before = windows.metrics(objective, before_runs)
-    model = Model(building, before_runs, before)
+    model = Model(building, before_runs, before, bases)
 
     convergence = []
     localization = locate(building, windows.calibrations[0], objective, workdir, source=records[0].source,
@@ -308,6 +324,10 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
               else {"effect": "none", "target": None, "parameters": {}})
     (workdir / "building_after.json").write_text(json.dumps(after_building.to_json(), indent=2) + "\n")
     fmu_after = build_fmu(after_building, workdir / "model_after.fmu", kind=fmu_kind)
+    # a record under another protocol: its own building as corrected, for `nodeforce compare`
+    protocols_after = {i: workdir / f"building_after_record{i + 1}.json" for i, b in enumerate(model.bases) if b is not None}
+    for i, path in protocols_after.items():
+        path.write_text(json.dumps(model.bases[i].to_json(), indent=2) + "\n")
 
     # every record's phases, each named with its record's name where there are several
     by_phase = []
@@ -350,7 +370,8 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
     if len(records) > 1:
         report["records"] = [{"name": r.name, "measurements": str(r.source), "period": period(windows, i),
                               "before": windows.metrics(objective, before_runs, i),
-                              "after": windows.metrics(objective, after_runs, i)}
+                              "after": windows.metrics(objective, after_runs, i),
+                              **({"building_after": str(protocols_after[i])} if i in protocols_after else {})}
                              for i, r in enumerate(records)]
     if reference:
         report["reference"] = reference
@@ -367,6 +388,21 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
     report["artifacts"]["report"] = str(workdir / "report.md")
     (workdir / "report.json").write_text(json.dumps(report, indent=2, default=_plain) + "\n")
     return report
+
+
+def protocol(building, record):
+    """The record's own building (its protocol's), None where it is `building`; InputError naming
+    its file where it is not the same house node for node."""
+    other = record.building if record.building is not None else record.case.building
+    if other is None or other is building or other.to_json() == building.to_json():
+        return None
+    for what, of in (("zones", lambda b: [z.name for z in b.zones]),
+                     ("components", lambda b: [c.name for c in b.components]),
+                     ("nodes", lambda b: b.n_nodes)):
+        if of(other) != of(building):
+            raise InputError(other.source, what, f"record {record.name}'s building is not {building.source}'s house "
+                                                 f"under another protocol: its {what} differ")
+    return other
 
 
 def period(windows, i):

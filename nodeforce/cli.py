@@ -234,7 +234,7 @@ def the_record(case, source, args):
 
 # The fields of --record: each a file or a window of one record; those not given take the option
 # of the same name.
-RECORD_FIELDS = ("name", "weather", "measurements", "calibration-end", "calibration-fraction", "phases",
+RECORD_FIELDS = ("name", "building", "weather", "measurements", "calibration-end", "calibration-fraction", "phases",
                  "burn-in-days")
 
 
@@ -282,14 +282,16 @@ def records_of(building, args):
         except ValueError:
             raise InputError("--record", "burn-in-days", f"a number of days, and calibration-fraction a number, "
                                                          f"in {text!r}") from None
-        case = measured_case(building, read_weather(f["weather"]), read_measurements(f["measurements"]), burn_in,
+        # a record run under another protocol (other flows, other blinds) reads the house as written for it
+        own = load_building(f["building"]) if "building" in f else building
+        case = measured_case(own, read_weather(f["weather"]), read_measurements(f["measurements"]), burn_in,
                              args.decomposition)
         end = f.get("calibration-end", args.calibration_end)
         phases = f.get("phases", args.phases)
         records.append(Record(case, f["measurements"], f.get("name", Path(f["measurements"]).name.split(".")[0]),
                               check_fraction("--record calibration-fraction", fraction),
                               instant("--record calibration-end", end) if end else None,
-                              tuple(read_phases(phases)) if phases else ()))
+                              tuple(read_phases(phases)) if phases else (), own))
     for said in dict.fromkeys(a for r in records for a in r.case.assumptions):
         print(f"assumed: {said}")
     return records

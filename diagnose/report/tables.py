@@ -233,3 +233,16 @@ def phases(report):
     return markdown(["phase", "from", "n"] + labels,
                     [[row["phase"], time_text(row["start"]), fmt_int(row["n"])] + [cell(row, label) for label in labels]
                      for row in rows])
+
+
+def records(report):
+    """RMSE (C) before and after per record, window and zone, the objective's first, of a
+    diagnosis of several records; "" for one."""
+    rows = []
+    for record in report.get("records") or []:
+        for window in ("calibration", "validation"):
+            b, a = record["before"][window], record["after"][window]
+            rows.append([record["name"], window, "objective", fmt_temp(b["rmse"]), fmt_temp(a["rmse"]), fmt_int(b["n"])])
+            rows += [[record["name"], window, zone, fmt_temp(z["rmse"]), fmt_temp(a["zones"][zone]["rmse"]),
+                      fmt_int(z["n"])] for zone, z in b["zones"].items()] if len(b["zones"]) > 1 else []
+    return markdown(["record", "window", "zone", "RMSE before (C)", "RMSE after (C)", "n"], rows) if rows else ""
