@@ -229,3 +229,23 @@ def test_a_reference_without_rmse_figures_is_a_one_line_error(files, capsys):
                             "--measurements", str(files["measurements"]), "-o", str(files["dir"] / "d"),
                             "--reference", str(bad)])
     assert err.startswith(f"nodeforce: {bad}: rmse:")
+
+
+def test_bad_records_stop_with_one_line_naming_the_field(files, capsys, tmp_path):
+    b, w, m = str(files["building"]), str(files["weather"]), str(files["measurements"])
+    base = ["diagnose", b, "-o", str(tmp_path / "out")]
+    err = error_of(capsys, base + ["--record", f"weather={w},measurements={m},colour=blue"])
+    assert "--record: colour: no such field" in err
+    err = error_of(capsys, base + ["--record", f"weather={w}"])
+    assert "--record: measurements: missing" in err
+    err = error_of(capsys, base + ["--record", f"weather={w},measurements={m},weather={w}"])
+    assert "--record: weather: given twice" in err
+    err = error_of(capsys, base + ["--weather", w, "--record", f"weather={w},measurements={m}"])
+    assert err.startswith("nodeforce: --record: weather:")
+    err = error_of(capsys, base + ["--record", f"weather={w},measurements={m},burn-in-days=two"])
+    assert "--record: burn-in-days:" in err
+    err = error_of(capsys, base)
+    assert "--weather and --measurements, or one --record per record" in err
+    # two records under one name
+    err = error_of(capsys, base + ["--record", f"weather={w},measurements={m},name=a"] * 2)
+    assert "name: two records are named 'a'" in err
