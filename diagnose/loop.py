@@ -91,19 +91,23 @@ def assess(task):
     worker process.
 
     Returns the calibrated parameters, what the data determine, the simulated objective air over
-    each whole record, the Morris screening, the folds and the simulations it took; writes the
+    each whole record, the folds and the simulations it took; writes the
     candidate's building file, declared at the calibrated values, in `folder`.
     """
     building, bases, effect, target, folder, calibrations, cases, objective, blocks, seed = task
-    protocols = {id(c): base for windows in (calibrations, cases) for c, base in zip(windows, bases) if base is not None}
-    candidate = Candidate(building, effect, target, protocols)
+    candidate = Candidate(building, effect, target, protocols(bases, calibrations, cases))
     parameters, determined, folds = calibrate(candidate, calibrations, objective, blocks)
     values = [parameters[p.name]["value"] for p in candidate.parameters]
     runs = [candidate.nodes(case, objective.air_nodes, values) for case in cases]
-    screening = sensitivity(candidate, calibrations, objective, seed=seed)
     calibrated = EFFECTS[effect].apply(building, target, {name: p["value"] for name, p in parameters.items()})
     (folder / f"{candidate.label}.json").write_text(json.dumps(calibrated.to_json(), indent=2) + "\n")
-    return parameters, determined, runs, screening, folds, candidate.simulations
+    return parameters, determined, runs, folds, candidate.simulations
+
+
+def protocols(bases, *windows):
+    """{id(case): building} of the cases (each sequence of `windows` one per record) of the records
+    run under their own protocol's building (`Candidate`)."""
+    return {id(c): base for cases in windows for c, base in zip(cases, bases) if base is not None}
 
 
 @dataclass
@@ -196,7 +200,7 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers):
     """Each (effect, target) added to `model`, calibrated on every record's calibration window
     (t_0..t_k) with a fold per block, and run over each record, in parallel worker processes
     (which end with this process: nodeforce.lifetime): the candidates' records, their `Model`s by
-    label, their Morris screenings, and the simulations they took."""
+    label, and the simulations they took."""
     tasks = [(model.building, model.bases, effect, target, folder, windows.calibrations, windows.cases, objective,
               windows.blocks, seed) for effect, target in pairs]
     n_workers = min(workers or os.cpu_count(), len(tasks))
@@ -205,8 +209,8 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers):
                              desc="calibrating candidate effects", unit="candidate",
                              disable=not sys.stderr.isatty()))
     n = windows.scored()
-    results, models, sensitivities, simulations = [], {}, {}, 0
-    for (effect, target), (parameters, determined, runs, screening, folds, count) in zip(pairs, assessed):
+    results, models, simulations = [], {}, 0
+    for (effect, target), (parameters, determined, runs, folds, count) in zip(pairs, assessed):
         scores = [float(np.nansum(np.square(f["residuals"]))) for f in folds]
         metrics = windows.metrics(objective, runs)
         result = {"effect": effect, "target": target, "parameters": parameters, "derived": determined,
@@ -216,9 +220,8 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers):
         values = {name: p["value"] for name, p in parameters.items()}
         models[label(result)] = model.adding(effect, target, values, runs, metrics)
         results.append(result)
-        sensitivities[label(result)] = screening
         simulations += count
-    return results, models, sensitivities, simulations
+    return results, models, simulations
 
 
 def diagnose(building, records, objective, workdir, *, source="measurements", fraction=0.6, calibration_end=None,
@@ -291,16 +294,15 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
         started = time.perf_counter()
         pairs = [p for p in physical(model.building, localization["components"], objective.zones,
                                      measured_ids, localization["best_nodes"]) if "@".join(p) not in done]
-        tried, models, screened, simulations = assessed(model, pairs, number)
+        tried, models, simulations = assessed(model, pairs, number)
         # shapes only where no physical candidate physics admits brings the error left to the
         # noise; the residual's statistics then choose which
         if not any(at_noise(r["cv"]["J"], n, sigma) and not objection(model.building, r["effect"], r["target"],
                                                                       r["parameters"], r["derived"]) for r in tried):
             pairs = [p for p in shapes(model.building, left_by(model), objective.zones) if "@".join(p) not in done]
-            more, more_models, more_screened, more_simulations = assessed(model, pairs, number)
+            more, more_models, more_simulations = assessed(model, pairs, number)
             tried, simulations = tried + more, simulations + more_simulations
             models.update(more_models)
-            screened.update(more_screened)
         chosen, decision = decide(model.building, tried, base_blocks, sigma, n, windows.groups())
         decision["cost"] = {"candidates": len(tried), "simulations": simulations,
                             "seconds": round(time.perf_counter() - started, 1)}
@@ -308,9 +310,13 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
         on_top = {"on_top_of": [label(a) for a in added]} if added else {}
         results += [{**r, "round": number + 1, **on_top} for r in tried]
         runs.update({(key if not added else f"{key} (round {number + 1})"): m.runs for key, m in models.items()})
-        sensitivities.update(screened)
         if not chosen:
             break
+        # the Morris screening of the chosen effect's parameters, on the model it is added to: a
+        # screening of every candidate would cost a quarter of a round's simulations
+        screened = Candidate(model.building, chosen["effect"], chosen["target"],
+                             protocols(model.bases, windows.calibrations))
+        sensitivities[label(chosen)] = sensitivity(screened, windows.calibrations, objective, seed=seed)
         added.append(chosen)
         model = models[label(chosen)]
 
