@@ -134,7 +134,9 @@ def write_markdown(out_dir, report, plots, notes):
     by_phase = tables.phases(report)
     if by_phase:
         md += ["RMSE (C) of the objective's air in each phase of the record, over both windows (the "
-               f"calibration fitted the first): ▲ marks a phase made worse than before by {WORSE:.0%} or more.", "",
+               f"calibration fitted the first): ▲ marks a phase made worse than before by {WORSE:.0%} or more"
+               + (f"; the chosen candidates only, every candidate's in report.json" if len(
+                   report["phases"][0]["rmse"]) > tables.PHASE_COLUMNS else "") + ".", "",
                by_phase, ""]
     md += figure("temperature", "Measured and simulated indoor air temperature, before and after")
     md += figure("residuals", "Air residual before and after, mean and sd per window")

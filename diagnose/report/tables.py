@@ -219,6 +219,10 @@ def residual_diagnostics(report):
                      "follows most (input, lag, prewhitened r)", "daily profile (amplitude, peak)"], rows) if rows else ""
 
 
+# Columns of the phases table beyond which only the chosen candidates' are shown.
+PHASE_COLUMNS = 12
+
+
 def phases(report):
     """RMSE (C) of each phase of the record: before, every candidate, after; a value made worse
     than before by the loop's margin (diagnose.phases.WORSE) is marked ▲."""
@@ -226,6 +230,11 @@ def phases(report):
     if not rows:
         return ""
     labels = list(rows[0]["rmse"])
+    if len(labels) > PHASE_COLUMNS:
+        # a whole house tries a hundred candidates: the table keeps the chosen ones (report.json has all)
+        chosen = [r["chosen"] if i == 0 else f"{r['chosen']} (round {i + 1})"
+                  for i, r in enumerate((report.get("decision") or {}).get("rounds") or []) if r.get("chosen")]
+        labels = [label for label in labels if label in ("before", "after") or label in chosen]
 
     def cell(row, label):
         value, before = num(row["rmse"].get(label)), num(row["rmse"].get("before"))
