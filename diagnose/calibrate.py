@@ -44,13 +44,18 @@ KEPT_RUNS = 64
 
 
 class Candidate:
-    """The model with one added effect, simulated by the direct model at any parameter values."""
+    """The model with one added effect, simulated by the direct model at any parameter values.
 
-    def __init__(self, building, effect, target):
+    `protocols` ({id(case): Building}) gives, for a case of a record run under another protocol
+    (its own supply flows, its own blinds), that record's building as the model stands; the effect
+    is added to it there. Other cases run `building`."""
+
+    def __init__(self, building, effect, target, protocols=None):
         self.building, self.effect, self.target = building, effect, target
+        self.protocols = protocols or {}
+        self.declared = EFFECTS[effect].apply(building, target, {})  # the inputs it reads
         self.parameters = EFFECTS[effect].parameters
         self.bounds = EFFECTS[effect].bounds(building, target)  # [(low, high)] a calibration explores
-        self.declared = EFFECTS[effect].apply(building, target, {})  # the inputs it reads
         self._runs, self._inputs = {}, {}
         self.simulations = 0  # simulations run (kept ones not counted again): a round's cost
 
@@ -58,9 +63,10 @@ class Candidate:
     def label(self):
         return f"{self.effect}@{self.target}"
 
-    def built(self, values):
-        """The building with the effect at `values` (sequence, in `parameters` order)."""
-        return EFFECTS[self.effect].apply(self.building, self.target,
+    def built(self, values, base=None):
+        """The building (`base`, default the candidate's) with the effect at `values` (sequence, in
+        `parameters` order)."""
+        return EFFECTS[self.effect].apply(self.building if base is None else base, self.target,
                                           {p.name: float(v) for p, v in zip(self.parameters, values)})
 
     def nodes(self, case, node_ids, values):
@@ -68,11 +74,13 @@ class Candidate:
         at `values` (sequence)."""
         key = (id(case), tuple(node_ids), tuple(float(v) for v in values))
         if key not in self._runs:
+            base = self.protocols.get(id(case), self.building)
             if id(case) not in self._inputs:
                 # the effect may read inputs the building as declared does not (a daily gain, the clock)
-                self._inputs[id(case)] = (case, case.with_inputs(self.declared))
+                declared = EFFECTS[self.effect].apply(base, self.target, {})
+                self._inputs[id(case)] = (case, case.with_inputs(declared))
             _, inputs = self._inputs[id(case)]
-            building = self.built(values)
+            building = self.built(values, base)
             self.simulations += 1
             T = simulate(building, assemble(building), inputs.U, inputs.dt, inputs.measured,
                          burn_in_steps=inputs.burn_in_steps, steady_start=inputs.steady_start)
@@ -82,34 +90,47 @@ class Candidate:
         return self._runs[key]
 
 
-def calibrate(candidate, case, objective, blocks=()):
-    """Least-squares values of the candidate's parameters on `case` (the calibration window), on
-    the residuals of every objective zone, and the same fit with each block of steps left out.
+def calibrate(candidate, cases, objective, blocks=()):
+    """Least-squares values of the candidate's parameters on the calibration windows of one or
+    several records of the building (`cases`), on the residuals of every objective zone of every
+    record together (the sum of each window's J), and the same fit with each block of steps left out.
 
     Parameters
     ----------
     candidate : Candidate
-    case : Case, the calibration window
+    cases : Case, or a sequence of Cases: each record's calibration window
     objective : model.score.Objective
-    blocks : (N_t,) bool masks of the steps of each cross-validation block (`diagnose.selection`)
+    blocks : (record index, (N_t,) bool mask of the steps of that record's window) of each
+        cross-validation block (`diagnose.selection`); a bare mask is a block of the first record
 
     Returns
     -------
     dict {name: {"value", "std", "identifiable", "on_bound"}}; the quantities the data determine
     even where the parameters are not (see `derived`); and per block the parameter values fitted
-    without it (`fold`) and the residuals (C, (N_t, zones), NaN off the block) they leave on it
+    without it (`fold`) and the residuals (C, (N_t, zones) of its record, NaN off the block) they
+    leave on it
     """
-    measured = objective.measured(case)
-    have = np.isfinite(measured)
+    cases = [cases] if not isinstance(cases, (list, tuple)) else list(cases)
+    blocks = [b if isinstance(b, tuple) else (0, b) for b in blocks]
+    measured = [objective.measured(case) for case in cases]
+    have = [np.isfinite(m) for m in measured]
     lows, highs = np.array(candidate.bounds).T
     start = calibration_start(candidate.building, candidate.effect, candidate.target)
     x0 = np.clip([start[p.name] for p in candidate.parameters], lows, highs)
 
     def residuals(x):
-        return measured[have] - candidate.nodes(case, objective.air_nodes, x)[have]
+        return np.concatenate([m[h] - candidate.nodes(case, objective.air_nodes, x)[h]
+                               for case, m, h in zip(cases, measured, have)])
 
     fit = least_squares(residuals, x0, bounds=(lows, highs), x_scale="jac", method="trf")
-    cov = parameter_covariance(fit.jac, fit.fun, np.nonzero(have)[0], bandwidth(case.dt))
+    # each record's steps numbered apart from the others' by more than the HAC's lags: residuals
+    # of two records are not correlated
+    lags = bandwidth(cases[0].dt)
+    steps, offset = [], 0
+    for h in have:
+        steps.append(np.nonzero(h)[0] + offset)
+        offset += len(h) + lags + 1
+    cov = parameter_covariance(fit.jac, fit.fun, np.concatenate(steps), lags)
     std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     result = {}
     for p, value, sd, bound in zip(candidate.parameters, fit.x, std, fit.active_mask):
@@ -121,12 +142,14 @@ def calibrate(candidate, case, objective, blocks=()):
         result[p.name] = {"value": float(value), "std": float(sd), "identifiable": identifiable,
                           "on_bound": bool(bound != 0)}
     folds = []
-    for block in blocks:
-        train = ~np.broadcast_to(block[:, None], have.shape)[have]
-        x = fold(fit, train, lows, highs)
-        left = np.where(have & block[:, None], measured - candidate.nodes(case, objective.air_nodes, x), np.nan)
+    for record, block in blocks:
+        rows = [np.broadcast_to((block[:, None] if i == record else np.zeros((len(h), 1), bool)), h.shape)[h]
+                for i, h in enumerate(have)]
+        x = fold(fit, ~np.concatenate(rows), lows, highs)
+        case, m, h = cases[record], measured[record], have[record]
+        left = np.where(h & block[:, None], m - candidate.nodes(case, objective.air_nodes, x), np.nan)
         folds.append({"values": [float(v) for v in x], "residuals": left})
-    return result, derived(candidate, case, fit.x, cov), folds
+    return result, derived(candidate, cases[0], fit.x, cov), folds
 
 
 def fold(fit, train, lows, highs):
@@ -206,17 +229,20 @@ def hlc_gradient(candidate, x):
     return at, gradient
 
 
-def sensitivity(candidate, case, objective, seed=0):
-    """Morris elementary effects of the parameters, over their bounds, on J of `case`.
+def sensitivity(candidate, cases, objective, seed=0):
+    """Morris elementary effects of the parameters, over their bounds, on J of `cases` (a Case,
+    or several records' calibration windows, their J summed).
 
     Returns {name: {"mu_star": C2, "sigma": C2}}: mu* ranks how much J moves with a parameter,
     sigma how much that depends on the others (interaction or non-linearity).
     """
-    measured = objective.measured(case)
+    cases = [cases] if not isinstance(cases, (list, tuple)) else list(cases)
+    measured = [objective.measured(case) for case in cases]
     problem = {"num_vars": len(candidate.parameters), "names": [p.name for p in candidate.parameters],
                "bounds": [list(b) for b in candidate.bounds]}
     X = morris_sample.sample(problem, MORRIS_TRAJECTORIES, num_levels=4, seed=seed)
-    Y = np.array([objective.J(measured, candidate.nodes(case, objective.air_nodes, x)) for x in X])
+    Y = np.array([sum(objective.J(m, candidate.nodes(case, objective.air_nodes, x)) for case, m in zip(cases, measured))
+                  for x in X])
     analysis = morris_analyze.analyze(problem, X, Y, num_levels=4, seed=seed)
     return {name: {"mu_star": float(m), "sigma": float(s)}
             for name, m, s in zip(problem["names"], analysis["mu_star"], analysis["sigma"])}

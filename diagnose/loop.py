@@ -48,7 +48,7 @@ from nodeforce.diagnose.loss import heat_loss
 from nodeforce.diagnose.report import write_report
 from nodeforce.diagnose.phases import phase_errors, worsened
 from nodeforce.diagnose.residuals import diagnostics as residual_diagnostics
-from nodeforce.diagnose.selection import at_noise, block_J, blocks, decide, label
+from nodeforce.diagnose.selection import at_noise, block_J, blocks as blocks_of, decide, label
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.locate import check_measured, locate
 from nodeforce.model.effects import EFFECTS
@@ -91,140 +91,232 @@ def assess(task):
     worker process.
 
     Returns the calibrated parameters, what the data determine, the simulated objective air over
-    the whole record, the Morris screening, the folds and the simulations it took; writes the
+    each whole record, the folds and the simulations it took; writes the
     candidate's building file, declared at the calibrated values, in `folder`.
     """
-    building, effect, target, folder, calibration, case, objective, masks, seed = task
-    candidate = Candidate(building, effect, target)
-    parameters, determined, folds = calibrate(candidate, calibration, objective, masks)
+    building, bases, effect, target, folder, calibrations, cases, objective, blocks, seed = task
+    candidate = Candidate(building, effect, target, protocols(bases, calibrations, cases))
+    parameters, determined, folds = calibrate(candidate, calibrations, objective, blocks)
     values = [parameters[p.name]["value"] for p in candidate.parameters]
-    run = candidate.nodes(case, objective.air_nodes, values)
-    screening = sensitivity(candidate, calibration, objective, seed=seed)
+    runs = [candidate.nodes(case, objective.air_nodes, values) for case in cases]
     calibrated = EFFECTS[effect].apply(building, target, {name: p["value"] for name, p in parameters.items()})
     (folder / f"{candidate.label}.json").write_text(json.dumps(calibrated.to_json(), indent=2) + "\n")
-    return parameters, determined, run, screening, folds, candidate.simulations
+    return parameters, determined, runs, folds, candidate.simulations
+
+
+def protocols(bases, *windows):
+    """{id(case): building} of the cases (each sequence of `windows` one per record) of the records
+    run under their own protocol's building (`Candidate`)."""
+    return {id(c): base for cases in windows for c, base in zip(cases, bases) if base is not None}
 
 
 @dataclass
+class Record:
+    """One record of the building: its case (burn-in set), the measurement file it came from (for
+    errors), its name in the report, where its calibration window ends (`calibration_end`, a
+    pandas Timestamp, else the `fraction` of it by time), its phases (iotools.phases.Phase) and,
+    for a record run under another protocol than the building file's (other supply flows, other
+    blinds), the building as written for that protocol (`building`, the case's): the same house,
+    node for node, to which every correction is added as to the building file."""
+    case: object
+    source: str = "measurements"
+    name: str = None
+    fraction: float = 0.6
+    calibration_end: object = None
+    phases: tuple = ()
+    building: object = None
+
+
+@dataclass
+class Windows:
+    """The records as the loop reads them: each one's case (steady start), the row k of its last
+    calibration time, its calibration window, its measured objective air (N_t, zones) and the
+    cross-validation blocks of all records in order, (record index, mask)."""
+    records: list
+    cases: list
+    ks: list
+    calibrations: list
+    measured: list
+    blocks: list
+
+    @classmethod
+    def of(cls, records, objective):
+        cases, ks, calibrations, measured, blocks = [], [], [], [], []
+        for i, record in enumerate(records):
+            # what no sensor sets (every wall of an air-only record) starts from the steady state of
+            # the first day, not at the air's temperature: a heavy component would carry that guess
+            # for weeks, and the candidates' slow parameters would fit it
+            case = record.case if record.case.steady_start else record.case.with_steady_start()
+            k = split(case, record.source, record.fraction, record.calibration_end)
+            cases.append(case)
+            ks.append(k)
+            calibrations.append(case.window(0, k))
+            measured.append(objective.measured(case))
+            blocks += [(i, m) for m in blocks_of(k, case.burn_in_steps, case.dt, record.source)]
+        return cls(list(records), cases, ks, calibrations, measured, blocks)
+
+    def metrics(self, objective, runs, record=None):
+        """{"calibration", "validation"}: the objective's metrics of `runs` (one (N_t, zones) per
+        record) on every record's window together, or on `record`'s (an index) alone."""
+        chosen = range(len(self.cases)) if record is None else [record]
+        return {window: objective.metrics(*(np.concatenate([part[i][rows(self.ks[i])] for i in chosen])
+                                            for part in (self.measured, runs)))
+                for window, rows in (("calibration", lambda k: slice(None, k)),
+                                     ("validation", lambda k: slice(k, None)))}
+
+    def block_J(self, runs):
+        """J (C2) of `runs` on every block, the records' in order."""
+        return np.array([block_J(self.measured[i][:self.ks[i]] - runs[i][:self.ks[i]], [m])[0]
+                         for i, m in self.blocks])
+
+    def scored(self):
+        """Residuals the blocks score, on every record."""
+        return sum(int(np.isfinite(m[:k]).sum()) for m, k in zip(self.measured, self.ks))
+
+    def groups(self):
+        """Per record, its name, the indices of its blocks and the residuals they score: what
+        `selection.decide` needs to see a candidate that harms one record; [] for one record."""
+        if len(self.records) < 2:
+            return []
+        return [{"record": r.name, "blocks": [b for b, (i, _) in enumerate(self.blocks) if i == j],
+                 "n": int(np.isfinite(self.measured[j][:self.ks[j]]).sum())} for j, r in enumerate(self.records)]
+@dataclass
 class Model:
-    """A model of the loop: its building, its objective air simulated over the whole record
-    (`run`) and its metrics."""
+    """A model of the loop: its building, its objective air simulated over each whole record
+    (`runs`), its metrics on every record's windows together, and per record the building it
+    runs under that record's protocol (None: `building`)."""
     building: object
-    run: np.ndarray
+    runs: list
     metrics: dict
+    bases: list
+
+    def adding(self, effect, target, values, runs, metrics):
+        """The model with the effect at `values` added to its building and to every record's."""
+        return Model(EFFECTS[effect].apply(self.building, target, values), runs, metrics,
+                     [None if b is None else EFFECTS[effect].apply(b, target, values) for b in self.bases])
 
 
-def assess_all(model, pairs, calibration, case, objective, folder, seed, workers, masks):
-    """Each (effect, target) added to `model`, calibrated on `calibration` (t_0..t_k) with a fold
-    per block of `masks`, and run over `case`, in parallel worker processes (which end with this
-    process: nodeforce.lifetime): the candidates' records, their `Model`s by label, their Morris
-    screenings, and the simulations they took."""
-    tasks = [(model.building, effect, target, folder, calibration, case, objective, masks, seed)
-             for effect, target in pairs]
+def assess_all(model, pairs, windows, objective, folder, seed, workers):
+    """Each (effect, target) added to `model`, calibrated on every record's calibration window
+    (t_0..t_k) with a fold per block, and run over each record, in parallel worker processes
+    (which end with this process: nodeforce.lifetime): the candidates' records, their `Model`s by
+    label, and the simulations they took."""
+    tasks = [(model.building, model.bases, effect, target, folder, windows.calibrations, windows.cases, objective,
+              windows.blocks, seed) for effect, target in pairs]
     n_workers = min(workers or os.cpu_count(), len(tasks))
     with (lifetime.worker_pool(n_workers) if n_workers > 1 else nullcontext()) as pool:
         assessed = list(tqdm((pool.map if pool else map)(assess, tasks), total=len(tasks),
                              desc="calibrating candidate effects", unit="candidate",
                              disable=not sys.stderr.isatty()))
-    measured = objective.measured(case)
-    k = len(calibration.times) - 1
-    n = int(np.isfinite(measured[:k]).sum())
-    results, models, sensitivities, simulations = [], {}, {}, 0
-    for (effect, target), (parameters, determined, run, screening, folds, count) in zip(pairs, assessed):
+    n = windows.scored()
+    results, models, simulations = [], {}, 0
+    for (effect, target), (parameters, determined, runs, folds, count) in zip(pairs, assessed):
         scores = [float(np.nansum(np.square(f["residuals"]))) for f in folds]
+        metrics = windows.metrics(objective, runs)
         result = {"effect": effect, "target": target, "parameters": parameters, "derived": determined,
-                  "calibration": objective.metrics(measured[:k], run[:k]),
-                  "validation": objective.metrics(measured[k:], run[k:]),
+                  **metrics,
                   "cv": {"blocks": scores, "J": sum(scores), "n": n, "rmse": float(np.sqrt(sum(scores) / n)),
                          "folds": [f["values"] for f in folds]}}
         values = {name: p["value"] for name, p in parameters.items()}
-        models[label(result)] = Model(EFFECTS[effect].apply(model.building, target, values), run,
-                                      {w: result[w] for w in ("calibration", "validation")})
+        models[label(result)] = model.adding(effect, target, values, runs, metrics)
         results.append(result)
-        sensitivities[label(result)] = screening
         simulations += count
-    return results, models, sensitivities, simulations
+    return results, models, simulations
 
 
-def diagnose(building, case, objective, workdir, *, source="measurements", fraction=0.6, calibration_end=None,
+def diagnose(building, records, objective, workdir, *, source="measurements", fraction=0.6, calibration_end=None,
              seed=0, workers=None, population=30, generations=400, fmu_kind="python", reference=None,
              noise=None, phases=None):
     """Run the whole loop; write the artifacts in `workdir`; return the report.json content.
+
+    `records` is a Case (one record: `source`, `fraction`, `calibration_end` and `phases` are
+    its) or a list of `Record`s of the same building, each with its own windows and phases: the
+    fits minimise the sum of every record's calibration J, the choice reads every record's
+    blocks, and a candidate that harms one record is refused (`selection.decide`). The forcing
+    search reads the first record's calibration window.
     `reference` ({"label", "rmse": {phase: K}}), another model's error, is reported for scale;
-    `noise` (C) is the air sensors' noise sd if the user knows it, else it is estimated;
-    `phases` (iotools.phases.Phase records) are the experiment's phases, each model scored on each."""
-    check_measured(objective, case, source)
-    # what no sensor sets (every wall of an air-only record) starts from the steady state of the
-    # first day, not at the air's temperature: a heavy component would carry that guess for weeks,
-    # and the candidates' slow parameters would fit it
-    case = case if case.steady_start else case.with_steady_start()
-    k = split(case, source, fraction, calibration_end)
-    # the forcing search and the candidates' fits read the calibration window, the choice its
-    # days left out one at a time; the validation window only reports
-    calibration = case.window(0, k)
-    masks = blocks(k, case.burn_in_steps, case.dt, source)
-    measured = objective.measured(case)
-    scored = measured[:k]
-    n = int(np.isfinite(scored).sum())
-    noise = Noise.of(measured, noise)
+    `noise` (C) is the air sensors' noise sd if the user knows it, else it is estimated from
+    every record's air."""
+    if not isinstance(records, (list, tuple)):
+        records = [Record(records, source, source, fraction, calibration_end, tuple(phases or ()))]
+    names = [r.name for r in records]
+    for r in records:
+        if names.count(r.name) > 1:
+            raise InputError(r.source, "name", f"two records are named {r.name!r}: each needs its own name")
+        check_measured(objective, r.case, r.source)
+    windows = Windows.of(records, objective)
+    first = windows.cases[0]
+    n = windows.scored()
+    # the records apart by a row of NaN: no second difference spans two records
+    gap = np.full((1, len(objective.zones)), np.nan)
+    noise = Noise.of(np.concatenate([x for m in windows.measured for x in (m, gap)][:-1]), noise)
     sigma = noise.sigma
 
-    with FmuInstance(build_fmu(building, workdir / "model_before.fmu", kind=fmu_kind)) as base:
-        before_run = simulate_fmu(base, case, output_ids=objective.air_nodes)
-    before = {"calibration": objective.metrics(scored, before_run[:k]),
-              "validation": objective.metrics(measured[k:], before_run[k:])}
-    model = Model(building, before_run, before)
+    bases = [protocol(building, r) for r in records]
+    before_runs = []
+    for i, (case, base) in enumerate(zip(windows.cases, bases)):
+        name = "model_before.fmu" if base is None else f"model_before_{i + 1}.fmu"
+        with FmuInstance(build_fmu(base or building, workdir / name, kind=fmu_kind)) as fmu:
+            before_runs.append(simulate_fmu(fmu, case, output_ids=objective.air_nodes))
+    before = windows.metrics(objective, before_runs)
+    model = Model(building, before_runs, before, bases)
 
     convergence = []
-    localization = locate(building, calibration, objective, workdir, source=source, seed=seed,
-                          workers=workers, population=population, generations=generations, fmu_kind=fmu_kind,
-                          noise=noise.sigma if noise.given else None,
+    localization = locate(building, windows.calibrations[0], objective, workdir, source=records[0].source,
+                          seed=seed, workers=workers, population=population, generations=generations,
+                          fmu_kind=fmu_kind, noise=noise.sigma if noise.given else None,
                           progress=lambda generation, total, J, unique: convergence.append((generation, J)))
 
     folder = workdir / "candidates"
     folder.mkdir(exist_ok=True)
+    k0, scored0 = windows.ks[0], windows.measured[0][:windows.ks[0]]
 
     def left_by(model):
-        """What the model's residual on the calibration window follows (an input, the time of day)."""
+        """What the model's residual on the first record's calibration window follows (an input,
+        the time of day)."""
         shaped = shaped_inputs(model.building)
-        inputs = {name: values for name, values in zip(case.input_names, case.U[1:k + 1].T) if name in shaped}
-        return residual_diagnostics(calibration.times[1:], scored[:, 0] - model.run[:k, 0], inputs)
+        inputs = {name: values for name, values in zip(first.input_names, first.U[1:k0 + 1].T) if name in shaped}
+        return residual_diagnostics(windows.calibrations[0].times[1:], scored0[:, 0] - model.runs[0][:k0, 0], inputs)
 
     def assessed(model, pairs, number):
         # a later round's candidates, on top of the earlier choices, are building files of their own
         into = folder / f"round{number + 1}" if number else folder
         into.mkdir(exist_ok=True)
-        return assess_all(model, pairs, calibration, case, objective, into, seed, workers, masks)
+        return assess_all(model, pairs, windows, objective, into, seed, workers)
 
+    measured_ids = sorted({i for case in windows.cases for i in case.measured_ids})
     added, rounds, results, runs, sensitivities = [], [], [], {}, {}
     for number in range(MAX_ROUNDS):
-        base_blocks = block_J(scored - model.run[:k], masks)
+        base_blocks = windows.block_J(model.runs)
         if number and at_noise(base_blocks.sum(), n, sigma):
             break  # the error left is the noise's
         done = {label(a) for a in added}
         started = time.perf_counter()
         pairs = [p for p in physical(model.building, localization["components"], objective.zones,
-                                     case.measured_ids, localization["best_nodes"]) if "@".join(p) not in done]
-        tried, models, screened, simulations = assessed(model, pairs, number)
+                                     measured_ids, localization["best_nodes"]) if "@".join(p) not in done]
+        tried, models, simulations = assessed(model, pairs, number)
         # shapes only where no physical candidate physics admits brings the error left to the
         # noise; the residual's statistics then choose which
         if not any(at_noise(r["cv"]["J"], n, sigma) and not objection(model.building, r["effect"], r["target"],
                                                                       r["parameters"], r["derived"]) for r in tried):
             pairs = [p for p in shapes(model.building, left_by(model), objective.zones) if "@".join(p) not in done]
-            more, more_models, more_screened, more_simulations = assessed(model, pairs, number)
+            more, more_models, more_simulations = assessed(model, pairs, number)
             tried, simulations = tried + more, simulations + more_simulations
             models.update(more_models)
-            screened.update(more_screened)
-        chosen, decision = decide(model.building, tried, base_blocks, sigma, n)
+        chosen, decision = decide(model.building, tried, base_blocks, sigma, n, windows.groups())
         decision["cost"] = {"candidates": len(tried), "simulations": simulations,
                             "seconds": round(time.perf_counter() - started, 1)}
         rounds.append(decision)
         on_top = {"on_top_of": [label(a) for a in added]} if added else {}
         results += [{**r, "round": number + 1, **on_top} for r in tried]
-        runs.update({(key if not added else f"{key} (round {number + 1})"): m.run for key, m in models.items()})
-        sensitivities.update(screened)
+        runs.update({(key if not added else f"{key} (round {number + 1})"): m.runs for key, m in models.items()})
         if not chosen:
             break
+        # the Morris screening of the chosen effect's parameters, on the model it is added to: a
+        # screening of every candidate would cost a quarter of a round's simulations
+        screened = Candidate(model.building, chosen["effect"], chosen["target"],
+                             protocols(model.bases, windows.calibrations))
+        sensitivities[label(chosen)] = sensitivity(screened, windows.calibrations, objective, seed=seed)
         added.append(chosen)
         model = models[label(chosen)]
 
@@ -233,34 +325,37 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
                 "reason": " ".join(f"Round {i + 1}: {d['reason']}" if len(rounds) > 1 else d["reason"]
                                    for i, d in enumerate(rounds)),
                 "rounds": rounds, "structure_left": left["sentence"]}
-    after_building, after_run, after = model.building, model.run, model.metrics
+    after_building, after_runs, after = model.building, model.runs, model.metrics
     effect = ({key: added[-1][key] for key in ("effect", "target", "parameters", "derived")} if added
               else {"effect": "none", "target": None, "parameters": {}})
     (workdir / "building_after.json").write_text(json.dumps(after_building.to_json(), indent=2) + "\n")
     fmu_after = build_fmu(after_building, workdir / "model_after.fmu", kind=fmu_kind)
+    # a record under another protocol: its own building as corrected, for `nodeforce compare`
+    protocols_after = {i: workdir / f"building_after_record{i + 1}.json" for i, b in enumerate(model.bases) if b is not None}
+    for i, path in protocols_after.items():
+        path.write_text(json.dumps(model.bases[i].to_json(), indent=2) + "\n")
 
-    times = case.times
-    by_phase = phase_errors(phases or (), times[1:], measured, {"before": before_run, **runs, "after": after_run})
+    # every record's phases, each named with its record's name where there are several
+    by_phase = []
+    for i, (record, case) in enumerate(zip(records, windows.cases)):
+        rows = phase_errors(record.phases, case.times[1:], windows.measured[i],
+                            {"before": before_runs[i], **{key: r[i] for key, r in runs.items()}, "after": after_runs[i]})
+        by_phase += [{**row, "phase": f"{record.name}: {row['phase']}", "record": record.name}
+                     if len(records) > 1 else row for row in rows]
     if by_phase and added:
         decision["worsened_phases"] = worsened(by_phase, "before", "after")
         if decision["worsened_phases"]:
             decision["reason"] += (" It lowers the total error but makes the phase " + "; ".join(
                 f"{w['phase']} worse ({w['before']:.3f} C -> {w['after']:.3f} C)" for w in decision["worsened_phases"])
                 + ", which the total hides.")
+    times, k, measured = first.times, k0, windows.measured[0]
     validation = slice(k, None)
-    residuals = {state: residual_diagnostics(times[1:][validation], measured[validation, 0] - run[validation, 0],
+    residuals = {state: residual_diagnostics(times[1:][validation], measured[validation, 0] - run[0][validation, 0],
                                              {name: values[validation] for name, values in
-                                              zip(case.input_names, case.U[1:].T)})
-                 for state, run in (("before", before_run), ("after", after_run))}
+                                              zip(first.input_names, first.U[1:].T)})
+                 for state, run in (("before", before_runs), ("after", after_runs))}
     report = {
-        "period": {"calibration": [times[0].isoformat(), times[k].isoformat()],
-                   "calibration_scored_from": times[case.burn_in_steps + 1].isoformat(),
-                   "validation": [times[k + 1].isoformat(), times[-1].isoformat()],
-                   "blocks": [[times[1:k + 1][m][0].isoformat(), times[1:k + 1][m][-1].isoformat()] for m in masks],
-                   "roles": {"calibration": "the forcing search and the candidates' fits read it; each of its "
-                                            "blocks of whole days ('blocks') is left out of a fit in turn and "
-                                            "predicted, and the choice is made on those predictions",
-                             "validation": "reports before and after only; no part in any choice"}},
+        "period": period(windows, 0),
         "objective": list(objective.zones),
         "before": before,
         "localization": localization,
@@ -270,7 +365,7 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
         "effect": effect,
         "after": after,
         "heat_loss_coefficient": heat_loss(building, after_building, added, results, sigma),
-        "assumptions": list(case.assumptions),
+        "assumptions": list(dict.fromkeys(a for case in windows.cases for a in case.assumptions)),
         "residuals": residuals,
         "sensitivity": sensitivities,
         "noise_sigma": sigma,
@@ -278,21 +373,56 @@ def diagnose(building, case, objective, workdir, *, source="measurements", fract
         "node_names": {str(i): name for i, name in building.node_names().items()},
         "artifacts": {"building_after": str(workdir / "building_after.json"), "fmu_after": str(fmu_after)},
     }
+    if len(records) > 1:
+        report["records"] = [{"name": r.name, "measurements": str(r.source), "period": period(windows, i),
+                              "before": windows.metrics(objective, before_runs, i),
+                              "after": windows.metrics(objective, after_runs, i),
+                              **({"building_after": str(protocols_after[i])} if i in protocols_after else {})}
+                             for i, r in enumerate(records)]
     if reference:
         report["reference"] = reference
     if by_phase:
         report["phases"] = by_phase
-    series = {"times": times[1:], "validation_start": times[k + 1], "scored_from": times[case.burn_in_steps + 1],
+    series = {"times": times[1:], "validation_start": times[k + 1], "scored_from": times[first.burn_in_steps + 1],
               "convergence": convergence,
-              "zones": {zone: {"air_node": air, "measured": measured[:, j], "before": before_run[:, j],
-                               "after": after_run[:, j]}
+              "zones": {zone: {"air_node": air, "measured": measured[:, j], "before": before_runs[0][:, j],
+                               "after": after_runs[0][:, j]}
                         for j, (zone, air) in enumerate(zip(objective.zones, objective.air_nodes))},
-              "inputs": dict(zip(case.input_names, case.U[1:].T))}
+              "inputs": dict(zip(first.input_names, first.U[1:].T))}
     plots = write_report(workdir, report, series)
     report["artifacts"]["plots"] = [str(p) for p in plots]
     report["artifacts"]["report"] = str(workdir / "report.md")
     (workdir / "report.json").write_text(json.dumps(report, indent=2, default=_plain) + "\n")
     return report
+
+
+def protocol(building, record):
+    """The record's own building (its protocol's), None where it is `building`; InputError naming
+    its file where it is not the same house node for node."""
+    other = record.building if record.building is not None else record.case.building
+    if other is None or other is building or other.to_json() == building.to_json():
+        return None
+    for what, of in (("zones", lambda b: [z.name for z in b.zones]),
+                     ("components", lambda b: [c.name for c in b.components]),
+                     ("nodes", lambda b: b.n_nodes)):
+        if of(other) != of(building):
+            raise InputError(other.source, what, f"record {record.name}'s building is not {building.source}'s house "
+                                                 f"under another protocol: its {what} differ")
+    return other
+
+
+def period(windows, i):
+    """The calibration and validation spans of record i, where its scoring starts and its blocks."""
+    times, k, case = windows.cases[i].times, windows.ks[i], windows.cases[i]
+    return {"calibration": [times[0].isoformat(), times[k].isoformat()],
+            "calibration_scored_from": times[case.burn_in_steps + 1].isoformat(),
+            "validation": [times[k + 1].isoformat(), times[-1].isoformat()],
+            "blocks": [[times[1:k + 1][m][0].isoformat(), times[1:k + 1][m][-1].isoformat()]
+                       for j, m in windows.blocks if j == i],
+            "roles": {"calibration": "the forcing search and the candidates' fits read it; each of its "
+                                     "blocks of whole days ('blocks') is left out of a fit in turn and "
+                                     "predicted, and the choice is made on those predictions",
+                      "validation": "reports before and after only; no part in any choice"}}
 
 
 def _plain(value):

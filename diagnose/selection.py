@@ -32,8 +32,12 @@ to, block by block:
 The validation window plays no part. A model built by earlier rounds is the baseline a later
 round's candidate must pass against (its parameters held).
 
-Several records of one building would add their days to the blocks and their residuals to the
-sums; nothing here depends on the blocks coming from one record.
+Several records of one building add their days to the blocks and their residuals to the sums;
+nothing above depends on the blocks coming from one record. One objection is theirs: a candidate
+that helps the records together but harms one of them, its cross-validated fall on that record's
+blocks below minus the same yardstick (the noise's tolerance of that record's J, and one standard
+error of that record's per-block falls), is a correction of the house that does not hold on every
+record of it: it is refused, with the record named (`harmed`).
 """
 import math
 
@@ -89,7 +93,29 @@ def fall(base, scores):
     return float(d.sum()), float(math.sqrt(len(d)) * d.std(ddof=1))
 
 
-def decide(building, results, base, sigma, n):
+def harmed(base, scores, sigma, groups):
+    """The records a candidate harms: those on whose blocks its cross-validated J rises by more
+    than the noise's tolerance of that record's J and one standard error of its per-block falls;
+    [{"record", "cv_fall", "needed"}] (C2).
+
+    Parameters
+    ----------
+    base, scores : per-block J (C2) of the model without and with the candidate
+    sigma : the air sensors' noise sd (C)
+    groups : [{"record": name, "blocks": indices into base, "n": residuals they score}]
+    """
+    base, scores = np.asarray(base, dtype=float), np.asarray(scores, dtype=float)
+    out = []
+    for group in groups:
+        rows = np.asarray(group["blocks"], dtype=int)
+        down, se = fall(base[rows], scores[rows]) if len(rows) > 1 else (float((base[rows] - scores[rows]).sum()), 0.0)
+        needed = max(tolerance(float(base[rows].sum()), sigma, group["n"]), STANDARD_ERRORS * se)
+        if down < -needed:
+            out.append({"record": group["record"], "cv_fall": down, "needed": needed})
+    return out
+
+
+def decide(building, results, base, sigma, n, groups=()):
     """The decision record of one round (module docstring): the chosen candidate (or None), each
     candidate's test, the candidates the data support but physics refuses (suggestions), those
     the data cannot tell from the chosen, and the reason in words.
@@ -101,6 +127,7 @@ def decide(building, results, base, sigma, n):
     base : per-block J (C2) of the model without them
     sigma : the air sensors' noise sd (C)
     n : residuals the blocks score
+    groups : the records the blocks come from (`harmed`), where there are several
     """
     base = np.asarray(base, dtype=float)
     margin = tolerance(float(base.sum()), sigma, n)
@@ -110,10 +137,15 @@ def decide(building, results, base, sigma, n):
         needed = max(margin, STANDARD_ERRORS * se)
         # the other days than its best must gain too: one day alone is no evidence
         others = down - float(np.max(base - np.asarray(r["cv"]["blocks"])))
+        harms = harmed(base, r["cv"]["blocks"], sigma, groups)
+        said = objection(building, r["effect"], r["target"], r["parameters"], r.get("derived"))
+        if harms:
+            said = "; ".join(filter(None, [said, "it helps the records together but harms " + "; ".join(
+                f"{h['record']} (its cross-validated J there rises by {-h['cv_fall']:.3g} C2, beyond the "
+                f"{h['needed']:.3g} C2 the noise and the day-to-day scatter could make)" for h in harms)
+                + ": a correction of the building must hold on every record of it"]))
         tests[label(r)] = {"cv_fall": down, "cv_se": se, "needed": needed, "other_days": others,
-                           "passes": bool(down > needed and others > 0),
-                           "objection": objection(building, r["effect"], r["target"], r["parameters"],
-                                                  r.get("derived"))}
+                           "passes": bool(down > needed and others > 0), "harms": harms, "objection": said}
     passing = [r for r in results if tests[label(r)]["passes"]]
     admissible = [r for r in passing if not tests[label(r)]["objection"]]
     suggestions = [{"candidate": label(r), "reason": tests[label(r)]["objection"], "cv_rmse": r["cv"]["rmse"]}
@@ -149,7 +181,7 @@ def _reason(chosen, alike, results, passing, base, n, tests, margin, components)
         return (f"None of the {len(results)} candidates lowers the cross-validated J ({base.sum():.3g} C2 over "
                 f"{B} days) by more than the noise could ({margin:.3g} C2) and {STANDARD_ERRORS:g} standard error of "
                 f"its fall from day to day, on more days than one"
-                + (f" ({len(passing)} do, and physics refuses each)" if passing else "") + ": no effect is added.")
+                + (f" ({len(passing)} do, and physics or a record they harm refuses each)" if passing else "") + ": no effect is added.")
     what = (f"an unexplained heat source, acting {acting(chosen)} ({chosen['effect']} on {chosen['target']})"
             if is_shape(chosen["effect"]) else f"{chosen['effect']} on {chosen['target']}")
     test = tests[label(chosen)]

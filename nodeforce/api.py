@@ -25,7 +25,11 @@ from nodeforce.model.score import Objective
 
 __all__ = ["InputError", "read_building", "read_weather", "read_measurements", "read_phases", "measured_case",
            "objective", "simulate", "write_fmu", "open_fmu", "simulate_fmu", "forcing_candidates",
-           "score_forcing", "locate", "diagnose", "compare"]
+           "score_forcing", "locate", "diagnose", "Record", "compare"]
+
+# One record of a building among several in one diagnosis: case, source, name, fraction,
+# calibration_end, phases (diagnose.loop.Record).
+Record = _loop.Record
 
 # The API's cases carry no file name: errors about their measurements say "measurements".
 SOURCE = "measurements"
@@ -207,14 +211,18 @@ def diagnose(building, case, workdir, objective=None, **options):
     ----------
     building : Building
     case : Case from `measured_case`, with measurements (its burn-in is `diagnose`'s; the command
-        line's default is one day)
+        line's default is one day); or a list of `Record`s, several records of the same building
+        (each its case, name, calibration window and phases): the fits minimise the sum of their
+        calibration windows' J, the choice reads every record's days, and a correction that
+        harms one record is refused
     workdir : str or Path
         Folder for report.json, report.md, the plots, building_after.json and model_after.fmu.
     objective : Objective, optional
         Default: the building's first zone.
     **options
-        `nodeforce.diagnose.loop.diagnose`'s: fraction, calibration_end (a pandas Timestamp),
-        seed, workers, fmu_kind, noise, phases (from `read_phases`), reference. Worker
+        `nodeforce.diagnose.loop.diagnose`'s: fraction, calibration_end (a pandas Timestamp) and
+        phases (from `read_phases`) of a single case (a `Record` carries its own), seed, workers,
+        fmu_kind, noise, reference. Worker
         processes as for `locate`.
 
     Returns

@@ -205,21 +205,96 @@ def cmd_synth(args):
           f"noise {args.noise} C" + (f", with {' and '.join(args.effect)} not in {args.building}" if args.effect else ""))
 
 
-def run_diagnosis(building, case, objective, out, source, args):
+def run_diagnosis(building, records, objective, out, args):
+    """The loop on `records` (diagnose.loop.Record), its summary printed."""
     from nodeforce.diagnose.loop import diagnose
-    from nodeforce.iotools.phases import read_phases
     from nodeforce.diagnose.report import terminal_summary
-    if not 0.0 < args.calibration_fraction < 1.0:
-        raise InputError("--calibration-fraction", args.calibration_fraction, "a fraction between 0 and 1")
-    end = instant("--calibration-end", args.calibration_end) if args.calibration_end else None
     check_workers(args)
     out.mkdir(parents=True, exist_ok=True)
-    report = diagnose(building, case, objective, out, source=source, fraction=args.calibration_fraction,
-                      calibration_end=end, seed=args.seed, workers=args.workers, fmu_kind=kind_of(args),
-                      reference=read_reference(args.reference) if args.reference else None, noise=noise(args),
-                      phases=read_phases(args.phases) if args.phases else None)
+    report = diagnose(building, records, objective, out, seed=args.seed, workers=args.workers, fmu_kind=kind_of(args),
+                      reference=read_reference(args.reference) if args.reference else None, noise=noise(args))
     print(terminal_summary(report))
     print(f"wrote {out / 'report.json'}, {out / 'report.md'}, {out / 'building_after.json'}, {out / 'model_after.fmu'}")
+
+
+def check_fraction(option, fraction):
+    if not 0.0 < fraction < 1.0:
+        raise InputError(option, fraction, "a fraction between 0 and 1")
+    return fraction
+
+
+def the_record(case, source, args):
+    """The diagnosis' one record of --weather, --measurements and the window options."""
+    from nodeforce.diagnose.loop import Record
+    from nodeforce.iotools.phases import read_phases
+    return Record(case, source, str(source), check_fraction("--calibration-fraction", args.calibration_fraction),
+                  instant("--calibration-end", args.calibration_end) if args.calibration_end else None,
+                  tuple(read_phases(args.phases)) if args.phases else ())
+
+
+# The fields of --record: each a file or a window of one record; those not given take the option
+# of the same name.
+RECORD_FIELDS = ("name", "building", "weather", "measurements", "calibration-end", "calibration-fraction", "phases",
+                 "burn-in-days")
+
+
+def record_fields(text):
+    """{field: value} of one --record, "weather=W,measurements=M,calibration-end=T,..."."""
+    fields = {}
+    for part in (p for p in text.split(",") if p.strip()):
+        key, equals, value = part.partition("=")
+        key = key.strip()
+        if not equals or not value.strip():
+            raise InputError("--record", part, "must read FIELD=VALUE (fields: " + ", ".join(RECORD_FIELDS) + ")")
+        if key not in RECORD_FIELDS:
+            raise InputError("--record", key, "no such field; the fields are " + ", ".join(RECORD_FIELDS))
+        if key in fields:
+            raise InputError("--record", key, f"given twice in {text!r}")
+        fields[key] = value.strip()
+    for key in ("weather", "measurements"):
+        if key not in fields:
+            raise InputError("--record", key, f"missing in {text!r}: every record names its weather and measurements")
+    return fields
+
+
+def records_of(building, args):
+    """The records of a diagnosis: each --record, or the one of --weather and --measurements."""
+    from nodeforce.diagnose.loop import Record
+    from nodeforce.iotools.phases import read_phases
+    if not args.record:
+        if not (args.weather and args.measurements):
+            raise InputError("--weather", args.weather or "", "diagnose needs --weather and --measurements, "
+                                                              "or one --record per record")
+        case = measured_case(building, read_weather(args.weather), read_measurements(args.measurements),
+                             args.burn_in_days, args.decomposition)
+        for said in case.assumptions:
+            print(f"assumed: {said}")
+        return [the_record(case, args.measurements, args)]
+    if args.weather or args.measurements:
+        raise InputError("--record", "weather", "give each record's weather and measurements in its --record, "
+                                                "not --weather or --measurements beside them")
+    records = []
+    for text in args.record:
+        f = record_fields(text)
+        try:
+            burn_in = float(f.get("burn-in-days", args.burn_in_days))
+            fraction = float(f.get("calibration-fraction", args.calibration_fraction))
+        except ValueError:
+            raise InputError("--record", "burn-in-days", f"a number of days, and calibration-fraction a number, "
+                                                         f"in {text!r}") from None
+        # a record run under another protocol (other flows, other blinds) reads the house as written for it
+        own = load_building(f["building"]) if "building" in f else building
+        case = measured_case(own, read_weather(f["weather"]), read_measurements(f["measurements"]), burn_in,
+                             args.decomposition)
+        end = f.get("calibration-end", args.calibration_end)
+        phases = f.get("phases", args.phases)
+        records.append(Record(case, f["measurements"], f.get("name", Path(f["measurements"]).name.split(".")[0]),
+                              check_fraction("--record calibration-fraction", fraction),
+                              instant("--record calibration-end", end) if end else None,
+                              tuple(read_phases(phases)) if phases else (), own))
+    for said in dict.fromkeys(a for r in records for a in r.case.assumptions):
+        print(f"assumed: {said}")
+    return records
 
 
 def read_reference(path):
@@ -237,8 +312,10 @@ def read_reference(path):
 
 
 def cmd_diagnose(args):
-    building, case, objective = load_inputs(args)
-    run_diagnosis(building, case, objective, Path(args.output), args.measurements, args)
+    building = load_building(args.building)
+    records = records_of(building, args)
+    objective = Objective.of(building, zone_list(args.objective) if args.objective else None)
+    run_diagnosis(building, records, objective, Path(args.output), args)
 
 
 def cmd_compare(args):
@@ -282,8 +359,8 @@ def cmd_demo(args):
     case = prepare_case(building, read_weather(DATA / "miami_tmy2.csv"), read_measurements(measurements_path))
     print(f"{building.name}: measurements {measurements_path.name} carry an effect the building file does "
           f"not declare (made by: {DEMO_COMMAND})")
-    run_diagnosis(building, case.with_burn_in(args.burn_in_days), Objective.of(building), Path(args.output),
-                  str(measurements_path), args)
+    run_diagnosis(building, [the_record(case.with_burn_in(args.burn_in_days), measurements_path, args)],
+                  Objective.of(building), Path(args.output), args)
 
 
 def case_arguments(s, measurements_required, output_help, output_default=None):
@@ -401,7 +478,15 @@ def parser():
     s.set_defaults(run=cmd_locate)
 
     s = sub.add_parser("diagnose", help="localise, add the missing effect, calibrate, report before/after")
-    case_arguments(s, True, "folder for report.json, report.md, building_after.json")
+    s.add_argument("building")
+    s.add_argument("--weather")
+    s.add_argument("--measurements")
+    s.add_argument("--record", action="append",
+                   help="one record of the building, instead of --weather and --measurements; repeat it for "
+                        "several: weather=W,measurements=M[,name=N][,calibration-end=T][,calibration-fraction=F]"
+                        "[,phases=P][,burn-in-days=D] (a field not given takes the option of its name)")
+    s.add_argument("-o", "--output", required=True, help="folder for report.json, report.md, building_after.json")
+    decomposition_argument(s)
     diagnosis_arguments(s)
     objective_argument(s)
     s.set_defaults(run=cmd_diagnose)

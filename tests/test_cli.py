@@ -235,3 +235,45 @@ def test_a_reference_without_rmse_figures_is_a_one_line_error(files, capsys):
                             "--measurements", str(files["measurements"]), "-o", str(files["dir"] / "d"),
                             "--reference", str(bad)])
     assert err.startswith(f"nodeforce: {bad}: rmse:")
+
+
+def test_bad_records_stop_with_one_line_naming_the_field(files, capsys, tmp_path):
+    b, w, m = str(files["building"]), str(files["weather"]), str(files["measurements"])
+    base = ["diagnose", b, "-o", str(tmp_path / "out")]
+    err = error_of(capsys, base + ["--record", f"weather={w},measurements={m},colour=blue"])
+    assert "--record: colour: no such field" in err
+    err = error_of(capsys, base + ["--record", f"weather={w}"])
+    assert "--record: measurements: missing" in err
+    err = error_of(capsys, base + ["--record", f"weather={w},measurements={m},weather={w}"])
+    assert "--record: weather: given twice" in err
+    err = error_of(capsys, base + ["--weather", w, "--record", f"weather={w},measurements={m}"])
+    assert err.startswith("nodeforce: --record: weather:")
+    err = error_of(capsys, base + ["--record", f"weather={w},measurements={m},burn-in-days=two"])
+    assert "--record: burn-in-days:" in err
+    err = error_of(capsys, base)
+    assert "--weather and --measurements, or one --record per record" in err
+    # two records under one name
+    err = error_of(capsys, base + ["--record", f"weather={w},measurements={m},name=a"] * 2)
+    assert "name: two records are named 'a'" in err
+
+
+def test_two_records_on_the_command_line_find_the_demos_ground_coupling(tmp_path, capsys):
+    """The demo's fortnight cut into two weeks, each a --record with its own window: one
+    diagnosis of both finds the floor's coupling to the ground, reports before and after per
+    record and pools the cross-validation's days of both."""
+    measured = pd.read_csv(DATA / "demo_measurements.csv")
+    for half, rows in (("first", measured.iloc[:673]), ("second", measured.iloc[672:])):
+        rows.to_csv(tmp_path / f"{half}.csv", index=False)
+    out = tmp_path / "out"
+    records = [f"name={half},weather={DATA / 'miami_tmy2.csv'},measurements={tmp_path / f'{half}.csv'}"
+               for half in ("first", "second")]
+    assert main(["diagnose", str(DATA / "testcell_miami.json"), "-o", str(out), "--workers", "1",
+                 "--record", records[0], "--record", records[1] + ",calibration-fraction=0.7"]) == 0
+    report = json.loads((out / "report.json").read_text())
+    assert (report["effect"]["effect"], report["effect"]["target"]) == ("ground_coupling", "floor")
+    assert [r["name"] for r in report["records"]] == ["first", "second"]
+    # 7 days: 1 of burn-in, then 0.6 x 7 = 4.2 days and 0.7 x 7 = 4.9 days of calibration: 3 whole days each
+    assert report["decision"]["blocks"] == 3 + 3
+    for r in report["records"]:
+        assert r["after"]["validation"]["rmse"] < 0.6 * r["before"]["validation"]["rmse"]
+    assert "The 2 records apart" in (out / "report.md").read_text()

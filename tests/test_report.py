@@ -372,3 +372,16 @@ def test_the_decision_says_each_refusal_reason_once(tmp_path):
             "of its range: ground_coupling@floor (U = 0.52 +- 0.9 W/m2/K; T_ground = 24.3 C)") in decision
     for candidate, _ in gains + other:
         assert decision.count(candidate) == 1
+
+
+def test_the_phases_table_of_a_whole_house_keeps_the_chosen_candidates():
+    """Beyond PHASE_COLUMNS candidates (a house of seven rooms tries 163) the table shows before,
+    each round's chosen candidate and after; report.json keeps them all."""
+    from nodeforce.diagnose.report import tables
+    labels = [f"conductivity@W{i}" for i in range(tables.PHASE_COLUMNS + 2)]
+    rmse = {"before": 1.0, **{label: 0.9 for label in labels}, "gain@x (round 2)": 0.5, "after": 0.5}
+    report = {"phases": [{"phase": "free float", "start": "2014-04-17T07:30:00+01:00", "end": None, "n": 10,
+                          "rmse": rmse}],
+              "decision": {"rounds": [{"chosen": "conductivity@W3"}, {"chosen": "gain@x"}]}}
+    header = tables.phases(report).splitlines()[0]
+    assert header == "| phase | from | n | before | conductivity@W3 | gain@x (round 2) | after |"

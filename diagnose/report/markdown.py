@@ -99,6 +99,8 @@ def write_markdown(out_dir, report, plots, notes):
     search = (report.get("localization") or {}).get("search") or {}
     period = report.get("period") or {}
     ref = tables.reference_text(report)
+    first_record = (f" of the first record ({report['records'][0]['name']}: the forcing search reads it, the plots "
+                    "show it)" if report.get("records") else "")
     md = ["# nodeforce diagnosis report", "", *[_bold_label(line) + "  " for line in summary.first_screen(report, pm="±")],
           "", "From the residual of the indoor air, to the nodes whose forcing explains it, to a physical "
           "effect the model lacks, added and calibrated on the calibration window and chosen by "
@@ -109,22 +111,32 @@ def write_markdown(out_dir, report, plots, notes):
           "## Decision", "", *decision_lines(report), "",
           "## Period", "",
           f"- objective zones: {', '.join(content.zones(report)) or NA}",
-          f"- calibration: {content.period_text(report, 'calibration')}{content.scored_from_note(report)}",
+          f"- calibration{first_record}: {content.period_text(report, 'calibration')}{content.scored_from_note(report)}",
           *([f"- cross-validation blocks (each left out of a fit in turn): {len(period['blocks'])} whole days"]
             if period.get("blocks") else []),
           f"- validation (before and after only, no part in any choice): {content.period_text(report, 'validation')}"]
+    if report.get("records"):
+        md += [f"- record {r['name']} ({r['measurements']}): calibration {content.period_text(r, 'calibration')}, "
+               f"{len(r['period']['blocks'])} blocks; validation {content.period_text(r, 'validation')}"
+               for r in report["records"]]
     if (report.get("noise") or {}).get("sentence"):
         md.append(f"- {report['noise']['sentence']}")
     md += ["", "## Before and after", "",
            "Residual r = T_air measured - T_air simulated (a positive mean: the model is too cold); "
            "mean and standard deviation as in the paper's Table 5, with RMSE, J = Σ r² and n the "
            "number of measured steps.", "", tables.before_after(report), ""]
+    per_record = tables.records(report)
+    if per_record:
+        md += [f"The {len(report['records'])} records apart (the table above pools them; the plots show the "
+               "first record):", "", per_record, ""]
     if ref:
         md += [f"For scale, the {ref}.", ""]
     by_phase = tables.phases(report)
     if by_phase:
         md += ["RMSE (C) of the objective's air in each phase of the record, over both windows (the "
-               f"calibration fitted the first): ▲ marks a phase made worse than before by {WORSE:.0%} or more.", "",
+               f"calibration fitted the first): ▲ marks a phase made worse than before by {WORSE:.0%} or more"
+               + (f"; the chosen candidates only, every candidate's in report.json" if len(
+                   report["phases"][0]["rmse"]) > tables.PHASE_COLUMNS else "") + ".", "",
                by_phase, ""]
     md += figure("temperature", "Measured and simulated indoor air temperature, before and after")
     md += figure("residuals", "Air residual before and after, mean and sd per window")

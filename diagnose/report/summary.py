@@ -100,7 +100,8 @@ def error_line(report):
     b, a = (metrics(report, state, "validation") for state in content.STATES)
     return (f"Validation: RMSE {_change(b.get('rmse'), a.get('rmse'))}, mean error "
             f"{_change(b.get('mean'), a.get('mean'), signed=True)} (measured - simulated, "
-            f"{content.period_text(report, 'validation')})")
+            + (f"the validation windows of the {len(report['records'])} records together)" if report.get("records")
+               else f"{content.period_text(report, 'validation')})"))
 
 
 def hlc_line(report, pm):

@@ -219,6 +219,10 @@ def residual_diagnostics(report):
                      "follows most (input, lag, prewhitened r)", "daily profile (amplitude, peak)"], rows) if rows else ""
 
 
+# Columns of the phases table beyond which only the chosen candidates' are shown.
+PHASE_COLUMNS = 12
+
+
 def phases(report):
     """RMSE (C) of each phase of the record: before, every candidate, after; a value made worse
     than before by the loop's margin (diagnose.phases.WORSE) is marked ▲."""
@@ -226,6 +230,11 @@ def phases(report):
     if not rows:
         return ""
     labels = list(rows[0]["rmse"])
+    if len(labels) > PHASE_COLUMNS:
+        # a whole house tries a hundred candidates: the table keeps the chosen ones (report.json has all)
+        chosen = [r["chosen"] if i == 0 else f"{r['chosen']} (round {i + 1})"
+                  for i, r in enumerate((report.get("decision") or {}).get("rounds") or []) if r.get("chosen")]
+        labels = [label for label in labels if label in ("before", "after") or label in chosen]
 
     def cell(row, label):
         value, before = num(row["rmse"].get(label)), num(row["rmse"].get("before"))
@@ -233,3 +242,16 @@ def phases(report):
     return markdown(["phase", "from", "n"] + labels,
                     [[row["phase"], time_text(row["start"]), fmt_int(row["n"])] + [cell(row, label) for label in labels]
                      for row in rows])
+
+
+def records(report):
+    """RMSE (C) before and after per record, window and zone, the objective's first, of a
+    diagnosis of several records; "" for one."""
+    rows = []
+    for record in report.get("records") or []:
+        for window in ("calibration", "validation"):
+            b, a = record["before"][window], record["after"][window]
+            rows.append([record["name"], window, "objective", fmt_temp(b["rmse"]), fmt_temp(a["rmse"]), fmt_int(b["n"])])
+            rows += [[record["name"], window, zone, fmt_temp(z["rmse"]), fmt_temp(a["zones"][zone]["rmse"]),
+                      fmt_int(z["n"])] for zone, z in b["zones"].items()] if len(b["zones"]) > 1 else []
+    return markdown(["record", "window", "zone", "RMSE before (C)", "RMSE after (C)", "n"], rows) if rows else ""

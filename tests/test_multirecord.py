@@ -1,0 +1,112 @@
+"""Several records of one building in one diagnosis: a fault that only one record shows is found
+from the two together, and a correction that helps one record and harms the other is refused,
+with the record named in report.json."""
+import numpy as np
+import pandas as pd
+import pytest
+
+from nodeforce.diagnose.loop import Record, diagnose
+from nodeforce.diagnose.selection import harmed
+from nodeforce.model.building import parse_building
+from nodeforce.model.case import Case
+from nodeforce.model.effects import EFFECTS
+from nodeforce.model.integrate import simulate
+from nodeforce.model.network import assemble
+from nodeforce.model.score import Objective
+
+from .test_zones import two_zones
+
+STEP = 1800.0  # s
+NOISE = 0.05  # C
+
+
+def house():
+    """Zones A (supply air) and B (a heater), each with one exterior wall."""
+    return parse_building(two_zones(heat_input="heater"))
+
+
+def record(truth, building, start, days, heater, seed):
+    """A record of both airs (C, NOISE of noise) of `truth` under a sunny spring weather, read with
+    the inputs of `building`, the file the diagnosis is given; `heater` (W) at each step, or None
+    for a PRBS of 0 / 600 W (a record with the heater off is a record where it reads 0)."""
+    rng = np.random.default_rng(seed)
+    n_rows = int(days * 86400 / STEP) + 1
+    times = pd.date_range(start, periods=n_rows, freq=pd.Timedelta(seconds=STEP), tz="+01:00", name="time")
+    hours = np.arange(n_rows) * STEP / 3600
+    day = np.sin(2 * np.pi * (hours - 9) / 24)
+    # the heater switches every 2 to 6 h, so its steps stand out from the day's cycle
+    switches = np.repeat(rng.choice([0.0, 600.0], n_rows), rng.integers(4, 13, n_rows))[:n_rows]
+    columns = {"T_out": 9 + 5 * day + rng.normal(0, 0.3, n_rows), "T_sky": -1 + 5 * day,
+               "I_wA": np.clip(400 * day, 0, None), "I_wB": np.clip(400 * day, 0, None),
+               "heater": switches if heater is None else np.full(n_rows, heater)}
+    net = assemble(building)
+    U = np.column_stack([columns[n] for n in net.input_names])
+    T = simulate(truth, assemble(truth, net.input_names), U, STEP, None, warmup_days=30, include_start=True)
+    measured = np.full((n_rows, net.n_nodes), np.nan)
+    air = [building.zone(z).air_node - 1 for z in ("A", "B")]
+    measured[:, air] = T[:, air] + rng.normal(0.0, NOISE, (n_rows, len(air)))
+    return Case(times, STEP, net.input_names, U, measured, building=building).with_burn_in(1)
+
+
+def test_harm_is_a_fall_below_minus_the_rules_yardstick_on_one_records_blocks():
+    """Hand-made per-block J: the candidate gains 4 C2 a day on record a's three days and loses
+    3 C2 a day on record b's two; b is harmed (a fall of -6 below minus max(tolerance, one
+    standard error) where the falls agree), a is not."""
+    base = [10.0, 10.0, 10.0, 5.0, 5.0]
+    scores = [6.0, 6.0, 6.0, 8.0, 8.0]
+    groups = [{"record": "a", "blocks": [0, 1, 2], "n": 144}, {"record": "b", "blocks": [3, 4], "n": 96}]
+    harms = harmed(base, scores, 0.01, groups)
+    assert [h["record"] for h in harms] == ["b"]
+    assert harms[0]["cv_fall"] == pytest.approx(-6.0)
+    # within the noise: a rise of 0.001 C2 on b is no harm
+    assert harmed(base, [6.0, 6.0, 6.0, 5.0005, 5.0005], 0.01, groups) == []
+
+
+@pytest.mark.slow  # a diagnosis of two records
+def test_a_fault_one_record_shows_is_found_from_both_records(tmp_path):
+    """The heater delivers 0.7 W per W read. Record one runs it (a PRBS), record two leaves it off:
+    only the first can show the fault, the second holds every other explanation to account. The
+    two together name the heater's factor and find its value."""
+    b = house()
+    truth = EFFECTS["heat_input_factor"].apply(b, "B", {"factor": 0.7})
+    on = record(truth, b, "2014-04-01", 6, None, seed=1)
+    off = record(truth, b, "2014-04-20", 5, 0.0, seed=2)
+    records = [Record(on, "on.csv", "heater on", calibration_end=on.times[0] + pd.Timedelta(days=4)),
+               Record(off, "off.csv", "heater off", calibration_end=off.times[0] + pd.Timedelta(days=3))]
+    report = diagnose(b, records, Objective.of(b, ["A", "B"]), tmp_path, workers=1, noise=NOISE)
+    assert [(e["effect"], e["target"]) for e in report["effects"]][:1] == [("heat_input_factor", "B")]
+    assert report["effects"][0]["parameters"]["factor"]["value"] == pytest.approx(0.7, abs=0.03)
+    # before and after per record, zone and window; the record without the heater was right already
+    by_name = {r["name"]: r for r in report["records"]}
+    assert set(by_name) == {"heater on", "heater off"}
+    heated = by_name["heater on"]
+    assert heated["after"]["validation"]["zones"]["B"]["rmse"] < 0.5 * heated["before"]["validation"]["zones"]["B"]["rmse"]
+    assert heated["after"]["validation"]["zones"]["B"]["rmse"] < 3 * NOISE
+    assert by_name["heater off"]["after"]["validation"]["rmse"] < 3 * NOISE
+    # the cross-validation's blocks are both records' days: 3 after the burn-in in the first, 2 in the second
+    assert report["decision"]["blocks"] == 5
+
+
+@pytest.mark.slow  # a diagnosis of two records
+def test_a_correction_that_helps_one_record_and_harms_the_other_is_refused(tmp_path):
+    """Record one was made with 120 W the file leaves out of zone B, record two without: the same
+    house cannot have both. Fitted to both, a constant gain helps the first and harms the second;
+    it is not added, and report.json gives that reason with the harmed record's name."""
+    b = house()
+    truth = EFFECTS["internal_gain"].apply(b, "B", {"Q": 120.0})
+    gained = record(truth, b, "2014-04-01", 7, 0.0, seed=3)
+    plain = record(b, b, "2014-04-20", 5, 0.0, seed=4)
+    records = [Record(gained, "gained.csv", "one", calibration_end=gained.times[0] + pd.Timedelta(days=5)),
+               Record(plain, "plain.csv", "two", calibration_end=plain.times[0] + pd.Timedelta(days=3))]
+    report = diagnose(b, records, Objective.of(b, ["A", "B"]), tmp_path, workers=1, noise=NOISE)
+    rounds = report["decision"]["rounds"]
+    tests = {name: t for r in rounds for name, t in r["candidates"].items()}
+    gain = tests["internal_gain@B"]
+    assert gain["passes"] and [h["record"] for h in gain["harms"]] == ["two"]
+    assert "harms two" in gain["objection"]
+    refused = {s["candidate"]: s["reason"] for r in rounds for s in r["suggestions"]}
+    assert "internal_gain@B" in refused and "harms two" in refused["internal_gain@B"]
+    # nothing added harms a record
+    added = [f"{e['effect']}@{e['target']}" for e in report["effects"]]
+    assert "internal_gain@B" not in added
+    assert all(not tests[a]["harms"] for a in added)
