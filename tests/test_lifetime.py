@@ -1,0 +1,30 @@
+"""Worker pools share the cores: each worker's BLAS threads are its share, unless the user chose."""
+import os
+
+from threadpoolctl import threadpool_info
+
+from nodeforce import lifetime
+
+
+def blas_threads():
+    """The worker's BLAS thread counts, after numpy has loaded its library."""
+    import numpy as np
+    np.linalg.inv(np.eye(3))
+    return sorted({lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas"})
+
+
+def test_each_worker_gets_its_share_of_the_cores_for_blas(monkeypatch):
+    for name in lifetime.THREAD_VARIABLES:
+        monkeypatch.delenv(name, raising=False)
+    workers = os.cpu_count()
+    with lifetime.worker_pool(workers) as pool:
+        assert pool.submit(blas_threads).result() == [1]
+    with lifetime.worker_pool(1) as pool:
+        # one worker alone has every core
+        assert pool.submit(blas_threads).result() == [os.cpu_count()]
+
+
+def test_a_thread_count_the_user_set_is_kept(monkeypatch):
+    monkeypatch.setenv("OPENBLAS_NUM_THREADS", "1")
+    with lifetime.worker_pool(1) as pool:
+        assert pool.submit(blas_threads).result() == [1]
