@@ -112,7 +112,8 @@ def diagnose_one(task):
             "loop": {"effects": [[e["effect"], e["target"]] for e in report.get("effects", [])],
                      "before": report["before"]["validation"]["rmse"], "after": report["after"]["validation"]["rmse"],
                      "hlc_before": hlc.get("before"), "hlc_after": hlc.get("after"), "seconds": seconds,
-                     "reason": report.get("decision", {}).get("reason")},
+                     "reason": report.get("decision", {}).get("reason"),
+                     "rounds": [rounded(d) for d in report.get("decision", {}).get("rounds", [])]},
             "baseline": {k: base[k] for k in ("effect", "target", "values", "delta_bic", "validation_rmse",
                                               "candidates", "seconds")},
             "hlc_truth": r.hlc_truth, "hlc_file": r.hlc_file, "generation_seconds": generated,
@@ -124,6 +125,17 @@ def diagnose_one(task):
     tmp.write_text(json.dumps(result, indent=1) + "\n")
     os.replace(tmp, path)
     return result
+
+
+def rounded(decision, kept=8):
+    """A round's decision as the benchmark keeps it, to see which step chose what: the chosen, the
+    cross-validated J before, and the `kept` candidates of lowest cross-validated J with their test."""
+    tests = decision.get("candidates", {})
+    best = sorted(tests, key=lambda k: -tests[k]["cv_fall"])[:kept]
+    return {"chosen": decision.get("chosen"), "cv_J_before": decision.get("cv_J_before"),
+            "needed_noise": decision.get("noise_margin"), "indistinct": decision.get("indistinct", []),
+            "best": {k: {key: tests[k][key] for key in ("cv_fall", "cv_se", "needed", "passes", "objection")}
+                     for k in best}}
 
 
 def run(tasks, workers):

@@ -262,10 +262,20 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
     model = Model(building, before_runs, before, bases)
 
     convergence = []
-    localization = locate(building, windows.calibrations[0], objective, workdir, source=records[0].source,
-                          seed=seed, workers=workers, population=population, generations=generations,
-                          fmu_kind=fmu_kind, noise=noise.sigma if noise.given else None,
-                          progress=lambda generation, total, J, unique: convergence.append((generation, J)))
+    search = dict(seed=seed, workers=workers, population=population, generations=generations, fmu_kind=fmu_kind,
+                  noise=noise.sigma if noise.given else None)
+    # the forcing search on every record's calibration window together: a forcing applies to all
+    localization = locate(building, windows.calibrations, objective, workdir, source=records[0].source,
+                          protocols=bases, progress=lambda generation, total, J, unique: convergence.append((generation, J)),
+                          **search)
+    # and on each record alone, reported: a record's own sensors (experiment 2's surfaces) may
+    # point where the records together do not
+    alone = []
+    for i, record in enumerate(records if len(records) > 1 else ()):
+        into = workdir / "locate" / record.name
+        into.mkdir(parents=True, exist_ok=True)
+        alone.append(locate(building, [windows.calibrations[i]], objective, into, source=record.source,
+                            protocols=[bases[i]], **search))
 
     folder = workdir / "candidates"
     folder.mkdir(exist_ok=True)
@@ -377,6 +387,7 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
         report["records"] = [{"name": r.name, "measurements": str(r.source), "period": period(windows, i),
                               "before": windows.metrics(objective, before_runs, i),
                               "after": windows.metrics(objective, after_runs, i),
+                              "localization": alone[i],
                               **({"building_after": str(protocols_after[i])} if i in protocols_after else {})}
                              for i, r in enumerate(records)]
     if reference:

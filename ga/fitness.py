@@ -3,7 +3,8 @@
 `FmuFitness` is the picklable factory `ga.search` sends to each worker; the worker calls it
 once, extracting and instantiating the FMU once, and then scores every chromosome it is given
 by resetting and re-running that one instance, warm-up included; `close()` frees it.
-`ModelFitness` scores the same J with the direct model (`model.integrate.simulate`, equal to the
+`RecordsFitness` sums J over several records of one building, each through its own FMU (a record
+run under another protocol has its own building file). `ModelFitness` scores the same J with the direct model (`model.integrate.simulate`, equal to the
 FMU within 1e-9 C) for studies that simulate many thousand masks: the patience measurement and
 the paper-mode comparisons (benchmarks/bench_search.py, tests).
 """
@@ -41,6 +42,45 @@ class FmuFitness:
 
     def __call__(self):
         return FmuEvaluator(self)
+
+
+class RecordsFitness:
+    """Factory of evaluators scoring a mask on several records of one building: the sum of each
+    record's J (`FmuFitness`, all over the same chromosome), each record's mask nodes forced where
+    that record measures them (a node a record does not measure stays computed there), and the
+    records' residuals stacked for the paired comparison.
+
+    Parameters
+    ----------
+    parts : FmuFitness of each record, their chromosome_nodes equal
+    """
+
+    keeps_residuals = True
+
+    def __init__(self, parts):
+        self.parts = list(parts)
+        self.chromosome_nodes = self.parts[0].chromosome_nodes
+        if any(not np.array_equal(p.chromosome_nodes, self.chromosome_nodes) for p in self.parts):
+            raise ValueError("the records of one search must share its chromosome")
+
+    def __call__(self):
+        return RecordsEvaluator([part() for part in self.parts])
+
+
+class RecordsEvaluator:
+    def __init__(self, evaluators):
+        self.evaluators = evaluators
+
+    def J(self, mask):
+        return sum(e.J(mask) for e in self.evaluators)
+
+    def residuals(self, mask):
+        """(sum of N_t, k) residuals (C) of the records in turn, NaN where not scored."""
+        return np.vstack([e.residuals(mask) for e in self.evaluators])
+
+    def close(self):
+        for e in self.evaluators:
+            e.close()
 
 
 class ModelFitness:

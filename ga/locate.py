@@ -14,7 +14,7 @@ from scipy.sparse.csgraph import shortest_path
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.checkpoint import NAME as CHECKPOINT
 from nodeforce.fmu_build.compiler import find_compiler
-from nodeforce.ga.fitness import FmuFitness
+from nodeforce.ga.fitness import FmuFitness, RecordsFitness
 from nodeforce.ga.parsimony import EXPLAINED, removed
 from nodeforce.ga.search import PATIENCE, search
 from nodeforce.model.errors import InputError
@@ -47,13 +47,17 @@ def links_to(network, nodes):
 def chromosome_nodes(building, case, objective, source, nodes=None, include_algebraic=False):
     """The nodes the search may force (ids), nearest the objective's air first, then by id.
 
+    `case` is a Case or the Cases of several records of the building: a node any of them
+    measures may be forced (where a record does not measure it, it stays computed there).
     The order is the search's preference between nodes whose scores the noise cannot separate:
     forcing a node nearer the zone cuts off more of the sub-model behind it (the inside surface
     isolates the whole component, a node deeper in cuts only the layers beyond).
     """
-    check_measured(objective, case, source)
+    cases = as_cases(case)
+    for c in cases:
+        check_measured(objective, c, source)
     network = assemble(building)
-    measured = set(case.measured_ids) - set(objective.air_nodes)
+    measured = set().union(*(c.measured_ids for c in cases)) - set(objective.air_nodes)
     if nodes is None:
         algebraic = set(np.flatnonzero(network.algebraic) + 1)
         chosen = measured if include_algebraic else measured - algebraic
@@ -68,34 +72,54 @@ def chromosome_nodes(building, case, objective, source, nodes=None, include_alge
     return sorted(chosen, key=lambda i: (distance[i - 1], i))
 
 
+def as_cases(case):
+    """A list of Cases from a Case or a sequence of them."""
+    return list(case) if isinstance(case, (list, tuple)) else [case]
+
+
 def locate(building, case, objective, workdir, *, source="measurements", nodes=None,
            include_algebraic=False, population=30, generations=400, pc=0.8, pm=0.03, seed=0,
            patience=PATIENCE, seeded=True, workers=None, scheduler=None, warmup_days=2, progress=None,
-           fmu_kind="python", noise=None):
+           fmu_kind="python", noise=None, protocols=None):
     """Run the forcing search on a case; return the content of locate.json.
 
-    The FMU (`model.fmu`) and the search's checkpoint (`locate.checkpoint.json`) are written in
+    `case` may be the Cases of several records of the building: J is then the sum of each
+    record's J, a forcing applied to every record (`ga.fitness.RecordsFitness`), and `protocols`
+    gives, per record, the building it runs under when that is not `building` (another
+    protocol's flows and blinds; None: `building`), each with its own FMU.
+    The FMU (`model.fmu`, `model_<k>.fmu` of the k-th record's own building) and the search's
+    checkpoint (`locate.checkpoint.json`) are written in
     `workdir`, so a run stopped midway and started again resumes. `progress` is called after
     every generation with (generation, total, best J, unique evaluations). `noise` is the air
-    sensors' noise sd (C) if the user knows it, else it is estimated (`model.score.Noise`). patience and seeded
+    sensors' noise sd (C) if the user knows it, else it is estimated (`model.score.Noise`) from
+    every record's air. patience and seeded
     choose the search (ga.search: the defaults stop at convergence; ga.search.PAPER's values
     give the paper's search). fmu_kind: "python", "standalone" (or their "-fmi3" kinds) or "auto"
     (`evaluator_kind`, FMI 2.0).
     """
-    candidates = chromosome_nodes(building, case, objective, source, nodes, include_algebraic)
+    cases = as_cases(case)
+    protocols = list(protocols) if protocols is not None else [None] * len(cases)
+    candidates = chromosome_nodes(building, cases, objective, source, nodes, include_algebraic)
     kind = evaluator_kind() if fmu_kind == "auto" else fmu_kind
     fmu = build_fmu(building, workdir / "model.fmu", kind=kind)
-    measured = objective.measured(case)
-    noise = Noise.of(measured, noise)
+    fmus = [fmu if own is None else build_fmu(own, workdir / f"model_{k + 1}.fmu", kind=kind)
+            for k, own in enumerate(protocols)]
+    parts = [FmuFitness(path, c, candidates, objective, warmup_days) for path, c in zip(fmus, cases)]
+    fitness = parts[0] if len(parts) == 1 else RecordsFitness(parts)
+    measured = [objective.measured(c) for c in cases]
+    # the records apart by a row of NaN: no second difference spans two records
+    gap = np.full((1, len(objective.zones)), np.nan)
+    noise = Noise.of(np.concatenate([x for m in measured for x in (m, gap)][:-1]), noise)
+    measured_ids = sorted(set().union(*(c.measured_ids for c in cases)))
     if not candidates:
-        return nothing_to_force(building, case, objective, FmuFitness(fmu, case, [], objective, warmup_days), noise)
-    result = search(FmuFitness(fmu, case, candidates, objective, warmup_days), candidates,
+        return nothing_to_force(building, measured_ids, objective, fitness, noise)
+    result = search(fitness, candidates,
                     population=population, generations=generations, pc=pc, pm=pm, seed=seed,
                     patience=patience, seeded=seeded,
                     workers=workers, scheduler=scheduler, checkpoint=workdir / CHECKPOINT,
                     progress=progress, noise_sigma=noise.sigma,
-                    n_residuals=int(np.isfinite(measured).sum()))
-    result = {"measured_nodes": case.measured_ids, "output_node": objective.air_nodes[0],
+                    n_residuals=int(sum(np.isfinite(m).sum() for m in measured)))
+    result = {"measured_nodes": measured_ids, "output_node": objective.air_nodes[0],
               "objective": list(objective.zones), "output_nodes": list(objective.air_nodes), **result,
               "noise": noise.to_json()}
     result["components"] = evidence(building, result)
@@ -122,7 +146,7 @@ def evidence(building, result):
     return sorted(out, key=lambda e: (e["J"], e["component"]))
 
 
-def nothing_to_force(building, case, objective, fitness, noise):
+def nothing_to_force(building, measured_ids, objective, fitness, noise):
     """locate.json of a record with no measured node but the objective's air (a thermostat's
     record): J unforced, `best_nodes` [], and a finding that says no forcing can be tested and
     which sensors would let it."""
@@ -139,7 +163,7 @@ def nothing_to_force(building, case, objective, fitness, noise):
             "temperature measured on the inside surface of a component facing the objective's air"
             + (f" (the largest: {largest})" if largest else "")
             + ", or inside one, would let the search test that component's sub-model.")
-    return {"measured_nodes": case.measured_ids, "chromosome_nodes": [], "output_node": objective.air_nodes[0],
+    return {"measured_nodes": measured_ids, "chromosome_nodes": [], "output_node": objective.air_nodes[0],
             "objective": list(objective.zones), "output_nodes": list(objective.air_nodes),
             "J_unforced": J, "best_nodes": [], "J_best": J, "node_scores": {}, "ranked_nodes": [],
             "tied_nodes": [], "components": [],

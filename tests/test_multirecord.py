@@ -110,3 +110,50 @@ def test_a_correction_that_helps_one_record_and_harms_the_other_is_refused(tmp_p
     added = [f"{e['effect']}@{e['target']}" for e in report["effects"]]
     assert "internal_gain@B" not in added
     assert all(not tests[a]["harms"] for a in added)
+
+
+def J_direct(building, case, objective, force_ids=()):
+    """J (C2) of the objective's air with `force_ids` forced, by the direct model: an evaluation
+    apart from the search's FMUs."""
+    force = np.zeros(case.measured.shape[1], dtype=bool)
+    force[np.asarray(force_ids, dtype=int) - 1] = True
+    T = simulate(building, assemble(building), case.U, case.dt, case.measured, force=force,
+                 burn_in_steps=case.burn_in_steps)
+    return objective.J(objective.measured(case), T[:, np.asarray(objective.air_nodes) - 1])
+
+
+@pytest.mark.slow  # two forcing searches through the FMU
+def test_the_forcing_search_of_two_records_forces_a_node_where_a_record_measures_it(tmp_path):
+    """B's wall conducts three times as declared. The first record measures the airs alone, the
+    second the wall's inside surface too: the search on both may force that surface, which the
+    first record alone has no sensor for; J of a forcing is the sum of each record's, the surface
+    forced in the second and computed in the first (checked by the direct model); the second
+    record alone locates the fault in the wall."""
+    from nodeforce.ga.locate import locate
+    b = house()
+    truth = EFFECTS["conductivity"].apply(b, "wB", {"factor": 3.0})
+    airs = record(truth, b, "2014-04-01", 4, None, seed=3)
+    surface = b.component("wB").node_ids[0]
+    second = record(truth, b, "2014-04-10", 4, None, seed=4)
+    rng = np.random.default_rng(5)
+    T_truth = simulate(truth, assemble(truth, second.input_names), second.U, STEP, None, warmup_days=30,
+                       include_start=True)
+    measured = second.measured.copy()
+    measured[:, surface - 1] = T_truth[:, surface - 1] + rng.normal(0.0, NOISE, len(measured))
+    second = Case(second.times, STEP, second.input_names, second.U, measured, building=b).with_burn_in(1)
+    objective = Objective.of(b, ["A", "B"])
+    both = locate(b, [airs, second], objective, tmp_path, workers=1, noise=NOISE)
+    assert both["chromosome_nodes"] == [surface]
+    J1, J2, J2_forced = (J_direct(b, airs, objective), J_direct(b, second, objective),
+                         J_direct(b, second, objective, [surface]))
+    assert both["J_unforced"] == pytest.approx(J1 + J2, rel=1e-6)
+    assert both["node_scores"][str(surface)] == pytest.approx(J1 + J2_forced, rel=1e-6)
+    # forcing it removes the second record's share of the error, not the first's: the records
+    # together rank it, the second alone locates the fault
+    assert both["ranked_nodes"] == [surface]
+    alone = {}
+    for name, case in (("first", airs), ("second", second)):
+        (tmp_path / name).mkdir()
+        alone[name] = locate(b, [case], objective, tmp_path / name, workers=1, noise=NOISE)
+    assert alone["first"]["chromosome_nodes"] == []
+    assert alone["second"]["best_nodes"] == [surface]

@@ -99,8 +99,8 @@ def write_markdown(out_dir, report, plots, notes):
     search = (report.get("localization") or {}).get("search") or {}
     period = report.get("period") or {}
     ref = tables.reference_text(report)
-    first_record = (f" of the first record ({report['records'][0]['name']}: the forcing search reads it, the plots "
-                    "show it)" if report.get("records") else "")
+    first_record = (f" of the first record ({report['records'][0]['name']}: the plots show it)"
+                    if report.get("records") else "")
     md = ["# nodeforce diagnosis report", "", *[_bold_label(line) + "  " for line in summary.first_screen(report, pm="±")],
           "", "From the residual of the indoor air, to the nodes whose forcing explains it, to a physical "
           "effect the model lacks, added and calibrated on the calibration window and chosen by "
@@ -142,7 +142,18 @@ def write_markdown(out_dir, report, plots, notes):
     md += figure("residuals", "Air residual before and after, mean and sd per window")
     md += ["## Residual diagnostics", "", *residual_lines(report), ""]
     md += figure("residual_diagnostics", "Autocorrelation and strongest cross-correlation of the residual")
-    md += ["## Localisation", "", *localization_lines(report), ""]
+    md += ["## Localisation", ""]
+    if report.get("records"):
+        md += [f"The forcing search on the calibration windows of the {len(report['records'])} records together "
+               "(a forcing applies to every record that measures its nodes; J is their sum), then on each "
+               "record alone.", ""]
+    md += [*localization_lines(report), ""]
+    for r in report.get("records") or []:
+        loc = r.get("localization") or {}
+        if loc:
+            md += [f"- {r['name']} alone: chromosome {loc.get('chromosome_nodes', NA)}; best_nodes "
+                   f"{loc.get('best_nodes', NA)}. {loc.get('finding', '')}"]
+    md += [""] if report.get("records") else []
     md += figure("node_scores", "J with each node forced alone")
     md += figure("convergence", "Exhaustive search: best J per batch" if search.get("method") == "exhaustive"
                  else "GA convergence: best J against the generation")
