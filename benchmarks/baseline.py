@@ -42,7 +42,7 @@ def air_run(building, case, air_nodes):
     """(N_t, zones) simulated air (C) of `building` on `case`, as the diagnosis runs it."""
     case = case.with_inputs(building)
     T = simulate(building, assemble(building), case.U, case.dt, case.measured, burn_in_steps=case.burn_in_steps,
-                 steady_start=case.steady_start)
+                 steady_start=case.steady_start, substeps=case.substeps)
     return T[:, np.array(air_nodes) - 1]
 
 

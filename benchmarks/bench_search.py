@@ -244,9 +244,10 @@ def main(argv=None):
 
         # 1. direct model simulation
         network = assemble(building)
-        T_direct = simulate(building, network, case.U, case.dt, case.measured, force=force, warmup_days=WARMUP_DAYS)
+        T_direct = simulate(building, network, case.U, case.dt, case.measured, force=force, warmup_days=WARMUP_DAYS,
+                            substeps=case.substeps)
         t_direct = median_time(lambda: simulate(building, network, case.U, case.dt, case.measured, force=force,
-                                                warmup_days=WARMUP_DAYS), args.repeats)
+                                                warmup_days=WARMUP_DAYS, substeps=case.substeps), args.repeats)
 
         # 2. one FMU evaluation through the driver, evaluator built once
         (tmp / "fmu").mkdir()

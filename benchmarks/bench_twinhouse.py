@@ -48,7 +48,7 @@ def main():
     steps = len(case.times) - 1 + 2 * 144
     print(f"Twin House N2: {building.n_nodes} nodes, {len(case.input_names)} inputs, {steps} steps incl. warm-up")
     t_direct, T = timed(lambda: simulate(building, network, case.U, case.dt, case.measured,
-                                         burn_in_steps=case.burn_in_steps))
+                                         burn_in_steps=case.burn_in_steps, substeps=case.substeps))
     print(f"direct model          {t_direct:7.2f} s  ({t_direct / steps * 1e6:6.0f} us/step)")
     with tempfile.TemporaryDirectory(prefix="nodeforce_bench_") as tmp:
         for kind in ("python", "standalone"):

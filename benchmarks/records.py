@@ -351,7 +351,7 @@ def before_error(building, weather, record, objective_node, burn_in=BURN_IN_DAYS
     40 %."""
     case = prepare_case(building, weather, record).with_burn_in(burn_in).with_steady_start()
     T = simulate(building, assemble(building), case.U, case.dt, case.measured, burn_in_steps=case.burn_in_steps,
-                 steady_start=True)
+                 steady_start=True, substeps=case.substeps)
     n = len(case.times) - 1
     k = int(round(CALIBRATION_FRACTION * n))
     residual = case.measured[1:, objective_node - 1] - T[:, objective_node - 1]

@@ -5,7 +5,8 @@ driver's, and follow the same rules as `model.integrate.simulate`, so both give 
 """
 import numpy as np
 
-from nodeforce.model.integrate import STEADY_STEP, forcing_schedule, steady_inputs, warmup_rows
+from nodeforce.model.integrate import (STEADY_STEP, forcing_schedule, held_inputs, steady_inputs, warmup_rows,
+                                       within_steps)
 
 
 def node_names(prefix, ids):
@@ -46,13 +47,19 @@ def simulate_fmu(instance, case, force=None, warmup_days=2, output_ids=None, T_d
                   **{name: True for name in node_names("force", forced_ids)}, **(parameters or {})}
     rows = warmup_rows(n_rows, case.dt, warmup_days)
     columns = np.array(forced_ids, dtype=int) - 1
-    imposed = np.where(schedule[:, columns], measured[:, columns], np.nan)
-    inputs = np.hstack([case.U[rows], imposed[rows]])
-    steps = np.full(len(rows), case.dt)
+    # each sample's step in case.substeps steps, its inputs and imposed temperatures in between
+    # as the direct model has them (model.integrate.within_steps); T_forced NaN where not imposed
+    k = case.substeps
+    within = zip(within_steps(case.U, k, held_inputs(case.building, case.input_names)),
+                 within_steps(measured[:, columns], k))
+    inputs = np.stack([np.hstack([u[rows], np.where(schedule[rows][:, columns], imposed[rows], np.nan)])
+                       for u, imposed in within], axis=1).reshape(len(rows) * k, -1)
+    steps = np.full(len(inputs), case.dt / k)
     if case.steady_start:
         u, held, values = steady_inputs(case.U, measured, schedule, case.dt)
         inputs = np.vstack([np.concatenate([u, np.where(held[columns], values[columns], np.nan)]), inputs])
         steps = np.concatenate([[STEADY_STEP], steps])
-    return instance.run(steps, parameters, {},
-                        list(case.input_names) + node_names("T_forced", forced_ids),
-                        inputs, node_names("T", output_ids), skip=len(inputs) - (n_rows - 1))
+    out = instance.run(steps, parameters, {},
+                       list(case.input_names) + node_names("T_forced", forced_ids),
+                       inputs, node_names("T", output_ids), skip=len(inputs) - (n_rows - 1) * k)
+    return out[k - 1::k]

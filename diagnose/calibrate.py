@@ -83,7 +83,8 @@ class Candidate:
             building = self.built(values, base)
             self.simulations += 1
             T = simulate(building, assemble(building), inputs.U, inputs.dt, inputs.measured,
-                         burn_in_steps=inputs.burn_in_steps, steady_start=inputs.steady_start)
+                         burn_in_steps=inputs.burn_in_steps, steady_start=inputs.steady_start,
+                         substeps=inputs.substeps)
             if len(self._runs) >= KEPT_RUNS:
                 self._runs.pop(next(iter(self._runs)))
             self._runs[key] = T[:, np.asarray(node_ids) - 1]
@@ -154,7 +155,8 @@ def calibrate(candidate, cases, objective, blocks=()):
 
 def fold(fit, train, lows, highs):
     """The parameters fitted without a block: one Gauss-Newton step from the whole window's
-    optimum on the `train` rows of its residuals and Jacobian, kept inside the bounds.
+    optimum on the `train` rows of its residuals and Jacobian, shortened along its direction
+    where it would leave the bounds.
 
     Leaving one day out of several moves the optimum by little, and the step from the optimum
     is exact to first order in that move (for a model linear in its parameters, exact): a fold
@@ -162,12 +164,18 @@ def fold(fit, train, lows, highs):
     tens; on the Twin House's eighteen days a candidate's fifteen folds would otherwise be most
     of a diagnosis's time."""
     # a parameter the whole window's fit left on a bound stays there: its step would leave the
-    # range, and clipping it alone would break the trade-off the others made with it
+    # range. Nor is a step that leaves the range clipped parameter by parameter: where two
+    # parameters trade off (a ground coupling's U and T_ground), the step runs along their valley,
+    # and clipping one alone (U to 0) would leave the valley, and the fit, altogether
     free = fit.active_mask == 0
     x = fit.x.copy()
     if free.any():
-        x[free] += np.linalg.lstsq(fit.jac[train][:, free], -fit.fun[train], rcond=None)[0]
-    return np.clip(x, lows, highs)
+        step = np.linalg.lstsq(fit.jac[train][:, free], -fit.fun[train], rcond=None)[0]
+        room = np.where(step > 0, highs[free] - x[free], lows[free] - x[free])
+        moving = step != 0
+        shortest = np.min(room[moving] / step[moving]) if moving.any() else 1.0
+        x[free] += min(1.0, shortest) * step
+    return np.clip(x, lows, highs)  # rounding only
 
 
 # The derived time constant (s) of the effects that add a node of capacity C and conductance H.

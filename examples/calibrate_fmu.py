@@ -11,7 +11,10 @@ max), simulates with FMPy's `simulate_fmu` and fits the measured air with
 
 What the FMU asks of a host, as any tool must give it:
 - one doStep of h seconds is a backward-Euler step with the inputs set before it: the step from
-  t_k takes the inputs of t_k+1, so the input table is given one sample ahead;
+  t takes the inputs of t + h, so the input table is given one step ahead;
+- h of at most 5 min, as nodeforce steps it (docs/model.md, section 5.1): a record sampled
+  every 15 min is stepped three times per sample, FMPy interpolating the inputs between samples
+  (a heater's power, which nodeforce holds over the interval, would need a table that holds it);
 - the state at the start is `T_start[i]`: the measured nodes at their measurement at t_0 and the
   rest, here, at the measured air's;
 - a node i with `force[i]` set is held at the input `T_forced[i]` wherever that is not NaN.
@@ -31,6 +34,7 @@ record its calibration reads), this script gives its value within its uncertaint
 import argparse
 import copy
 import json
+import math
 import sys
 import tempfile
 from pathlib import Path
@@ -102,13 +106,15 @@ def calibrate(fmu, inputs_path, measurements_path, until=None):
     t, names, U = read_table(inputs_path, until)
     _, measured_names, measured = read_table(measurements_path, until)
     dt = t[1] - t[0]
+    k = math.ceil(dt / 300.0 - 1e-9)
+    h = dt / k  # s, the step: at most 5 min
     column = dict(zip(measured_names, measured.T))
     # the burn-in: each sensor's node held at its measurement over the first day, then free
     held = {f"T_forced[{i}]": np.where(np.arange(len(t)) <= BURN_IN, column[f"T{i}"], np.nan) if i in SENSORS
             else np.full(len(t), np.nan) for i in range(1, n_nodes + 1)}
     names, U = names + list(held), np.column_stack([U, *held.values()])
-    # the step from t_k takes the inputs of t_k+1: the table one sample ahead
-    table = np.array([tuple([time, *row]) for time, row in zip(t[:-1], U[1:])],
+    # the step from t takes the inputs of t + h: the table one step ahead
+    table = np.array([tuple([time - h, *row]) for time, row in zip(t, U)],
                      dtype=[("time", float)] + [(name, float) for name in names])
     first = {f"T{i}": column[f"T{i}"][0] for i in SENSORS}
     starts = {**{f"T_start[{i}]": first.get(f"T{i}", first[f"T{AIR}"]) for i in range(1, n_nodes + 1)},
@@ -119,9 +125,9 @@ def calibrate(fmu, inputs_path, measurements_path, until=None):
 
     def residuals(x):
         result = simulate_fmu(unzipped, start_values={**starts, PARAMETER: float(x[0])}, input=table,
-                              output=[f"T[{AIR}]"], step_size=dt, output_interval=dt, stop_time=t[-1],
+                              output=[f"T[{AIR}]"], output_interval=h, stop_time=t[-1],
                               fmi_type="CoSimulation")
-        simulated = result[f"T[{AIR}]"][1:]
+        simulated = result[f"T[{AIR}]"][k::k]  # at t_1..t_N, every k-th step (FMPy's CS step is the interval)
         evaluations.append(float(x[0]))
         return (air - simulated)[scored]
 

@@ -148,7 +148,7 @@ class ModelEvaluator(_Evaluator):
     def __init__(self, spec):
         super().__init__(spec)
         self.network = assemble(spec.building)
-        self.stepper = ImplicitEuler(self.network, spec.case.dt)  # kept: its partition and factors
+        self.stepper = ImplicitEuler(self.network, spec.case.dt / spec.case.substeps)  # kept: its factors
         self.steady = ImplicitEuler(self.network, STEADY_STEP) if spec.case.steady_start else None
 
     def air(self, force):
@@ -156,5 +156,5 @@ class ModelEvaluator(_Evaluator):
         case = self.spec.case
         T = simulate(self.spec.building, self.network, case.U, case.dt, case.measured, force=force,
                      warmup_days=self.spec.warmup_days, burn_in_steps=case.burn_in_steps, stepper=self.stepper,
-                     steady_start=case.steady_start, steady_stepper=self.steady)
+                     steady_start=case.steady_start, steady_stepper=self.steady, substeps=case.substeps)
         return T[:, np.array(self.spec.objective.air_nodes) - 1]

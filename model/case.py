@@ -13,7 +13,7 @@ import pandas as pd
 from nodeforce.iotools.timetable import check_celsius
 
 from .errors import InputError
-from .integrate import initial_state, simulate, steps_per_day
+from .integrate import initial_state, simulate, steps_per_day, substeps
 from .building import DAY_TERMS
 from .network import assemble, clock_input_names, day_input, input_names
 from .solar import (DECOMPOSITIONS, complete_irradiance, incident_irradiance, measured_irradiance, sky_temperature,
@@ -38,6 +38,7 @@ class Case:
     steady_start: bool = False  # the warm-up starts from the first day's steady state (`with_steady_start`)
     fluxes: dict = field(default_factory=dict)  # flux sensor -> (N_t+1,) W/m2 measured, NaN where missing
     building: object = None  # the Building whose nodes `measured` holds (its state at t_0: `start_state`)
+    substeps: int = 1  # integration steps per sample (`integrate.substeps`: of at most MAX_STEP)
 
     def start_state(self, T_default=20.0):
         """(N,) node temperatures (C) at t_0 of the case's building, N its nodes (those its
@@ -261,7 +262,7 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs"):
                 else np.full((len(times), building.n_nodes), np.nan))
     fluxes = measured_fluxes(building, measurements, times) if measurements is not None else {}
     return Case(times=times, dt=dt, input_names=names, U=U, measured=measured, assumptions=tuple(assumptions),
-                fluxes=fluxes, building=building)
+                fluxes=fluxes, building=building, substeps=substeps(dt))
 
 
 def check_warmup(case, source):
@@ -318,5 +319,5 @@ def simulate_building(building, weather, measurements=None, force=(), warmup_day
     case = measured_case(building, weather, measurements, burn_in_days)
     mask = force_mask(case, force, "force")
     T = simulate(building, assemble(building), case.U, case.dt, case.measured, mask, warmup_days,
-                 burn_in_steps=case.burn_in_steps)
+                 burn_in_steps=case.burn_in_steps, substeps=case.substeps)
     return pd.DataFrame(T, index=case.times[1:], columns=[f"T{i}" for i in range(1, building.n_nodes + 1)])

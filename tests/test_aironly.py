@@ -203,9 +203,11 @@ RECOVERY = [("internal_mass", {"C_m": 1e6, "H_m": 80.0}),
 def test_the_steady_start_finds_the_walls_state_the_replay_alone_misses(heated, heated_weather, effect, values):
     """The records are made periodic by a year of replays of their first day (`pseudo_measurements`),
     an independent way to the walls' state at t_0. With the air alone measured, the true model
-    started from the first day's steady state reproduces the record to the hundredth of a degree;
-    the two replays of docs/model.md section 5 alone leave the heavy floor at the air's temperature,
-    tenths of a degree off for the whole record."""
+    started from the first day's steady state reproduces the record to two hundredths of a degree
+    (over the burn-in, the air is forced to its samples linear in between, where the true air
+    follows the heater's switching: the walls' state keeps a trace of that); the two replays of
+    docs/model.md section 5 alone leave the heavy floor at the air's temperature, tenths of a
+    degree off for the whole record."""
     truth = EFFECTS[effect].apply(heated, "cell", values)
     times = pd.date_range("2001-06-10T00:00-05:00", periods=5 * 48 + 1, freq="30min", name="time")
     record = pseudo_measurements(truth, heated_weather, times, [23])
@@ -214,9 +216,9 @@ def test_the_steady_start_finds_the_walls_state_the_replay_alone_misses(heated, 
 
     def error(steady_start):
         T = simulate(truth, network, case.U, case.dt, case.measured, burn_in_steps=case.burn_in_steps,
-                     steady_start=steady_start)
+                     steady_start=steady_start, substeps=case.substeps)
         return np.abs(record["T23"].to_numpy()[1:] - T[:, 22])[case.burn_in_steps:].max()
-    assert error(True) < 0.01 < 0.1 < error(False)
+    assert error(True) < 0.02 < 0.1 < error(False)
 
 
 @pytest.mark.slow  # a diagnosis each

@@ -50,7 +50,7 @@ def test_simulate_writes_every_node_as_the_direct_model_computes(files, testcell
     case = prepare_case(testcell, weather, read_measurements(files["measurements"]))
     force = np.zeros(23, dtype=bool)
     force[[6, 16]] = True
-    direct = simulate(testcell, assemble(testcell), case.U, case.dt, case.measured, force)
+    direct = simulate(testcell, assemble(testcell), case.U, case.dt, case.measured, force, substeps=case.substeps)
     assert len(sim) == len(measurements) - 1  # t_1..t_N
     assert np.abs(sim.iloc[:, 1:].to_numpy() - direct).max() < 1e-9
     assert np.array_equal(sim["T7"].to_numpy(), measurements["T7"].to_numpy()[1:])

@@ -20,7 +20,7 @@ def direct_rmse(building, weather, measurements, start, end):
     `start` to `end`, simulated by the direct model with the first day a burn-in (every measured
     node forced, not scored), as docs/model.md section 5 says."""
     case = prepare_case(building, weather, measurements).with_burn_in(1)
-    T = simulate(building, assemble(building), case.U, case.dt, case.measured, burn_in_steps=case.burn_in_steps)
+    T = simulate(building, assemble(building), case.U, case.dt, case.measured, burn_in_steps=case.burn_in_steps, substeps=case.substeps)
     rows = (case.times[1:] >= start) & (case.times[1:] <= end)
     residual = (measurements["T23"].to_numpy()[1:] - T[:, 22])[rows]
     return float(np.sqrt(np.mean(residual ** 2)))

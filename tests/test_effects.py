@@ -16,7 +16,7 @@ from nodeforce.model.network import assemble
 
 
 def direct(b, case):
-    return simulate(b, assemble(b), case.U, case.dt, case.measured)
+    return simulate(b, assemble(b), case.U, case.dt, case.measured, substeps=case.substeps)
 
 
 CASES = [

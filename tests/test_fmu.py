@@ -30,7 +30,7 @@ def forcing(*ids, n=23):
 def test_fmu_equals_direct_model_on_real_weather(fmu, testcell, real_case, forced):
     net = assemble(testcell)
     force = forcing(*forced)
-    direct = simulate(testcell, net, real_case.U, real_case.dt, real_case.measured, force)
+    direct = simulate(testcell, net, real_case.U, real_case.dt, real_case.measured, force, substeps=real_case.substeps)
     with FmuInstance(fmu) as instance:
         through_fmu = simulate_fmu(instance, real_case, force)
     assert np.abs(through_fmu - direct).max() < 1e-9
@@ -46,11 +46,11 @@ def test_a_steady_start_is_the_same_year_long_step_through_the_fmu(fmu, testcell
     case = replace(real_case, measured=air_only).with_burn_in(1).with_steady_start()
     net = assemble(testcell)
     direct = simulate(testcell, net, case.U, case.dt, case.measured, burn_in_steps=case.burn_in_steps,
-                      steady_start=True)
+                      steady_start=True, substeps=case.substeps)
     with FmuInstance(fmu) as instance:
         through_fmu = simulate_fmu(instance, case)
     assert np.abs(through_fmu - direct).max() < 1e-9
-    replay = simulate(testcell, net, case.U, case.dt, case.measured, burn_in_steps=case.burn_in_steps)
+    replay = simulate(testcell, net, case.U, case.dt, case.measured, burn_in_steps=case.burn_in_steps, substeps=case.substeps)
     assert np.abs(replay - direct).max() > 0.01
 
 
@@ -153,7 +153,7 @@ def test_two_different_fmus_in_one_process_run_their_own_model(tmp_path, testcel
         out_b = simulate_fmu(b, real_case, output_ids=[23])
     for data, out in ((testcell_data, out_a), (leaky, out_b)):
         building = parse_building(data)
-        direct = simulate(building, assemble(building), real_case.U, real_case.dt, real_case.measured)
+        direct = simulate(building, assemble(building), real_case.U, real_case.dt, real_case.measured, substeps=real_case.substeps)
         assert np.abs(out[:, 0] - direct[:, 22]).max() < 1e-9
     assert np.abs(out_a - out_b).max() > 0.01
 

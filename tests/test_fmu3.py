@@ -77,12 +77,12 @@ def test_fmi3_equals_fmi2_and_the_direct_model_with_forcing_and_effect(fmus, tes
         with FmuInstance(fmus[(kind, fmi)]) as instance:
             results[fmi] = simulate_fmu(instance, real_case, force, parameters=parameters)
     coupled = EFFECTS[EFFECT[0]].apply(testcell, EFFECT[1], values)
-    direct = simulate(coupled, assemble(coupled), real_case.U, real_case.dt, real_case.measured, force)
+    direct = simulate(coupled, assemble(coupled), real_case.U, real_case.dt, real_case.measured, force, substeps=real_case.substeps)
     assert np.abs(results[3] - results[2]).max() < 1e-9
     assert np.abs(results[3] - direct).max() < 1e-9
     measured = real_case.measured[1:, 8]
     assert np.array_equal(results[3][:, 8], measured)  # forced through the T_forced array
-    uncoupled = simulate(testcell, assemble(testcell), real_case.U, real_case.dt, real_case.measured, force)
+    uncoupled = simulate(testcell, assemble(testcell), real_case.U, real_case.dt, real_case.measured, force, substeps=real_case.substeps)
     assert np.abs(direct - uncoupled).max() > 0.1  # the effect's parameters reached the model
 
 

@@ -118,7 +118,7 @@ def J_direct(building, case, objective, force_ids=()):
     force = np.zeros(case.measured.shape[1], dtype=bool)
     force[np.asarray(force_ids, dtype=int) - 1] = True
     T = simulate(building, assemble(building), case.U, case.dt, case.measured, force=force,
-                 burn_in_steps=case.burn_in_steps)
+                 burn_in_steps=case.burn_in_steps, substeps=case.substeps)
     return objective.J(objective.measured(case), T[:, np.asarray(objective.air_nodes) - 1])
 
 

@@ -257,3 +257,46 @@ def test_adiabatic_building_conserves_heat_from_an_uneven_start():
     assert np.abs(stored - stored[0]).max() <= 1e-9 * np.abs(stored[0])
     # and the building tends to one uniform temperature
     assert T[-1].max() - T[-1].min() < T[0].max() - T[0].min()
+
+
+def test_within_steps_interpolates_samples_and_holds_heat_inputs_by_hand():
+    """Two samples of a temperature (10 -> 20 C) and a heater (0 -> 600 W), three sub-steps: the
+    temperature at 1/3, 2/3 and the whole step, the heater's step value throughout; a missing end
+    sample stays missing, a missing start sample leaves the end value."""
+    from nodeforce.model.integrate import within_steps
+    values = np.array([[10.0, 0.0, np.nan], [20.0, 600.0, 5.0], [20.0, 600.0, np.nan]])
+    parts = within_steps(values, 3, held=[False, True, False])
+    assert [p[1, 0] for p in parts] == pytest.approx([10 + 10 / 3, 10 + 20 / 3, 20.0])
+    assert [p[1, 1] for p in parts] == [600.0, 600.0, 600.0]
+    assert [p[1, 2] for p in parts] == [5.0, 5.0, 5.0]
+    assert all(np.isnan(p[2, 2]) for p in parts)
+    assert all(np.array_equal(p[0], values[0], equal_nan=True) for p in parts)
+
+
+def test_substeps_converge_to_the_exact_response_to_a_ramp_at_first_order():
+    """A zone's air (C = rho c V) behind a massless wall (G) to a boundary whose temperature rises
+    at r per hour: C T' = G (T_b - T) has the exact solution T = T_b(t) - r tau + (T_0 - T_b(0)
+    + r tau) e^(-t/tau), tau = C / G. Backward Euler at the record's hour is off by O(dt); k
+    sub-steps cut that error k-fold (first order), the boundary linear between samples."""
+    data = {"format": "nodal-building/1", "name": "ramp", "site": {"latitude": 45.0, "longitude": 5.0},
+            "materials": {"board": {"conductivity": 0.5, "density": 0.0, "specific_heat": 1000.0}},
+            "zones": [{"name": "room", "volume": 30.0}],
+            "components": [{"name": "wall", "area": 10.0, "tilt": 90.0, "azimuth": 180.0,
+                            "layers": [["board", 0.1]], "nodes": {"max_spacing": 1.0},
+                            "inside": {"zone": "room", "h_conv": 3.0, "h_rad": 5.0},
+                            "outside": {"type": "boundary", "temperature": "T_b", "h": 25.0}}]}
+    b = parse_building(data)
+    net = assemble(b)
+    dt, n, r = 3600.0, 12, 2.0  # s, steps, K/h
+    t = np.arange(n + 1) * dt
+    columns = {"T_out": 0.0, "T_sky": 0.0, "T_b": 20.0 + r * t / 3600}
+    U = np.column_stack([np.broadcast_to(columns[name], n + 1) for name in net.input_names])
+    G = 10.0 / (1 / 3.0 + 0.1 / 0.5 + 1 / 25.0)
+    tau = net.C[b.zone("room").air_node - 1] / G
+    exact = columns["T_b"][1:] - r * tau / 3600 + r * tau / 3600 * np.exp(-t[1:] / tau)
+    errors = [np.abs(simulate(b, net, U, dt, warmup_days=0, substeps=k)[:, b.zone("room").air_node - 1]
+                     - exact).max() for k in (1, 4, 16, 64)]
+    assert errors[0] > 0.1  # the hour's step is visibly off
+    assert errors[2] / errors[1] == pytest.approx(1 / 4, rel=0.15)
+    assert errors[3] / errors[2] == pytest.approx(1 / 4, rel=0.15)
+    assert errors[3] < 0.005

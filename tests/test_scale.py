@@ -205,7 +205,7 @@ def test_standalone_fmu_equals_the_direct_model_on_the_generated_office(office, 
     force = np.zeros(building.n_nodes, dtype=bool)
     force[np.array(sensors[::3]) - 1] = True
     expected = simulate(building, assemble(building), case.U, case.dt, case.measured, force=force,
-                        burn_in_steps=case.burn_in_steps, steady_start=steady_start)
+                        burn_in_steps=case.burn_in_steps, steady_start=steady_start, substeps=case.substeps)
     instance = FmuInstance(build_fmu(building, tmp_path / "office.fmu", kind="standalone"))
     try:
         assert np.abs(simulate_fmu(instance, case, force) - expected).max() < 1e-9

@@ -131,7 +131,7 @@ def test_the_standalone_fmu_carries_the_daily_gain(tmp_path, testcell, real_case
     case = real_case.with_inputs(after)
     with FmuInstance(fmu) as instance:
         T = simulate_fmu(instance, case, parameters={f"daily_gain.{k}": v for k, v in values.items()})
-    assert np.abs(T - simulate(after, assemble(after), case.U, case.dt, case.measured)).max() < 1e-9
+    assert np.abs(T - simulate(after, assemble(after), case.U, case.dt, case.measured, substeps=case.substeps)).max() < 1e-9
 
 
 @pytest.mark.parametrize("change,field", [

@@ -95,7 +95,7 @@ def test_compare_reports_the_model_s_flux_beside_the_reading(tmp_path, testcell_
     measurements = pseudo_measurements(truth, weather, record_times(3), SENSORS, noise_sd=0.0, history_days=3)
     case = prepare_case(truth, weather, measurements).with_burn_in(1)
     net = assemble(truth)
-    T = simulate(truth, net, case.U, case.dt, case.measured, burn_in_steps=case.burn_in_steps, include_start=True)
+    T = simulate(truth, net, case.U, case.dt, case.measured, burn_in_steps=case.burn_in_steps, include_start=True, substeps=case.substeps)
     for sensor in ("roof_flux", "roof_out_flux"):
         measurements[sensor] = face_heat_flux(truth, net, T, case.U, "roof", truth.flux_sensors[sensor][1])
     measurements.to_csv(tmp_path / "m.csv", date_format="%Y-%m-%dT%H:%M:%S%z")

@@ -161,7 +161,7 @@ def test_an_irradiance_column_equals_the_same_values_given_as_I_component(tmp_pa
 
 def simulate_case(building, weather):
     case = prepare_case(building, weather)
-    return simulate(building, assemble(building), case.U, case.dt, case.measured, warmup_days=1)
+    return simulate(building, assemble(building), case.U, case.dt, case.measured, warmup_days=1, substeps=case.substeps)
 
 
 def test_the_burn_in_forces_every_measured_node_and_only_during_its_days():
