@@ -3,7 +3,7 @@ PYTHON ?= python3
 VENV ?= .venv
 BIN := $(VENV)/bin
 
-.PHONY: demo test check venv system-deps benchmark clean twinhouse twinhouse-house
+.PHONY: demo test check venv system-deps benchmark clean twinhouse twinhouse-living
 
 $(BIN)/nodeforce: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -33,61 +33,16 @@ test: venv system-deps
 check: venv
 	$(PYTEST) -m "not slow"
 
-# Twin House N2, experiment 1 (examples/twinhouse_n2/README.md): the measurements the repository
-# carries (examples/twinhouse_n2/data/, read compressed) converted, then diagnosed on the living
-# room; then experiment 2 (spring 2014, another protocol) converted and the house as written and as
-# corrected on experiment 1 compared on it, a record the correction never saw.
-TWINHOUSE_EXAMPLE := examples/twinhouse_n2
-TWINHOUSE_DATA := $(TWINHOUSE_EXAMPLE)/data/exp1
-TWINHOUSE_DATA2 := $(TWINHOUSE_EXAMPLE)/data/exp2
-TWINHOUSE_OUT := out/twinhouse
-TWINHOUSE_OUT2 := $(TWINHOUSE_OUT)/exp2
-TWINHOUSE_TABLE = $(BIN)/nodeforce table $(TWINHOUSE_DATA)/validationdataN2Exp1.txt.gz \
-	--names $(TWINHOUSE_DATA)/columns.csv --origin 2013-01-01T00:00+01:00
-TWINHOUSE_TABLE2 = $(BIN)/nodeforce table $(TWINHOUSE_DATA2)/validationdataExp2.txt.gz \
-	--names $(TWINHOUSE_DATA2)/columns.csv --origin 2014-01-01T00:00+01:00
-
-twinhouse: venv
-	mkdir -p $(TWINHOUSE_OUT) $(TWINHOUSE_OUT2)
-	$(TWINHOUSE_TABLE) --select @$(TWINHOUSE_EXAMPLE)/weather_columns.txt --set shading_south=0 \
-		-o $(TWINHOUSE_OUT)/weather.csv
-	$(TWINHOUSE_TABLE) --select @$(TWINHOUSE_EXAMPLE)/measurement_columns.txt \
-		--start 2013-08-27T00:00+01:00 --end 2013-10-01T00:00+01:00 -o $(TWINHOUSE_OUT)/measurements.csv
-	$(BIN)/nodeforce diagnose $(TWINHOUSE_EXAMPLE)/building.json --weather $(TWINHOUSE_OUT)/weather.csv \
-		--measurements $(TWINHOUSE_OUT)/measurements.csv -o $(TWINHOUSE_OUT) --objective living \
-		--calibration-end 2013-09-14T00:00+01:00 --burn-in-days 3 --seed 0 \
-		--reference $(TWINHOUSE_EXAMPLE)/reference.json --phases $(TWINHOUSE_EXAMPLE)/phases.csv
-	$(TWINHOUSE_TABLE2) --select @$(TWINHOUSE_EXAMPLE)/weather_columns_exp2.txt \
-		--set shading_south=1,shading_W27=0,shading_W33=0 -o $(TWINHOUSE_OUT2)/weather.csv
-	$(BIN)/python $(TWINHOUSE_EXAMPLE)/make_building.py --experiment 2 -o $(TWINHOUSE_OUT2)/building_as_written.json
-	$(BIN)/python $(TWINHOUSE_EXAMPLE)/make_building.py --experiment 2 --corrected-by $(TWINHOUSE_OUT)/report.json \
-		-o $(TWINHOUSE_OUT2)/building_corrected_on_exp1.json
-	@# experiment 2's record has two gaps (a row at 04-22 13:20, 6.5 h on 04-28): it is compared on the
-	@# two stretches between them, each with its own three days of burn-in
-	$(call twinhouse_exp2_part,early,2014-04-09T00:10+01:00,2014-04-22T13:10+01:00)
-	$(call twinhouse_exp2_part,late,2014-04-28T08:10+01:00,2014-05-19T23:20+01:00)
-
-# $(call twinhouse_exp2_part,NAME,START,END): experiment 2's measurements from START to END, and the
-# comparison of the two building files on them in out/twinhouse/exp2/NAME
-define twinhouse_exp2_part
-$(TWINHOUSE_TABLE2) --select @$(TWINHOUSE_EXAMPLE)/measurement_columns_exp2.txt --start $(2) --end $(3) \
-	-o $(TWINHOUSE_OUT2)/measurements_$(1).csv
-$(BIN)/nodeforce compare $(TWINHOUSE_OUT2)/building_as_written.json $(TWINHOUSE_OUT2)/building_corrected_on_exp1.json \
-	--weather $(TWINHOUSE_OUT2)/weather.csv --measurements $(TWINHOUSE_OUT2)/measurements_$(1).csv \
-	-o $(TWINHOUSE_OUT2)/$(1) --objective living --burn-in-days 3 --phases $(TWINHOUSE_EXAMPLE)/phases_exp2.csv
-endef
-
-# The whole Twin House N2 (examples/twinhouse_n2/README.md, docs/real-data.md): the measurements the
+# Twin House N2 (examples/twinhouse_n2/README.md, docs/real-data.md): the measurements the
 # repository carries (examples/twinhouse_n2/data/, read compressed) converted; the whole house
 # (every room with an air sensor) diagnosed on experiment 1 (summer 2013) and the early stretch of
 # experiment 2 (spring 2014, another protocol: its own supply flows and blinds, so its own building
 # file of the same house) together; then experiment 2's late stretch, which the diagnosis never
-# saw, compared with the house as written and as corrected (out/twinhouse_house/exp2/late).
-# Some 70 minutes on two free cores (163 candidates a round): not part of `make twinhouse`.
+# saw, compared with the house as written and as corrected (out/twinhouse/exp2/late).
 TWINHOUSE_ROOMS := living,corridor,bath,child,kitchen,doorway,bedroom
-TWINHOUSE_HOUSE_OUT := out/twinhouse_house
+TWINHOUSE_HOUSE_OUT := out/twinhouse
 
-twinhouse-house: venv
+twinhouse: venv
 	mkdir -p $(TWINHOUSE_HOUSE_OUT) $(TWINHOUSE_HOUSE_OUT)/exp2
 	$(TWINHOUSE_TABLE) --select @$(TWINHOUSE_EXAMPLE)/weather_columns.txt --set shading_south=0 \
 		-o $(TWINHOUSE_HOUSE_OUT)/weather.csv
@@ -109,6 +64,50 @@ twinhouse-house: venv
 	$(BIN)/nodeforce compare $(TWINHOUSE_HOUSE_OUT)/exp2/building_as_written.json $(TWINHOUSE_HOUSE_OUT)/building_after_record2.json \
 		--weather $(TWINHOUSE_HOUSE_OUT)/exp2/weather.csv --measurements $(TWINHOUSE_HOUSE_OUT)/exp2/measurements_late.csv \
 		-o $(TWINHOUSE_HOUSE_OUT)/exp2/late --objective $(TWINHOUSE_ROOMS) --burn-in-days 3 --phases $(TWINHOUSE_EXAMPLE)/phases_exp2.csv
+
+
+# The living room alone, on experiment 1 (examples/twinhouse_n2/README.md), into out/twinhouse_living:
+# diagnosed on its air, then experiment 2 (spring 2014, another protocol) converted and the house
+# as written and as corrected on experiment 1 compared on it, a record the correction never saw.
+TWINHOUSE_EXAMPLE := examples/twinhouse_n2
+TWINHOUSE_DATA := $(TWINHOUSE_EXAMPLE)/data/exp1
+TWINHOUSE_DATA2 := $(TWINHOUSE_EXAMPLE)/data/exp2
+TWINHOUSE_OUT := out/twinhouse_living
+TWINHOUSE_OUT2 := $(TWINHOUSE_OUT)/exp2
+TWINHOUSE_TABLE = $(BIN)/nodeforce table $(TWINHOUSE_DATA)/validationdataN2Exp1.txt.gz \
+	--names $(TWINHOUSE_DATA)/columns.csv --origin 2013-01-01T00:00+01:00
+TWINHOUSE_TABLE2 = $(BIN)/nodeforce table $(TWINHOUSE_DATA2)/validationdataExp2.txt.gz \
+	--names $(TWINHOUSE_DATA2)/columns.csv --origin 2014-01-01T00:00+01:00
+
+twinhouse-living: venv
+	mkdir -p $(TWINHOUSE_OUT) $(TWINHOUSE_OUT2)
+	$(TWINHOUSE_TABLE) --select @$(TWINHOUSE_EXAMPLE)/weather_columns.txt --set shading_south=0 \
+		-o $(TWINHOUSE_OUT)/weather.csv
+	$(TWINHOUSE_TABLE) --select @$(TWINHOUSE_EXAMPLE)/measurement_columns.txt \
+		--start 2013-08-27T00:00+01:00 --end 2013-10-01T00:00+01:00 -o $(TWINHOUSE_OUT)/measurements.csv
+	$(BIN)/nodeforce diagnose $(TWINHOUSE_EXAMPLE)/building.json --weather $(TWINHOUSE_OUT)/weather.csv \
+		--measurements $(TWINHOUSE_OUT)/measurements.csv -o $(TWINHOUSE_OUT) --objective living \
+		--calibration-end 2013-09-14T00:00+01:00 --burn-in-days 3 --seed 0 \
+		--reference $(TWINHOUSE_EXAMPLE)/reference.json --phases $(TWINHOUSE_EXAMPLE)/phases.csv
+	$(TWINHOUSE_TABLE2) --select @$(TWINHOUSE_EXAMPLE)/weather_columns_exp2.txt \
+		--set shading_south=1,shading_W27=0,shading_W33=0 -o $(TWINHOUSE_OUT2)/weather.csv
+	$(BIN)/python $(TWINHOUSE_EXAMPLE)/make_building.py --experiment 2 -o $(TWINHOUSE_OUT2)/building_as_written.json
+	$(BIN)/python $(TWINHOUSE_EXAMPLE)/make_building.py --experiment 2 --corrected-by $(TWINHOUSE_OUT)/report.json \
+		-o $(TWINHOUSE_OUT2)/building_corrected_on_exp1.json
+	@# experiment 2's record has two gaps (a row at 04-22 13:20, 6.5 h on 04-28): it is compared on the
+	@# two stretches between them, each with its own three days of burn-in
+	$(call twinhouse_exp2_part,early,2014-04-09T00:10+01:00,2014-04-22T13:10+01:00)
+	$(call twinhouse_exp2_part,late,2014-04-28T08:10+01:00,2014-05-19T23:20+01:00)
+
+# $(call twinhouse_exp2_part,NAME,START,END): experiment 2's measurements from START to END, and the
+# comparison of the two building files on them in out/twinhouse_living/exp2/NAME
+define twinhouse_exp2_part
+$(TWINHOUSE_TABLE2) --select @$(TWINHOUSE_EXAMPLE)/measurement_columns_exp2.txt --start $(2) --end $(3) \
+	-o $(TWINHOUSE_OUT2)/measurements_$(1).csv
+$(BIN)/nodeforce compare $(TWINHOUSE_OUT2)/building_as_written.json $(TWINHOUSE_OUT2)/building_corrected_on_exp1.json \
+	--weather $(TWINHOUSE_OUT2)/weather.csv --measurements $(TWINHOUSE_OUT2)/measurements_$(1).csv \
+	-o $(TWINHOUSE_OUT2)/$(1) --objective living --burn-in-days 3 --phases $(TWINHOUSE_EXAMPLE)/phases_exp2.csv
+endef
 
 # The forcing search's speed, then the diagnosis on 62 records x 3 noise draws (about an hour on
 # 2 cores; finished records are kept in out/bench_diagnosis and skipped by a rerun):

@@ -174,6 +174,17 @@ def right(result, who):
     return found[0] == "none" if not answers else found in answers
 
 
+def tied(result):
+    """The first effect is right, or the record's fault is among the candidates the first round
+    names as not told apart from it by the data (within one standard error: `indistinct`), the
+    report then saying the fault may be either: what the data allow, beside what was chosen."""
+    if right(result, "loop"):
+        return True
+    rounds = result["loop"].get("rounds") or []
+    answers = {"@".join(map(str, a)) for a in result["answers"]}
+    return bool(rounds and result["loop"]["effects"] and answers & set(rounds[0].get("indistinct", [])))
+
+
 def truth_label(result):
     return "none" if result["effect"] == "none" else f"{result['effect']}@{result['target']}"
 
@@ -225,6 +236,7 @@ def summary(results, draws):
         "diagnoses": len(ok), "failed": len(failed), "records": len(by_record),
         "right": share(right(r, "loop") for r in faulty), "right_subtle": share(right(r, "loop") for r in subtle),
         "right_strong": share(right(r, "loop") for r in strong),
+        "right_or_tied": share(tied(r) for r in faulty), "right_or_tied_subtle": share(tied(r) for r in subtle),
         "baseline_right": share(right(r, "baseline") for r in faulty),
         "baseline_right_subtle": share(right(r, "baseline") for r in subtle),
         "clean_untouched": share(right(r, "loop") for r in clean),
@@ -245,6 +257,9 @@ def summary(results, draws):
         f"{pct(numbers['right'])} of the diagnoses of faulty records (>= 90 %); the baseline {pct(numbers['baseline_right'])}",
         f"- {mark(numbers['right_subtle'], CRITERIA['right_subtle'])}: on {pct(numbers['right_subtle'])} of the "
         f"subtle ones (>= 80 %); the baseline {pct(numbers['baseline_right_subtle'])}",
+        f"- (beside the criteria) the record's fault first, or named among the candidates the data cannot tell "
+        f"from the first (within one standard error): {pct(numbers['right_or_tied'])} of the faulty records, "
+        f"{pct(numbers['right_or_tied_subtle'])} of the subtle ones",
         f"- {mark(numbers['clean_untouched'], 1)}: nothing added to {pct(numbers['clean_untouched'])} of the "
         f"diagnoses of records without a fault (100 %); the baseline {pct(numbers['baseline_clean_untouched'])}",
         f"- {mark(numbers['within'], CRITERIA['within'])}: validation RMSE after within {WITHIN} x the noise on "

@@ -34,6 +34,7 @@ import pandas as pd
 import pvlib
 
 from nodeforce import tempdirs
+from nodeforce.diagnose.candidates import limits
 from nodeforce.iotools.typical_year import convert_typical_year, relocate
 from nodeforce.iotools.weather import read_weather
 from nodeforce.model.building import load_building, parse_building
@@ -394,8 +395,11 @@ def tuned_scale(spec, building, truth0, weather0, times, nodes, air):
 
 
 def max_scale(building, spec):
-    """The largest scale keeping every parameter in the effect's range (and the opening smaller
-    than its wall)."""
+    """The largest scale keeping every parameter in the effect's range and within its physical
+    limits (`diagnose.candidates.limits`: a record whose fault no building could have, a door 19
+    times as conductive as its wood, inside convection at a twentieth, tests a refusal, not a
+    diagnosis), and the opening smaller than its wall. A fault that is still not subtle at that
+    scale is as large as physics lets it be: its record says so by its before/noise."""
     if spec.effect not in EFFECTS:
         if spec.effect == "opening":
             return 0.9 * building.component(spec.target).area / spec.full["area"]
@@ -404,6 +408,8 @@ def max_scale(building, spec):
     base = neutral(building, spec)
     limit = 20.0
     for p, (low, high) in zip(effect.parameters, effect.bounds(building, spec.target)):
+        physical = limits(building, spec.effect, spec.target, p.name)
+        low, high = max(low, physical[0]), min(high, physical[1])
         if p.name in spec.full and p.name != "T_ground":
             delta = spec.full[p.name] - base[p.name]
             if delta > 0:
@@ -496,8 +502,8 @@ GROUND = {"mia-jun": 24.0, "mia-dec": 15.0, "sdp-jul": 5.0}  # C, the ground bel
 PLAN = {  # scenario: [fault or "none", size "s" subtle / "L" strong]
     "mia-jun": ["none", "infiltration s", "bridge s", "envelope s", "convection s", "door s", "wall s",
                 "ground s", "schedule s", "opening s"],
-    # every node measured in winter: the door (1.6 m2) 20 times as conductive, or the inside convection
-    # a twentieth, stay subtle here
+    # every node measured in winter: the door (1.6 m2) ten times as conductive, or the inside
+    # convection a tenth, the most physics allows (`max_scale`), stay subtle here
     "gso-jan": ["none", "infiltration L", "bridge L", "envelope L", "convection s", "door s", "wall L",
                 "roof-alpha s", "window-tau s", "mass s"],
     "sdp-jul": ["none", "ground L", "roof-alpha L", "window-tau L", "gain s", "daily s", "east-sun s",

@@ -151,3 +151,15 @@ def test_the_baseline_fits_a_strong_air_change_to_its_size():
     values, J, _ = fit_one(r.building, case, "infiltration", "cell", [23], rows)
     assert values["n"] == pytest.approx(r.values["n"], rel=0.05)
     assert J < 2 * rows.size * r.spec.noise ** 2
+
+
+def test_a_fault_is_never_scaled_beyond_what_a_building_could_have():
+    """The door's conductivity factor and the inside convection's stay within their physical
+    limits (0.1 to 10, as a diagnosis judges them) whatever size a record asks for."""
+    from benchmarks.records import max_scale, at_scale
+    for fault, name in (("door", "factor"), ("convection", "factor")):
+        spec = small(fault)
+        building = file_building(spec)
+        value = at_scale(building, spec, max_scale(building, spec))[name]
+        assert 0.1 <= value <= 10.0
+        assert value > 9.0 or value < 0.2  # and the scale reaches near the limit, not short of it

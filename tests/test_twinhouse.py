@@ -357,7 +357,7 @@ def test_energy_balance_closes_every_step_on_real_days(tmp_path, data, measured)
 
 @pytest.mark.slow  # processes, a cluster or a whole diagnosis: not in `make check`
 def test_diagnose_end_to_end_on_a_few_real_days(tmp_path):
-    """The conversion and the diagnosis `make twinhouse` runs, on four days of the heat pulses.
+    """The conversion and the diagnosis `make twinhouse-living` runs, on four days of the heat pulses.
     Of the nine forcing candidates, the corridor's air and W9's three nodes only: 16 forcing
     patterns rather than 512 keep the test to a small budget."""
     from nodeforce.cli import main
