@@ -17,7 +17,7 @@ import time
 import numpy as np
 from scipy.optimize import least_squares
 
-from nodeforce.model.effects import BRIDGE_TO, EFFECTS, bridge_parts
+from nodeforce.model.effects import BRIDGE_TO, EFFECTS, PAIR, bridge_parts, pair_parts
 from nodeforce.model.building import Surface
 from nodeforce.model.integrate import simulate
 from nodeforce.model.network import assemble
@@ -34,6 +34,10 @@ def concerns(building, effect, target, zones):
         return target.partition(BRIDGE_TO)[0] in zones
     if target in {z.name for z in building.zones}:
         return target in zones
+    if PAIR in target:  # air exchanged between two zones
+        return bool(set(pair_parts(target)) & set(zones))
+    if target in building.boundary_columns:  # every conductance to a boundary, the house's
+        return True
     c = building.component(target)
     return c.inside.zone in zones or (isinstance(c.outside, Surface) and c.outside.zone in zones)
 

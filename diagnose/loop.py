@@ -349,7 +349,8 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
     by_phase = []
     for i, (record, case) in enumerate(zip(records, windows.cases)):
         rows = phase_errors(record.phases, case.times[1:], windows.measured[i],
-                            {"before": before_runs[i], **{key: r[i] for key, r in runs.items()}, "after": after_runs[i]})
+                            {"before": before_runs[i], **{key: r[i] for key, r in runs.items()}, "after": after_runs[i]},
+                            zones=objective.zones)
         by_phase += [{**row, "phase": f"{record.name}: {row['phase']}", "record": record.name}
                      if len(records) > 1 else row for row in rows]
     if by_phase and added:

@@ -13,8 +13,10 @@ from nodeforce.model.score import metrics
 WORSE = 0.05
 
 
-def phase_errors(phases, times, measured, runs):
-    """The RMSE (C) of every run on every phase, over the scored steps the phase holds.
+def phase_errors(phases, times, measured, runs, zones=(), apart=("before", "after")):
+    """The RMSE (C) of every run on every phase, over the scored steps the phase holds, and of
+    the runs `apart` in each zone where the objective has several (`zones`, the columns' names):
+    a house's total can hide a room made worse.
 
     Parameters
     ----------
@@ -23,9 +25,12 @@ def phase_errors(phases, times, measured, runs):
     measured : (N_t, n_zones) measured air of the objective (C), NaN where not scored
     runs : {label: (N_t, n_zones) simulated air (C)}
 
+    zones : names of the columns of `measured`; apart : the labels of `runs` given per zone
+
     Returns
     -------
-    [{"phase", "start", "end", "n", "rmse": {label: C, or None where the phase holds no scored step}}]
+    [{"phase", "start", "end", "n", "rmse": {label: C, or None where the phase holds no scored
+    step}, and with several zones "zones": {zone: {label of `apart`: C or None}}}]
     """
     rows = []
     for phase in phases:
@@ -35,6 +40,11 @@ def phase_errors(phases, times, measured, runs):
                      "end": phase.end.isoformat() if phase.end is not None else None, "n": n,
                      "rmse": {label: metrics(measured[inside], run[inside])["rmse"] if n else None
                               for label, run in runs.items()}})
+        if len(zones) > 1:
+            rows[-1]["zones"] = {
+                zone: {label: metrics(measured[inside, j:j + 1], runs[label][inside, j:j + 1])["rmse"]
+                       if np.isfinite(measured[inside, j]).any() else None for label in apart if label in runs}
+                for j, zone in enumerate(zones)}
     return rows
 
 

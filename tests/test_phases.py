@@ -52,3 +52,20 @@ def test_errors_by_phase_by_hand_and_the_phase_made_worse(tmp_path):
     assert rows[2]["rmse"] == {"before": None, "after": None}  # kept, not dropped: nothing to score
     assert worsened(rows, "before", "after") == [{"phase": "free", "before": pytest.approx(0.5),
                                                    "after": pytest.approx(1.0)}]
+
+
+def test_each_zone_by_phase_by_hand_where_the_total_hides_a_room_made_worse(tmp_path):
+    """Two rooms: the correction cures room a (residuals 2, 2 -> 0) and harms room b (0 -> 1, 1);
+    the phase's total falls (sqrt(2) -> sqrt(1/2)) while room b's RMSE goes from 0 to 1."""
+    phases = read_phases(write(tmp_path, "time,phase\n2020-01-01T00:00+00:00,held\n"))
+    times = pd.date_range("2020-01-01T00:00+00:00", periods=2, freq="1h")
+    measured = np.array([[22.0, 20.0], [22.0, 20.0]])
+    before = np.array([[20.0, 20.0], [20.0, 20.0]])
+    after = np.array([[22.0, 19.0], [22.0, 19.0]])
+    [row] = phase_errors(phases, times, measured, {"before": before, "after": after}, zones=("a", "b"))
+    assert row["rmse"] == {"before": pytest.approx(2 ** 0.5), "after": pytest.approx(0.5 ** 0.5)}
+    assert row["zones"] == {"a": {"before": pytest.approx(2.0), "after": pytest.approx(0.0)},
+                            "b": {"before": pytest.approx(0.0), "after": pytest.approx(1.0)}}
+    # one zone: no per-zone rows, the total is the zone's
+    [alone] = phase_errors(phases, times, measured[:, :1], {"before": before[:, :1]}, zones=("a",))
+    assert "zones" not in alone

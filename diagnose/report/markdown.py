@@ -138,6 +138,9 @@ def write_markdown(out_dir, report, plots, notes):
                + (f"; the chosen candidates only, every candidate's in report.json" if len(
                    report["phases"][0]["rmse"]) > tables.PHASE_COLUMNS else "") + ".", "",
                by_phase, ""]
+        by_zone = tables.phase_zones(report)
+        if by_zone:
+            md += ["Each zone in each phase, RMSE (C) before -> after:", "", by_zone, ""]
     md += figure("temperature", "Measured and simulated indoor air temperature, before and after")
     md += figure("residuals", "Air residual before and after, mean and sd per window")
     md += ["## Residual diagnostics", "", *residual_lines(report), ""]

@@ -244,6 +244,22 @@ def phases(report):
                      for row in rows])
 
 
+def phase_zones(report):
+    """RMSE (C) of each zone in each phase, before -> after, where the objective has several zones
+    (a house's total can hide a room made worse: ▲); "" otherwise."""
+    rows = [row for row in report.get("phases") or [] if row.get("zones") and row["n"]]
+    if not rows:
+        return ""
+    zones = list(rows[0]["zones"])
+
+    def cell(values):
+        before, after = num(values.get("before")), num(values.get("after"))
+        if before is None or after is None:
+            return NA
+        return f"{fmt_temp(before)} -> {fmt_temp(after)}" + (" ▲" if is_worse(before, after) else "")
+    return markdown(["phase"] + zones, [[row["phase"]] + [cell(row["zones"][z]) for z in zones] for row in rows])
+
+
 def records(report):
     """RMSE (C) before and after per record, window and zone, the objective's first, of a
     diagnosis of several records; "" for one."""
