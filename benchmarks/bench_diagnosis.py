@@ -359,10 +359,12 @@ def write_docs(path, lines, args, elapsed):
         "schedule (150 W from 08:00 to 18:00 at scale 1), or a south opening (0.6 m2 of glazing at scale "
         "1, its sun to the floor); its size is tuned by simulating so that the file's validation RMSE is "
         "2.2 x the noise (subtle, accepted 1.5 to 3) or 6 x (strong, 4 to 9); Gaussian noise, seeded by "
-        "the record's name and draw. Even without a fault the file is not the truth: its coarser walls "
-        "and its step leave an error that grows with the step (0.08 C at 10 min, 0.14 C at 30 min, "
-        "0.24 C at 60 min on the test cell in June; the noise of each scenario is chosen so that the "
-        "record without a fault has a 'before' of at most 1.6 x the noise, its 'before/noise' below).", "",
+        "the record's name and draw. A fault is never scaled beyond its physical limits (a factor on a "
+        "conductance or a convection coefficient within 0.1 to 10): where that limit comes before the "
+        "size asked for, the record is as large as physics lets it be, its 'before/noise' below. Even "
+        "without a fault the file is not the truth: its coarser walls and the truth's real history "
+        "leave it 0.03 to 0.06 C (it integrates every record in steps of at most 5 min, docs/model.md "
+        "5.1; at the record's own step, the error grew with the step, to 0.3 C at 60 min).", "",
         scenarios_table(), "",
         "A first effect is right when it is the record's fault with its target; an air change and a "
         "bridge to the outdoor air are one equation and count as one; a schedule is right as a daily "
