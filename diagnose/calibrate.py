@@ -21,6 +21,7 @@ from SALib.sample import morris as morris_sample
 from scipy.optimize import least_squares
 
 from nodeforce.diagnose.candidates import IDENTIFIABLE_RELATIVE, calibration_start
+from nodeforce.model.case import as_cases
 from nodeforce.model.significance import bandwidth, parameter_covariance
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.hlc import heat_loss_coefficient
@@ -111,7 +112,7 @@ def calibrate(candidate, cases, objective, blocks=()):
     without it (`fold`) and the residuals (C, (N_t, zones) of its record, NaN off the block) they
     leave on it
     """
-    cases = [cases] if not isinstance(cases, (list, tuple)) else list(cases)
+    cases = as_cases(cases)
     blocks = [b if isinstance(b, tuple) else (0, b) for b in blocks]
     measured = [objective.measured(case) for case in cases]
     have = [np.isfinite(m) for m in measured]
@@ -244,7 +245,7 @@ def sensitivity(candidate, cases, objective, seed=0):
     Returns {name: {"mu_star": C2, "sigma": C2}}: mu* ranks how much J moves with a parameter,
     sigma how much that depends on the others (interaction or non-linearity).
     """
-    cases = [cases] if not isinstance(cases, (list, tuple)) else list(cases)
+    cases = as_cases(cases)
     measured = [objective.measured(case) for case in cases]
     problem = {"num_vars": len(candidate.parameters), "names": [p.name for p in candidate.parameters],
                "bounds": [list(b) for b in candidate.bounds]}

@@ -233,7 +233,7 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
     its) or a list of `Record`s of the same building, each with its own windows and phases: the
     fits minimise the sum of every record's calibration J, the choice reads every record's
     blocks, and a candidate that harms one record is refused (`selection.decide`). The forcing
-    search reads the first record's calibration window.
+    search reads every record's calibration window together, then, reported, each one's alone.
     `reference` ({"label", "rmse": {phase: K}}), another model's error, is reported for scale;
     `noise` (C) is the air sensors' noise sd if the user knows it, else it is estimated from
     every record's air."""
@@ -247,9 +247,7 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
     windows = Windows.of(records, objective)
     first = windows.cases[0]
     n = windows.scored()
-    # the records apart by a row of NaN: no second difference spans two records
-    gap = np.full((1, len(objective.zones)), np.nan)
-    noise = Noise.of(np.concatenate([x for m in windows.measured for x in (m, gap)][:-1]), noise)
+    noise = Noise.of_records(windows.measured, noise)
     sigma = noise.sigma
 
     bases = [protocol(building, r) for r in records]

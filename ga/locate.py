@@ -17,6 +17,7 @@ from nodeforce.fmu_build.compiler import find_compiler
 from nodeforce.ga.fitness import FmuFitness, RecordsFitness
 from nodeforce.ga.parsimony import EXPLAINED, removed
 from nodeforce.ga.search import PATIENCE, search
+from nodeforce.model.case import as_cases
 from nodeforce.model.errors import InputError
 from nodeforce.model.network import assemble
 from nodeforce.model.score import Noise
@@ -72,11 +73,6 @@ def chromosome_nodes(building, case, objective, source, nodes=None, include_alge
     return sorted(chosen, key=lambda i: (distance[i - 1], i))
 
 
-def as_cases(case):
-    """A list of Cases from a Case or a sequence of them."""
-    return list(case) if isinstance(case, (list, tuple)) else [case]
-
-
 def locate(building, case, objective, workdir, *, source="measurements", nodes=None,
            include_algebraic=False, population=30, generations=400, pc=0.8, pm=0.03, seed=0,
            patience=PATIENCE, seeded=True, workers=None, scheduler=None, warmup_days=2, progress=None,
@@ -107,9 +103,7 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
     parts = [FmuFitness(path, c, candidates, objective, warmup_days) for path, c in zip(fmus, cases)]
     fitness = parts[0] if len(parts) == 1 else RecordsFitness(parts)
     measured = [objective.measured(c) for c in cases]
-    # the records apart by a row of NaN: no second difference spans two records
-    gap = np.full((1, len(objective.zones)), np.nan)
-    noise = Noise.of(np.concatenate([x for m in measured for x in (m, gap)][:-1]), noise)
+    noise = Noise.of_records(measured, noise)
     measured_ids = sorted(set().union(*(c.measured_ids for c in cases)))
     if not candidates:
         return nothing_to_force(building, measured_ids, objective, fitness, noise)

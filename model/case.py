@@ -102,6 +102,11 @@ class Case:
                        fluxes={name: values[rows] for name, values in self.fluxes.items()})
 
 
+def as_cases(case):
+    """A list of Cases from a Case or a sequence of them (the records of one building)."""
+    return list(case) if isinstance(case, (list, tuple)) else [case]
+
+
 def uniform_grid(times, source):
     """The uniform grid spanning `times` (their most common step, s), or InputError where a
     time falls off it. Rows absent from a file become grid rows with nothing measured."""

@@ -358,6 +358,8 @@ def within_steps(values, k, held=None):
     list of k (N_t+1, m) arrays, the last equal to `values`
     """
     values = np.asarray(values, dtype=float)
+    if k == 1:  # one step per sample: nothing in between
+        return [values]
     start = values.copy()
     apart = np.isfinite(values[:-1]) & np.isfinite(values[1:])
     if held is not None:
@@ -404,8 +406,7 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     if force is None:
         force = np.zeros(n, dtype=bool)
     forced = forcing_schedule(force, measured, burn_in_steps)
-    held = held_inputs(building, network.input_names)
-    sources = [network.sources(u) for u in within_steps(U, substeps, held)]
+    sources = [network.sources(u) for u in within_steps(U, substeps, held_inputs(building, network.input_names))]
     imposed_at = within_steps(measured, substeps)
     stepper = ImplicitEuler(network, dt / substeps) if stepper is None else stepper
     T = initial_state(building, measured[0], T_default)

@@ -84,6 +84,13 @@ class Noise:
         return cls(float(np.sqrt(np.mean(np.square(sigmas)))) if sigmas else None,
                    lag1=max(lags) if lags else None)
 
+    @classmethod
+    def of_records(cls, measured_airs, given=None):
+        """`of` the measured air of several records ((N_t, k) each), joined apart by a row of NaN
+        so that no second difference spans two records."""
+        gap = np.full((1, np.shape(measured_airs[0])[1]), np.nan)
+        return cls.of(np.concatenate([x for m in measured_airs for x in (m, gap)][:-1]), given)
+
     @property
     def visible(self):
         """Whether sigma is the noise itself (given, or white noise dominating the differences)."""
