@@ -143,7 +143,8 @@ def implausible(building, effect, target):
 SHAPES = ("daily_gain", "proportional_gain")
 
 # Physical limits, tighter than the range a calibration explores (model.effects): a value
-# outside them is not a property of a building but a fit compensating something else. A gain to
+# outside them, by more than its uncertainty (`LIMIT_STANDARD_DEVIATIONS`), is not a property of
+# a building but a fit compensating something else. A gain to
 # the air is a source, not a sink (a heat sink would be a cooler the file would declare); scales
 # of conductances and convection within a factor of ten of what the file declares.
 PHYSICAL_LIMITS = {("internal_gain", "Q"): (0.0, math.inf),
@@ -160,6 +161,10 @@ PHYSICAL_LIMITS = {("internal_gain", "Q"): (0.0, math.inf),
 # profile's harmonics may each be near zero, and small next to their uncertainty, while the
 # profile and its mean are determined.
 JUDGED = {"daily_gain": ("mean",)}
+# Standard deviations of its estimate a value must lie beyond a physical limit to be refused: a
+# door at the limit of ten times its wood's conductivity, estimated at 11.4 +- 1.5, may well be at
+# ten; only an estimate whose two-sided 95 % interval leaves the physical range says it is not.
+LIMIT_STANDARD_DEVIATIONS = 2.0
 
 
 def is_shape(effect):
@@ -196,7 +201,7 @@ def objection(building, effect, target, parameters, derived=None):
     """Why a calibrated effect may not be added to the model, or None: a gain the building file's
     description rules out (`implausible`), a parameter on a bound of its search range or not
     identifiable from the data (unless the quantity its parameters trade off along is, TRADE_OFFS),
-    or a value outside physical limits.
+    or a value outside physical limits beyond its uncertainty (`LIMIT_STANDARD_DEVIATIONS`).
 
     parameters : {name: {"value", "std", "identifiable", "on_bound"}} of `diagnose.calibrate`
     derived : what the data determine besides (`diagnose.calibrate.derived`)
@@ -212,9 +217,11 @@ def objection(building, effect, target, parameters, derived=None):
             reasons.append(f"{name} = {p['value']:.3g} {unit} ends on a bound of its range")
         elif not p["identifiable"] and not resolved:
             reasons.append(f"{name} = {p['value']:.3g} +- {p['std']:.2g} {unit} is not identifiable from these data")
-        if not low <= p["value"] <= high:
+        margin = LIMIT_STANDARD_DEVIATIONS * p["std"]
+        if not low - margin <= p["value"] <= high + margin:
             what = "a negative gain (a heat sink)" if low == 0.0 and "gain" in effect else "outside physical limits"
-            reasons.append(f"{name} = {p['value']:.3g} {unit} is {what} [{low:g}, {high:g}]")
+            reasons.append(f"{name} = {p['value']:.3g} +- {p['std']:.2g} {unit} is {what} [{low:g}, {high:g}] "
+                           f"by more than {LIMIT_STANDARD_DEVIATIONS:g} standard deviations")
     return "; ".join(r for r in reasons if r) or None
 
 

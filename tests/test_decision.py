@@ -44,6 +44,14 @@ def test_a_factor_outside_physical_limits_is_refused(testcell):
     assert objection(testcell, "conductivity", "door", {"factor": parameter(3.4, 0.2)}) is None
 
 
+def test_a_physical_limit_is_judged_with_the_estimate_s_uncertainty(testcell):
+    # the limit is ten times the declared conductivity: 11.4 +- 1.5 may be ten, 11.4 +- 0.5 is not
+    assert objection(testcell, "conductivity", "door", {"factor": parameter(11.4, 1.5)}) is None
+    assert "2 standard deviations" in objection(testcell, "conductivity", "door", {"factor": parameter(11.4, 0.5)})
+    # a gain of -3 +- 2 W may be no gain at all; -545 +- 16 W is a heat sink
+    assert objection(testcell, "internal_gain", "cell", {"Q": parameter(-3.0, 2.0)}) is None
+
+
 def test_a_gain_in_a_zone_declared_unoccupied_is_refused(unoccupied):
     values = {"mean": parameter(46.0, 3.0), **{t: parameter(1.0, 5.0, identifiable=False)
                                                 for t in ("cos1", "sin1", "cos2", "sin2", "cos3", "sin3", "cos4", "sin4")}}
