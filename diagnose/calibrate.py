@@ -54,7 +54,6 @@ class Candidate:
     def __init__(self, building, effect, target, protocols=None):
         self.building, self.effect, self.target = building, effect, target
         self.protocols = protocols or {}
-        self.declared = EFFECTS[effect].apply(building, target, {})  # the inputs it reads
         self.parameters = EFFECTS[effect].parameters
         self.bounds = EFFECTS[effect].bounds(building, target)  # [(low, high)] a calibration explores
         self._runs, self._inputs = {}, {}
