@@ -216,7 +216,9 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers):
         result = {"effect": effect, "target": target, "parameters": parameters, "derived": determined,
                   **metrics,
                   "cv": {"blocks": scores, "J": sum(scores), "n": n, "rmse": float(np.sqrt(sum(scores) / n)),
-                         "folds": [f["values"] for f in folds]}}
+                         "folds": [f["values"] for f in folds],
+                         # each block's left-out residuals, in one order for every candidate
+                         "left_out": np.concatenate([f["residuals"][np.isfinite(f["residuals"])] for f in folds])}}
         values = {name: p["value"] for name, p in parameters.items()}
         models[label(result)] = model.adding(effect, target, values, runs, metrics)
         results.append(result)
@@ -316,7 +318,8 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
                             "seconds": round(time.perf_counter() - started, 1)}
         rounds.append(decision)
         on_top = {"on_top_of": [label(a) for a in added]} if added else {}
-        results += [{**r, "round": number + 1, **on_top} for r in tried]
+        results += [{**r, "cv": {k: v for k, v in r["cv"].items() if k != "left_out"}, "round": number + 1, **on_top}
+                    for r in tried]
         runs.update({(key if not added else f"{key} (round {number + 1})"): m.runs for key, m in models.items()})
         if not chosen:
             break

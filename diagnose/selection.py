@@ -25,9 +25,14 @@ to, block by block:
    suggestion, with its reason, never added.
 3. Among the admissible candidates that pass, the one-standard-error rule: the candidates whose
    cross-validated J exceeds the best's by no more than one standard error of that paired
-   difference (per block) cannot be told apart from it, and among them a physical effect
-   before a shape, then fewer parameters before more, then the lower J. Components whose
-   corrections cannot be told apart are named together in the reason.
+   difference cannot be told apart from it, and among them a physical effect before a shape,
+   then fewer parameters before more, then the lower J. That standard error is the larger of
+   two: the difference's scatter from block to block, and what the sensors' noise alone makes of
+   it (`noise_difference`). Two corrections that predict nearly the same air (an air change and
+   an envelope factor in a mild month) differ by nearly the same small amount every day, so the
+   blocks' scatter is tiny; yet another draw of the noise would move that difference by
+   2 sigma |r_a - r_b|, and reverse it where it is smaller. Components whose corrections cannot
+   be told apart are named together in the reason.
 
 The validation window plays no part. A model built by earlier rounds is the baseline a later
 round's candidate must pass against (its parameters held).
@@ -91,6 +96,18 @@ def fall(base, scores):
     per-block falls (blocks as the unit)."""
     d = np.asarray(base, dtype=float) - np.asarray(scores, dtype=float)
     return float(d.sum()), float(math.sqrt(len(d)) * d.std(ddof=1))
+
+
+def noise_difference(a, b, sigma):
+    """The standard deviation (C2) of the difference of two candidates' cross-validated J that
+    sensor noise of sd sigma (C) alone makes: J_a - J_b = sum (r_a - r_b)(r_a + r_b), and the
+    noise e of a measurement enters r_a + r_b twice, so the difference moves by 2 sum (r_a - r_b) e,
+    of sd 2 sigma |r_a - r_b|. `a`, `b`: the candidates' records; 0 where either lacks its
+    left-out residuals (`cv.left_out`, C, every block's in one order)."""
+    ra, rb = a["cv"].get("left_out"), b["cv"].get("left_out")
+    if ra is None or rb is None:
+        return 0.0
+    return float(2.0 * sigma * np.linalg.norm(np.asarray(ra) - np.asarray(rb)))
 
 
 def harmed(base, scores, sigma, groups):
@@ -158,7 +175,7 @@ def decide(building, results, base, sigma, n, groups=()):
         def close(r):
             # how much worse than the best it predicts the left-out days, and the scatter of that
             worse, se = fall(r["cv"]["blocks"], best["cv"]["blocks"])
-            return worse <= max(STANDARD_ERRORS * se, floor)
+            return worse <= max(STANDARD_ERRORS * max(se, noise_difference(r, best, sigma)), floor)
         near = [r for r in admissible if close(r)]
         chosen = min(near, key=lambda r: (preference(r["effect"]), r["cv"]["J"]))
         alike = [r for r in near if r is not chosen]

@@ -176,3 +176,30 @@ def test_two_components_the_data_cannot_tell_apart_are_both_named(testcell):
     chosen, decision = decide(testcell, [door([2.0, 2.2, 2.1, 2.2]), wall], BASE, SIGMA, N)
     assert chosen["target"] == "door"
     assert "cannot be told from that of west_wall" in decision["reason"]
+
+
+def with_left_out(result, residuals):
+    """The candidate with its left-out residuals (C, every block's in one order), its per-day J
+    computed from them: four days of N / 4."""
+    days = [float(np.sum(np.square(part))) for part in np.split(residuals, 4)]
+    return {**result, "cv": {**result["cv"], "blocks": days, "J": sum(days), "rmse": float(np.sqrt(sum(days) / N)),
+                             "left_out": residuals}}
+
+
+def test_two_corrections_the_noise_could_order_either_way_are_not_told_apart(testcell):
+    # an air change and an envelope factor predicting nearly the same air, 0.01 C apart at every
+    # step: a J difference of N x 0.01^2 = 0.019 C2, alike on every day (no scatter), which
+    # another draw of the noise would move by 2 x 0.1 x 0.01 x sqrt(192) = 0.028 C2 (one sd)
+    rng = np.random.default_rng(0)
+    noise = rng.normal(0.0, SIGMA, N)
+    noise -= np.repeat([part.mean() for part in np.split(noise, 4)], N // 4)  # every day alike
+    air = candidate("infiltration", "cell", {"n": parameter(0.8, 0.05)}, BASE)
+    envelope = candidate("envelope_conductance", "cell", {"factor": parameter(1.3, 0.05)}, BASE)
+    near = with_left_out(air, noise + 0.01)
+    best = with_left_out(envelope, noise)
+    chosen, decision = decide(testcell, [near, best], BASE, SIGMA, N)
+    assert decision["indistinct"], decision["reason"]
+    # 0.2 C apart: a J difference of 7.7 C2 against a noise sd of 0.55 C2: told apart
+    far = with_left_out(air, noise + 0.2)
+    chosen, decision = decide(testcell, [far, best], BASE, SIGMA, N)
+    assert chosen["effect"] == "envelope_conductance" and not decision["indistinct"]
