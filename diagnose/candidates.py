@@ -20,6 +20,8 @@ ABSENT_START = {("ground_coupling", "U"): 1.0,  # W/m2/K
 # half an hour), so the mass's time constant starts at hours and the heater's at half an hour.
 ZONE_START = {("internal_mass", "C_m"): 10.0,
               ("heat_input_lag", "C_h"): 1.0}
+# How far inside its range (a fraction of it) a calibration starts a value declared on a bound.
+INSIDE = 1e-3
 
 
 # A scale parameter, or a derived quantity, is identifiable when its standard deviation is under
@@ -117,13 +119,21 @@ def calibration_start(building, effect, target):
     n = 0, UA = 0, a closed shading's leak f = 0) starts at `ABSENT_START` and an absent zone node
     (C = 0) at `ZONE_START`: on its bound, a bounded trust-region step is scaled to nothing and the
     fit stops where it began, and at U = 0 the ground temperature (at C = 0 the node's
-    conductance) has no influence to fit at all; an absent door, V = 0, likewise."""
+    conductance) has no influence to fit at all; an absent door, V = 0, likewise. Any other value
+    declared on a bound of the range (a heater declared all convective, f_r = 0) starts `INSIDE`
+    of the range inside it, for the same reason: declared there, the effect was never calibrated."""
     values = EFFECTS[effect].read(building, target)
     for name, value in values.items():
         if value == 0.0 and (effect, name) in ABSENT_START:
             values[name] = ABSENT_START[(effect, name)]
         if value == 0.0 and (effect, name) in ZONE_START:
             values[name] = ZONE_START[(effect, name)] * RHO_C_AIR * building.zone(target).volume
+    for p, (low, high) in zip(EFFECTS[effect].parameters, EFFECTS[effect].bounds(building, target)):
+        step = INSIDE * (high - low if math.isfinite(high - low) else 1.0)
+        if values[p.name] <= low:
+            values[p.name] = low + step
+        elif values[p.name] >= high:
+            values[p.name] = high - step
     return values
 
 

@@ -10,6 +10,7 @@ import pandas as pd
 import pvlib
 import pytest
 
+from nodeforce.diagnose.calibrate import Candidate, calibrate
 from nodeforce.diagnose.loop import diagnose
 from nodeforce.iotools.typical_year import convert_typical_year, relocate
 from nodeforce.iotools.weather import read_weather
@@ -160,3 +161,16 @@ def test_furniture_behind_a_small_conductance_with_the_air_alone(testcell_data, 
     report = run(building, case, tmp_path, noise=0.1)
     assert added(report)[:1] == [("internal_mass", "cell")], report["decision"]["reason"]
     assert report["after"]["validation"]["rmse"] < 1.5 * 0.1 < report["before"]["validation"]["rmse"]
+
+
+def test_a_heater_declared_all_convective_has_its_radiative_share_calibrated(testcell_data, weather):
+    """The file declares f_r = 0, the bound of the share's range: the calibration starts inside
+    it (else its first step is scaled to nothing and the split is never calibrated) and finds
+    the truth's 0.8."""
+    building = heated_cell(testcell_data)
+    heated = prbs_weather(weather, "2001-06-10 00:00-05:00", 5, 500.0)
+    case = record(building, heated, "2001-06-10 00:00-05:00", 5, "30min", sensors=[23], history=0, noise=0.05,
+                  effect=("heat_input_split", "cell", {"f_r": 0.8})).with_steady_start()
+    assert EFFECTS["heat_input_split"].read(building, "cell")["f_r"] == 0.0
+    found, _, _ = calibrate(Candidate(building, "heat_input_split", "cell"), case, Objective.of(building))
+    assert found["f_r"]["value"] == pytest.approx(0.8, abs=0.05)
