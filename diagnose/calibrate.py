@@ -117,7 +117,7 @@ def calibrate(candidate, cases, objective, blocks=()):
     have = [np.isfinite(m) for m in measured]
     lows, highs = np.array(candidate.bounds).T
     start = calibration_start(candidate.building, candidate.effect, candidate.target)
-    x0 = np.clip([start[p.name] for p in candidate.parameters], lows, highs)
+    x0 = np.array([start[p.name] for p in candidate.parameters])  # inside the bounds: `calibration_start`
 
     def residuals(x):
         return np.concatenate([m[h] - candidate.nodes(case, objective.air_nodes, x)[h]

@@ -120,8 +120,9 @@ def calibration_start(building, effect, target):
     (C = 0) at `ZONE_START`: on its bound, a bounded trust-region step is scaled to nothing and the
     fit stops where it began, and at U = 0 the ground temperature (at C = 0 the node's
     conductance) has no influence to fit at all; an absent door, V = 0, likewise. Any other value
-    declared on a bound of the range (a heater declared all convective, f_r = 0) starts `INSIDE`
-    of the range inside it, for the same reason: declared there, the effect was never calibrated."""
+    on or beyond a bound of the range (a heater declared all convective, f_r = 0) starts `INSIDE`
+    of the range inside it, for the same reason: declared there, the effect was never calibrated.
+    Every value returned is strictly inside the range a calibration explores."""
     values = EFFECTS[effect].read(building, target)
     for name, value in values.items():
         if value == 0.0 and (effect, name) in ABSENT_START:

@@ -11,8 +11,8 @@ import pandas as pd
 import pytest
 
 from benchmarks.baseline import fit_one
-from benchmarks.records import (CELLS, FAULTS, FINE_STEP, STRONG_BAND, SUBTLE_BAND, Spec, before_error,
-                                file_building, record, refined)
+from benchmarks.records import (CELLS, FAULTS, FINE_STEP, STRONG_BAND, SUBTLE_BAND, Spec, at_scale, before_error,
+                                file_building, max_scale, record, refined)
 from nodeforce.model.building import load_building
 from nodeforce.model.hlc import heat_loss_coefficient
 from nodeforce.model.network import assemble
@@ -156,7 +156,6 @@ def test_the_baseline_fits_a_strong_air_change_to_its_size():
 def test_a_fault_is_never_scaled_beyond_what_a_building_could_have():
     """The door's conductivity factor and the inside convection's stay within their physical
     limits (0.1 to 10, as a diagnosis judges them) whatever size a record asks for."""
-    from benchmarks.records import max_scale, at_scale
     for fault, name in (("door", "factor"), ("convection", "factor")):
         spec = small(fault)
         building = file_building(spec)
