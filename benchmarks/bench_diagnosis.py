@@ -134,7 +134,7 @@ def rounded(decision, kept=8):
     best = sorted(tests, key=lambda k: -tests[k]["cv_fall"])[:kept]
     return {"chosen": decision.get("chosen"), "cv_J_before": decision.get("cv_J_before"),
             "needed_noise": decision.get("noise_margin"), "indistinct": decision.get("indistinct", []),
-            "best": {k: {key: tests[k][key] for key in ("cv_fall", "cv_se", "needed", "passes", "objection")}
+            "best": {k: {key: tests[k].get(key) for key in ("cv_fall", "cv_se", "needed", "passes", "objection", "evidence")}
                      for k in best}}
 
 

@@ -42,6 +42,8 @@ HLC_STEP = 1e-6
 # Simulations a candidate keeps, by parameter values and window: the runs the report needs at the
 # calibrated values are then simulations already made.
 KEPT_RUNS = 64
+# Halvings of a fold's step before it falls back on the whole window's optimum (`fold`).
+FOLD_HALVINGS = 6
 
 
 class Candidate:
@@ -146,36 +148,49 @@ def calibrate(candidate, cases, objective, blocks=()):
     for record, block in blocks:
         rows = [np.broadcast_to((block[:, None] if i == record else np.zeros((len(h), 1), bool)), h.shape)[h]
                 for i, h in enumerate(have)]
-        x = fold(fit, ~np.concatenate(rows), lows, highs)
+        x = fold(fit, ~np.concatenate(rows), lows, highs, residuals)
         case, m, h = cases[record], measured[record], have[record]
         left = np.where(h & block[:, None], m - candidate.nodes(case, objective.air_nodes, x), np.nan)
         folds.append({"values": [float(v) for v in x], "residuals": left})
     return result, derived(candidate, cases[0], fit.x, cov), folds
 
 
-def fold(fit, train, lows, highs):
+def fold(fit, train, lows, highs, residuals):
     """The parameters fitted without a block: one Gauss-Newton step from the whole window's
     optimum on the `train` rows of its residuals and Jacobian, shortened along its direction
-    where it would leave the bounds.
+    where it would leave the bounds, and halved while it fits its own rows worse than the whole
+    window's optimum does (`residuals(x)`: every row's residual at x).
 
     Leaving one day out of several moves the optimum by little, and the step from the optimum
     is exact to first order in that move (for a model linear in its parameters, exact): a fold
     costs the one simulation that scores its left-out day, where a fit of its own would cost
     tens; on the Twin House's eighteen days a candidate's fifteen folds would otherwise be most
-    of a diagnosis's time."""
+    of a diagnosis's time. Where two parameters trade off (a ground coupling's U and T_ground, a
+    mass's C and H), the linearised valley is nearly flat and the step runs far along it, where
+    the model no longer is linear: such a fold, worse on its own days than the optimum it started
+    from, would score the left-out day with a fit that is no fit, and a candidate would lose the
+    cross-validation to its own linearisation. The optimum is a fit of the training rows too, so
+    a fold never does worse on them; the halvings cost a simulation each, and only where the
+    step overshoots."""
     # a parameter the whole window's fit left on a bound stays there: its step would leave the
     # range. Nor is a step that leaves the range clipped parameter by parameter: where two
-    # parameters trade off (a ground coupling's U and T_ground), the step runs along their valley,
-    # and clipping one alone (U to 0) would leave the valley, and the fit, altogether
+    # parameters trade off, the step runs along their valley, and clipping one alone (U to 0)
+    # would leave the valley, and the fit, altogether
     free = fit.active_mask == 0
-    x = fit.x.copy()
-    if free.any():
-        step = np.linalg.lstsq(fit.jac[train][:, free], -fit.fun[train], rcond=None)[0]
-        room = np.where(step > 0, highs[free] - x[free], lows[free] - x[free])
-        moving = step != 0
-        shortest = np.min(room[moving] / step[moving]) if moving.any() else 1.0
-        x[free] += min(1.0, shortest) * step
-    return np.clip(x, lows, highs)  # rounding only
+    if not free.any():
+        return fit.x.copy()
+    step = np.zeros_like(fit.x)
+    step[free] = np.linalg.lstsq(fit.jac[train][:, free], -fit.fun[train], rcond=None)[0]
+    room = np.where(step > 0, highs - fit.x, lows - fit.x)
+    moving = step != 0
+    step *= min(1.0, np.min(room[moving] / step[moving])) if moving.any() else 0.0
+    at_optimum = float(np.sum(np.square(fit.fun[train])))
+    for _ in range(FOLD_HALVINGS):
+        x = np.clip(fit.x + step, lows, highs)  # rounding only
+        if float(np.sum(np.square(residuals(x)[train]))) <= at_optimum:
+            return x
+        step /= 2.0
+    return fit.x.copy()
 
 
 # The derived time constant (s) of the effects that add a node of capacity C and conductance H.

@@ -90,18 +90,21 @@ def assess(task):
     """Calibrate one candidate effect, with its cross-validation folds, and run it: a task for a
     worker process.
 
-    Returns the calibrated parameters, what the data determine, the simulated objective air over
-    each whole record, the folds and the simulations it took; writes the
+    Returns the calibrated parameters, what the data determine, the simulated objective air and
+    other sensed nodes (`Windows.sensors`) over each whole record, the folds and the simulations
+    it took; writes the
     candidate's building file, declared at the calibrated values, in `folder`.
     """
-    building, bases, effect, target, folder, calibrations, cases, objective, blocks, seed = task
+    building, bases, effect, target, folder, calibrations, cases, objective, blocks, sensors, seed = task
     candidate = Candidate(building, effect, target, protocols(bases, calibrations, cases))
     parameters, determined, folds = calibrate(candidate, calibrations, objective, blocks)
     values = [parameters[p.name]["value"] for p in candidate.parameters]
     runs = [candidate.nodes(case, objective.air_nodes, values) for case in cases]
+    sensed = [candidate.nodes(case, ids, values) if ids else np.empty((len(case.times) - 1, 0))
+              for case, ids in zip(cases, sensors)]
     calibrated = EFFECTS[effect].apply(building, target, {name: p["value"] for name, p in parameters.items()})
     (folder / f"{candidate.label}.json").write_text(json.dumps(calibrated.to_json(), indent=2) + "\n")
-    return parameters, determined, runs, folds, candidate.simulations
+    return parameters, determined, runs, sensed, folds, candidate.simulations
 
 
 def protocols(bases, *windows):
@@ -130,18 +133,23 @@ class Record:
 @dataclass
 class Windows:
     """The records as the loop reads them: each one's case (steady start), the row k of its last
-    calibration time, its calibration window, its measured objective air (N_t, zones) and the
-    cross-validation blocks of all records in order, (record index, mask)."""
+    calibration time, its calibration window, its measured objective air (N_t, zones), the
+    cross-validation blocks of all records in order, (record index, mask), and each one's other
+    sensed nodes (`sensors`: the measured nodes besides the objective air, a wall's surface, a
+    neighbouring zone's air) with their measurements (`sensed`, (N_t, len(sensors)), NaN where
+    not scored)."""
     records: list
     cases: list
     ks: list
     calibrations: list
     measured: list
     blocks: list
+    sensors: list
+    sensed: list
 
     @classmethod
     def of(cls, records, objective):
-        cases, ks, calibrations, measured, blocks = [], [], [], [], []
+        cases, ks, calibrations, measured, blocks, sensors, sensed = [], [], [], [], [], [], []
         for i, record in enumerate(records):
             # what no sensor sets (every wall of an air-only record) starts from the steady state of
             # the first day, not at the air's temperature: a heavy component would carry that guess
@@ -153,7 +161,9 @@ class Windows:
             calibrations.append(case.window(0, k))
             measured.append(objective.measured(case))
             blocks += [(i, m) for m in blocks_of(k, case.burn_in_steps, case.dt, record.source)]
-        return cls(list(records), cases, ks, calibrations, measured, blocks)
+            sensors.append([node for node in case.measured_ids if node not in objective.air_nodes])
+            sensed.append(case.scored([node - 1 for node in sensors[-1]]))
+        return cls(list(records), cases, ks, calibrations, measured, blocks, sensors, sensed)
 
     def metrics(self, objective, runs, record=None):
         """{"calibration", "validation"}: the objective's metrics of `runs` (one (N_t, zones) per
@@ -168,6 +178,14 @@ class Windows:
         """J (C2) of `runs` on every block, the records' in order."""
         return np.array([block_J(self.measured[i][:self.ks[i]] - runs[i][:self.ks[i]], [m])[0]
                          for i, m in self.blocks])
+
+    def sensor_scores(self, sensed):
+        """J (C2) of the other sensed nodes' runs `sensed` (one (N_t, len(sensors)) per record) on
+        every block, the records' in order, and their residuals there (C, every block's in one
+        order): what a candidate, fitted to the air alone, predicts of what the other sensors saw."""
+        parts = [(self.sensed[i][:self.ks[i]] - sensed[i][:self.ks[i]])[m] for i, m in self.blocks]
+        return (np.array([float(np.nansum(np.square(r))) for r in parts]),
+                np.concatenate([r[np.isfinite(r)] for r in parts]))
 
     def scored(self):
         """Residuals the blocks score, on every record."""
@@ -202,7 +220,7 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers):
     (which end with this process: nodeforce.lifetime): the candidates' records, their `Model`s by
     label, and the simulations they took."""
     tasks = [(model.building, model.bases, effect, target, folder, windows.calibrations, windows.cases, objective,
-              windows.blocks, seed) for effect, target in pairs]
+              windows.blocks, windows.sensors, seed) for effect, target in pairs]
     n_workers = min(workers or os.cpu_count(), len(tasks))
     with (lifetime.worker_pool(n_workers) if n_workers > 1 else nullcontext()) as pool:
         assessed = list(tqdm((pool.map if pool else map)(assess, tasks), total=len(tasks),
@@ -210,15 +228,19 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers):
                              disable=not sys.stderr.isatty()))
     n = windows.scored()
     results, models, simulations = [], {}, 0
-    for (effect, target), (parameters, determined, runs, folds, count) in zip(pairs, assessed):
+    for (effect, target), (parameters, determined, runs, sensed, folds, count) in zip(pairs, assessed):
         scores = [float(np.nansum(np.square(f["residuals"]))) for f in folds]
         metrics = windows.metrics(objective, runs)
+        sensor_blocks, sensor_residuals = windows.sensor_scores(sensed)
         result = {"effect": effect, "target": target, "parameters": parameters, "derived": determined,
                   **metrics,
                   "cv": {"blocks": scores, "J": sum(scores), "n": n, "rmse": float(np.sqrt(sum(scores) / n)),
                          "folds": [f["values"] for f in folds],
                          # each block's left-out residuals, in one order for every candidate
-                         "left_out": np.concatenate([f["residuals"][np.isfinite(f["residuals"])] for f in folds])}}
+                         "left_out": np.concatenate([f["residuals"][np.isfinite(f["residuals"])] for f in folds])},
+                  # the other sensors over the blocks, which no fit read
+                  "sensors": {"blocks": [float(v) for v in sensor_blocks], "J": float(sensor_blocks.sum()),
+                              "n": int(sensor_residuals.size), "residuals": sensor_residuals}}
         values = {name: p["value"] for name, p in parameters.items()}
         models[label(result)] = model.adding(effect, target, values, runs, metrics)
         results.append(result)
@@ -318,7 +340,8 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
                             "seconds": round(time.perf_counter() - started, 1)}
         rounds.append(decision)
         on_top = {"on_top_of": [label(a) for a in added]} if added else {}
-        results += [{**r, "cv": {k: v for k, v in r["cv"].items() if k != "left_out"}, "round": number + 1, **on_top}
+        results += [{**r, "cv": {k: v for k, v in r["cv"].items() if k != "left_out"},
+                     "sensors": {k: v for k, v in r["sensors"].items() if k != "residuals"}, "round": number + 1, **on_top}
                     for r in tried]
         runs.update({(key if not added else f"{key} (round {number + 1})"): m.runs for key, m in models.items()})
         if not chosen:

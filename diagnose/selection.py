@@ -23,16 +23,27 @@ to, block by block:
 2. Physics may still refuse it (`diagnose.candidates.objection`: a gain in a zone declared
    unoccupied, a parameter on its bound or not identifiable, a negative gain): then it is a
    suggestion, with its reason, never added.
-3. Among the admissible candidates that pass, the one-standard-error rule: the candidates whose
-   cross-validated J exceeds the best's by no more than one standard error of that paired
+3. Among the admissible candidates that pass, the one-standard-error rule on every temperature
+   the candidate predicts and no fit read (`evidence`): the objective air on the blocks left out,
+   and the other sensors (a wall's surface, a neighbouring zone's air) over the same blocks,
+   since the fits read the air alone. Look-alikes that predict nearly the same air (an air
+   change, a bridge, an envelope factor and inside convection in a mild month; a ground coupling
+   and inside convection) predict different surfaces: inside convection moves every surface
+   from the air, an envelope factor the walls' inner faces, an air change neither, a ground
+   coupling the floor. Where sensors besides the air are measured, they are the evidence that
+   tells such corrections apart; the air alone would leave them to the noise. The candidates
+   whose evidence exceeds the best's by no more than one standard error of that paired
    difference cannot be told apart from it, and among them a physical effect before a shape,
-   then fewer parameters before more, then the lower J. That standard error is the larger of
-   two: the difference's scatter from block to block, and what the sensors' noise alone makes of
-   it (`noise_difference`). Two corrections that predict nearly the same air (an air change and
-   an envelope factor in a mild month) differ by nearly the same small amount every day, so the
-   blocks' scatter is tiny; yet another draw of the noise would move that difference by
-   2 sigma |r_a - r_b|, and reverse it where it is smaller. Components whose corrections cannot
-   be told apart are named together in the reason.
+   then fewer parameters before more, then the lower evidence. That standard error is the larger
+   of two: the difference's scatter from block to block, and what the sensors' noise alone makes
+   of it (`noise_difference`); against a simpler candidate, a candidate with more freedom must
+   also gain beyond the noise's tolerance of J, as any candidate must against the model
+   (`parsimony`). Two corrections that predict nearly the same temperatures differ
+   by nearly the same small amount every day, so the blocks' scatter is tiny; yet another draw
+   of the noise would move that difference by 2 sigma |r_a - r_b|, and reverse it where it is
+   smaller. Components whose corrections cannot be told apart are named together in the reason.
+   Whether a candidate passes (1.) reads the air alone, the objective: the other sensors judge
+   between explanations of the air, never whether it needs one.
 
 The validation window plays no part. A model built by earlier rounds is the baseline a later
 round's candidate must pass against (its parameters held).
@@ -98,16 +109,41 @@ def fall(base, scores):
     return float(d.sum()), float(math.sqrt(len(d)) * d.std(ddof=1))
 
 
+def evidence(result):
+    """Per-block J (C2) a candidate's choice reads: its objective air on each block left out of
+    its fit (`cv.blocks`) and, where other nodes are sensed, their J over the same blocks
+    (`sensors.blocks`), which no fit read."""
+    return np.asarray(result["cv"]["blocks"], dtype=float) + np.asarray(
+        result.get("sensors", {}).get("blocks", 0.0), dtype=float)
+
+
 def noise_difference(a, b, sigma):
-    """The standard deviation (C2) of the difference of two candidates' cross-validated J that
+    """The standard deviation (C2) of the difference of two candidates' evidence (`evidence`) that
     sensor noise of sd sigma (C) alone makes: J_a - J_b = sum (r_a - r_b)(r_a + r_b), and the
     noise e of a measurement enters r_a + r_b twice, so the difference moves by 2 sum (r_a - r_b) e,
-    of sd 2 sigma |r_a - r_b|. `a`, `b`: the candidates' records; 0 where either lacks its
-    left-out residuals (`cv.left_out`, C, every block's in one order)."""
-    ra, rb = a["cv"].get("left_out"), b["cv"].get("left_out")
+    of sd 2 sigma |r_a - r_b|. `a`, `b`: the candidates' records; their residuals are the air's
+    left out (`cv.left_out`, C, every block's in one order) and the other sensors' on the blocks
+    (`sensors.residuals`); 0 where either lacks them."""
+    def residuals(r):
+        parts = [r["cv"].get("left_out"), r.get("sensors", {}).get("residuals", np.empty(0))]
+        return None if parts[0] is None else np.concatenate([np.asarray(x, dtype=float) for x in parts])
+    ra, rb = residuals(a), residuals(b)
     if ra is None or rb is None:
         return 0.0
-    return float(2.0 * sigma * np.linalg.norm(np.asarray(ra) - np.asarray(rb)))
+    return float(2.0 * sigma * np.linalg.norm(ra - rb))
+
+
+def parsimony(result, sigma, n):
+    """The fall of evidence (C2) a candidate must add over a simpler one (a physical effect
+    against a shape, fewer parameters against more) to be preferred to it: what the sensors' noise
+    alone could make of J over the residuals its evidence scores (`ga.parsimony.noise_tolerance`),
+    the yardstick that admits a candidate against the model (1.) and a forced node against fewer
+    in the search. Its extra freedom fits what the file itself leaves (its coarser walls, a
+    history it does not know) as well as the fault: a ground coupling against a constant gain, a
+    daily profile against a window's sun, both on the air alone, differ by a hundredth of that,
+    alike on every day, which neither the days' scatter nor a fixed pair's noise
+    (`noise_difference`) would call small. `n`: the air's scored residuals."""
+    return noise_tolerance(sigma, n + result.get("sensors", {}).get("n", 0))
 
 
 def harmed(base, scores, sigma, groups):
@@ -162,6 +198,7 @@ def decide(building, results, base, sigma, n, groups=()):
                 f"{h['needed']:.3g} C2 the noise and the day-to-day scatter could make)" for h in harms)
                 + ": a correction of the building must hold on every record of it"]))
         tests[label(r)] = {"cv_fall": down, "cv_se": se, "needed": needed, "other_days": others,
+                           "evidence": float(evidence(r).sum()),
                            "passes": bool(down > needed and others > 0), "harms": harms, "objection": said}
     passing = [r for r in results if tests[label(r)]["passes"]]
     admissible = [r for r in passing if not tests[label(r)]["objection"]]
@@ -169,15 +206,18 @@ def decide(building, results, base, sigma, n, groups=()):
                    for r in passing if tests[label(r)]["objection"]]
     chosen, alike = None, []
     if admissible:
-        best = min(admissible, key=lambda r: r["cv"]["J"])
+        best = min(admissible, key=lambda r: evidence(r).sum())
         floor = ROUNDING * float(base.sum())
 
         def close(r):
             # how much worse than the best it predicts the left-out days, and the scatter of that
-            worse, se = fall(r["cv"]["blocks"], best["cv"]["blocks"])
-            return worse <= max(STANDARD_ERRORS * max(se, noise_difference(r, best, sigma)), floor)
+            worse, se = fall(evidence(r), evidence(best))
+            needed = max(STANDARD_ERRORS * max(se, noise_difference(r, best, sigma)), floor)
+            if preference(r["effect"]) < preference(best["effect"]):
+                needed = max(needed, parsimony(best, sigma, n))
+            return worse <= needed
         near = [r for r in admissible if close(r)]
-        chosen = min(near, key=lambda r: (preference(r["effect"]), r["cv"]["J"]))
+        chosen = min(near, key=lambda r: (preference(r["effect"]), evidence(r).sum()))
         alike = [r for r in near if r is not chosen]
     components = {c.name for c in building.components}
     # the candidates physics refused are in `suggestions`; the report says them grouped by reason
@@ -206,11 +246,15 @@ def _reason(chosen, alike, results, passing, base, n, tests, margin, components)
             f"{chosen['cv']['J']:.3g} C2 ({rmse_before:.3f} -> {chosen['cv']['rmse']:.3f} C; each of {B} days "
             f"predicted by a fit to the others), beyond the {test['needed']:.3g} C2 that the noise and its day-to-day "
             f"scatter could make; {len(passing)} of {len(results)} candidates pass")
+    sensed = chosen.get("sensors", {}).get("n", 0)
+    if sensed and len(passing) > 1:
+        said += (f"; among them it best predicts the air left out together with the other sensors over the "
+                 f"same days ({sensed} readings no fit read; J {evidence(chosen).sum():.3g} C2)")
     if alike:
         said += ("; within one standard error of the best, and so not told apart by these data: "
-                 + ", ".join(f"{r['effect']} on {r['target']} ({r['cv']['J']:.3g} C2)" for r in alike)
+                 + ", ".join(f"{r['effect']} on {r['target']} ({evidence(r).sum():.3g} C2)" for r in alike)
                  + (" (a physical effect, then fewer parameters, is preferred)" if any(
-                     r["cv"]["J"] < chosen["cv"]["J"] for r in alike) else ""))
+                     evidence(r).sum() < evidence(chosen).sum() for r in alike) else ""))
     others = [r["target"] for r in alike if r["target"] != chosen["target"] and r["target"] in components]
     if others and chosen["target"] in components:
         said += (f". The correction of {chosen['target']} cannot be told from that of "

@@ -203,3 +203,42 @@ def test_two_corrections_the_noise_could_order_either_way_are_not_told_apart(tes
     far = with_left_out(air, noise + 0.2)
     chosen, decision = decide(testcell, [far, best], BASE, SIGMA, N)
     assert chosen["effect"] == "envelope_conductance" and not decision["indistinct"]
+
+
+def with_sensors(result, residuals):
+    """The candidate with the other sensors' residuals (C) over the four days, as assess_all
+    records them: per-day J and the residuals in one order."""
+    days = [float(np.sum(np.square(part))) for part in np.split(residuals, 4)]
+    return {**result, "sensors": {"blocks": days, "J": sum(days), "n": residuals.size, "residuals": residuals}}
+
+
+def test_the_other_sensors_tell_apart_corrections_that_predict_the_same_air(testcell):
+    # an air change and inside convection predicting the same air on the left-out days, 0.002 C
+    # apart (the air alone leaves them to the noise); four surfaces measured with 0.1 C of noise:
+    # inside convection's off by 0.1 C at every step
+    rng = np.random.default_rng(1)
+    air = rng.normal(0.0, SIGMA, N)
+    surfaces = rng.normal(0.0, SIGMA, 4 * N)
+    infiltration = with_left_out(candidate("infiltration", "cell", {"n": parameter(0.8, 0.05)}, BASE), air + 0.002)
+    convection = with_left_out(candidate("inside_convection", "cell", {"factor": parameter(1.9, 0.1)}, BASE), air)
+    chosen, decision = decide(testcell, [with_sensors(convection, surfaces + 0.1), with_sensors(infiltration, surfaces)],
+                              BASE, SIGMA, N)
+    assert chosen["effect"] == "infiltration" and not decision["indistinct"], decision["reason"]
+    assert "other sensors" in decision["reason"]
+    # surfaces 0.005 C apart: within what the noise makes of their difference (2 x 0.1 x 0.005 x
+    # sqrt(768) = 0.028 C2 against 768 x 0.005^2 = 0.019 C2): not told apart, both named
+    chosen, decision = decide(testcell, [with_sensors(convection, surfaces + 0.005), with_sensors(infiltration, surfaces)],
+                              BASE, SIGMA, N)
+    assert decision["indistinct"], decision["reason"]
+    # and the air alone cannot tell them apart
+    chosen, decision = decide(testcell, [convection, infiltration], BASE, SIGMA, N)
+    assert decision["indistinct"], decision["reason"]
+
+
+def test_the_other_sensors_never_make_a_candidate_pass(testcell):
+    # a door that predicts the surfaces perfectly but the left-out air no better than the model:
+    # whether the air needs a correction is the objective's question, and the answer is no
+    surfaces = np.random.default_rng(2).normal(0.0, SIGMA, 4 * N)
+    flat = with_sensors(door(BASE), surfaces)
+    chosen, decision = decide(testcell, [flat], BASE, SIGMA, N)
+    assert chosen is None and not decision["candidates"]["conductivity@door"]["passes"]

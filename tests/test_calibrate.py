@@ -1,0 +1,51 @@
+"""The cross-validation folds of a calibration (`diagnose.calibrate.fold`): a fold is the fit
+without one day, one Gauss-Newton step from the whole window's optimum; checked against fits
+made afresh by scipy on the days it keeps."""
+import numpy as np
+from scipy.optimize import least_squares
+
+from nodeforce.diagnose.calibrate import fold
+
+DAYS, PER_DAY = 4, 100
+
+
+def fitted(residuals, x0, lows, highs):
+    return least_squares(residuals, x0, bounds=(lows, highs), x_scale="jac", method="trf")
+
+
+def test_a_fold_of_a_model_linear_in_its_parameters_is_the_fit_without_the_day():
+    rng = np.random.default_rng(0)
+    t = np.arange(DAYS * PER_DAY) / PER_DAY
+    y = 2.0 + 0.5 * np.sin(2 * np.pi * t) + rng.normal(0.0, 0.1, t.size)
+
+    def residuals(x):
+        return y - (x[0] + x[1] * np.sin(2 * np.pi * t))
+    lows, highs = np.array([-10.0, -10.0]), np.array([10.0, 10.0])
+    fit = fitted(residuals, [0.0, 0.0], lows, highs)
+    for day in range(DAYS):
+        train = (t // 1).astype(int) != day
+        alone = fitted(lambda x: residuals(x)[train], fit.x, lows, highs)
+        np.testing.assert_allclose(fold(fit, train, lows, highs, residuals), alone.x, atol=1e-6)
+
+
+def test_a_fold_along_a_valley_never_fits_its_own_days_worse_than_the_whole_window_s_optimum():
+    # a ground coupling's heat flow, U (T_ground - T_face), with a face whose temperature hardly
+    # moves: U and T_ground trade off along a curved valley, where the linearised step overshoots
+    rng = np.random.default_rng(0)
+    t = np.linspace(0.0, DAYS * 2 * np.pi, DAYS * PER_DAY)
+    face = 20.0 + 0.02 * np.sin(t)
+    y = 3.0 * (24.0 - face) + rng.normal(0.0, 0.5, t.size) + 0.8 * (t > (DAYS - 1) * 2 * np.pi)
+
+    def residuals(x):
+        return y - x[0] * (x[1] - face)
+    lows, highs = np.array([0.0, -10.0]), np.array([20.0, 40.0])
+    fit = fitted(residuals, [1.0, 20.0], lows, highs)
+    overshoots = 0
+    for day in range(DAYS):
+        train = (t // (2 * np.pi)).astype(int) != day
+        J = lambda x: float(np.sum(np.square(residuals(x)[train])))  # noqa: E731
+        step = np.linalg.lstsq(fit.jac[train], -fit.fun[train], rcond=None)[0]
+        overshoots += J(fit.x + step) > J(fit.x)
+        x = fold(fit, train, lows, highs, residuals)
+        assert J(x) <= J(fit.x) and np.all((lows <= x) & (x <= highs))
+    assert overshoots >= 2  # the plain step would have scored those days with no fit at all
