@@ -53,7 +53,8 @@ from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.locate import check_measured, locate
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
-from nodeforce.model.integrate import steps_per_day
+from nodeforce.model.integrate import simulate, steps_per_day
+from nodeforce.model.network import assemble
 from nodeforce.model.score import Noise
 
 # Rounds of candidates at most: each adds one effect on top of the last, while the error left is
@@ -179,13 +180,44 @@ class Windows:
         return np.array([block_J(self.measured[i][:self.ks[i]] - runs[i][:self.ks[i]], [m])[0]
                          for i, m in self.blocks])
 
-    def sensor_scores(self, sensed):
-        """J (C2) of the other sensed nodes' runs `sensed` (one (N_t, len(sensors)) per record) on
-        every block, the records' in order, and their residuals there (C, every block's in one
-        order): what a candidate, fitted to the air alone, predicts of what the other sensors saw."""
-        parts = [(self.sensed[i][:self.ks[i]] - sensed[i][:self.ks[i]])[m] for i, m in self.blocks]
-        return (np.array([float(np.nansum(np.square(r))) for r in parts]),
-                np.concatenate([r[np.isfinite(r)] for r in parts]))
+    def sensor_scores(self, sensed, weights):
+        """What a candidate, fitted to the air alone, predicts of what the other sensors saw: their
+        J (C2) on every block, the records' in order, each sensor's squares times its weight
+        (`sensor_weights`); the weighted residuals w r there (C, every block's in one order),
+        from which the noise makes 2 sigma |w (r_a - r_b)| of a difference (`selection`); and
+        the readings, and what the noise counts of them, sum w^2.
+
+        sensed : the other sensed nodes' runs, one (N_t, len(sensors)) per record
+        weights : one (len(sensors),) per record"""
+        parts = [((self.sensed[i][:self.ks[i]] - sensed[i][:self.ks[i]])[m], weights[i]) for i, m in self.blocks]
+        return (np.array([float(np.nansum(w * np.square(r))) for r, w in parts]),
+                np.concatenate([(w * r)[np.isfinite(r)] for r, w in parts]),
+                int(sum(np.isfinite(r).sum() for r, _ in parts)),
+                float(sum((np.isfinite(r) * w ** 2).sum() for r, w in parts)))
+
+    def sensor_weights(self, building, bases, sigma):
+        """Per record, each other sensor's weight in the choice: sigma^2 over its mean squared
+        residual under the model the candidates are added to (`building`, or the record's
+        protocol's in `bases`), over the calibration window, at most 1.
+
+        A sensor the model follows to the noise counts fully. One it misses by far more (a real
+        house's surface the model sees through a simplified wall, a heavy wall still carrying the
+        start the model does not know) counts as a measurement whose error is that misfit: its
+        residual is mostly what no candidate is about, and unweighted it would choose, among the
+        explanations of the air, the one that mends it (on the real Twin House, a west-sun gain
+        in the living room whose validation error doubled)."""
+        out = []
+        for i, (case, ids) in enumerate(zip(self.cases, self.sensors)):
+            if not ids:
+                out.append(np.zeros(0))
+                continue
+            model = bases[i] or building
+            inputs = case.with_inputs(model)
+            T = simulate(model, assemble(model), inputs.U, inputs.dt, inputs.measured, burn_in_steps=inputs.burn_in_steps,
+                         steady_start=inputs.steady_start, substeps=inputs.substeps)[:, np.asarray(ids) - 1]
+            misfit = np.nanmean(np.square(self.sensed[i][:self.ks[i]] - T[:self.ks[i]]), axis=0)
+            out.append(np.minimum(1.0, sigma ** 2 / np.maximum(misfit, np.finfo(float).tiny)))
+        return out
 
     def scored(self):
         """Residuals the blocks score, on every record."""
@@ -214,11 +246,12 @@ class Model:
                      [None if b is None else EFFECTS[effect].apply(b, target, values) for b in self.bases])
 
 
-def assess_all(model, pairs, windows, objective, folder, seed, workers):
+def assess_all(model, pairs, windows, objective, folder, seed, workers, weights):
     """Each (effect, target) added to `model`, calibrated on every record's calibration window
     (t_0..t_k) with a fold per block, and run over each record, in parallel worker processes
     (which end with this process: nodeforce.lifetime): the candidates' records, their `Model`s by
-    label, and the simulations they took."""
+    label, and the simulations they took. `weights`: each record's other sensors' weights in the
+    choice (`Windows.sensor_weights`)."""
     tasks = [(model.building, model.bases, effect, target, folder, windows.calibrations, windows.cases, objective,
               windows.blocks, windows.sensors, seed) for effect, target in pairs]
     n_workers = min(workers or os.cpu_count(), len(tasks))
@@ -231,7 +264,7 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers):
     for (effect, target), (parameters, determined, runs, sensed, folds, count) in zip(pairs, assessed):
         scores = [float(np.nansum(np.square(f["residuals"]))) for f in folds]
         metrics = windows.metrics(objective, runs)
-        sensor_blocks, sensor_residuals = windows.sensor_scores(sensed)
+        sensor_blocks, sensor_residuals, readings, counted = windows.sensor_scores(sensed, weights)
         result = {"effect": effect, "target": target, "parameters": parameters, "derived": determined,
                   **metrics,
                   "cv": {"blocks": scores, "J": sum(scores), "n": n, "rmse": float(np.sqrt(sum(scores) / n)),
@@ -240,7 +273,7 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers):
                          "left_out": np.concatenate([f["residuals"][np.isfinite(f["residuals"])] for f in folds])},
                   # the other sensors over the blocks, which no fit read
                   "sensors": {"blocks": [float(v) for v in sensor_blocks], "J": float(sensor_blocks.sum()),
-                              "n": int(sensor_residuals.size), "residuals": sensor_residuals}}
+                              "n": readings, "n_weighted": counted, "residuals": sensor_residuals}}
         values = {name: p["value"] for name, p in parameters.items()}
         models[label(result)] = model.adding(effect, target, values, runs, metrics)
         results.append(result)
@@ -314,7 +347,8 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
         # a later round's candidates, on top of the earlier choices, are building files of their own
         into = folder / f"round{number + 1}" if number else folder
         into.mkdir(exist_ok=True)
-        return assess_all(model, pairs, windows, objective, into, seed, workers)
+        return assess_all(model, pairs, windows, objective, into, seed, workers,
+                          windows.sensor_weights(model.building, model.bases, sigma))
 
     measured_ids = sorted({i for case in windows.cases for i in case.measured_ids})
     added, rounds, results, runs, sensitivities = [], [], [], {}, {}

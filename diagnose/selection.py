@@ -31,7 +31,9 @@ to, block by block:
    and inside convection) predict different surfaces: inside convection moves every surface
    from the air, an envelope factor the walls' inner faces, an air change neither, a ground
    coupling the floor. Where sensors besides the air are measured, they are the evidence that
-   tells such corrections apart; the air alone would leave them to the noise. The candidates
+   tells such corrections apart; the air alone would leave them to the noise. Each sensor counts
+   as a measurement whose error is what the model already misses there, sigma^2 over its mean
+   squared residual (at most 1): a surface the model cannot follow does not choose for the air. The candidates
    whose evidence exceeds the best's by no more than one standard error of that paired
    difference cannot be told apart from it, and among them a physical effect before a shape,
    then fewer parameters before more, then the lower evidence. That standard error is the larger
@@ -112,7 +114,8 @@ def fall(base, scores):
 def evidence(result):
     """Per-block J (C2) a candidate's choice reads: its objective air on each block left out of
     its fit (`cv.blocks`) and, where other nodes are sensed, their J over the same blocks
-    (`sensors.blocks`), which no fit read."""
+    (`sensors.blocks`), which no fit read, each sensor weighted by how well the model the
+    candidate is added to follows it (`diagnose.loop.Windows.sensor_weights`)."""
     return np.asarray(result["cv"]["blocks"], dtype=float) + np.asarray(
         result.get("sensors", {}).get("blocks", 0.0), dtype=float)
 
@@ -143,7 +146,7 @@ def parsimony(result, sigma, n):
     daily profile against a window's sun, both on the air alone, differ by a hundredth of that,
     alike on every day, which neither the days' scatter nor a fixed pair's noise
     (`noise_difference`) would call small. `n`: the air's scored residuals."""
-    return noise_tolerance(sigma, n + result.get("sensors", {}).get("n", 0))
+    return noise_tolerance(sigma, n + result.get("sensors", {}).get("n_weighted", 0))
 
 
 def harmed(base, scores, sigma, groups):

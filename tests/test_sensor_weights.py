@@ -1,0 +1,28 @@
+"""The other sensors' weights in the choice among explanations of the air
+(`diagnose.loop.Windows.sensor_weights`): sigma^2 over what the model already misses at each,
+checked against a sensor offset by a known amount."""
+import numpy as np
+
+from nodeforce.diagnose.loop import Record, Windows
+from nodeforce.model.case import prepare_case
+from nodeforce.model.score import Objective
+from nodeforce.model.synth import pseudo_measurements
+
+from .conftest import SENSORS, record_times
+
+
+def test_a_sensor_the_model_misses_by_a_kelvin_weighs_sigma_squared_and_one_it_follows_fully(testcell, weather):
+    # the model's own record, noise-free, steady from its first day: it follows every sensor but
+    # the one offset by 1 K, whose mean squared residual is then 1 K2
+    measurements = pseudo_measurements(testcell, weather, record_times(), SENSORS, history_days=0)
+    offset = "T9"  # the roof's inner surface
+    measurements[offset] = measurements[offset] + 1.0
+    case = prepare_case(testcell, weather, measurements).with_burn_in(1)
+    objective = Objective.of(testcell)
+    windows = Windows.of([Record(case)], objective)
+    assert windows.sensors == [[1, 7, 9, 16, 17]]
+    sigma = 0.1
+    (weights,) = windows.sensor_weights(testcell, [None], sigma)
+    roof = windows.sensors[0].index(9)
+    assert abs(weights[roof] - sigma ** 2 / 1.0) < 0.1 * sigma ** 2
+    assert np.all(np.delete(weights, roof) == 1.0)
