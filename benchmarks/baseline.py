@@ -19,8 +19,6 @@ from scipy.optimize import least_squares
 
 from nodeforce.model.effects import BRIDGE_TO, EFFECTS, PAIR, bridge_parts, pair_parts
 from nodeforce.model.building import Surface
-from nodeforce.model.integrate import simulate
-from nodeforce.model.network import assemble
 
 BIC_MARGIN = 10.0
 MAX_EVALUATIONS = 40  # least-squares residual evaluations per parameter and candidate
@@ -44,10 +42,7 @@ def concerns(building, effect, target, zones):
 
 def air_run(building, case, air_nodes):
     """(N_t, zones) simulated air (C) of `building` on `case`, as the diagnosis runs it."""
-    case = case.with_inputs(building)
-    T = simulate(building, assemble(building), case.U, case.dt, case.measured, burn_in_steps=case.burn_in_steps,
-                 steady_start=case.steady_start, substeps=case.substeps)
-    return T[:, np.array(air_nodes) - 1]
+    return case.with_inputs(building).run(building)[:, np.array(air_nodes) - 1]
 
 
 def fit_one(building, case, effect, target, air_nodes, rows):

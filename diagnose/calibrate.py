@@ -25,8 +25,6 @@ from nodeforce.model.case import as_cases
 from nodeforce.model.significance import bandwidth, parameter_covariance
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.hlc import heat_loss_coefficient
-from nodeforce.model.integrate import simulate
-from nodeforce.model.network import assemble
 
 log = logging.getLogger("nodeforce.diagnose")
 
@@ -84,9 +82,7 @@ class Candidate:
             _, inputs = self._inputs[id(case)]
             building = self.built(values, base)
             self.simulations += 1
-            T = simulate(building, assemble(building), inputs.U, inputs.dt, inputs.measured,
-                         burn_in_steps=inputs.burn_in_steps, steady_start=inputs.steady_start,
-                         substeps=inputs.substeps)
+            T = inputs.run(building)
             if len(self._runs) >= KEPT_RUNS:
                 self._runs.pop(next(iter(self._runs)))
             self._runs[key] = T[:, np.asarray(node_ids) - 1]

@@ -53,8 +53,7 @@ from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.locate import check_measured, locate
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
-from nodeforce.model.integrate import simulate, steps_per_day
-from nodeforce.model.network import assemble
+from nodeforce.model.integrate import steps_per_day
 from nodeforce.model.score import Noise
 
 # Rounds of candidates at most: each adds one effect on top of the last, while the error left is
@@ -212,9 +211,7 @@ class Windows:
                 out.append(np.zeros(0))
                 continue
             model = bases[i] or building
-            inputs = case.with_inputs(model)
-            T = simulate(model, assemble(model), inputs.U, inputs.dt, inputs.measured, burn_in_steps=inputs.burn_in_steps,
-                         steady_start=inputs.steady_start, substeps=inputs.substeps)[:, np.asarray(ids) - 1]
+            T = case.with_inputs(model).run(model)[:, np.asarray(ids) - 1]
             misfit = np.nanmean(np.square(self.sensed[i][:self.ks[i]] - T[:self.ks[i]]), axis=0)
             out.append(np.minimum(1.0, sigma ** 2 / np.maximum(misfit, np.finfo(float).tiny)))
         return out
@@ -375,7 +372,8 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
         rounds.append(decision)
         on_top = {"on_top_of": [label(a) for a in added]} if added else {}
         results += [{**r, "cv": {k: v for k, v in r["cv"].items() if k != "left_out"},
-                     "sensors": {k: v for k, v in r["sensors"].items() if k != "residuals"}, "round": number + 1, **on_top}
+                     "sensors": {k: v for k, v in r["sensors"].items() if k != "residuals"},
+                     "round": number + 1, **on_top}
                     for r in tried]
         runs.update({(key if not added else f"{key} (round {number + 1})"): m.runs for key, m in models.items()})
         if not chosen:

@@ -33,9 +33,9 @@ to, block by block:
    coupling the floor. Where sensors besides the air are measured, they are the evidence that
    tells such corrections apart; the air alone would leave them to the noise. Each sensor counts
    as a measurement whose error is what the model already misses there, sigma^2 over its mean
-   squared residual (at most 1): a surface the model cannot follow does not choose for the air. The candidates
-   whose evidence exceeds the best's by no more than one standard error of that paired
-   difference cannot be told apart from it, and among them a physical effect before a shape,
+   squared residual (at most 1): a surface the model cannot follow does not choose for the air.
+   The candidates whose evidence exceeds the best's by no more than one standard error of that
+   paired difference cannot be told apart from it, and among them a physical effect before a shape,
    then fewer parameters before more, then the lower evidence. That standard error is the larger
    of two: the difference's scatter from block to block, and what the sensors' noise alone makes
    of it (`noise_difference`); against a simpler candidate, a candidate with more freedom must

@@ -221,14 +221,14 @@ def test_the_other_sensors_tell_apart_corrections_that_predict_the_same_air(test
     surfaces = rng.normal(0.0, SIGMA, 4 * N)
     infiltration = with_left_out(candidate("infiltration", "cell", {"n": parameter(0.8, 0.05)}, BASE), air + 0.002)
     convection = with_left_out(candidate("inside_convection", "cell", {"factor": parameter(1.9, 0.1)}, BASE), air)
-    chosen, decision = decide(testcell, [with_sensors(convection, surfaces + 0.1), with_sensors(infiltration, surfaces)],
-                              BASE, SIGMA, N)
+    chosen, decision = decide(testcell, [with_sensors(convection, surfaces + 0.1),
+                                         with_sensors(infiltration, surfaces)], BASE, SIGMA, N)
     assert chosen["effect"] == "infiltration" and not decision["indistinct"], decision["reason"]
     assert "other sensors" in decision["reason"]
     # surfaces 0.005 C apart: within what the noise makes of their difference (2 x 0.1 x 0.005 x
     # sqrt(768) = 0.028 C2 against 768 x 0.005^2 = 0.019 C2): not told apart, both named
-    chosen, decision = decide(testcell, [with_sensors(convection, surfaces + 0.005), with_sensors(infiltration, surfaces)],
-                              BASE, SIGMA, N)
+    chosen, decision = decide(testcell, [with_sensors(convection, surfaces + 0.005),
+                                         with_sensors(infiltration, surfaces)], BASE, SIGMA, N)
     assert decision["indistinct"], decision["reason"]
     # and the air alone cannot tell them apart
     chosen, decision = decide(testcell, [convection, infiltration], BASE, SIGMA, N)
