@@ -157,17 +157,25 @@ SHAPES = ("daily_gain", "proportional_gain")
 # outside them, by more than its uncertainty (`LIMIT_STANDARD_DEVIATIONS`), is not a property of
 # a building but a fit compensating something else. A gain to
 # the air is a source, not a sink (a heat sink would be a cooler the file would declare); scales
-# of conductances and convection within a factor of ten of what the file declares.
+# of conductances within a factor of ten of what the file declares; inside convection within what
+# a room's air can do (`ROOM_CONVECTION`).
 PHYSICAL_LIMITS = {("internal_gain", "Q"): (0.0, math.inf),
                    ("daily_gain", "mean"): (0.0, math.inf),
                    ("conductivity", "factor"): (0.1, 10.0),
                    ("envelope_conductance", "factor"): (0.1, 10.0),
-                   ("inside_convection", "factor"): (0.1, 10.0),
                    ("boundary_conductance", "factor"): (0.1, 10.0),
                    ("supply_flow", "factor"): (0.1, 10.0),
                    # a heater or meter off its reading by more than a factor of two is a fault
                    # the building file should state, not a property to fit
                    ("heat_input_factor", "factor"): (0.5, 2.0)}
+# The area-weighted mean convective coefficient of a room's surfaces, W/m2/K, that air can give.
+# Natural convection (Alamdari and Hammond's correlations for walls, floors and ceilings, stable
+# and unstable) gives a room about 0.6 with every surface within 0.1 K of its air, a stiller room
+# than a heated or free-floating one holds; forced convection at a hundred air changes an hour
+# (Fisher and Pedersen's ceiling-diffuser correlations) stays below 20, a facade's in a stiff wind.
+# A limit on the coefficient, not on the factor: a factor of 0.1 is 0.5 W/m2/K where a file
+# declares 5 on every face, 0.26 where it declares ISO 6946's 2.5 on walls and 0.7 on floors.
+ROOM_CONVECTION = (0.5, 20.0)
 # The parameters whose identifiability decides for an effect (default: all of them): a daily
 # profile's harmonics may each be near zero, and small next to their uncertainty, while the
 # profile and its mean are determined.
@@ -189,9 +197,13 @@ def preference(effect):
 
 
 def limits(building, effect, target, name):
-    """The physical (low, high) of a parameter: PHYSICAL_LIMITS, and for a proportional gain an
+    """The physical (low, high) of a parameter: PHYSICAL_LIMITS; for a proportional gain an
     area of sun that cannot be negative (an irradiance column) or a share of a heat input that
-    cannot take away more than the input (k >= -1)."""
+    cannot take away more than the input (k >= -1); for inside convection the factors that
+    bring the zone's mean declared coefficient into `ROOM_CONVECTION`."""
+    if effect == "inside_convection":
+        declared = building.mean_inside_convection(target)
+        return tuple(h / declared for h in ROOM_CONVECTION)
     if effect == "proportional_gain":
         _, column = bridge_parts(target)
         heat_inputs = {c for z in building.zones for c in z.heat_input}

@@ -227,6 +227,14 @@ class Building:
                 if isinstance(c.outside, Surface) and c.outside.zone == zone_name]
         return tuple(ids)
 
+    def mean_inside_convection(self, zone_name):
+        """The area-weighted mean of the declared convective coefficients h_conv of the surfaces
+        facing a zone (the ones of `facing`), W/m2/K, before its `convection_factor`."""
+        faces = [(c.area, c.inside.h_conv) for c in self.components if c.inside.zone == zone_name]
+        faces += [(c.area, c.outside.h_conv) for c in self.components
+                  if isinstance(c.outside, Surface) and c.outside.zone == zone_name]
+        return sum(a * h for a, h in faces) / sum(a for a, _ in faces)
+
     def node_names(self):
         """{id: readable name}: "<component> at <depth> m", "<zone> air", "<zone> radiant"."""
         names = {}

@@ -52,6 +52,30 @@ def test_a_physical_limit_is_judged_with_the_estimate_s_uncertainty(testcell):
     assert objection(testcell, "internal_gain", "cell", {"Q": parameter(-3.0, 2.0)}) is None
 
 
+def _with_inside_h(data, h_conv):
+    """The test cell with every inside face declaring h_conv[name] (W/m2/K) where given."""
+    components = [{**c, "inside": {**c["inside"], "h_conv": h_conv.get(c["name"], c["inside"]["h_conv"])}}
+                  for c in data["components"]]
+    return parse_building({**data, "components": components})
+
+
+def test_a_zone_s_mean_inside_convection_weighs_each_face_by_its_area(testcell_data):
+    # by hand: the floor's 9.0 m2 at 0.7, the roof's 9.0 at 2.5, the other 30.0 m2 at 5.0
+    building = _with_inside_h(testcell_data, {"floor": 0.7, "roof": 2.5})
+    assert building.mean_inside_convection("cell") == pytest.approx((9.0 * 0.7 + 9.0 * 2.5 + 30.0 * 5.0) / 48.0)
+
+
+def test_a_convection_factor_is_judged_by_the_coefficient_it_gives_the_room(testcell, testcell_data):
+    # 0.15 of the cell's declared 5 W/m2/K is 0.75, air a room can have; 0.15 of ISO 6946's
+    # 2.5 is 0.38, a room stiller than any natural convection leaves it
+    factor = {"factor": parameter(0.15, 0.02)}
+    assert objection(testcell, "inside_convection", "cell", factor) is None
+    iso = _with_inside_h(testcell_data, {c["name"]: 2.5 for c in testcell_data["components"]})
+    assert "physical limits" in objection(iso, "inside_convection", "cell", factor)
+    # ten times the cell's 5 W/m2/K is a room in a gale
+    assert "physical limits" in objection(testcell, "inside_convection", "cell", {"factor": parameter(10.0, 0.5)})
+
+
 def test_a_gain_in_a_zone_declared_unoccupied_is_refused(unoccupied):
     values = {"mean": parameter(46.0, 3.0), **{t: parameter(1.0, 5.0, identifiable=False)
                                                 for t in ("cos1", "sin1", "cos2", "sin2", "cos3", "sin3", "cos4", "sin4")}}
