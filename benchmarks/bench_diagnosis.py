@@ -360,7 +360,7 @@ def write_docs(path, lines, args, elapsed):
         "1, its sun to the floor); its size is tuned by simulating so that the file's validation RMSE is "
         "2.2 x the noise (subtle, accepted 1.5 to 3) or 6 x (strong, 4 to 9); Gaussian noise, seeded by "
         "the record's name and draw. A fault is never scaled beyond its physical limits (a factor on a "
-        "conductance or a convection coefficient within 0.1 to 10): where that limit comes before the "
+        "conductance within 0.1 to 10, a room's mean convective coefficient within 0.5 to 20 W/m2/K): where that limit comes before the "
         "size asked for, the record is as large as physics lets it be, its 'before/noise' below. Even "
         "without a fault the file is not the truth: its coarser walls and the truth's real history "
         "leave it 0.03 to 0.06 C (it integrates every record in steps of at most 5 min, docs/model.md "
