@@ -243,7 +243,7 @@ def objection(building, effect, target, parameters, derived=None):
         margin = LIMIT_STANDARD_DEVIATIONS * p["std"]
         if not low - margin <= p["value"] <= high + margin:
             what = "a negative gain (a heat sink)" if low == 0.0 and "gain" in effect else "outside physical limits"
-            reasons.append(f"{name} = {p['value']:.3g} +- {p['std']:.2g} {unit} is {what} [{low:g}, {high:g}] "
+            reasons.append(f"{name} = {p['value']:.3g} +- {p['std']:.2g} {unit} is {what} [{low:.3g}, {high:.3g}] "
                            f"by more than {LIMIT_STANDARD_DEVIATIONS:g} standard deviations")
     return "; ".join(r for r in reasons if r) or None
 
