@@ -83,7 +83,8 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
     record's J, a forcing applied to every record (`ga.fitness.RecordsFitness`), and `protocols`
     gives, per record, the building it runs under when that is not `building` (another
     protocol's flows and blinds; None: `building`), each with its own FMU.
-    The FMU (`model.fmu`, `model_<k>.fmu` of the k-th record's own building) and the search's
+    The FMUs (`model.fmu` of `building` where a record runs it, `model_<k>.fmu` of the k-th
+    record's own building) and the search's
     checkpoint (`locate.checkpoint.json`) are written in
     `workdir`, so a run stopped midway and started again resumes. `progress` is called after
     every generation with (generation, total, best J, unique evaluations). `noise` is the air
@@ -97,9 +98,13 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
     protocols = list(protocols) if protocols is not None else [None] * len(cases)
     candidates = chromosome_nodes(building, cases, objective, source, nodes, include_algebraic)
     kind = evaluator_kind() if fmu_kind == "auto" else fmu_kind
-    fmu = build_fmu(building, workdir / "model.fmu", kind=kind)
-    fmus = [fmu if own is None else build_fmu(own, workdir / f"model_{k + 1}.fmu", kind=kind)
-            for k, own in enumerate(protocols)]
+    # one FMU per building a record runs under: `building`'s only where a record runs it
+    names = ["model.fmu" if own is None else f"model_{k + 1}.fmu" for k, own in enumerate(protocols)]
+    built = {}
+    for name, own in zip(names, protocols):
+        if name not in built:
+            built[name] = build_fmu(own or building, workdir / name, kind=kind)
+    fmus = [built[name] for name in names]
     parts = [FmuFitness(path, c, candidates, objective, warmup_days) for path, c in zip(fmus, cases)]
     fitness = parts[0] if len(parts) == 1 else RecordsFitness(parts)
     measured = [objective.measured(c) for c in cases]

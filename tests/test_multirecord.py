@@ -152,8 +152,12 @@ def test_the_forcing_search_of_two_records_forces_a_node_where_a_record_measures
     # together rank it, the second alone locates the fault
     assert both["ranked_nodes"] == [surface]
     alone = {}
-    for name, case in (("first", airs), ("second", second)):
+    # the second record runs under a building of its own (here the same house, as a protocol
+    # that changes nothing would be): it gets that building's FMU, and no unused one of `b`
+    for name, case, protocols in (("first", airs, None), ("second", second, [house()])):
         (tmp_path / name).mkdir()
-        alone[name] = locate(b, [case], objective, tmp_path / name, workers=1, noise=NOISE)
+        alone[name] = locate(b, [case], objective, tmp_path / name, workers=1, noise=NOISE, protocols=protocols)
     assert alone["first"]["chromosome_nodes"] == []
     assert alone["second"]["best_nodes"] == [surface]
+    assert [p.name for p in (tmp_path / "first").glob("*.fmu")] == ["model.fmu"]
+    assert [p.name for p in (tmp_path / "second").glob("*.fmu")] == ["model_1.fmu"]
