@@ -207,6 +207,11 @@ def derived(candidate, case, x, cov):
     - A zone's internal mass or heater node answers with its time constant tau = C / H (s): a
       short record of the air fixes tau far better than C and H apart, which trade off along it.
       g = (1 / H, -C / H^2).
+    - A component's conductivity factor acts through the heat the component loses (W/K): the HLC
+      with the factor less the HLC with the factor at its lower bound, where the layers pass
+      almost nothing. In series with the surface coefficients that loss saturates as the layers
+      conduct more, so a door twice as conductive as its wood and one ten times are told apart
+      by little, while the loss the data see is fixed. g is the HLC's.
     """
     def with_sd(value, gradient, unit):
         return {"value": float(value), "std": float(np.sqrt(max(gradient @ cov @ gradient, 0.0))), "unit": unit}
@@ -218,6 +223,10 @@ def derived(candidate, case, x, cov):
         face = candidate.building.component(candidate.target).node_ids[-1]
         T_face = float(np.mean(candidate.nodes(case, [face], x)))
         out["ground_heat_flux"] = with_sd(U * (T_ground - T_face), np.array([T_ground - T_face, U]), "W/m2")
+    if candidate.effect == "conductivity":
+        (low, _), = candidate.bounds
+        shut = EFFECTS["conductivity"].apply(candidate.building, candidate.target, {"factor": low})
+        out["component_loss"] = with_sd(hlc - heat_loss_coefficient(shut), gradient, "W/K")
     if candidate.effect in TIME_CONSTANTS:
         C, H = x
         out[TIME_CONSTANTS[candidate.effect]] = with_sd(C / H, np.array([1.0 / H, -C / H ** 2]), "s")

@@ -214,8 +214,11 @@ def limits(building, effect, target, name):
 # What the data fix where an effect's parameters trade off (`diagnose.calibrate.derived`): when
 # it is determined, the parameters need not be one by one. A ground coupling's (U, T_ground) is
 # then one of the many pairs that give the flux, wherever it ended, a bound included; a node's
-# (C, H) must still be inside its range, where a bound means a node that is not there.
+# (C, H) must still be inside its range, where a bound means a node that is not there; a
+# component's conductivity factor, which trades off against nothing but saturates behind the
+# surface coefficients, is judged by the heat the component loses, and still refused on a bound.
 TRADE_OFFS = {"ground_coupling": ("ground_heat_flux", True),
+              "conductivity": ("component_loss", False),
               "heat_input_lag": ("heater_time_constant", False),
               "internal_mass": ("mass_time_constant", False)}
 

@@ -2,6 +2,7 @@
 without one day, one Gauss-Newton step from the whole window's optimum; checked against fits
 made afresh by scipy on the days it keeps."""
 import numpy as np
+import pytest
 from scipy.optimize import least_squares
 
 from nodeforce.diagnose.calibrate import fold
@@ -49,3 +50,31 @@ def test_a_fold_along_a_valley_never_fits_its_own_days_worse_than_the_whole_wind
         x = fold(fit, train, lows, highs, residuals)
         assert J(x) <= J(fit.x) and np.all((lows <= x) & (x <= highs))
     assert overshoots >= 2  # the plain step would have scored those days with no fit at all
+
+
+def test_a_component_s_loss_is_what_its_layers_add_to_the_heat_loss_coefficient(testcell):
+    """The door's loss at a conductivity factor, as `derived` reports it, against the heat loss
+    coefficient computed apart: the HLC less that of the door with its layers at the factor's
+    lower bound; it saturates behind the surface coefficients; its sd is the slope times the
+    factor's sd (a central difference, apart from the forward one `derived` takes)."""
+    from nodeforce.diagnose.calibrate import Candidate, derived
+    from nodeforce.model.effects import EFFECTS
+    from nodeforce.model.hlc import heat_loss_coefficient
+
+    door = Candidate(testcell, "conductivity", "door")
+
+    def hlc(factor):
+        return heat_loss_coefficient(EFFECTS["conductivity"].apply(testcell, "door", {"factor": factor}))
+
+    def loss(factor, sd=0.0):
+        return derived(door, None, np.array([factor]), np.array([[sd ** 2]]))["component_loss"]
+
+    assert loss(3.0)["value"] == pytest.approx(hlc(3.0) - hlc(0.05), rel=1e-9)
+    assert loss(3.0)["value"] > loss(1.0)["value"] > 0.0
+    # doubling the layers' conductance at ten times adds less than a third of what it adds at once
+    assert loss(20.0)["value"] - loss(10.0)["value"] < (loss(2.0)["value"] - loss(1.0)["value"]) / 3
+    slope = (hlc(7.2) - hlc(7.0)) / 0.2
+    assert loss(7.1, sd=2.4)["std"] == pytest.approx(abs(slope) * 2.4, rel=1e-3)
+    # an adiabatic floor loses nothing whatever its layers conduct
+    assert derived(Candidate(testcell, "conductivity", "floor"), None, np.array([3.0]),
+                   np.array([[1.0]]))["component_loss"]["value"] == pytest.approx(0.0, abs=1e-9)

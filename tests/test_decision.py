@@ -76,6 +76,18 @@ def test_a_convection_factor_is_judged_by_the_coefficient_it_gives_the_room(test
     assert "physical limits" in objection(testcell, "inside_convection", "cell", {"factor": parameter(10.0, 0.5)})
 
 
+def test_a_conductivity_is_judged_by_the_heat_its_component_loses(testcell):
+    # a door's loss saturates behind its surface coefficients: the factor is loose, the loss fixed
+    loose = {"factor": parameter(7.1, 2.4, identifiable=False)}
+    lost = {"component_loss": {"value": 4.0, "std": 0.2, "unit": "W/K"}}
+    assert objection(testcell, "conductivity", "door", loose, lost) is None
+    assert "not identifiable" in objection(testcell, "conductivity", "door", loose,
+                                           {"component_loss": {"value": 4.0, "std": 2.0, "unit": "W/K"}})
+    # a factor on its bound is still a layer that is not there
+    on_bound = {"factor": parameter(20.0, 9.0, identifiable=False, on_bound=True)}
+    assert "bound" in objection(testcell, "conductivity", "door", on_bound, lost)
+
+
 def test_a_gain_in_a_zone_declared_unoccupied_is_refused(unoccupied):
     values = {"mean": parameter(46.0, 3.0), **{t: parameter(1.0, 5.0, identifiable=False)
                                                 for t in ("cos1", "sin1", "cos2", "sin2", "cos3", "sin3", "cos4", "sin4")}}
