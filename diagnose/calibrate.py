@@ -225,8 +225,7 @@ def derived(candidate, case, x, cov):
         out["ground_heat_flux"] = with_sd(U * (T_ground - T_face), np.array([T_ground - T_face, U]), "W/m2")
     if candidate.effect == "conductivity":
         (low, _), = candidate.bounds
-        shut = EFFECTS["conductivity"].apply(candidate.building, candidate.target, {"factor": low})
-        out["component_loss"] = with_sd(hlc - heat_loss_coefficient(shut), gradient, "W/K")
+        out["component_loss"] = with_sd(hlc - heat_loss_coefficient(candidate.built([low])), gradient, "W/K")
     if candidate.effect in TIME_CONSTANTS:
         C, H = x
         out[TIME_CONSTANTS[candidate.effect]] = with_sd(C / H, np.array([1.0 / H, -C / H ** 2]), "s")
@@ -237,11 +236,8 @@ def hlc_gradient(candidate, x):
     """The heat loss coefficient (W/K) of the building with the effect at x, and its gradient over
     the parameters (W/K per unit of each), by differences of HLC_STEP of each parameter's range,
     taken inside the bounds."""
-    effect = EFFECTS[candidate.effect]
-
     def hlc(values):
-        return heat_loss_coefficient(effect.apply(candidate.building, candidate.target,
-                                                  {p.name: float(v) for p, v in zip(candidate.parameters, values)}))
+        return heat_loss_coefficient(candidate.built(values))
 
     x = np.asarray(x, dtype=float)
     at = hlc(x)

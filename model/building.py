@@ -220,20 +220,23 @@ class Building:
     def component(self, name):
         return next(c for c in self.components if c.name == name)
 
+    def _faces(self, zone_name):
+        """[(component, its Surface toward the zone, that face's node id)]: the inside faces of
+        the zone's components, then the outside faces of partitions toward it."""
+        faces = [(c, c.inside, c.node_ids[0]) for c in self.components if c.inside.zone == zone_name]
+        faces += [(c, c.outside, c.node_ids[-1]) for c in self.components
+                  if isinstance(c.outside, Surface) and c.outside.zone == zone_name]
+        return faces
+
     def facing(self, zone_name):
         """Ids of the surface nodes that face a zone (inside faces, and outside faces of partitions)."""
-        ids = [c.node_ids[0] for c in self.components if c.inside.zone == zone_name]
-        ids += [c.node_ids[-1] for c in self.components
-                if isinstance(c.outside, Surface) and c.outside.zone == zone_name]
-        return tuple(ids)
+        return tuple(i for _, _, i in self._faces(zone_name))
 
     def mean_inside_convection(self, zone_name):
         """The area-weighted mean of the declared convective coefficients h_conv of the surfaces
-        facing a zone (the ones of `facing`), W/m2/K, before its `convection_factor`."""
-        faces = [(c.area, c.inside.h_conv) for c in self.components if c.inside.zone == zone_name]
-        faces += [(c.area, c.outside.h_conv) for c in self.components
-                  if isinstance(c.outside, Surface) and c.outside.zone == zone_name]
-        return sum(a * h for a, h in faces) / sum(a for a, _ in faces)
+        facing a zone, W/m2/K, before its `convection_factor`."""
+        faces = self._faces(zone_name)
+        return sum(c.area * side.h_conv for c, side, _ in faces) / sum(c.area for c, _, _ in faces)
 
     def node_names(self):
         """{id: readable name}: "<component> at <depth> m", "<zone> air", "<zone> radiant"."""
