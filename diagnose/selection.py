@@ -36,7 +36,10 @@ to, block by block:
    squared residual (at most 1): a surface the model cannot follow does not choose for the air.
    The candidates whose evidence exceeds the best's by no more than one standard error of that
    paired difference cannot be told apart from it, and among them a physical effect before a shape,
-   then fewer parameters before more, then the lower evidence. That standard error is the larger
+   then fewer parameters before more, then a zone's effect before one component's, then the lower
+   evidence. A component's correction says where the fault is; where the zone's own (its envelope,
+   its air change) predicts as well, the data have not placed it there, and the components are
+   named beside the zone's effect instead (an air-only record cannot tell its walls apart). That standard error is the larger
    of two: the difference's scatter from block to block, and what the sensors' noise alone makes
    of it (`noise_difference`); against a simpler candidate, a candidate with more freedom must
    also gain beyond the noise's tolerance of J, as any candidate must against the model
@@ -207,6 +210,7 @@ def decide(building, results, base, sigma, n, groups=()):
     admissible = [r for r in passing if not tests[label(r)]["objection"]]
     suggestions = [{"candidate": label(r), "reason": tests[label(r)]["objection"], "cv_rmse": r["cv"]["rmse"]}
                    for r in passing if tests[label(r)]["objection"]]
+    components = {c.name for c in building.components}
     chosen, alike = None, []
     if admissible:
         best = min(admissible, key=lambda r: evidence(r).sum())
@@ -220,9 +224,8 @@ def decide(building, results, base, sigma, n, groups=()):
                 needed = max(needed, parsimony(best, sigma, n))
             return worse <= needed
         near = [r for r in admissible if close(r)]
-        chosen = min(near, key=lambda r: (preference(r["effect"]), evidence(r).sum()))
+        chosen = min(near, key=lambda r: (preference(r["effect"]), r["target"] in components, evidence(r).sum()))
         alike = [r for r in near if r is not chosen]
-    components = {c.name for c in building.components}
     # the candidates physics refused are in `suggestions`; the report says them grouped by reason
     reason = _reason(chosen, alike, results, passing, base, n, tests, margin, components)
     return chosen, {"chosen": label(chosen) if chosen else None, "reason": reason,
@@ -256,12 +259,15 @@ def _reason(chosen, alike, results, passing, base, n, tests, margin, components)
     if alike:
         said += ("; within one standard error of the best, and so not told apart by these data: "
                  + ", ".join(f"{r['effect']} on {r['target']} ({evidence(r).sum():.3g} C2)" for r in alike)
-                 + (" (a physical effect, then fewer parameters, is preferred)" if any(
-                     evidence(r).sum() < evidence(chosen).sum() for r in alike) else ""))
+                 + (" (a physical effect, then fewer parameters, then a zone's effect before one component's, "
+                    "is preferred)" if any(evidence(r).sum() < evidence(chosen).sum() for r in alike) else ""))
     others = [r["target"] for r in alike if r["target"] != chosen["target"] and r["target"] in components]
     if others and chosen["target"] in components:
         said += (f". The correction of {chosen['target']} cannot be told from that of "
                  f"{', '.join(dict.fromkeys(others))}: the fault may be in either")
+    elif others:
+        said += (f". A correction of {' or '.join(dict.fromkeys(others))} alone explains the data as well: "
+                 f"they do not place the fault in one component")
     if is_shape(chosen["effect"]):
         said += "; no physical effect comes within one standard error of it"
     return said + "."

@@ -214,6 +214,21 @@ def test_two_components_the_data_cannot_tell_apart_are_both_named(testcell):
     assert "cannot be told from that of west_wall" in decision["reason"]
 
 
+def test_a_zone_s_correction_comes_before_a_component_s_the_data_cannot_tell_from_it(testcell):
+    # the air alone: the west wall predicts the left-out days a little better than the envelope
+    # factor, within one standard error; naming the wall would place the fault where the data did not
+    wall = candidate("conductivity", "west_wall", {"factor": parameter(2.0, 0.2)}, [2.0, 2.2, 2.1, 2.2])
+    envelope = candidate("envelope_conductance", "cell", {"factor": parameter(1.2, 0.02)}, [2.1, 2.0, 2.3, 2.2])
+    chosen, decision = decide(testcell, [wall, envelope], BASE, SIGMA, N)
+    assert chosen["effect"] == "envelope_conductance", decision["reason"]
+    assert decision["indistinct"] == ["conductivity@west_wall"]
+    assert "west_wall alone explains the data as well" in decision["reason"]
+    # where the wall predicts every day clearly better, the data have placed it: the wall
+    worse = candidate("envelope_conductance", "cell", {"factor": parameter(1.2, 0.02)}, [4.0, 4.1, 4.0, 4.1])
+    chosen, decision = decide(testcell, [door([2.0, 2.2, 2.1, 2.2]), worse], BASE, SIGMA, N)
+    assert chosen["target"] == "door" and not decision["indistinct"]
+
+
 def with_left_out(result, residuals):
     """The candidate with its left-out residuals (C, every block's in one order), its per-day J
     computed from them: four days of N / 4."""
