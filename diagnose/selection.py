@@ -39,12 +39,12 @@ to, block by block:
    then fewer parameters before more, then a zone's effect before one component's, then the lower
    evidence. A component's correction says where the fault is; where the zone's own (its envelope,
    its air change) predicts as well, the data have not placed it there, and the components are
-   named beside the zone's effect instead (an air-only record cannot tell its walls apart). That standard error is the larger
-   of two: the difference's scatter from block to block, and what the sensors' noise alone makes
-   of it (`noise_difference`); against a simpler candidate, a candidate with more freedom must
-   also gain beyond the noise's tolerance of J, as any candidate must against the model
-   (`parsimony`). Two corrections that predict nearly the same temperatures differ
-   by nearly the same small amount every day, so the blocks' scatter is tiny; yet another draw
+   named beside the zone's effect instead (an air-only record cannot tell its walls apart). That
+   standard error is the larger of two: the difference's scatter from block to block, and what the
+   sensors' noise alone makes of it (`noise_difference`); against a simpler candidate, a candidate
+   with more freedom must also gain beyond the noise's tolerance of J, as any candidate must
+   against the model (`parsimony`). Two corrections that predict nearly the same temperatures
+   differ by nearly the same small amount every day, so the blocks' scatter is tiny; yet another draw
    of the noise would move that difference by 2 sigma |r_a - r_b|, and reverse it where it is
    smaller. Components whose corrections cannot be told apart are named together in the reason.
    Whether a candidate passes (1.) reads the air alone, the objective: the other sensors judge
