@@ -223,7 +223,7 @@ def test_a_zone_s_correction_comes_before_a_component_s_the_data_cannot_tell_fro
     assert chosen["effect"] == "envelope_conductance", decision["reason"]
     assert decision["indistinct"] == ["conductivity@west_wall"]
     assert "west_wall alone explains the data as well" in decision["reason"]
-    # where the wall predicts every day clearly better, the data have placed it: the wall
+    # where a component (the door) predicts every day clearly better, the data have placed it there
     worse = candidate("envelope_conductance", "cell", {"factor": parameter(1.2, 0.02)}, [4.0, 4.1, 4.0, 4.1])
     chosen, decision = decide(testcell, [door([2.0, 2.2, 2.1, 2.2]), worse], BASE, SIGMA, N)
     assert chosen["target"] == "door" and not decision["indistinct"]
