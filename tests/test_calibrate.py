@@ -74,7 +74,37 @@ def test_a_component_s_loss_is_what_its_layers_add_to_the_heat_loss_coefficient(
     # doubling the layers' conductance at ten times adds less than a third of what it adds at once
     assert loss(20.0)["value"] - loss(10.0)["value"] < (loss(2.0)["value"] - loss(1.0)["value"]) / 3
     slope = (hlc(7.2) - hlc(7.0)) / 0.2
-    assert loss(7.1, sd=2.4)["std"] == pytest.approx(abs(slope) * 2.4, rel=1e-3)
+    # the factor's sd, 2.4, combined with its range's as a uniform distribution (`within_ranges`)
+    (low, high), = door.bounds
+    sd = (1 / 2.4 ** 2 + 12 / (high - low) ** 2) ** -0.5
+    assert loss(7.1, sd=2.4)["std"] == pytest.approx(abs(slope) * sd, rel=1e-3)
     # an adiabatic floor loses nothing whatever its layers conduct
     assert derived(Candidate(testcell, "conductivity", "floor"), None, np.array([3.0]),
                    np.array([[1.0]]))["component_loss"]["value"] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_a_flux_the_data_fix_keeps_its_spread_where_the_valley_along_it_is_unbounded():
+    """A ground coupling whose data fix only the flux q = U (T_ground - T_face): its information is
+    g g' / sigma_q^2, g = (T_ground - T_face, U), singular along the valley. Combined with the
+    ranges' uniform precision P (`within_ranges`), the flux's variance is, by Sherman-Morrison,
+    sigma_q^2 a / (sigma_q^2 + a) with a = g' P^-1 g: at most sigma_q^2, whatever the valley; the
+    linearised covariance alone, read by a gradient off the valley by 1e-3, gives tens of sigma_q."""
+    from nodeforce.diagnose.calibrate import within_ranges
+
+    bounds = [(0.0, 20.0), (-10.0, 40.0)]
+    U, T_ground, T_face, sigma_q = 0.13, 4.2, 25.0, 0.15
+    g = np.array([T_ground - T_face, U])
+    across, along = g / np.linalg.norm(g), np.array([U, T_face - T_ground]) / np.linalg.norm(g)
+    # the data alone: sigma_q across the valley, 1e4 along it (as the linearised fit gave there)
+    cov = (sigma_q / np.linalg.norm(g)) ** 2 * np.outer(across, across) + 1e8 * np.outer(along, along)
+    a = g @ np.diag([w ** 2 / 12.0 for w in (20.0, 50.0)]) @ g
+    assert g @ within_ranges(cov, bounds) @ g == pytest.approx(sigma_q ** 2 * a / (sigma_q ** 2 + a), rel=1e-5)
+    off = g + np.array([0.0, 1e-3])
+    assert np.sqrt(off @ cov @ off) > 30 * sigma_q
+    assert np.sqrt(off @ within_ranges(cov, bounds) @ off) < 1.01 * sigma_q
+    # a covariance the data fix well: the sum of precisions, inverted directly, and barely changed
+    tight = np.array([[0.01, 0.002], [0.002, 0.04]])
+    combined = within_ranges(tight, bounds)
+    assert combined == pytest.approx(
+        np.linalg.inv(np.linalg.inv(tight) + np.diag([12 / 20.0 ** 2, 12 / 50.0 ** 2])), rel=1e-9)
+    assert combined == pytest.approx(tight, rel=2e-3)
