@@ -213,15 +213,19 @@ def derived(candidate, case, x, cov):
       conduct more, so a door twice as conductive as its wood and one ten times are told apart
       by little, while the loss the data see is fixed. g is the HLC's.
 
-    The covariance read is the data's combined with the parameters' ranges (`within_ranges`).
+    What the parameters trade off along (the flux, a time constant, a component's loss) reads
+    their covariance combined with their ranges (`within_ranges`): the valley leaves it unchanged,
+    and only the linearisation's share of the valley's spread is bounded. The HLC reads the data's
+    covariance alone: with a ground coupling it changes along the valley (U = q / (T_ground -
+    T_face), a hyperbola the range's linear extrapolation does not follow), and so is not fixed.
     """
-    cov = within_ranges(cov, candidate.bounds)
+    within = within_ranges(cov, candidate.bounds)
 
-    def with_sd(value, gradient, unit):
+    def with_sd(value, gradient, unit, cov=within):
         return {"value": float(value), "std": float(np.sqrt(max(gradient @ cov @ gradient, 0.0))), "unit": unit}
 
     hlc, gradient = hlc_gradient(candidate, x)
-    out = {"heat_loss_coefficient": with_sd(hlc, gradient, "W/K")}
+    out = {"heat_loss_coefficient": with_sd(hlc, gradient, "W/K", cov)}
     if candidate.effect == "ground_coupling":
         U, T_ground = x
         face = candidate.building.component(candidate.target).node_ids[-1]
