@@ -5,8 +5,8 @@ driver's, and follow the same rules as `model.integrate.simulate`, so both give 
 """
 import numpy as np
 
-from nodeforce.model.integrate import (STEADY_STEP, forcing_schedule, held_inputs, steady_inputs, warmup_rows,
-                                       within_steps)
+from nodeforce.model.integrate import (STEADY_STEP, forcing_schedule, held_inputs, history_block, history_inputs,
+                                       steady_inputs, warmup_rows, within_steps)
 
 
 def node_names(prefix, ids):
@@ -45,7 +45,8 @@ def simulate_fmu(instance, case, force=None, warmup_days=2, output_ids=None, T_d
     start = case.start_state(T_default)
     parameters = {**dict(zip(node_names("T_start", range(1, len(start) + 1)), start.tolist())),
                   **{name: True for name in node_names("force", forced_ids)}, **(parameters or {})}
-    rows = warmup_rows(n_rows, case.dt, warmup_days)
+    H = case.history_steps  # a history stands in for the warm-up, in steps of its own (integrate.simulate)
+    rows = H + warmup_rows(n_rows - H, case.dt, 0 if H else warmup_days)
     columns = np.array(forced_ids, dtype=int) - 1
     # each sample's step in case.substeps steps, its inputs and imposed temperatures in between
     # as the direct model has them (model.integrate.within_steps); T_forced NaN where not imposed
@@ -55,11 +56,18 @@ def simulate_fmu(instance, case, force=None, warmup_days=2, output_ids=None, T_d
     inputs = np.stack([np.hstack([u[rows], np.where(schedule[rows][:, columns], imposed[rows], np.nan)])
                        for u, imposed in within], axis=1).reshape(len(rows) * k, -1)
     steps = np.full(len(inputs), case.dt / k)
+    block = history_block(case.dt)
+    if H:
+        coarse = history_inputs(case.U, H, case.dt)
+        inputs = np.vstack([np.hstack([coarse, np.full((len(coarse), len(columns)), np.nan)]), inputs])
+        steps = np.concatenate([np.full(len(coarse), block * case.dt), steps])
     if case.steady_start:
         u, held, values = steady_inputs(case.U, measured, schedule, case.dt)
         inputs = np.vstack([np.concatenate([u, np.where(held[columns], values[columns], np.nan)]), inputs])
         steps = np.concatenate([[STEADY_STEP], steps])
+    history = H // block
     out = instance.run(steps, parameters, {},
                        list(case.input_names) + node_names("T_forced", forced_ids),
-                       inputs, node_names("T", output_ids), skip=len(inputs) - (n_rows - 1) * k)
-    return out[k - 1::k]
+                       inputs, node_names("T", output_ids), skip=len(inputs) - (n_rows - 1 - H) * k - history)
+    # a history's rows hold each of its steps' end state, as the direct model's do
+    return np.vstack([np.repeat(out[:history], block, axis=0), out[history:][k - 1::k]])

@@ -76,10 +76,12 @@ def compare(models, phases=(), fmu_kind="python"):
             raise InputError(path, "time", f"its record does not have the times of {path0}'s")
         check_measured(objective, case, path)
     times = case0.times[1:]
-    result = {"record": [case0.times[0].isoformat(), case0.times[-1].isoformat()],
+    result = {"record": [case0.start.isoformat(), case0.times[-1].isoformat()],
               "objective": list(objective0.zones),
               "scored_from": case0.times[case0.burn_in_steps + 1].isoformat(), "models": []}
-    series = {"times": times, "scored_from": case0.times[case0.burn_in_steps + 1], "measured": None, "runs": []}
+    # plotted from the first measurement: the weather's history before it is not the record
+    h = case0.history_steps
+    series = {"times": times[h:], "scored_from": case0.times[case0.burn_in_steps + 1], "measured": None, "runs": []}
     for path, building, case, objective in models:
         measured = objective.measured(case)
         if case.fluxes:
@@ -95,8 +97,8 @@ def compare(models, phases=(), fmu_kind="python"):
         result["models"].append({"building": str(path), "heat_loss_coefficient": heat_loss_coefficient(building),
                                  "metrics": objective.metrics(measured, simulated), "phases": by_phase,
                                  "surface_heat_flux": surface_fluxes(building, case, T) if case.fluxes else {}})
-        series["measured"] = measured
-        series["runs"].append(simulated)
+        series["measured"] = measured[h:]
+        series["runs"].append(simulated[h:])
     return result, series
 
 

@@ -71,16 +71,16 @@ def split(case, source, fraction=None, end=None):
     fraction : the part of the record, by time, that calibrates
     end : pandas Timestamp, the last calibration time (the row at or before it)
     """
-    n = len(case.times) - 1
+    n, h = len(case.times) - 1, case.history_steps
     if end is not None:
         k = int(case.times.searchsorted(end, side="right")) - 1
         what = f"a calibration ending {end.isoformat()}"
-    else:
-        k = int(round(fraction * n))
+    else:  # of the measured record: the weather's history before it is no part of either window
+        k = h + int(round(fraction * (n - h)))
         what = f"a split {fraction:.0%} / {1 - fraction:.0%}"
     day = steps_per_day(case.dt)
     if k < case.burn_in_steps + day or n - k < day:
-        raise InputError(source, "time", f"{n} steps of {case.dt:g} s from {case.times[0].isoformat()}: {what} "
+        raise InputError(source, "time", f"{n - h} steps of {case.dt:g} s from {case.start.isoformat()}: {what} "
                                          f"leaves no calibration window of the burn-in plus a day, or no "
                                          f"validation window of a day")
     return k
@@ -451,12 +451,14 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
         report["reference"] = reference
     if by_phase:
         report["phases"] = by_phase
-    series = {"times": times[1:], "validation_start": times[k + 1], "scored_from": times[first.burn_in_steps + 1],
+    # plotted from the first measurement: the weather's history before it is not the record
+    h = first.history_steps
+    series = {"times": times[h + 1:], "validation_start": times[k + 1], "scored_from": times[first.burn_in_steps + 1],
               "convergence": convergence,
-              "zones": {zone: {"air_node": air, "measured": measured[:, j], "before": before_runs[0][:, j],
-                               "after": after_runs[0][:, j]}
+              "zones": {zone: {"air_node": air, "measured": measured[h:, j], "before": before_runs[0][h:, j],
+                               "after": after_runs[0][h:, j]}
                         for j, (zone, air) in enumerate(zip(objective.zones, objective.air_nodes))},
-              "inputs": dict(zip(first.input_names, first.U[1:].T))}
+              "inputs": dict(zip(first.input_names, first.U[h + 1:].T))}
     plots = write_report(workdir, report, series)
     report["artifacts"]["plots"] = [str(p) for p in plots]
     report["artifacts"]["report"] = str(workdir / "report.md")
@@ -482,7 +484,7 @@ def protocol(building, record):
 def period(windows, i):
     """The calibration and validation spans of record i, where its scoring starts and its blocks."""
     times, k, case = windows.cases[i].times, windows.ks[i], windows.cases[i]
-    return {"calibration": [times[0].isoformat(), times[k].isoformat()],
+    return {"calibration": [case.start.isoformat(), times[k].isoformat()],
             "calibration_scored_from": times[case.burn_in_steps + 1].isoformat(),
             "validation": [times[k + 1].isoformat(), times[-1].isoformat()],
             "blocks": [[times[1:k + 1][m][0].isoformat(), times[1:k + 1][m][-1].isoformat()]

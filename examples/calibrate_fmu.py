@@ -78,7 +78,8 @@ def door_case(folder, days, kind, seed):
     measured = pseudo_measurements(parse_building(real), weather, times, SENSORS, noise_sd=0.1, seed=seed,
                                    history_days=7)
     building = parse_building(data)
-    case = nodeforce.measured_case(building, weather, measured)
+    # the outside tool starts at the first measurement, from the sensors' values: no history
+    case = nodeforce.measured_case(building, weather, measured, history_days=0)
     folder.mkdir(parents=True, exist_ok=True)
     fmu = build_fmu(building, folder / "testcell.fmu", kind=kind)
     pd.DataFrame(case.U, index=case.times, columns=case.input_names).to_csv(folder / "inputs.csv")

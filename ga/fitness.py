@@ -12,7 +12,7 @@ import numpy as np
 
 from nodeforce.cosim.fmi import FmuInstance, content_id
 from nodeforce.cosim.run import simulate_fmu
-from nodeforce.model.integrate import STEADY_STEP, ImplicitEuler, simulate
+from nodeforce.model.integrate import STEADY_STEP, ImplicitEuler, history_block, simulate
 from nodeforce.model.network import assemble
 
 
@@ -150,11 +150,14 @@ class ModelEvaluator(_Evaluator):
         self.network = assemble(spec.building)
         self.stepper = ImplicitEuler(self.network, spec.case.dt / spec.case.substeps)  # kept: its factors
         self.steady = ImplicitEuler(self.network, STEADY_STEP) if spec.case.steady_start else None
+        self.history = (ImplicitEuler(self.network, history_block(spec.case.dt) * spec.case.dt)
+                        if spec.case.history_steps else None)
 
     def air(self, force):
         """Objective air temperatures (C) at t_1..t_N with the `force` (N,) bool nodes forced."""
         case = self.spec.case
         T = simulate(self.spec.building, self.network, case.U, case.dt, case.measured, force=force,
                      warmup_days=self.spec.warmup_days, burn_in_steps=case.burn_in_steps, stepper=self.stepper,
-                     steady_start=case.steady_start, steady_stepper=self.steady, substeps=case.substeps)
+                     steady_start=case.steady_start, steady_stepper=self.steady, substeps=case.substeps,
+                     history_steps=case.history_steps, history_stepper=self.history)
         return T[:, np.array(self.spec.objective.air_nodes) - 1]

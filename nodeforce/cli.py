@@ -13,7 +13,7 @@ from nodeforce import lifetime, tempdirs
 from nodeforce.ga.checkpoint import NAME as CHECKPOINT, resume_hint
 from nodeforce.ga.search import PAPER, PATIENCE
 from nodeforce.model.building import load_building
-from nodeforce.model.case import force_mask, measured_case, prepare_case
+from nodeforce.model.case import HISTORY_DAYS, force_mask, measured_case
 from nodeforce.model.errors import InputError
 from nodeforce.iotools.measurements import read_measurements
 from nodeforce.iotools.timetable import instant
@@ -44,7 +44,8 @@ def load_inputs(args):
     building = load_building(args.building)
     weather = read_weather(args.weather)
     measurements = read_measurements(args.measurements) if getattr(args, "measurements", None) else None
-    case = measured_case(building, weather, measurements, args.burn_in_days, args.decomposition)
+    case = measured_case(building, weather, measurements, args.burn_in_days, args.decomposition,
+                         history(args))
     for said in case.assumptions:
         print(f"assumed: {said}")
     objective = Objective.of(building, zone_list(args.objective) if getattr(args, "objective", None) else None)
@@ -78,11 +79,14 @@ def cmd_simulate(args):
     with tempdirs.folder("simulate") as tmp:
         with FmuInstance(build_fmu(building, Path(tmp) / "model.fmu", kind=fmu_kind("python", args.fmi))) as instance:
             T = simulate_fmu(instance, case, force)
-    write_node_temperatures(args.output, case.times[1:], T)
+    # the weather's history before the first measurement set the start; the output is the record's
+    h = case.history_steps
+    T, times = T[h:], case.times[h + 1:]
+    write_node_temperatures(args.output, times, T)
     names = write_node_names(args.output, building)
     print(f"wrote {args.output}: nodes 1..{T.shape[1]} at {len(T)} times "
-          f"({case.times[1].isoformat()} to {case.times[-1].isoformat()}, step {case.dt:g} s); node names in {names}")
-    measured = objective.measured(case)
+          f"({times[0].isoformat()} to {times[-1].isoformat()}, step {case.dt:g} s); node names in {names}")
+    measured = objective.measured(case)[h:]
     simulated = T[:, np.array(objective.air_nodes) - 1]
     if np.isfinite(measured).any():
         for zone, m in objective.metrics(measured, simulated)["zones"].items():
@@ -266,7 +270,7 @@ def records_of(building, args):
             raise InputError("--weather", args.weather or "", "diagnose needs --weather and --measurements, "
                                                               "or one --record per record")
         case = measured_case(building, read_weather(args.weather), read_measurements(args.measurements),
-                             args.burn_in_days, args.decomposition)
+                             args.burn_in_days, args.decomposition, history(args))
         for said in case.assumptions:
             print(f"assumed: {said}")
         return [the_record(case, args.measurements, args)]
@@ -285,7 +289,7 @@ def records_of(building, args):
         # a record run under another protocol (other flows, other blinds) reads the house as written for it
         own = load_building(f["building"]) if "building" in f else building
         case = measured_case(own, read_weather(f["weather"]), read_measurements(f["measurements"]), burn_in,
-                             args.decomposition)
+                             args.decomposition, history(args))
         end = f.get("calibration-end", args.calibration_end)
         phases = f.get("phases", args.phases)
         records.append(Record(case, f["measurements"], f.get("name", Path(f["measurements"]).name.split(".")[0]),
@@ -326,7 +330,8 @@ def cmd_compare(args):
     models = []
     for path in args.buildings:
         building = load_building(path)
-        case = measured_case(building, weather, measurements, args.burn_in_days, args.decomposition)
+        case = measured_case(building, weather, measurements, args.burn_in_days, args.decomposition,
+                             history(args))
         models.append((path, building, case, Objective.of(building, names)))
     for said in dict.fromkeys(a for _, _, case, _ in models for a in case.assumptions):
         print(f"assumed: {said}")
@@ -356,10 +361,11 @@ DEMO_COMMAND = ("nodeforce synth model/data/testcell_miami.json --weather model/
 def cmd_demo(args):
     building = load_building(DATA / "testcell_miami.json")
     measurements_path = DATA / "demo_measurements.csv"
-    case = prepare_case(building, read_weather(DATA / "miami_tmy2.csv"), read_measurements(measurements_path))
+    case = measured_case(building, read_weather(DATA / "miami_tmy2.csv"), read_measurements(measurements_path),
+                         args.burn_in_days, history_days=history(args))
     print(f"{building.name}: measurements {measurements_path.name} carry an effect the building file does "
           f"not declare (made by: {DEMO_COMMAND})")
-    run_diagnosis(building, [the_record(case.with_burn_in(args.burn_in_days), measurements_path, args)],
+    run_diagnosis(building, [the_record(case, measurements_path, args)],
                   Objective.of(building), Path(args.output), args)
 
 
@@ -405,13 +411,25 @@ def diagnosis_arguments(s):
     s.add_argument("--phases", help="CSV time,phase: the experiment's phases (each from its time to the next); "
                                     "every model is scored on each and a phase made worse is flagged")
     noise_argument(s)
-    burn_in_argument(s, 1.0)
+    start_arguments(s, 1.0)
 
 
-def burn_in_argument(s, default):
-    s.add_argument("--burn-in-days", type=float, default=default,
-                   help=f"days after t_0 over which every measured node is forced and nothing is scored "
-                        f"(docs/model.md section 5; default {default:g})")
+def start_arguments(s, burn_in):
+    """How a record starts: the weather's history before it, then its burn-in."""
+    s.add_argument("--burn-in-days", type=float, default=burn_in,
+                   help=f"days after the first measurement over which every measured node is forced and nothing "
+                        f"is scored (docs/model.md section 5; default {burn_in:g})")
+    s.add_argument("--history-days", type=float, default=HISTORY_DAYS,
+                   help=f"days of the weather before the first measurement simulated before it, nothing measured "
+                        f"or scored, so that the walls start from the weather's past (docs/model.md section 5; "
+                        f"default {HISTORY_DAYS:g}, as far as the weather and every input reach; 0: none)")
+
+
+def history(args):
+    """The user's --history-days, which must not be negative."""
+    if not args.history_days >= 0:
+        raise InputError("--history-days", args.history_days, "days of weather before the record, not negative")
+    return args.history_days
 
 
 def noise_argument(s):
@@ -446,7 +464,7 @@ def parser():
     case_arguments(s, False, "the CSV of node temperatures to write", output_default="sim.csv")
     s.add_argument("--force", help="node ids forced to their measurements, e.g. 1,7,9")
     fmi_argument(s)
-    burn_in_argument(s, 0.0)
+    start_arguments(s, 0.0)
     objective_argument(s)
     s.set_defaults(run=cmd_simulate)
 
@@ -473,7 +491,7 @@ def parser():
     s.add_argument("--scheduler", help="a Dask scheduler address, tcp://host:port")
     fmi_argument(s)
     noise_argument(s)
-    burn_in_argument(s, 0.0)
+    start_arguments(s, 0.0)
     objective_argument(s)
     s.set_defaults(run=cmd_locate)
 
@@ -500,7 +518,7 @@ def parser():
     s.add_argument("--phases", help="CSV time,phase: every model is scored on each phase")
     s.add_argument("--fmu", choices=("python", "standalone"), default="python", help="the FMU kind to run")
     decomposition_argument(s)
-    burn_in_argument(s, 1.0)
+    start_arguments(s, 1.0)
     objective_argument(s)
     s.set_defaults(run=cmd_compare)
 

@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 
 from nodeforce.model.building import parse_building
-from nodeforce.model.case import prepare_case
+from nodeforce.model.case import measured_case
 from nodeforce.model.integrate import simulate
 from nodeforce.iotools.measurements import read_measurements
 from nodeforce.model.network import assemble
@@ -47,10 +47,11 @@ def test_simulate_writes_every_node_as_the_direct_model_computes(files, testcell
     sim = pd.read_csv(out)
     assert list(sim.columns) == ["time"] + [f"T{i}" for i in range(1, 24)]
     measurements = pd.read_csv(files["measurements"], index_col="time")
-    case = prepare_case(testcell, weather, read_measurements(files["measurements"]))
+    case = measured_case(testcell, weather, read_measurements(files["measurements"]))  # the weather's history first
     force = np.zeros(23, dtype=bool)
     force[[6, 16]] = True
-    direct = simulate(testcell, assemble(testcell), case.U, case.dt, case.measured, force, substeps=case.substeps)
+    direct = simulate(testcell, assemble(testcell), case.U, case.dt, case.measured, force, burn_in_steps=case.burn_in_steps,
+                      steady_start=True, substeps=case.substeps, history_steps=case.history_steps)[case.history_steps:]
     assert len(sim) == len(measurements) - 1  # t_1..t_N
     assert np.abs(sim.iloc[:, 1:].to_numpy() - direct).max() < 1e-9
     assert np.array_equal(sim["T7"].to_numpy(), measurements["T7"].to_numpy()[1:])
@@ -140,11 +141,14 @@ def test_an_unreachable_scheduler_is_a_one_line_error(files, capsys):
     assert err.startswith("nodeforce: --scheduler: tcp://127.0.0.1:1: cannot reach a Dask scheduler")
 
 
-def test_a_record_shorter_than_the_warm_up_is_refused(files, capsys):
+def test_a_record_shorter_than_the_warm_up_is_refused_unless_the_weather_gives_a_history(files, capsys, tmp_path):
     short = rewrite_csv(files, "measurements", "short.csv", lambda f: f.iloc[:40])
-    err = error_of(capsys, ["simulate", str(files["building"]), "--weather", str(files["weather"]),
-                            "--measurements", short])
+    command = ["simulate", str(files["building"]), "--weather", str(files["weather"]), "--measurements", short]
+    err = error_of(capsys, command + ["--history-days", "0"])
     assert "short.csv: time: 39 steps of 900 s" in err and "one day" in err
+    # the replay of a first day is what needs the day; a history takes its place
+    assert main(command + ["-o", str(tmp_path / "short_sim.csv")]) == 0
+    assert len(pd.read_csv(tmp_path / "short_sim.csv")) == 39
 
 
 def test_synth_refuses_impossible_settings(files, capsys):

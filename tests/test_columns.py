@@ -47,8 +47,9 @@ def files(tmp_path_factory, testcell_data, weather):
     building.write_text(json.dumps(data))
     weather_csv = d / "weather.csv"
     write_time_table(named_weather(weather), weather_csv)
+    # the building lived through the weather before its record, which the commands read as its history
     measurements = pseudo_measurements(parse_building(data, source=str(building)), read_weather(weather_csv),
-                                       record_times(days=5), SENSORS)
+                                       record_times(days=5), SENSORS, history_days=60)
     measured = d / "measured.csv"
     write_time_table(measurements, measured)
     return {"dir": d, "data": data, "building": str(building), "weather": str(weather_csv), "measurements": str(measured)}
@@ -129,8 +130,8 @@ def test_named_columns_through_simulate_locate_and_diagnose(files, capsys):
     direct = simulate_building(building, read_weather(files["weather"]), measured)
     through_fmu = pd.read_csv(sim)
     assert np.abs(through_fmu.iloc[:, 1:].to_numpy() - direct.to_numpy()).max() < 1e-9
-    # the measurements come from this building and weather: what is left is the warm-up's
-    # hundredths, where a heater or cellar read wrong would leave degrees
+    # the measurements come from this building and weather: what is left is the history's start
+    # and steps' hundredths, where a heater or cellar read wrong would leave degrees
     residual = through_fmu["T23"].to_numpy() - measured["T23"].to_numpy()[1:]
     assert np.sqrt(np.mean(residual ** 2)) < 0.1
 

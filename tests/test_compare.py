@@ -7,7 +7,7 @@ import pytest
 
 from nodeforce.cli import main
 from nodeforce.model.building import parse_building
-from nodeforce.model.case import prepare_case
+from nodeforce.model.case import measured_case
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.integrate import simulate
 from nodeforce.model.network import RHO_C_AIR, assemble
@@ -17,11 +17,13 @@ from tests.conftest import DATA, SENSORS, record_times
 
 def direct_rmse(building, weather, measurements, start, end):
     """RMSE (C) of the cell's air of `building` against the measurements over the steps from
-    `start` to `end`, simulated by the direct model with the first day a burn-in (every measured
-    node forced, not scored), as docs/model.md section 5 says."""
-    case = prepare_case(building, weather, measurements).with_burn_in(1)
-    T = simulate(building, assemble(building), case.U, case.dt, case.measured, burn_in_steps=case.burn_in_steps, substeps=case.substeps)
-    rows = (case.times[1:] >= start) & (case.times[1:] <= end)
+    `start` to `end`, simulated by the direct model from the weather's history with the first day
+    a burn-in (every measured node forced, not scored), as docs/model.md section 5 says."""
+    case = measured_case(building, weather, measurements, burn_in_days=1)
+    h = case.history_steps
+    T = simulate(building, assemble(building), case.U, case.dt, case.measured, burn_in_steps=case.burn_in_steps,
+                 steady_start=True, substeps=case.substeps, history_steps=h)[h:]
+    rows = (case.times[h + 1:] >= start) & (case.times[h + 1:] <= end)
     residual = (measurements["T23"].to_numpy()[1:] - T[:, 22])[rows]
     return float(np.sqrt(np.mean(residual ** 2)))
 

@@ -121,8 +121,9 @@ def test_locate_command_on_the_papers_sensors_is_exhaustive(tmp_path, testcell_d
     weather_csv = tmp_path / "weather.csv"
     weather_csv.write_text((weather.attrs["source"] and open(weather.attrs["source"]).read()))
     out = tmp_path / "out"
+    # the paper's verification: the real cell starts in the periodic regime of its first day, no history
     assert main(["locate", str(building), "--weather", str(weather_csv), "--measurements", str(measured),
-                 "-o", str(out), "--workers", "1"]) == 0
+                 "-o", str(out), "--workers", "1", "--history-days", "0"]) == 0
     result = json.loads((out / "locate.json").read_text())
     assert result["measured_nodes"] == [1, 7, 9, 16, 17, 23]
     assert result["output_node"] == 23 and result["output_nodes"] == [23] and result["objective"] == ["cell"]

@@ -177,7 +177,8 @@ def test_small_office_two_faults_located(office, tmp_path):
     subprocess.run(run + ["locate", str(out / "building.json"), "--weather", str(out / "weather.csv"),
                           "--measurements", str(measured), "-o", str(tmp_path / "locate"), "--objective", offices,
                           "--noise", "0.05", "--burn-in-days", "1", "--workers", "1", "--population", "10",
-                          "--patience", "5"], check=True, capture_output=True)
+                          "--patience", "5", "--history-days", "0"],  # synthesised without a past, as told
+                   check=True, capture_output=True)
     result = json.loads((tmp_path / "locate" / "locate.json").read_text())
     names = building.node_names()
     assert sorted(names[i] for i in result["best_nodes"]) == ["s0_N1_wallN at 0.000 m", "s1_S0_wallS at 0.000 m"]

@@ -10,7 +10,7 @@ import pytest
 
 from nodeforce.cli import main
 from nodeforce.model.building import parse_building
-from nodeforce.model.case import prepare_case
+from nodeforce.model.case import measured_case, prepare_case
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import simulate
@@ -93,11 +93,12 @@ def test_compare_reports_the_model_s_flux_beside_the_reading(tmp_path, testcell_
     written = parse_building(data)
     truth = EFFECTS["infiltration"].apply(written, "cell", {"n": 2.0})
     measurements = pseudo_measurements(truth, weather, record_times(3), SENSORS, noise_sd=0.0, history_days=3)
-    case = prepare_case(truth, weather, measurements).with_burn_in(1)
-    net = assemble(truth)
-    T = simulate(truth, net, case.U, case.dt, case.measured, burn_in_steps=case.burn_in_steps, include_start=True, substeps=case.substeps)
+    case = measured_case(truth, weather, measurements, burn_in_days=1)  # from the weather's history, as compare runs it
+    net, h = assemble(truth), case.history_steps
+    T = simulate(truth, net, case.U, case.dt, case.measured, burn_in_steps=case.burn_in_steps, include_start=True,
+                 steady_start=True, substeps=case.substeps, history_steps=h)[h:]
     for sensor in ("roof_flux", "roof_out_flux"):
-        measurements[sensor] = face_heat_flux(truth, net, T, case.U, "roof", truth.flux_sensors[sensor][1])
+        measurements[sensor] = face_heat_flux(truth, net, T, case.U[h:], "roof", truth.flux_sensors[sensor][1])
     measurements.to_csv(tmp_path / "m.csv", date_format="%Y-%m-%dT%H:%M:%S%z")
     (tmp_path / "written.json").write_text(json.dumps(data))
     (tmp_path / "truth.json").write_text(json.dumps(truth.to_json()))
