@@ -6,8 +6,8 @@ concerns the objective zones (the zone itself, a component facing it, a `zone->c
 the zone), the effect's parameters are fitted, within the registry's bounds, by
 `scipy.optimize.least_squares` to the objective air on the calibration window (the record's
 first `fraction`, after the burn-in), with the direct model (`model.integrate.simulate`, the
-FMU's equal to 1e-9 C) started as the diagnosis starts (the burn-in's forcing, the first day's
-steady state). The candidate of lowest BIC = n log(J/n) + k log(n) is the answer if its BIC is
+FMU's equal to 1e-9 C) started as the diagnosis starts (the weather's history, the steady state,
+the burn-in's forcing). The candidate of lowest BIC = n log(J/n) + k log(n) is the answer if its BIC is
 more than `BIC_MARGIN` below the file's as given; else "none". No localisation, no residual
 statistics, no rule beyond that one.
 """
@@ -84,8 +84,8 @@ def baseline(building, case, zones, fraction=0.6):
     """
     started = time.time()
     air_nodes = [building.zone(z).air_node for z in zones]
-    n_steps = len(case.times) - 1
-    k = int(round(fraction * n_steps))
+    n_steps, h = len(case.times) - 1, case.history_steps
+    k = h + int(round(fraction * (n_steps - h)))  # of the measured record, as the diagnosis splits it
     rows = np.arange(case.burn_in_steps, k)
     measured = case.measured[1:, np.array(air_nodes) - 1]
     ok = np.isfinite(measured[rows]).all(axis=1)
