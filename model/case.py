@@ -9,7 +9,7 @@ Where the weather starts before the first measurement, the grid reaches back ove
 history, at most `HISTORY_DAYS`): a building measured from some date had a past, and its heavy
 components carry it for weeks. Simulated over that weather, nothing measured or scored, the
 model reaches the first measurement in the state the weather left it, as the building did,
-rather than in the steady state of the record's first day (docs/model.md 5.6).
+rather than in the steady state of the record's first day (docs/model.md 5.7).
 """
 from dataclasses import dataclass, field, replace
 
@@ -27,13 +27,14 @@ from .solar import (DECOMPOSITIONS, complete_irradiance, incident_irradiance, me
 from .weather import IRRADIANCE_COLUMNS, check_columns, weather_on_grid
 
 
-# Days of weather before the first measurement a measured case simulates at most, in steps of an
-# hour (`integrate.HISTORY_STEP`), from the steady state of their mean conditions. Measured on 30
+# Days of weather before the first measurement a measured case simulates at most, in steps of up
+# to 3 h (`integrate.HISTORY_STEP`), from the steady state of their mean conditions. Measured on 30
 # weeks of the test cell's air alone (three climates, a 90-day past, benchmarks/records.py's
 # truth), the file missed the record by 0.33 C RMS on average (1.3 at worst) without a history,
 # 0.21 (0.61) after 14 days, 0.10 (0.26) after 30 and 0.066 (0.09) after 60, its coarser walls'
 # own error: the test cell's floor above its adiabatic face has a mode of 14.7 days, and 60 days
-# leave e^-4 of what the start got wrong. The hourly steps add a third to a week's run at 30 min.
+# leave e^-4 of what the start got wrong. Their 480 steps cost about the two days' replay of the
+# first day (at 5-min steps) they replace.
 HISTORY_DAYS = 60.0
 
 STEADY_START = ("the nodes no measurement sets start from the steady state of the first day's mean conditions, "
@@ -309,17 +310,17 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
         row, col = np.argwhere(missing)[0]
         raise InputError(source, names[col], f"no value at {times[row].isoformat()}: every input is needed "
                                              "at every step, and a gap is not filled in")
-    if before:
+    if before:  # no measurement sets the history's first state: the steady state of its mean conditions does
         assumptions.append(f"The {before * dt / 86400:.3g} days of weather before the first measurement "
-                           f"({times[0].isoformat()} to {times[before].isoformat()}) are simulated before it, "
-                           "nothing measured or scored: the walls start from the weather's past.")
+                           f"({times[0].isoformat()} to {times[before].isoformat()}) are simulated before it from "
+                           "the steady state of their mean conditions, nothing measured or scored: the walls "
+                           "start from the weather's past.")
     measured = (measured_matrix(building, measurements, times) if measurements is not None
                 else np.full((len(times), building.n_nodes), np.nan))
     fluxes = measured_fluxes(building, measurements, times) if measurements is not None else {}
-    case = Case(times=times, dt=dt, input_names=names, U=U, measured=measured, assumptions=tuple(assumptions),
-                fluxes=fluxes, building=building, substeps=substeps(dt), burn_in_steps=before, history_steps=before)
-    # no measurement sets the state at the history's start: its first day's steady state does
-    return case.with_steady_start() if before else case
+    return Case(times=times, dt=dt, input_names=names, U=U, measured=measured, assumptions=tuple(assumptions),
+                fluxes=fluxes, building=building, substeps=substeps(dt), burn_in_steps=before, history_steps=before,
+                steady_start=bool(before))
 
 
 def check_warmup(case, source):
