@@ -44,6 +44,7 @@ from tqdm import tqdm  # noqa: E402
 
 from benchmarks.baseline import baseline  # noqa: E402
 from benchmarks.records import PLAN, SCENARIOS, SPECS, SPECS_BY_NAME, quick_specs, record  # noqa: E402
+from nodeforce.model.case import measured_case  # noqa: E402
 
 OUT = ROOT / "out" / "bench_diagnosis"
 DOCS = ROOT / "docs" / "benchmark_diagnosis.md"
@@ -89,12 +90,13 @@ def finished(path, name):
 
 def diagnose_one(task):
     """Generate one record, diagnose it with the loop and the baseline; write and return the result."""
-    name, draw, path, population, generations = task
+    name, draw, path, population, generations, history_days = task
     from nodeforce import api, tempdirs
     started = time.time()
     try:
         r = record(name, draw)
-        case = r.case()
+        case = r.case() if history_days is None else measured_case(
+            r.building, r.weather, r.measurements, burn_in_days=r.spec.burn_in, history_days=history_days)
         generated = time.time() - started
         t = time.time()
         # the loop's own lines (its findings, the candidates' fits) would bury the progress bar
@@ -303,18 +305,20 @@ def summary(results, draws):
     return lines, numbers
 
 
-# What one diagnosis costs, measured on the loop of 2026-11 (the quick subset, one draw, on 2 cores
-# shared with other work): the whole run is sized from it.
-BUDGET = ("The budget: on the loop of November 2026 (the `--quick` subset, one draw, 2 cores less loaded "
-          "than the last run's), a test-cell record took some 15 s in all (the loop 8 to 16 s, the baseline "
-          "1 to 3 s, the record 1 to 3 s) and a Twin House record some 6 min (the loop 250 s, the baseline "
-          "120 s); 58 test-cell and 4 Twin House records, 3 draws each, are then about 120 "
-          "processor-minutes: an hour on 2 workers, on 2 cores of its own (the times below were measured "
-          "with the cores shared, at a load of 10). The GA and the calibrations keep the command "
-          "line's defaults; the four Twin House records are what the hour affords. Finished records are "
-          "kept in out/bench_diagnosis/records, each with a digest of its spec and of the code (the "
-          "package, the records, the baseline, the examples): a rerun skips what is unchanged, a changed "
-          "loop runs everything again.")
+# What one diagnosis costs, measured in the run of 2026-11-27 (every record, 3 draws of the test
+# cell's): the whole run is sized from it.
+BUDGET = ("The budget, measured in the run of 2026-11-27 on 2 cores (a machine some 2.5 times slower than "
+          "the one of the earlier runs: the test suite at one commit took that much longer): a test-cell "
+          "diagnosis takes 10 to 70 s with the paper's sensors or the air alone and 2 to 4 min with every "
+          "node measured (gso-jan, 23 forcing genes), the baseline about a quarter of that, a Twin House "
+          "diagnosis 4 to 5 min. Every record under one draw is then about an hour on 2 workers, the 58 "
+          "test-cell records under two draws more about 70 min; the Twin House's two draws more (`make "
+          "benchmark` runs them) would add 40 min, and this run left them out: its stability criterion "
+          "covers the test cell's 58 records. The GA and the "
+          "calibrations keep the command line's defaults. Finished records are kept in "
+          "out/bench_diagnosis/records, each with a digest of its spec and of the code (the package, the "
+          "records, the baseline, the examples): a rerun skips what is unchanged, a changed loop runs "
+          "everything again.")
 
 
 def scenarios_table():
@@ -394,6 +398,10 @@ def main(argv=None):
     p.add_argument("--report", action="store_true", help="no diagnosis: the tables of the records already run")
     p.add_argument("--fresh", action="store_true", help="run every record again (after a change of the loop)")
     p.add_argument("--list", action="store_true", help="list the records and exit")
+    p.add_argument("--history-days", type=float,
+                   help="days of the weather before each record the loop and the baseline read at most (default "
+                        "the loop's own, docs/model.md 5.7; 0: none), to measure what the history does: give "
+                        "another --out, the records' digests do not hold it")
     args = p.parse_args(argv)
     specs = quick_specs() if args.quick else SPECS
     if args.only:
@@ -403,7 +411,7 @@ def main(argv=None):
             print(s.name, s.effect, s.target, s.size, s.climate, f"{s.days} d", f"{s.step_min} min", s.noise, s.sensors)
         return 0
     draws = args.draws or (1 if args.quick else 3)
-    tasks = [(s.name, d, result_path(args.out, s.name, d), args.population, args.generations)
+    tasks = [(s.name, d, result_path(args.out, s.name, d), args.population, args.generations, args.history_days)
              for s in specs for d in range(draws)]
     todo = [t for t in tasks if args.fresh or not finished(t[2], t[0])] if not args.report else []
     print(f"{len(specs)} records x {draws} draws: {len(tasks) - len(todo)} done before, {len(todo)} to run "
