@@ -44,7 +44,7 @@ from tqdm import tqdm  # noqa: E402
 
 from benchmarks.baseline import baseline  # noqa: E402
 from benchmarks.records import PLAN, SCENARIOS, SPECS, SPECS_BY_NAME, quick_specs, record  # noqa: E402
-from nodeforce.model.case import measured_case  # noqa: E402
+from nodeforce.model.case import HISTORY_DAYS  # noqa: E402
 
 OUT = ROOT / "out" / "bench_diagnosis"
 DOCS = ROOT / "docs" / "benchmark_diagnosis.md"
@@ -95,8 +95,7 @@ def diagnose_one(task):
     started = time.time()
     try:
         r = record(name, draw)
-        case = r.case() if history_days is None else measured_case(
-            r.building, r.weather, r.measurements, burn_in_days=r.spec.burn_in, history_days=history_days)
+        case = r.case(history_days)
         generated = time.time() - started
         t = time.time()
         # the loop's own lines (its findings, the candidates' fits) would bury the progress bar
@@ -398,10 +397,10 @@ def main(argv=None):
     p.add_argument("--report", action="store_true", help="no diagnosis: the tables of the records already run")
     p.add_argument("--fresh", action="store_true", help="run every record again (after a change of the loop)")
     p.add_argument("--list", action="store_true", help="list the records and exit")
-    p.add_argument("--history-days", type=float,
+    p.add_argument("--history-days", type=float, default=HISTORY_DAYS,
                    help="days of the weather before each record the loop and the baseline read at most (default "
-                        "the loop's own, docs/model.md 5.7; 0: none), to measure what the history does: give "
-                        "another --out, the records' digests do not hold it")
+                        "the loop's own, %(default)g, docs/model.md 5.7; 0: none), to measure what the history "
+                        "does: give another --out, the records' digests do not hold it")
     args = p.parse_args(argv)
     specs = quick_specs() if args.quick else SPECS
     if args.only:

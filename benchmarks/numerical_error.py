@@ -19,14 +19,13 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.records import CALIBRATION_FRACTION, SPECS_BY_NAME, record, refined  # noqa: E402
-from nodeforce.model.case import measured_case  # noqa: E402
 
 CELLS = (2, 4)
 
 
 def air_on_calibration(building, r, air):
-    """(n,) the air node's simulated temperature (C) on the record's calibration window."""
-    case = measured_case(building, r.weather, r.measurements, burn_in_days=r.spec.burn_in)
+    """(n,) the air node's temperature (C) simulated from `building` on record `r`'s calibration window."""
+    case = r.case(building=building)
     T = case.run(building)[case.burn_in_steps:, air - 1]
     return T[:int(round(CALIBRATION_FRACTION * len(T)))]
 
@@ -39,7 +38,7 @@ def main(argv=None):
     if unknown:
         p.error(f"no such record: {', '.join(unknown)}")
     print("| record | noise (C) | " + " | ".join(f"file x{c} - file, RMS (C)" for c in CELLS)
-          + " | (noise^2 + RMS x4^2) / noise^2 |")
+          + f" | (noise^2 + RMS x{CELLS[-1]}^2) / noise^2 |")
     print("|---|---|" + "---|" * (len(CELLS) + 1))
     for name in args.records:
         r = record(name, 0)

@@ -41,7 +41,7 @@ from nodeforce.diagnose.candidates import limits
 from nodeforce.iotools.typical_year import convert_typical_year, relocate
 from nodeforce.iotools.weather import read_weather
 from nodeforce.model.building import load_building, parse_building
-from nodeforce.model.case import measured_case, prepare_case
+from nodeforce.model.case import HISTORY_DAYS, measured_case, prepare_case
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.hlc import heat_loss_coefficient
 from nodeforce.model.integrate import simulate
@@ -130,9 +130,11 @@ class Record:
         """The objective zones (the first zone unless the spec names one)."""
         return [self.spec.objective or self.building.zones[0].name]
 
-    def case(self):
-        """The measured case as the diagnosis reads it: its grid, inputs and burn-in."""
-        return measured_case(self.building, self.weather, self.measurements, burn_in_days=self.spec.burn_in)
+    def case(self, history_days=HISTORY_DAYS, building=None):
+        """The measured case as the diagnosis of `building` (default the record's file) reads it:
+        its grid, inputs, burn-in and at most `history_days` of the weather before the record."""
+        return measured_case(building or self.building, self.weather, self.measurements,
+                             burn_in_days=self.spec.burn_in, history_days=history_days)
 
 
 def record_seed(name, draw):
