@@ -113,6 +113,7 @@ def diagnose_one(task):
             "loop": {"effects": [[e["effect"], e["target"]] for e in report.get("effects", [])],
                      "before": report["before"]["validation"]["rmse"], "after": report["after"]["validation"]["rmse"],
                      "hlc_before": hlc.get("before"), "hlc_after": hlc.get("after"), "seconds": seconds,
+                     "numerical": report["noise"]["numerical"],
                      "reason": report.get("decision", {}).get("reason"),
                      "rounds": [rounded(d) for d in report.get("decision", {}).get("rounds", [])]},
             "baseline": {k: base[k] for k in ("effect", "target", "values", "delta_bic", "validation_rmse",

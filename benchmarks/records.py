@@ -29,7 +29,6 @@ to judge the answer. `SPECS` lists the benchmark's records; `quick_specs()` a su
 import functools
 import math
 from dataclasses import dataclass, field
-from itertools import count
 from pathlib import Path
 
 import numpy as np
@@ -46,6 +45,7 @@ from nodeforce.model.effects import EFFECTS
 from nodeforce.model.hlc import heat_loss_coefficient
 from nodeforce.model.integrate import simulate
 from nodeforce.model.network import assemble
+from nodeforce.model.numerical import refined
 from nodeforce.model.solar import incident_irradiance, solar_position
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -143,28 +143,6 @@ def record_seed(name, draw):
 
 
 # -- buildings ------------------------------------------------------------------------------
-
-def refined(building, cells=CELLS):
-    """The building with explicit nodes: each stretch between two of its nodes or layer boundaries
-    cut into `cells` equal cells; its own nodes keep their ids (the added ones follow them), so a
-    column T<id> or a sensor measures the same point in both."""
-    data = building.to_json()
-    own = sum(len(c.node_ids) for c in building.components) + 2 * len(building.zones)
-    ids = count(own + 1)
-    for raw, c in zip(data["components"], building.components):
-        bounds = np.cumsum([t for _, t in c.layers])[:-1]
-        points = sorted([(d, i) for i, d in zip(c.node_ids, c.depths)]
-                        + [(float(d), None) for d in bounds if np.abs(np.array(c.depths) - d).min() > 1e-9])
-        nodes = []
-        for (a, i), (b, _) in zip(points, points[1:]):
-            nodes.append({"id": i or next(ids), "depth": a})
-            nodes += [{"id": next(ids), "depth": a + (b - a) * k / cells} for k in range(1, cells)]
-        nodes.append({"id": points[-1][1], "depth": points[-1][0]})
-        raw["nodes"] = nodes
-    for raw, z in zip(data["zones"], building.zones):
-        raw["air_node"], raw["radiant_node"] = z.air_node, z.radiant_node
-    return parse_building(data, source=f"{building.source} (refined)")
-
 
 @functools.lru_cache(maxsize=None)
 def climate(name):
@@ -454,7 +432,7 @@ def _noiseless(spec, scale=None):
     times = record_times(spec)
     nodes = measured_nodes(spec, building)
     air = building.zone(spec.objective).air_node if spec.objective else building.zones[0].air_node
-    truth0 = refined(building)
+    truth0 = refined(building, CELLS)
     fine0 = fine_weather(spec, building, times, {})
     weather0 = read_by_diagnosis(fine0, times, spec.before)
     if scale is None:

@@ -54,6 +54,7 @@ from nodeforce.ga.locate import check_measured, locate
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
+from nodeforce.model.numerical import discretisation_error
 from nodeforce.model.score import Noise
 
 # Rounds of candidates at most: each adds one effect on top of the last, while the error left is
@@ -216,6 +217,14 @@ class Windows:
             out.append(np.minimum(1.0, sigma ** 2 / np.maximum(misfit, np.finfo(float).tiny)))
         return out
 
+    def numerical_error(self, building, bases, objective):
+        """The building file's own numerical error at the objective's air (C): the root mean
+        square, over the residuals the blocks score, of the file (or each record's protocol's,
+        in `bases`) minus itself refined (`model.numerical`)."""
+        squares = [np.square(discretisation_error(case, base or building, objective.air_nodes)[:k])[np.isfinite(m[:k])]
+                   for case, base, k, m in zip(self.cases, bases, self.ks, self.measured)]
+        return float(np.sqrt(np.concatenate(squares).mean()))
+
     def scored(self):
         """Residuals the blocks score, on every record."""
         return sum(int(np.isfinite(m[:k]).sum()) for m, k in zip(self.measured, self.ks))
@@ -301,10 +310,10 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
     windows = Windows.of(records, objective)
     first = windows.cases[0]
     n = windows.scored()
-    noise = Noise.of_records(windows.measured, noise)
-    sigma = noise.sigma
-
     bases = [protocol(building, r) for r in records]
+    noise = Noise.of_records(windows.measured, noise).with_numerical(windows.numerical_error(building, bases, objective))
+    sigma, floor = noise.sigma, noise.floor
+
     before_runs = []
     for i, (case, base) in enumerate(zip(windows.cases, bases)):
         name = "model_before.fmu" if base is None else f"model_before_{i + 1}.fmu"
@@ -351,7 +360,7 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
     added, rounds, results, runs, sensitivities = [], [], [], {}, {}
     for number in range(MAX_ROUNDS):
         base_blocks = windows.block_J(model.runs)
-        if number and at_noise(base_blocks.sum(), n, sigma):
+        if number and at_noise(base_blocks.sum(), n, floor):
             break  # the error left is the noise's
         done = {label(a) for a in added}
         started = time.perf_counter()
@@ -360,13 +369,13 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
         tried, models, simulations = assessed(model, pairs, number)
         # shapes only where no physical candidate physics admits brings the error left to the
         # noise; the residual's statistics then choose which
-        if not any(at_noise(r["cv"]["J"], n, sigma) and not objection(model.building, r["effect"], r["target"],
+        if not any(at_noise(r["cv"]["J"], n, floor) and not objection(model.building, r["effect"], r["target"],
                                                                       r["parameters"], r["derived"]) for r in tried):
             pairs = [p for p in shapes(model.building, left_by(model), objective.zones) if "@".join(p) not in done]
             more, more_models, more_simulations = assessed(model, pairs, number)
             tried, simulations = tried + more, simulations + more_simulations
             models.update(more_models)
-        chosen, decision = decide(model.building, tried, base_blocks, sigma, n, windows.groups())
+        chosen, decision = decide(model.building, tried, base_blocks, sigma, n, windows.groups(), floor)
         decision["cost"] = {"candidates": len(tried), "simulations": simulations,
                             "seconds": round(time.perf_counter() - started, 1)}
         rounds.append(decision)

@@ -98,8 +98,9 @@ def block_J(residuals, masks):
 
 
 def at_noise(J, n, sigma):
-    """Whether an error J (C2) on n residuals is what sensor noise of sd sigma alone leaves: within
-    the noise tolerance of n sigma^2."""
+    """Whether an error J (C2) on n residuals is what an error of sd sigma alone leaves (the
+    sensors' noise, and the file's own numerical error: `model.score.Noise.floor`): within the
+    noise tolerance of n sigma^2."""
     return J <= noise_floor(sigma, n) + noise_tolerance(sigma, n)
 
 
@@ -174,7 +175,7 @@ def harmed(base, scores, sigma, groups):
     return out
 
 
-def decide(building, results, base, sigma, n, groups=()):
+def decide(building, results, base, sigma, n, groups=(), floor=None):
     """The decision record of one round (module docstring): the chosen candidate (or None), each
     candidate's test, the candidates the data support but physics refuses (suggestions), those
     the data cannot tell from the chosen, and the reason in words.
@@ -184,19 +185,24 @@ def decide(building, results, base, sigma, n, groups=()):
     building : Building the candidates are added to
     results : candidate records, each with "cv": {"blocks": per-block J (C2) fitted without it}
     base : per-block J (C2) of the model without them
-    sigma : the air sensors' noise sd (C)
+    sigma : the air sensors' noise sd (C), what a fixed pair's difference moves by (`noise_difference`)
     n : residuals the blocks score
     groups : the records the blocks come from (`harmed`), where there are several
+    floor : the sd (C) of what a right model of the file leaves, the noise and the file's own
+        numerical error (`model.score.Noise.floor`), the yardstick of a fall of J: a candidate
+        with a slow parameter fits part of that deterministic error as it fits a fault; sigma if
+        None
     """
     base = np.asarray(base, dtype=float)
-    margin = tolerance(float(base.sum()), sigma, n)
+    floor = sigma if floor is None else floor
+    margin = tolerance(float(base.sum()), floor, n)
     tests = {}
     for r in results:
         down, se = fall(base, r["cv"]["blocks"])
         needed = max(margin, STANDARD_ERRORS * se)
         # the other days than its best must gain too: one day alone is no evidence
         others = down - float(np.max(base - np.asarray(r["cv"]["blocks"])))
-        harms = harmed(base, r["cv"]["blocks"], sigma, groups)
+        harms = harmed(base, r["cv"]["blocks"], floor, groups)
         said = objection(building, r["effect"], r["target"], r["parameters"], r.get("derived"))
         if harms:
             said = "; ".join(filter(None, [said, "it helps the records together but harms " + "; ".join(
@@ -221,7 +227,7 @@ def decide(building, results, base, sigma, n, groups=()):
             worse, se = fall(evidence(r), evidence(best))
             needed = max(STANDARD_ERRORS * max(se, noise_difference(r, best, sigma)), floor)
             if preference(r["effect"]) < preference(best["effect"]):
-                needed = max(needed, parsimony(best, sigma, n))
+                needed = max(needed, parsimony(best, floor, n))
             return worse <= needed
         near = [r for r in admissible if close(r)]
         chosen = min(near, key=lambda r: (preference(r["effect"]), r["target"] in components, evidence(r).sum()))
@@ -242,16 +248,16 @@ def _reason(chosen, alike, results, passing, base, n, tests, margin, components)
         return "No candidate effect was tried, so the model is left as it is."
     if not chosen:
         return (f"None of the {len(results)} candidates lowers the cross-validated J ({base.sum():.3g} C2 over "
-                f"{B} days) by more than the noise could ({margin:.3g} C2) and {STANDARD_ERRORS:g} standard error of "
-                f"its fall from day to day, on more days than one"
+                f"{B} days) by more than the noise and the file's numerical error could ({margin:.3g} C2) and "
+                f"{STANDARD_ERRORS:g} standard error of its fall from day to day, on more days than one"
                 + (f" ({len(passing)} do, and physics or a record they harm refuses each)" if passing else "") + ": no effect is added.")
     what = (f"an unexplained heat source, acting {acting(chosen)} ({chosen['effect']} on {chosen['target']})"
             if is_shape(chosen["effect"]) else f"{chosen['effect']} on {chosen['target']}")
     test = tests[label(chosen)]
     said = (f"{what[0].upper() + what[1:]} lowers the cross-validated J from {base.sum():.3g} to "
             f"{chosen['cv']['J']:.3g} C2 ({rmse_before:.3f} -> {chosen['cv']['rmse']:.3f} C; each of {B} days "
-            f"predicted by a fit to the others), beyond the {test['needed']:.3g} C2 that the noise and its day-to-day "
-            f"scatter could make; {len(passing)} of {len(results)} candidates pass")
+            f"predicted by a fit to the others), beyond the {test['needed']:.3g} C2 that the noise, the file's "
+            f"numerical error and the day-to-day scatter could make; {len(passing)} of {len(results)} candidates pass")
     sensed = chosen.get("sensors", {}).get("n", 0)
     if sensed and len(passing) > 1:
         said += (f"; among them it best predicts the air left out together with the other sensors over the "

@@ -1,9 +1,11 @@
 """The score of a simulation against the measured indoor air (docs/model.md section 6)."""
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from .errors import InputError
+from .numerical import REFERENCE_STEP, REFINEMENT
 
 
 def residuals(measured, simulated):
@@ -67,10 +69,26 @@ class Noise:
     that number comes from: the user's `--noise` (a sensor's stated accuracy), or second
     differences of the measurement, with their lag-1 autocorrelation telling whether the noise
     is visible in them at all (on real records of precise sensors the signal's curvature over
-    one step outweighs the white noise, and the error that matters is slow)."""
+    one step outweighs the white noise, and the error that matters is slow). Beside it, the
+    building file's own numerical error at the air (`numerical`, RMS in C, `model.numerical`):
+    together they are what a right model of the file leaves (`floor`)."""
     sigma: float | None
     given: bool = False
     lag1: float | None = None
+    numerical: float | None = None
+
+    def with_numerical(self, rms):
+        """The noise with the file's numerical error `rms` (C) beside it."""
+        return replace(self, numerical=float(rms))
+
+    @property
+    def floor(self):
+        """The sd (C) of what a model right but for its discretisation leaves, sqrt(sigma^2 +
+        numerical^2): the J a right correction brings the error to is n floor^2; None if the
+        noise is unknown."""
+        if self.sigma is None:
+            return None
+        return math.hypot(self.sigma, self.numerical or 0.0)
 
     @classmethod
     def of(cls, measured_air, given=None):
@@ -110,9 +128,19 @@ class Noise:
                 f"(offsets, radiation, stratification) are not in it; give the sensors' accuracy with --noise. "
                 f"The decisions allow for the residuals' correlation in time instead")
 
+    def numerical_sentence(self):
+        if self.numerical is None:
+            return None
+        return (f"numerical error of the building file at the air: {self.numerical:.2g} C RMS over the calibration "
+                f"window (the file against itself {REFINEMENT} times finer in space and at steps of at most "
+                f"{REFERENCE_STEP:g} s); the choices count it beside the noise, an error floor of "
+                + (f"{self.floor:.2g} C" if self.floor is not None else "its own") + ": no correction of the physics "
+                "is asked to explain it")
+
     def to_json(self):
         return {"sigma": self.sigma, "given": self.given, "lag1": self.lag1, "visible": self.visible,
-                "sentence": self.sentence()}
+                "numerical": self.numerical, "floor": self.floor, "sentence": self.sentence(),
+                "numerical_sentence": self.numerical_sentence()}
 
 
 @dataclass(frozen=True)

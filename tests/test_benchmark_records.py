@@ -12,10 +12,8 @@ import pytest
 
 from benchmarks.baseline import fit_one
 from benchmarks.records import (CELLS, FAULTS, FINE_STEP, STRONG_BAND, SUBTLE_BAND, Spec, at_scale, before_error,
-                                file_building, max_scale, record, refined)
-from nodeforce.model.building import load_building
-from nodeforce.model.hlc import heat_loss_coefficient
-from nodeforce.model.network import assemble
+                                file_building, max_scale, record)
+from nodeforce.model.numerical import refined
 
 pytestmark = pytest.mark.slow  # each record is simulated at 1 min, and a few tuned
 
@@ -29,31 +27,6 @@ def small(fault="none", size="subtle", **changes):
         fields.update(effect=effect, target=target, full={**full, **({"T_ground": 24.0} if "T_ground" in full else {})},
                       size=size, expected=expected)
     return Spec(**{**fields, **changes})
-
-
-def test_the_truth_is_finer_and_has_the_files_conductances_and_capacities():
-    """Every cell of the truth lies in one layer and in one of the file's cells and is at most
-    1/CELLS of it; each component's total resistance (sum of dx/lambda over its layers, by hand)
-    and capacity (sum of rho c dx) are the file's; the file's nodes keep their ids and depths."""
-    for path in ("model/data/testcell.json", "examples/twinhouse_n2/building.json"):
-        building = load_building(path)
-        truth = refined(building)
-        for c, f in zip(truth.components, building.components):
-            assert dict(zip(f.node_ids, f.depths)).items() <= dict(zip(c.node_ids, c.depths)).items()
-            bounds = np.cumsum([0.0] + [t for _, t in c.layers])
-            for a, b in zip(c.depths, c.depths[1:]):
-                assert not np.any((bounds > a + 1e-12) & (bounds < b - 1e-12))  # no layer boundary inside
-                k = np.searchsorted(f.depths, a, side="right") - 1
-                assert b - a <= (f.depths[k + 1] - f.depths[k]) / CELLS + 1e-12
-            by_hand_R = sum(t / m.conductivity for m, t in c.layers)
-            by_hand_C = sum(t * m.density * m.specific_heat for m, t in c.layers)
-            for b_ in (building, truth):
-                n = assemble(b_)
-                ids = np.array(b_.component(c.name).node_ids) - 1
-                G = [n.A[i, j] for i, j in zip(ids, ids[1:])]
-                assert sum(1 / g for g in G) * c.area == pytest.approx(by_hand_R, rel=1e-9)
-                assert n.C[ids].sum() == pytest.approx(by_hand_C * c.area, rel=1e-9)
-        assert heat_loss_coefficient(truth) == pytest.approx(heat_loss_coefficient(building), rel=1e-9)
 
 
 def test_the_no_fault_truth_tends_to_the_files_model_and_a_vanishing_fault_vanishes():
@@ -134,7 +107,7 @@ def test_the_heater_is_held_over_each_record_step_and_the_schedule_is_its_hours(
     # the schedule is the truth's, not the file's
     assert "Q_schedule" not in r.weather and "Q_schedule" in r.truth.input_columns
     import benchmarks.records as records
-    _, extra = records.faulty(refined(r.building), r.spec, r.values)
+    _, extra = records.faulty(refined(r.building, CELLS), r.spec, r.values)
     day = pd.date_range(times[0], periods=1440, freq="1min")
     power = extra["Q_schedule"](day)
     assert power.sum() * 60 == pytest.approx(r.values["Q"] * 10 * 3600)

@@ -9,6 +9,7 @@ from nodeforce.diagnose.candidates import objection, preference
 from nodeforce.diagnose.selection import blocks, decide
 from nodeforce.model.building import parse_building
 from nodeforce.model.errors import InputError
+from nodeforce.model.score import Noise
 
 
 def parameter(value, std, identifiable=True, on_bound=False):
@@ -191,6 +192,20 @@ def test_noise_alone_never_passes(testcell):
         days = base + rng.normal(0.0, 2 * SIGMA ** 2, 4)
         chosen, decision = decide(testcell, [door(days)], base, SIGMA, N)
         assert chosen is None, decision["reason"]
+
+
+def test_a_fall_the_files_own_numerical_error_could_make_does_not_pass(testcell):
+    """A model right but for its coarse walls leaves, beside the noise, 0.08 C RMS that follows
+    the weather; a wall's conductivity fits 0.8 C2 of it, alike every day. Against the noise
+    alone (0.59 C2) that would pass; against the floor the noise and that error make together,
+    sqrt(0.1^2 + 0.08^2) = 0.128 C (3 x 0.0164 x sqrt(384) = 0.96 C2), it does not."""
+    noise = Noise(SIGMA).with_numerical(0.08)
+    assert noise.floor == pytest.approx(np.sqrt(SIGMA ** 2 + 0.08 ** 2))
+    base = N / 4 * noise.floor ** 2 * np.ones(4)
+    wall = door(base - 0.2)
+    assert decide(testcell, [wall], base, SIGMA, N)[0] is not None
+    chosen, decision = decide(testcell, [wall], base, SIGMA, N, floor=noise.floor)
+    assert chosen is None and decision["noise_margin"] == pytest.approx(3 * noise.floor ** 2 * np.sqrt(2 * N))
 
 
 def test_a_fall_from_one_day_alone_or_that_the_days_disagree_on_does_not_pass(testcell):

@@ -106,7 +106,8 @@ def synthetic():
                       for state, r in residual.items()},
         "noise_sigma": 0.0987,
         "noise": {"sigma": 0.0987, "given": False, "visible": True,
-                  "sentence": "sensor noise of the air, estimated from its second differences: sigma = 0.099 C"},
+                  "sentence": "sensor noise of the air, estimated from its second differences: sigma = 0.099 C",
+                  "numerical": 0.04, "numerical_sentence": "numerical error of the building file at the air: 0.04 C RMS"},
         "phases": [{"phase": "held at 30 C", "start": "2001-06-10T00:00:00-05:00", "end": "2001-06-11T00:00:00-05:00",
                     "n": 96, "rmse": {"before": 0.57, "conductivity@door": 0.75, "after": 0.75}},
                    {"phase": "free float", "start": "2001-06-11T00:00:00-05:00", "end": None,
@@ -217,7 +218,8 @@ def test_write_report_with_an_effect(tmp_path):
     assert "For scale, the IDEAS detailed model: RMSE 0.400 C (validation), 0.600 C (free float)." in md
     # the decision as the loop wrote it, with its margins; the verdicts are read, not re-derived
     assert report["decision"]["reason"] in md
-    assert "sensor noise could (7.250 C²)" in md and "4 candidates, 310 simulations, 12.5 s" in md
+    assert "- numerical error of the building file at the air: 0.04 C RMS" in md
+    assert "numerical error could (7.250 C²)" in md and "4 candidates, 310 simulations, 12.5 s" in md
     # the cross-validated fall of J, the fall it needed, the verdict and physics' objection
     assert "| solar_absorptance | roof |" in md and "| 124.6 | 7.250 | yes |  |" in md
     assert "| 152.6 | 12.30 | yes |  |" in md

@@ -35,7 +35,7 @@ def decision_lines(report):
         cost = r.get("cost") or {}
         lines.append(f"- round {number}: cross-validated J of the model it starts from {fmt_sig(r.get('cv_J_before'))} C² "
                      f"over {r.get('blocks', NA)} days left out in turn; a candidate must lower it by more than the "
-                     f"sensor noise could ({fmt_sig(r.get('noise_margin'))} C²) and by more than "
+                     f"sensor noise and the file's numerical error could ({fmt_sig(r.get('noise_margin'))} C²) and by more than "
                      f"{fmt_sig(r.get('standard_errors'), 3)} standard error of its fall from day to day, on more "
                      f"days than its best (the fall needed, per candidate, in the candidates table); {cost.get('candidates', NA)} candidates, "
                      f"{cost.get('simulations', NA)} simulations, {cost.get('seconds', NA)} s; "
@@ -119,8 +119,7 @@ def write_markdown(out_dir, report, plots, notes):
         md += [f"- record {r['name']} ({r['measurements']}): calibration {content.period_text(r, 'calibration')}, "
                f"{len(r['period']['blocks'])} blocks; validation {content.period_text(r, 'validation')}"
                for r in report["records"]]
-    if (report.get("noise") or {}).get("sentence"):
-        md.append(f"- {report['noise']['sentence']}")
+    md += [f"- {report['noise'][key]}" for key in ("sentence", "numerical_sentence") if (report.get("noise") or {}).get(key)]
     md += ["", "## Before and after", "",
            "Residual r = T_air measured - T_air simulated (a positive mean: the model is too cold); "
            "mean and standard deviation as in the paper's Table 5, with RMSE, J = Σ r² and n the "

@@ -1,0 +1,64 @@
+"""The building file's own numerical error: what its discretisation (the nodes of its walls, the
+steps of the implicit scheme) makes of a record, which no correction of its physics should be
+fitted to (docs/model.md section 5.8).
+
+A wall of a few nodes and steps of up to 5 min are an approximation of the heat equation; the
+measured building is the continuum. The error they make is estimated the way a numerical analyst
+checks convergence: the same file, node for node, simulated on a grid `REFINEMENT` times finer in
+space and with steps of at most `REFERENCE_STEP`, over the same record, from the same history
+and burn-in. The difference at the objective's air is an estimate of the file's error that
+the sensors' noise does not contain: it is deterministic and follows the weather, so a candidate
+effect with a slow parameter (a wall's conductivity, a mass) can fit part of it.
+"""
+import math
+from dataclasses import replace
+from itertools import count
+
+import numpy as np
+
+from .building import parse_building
+
+REFINEMENT = 4  # cells of the reference per stretch between two of the file's nodes or layer boundaries
+REFERENCE_STEP = 60.0  # s, the reference's longest integration step
+
+
+def refined(building, cells=REFINEMENT):
+    """The building with explicit nodes: each stretch between two of its nodes or layer boundaries
+    cut into `cells` equal cells; its own nodes keep their ids (the added ones follow them), so a
+    column T<id> or a sensor measures the same point in both. Nodes an effect adds (an internal
+    mass, a heater) are numbered after all of them."""
+    data = building.to_json()
+    own = sum(len(c.node_ids) for c in building.components) + 2 * len(building.zones)
+    ids = count(own + 1)
+    for raw, c in zip(data["components"], building.components):
+        bounds = np.cumsum([t for _, t in c.layers])[:-1]
+        points = sorted([(d, i) for i, d in zip(c.node_ids, c.depths)]
+                        + [(float(d), None) for d in bounds if np.abs(np.array(c.depths) - d).min() > 1e-9])
+        nodes = []
+        for (a, i), (b, _) in zip(points, points[1:]):
+            nodes.append({"id": i or next(ids), "depth": a})
+            nodes += [{"id": next(ids), "depth": a + (b - a) * k / cells} for k in range(1, cells)]
+        nodes.append({"id": points[-1][1], "depth": points[-1][0]})
+        raw["nodes"] = nodes
+    for raw, z in zip(data["zones"], building.zones):
+        raw["air_node"], raw["radiant_node"] = z.air_node, z.radiant_node
+    return parse_building(data, source=f"{building.source} (refined)")
+
+
+def reference_case(case, building, cells=REFINEMENT, step=REFERENCE_STEP):
+    """The case of the refined building (`refined`): the same inputs and history, the
+    measurements of the file's own nodes at the same ids, sub-steps of at most `step` (s)."""
+    fine = refined(building, cells)
+    own = sum(len(c.node_ids) for c in building.components) + 2 * len(building.zones)
+    return fine, replace(case.with_inputs(fine), measured=case.measured[:, :own],
+                         substeps=max(case.substeps, math.ceil(case.dt / step - 1e-9)))
+
+
+def discretisation_error(case, building, nodes):
+    """(N_t, len(nodes)) the file's numerical error at `nodes` (ids), C, at t_1..t_N: the building
+    as written minus the refined reference (`reference_case`), both simulated as a diagnosis runs
+    `case` (its history, burn-in and steady start)."""
+    columns = np.asarray(nodes) - 1
+    coarse = case.with_inputs(building).run(building)[:, columns]
+    fine, on_fine = reference_case(case, building)
+    return coarse - on_fine.run(fine)[:, columns]

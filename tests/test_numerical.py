@@ -1,0 +1,79 @@
+"""The building file's own numerical error (model/numerical.py): the refined file is the same
+building, node for node, and the error estimated against it vanishes where the nodal model is
+exact (steady conduction) and falls as the file's own walls are refined."""
+import numpy as np
+import pandas as pd
+import pytest
+
+from nodeforce.model.building import load_building
+from nodeforce.model.case import measured_case
+from nodeforce.model.hlc import heat_loss_coefficient
+from nodeforce.model.network import assemble
+from nodeforce.model.numerical import discretisation_error, refined
+from nodeforce.model.synth import pseudo_measurements
+from tests.conftest import record_times
+
+AIR = 23
+
+
+@pytest.mark.parametrize("cells", [2, 4])
+def test_the_refined_file_is_finer_and_has_the_files_conductances_and_capacities(cells):
+    """Every cell of the refined file lies in one layer and in one of the file's cells and is at
+    most 1/cells of it; each component's total resistance (sum of dx/lambda over its layers, by
+    hand) and capacity (sum of rho c dx) are the file's; the file's nodes keep their ids and depths."""
+    for path in ("model/data/testcell.json", "examples/twinhouse_n2/building.json"):
+        building = load_building(path)
+        fine = refined(building, cells)
+        for c, f in zip(fine.components, building.components):
+            assert dict(zip(f.node_ids, f.depths)).items() <= dict(zip(c.node_ids, c.depths)).items()
+            bounds = np.cumsum([0.0] + [t for _, t in c.layers])
+            for a, b in zip(c.depths, c.depths[1:]):
+                assert not np.any((bounds > a + 1e-12) & (bounds < b - 1e-12))  # no layer boundary inside
+                k = np.searchsorted(f.depths, a, side="right") - 1
+                assert b - a <= (f.depths[k + 1] - f.depths[k]) / cells + 1e-12
+            by_hand_R = sum(t / m.conductivity for m, t in c.layers)
+            by_hand_C = sum(t * m.density * m.specific_heat for m, t in c.layers)
+            for b_ in (building, fine):
+                n = assemble(b_)
+                ids = np.array(b_.component(c.name).node_ids) - 1
+                G = [n.A[i, j] for i, j in zip(ids, ids[1:])]
+                assert sum(1 / g for g in G) * c.area == pytest.approx(by_hand_R, rel=1e-9)
+                assert n.C[ids].sum() == pytest.approx(by_hand_C * c.area, rel=1e-9)
+        assert heat_loss_coefficient(fine) == pytest.approx(heat_loss_coefficient(building), rel=1e-9)
+
+
+def air_case(building, weather, days=5, past=30):
+    """The test cell's air alone over `days` at 15 min in June, with `past` days of history."""
+    measured = pseudo_measurements(building, weather, record_times(days), [AIR], history_days=past)
+    return measured_case(building, weather, measured, burn_in_days=1)
+
+
+def scored_error(case, building):
+    e = discretisation_error(case, building, [AIR])[:, 0]
+    return float(np.sqrt(np.mean(e[np.isfinite(case.scored([AIR - 1]))[:, 0]] ** 2)))
+
+
+def test_steady_conduction_has_no_discretisation_error(testcell, weather):
+    """Under constant weather, no sun and no heat input, a wall's temperature is piecewise linear
+    within its layers and the file's conductances are exact integrals of dx/lambda: file and
+    refined file reach the same steady state, so the estimate is the solvers' rounding."""
+    steady = weather.copy()
+    for column in steady.columns:
+        steady[column] = steady[column].mean() if column in ("T_out", "T_sky", "T_ground") else 0.0
+    steady.attrs = dict(weather.attrs)
+    assert scored_error(air_case(testcell, steady), testcell) < 1e-8
+
+
+def test_the_error_falls_as_the_files_walls_are_refined(testcell, weather):
+    """Under June's sun the test cell's walls of one or two nodes per layer miss the continuum by
+    hundredths of a degree; the same file with each of its cells halved misses it by less than
+    half as much (the space discretisation is second order, the time step's first-order part the
+    same in both)."""
+    case = air_case(testcell, weather)
+    coarse = scored_error(case, testcell)
+    halved = refined(testcell, 2)
+    finer = scored_error(measured_case(halved, weather, pd.DataFrame(
+        {f"T{AIR}": case.measured[case.history_steps:, AIR - 1]}, index=case.times[case.history_steps:]),
+        burn_in_days=1), halved)
+    assert 0.01 < coarse < 0.2
+    assert finer < 0.5 * coarse
