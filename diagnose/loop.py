@@ -50,7 +50,7 @@ from nodeforce.diagnose.phases import phase_errors, worsened
 from nodeforce.diagnose.residuals import diagnostics as residual_diagnostics
 from nodeforce.diagnose.selection import at_noise, block_J, blocks as blocks_of, decide, label
 from nodeforce.fmu_build.build import build_fmu
-from nodeforce.ga.locate import check_measured, locate
+from nodeforce.ga.locate import check_measured, evaluator_kind, locate
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
@@ -288,7 +288,7 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers, weights)
 
 
 def diagnose(building, records, objective, workdir, *, source="measurements", fraction=0.6, calibration_end=None,
-             seed=0, workers=None, population=30, generations=400, fmu_kind="python", reference=None,
+             seed=0, workers=None, population=30, generations=400, fmu_kind="auto", reference=None,
              noise=None, phases=None):
     """Run the whole loop; write the artifacts in `workdir`; return the report.json content.
 
@@ -299,7 +299,8 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
     search reads every record's calibration window together, then, reported, each one's alone.
     `reference` ({"label", "rmse": {phase: K}}), another model's error, is reported for scale;
     `noise` (C) is the air sensors' noise sd if the user knows it, else it is estimated from
-    every record's air."""
+    every record's air. `fmu_kind`: the FMUs built, run and written (`ga.locate.locate`; "auto": the
+    standalone FMU where a C compiler is at hand)."""
     if not isinstance(records, (list, tuple)):
         records = [Record(records, source, source, fraction, calibration_end, tuple(phases or ()))]
     names = [r.name for r in records]
@@ -307,6 +308,7 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
         if names.count(r.name) > 1:
             raise InputError(r.source, "name", f"two records are named {r.name!r}: each needs its own name")
         check_measured(objective, r.case, r.source)
+    fmu_kind = evaluator_kind() if fmu_kind == "auto" else fmu_kind
     windows = Windows.of(records, objective)
     first = windows.cases[0]
     n = windows.scored()

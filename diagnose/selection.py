@@ -220,12 +220,12 @@ def decide(building, results, base, sigma, n, groups=(), floor=None):
     chosen, alike = None, []
     if admissible:
         best = min(admissible, key=lambda r: evidence(r).sum())
-        floor = ROUNDING * float(base.sum())
+        rounding = ROUNDING * float(base.sum())
 
         def close(r):
             # how much worse than the best it predicts the left-out days, and the scatter of that
             worse, se = fall(evidence(r), evidence(best))
-            needed = max(STANDARD_ERRORS * max(se, noise_difference(r, best, sigma)), floor)
+            needed = max(STANDARD_ERRORS * max(se, noise_difference(r, best, sigma)), rounding)
             if preference(r["effect"]) < preference(best["effect"]):
                 needed = max(needed, parsimony(best, floor, n))
             return worse <= needed

@@ -76,7 +76,7 @@ def chromosome_nodes(building, case, objective, source, nodes=None, include_alge
 def locate(building, case, objective, workdir, *, source="measurements", nodes=None,
            include_algebraic=False, population=30, generations=400, pc=0.8, pm=0.03, seed=0,
            patience=PATIENCE, seeded=True, workers=None, scheduler=None, warmup_days=2, progress=None,
-           fmu_kind="python", noise=None, protocols=None):
+           fmu_kind="auto", noise=None, protocols=None):
     """Run the forcing search on a case; return the content of locate.json.
 
     `case` may be the Cases of several records of the building: J is then the sum of each
@@ -92,7 +92,7 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
     every record's air. patience and seeded
     choose the search (ga.search: the defaults stop at convergence; ga.search.PAPER's values
     give the paper's search). fmu_kind: "python", "standalone" (or their "-fmi3" kinds) or "auto"
-    (`evaluator_kind`, FMI 2.0).
+    (`evaluator_kind`, FMI 2.0: the command line's default and this one's).
     """
     cases = as_cases(case)
     protocols = list(protocols) if protocols is not None else [None] * len(cases)

@@ -169,6 +169,19 @@ def test_a_physical_effect_wins_over_a_shape_the_data_cannot_tell_from_it(testce
     assert "an unexplained heat source, acting with a daily profile" in decision["reason"].lower()
 
 
+def test_a_shape_must_gain_more_than_the_noise_could_to_beat_a_physical_effect(testcell):
+    """A daily profile that predicts every left-out day 0.05 C2 better than a door, alike from day
+    to day (no scatter to widen the band), gains 0.2 C2: less than the 0.59 C2 the noise alone
+    could make of J (3 x 0.01 x sqrt(384)), so the door, a physical effect, is chosen; with the
+    file's numerical error beside the noise the band only widens. A gain of 1.2 C2 beats it."""
+    physical = door([2.0, 2.2, 2.1, 2.3])
+    for floor in (None, 0.128):
+        chosen, decision = decide(testcell, [daily([1.95, 2.15, 2.05, 2.25]), physical], BASE, SIGMA, N, floor=floor)
+        assert chosen is physical and decision["indistinct"] == ["daily_gain@cell"], decision["reason"]
+    chosen, _ = decide(testcell, [daily([1.7, 1.9, 1.8, 2.0]), physical], BASE, SIGMA, N)
+    assert chosen["effect"] == "daily_gain"
+
+
 def test_a_candidate_physics_refuses_is_never_added_but_suggested(testcell):
     sink = candidate("internal_gain", "cell", {"Q": parameter(-545.0, 16.0)}, [1.0, 1.0, 1.0, 1.0])
     weaker = door([4.0, 4.2, 3.9, 4.1])
