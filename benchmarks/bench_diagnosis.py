@@ -307,18 +307,16 @@ def summary(results, draws):
 
 # What one diagnosis costs, measured in the run of 2026-11-27 (every record, 3 draws of the test
 # cell's): the whole run is sized from it.
-BUDGET = ("The budget, measured in the run of 2026-11-27 on 2 cores (a machine some 2.5 times slower than "
-          "the one of the earlier runs: the test suite at one commit took that much longer): a test-cell "
-          "diagnosis takes 10 to 70 s with the paper's sensors or the air alone and 2 to 4 min with every "
-          "node measured (gso-jan, 23 forcing genes), the baseline about a quarter of that, a Twin House "
-          "diagnosis 4 to 5 min. Every record under one draw is then about an hour on 2 workers, the 58 "
-          "test-cell records under two draws more about 70 min; the Twin House's two draws more (`make "
-          "benchmark` runs them) would add 40 min, and this run left them out: its stability criterion "
-          "covers the test cell's 58 records. The GA and the "
-          "calibrations keep the command line's defaults. Finished records are kept in "
-          "out/bench_diagnosis/records, each with a digest of its spec and of the code (the package, the "
-          "records, the baseline, the examples): a rerun skips what is unchanged, a changed loop runs "
-          "everything again.")
+BUDGET = ("The budget, measured in the run of 2026-11-27 on 2 cores, the forcing search driving the "
+          "standalone FMU (the API's default since commit 7d6ad65, as the command line's; the Python FMU "
+          "made the search some 5 times slower): a test-cell diagnosis takes 11 to 32 s with the paper's "
+          "sensors or the air alone and 16 to 47 s with every node measured (gso-jan, 23 forcing genes), "
+          "the baseline about 15 s, a Twin House diagnosis 2 to 3 min (its baseline 2 min). Every record "
+          "under one draw is then about 35 min on 2 workers, the two draws more about an hour, the Twin "
+          "House's among them. The GA and the calibrations keep the command line's defaults. Finished "
+          "records are kept in out/bench_diagnosis/records, each with a digest of its spec and of the "
+          "code (the package, the records, the baseline, the examples): a rerun skips what is unchanged, "
+          "a changed loop runs everything again.")
 
 
 def scenarios_table():
