@@ -329,9 +329,8 @@ def measured_nodes(spec, building):
         return [building.zones[0].air_node]
     if spec.sensors == "own":
         return sorted(set(building.sensors.values()))
-    own = sum(len(c.node_ids) for c in building.components) + 2 * len(building.zones)
     radiant = {z.radiant_node for z in building.zones}
-    return [i for i in range(1, own + 1) if i not in radiant]
+    return [i for i in range(1, building.own_nodes + 1) if i not in radiant]
 
 
 def truth_record(truth, weather, times, nodes):

@@ -54,7 +54,7 @@ from nodeforce.ga.locate import check_measured, evaluator_kind, locate
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
-from nodeforce.model.numerical import discretisation_error
+from nodeforce.model.numerical import reference
 from nodeforce.model.score import Noise
 
 # Rounds of candidates at most: each adds one effect on top of the last, while the error left is
@@ -217,12 +217,13 @@ class Windows:
             out.append(np.minimum(1.0, sigma ** 2 / np.maximum(misfit, np.finfo(float).tiny)))
         return out
 
-    def numerical_error(self, building, bases, objective):
+    def numerical_error(self, runs, building, bases, objective):
         """The building file's own numerical error at the objective's air (C): the root mean
-        square, over the residuals the blocks score, of the file (or each record's protocol's,
-        in `bases`) minus itself refined (`model.numerical`)."""
-        squares = [np.square(discretisation_error(case, base or building, objective.air_nodes)[:k])[np.isfinite(m[:k])]
-                   for case, base, k, m in zip(self.cases, bases, self.ks, self.measured)]
+        square, over the residuals the blocks score, of the file's objective air as run (`runs`,
+        one (N_t, zones) per record, under the record's protocol's building in `bases`, else
+        `building`) minus the file refined (`model.numerical.reference`)."""
+        squares = [np.square(run[:k] - reference(case, base or building, objective.air_nodes)[:k])[np.isfinite(m[:k])]
+                   for run, case, base, k, m in zip(runs, self.cases, bases, self.ks, self.measured)]
         return float(np.sqrt(np.concatenate(squares).mean()))
 
     def scored(self):
@@ -313,8 +314,6 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
     first = windows.cases[0]
     n = windows.scored()
     bases = [protocol(building, r) for r in records]
-    noise = Noise.of_records(windows.measured, noise).with_numerical(windows.numerical_error(building, bases, objective))
-    sigma, floor = noise.sigma, noise.floor
 
     before_runs = []
     for i, (case, base) in enumerate(zip(windows.cases, bases)):
@@ -323,6 +322,9 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
             before_runs.append(simulate_fmu(fmu, case, output_ids=objective.air_nodes))
     before = windows.metrics(objective, before_runs)
     model = Model(building, before_runs, before, bases)
+    noise = Noise.of_records(windows.measured, noise).with_numerical(
+        windows.numerical_error(before_runs, building, bases, objective))
+    sigma, floor = noise.sigma, noise.floor
 
     convergence = []
     search = dict(seed=seed, workers=workers, population=population, generations=generations, fmu_kind=fmu_kind,

@@ -153,7 +153,7 @@ def parsimony(result, sigma, n):
     return noise_tolerance(sigma, n + result.get("sensors", {}).get("n_weighted", 0))
 
 
-def harmed(base, scores, sigma, groups):
+def harmed(base, scores, floor, groups):
     """The records a candidate harms: those on whose blocks its cross-validated J rises by more
     than the noise's tolerance of that record's J and one standard error of its per-block falls;
     [{"record", "cv_fall", "needed"}] (C2).
@@ -161,7 +161,8 @@ def harmed(base, scores, sigma, groups):
     Parameters
     ----------
     base, scores : per-block J (C2) of the model without and with the candidate
-    sigma : the air sensors' noise sd (C)
+    floor : the sd (C) of what a right model of the file leaves (`decide`'s floor: the sensors'
+        noise and the file's own numerical error)
     groups : [{"record": name, "blocks": indices into base, "n": residuals they score}]
     """
     base, scores = np.asarray(base, dtype=float), np.asarray(scores, dtype=float)
@@ -169,7 +170,7 @@ def harmed(base, scores, sigma, groups):
     for group in groups:
         rows = np.asarray(group["blocks"], dtype=int)
         down, se = fall(base[rows], scores[rows]) if len(rows) > 1 else (float((base[rows] - scores[rows]).sum()), 0.0)
-        needed = max(tolerance(float(base[rows].sum()), sigma, group["n"]), STANDARD_ERRORS * se)
+        needed = max(tolerance(float(base[rows].sum()), floor, group["n"]), STANDARD_ERRORS * se)
         if down < -needed:
             out.append({"record": group["record"], "cv_fall": down, "needed": needed})
     return out

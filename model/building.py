@@ -166,7 +166,13 @@ class Building:
 
     @property
     def n_nodes(self):
-        return sum(len(c.node_ids) for c in self.components) + 2 * len(self.zones) + len(self.added_nodes)
+        return self.own_nodes + len(self.added_nodes)
+
+    @property
+    def own_nodes(self):
+        """The number of nodes of its components and zones (ids 1..own_nodes); the nodes its
+        effects add follow them."""
+        return sum(len(c.node_ids) for c in self.components) + 2 * len(self.zones)
 
     @property
     def added_nodes(self):

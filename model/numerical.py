@@ -28,8 +28,7 @@ def refined(building, cells=REFINEMENT):
     column T<id> or a sensor measures the same point in both. Nodes an effect adds (an internal
     mass, a heater) are numbered after all of them."""
     data = building.to_json()
-    own = sum(len(c.node_ids) for c in building.components) + 2 * len(building.zones)
-    ids = count(own + 1)
+    ids = count(building.own_nodes + 1)
     for raw, c in zip(data["components"], building.components):
         bounds = np.cumsum([t for _, t in c.layers])[:-1]
         points = sorted([(d, i) for i, d in zip(c.node_ids, c.depths)]
@@ -49,16 +48,20 @@ def reference_case(case, building, cells=REFINEMENT, step=REFERENCE_STEP):
     """The case of the refined building (`refined`): the same inputs and history, the
     measurements of the file's own nodes at the same ids, sub-steps of at most `step` (s)."""
     fine = refined(building, cells)
-    own = sum(len(c.node_ids) for c in building.components) + 2 * len(building.zones)
-    return fine, replace(case.with_inputs(fine), measured=case.measured[:, :own],
+    return fine, replace(case.with_inputs(fine), measured=case.measured[:, :building.own_nodes],
                          substeps=max(case.substeps, math.ceil(case.dt / step - 1e-9)))
+
+
+def reference(case, building, nodes):
+    """(N_t, len(nodes)) the refined reference's temperatures (C) at `nodes` (ids of the file's
+    own nodes) at t_1..t_N, simulated as a diagnosis runs `case` (its history, burn-in and steady
+    start)."""
+    fine, on_fine = reference_case(case, building)
+    return on_fine.run(fine)[:, np.asarray(nodes) - 1]
 
 
 def discretisation_error(case, building, nodes):
     """(N_t, len(nodes)) the file's numerical error at `nodes` (ids), C, at t_1..t_N: the building
-    as written minus the refined reference (`reference_case`), both simulated as a diagnosis runs
-    `case` (its history, burn-in and steady start)."""
-    columns = np.asarray(nodes) - 1
-    coarse = case.with_inputs(building).run(building)[:, columns]
-    fine, on_fine = reference_case(case, building)
-    return coarse - on_fine.run(fine)[:, columns]
+    as written minus the refined reference (`reference`), both simulated as a diagnosis runs
+    `case`."""
+    return case.with_inputs(building).run(building)[:, np.asarray(nodes) - 1] - reference(case, building, nodes)
