@@ -33,10 +33,10 @@ log = logging.getLogger("nodeforce.diagnose")
 # when its standard deviation is under this many kelvin.
 IDENTIFIABLE_KELVIN = 1.0
 MORRIS_TRAJECTORIES = 4
-# The step of the heat loss coefficient's differences, as a fraction of a parameter's range: the
-# HLC is linear or smooth in every parameter (a conductance in series), so a small step is exact
-# to many digits.
-HLC_STEP = 1e-6
+# The step of a derived quantity's differences (`gradient`), as a fraction of a parameter's range:
+# the HLC and a ground coupling's flux are smooth in every parameter (a conductance in series, a
+# linear network solved exactly), so a small step is exact to many digits.
+STEP = 1e-6
 # Simulations a candidate keeps, by parameter values and window: the runs the report needs at the
 # calibrated values are then simulations already made.
 KEPT_RUNS = 64
@@ -199,11 +199,12 @@ def derived(candidate, case, x, cov):
 
     - The heat loss coefficient of the model with the effect (docs/model.md section 8), W/K: what a
       record of the air and the heating power fixes well even where the effect's parameters, or
-      the split of the loss among effects, it does not (`hlc_gradient`).
+      the split of the loss among effects, it does not (`gradient`).
     - A ground coupling acts through its heat flux density q = U (T_ground - T_face) (W/m2, into
-      the component), and over weeks the face's temperature barely moves: many (U, T_ground)
-      pairs give the same flux. g = (T_ground - T_face, U), T_face its mean simulated over the
-      window.
+      the component), T_face the face's mean temperature simulated over the window: many (U,
+      T_ground) pairs give the same flux. g is q's gradient with the face simulated at each
+      parameter moved (`gradient`): where U is large beside the component's own conductance the
+      face follows T_ground, and holding it fixed would make a well-fixed flux look unknown.
     - A zone's internal mass or heater node answers with its time constant tau = C / H (s): a
       short record of the air fixes tau far better than C and H apart, which trade off along it.
       g = (1 / H, -C / H^2).
@@ -224,16 +225,16 @@ def derived(candidate, case, x, cov):
     def with_sd(value, gradient, unit, cov=within):
         return {"value": float(value), "std": float(np.sqrt(max(gradient @ cov @ gradient, 0.0))), "unit": unit}
 
-    hlc, gradient = hlc_gradient(candidate, x)
-    out = {"heat_loss_coefficient": with_sd(hlc, gradient, "W/K", cov)}
+    hlc, slope = gradient(lambda values: heat_loss_coefficient(candidate.built(values)), x, candidate.bounds)
+    out = {"heat_loss_coefficient": with_sd(hlc, slope, "W/K", cov)}
     if candidate.effect == "ground_coupling":
-        U, T_ground = x
         face = candidate.building.component(candidate.target).node_ids[-1]
-        T_face = float(np.mean(candidate.nodes(case, [face], x)))
-        out["ground_heat_flux"] = with_sd(U * (T_ground - T_face), np.array([T_ground - T_face, U]), "W/m2")
+        out["ground_heat_flux"] = with_sd(*gradient(
+            lambda values: values[0] * (values[1] - float(np.mean(candidate.nodes(case, [face], values)))),
+            x, candidate.bounds), "W/m2")
     if candidate.effect == "conductivity":
         (low, _), = candidate.bounds
-        out["component_loss"] = with_sd(hlc - heat_loss_coefficient(candidate.built([low])), gradient, "W/K")
+        out["component_loss"] = with_sd(hlc - heat_loss_coefficient(candidate.built([low])), slope, "W/K")
     if candidate.effect in TIME_CONSTANTS:
         C, H = x
         out[TIME_CONSTANTS[candidate.effect]] = with_sd(C / H, np.array([1.0 / H, -C / H ** 2]), "s")
@@ -265,25 +266,21 @@ def within_ranges(cov, bounds):
     return np.outer(scale, scale) * ((vectors * (values / (1.0 + values))) @ vectors.T)
 
 
-def hlc_gradient(candidate, x):
-    """The heat loss coefficient (W/K) of the building with the effect at x, and its gradient over
-    the parameters (W/K per unit of each), by differences of HLC_STEP of each parameter's range,
-    taken inside the bounds."""
-    def hlc(values):
-        return heat_loss_coefficient(candidate.built(values))
-
+def gradient(f, x, bounds):
+    """f(x) and its gradient over the parameters (units of f per unit of each), by differences of
+    STEP of each parameter's range, taken inside the `bounds`."""
     x = np.asarray(x, dtype=float)
-    at = hlc(x)
-    gradient = np.zeros(len(x))
-    for j, (low, high) in enumerate(candidate.bounds):
-        h = HLC_STEP * (high - low)
+    at = f(x)
+    slope = np.zeros(len(x))
+    for j, (low, high) in enumerate(bounds):
+        h = STEP * (high - low)
         h = h if x[j] + h <= high else -h
         moved = x.copy()
         moved[j] += h
-        change = hlc(moved) - at
-        # a parameter the loss does not depend on (a capacity, a gain) moves it by rounding only
-        gradient[j] = change / h if abs(change) > 1e-12 * abs(at) else 0.0
-    return at, gradient
+        change = f(moved) - at
+        # a parameter f does not depend on (a capacity in the HLC, a gain) moves it by rounding only
+        slope[j] = change / h if abs(change) > 1e-12 * max(abs(at), 1.0) else 0.0
+    return at, slope
 
 
 def sensitivity(candidate, cases, objective, seed=0):
