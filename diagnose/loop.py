@@ -7,9 +7,7 @@ on data the calibration did not see.
    day, which a record with real history does not match; the calibration window's scored steps
    are cut into blocks of whole days for the cross-validation (`diagnose.selection`).
 2. Before: the building as described, simulated through its FMU; metrics on both windows, per
-   objective zone and together. Its numerical error at every measured node (the file against
-   itself refined, `model.numerical`) is taken out of the measurements every fit and choice
-   below reads; the metrics compare the FMUs with the measurements as given.
+   objective zone and together.
 3. The forcing search (`ga.locate`) on the calibration window: which nodes it locates, and per
    component the share of J above the noise its forcing removes (the evidence).
 4. Rounds. Each calibrates every physical candidate (`diagnose.candidates.physical`: every zone
@@ -56,7 +54,7 @@ from nodeforce.ga.locate import check_measured, evaluator_kind, locate
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
-from nodeforce.model import numerical
+from nodeforce.model.numerical import reference
 from nodeforce.model.score import Noise
 
 # Rounds of candidates at most: each adds one effect on top of the last, while the error left is
@@ -140,9 +138,7 @@ class Windows:
     cross-validation blocks of all records in order, (record index, mask), and each one's other
     sensed nodes (`sensors`: the measured nodes besides the objective air, a wall's surface, a
     neighbouring zone's air) with their measurements (`sensed`, (N_t, len(sensors)), NaN where
-    not scored). Given the file's numerical error (`of`), the cases, the measured air and the
-    sensed nodes every fit and choice reads are corrected for it; `raw`, the measured air as
-    the user gave it, is what the metrics read."""
+    not scored)."""
     records: list
     cases: list
     ks: list
@@ -151,21 +147,15 @@ class Windows:
     blocks: list
     sensors: list
     sensed: list
-    raw: list
 
     @classmethod
-    def of(cls, records, objective, errors=None):
-        """The windows of `records`; `errors`, per record, (node ids, (N_t, len(ids)) the file's
-        numerical error there, C), taken out of the residuals (`model.numerical.corrected`)."""
-        cases, ks, calibrations, measured, blocks, sensors, sensed, raw = [], [], [], [], [], [], [], []
+    def of(cls, records, objective):
+        cases, ks, calibrations, measured, blocks, sensors, sensed = [], [], [], [], [], [], []
         for i, record in enumerate(records):
             # what no sensor sets (every wall of an air-only record) starts from the steady state of
             # the first day, not at the air's temperature: a heavy component would carry that guess
             # for weeks, and the candidates' slow parameters would fit it
             case = record.case if record.case.steady_start else record.case.with_steady_start()
-            raw.append(objective.measured(case))
-            if errors:
-                case = numerical.corrected(case, *errors[i])
             k = split(case, record.source, record.fraction, record.calibration_end)
             cases.append(case)
             ks.append(k)
@@ -174,15 +164,14 @@ class Windows:
             blocks += [(i, m) for m in blocks_of(k, case.burn_in_steps, case.dt, record.source)]
             sensors.append([node for node in case.measured_ids if node not in objective.air_nodes])
             sensed.append(case.scored([node - 1 for node in sensors[-1]]))
-        return cls(list(records), cases, ks, calibrations, measured, blocks, sensors, sensed, raw)
+        return cls(list(records), cases, ks, calibrations, measured, blocks, sensors, sensed)
 
     def metrics(self, objective, runs, record=None):
         """{"calibration", "validation"}: the objective's metrics of `runs` (one (N_t, zones) per
-        record) against the measurements as given, on every record's window together, or on
-        `record`'s (an index) alone: what the FMUs written make of the record."""
+        record) on every record's window together, or on `record`'s (an index) alone."""
         chosen = range(len(self.cases)) if record is None else [record]
         return {window: objective.metrics(*(np.concatenate([part[i][rows(self.ks[i])] for i in chosen])
-                                            for part in (self.raw, runs)))
+                                            for part in (self.measured, runs)))
                 for window, rows in (("calibration", lambda k: slice(None, k)),
                                      ("validation", lambda k: slice(k, None)))}
 
@@ -228,11 +217,13 @@ class Windows:
             out.append(np.minimum(1.0, sigma ** 2 / np.maximum(misfit, np.finfo(float).tiny)))
         return out
 
-    def numerical_error(self, errors, objective):
+    def numerical_error(self, runs, building, bases, objective):
         """The building file's own numerical error at the objective's air (C): the root mean
-        square, over the residuals the blocks score, of `errors` (`of`) at the air nodes."""
-        squares = [np.square(e[:k, [ids.index(a) for a in objective.air_nodes]])[np.isfinite(m[:k])]
-                   for (ids, e), k, m in zip(errors, self.ks, self.measured)]
+        square, over the residuals the blocks score, of the file's objective air as run (`runs`,
+        one (N_t, zones) per record, under the record's protocol's building in `bases`, else
+        `building`) minus the file refined (`model.numerical.reference`)."""
+        squares = [np.square(run[:k] - reference(case, base or building, objective.air_nodes)[:k])[np.isfinite(m[:k])]
+                   for run, case, base, k, m in zip(runs, self.cases, bases, self.ks, self.measured)]
         return float(np.sqrt(np.concatenate(squares).mean()))
 
     def scored(self):
@@ -324,20 +315,15 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
     n = windows.scored()
     bases = [protocol(building, r) for r in records]
 
-    # the file as given, at its air and at every node measured: against itself refined
-    # (`model.numerical`), its numerical error there, which every choice reads corrected away
-    before_runs, errors = [], []
+    before_runs = []
     for i, (case, base) in enumerate(zip(windows.cases, bases)):
         name = "model_before.fmu" if base is None else f"model_before_{i + 1}.fmu"
-        ids = sorted(set(objective.air_nodes) | set(case.measured_ids))
         with FmuInstance(build_fmu(base or building, workdir / name, kind=fmu_kind)) as fmu:
-            run = simulate_fmu(fmu, case, output_ids=ids)
-        before_runs.append(run[:, [ids.index(a) for a in objective.air_nodes]])
-        errors.append((ids, run - numerical.reference(case, base or building, ids)))
-    noise = Noise.of_records(windows.raw, noise).with_numerical(windows.numerical_error(errors, objective))
-    windows = Windows.of(records, objective, errors)
+            before_runs.append(simulate_fmu(fmu, case, output_ids=objective.air_nodes))
     before = windows.metrics(objective, before_runs)
     model = Model(building, before_runs, before, bases)
+    noise = Noise.of_records(windows.measured, noise).with_numerical(
+        windows.numerical_error(before_runs, building, bases, objective))
     sigma, floor = noise.sigma, noise.floor
 
     convergence = []
@@ -431,7 +417,7 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
     # every record's phases, each named with its record's name where there are several
     by_phase = []
     for i, (record, case) in enumerate(zip(records, windows.cases)):
-        rows = phase_errors(record.phases, case.times[1:], windows.raw[i],
+        rows = phase_errors(record.phases, case.times[1:], windows.measured[i],
                             {"before": before_runs[i], **{key: r[i] for key, r in runs.items()}, "after": after_runs[i]},
                             zones=objective.zones)
         by_phase += [{**row, "phase": f"{record.name}: {row['phase']}", "record": record.name}
@@ -442,8 +428,6 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
             decision["reason"] += (" It lowers the total error but makes the phase " + "; ".join(
                 f"{w['phase']} worse ({w['before']:.3f} C -> {w['after']:.3f} C)" for w in decision["worsened_phases"])
                 + ", which the total hides.")
-    # what the residual left follows is read with the file's numerical error taken out, as the
-    # choices read it; the plots show the measurements as given
     times, k, measured = first.times, k0, windows.measured[0]
     validation = slice(k, None)
     residuals = {state: residual_diagnostics(times[1:][validation], measured[validation, 0] - run[0][validation, 0],
@@ -484,7 +468,7 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
     h = first.history_steps
     series = {"times": times[h + 1:], "validation_start": times[k + 1], "scored_from": times[first.burn_in_steps + 1],
               "convergence": convergence,
-              "zones": {zone: {"air_node": air, "measured": windows.raw[0][h:, j], "before": before_runs[0][h:, j],
+              "zones": {zone: {"air_node": air, "measured": measured[h:, j], "before": before_runs[0][h:, j],
                                "after": after_runs[0][h:, j]}
                         for j, (zone, air) in enumerate(zip(objective.zones, objective.air_nodes))},
               "inputs": dict(zip(first.input_names, first.U[h + 1:].T))}

@@ -8,9 +8,7 @@ checks convergence: the same file, node for node, simulated on a grid `REFINEMEN
 space and with steps of at most `REFERENCE_STEP`, over the same record, from the same history
 and burn-in. The difference at the objective's air is an estimate of the file's error that
 the sensors' noise does not contain: it is deterministic and follows the weather, so a candidate
-effect with a slow parameter (a wall's conductivity, a mass) could fit part of it. A diagnosis
-takes it out of what its choices read (`corrected`, a defect correction) and counts what the
-correction leaves (`left`) beside the noise.
+effect with a slow parameter (a wall's conductivity, a mass) can fit part of it.
 """
 import math
 from dataclasses import replace
@@ -22,10 +20,6 @@ from .building import parse_building
 
 REFINEMENT = 4  # cells of the reference per stretch between two of the file's nodes or layer boundaries
 REFERENCE_STEP = 60.0  # s, the reference's longest integration step
-# The slowest order of convergence of the file's scheme: implicit Euler is first order in time
-# (its walls' conductances are second order in space), so the reference's own error is taken as
-# at most 1/(REFINEMENT - 1) of the difference file - reference (Richardson's estimate).
-ORDER = 1
 
 
 def refined(building, cells=REFINEMENT):
@@ -71,20 +65,3 @@ def discretisation_error(case, building, nodes):
     as written minus the refined reference (`reference`), both simulated as a diagnosis runs
     `case`."""
     return case.with_inputs(building).run(building)[:, np.asarray(nodes) - 1] - reference(case, building, nodes)
-
-
-def corrected(case, nodes, error):
-    """The case with the file's numerical error at `nodes` (ids; `error` (N_t, len(nodes)), C, at
-    t_1..t_N, `discretisation_error`) added to their measurements: what the file, solved as
-    written, would read of a building its equations describe exactly. A residual against it is
-    the file's physics missing, not its grid (a defect correction). NaN stays NaN; during a
-    burn-in both solutions are forced to the measurements, so there the error is 0."""
-    measured = case.measured.copy()
-    measured[1:, np.asarray(nodes) - 1] += error
-    return replace(case, measured=measured)
-
-
-def left(rms):
-    """(C) the numerical error a defect correction by an error of RMS `rms` leaves: the
-    reference's own error, rms / (REFINEMENT^ORDER - 1) if the scheme converges at `ORDER`."""
-    return rms / (REFINEMENT ** ORDER - 1)

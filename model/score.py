@@ -5,7 +5,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .errors import InputError
-from .numerical import REFERENCE_STEP, REFINEMENT, left
+from .numerical import REFERENCE_STEP, REFINEMENT
 
 
 def residuals(measured, simulated):
@@ -70,9 +70,8 @@ class Noise:
     differences of the measurement, with their lag-1 autocorrelation telling whether the noise
     is visible in them at all (on real records of precise sensors the signal's curvature over
     one step outweighs the white noise, and the error that matters is slow). Beside it, the
-    building file's own numerical error at the air (`numerical`, RMS in C, `model.numerical`),
-    which a diagnosis takes out of its residuals; with what that correction leaves of it, the
-    noise is what a right model of the file leaves (`floor`)."""
+    building file's own numerical error at the air (`numerical`, RMS in C, `model.numerical`):
+    together they are what a right model of the file leaves (`floor`)."""
     sigma: float | None
     given: bool = False
     lag1: float | None = None
@@ -84,12 +83,12 @@ class Noise:
 
     @property
     def floor(self):
-        """The sd (C) of what a model right but for its discretisation leaves once its numerical
-        error is corrected, sqrt(sigma^2 + left(numerical)^2) (`model.numerical.left`): the J a
-        right correction brings the error to is n floor^2; None if the noise is unknown."""
+        """The sd (C) of what a model right but for its discretisation leaves, sqrt(sigma^2 +
+        numerical^2): the J a right correction brings the error to is n floor^2; None if the
+        noise is unknown."""
         if self.sigma is None:
             return None
-        return math.hypot(self.sigma, left(self.numerical or 0.0))
+        return math.hypot(self.sigma, self.numerical or 0.0)
 
     @classmethod
     def of(cls, measured_air, given=None):
@@ -134,11 +133,9 @@ class Noise:
             return None
         return (f"numerical error of the building file at the air: {self.numerical:.2g} C RMS over the calibration "
                 f"window (the file against itself {REFINEMENT} times finer in space and at steps of at most "
-                f"{REFERENCE_STEP:g} s); taken out of the residuals every choice reads (a defect correction), "
-                f"it leaves at most {left(self.numerical):.1g} C, counted beside the noise, an error floor of "
+                f"{REFERENCE_STEP:g} s); the choices count it beside the noise, an error floor of "
                 + (f"{self.floor:.2g} C" if self.floor is not None else "its own") + ": no correction of the physics "
-                "is asked to explain the file's grid. The errors before and after compare the FMUs with the "
-                "measurements as they are")
+                "is asked to explain it")
 
     def to_json(self):
         return {"sigma": self.sigma, "given": self.given, "lag1": self.lag1, "visible": self.visible,

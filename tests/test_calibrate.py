@@ -83,6 +83,38 @@ def test_a_component_s_loss_is_what_its_layers_add_to_the_heat_loss_coefficient(
                    np.array([[1.0]]))["component_loss"]["value"] == pytest.approx(0.0, abs=1e-9)
 
 
+def test_a_ground_flux_s_spread_moves_the_face_with_the_parameters(testcell, weather):
+    """Where U is large beside the floor's own conductance, the floor's underside follows
+    T_ground, and the flux q = U (T_ground - T_face) hardly moves with T_ground. Its sd, as
+    `derived` reports it, is the gradient's with the face simulated again (central differences
+    here, apart from the forward ones `derived` takes), not the (T_ground - T_face, U) that holds
+    the face still, which reads it several times larger."""
+    from nodeforce.diagnose.calibrate import Candidate, derived, within_ranges
+    from nodeforce.model.case import measured_case
+    from nodeforce.model.synth import pseudo_measurements
+
+    from .conftest import SENSORS, record_times
+    case = measured_case(testcell, weather, pseudo_measurements(testcell, weather, record_times(3), SENSORS),
+                         burn_in_days=1)
+    coupled = Candidate(testcell, "ground_coupling", "floor")
+    face = testcell.component("floor").node_ids[-1]
+
+    def flux(x):
+        return x[0] * (x[1] - float(np.mean(coupled.nodes(case, [face], x))))
+
+    x, cov = np.array([8.0, 10.0]), np.diag([2.4, 0.5]) ** 2
+    steps = np.array([1e-3, 1e-3])
+    g = np.array([(flux(x + h) - flux(x - h)) / (2 * h[j]) for j, h in enumerate(np.diag(steps))])
+    within = within_ranges(cov, coupled.bounds)
+    reported = derived(coupled, case, x, cov)["ground_heat_flux"]
+    assert reported["value"] == pytest.approx(flux(x), rel=1e-9)
+    assert reported["std"] == pytest.approx(np.sqrt(g @ within @ g), rel=1e-3)
+    T_face = float(np.mean(coupled.nodes(case, [face], x)))
+    held = np.array([x[1] - T_face, x[0]])
+    assert 0.0 < g[1] < 0.5 * x[0]  # the face follows T_ground: far less than U per kelvin
+    assert np.sqrt(held @ within @ held) > 3 * reported["std"]
+
+
 def test_a_flux_the_data_fix_keeps_its_spread_where_the_valley_along_it_is_unbounded():
     """A ground coupling whose data fix only the flux q = U (T_ground - T_face): its information is
     g g' / sigma_q^2, g = (T_ground - T_face, U), singular along the valley. Combined with the

@@ -208,12 +208,11 @@ def test_noise_alone_never_passes(testcell):
 
 
 def test_a_fall_the_files_own_numerical_error_could_make_does_not_pass(testcell):
-    """A file whose coarse walls miss the continuum by 0.24 C RMS: corrected for it, it keeps
-    what the reference four times finer misses, at most 0.24 / (4 - 1) = 0.08 C that follows the
-    weather; a wall's conductivity fits 0.8 C2 of that, alike every day. Against the noise alone
-    (0.59 C2) that would pass; against the floor the noise and that error make together,
+    """A model right but for its coarse walls leaves, beside the noise, 0.08 C RMS that follows
+    the weather; a wall's conductivity fits 0.8 C2 of it, alike every day. Against the noise
+    alone (0.59 C2) that would pass; against the floor the noise and that error make together,
     sqrt(0.1^2 + 0.08^2) = 0.128 C (3 x 0.0164 x sqrt(384) = 0.96 C2), it does not."""
-    noise = Noise(SIGMA).with_numerical(0.24)
+    noise = Noise(SIGMA).with_numerical(0.08)
     assert noise.floor == pytest.approx(np.sqrt(SIGMA ** 2 + 0.08 ** 2))
     base = N / 4 * noise.floor ** 2 * np.ones(4)
     wall = door(base - 0.2)

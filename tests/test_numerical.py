@@ -1,8 +1,6 @@
 """The building file's own numerical error (model/numerical.py): the refined file is the same
 building, node for node, and the error estimated against it vanishes where the nodal model is
 exact (steady conduction) and falls as the file's own walls are refined."""
-from dataclasses import replace
-
 import numpy as np
 import pandas as pd
 import pytest
@@ -11,7 +9,7 @@ from nodeforce.model.building import load_building
 from nodeforce.model.case import measured_case
 from nodeforce.model.hlc import heat_loss_coefficient
 from nodeforce.model.network import assemble
-from nodeforce.model.numerical import corrected, discretisation_error, left, reference_case, refined
+from nodeforce.model.numerical import discretisation_error, refined
 from nodeforce.model.synth import pseudo_measurements
 from tests.conftest import record_times
 
@@ -79,33 +77,3 @@ def test_the_error_falls_as_the_files_walls_are_refined(testcell, weather):
         burn_in_days=1), halved)
     assert 0.01 < coarse < 0.2
     assert finer < 0.5 * coarse
-
-
-def test_the_correction_leaves_of_the_files_error_at_most_what_left_says(testcell, weather):
-    """A record of the continuum (the file 16 times finer in space at 10-s steps, no noise) read by
-    the file: against the measurements corrected by the file's error estimated on the 4-times
-    finer reference, the file's residual at the air is at most `left` of that error (the
-    reference's own error, first order), and far below the uncorrected residual. The correction
-    touches only the measured column, and not over the burn-in's forced steps."""
-    case = air_case(testcell, weather, days=3)
-    fine, on_fine = reference_case(case, testcell, cells=16, step=10.0)
-    measured = case.measured.copy()
-    measured[1:, AIR - 1] = np.where(np.isfinite(measured[1:, AIR - 1]), on_fine.run(fine)[:, AIR - 1], np.nan)
-    continuum = replace(case, measured=measured)
-    error = discretisation_error(continuum, testcell, [AIR])
-    fixed = corrected(continuum, [AIR], error)
-    file = continuum.with_inputs(testcell).run(testcell)[:, AIR - 1]
-    scored = np.isfinite(continuum.scored([AIR - 1]))[:, 0]
-
-    def rms(x):
-        return float(np.sqrt(np.mean(x[scored] ** 2)))
-
-    e_num = rms(error[:, 0])
-    raw, after = rms(continuum.measured[1:, AIR - 1] - file), rms(fixed.measured[1:, AIR - 1] - file)
-    assert 0.01 < e_num and raw > 0.8 * e_num
-    assert after <= left(e_num) and after < 0.2 * raw
-    assert np.array_equal(np.isnan(fixed.measured), np.isnan(continuum.measured))
-    other = np.arange(fixed.measured.shape[1]) != AIR - 1
-    assert np.array_equal(fixed.measured[:, other], continuum.measured[:, other], equal_nan=True)
-    burn_in = slice(case.history_steps + 1, case.burn_in_steps + 1)  # the steps forced
-    assert np.allclose(fixed.measured[burn_in, AIR - 1], continuum.measured[burn_in, AIR - 1], atol=1e-9, equal_nan=True)
