@@ -229,9 +229,11 @@ def derived(candidate, case, x, cov):
     out = {"heat_loss_coefficient": with_sd(hlc, slope, "W/K", cov)}
     if candidate.effect == "ground_coupling":
         face = candidate.building.component(candidate.target).node_ids[-1]
-        out["ground_heat_flux"] = with_sd(*gradient(
-            lambda values: values[0] * (values[1] - float(np.mean(candidate.nodes(case, [face], values)))),
-            x, candidate.bounds), "W/m2")
+
+        def flux(values):
+            U, T_ground = values
+            return U * (T_ground - float(np.mean(candidate.nodes(case, [face], values))))
+        out["ground_heat_flux"] = with_sd(*gradient(flux, x, candidate.bounds), "W/m2")
     if candidate.effect == "conductivity":
         (low, _), = candidate.bounds
         out["component_loss"] = with_sd(hlc - heat_loss_coefficient(candidate.built([low])), slope, "W/K")

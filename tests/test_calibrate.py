@@ -102,15 +102,13 @@ def test_a_ground_flux_s_spread_moves_the_face_with_the_parameters(testcell, wea
     def flux(x):
         return x[0] * (x[1] - float(np.mean(coupled.nodes(case, [face], x))))
 
-    x, cov = np.array([8.0, 10.0]), np.diag([2.4, 0.5]) ** 2
-    steps = np.array([1e-3, 1e-3])
-    g = np.array([(flux(x + h) - flux(x - h)) / (2 * h[j]) for j, h in enumerate(np.diag(steps))])
+    x, cov, h = np.array([8.0, 10.0]), np.diag([2.4, 0.5]) ** 2, 1e-3
+    g = np.array([(flux(x + step) - flux(x - step)) / (2 * h) for step in h * np.eye(2)])
     within = within_ranges(cov, coupled.bounds)
     reported = derived(coupled, case, x, cov)["ground_heat_flux"]
     assert reported["value"] == pytest.approx(flux(x), rel=1e-9)
     assert reported["std"] == pytest.approx(np.sqrt(g @ within @ g), rel=1e-3)
-    T_face = float(np.mean(coupled.nodes(case, [face], x)))
-    held = np.array([x[1] - T_face, x[0]])
+    held = np.array([x[1] - float(np.mean(coupled.nodes(case, [face], x))), x[0]])
     assert 0.0 < g[1] < 0.5 * x[0]  # the face follows T_ground: far less than U per kelvin
     assert np.sqrt(held @ within @ held) > 3 * reported["std"]
 
