@@ -41,9 +41,10 @@ to, block by block:
    its air change) predicts as well, the data have not placed it there, and the components are
    named beside the zone's effect instead (an air-only record cannot tell its walls apart). That
    standard error is the larger of two: the difference's scatter from block to block, and what the
-   sensors' noise alone makes of it (`noise_difference`); against a simpler candidate, a candidate
-   with more freedom must also gain beyond the noise's tolerance of J, as any candidate must
-   against the model (`parsimony`). Two corrections that predict nearly the same temperatures
+   sensors' noise alone makes of it (`noise_difference`); against a candidate that claims less
+   (a physical effect against a shape, fewer parameters, the zone's own effect against one
+   component's), a candidate must also gain beyond the noise's tolerance of J, as any candidate
+   must against the model (`parsimony`). Two corrections that predict nearly the same temperatures
    differ by nearly the same small amount every day, so the blocks' scatter is tiny; yet another draw
    of the noise would move that difference by 2 sigma |r_a - r_b|, and reverse it where it is
    smaller. Components whose corrections cannot be told apart are named together in the reason.
@@ -141,15 +142,17 @@ def noise_difference(a, b, sigma):
 
 
 def parsimony(result, sigma, n):
-    """The fall of evidence (C2) a candidate must add over a simpler one (a physical effect
-    against a shape, fewer parameters against more) to be preferred to it: what the sensors' noise
-    alone could make of J over the residuals its evidence scores (`ga.parsimony.noise_tolerance`),
-    the yardstick that admits a candidate against the model (1.) and a forced node against fewer
-    in the search. Its extra freedom fits what the file itself leaves (its coarser walls, a
-    history it does not know) as well as the fault: a ground coupling against a constant gain, a
-    daily profile against a window's sun, both on the air alone, differ by a hundredth of that,
-    alike on every day, which neither the days' scatter nor a fixed pair's noise
-    (`noise_difference`) would call small. `n`: the air's scored residuals."""
+    """The fall of evidence (C2) a candidate must add over one that claims less (a physical effect
+    against a shape, fewer parameters against more, the zone's own effect against one
+    component's) to be preferred to it: what the sensors' noise alone could make of J over the
+    residuals its evidence scores (`ga.parsimony.noise_tolerance`), the yardstick that admits a
+    candidate against the model (1.) and a forced node against fewer in the search. Its extra
+    freedom fits what the file itself leaves (its coarser walls, a history it does not know) as
+    well as the fault: a ground coupling against a constant gain, a daily profile against a
+    window's sun, both on the air alone, differ by a hundredth of that, alike on every day, which
+    neither the days' scatter nor a fixed pair's noise (`noise_difference`) would call small. One
+    wall's factor bends that wall's dynamics, where the file's coarse nodes err, as the envelope's
+    cannot: on the air alone it fits that error too. `n`: the air's scored residuals."""
     return noise_tolerance(sigma, n + result.get("sensors", {}).get("n_weighted", 0))
 
 
@@ -223,15 +226,20 @@ def decide(building, results, base, sigma, n, groups=(), floor=None):
         best = min(admissible, key=lambda r: evidence(r).sum())
         rounding = ROUNDING * float(base.sum())
 
+        def claim(r):
+            # what a choice claims, least first: a physical effect before a shape, fewer parameters
+            # before more, the zone's own effect before one component's (which says where)
+            return preference(r["effect"]), r["target"] in components
+
         def close(r):
             # how much worse than the best it predicts the left-out days, and the scatter of that
             worse, se = fall(evidence(r), evidence(best))
             needed = max(STANDARD_ERRORS * max(se, noise_difference(r, best, sigma)), rounding)
-            if preference(r["effect"]) < preference(best["effect"]):
+            if claim(r) < claim(best):
                 needed = max(needed, parsimony(best, floor, n))
             return worse <= needed
         near = [r for r in admissible if close(r)]
-        chosen = min(near, key=lambda r: (preference(r["effect"]), r["target"] in components, evidence(r).sum()))
+        chosen = min(near, key=lambda r: (claim(r), evidence(r).sum()))
         alike = [r for r in near if r is not chosen]
     # the candidates physics refused are in `suggestions`; the report says them grouped by reason
     reason = _reason(chosen, alike, results, passing, base, n, tests, margin, components)
