@@ -268,7 +268,10 @@ def test_dask_cluster_gives_the_same_result(tmp_path):
                                   dashboard_address=None) as cluster:
         on_dask = search(spec, NODES12, scheduler=cluster.scheduler_address, **budget)
     assert without_time(on_dask) == without_time(serial)
-    assert evaluators_built(tmp_path) == [1, 1]  # one evaluator per Dask worker
+    # one evaluator per Dask worker that ran tasks: the scheduler, not nodeforce, places them, and on
+    # busy cores it may give every task to the worker that answered first
+    built = evaluators_built(tmp_path)
+    assert 1 <= len(built) <= 2 and set(built) == {1}, built
 
 
 # --- the default search: seeded from the single-node scores and a forward-backward pass, stopped
