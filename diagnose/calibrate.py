@@ -25,6 +25,7 @@ from nodeforce.model.case import as_cases
 from nodeforce.model.significance import bandwidth, parameter_covariance
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.hlc import heat_loss_coefficient
+from nodeforce.model.numerical import share
 
 log = logging.getLogger("nodeforce.diagnose")
 
@@ -89,10 +90,15 @@ class Candidate:
         return self._runs[key]
 
 
-def calibrate(candidate, cases, objective, blocks=()):
+def calibrate(candidate, cases, objective, blocks=(), numerical=None):
     """Least-squares values of the candidate's parameters on the calibration windows of one or
     several records of the building (`cases`), on the residuals of every objective zone of every
     record together (the sum of each window's J), and the same fit with each block of steps left out.
+
+    Where the file's own numerical error is given (`numerical`), the residual is taken less the
+    share of it least squares finds there (`model.numerical.share`, on the rows a fit reads): a
+    wall's conductivity or absorptance, slow and weather-driven, would otherwise be fitted to what
+    the file's coarse walls make, and chosen for it over the fault the record holds.
 
     Parameters
     ----------
@@ -101,6 +107,8 @@ def calibrate(candidate, cases, objective, blocks=()):
     objective : model.score.Objective
     blocks : (record index, (N_t,) bool mask of the steps of that record's window) of each
         cross-validation block (`diagnose.selection`); a bare mask is a block of the first record
+    numerical : per case, the file's numerical error at the objective air (C, (N_t, zones):
+        `model.numerical.discretisation_error`), or None
 
     Returns
     -------
@@ -117,9 +125,16 @@ def calibrate(candidate, cases, objective, blocks=()):
     start = calibration_start(candidate.building, candidate.effect, candidate.target)
     x0 = np.array([start[p.name] for p in candidate.parameters])  # inside the bounds: `calibration_start`
 
-    def residuals(x):
+    error = (np.concatenate([e[h] for e, h in zip(numerical, have)]) if numerical is not None
+             else np.zeros(sum(int(h.sum()) for h in have)))
+
+    def raw(x):
         return np.concatenate([m[h] - candidate.nodes(case, objective.air_nodes, x)[h]
                                for case, m, h in zip(cases, measured, have)])
+
+    def residuals(x, rows=None):
+        r = raw(x)
+        return r + share(r, error, rows) * error
 
     fit = least_squares(residuals, x0, bounds=(lows, highs), x_scale="jac", method="trf")
     # each record's steps numbered apart from the others' by more than the HAC's lags: residuals
@@ -144,9 +159,12 @@ def calibrate(candidate, cases, objective, blocks=()):
     for record, block in blocks:
         rows = [np.broadcast_to((block[:, None] if i == record else np.zeros((len(h), 1), bool)), h.shape)[h]
                 for i, h in enumerate(have)]
-        x = fold(fit, ~np.concatenate(rows), lows, highs, residuals)
+        train = ~np.concatenate(rows)
+        x = fold(fit, train, lows, highs, lambda x: residuals(x, train))
         case, m, h = cases[record], measured[record], have[record]
-        left = np.where(h & block[:, None], m - candidate.nodes(case, objective.air_nodes, x), np.nan)
+        s = share(raw(x), error, train)
+        e = numerical[record] if numerical is not None else 0.0
+        left = np.where(h & block[:, None], m - candidate.nodes(case, objective.air_nodes, x) + s * e, np.nan)
         folds.append({"values": [float(v) for v in x], "residuals": left})
     return result, derived(candidate, cases[0], fit.x, cov), folds
 

@@ -34,7 +34,7 @@ import os
 import sys
 import time
 from contextlib import nullcontext
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from tqdm import tqdm
@@ -54,7 +54,7 @@ from nodeforce.ga.locate import check_measured, evaluator_kind, locate
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
-from nodeforce.model.numerical import reference
+from nodeforce.model.numerical import reference, share
 from nodeforce.model.score import Noise
 
 # Rounds of candidates at most: each adds one effect on top of the last, while the error left is
@@ -96,9 +96,9 @@ def assess(task):
     it took; writes the
     candidate's building file, declared at the calibrated values, in `folder`.
     """
-    building, bases, effect, target, folder, calibrations, cases, objective, blocks, sensors, seed = task
+    building, bases, effect, target, folder, calibrations, cases, objective, blocks, sensors, numerical, seed = task
     candidate = Candidate(building, effect, target, protocols(bases, calibrations, cases))
-    parameters, determined, folds = calibrate(candidate, calibrations, objective, blocks)
+    parameters, determined, folds = calibrate(candidate, calibrations, objective, blocks, numerical)
     values = [parameters[p.name]["value"] for p in candidate.parameters]
     runs = [candidate.nodes(case, objective.air_nodes, values) for case in cases]
     sensed = [candidate.nodes(case, ids, values) if ids else np.empty((len(case.times) - 1, 0))
@@ -147,6 +147,7 @@ class Windows:
     blocks: list
     sensors: list
     sensed: list
+    numerical: list = None
 
     @classmethod
     def of(cls, records, objective):
@@ -176,9 +177,19 @@ class Windows:
                                      ("validation", lambda k: slice(k, None)))}
 
     def block_J(self, runs):
-        """J (C2) of `runs` on every block, the records' in order."""
-        return np.array([block_J(self.measured[i][:self.ks[i]] - runs[i][:self.ks[i]], [m])[0]
-                         for i, m in self.blocks])
+        """J (C2) of `runs` on every block, the records' in order, each less the share of the
+        file's numerical error (`model.numerical.share`) the other blocks hold, as a candidate's
+        left-out block is scored (`diagnose.calibrate`)."""
+        residuals = [m[:k] - run[:k] for m, run, k in zip(self.measured, runs, self.ks)]
+        errors = self.calibration_numerical() or [np.zeros_like(r) for r in residuals]
+        r, e = (np.concatenate([a.ravel() for a in parts]) for parts in (residuals, errors))
+        out = []
+        for i, mask in self.blocks:
+            rows = [np.broadcast_to(mask[:, None] if j == i else np.zeros((len(a), 1), bool), a.shape).ravel()
+                    for j, a in enumerate(residuals)]
+            s = share(r, e, ~np.concatenate(rows))
+            out.append(block_J(residuals[i] + s * errors[i], [mask])[0])
+        return np.array(out)
 
     def sensor_scores(self, sensed, weights):
         """What a candidate, fitted to the air alone, predicts of what the other sensors saw: their
@@ -217,14 +228,22 @@ class Windows:
             out.append(np.minimum(1.0, sigma ** 2 / np.maximum(misfit, np.finfo(float).tiny)))
         return out
 
-    def numerical_error(self, runs, building, bases, objective):
-        """The building file's own numerical error at the objective's air (C): the root mean
-        square, over the residuals the blocks score, of the file's objective air as run (`runs`,
-        one (N_t, zones) per record, under the record's protocol's building in `bases`, else
-        `building`) minus the file refined (`model.numerical.reference`)."""
-        squares = [np.square(run[:k] - reference(case, base or building, objective.air_nodes)[:k])[np.isfinite(m[:k])]
-                   for run, case, base, k, m in zip(runs, self.cases, bases, self.ks, self.measured)]
+    def with_numerical(self, runs, building, bases, objective):
+        """The windows with the building file's own numerical error at the objective air (C, one
+        (N_t, zones) per record): the file's objective air as run (`runs`, under the record's
+        protocol's building in `bases`, else `building`) minus the file refined
+        (`model.numerical.reference`)."""
+        return replace(self, numerical=[run - reference(case, base or building, objective.air_nodes)
+                                        for run, case, base in zip(runs, self.cases, bases)])
+
+    def numerical_rms(self):
+        """The root mean square (C) of the file's numerical error over the residuals the blocks score."""
+        squares = [np.square(e[:k])[np.isfinite(m[:k])] for e, k, m in zip(self.numerical, self.ks, self.measured)]
         return float(np.sqrt(np.concatenate(squares).mean()))
+
+    def calibration_numerical(self):
+        """The file's numerical error on each record's calibration window, None if not known."""
+        return None if self.numerical is None else [e[:k] for e, k in zip(self.numerical, self.ks)]
 
     def scored(self):
         """Residuals the blocks score, on every record."""
@@ -260,7 +279,7 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers, weights)
     label, and the simulations they took. `weights`: each record's other sensors' weights in the
     choice (`Windows.sensor_weights`)."""
     tasks = [(model.building, model.bases, effect, target, folder, windows.calibrations, windows.cases, objective,
-              windows.blocks, windows.sensors, seed) for effect, target in pairs]
+              windows.blocks, windows.sensors, windows.calibration_numerical(), seed) for effect, target in pairs]
     n_workers = min(workers or os.cpu_count(), len(tasks))
     with (lifetime.worker_pool(n_workers) if n_workers > 1 else nullcontext()) as pool:
         assessed = list(tqdm((pool.map if pool else map)(assess, tasks), total=len(tasks),
@@ -322,8 +341,8 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
             before_runs.append(simulate_fmu(fmu, case, output_ids=objective.air_nodes))
     before = windows.metrics(objective, before_runs)
     model = Model(building, before_runs, before, bases)
-    noise = Noise.of_records(windows.measured, noise).with_numerical(
-        windows.numerical_error(before_runs, building, bases, objective))
+    windows = windows.with_numerical(before_runs, building, bases, objective)
+    noise = Noise.of_records(windows.measured, noise).with_numerical(windows.numerical_rms())
     sigma, floor = noise.sigma, noise.floor
 
     convergence = []

@@ -65,3 +65,20 @@ def discretisation_error(case, building, nodes):
     as written minus the refined reference (`reference`), both simulated as a diagnosis runs
     `case`."""
     return case.with_inputs(building).run(building)[:, np.asarray(nodes) - 1] - reference(case, building, nodes)
+
+
+def share(residual, error, rows=None):
+    """The share s in [0, 1] of the file's numerical error `error` (C, the file's run minus the
+    continuum's: `discretisation_error`) that least squares finds in `residual` (C, measured
+    minus the file's run, the same shape, NaN where not scored), on the `rows` (bool, the same
+    shape; every finite one if None): the residual holds -s * error.
+
+    s = 0 says the building behaves as the file's network, s = 1 as the continuum the file
+    discretises; between, the error's share the residual holds. A correction fitted to the
+    residual plus s * error (measured minus the file's run moved s of the way to the continuum)
+    is fitted to what the physics the file declares misses, not to what its discretisation makes
+    (`diagnose.calibrate`)."""
+    keep = np.isfinite(residual) & np.isfinite(error) & (True if rows is None else rows)
+    e, r = error[keep], residual[keep]
+    energy = float(e @ e)
+    return float(np.clip(-(e @ r) / energy, 0.0, 1.0)) if energy > 0.0 else 0.0

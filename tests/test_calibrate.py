@@ -138,3 +138,54 @@ def test_a_flux_the_data_fix_keeps_its_spread_where_the_valley_along_it_is_unbou
     assert combined == pytest.approx(
         np.linalg.inv(np.linalg.inv(tight) + np.diag([12 / 20.0 ** 2, 12 / 50.0 ** 2])), rel=1e-9)
     assert combined == pytest.approx(tight, rel=2e-3)
+
+
+def test_a_fit_that_carries_the_files_numerical_error_finds_the_walls_of_the_file_and_of_the_continuum(testcell, weather):
+    """The air of the test cell as its own network makes it, and as the continuum it discretises
+    makes it (the file refined, `model.numerical.reference_case`), the west wall as declared
+    (factor 1) and 1.5 times as conductive. Fitted alone, the wall's factor bends onto the
+    continuum's difference from the file; carrying that difference as a share in [0, 1]
+    (`numerical`), the fit finds the continuum's wall as it finds the network's, and each day
+    left out is predicted to the rounding."""
+    from dataclasses import replace
+
+    from nodeforce.diagnose.calibrate import Candidate, calibrate
+    from nodeforce.diagnose.selection import blocks
+    from nodeforce.model.case import measured_case
+    from nodeforce.model.effects import EFFECTS
+    from nodeforce.model.numerical import discretisation_error, reference_case
+    from nodeforce.model.score import Objective
+    from nodeforce.model.synth import pseudo_measurements
+
+    from .conftest import record_times
+    air = testcell.zones[0].air_node
+    case = measured_case(testcell, weather, pseudo_measurements(testcell, weather, record_times(6), [air]),
+                         burn_in_days=1)
+    B = case.burn_in_steps
+    error = discretisation_error(case, testcell, [air])
+    days = blocks(len(case.times) - 1, B, case.dt)
+
+    def fitted(T, numerical):
+        measured = case.measured.copy()
+        measured[1 + B:, air - 1] = T[B:, air - 1]  # the burn-in forces the air as both runs had it
+        found, _, folds = calibrate(Candidate(testcell, "conductivity", "west_wall"), replace(case, measured=measured),
+                                    Objective.of(testcell), days, numerical)
+        return found["factor"]["value"], max(np.nanmax(np.abs(f["residuals"])) for f in folds)
+
+    for factor in (1.0, 1.5):
+        wall = EFFECTS["conductivity"].apply(testcell, "west_wall", {"factor": factor})
+        network = case.with_inputs(wall).run(wall)
+        fine, on_fine = reference_case(case, wall)
+        continuum = on_fine.run(fine)
+        for numerical in (None, [error]):
+            found, left = fitted(network, numerical)
+            assert found == pytest.approx(factor, abs=1e-4) and left < 1e-4
+        found, _ = fitted(continuum, [error])
+        # the error carried is the declared file's; the faulty wall's own differs a little
+        assert found == pytest.approx(factor, abs=0.03 * factor)
+    fine, on_fine = reference_case(case, testcell)
+    continuum = on_fine.run(fine)
+    found_alone, left_alone = fitted(continuum, None)
+    found, left = fitted(continuum, [error])
+    assert abs(found_alone - 1.0) > 3e-3 and found == pytest.approx(1.0, abs=1e-4)
+    assert left < 1e-4 < left_alone

@@ -9,7 +9,7 @@ from nodeforce.model.building import load_building
 from nodeforce.model.case import measured_case
 from nodeforce.model.hlc import heat_loss_coefficient
 from nodeforce.model.network import assemble
-from nodeforce.model.numerical import discretisation_error, refined
+from nodeforce.model.numerical import discretisation_error, refined, share
 from nodeforce.model.synth import pseudo_measurements
 from tests.conftest import record_times
 
@@ -77,3 +77,20 @@ def test_the_error_falls_as_the_files_walls_are_refined(testcell, weather):
         burn_in_days=1), halved)
     assert 0.01 < coarse < 0.2
     assert finer < 0.5 * coarse
+
+
+def test_the_share_of_the_error_a_residual_holds_is_its_least_squares_coefficient_within_0_and_1():
+    """A residual of -0.7 e plus a part orthogonal to e (a cosine against a sine over whole
+    periods) holds 0.7 of e; twice the error is the continuum and more, 1; the error's opposite
+    is no share of it, 0; on chosen rows, those rows' share; missing readings count for nothing."""
+    t = np.linspace(0.0, 4 * np.pi, 400, endpoint=False)
+    e = 0.05 * np.sin(t)
+    assert share(-0.7 * e + 0.1 * np.cos(t), e) == pytest.approx(0.7, abs=1e-12)
+    assert share(-2.0 * e, e) == 1.0
+    assert share(0.5 * e, e) == 0.0
+    halves = np.where(t < 2 * np.pi, -0.3 * e, -0.9 * e)
+    assert share(halves, e, t >= 2 * np.pi) == pytest.approx(0.9, abs=1e-12)
+    gappy = -0.4 * e
+    gappy[::3] = np.nan
+    assert share(gappy, e) == pytest.approx(0.4, abs=1e-12)
+    assert share(gappy, np.zeros_like(e)) == 0.0
