@@ -94,3 +94,30 @@ def test_the_share_of_the_error_a_residual_holds_is_its_least_squares_coefficien
     gappy[::3] = np.nan
     assert share(gappy, e) == pytest.approx(0.4, abs=1e-12)
     assert share(gappy, np.zeros_like(e)) == 0.0
+
+
+def test_the_model_a_candidate_is_measured_against_scores_each_day_with_the_share_the_other_days_hold():
+    """Two records of four days each whose residual is -0.6 e on every day but one, which holds
+    -0.2 e; e has the same energy E on every day. Each block is scored with the share fitted on
+    all the others, as a candidate's left-out day is: the odd day with s = 0.6 (seven days of
+    -0.6 e), leaving (0.6 - 0.2)^2 E; every other day with s = (6 x 0.6 + 0.2) / 7, leaving
+    (0.6 - s)^2 E. Without the error given, every day keeps its whole residual, 0.36 E."""
+    from nodeforce.diagnose.loop import Windows
+
+    day, days = 24, 4
+    t = np.arange(day * days) / day
+    e = (0.05 * np.sin(2 * np.pi * t) + 0.02)[:, None]
+    masks = [(t // 1 == d) for d in range(days)]
+    E = float(np.sum(e[masks[0]] ** 2))
+    measured = [np.where(masks[2][:, None], -0.2 * e, -0.6 * e), -0.6 * e]  # minus a run of zeros: the residual
+    runs = [np.zeros_like(e), np.zeros_like(e)]
+    blocks = [(i, m) for i in range(2) for m in masks]
+
+    def windows(numerical):
+        return Windows([None] * 2, [None] * 2, [len(t)] * 2, [None] * 2, measured, blocks, [[], []], [None] * 2,
+                       numerical)
+    s = (6 * 0.6 + 0.2) / 7
+    odd = [i == 0 and m is masks[2] for i, m in blocks]
+    expected = [(0.4 ** 2 if o else (0.6 - s) ** 2) * E for o in odd]
+    np.testing.assert_allclose(windows([e, e]).block_J(runs), expected, rtol=1e-9)
+    np.testing.assert_allclose(windows(None).block_J(runs), [(0.04 if o else 0.36) * E for o in odd], rtol=1e-9)
