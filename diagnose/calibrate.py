@@ -21,6 +21,7 @@ from SALib.sample import morris as morris_sample
 from scipy.optimize import least_squares
 
 from nodeforce.diagnose.candidates import IDENTIFIABLE_RELATIVE, calibration_start
+from nodeforce.diagnose.selection import on_block
 from nodeforce.model.case import as_cases
 from nodeforce.model.significance import bandwidth, parameter_covariance
 from nodeforce.model.effects import EFFECTS
@@ -125,8 +126,8 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None):
     start = calibration_start(candidate.building, candidate.effect, candidate.target)
     x0 = np.array([start[p.name] for p in candidate.parameters])  # inside the bounds: `calibration_start`
 
-    error = (np.concatenate([e[h] for e, h in zip(numerical, have)]) if numerical is not None
-             else np.zeros(sum(int(h.sum()) for h in have)))
+    numerical = numerical if numerical is not None else [np.zeros_like(m) for m in measured]
+    error = np.concatenate([e[h] for e, h in zip(numerical, have)])
 
     def raw(x):
         return np.concatenate([m[h] - candidate.nodes(case, objective.air_nodes, x)[h]
@@ -157,14 +158,12 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None):
                           "on_bound": bool(bound != 0)}
     folds = []
     for record, block in blocks:
-        rows = [np.broadcast_to((block[:, None] if i == record else np.zeros((len(h), 1), bool)), h.shape)[h]
-                for i, h in enumerate(have)]
-        train = ~np.concatenate(rows)
+        train = ~np.concatenate([rows[h] for rows, h in zip(on_block([h.shape for h in have], record, block), have)])
         x = fold(fit, train, lows, highs, lambda x: residuals(x, train))
         case, m, h = cases[record], measured[record], have[record]
         s = share(raw(x), error, train)
-        e = numerical[record] if numerical is not None else 0.0
-        left = np.where(h & block[:, None], m - candidate.nodes(case, objective.air_nodes, x) + s * e, np.nan)
+        left = np.where(h & block[:, None], m - candidate.nodes(case, objective.air_nodes, x) + s * numerical[record],
+                        np.nan)
         folds.append({"values": [float(v) for v in x], "residuals": left})
     return result, derived(candidate, cases[0], fit.x, cov), folds
 

@@ -48,7 +48,7 @@ from nodeforce.diagnose.loss import heat_loss
 from nodeforce.diagnose.report import write_report
 from nodeforce.diagnose.phases import phase_errors, worsened
 from nodeforce.diagnose.residuals import diagnostics as residual_diagnostics
-from nodeforce.diagnose.selection import at_noise, block_J, blocks as blocks_of, decide, label
+from nodeforce.diagnose.selection import at_noise, block_J, blocks as blocks_of, decide, label, on_block
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.locate import check_measured, evaluator_kind, locate
 from nodeforce.model.effects import EFFECTS
@@ -185,9 +185,7 @@ class Windows:
         r, e = (np.concatenate([a.ravel() for a in parts]) for parts in (residuals, errors))
         out = []
         for i, mask in self.blocks:
-            rows = [np.broadcast_to(mask[:, None] if j == i else np.zeros((len(a), 1), bool), a.shape).ravel()
-                    for j, a in enumerate(residuals)]
-            s = share(r, e, ~np.concatenate(rows))
+            s = share(r, e, ~np.concatenate([rows.ravel() for rows in on_block([a.shape for a in residuals], i, mask)]))
             out.append(block_J(residuals[i] + s * errors[i], [mask])[0])
         return np.array(out)
 

@@ -93,6 +93,14 @@ def blocks(n_steps, scored_from, dt, source="measurements"):
     return np.array([(index >= a) & (index < b) for a, b in zip(starts, ends)])
 
 
+def on_block(shapes, record, block):
+    """Per record, a bool array of its residuals' shape ((N_t, zones)): True on the steps of
+    `block` ((N_t,) bool) of record `record`, False everywhere else; its complement is what a fit
+    without the block reads."""
+    return [np.broadcast_to(block[:, None] if i == record else np.zeros((shape[0], 1), bool), shape)
+            for i, shape in enumerate(shapes)]
+
+
 def block_J(residuals, masks):
     """J (C2) of residuals ((N_t, zones), NaN where not scored) on each block."""
     return np.array([np.nansum(np.square(residuals[m])) for m in masks])
