@@ -13,6 +13,7 @@ from xml.etree.ElementTree import Element, SubElement, indent, tostring
 
 from nodeforce.model.building import Boundary
 from nodeforce.model.effects import EFFECTS, fmu_parameters, properties
+from nodeforce.model.integrate import MAX_STEP
 from nodeforce.model.network import clock_input_names
 
 from .guard import GUARD_GLIBC, PYTHONFMU_GLIBC
@@ -33,6 +34,7 @@ UNITS = {
     "W/m2/K": ("CoefficientOfHeatTransfer", {"kg": "1", "s": "-3", "K": "-1"}),
     "1/h": ("AirChangeRate", {"s": "-1", "factor": str(1 / 3600)}),
     "m3/h": ("VolumeFlowRate", {"m": "3", "s": "-1", "factor": str(1 / 3600)}),
+    "s": ("Time", {"s": "1"}),
 }
 EFFECT_UNITS = {"C": "degC", "-": None}  # effects.Parameter.unit spellings that differ from FMI's
 LOG_CATEGORIES = ("logStatusWarning", "logStatusDiscard", "logStatusError", "logStatusFatal", "logAll")
@@ -60,6 +62,7 @@ class Variable:
     # interpolates: a measurement, whose NaN (not measured) must not leak into its neighbours
     discrete: bool = False
     bounds: tuple = ()  # (min, max) of a parameter an importer may set, or none
+    tunable: bool = False  # a parameter that may change between steps
 
 
 def variables(layout, building, effect=None):
@@ -75,7 +78,10 @@ def variables(layout, building, effect=None):
                        f"measured temperature of node {i}, NaN if none; held between samples, "
                        "never interpolated", discrete=True) for i in n]
     found += [Variable(f"T[{i}]", "output", "Real", None, "degC", f"temperature of node {i}") for i in n]
-    return found + parameter_variables(building, effect)
+    return found + parameter_variables(building, effect) + [
+        Variable("max_step", "parameter", "Real", repr(MAX_STEP), "s",
+                 "the longest internal step (s): a doStep of h takes ceil(h / max_step) backward-Euler steps, "
+                 "the inputs linear within it", tunable=True)]
 
 
 def parameter_variables(building, effect=None):
@@ -135,7 +141,7 @@ def initial_dependencies(layout):
 
 
 def model_description(layout, building, guid, identifier, name, effect=None, standalone=False,
-                      source_files=(), step=DEFAULT_STEP, span=DEFAULT_SPAN, fmi=2):
+                      source_files=(), step=DEFAULT_STEP, span=DEFAULT_SPAN, fmi=2, interpolates=True):
     """modelDescription.xml (bytes) of a model.
 
     Parameters
@@ -146,6 +152,8 @@ def model_description(layout, building, guid, identifier, name, effect=None, sta
     standalone : the FMU needs no Python; source_files : names under sources/ (FMI 2.0)
     step, span : default communication step and stop time (s) of the DefaultExperiment
     fmi : 2 (scalars) or 3 (`force`, `T_forced` and `T` as arrays of N; c/fmi3.c)
+    interpolates : the binary takes input derivatives (fmi2SetRealInputDerivatives): every FMU
+        but the Python one without its guard (pythonfmu refuses them). FMI 3.0 has no such call.
     """
     version, licence = nodeforce_version()
     header = {"fmiVersion": "2.0", "modelName": name, "guid": guid} if fmi == 2 else \
@@ -162,7 +170,8 @@ def model_description(layout, building, guid, identifier, name, effect=None, sta
                     "canHandleVariableCommunicationStepSize": "true",
                     "canBeInstantiatedOnlyOncePerProcess": "false"}
     if fmi == 2:
-        capabilities.update({"canInterpolateInputs": "false", "canNotUseMemoryManagementFunctions": "true",
+        capabilities.update({"canInterpolateInputs": "true" if interpolates else "false",
+                             "canNotUseMemoryManagementFunctions": "true",
                              "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true"})
     else:
         capabilities.update({"canGetAndSetFMUState": "true", "canSerializeFMUState": "true",
@@ -190,7 +199,7 @@ def _attributes(v):
     """The attributes of a variable's element that both FMI versions spell alike."""
     attributes = {"name": v.name, "description": v.description, "causality": v.causality}
     if v.causality == "parameter":
-        attributes.update(variability="fixed", initial="exact")
+        attributes.update(variability="tunable" if v.tunable else "fixed", initial="exact")
     if v.discrete:
         attributes["variability"] = "discrete"
     return attributes
@@ -256,6 +265,19 @@ def _variables3(root, declared, building, layout):
         if array:
             SubElement(element, "Dimension", {"start": str(n)})
         k += n
+    # FMI 3.0 has no call for input derivatives: each input's is an input of its own, declared
+    # as its derivative (c/fmi3.c gives them to the FMI 2.0 instance's fmi2SetRealInputDerivatives)
+    for name in list(layout.input_names) + ["T_forced"]:
+        array = name == "T_forced"
+        attributes = {"name": f"der({name})", "valueReference": str(len(refs) + 1), "causality": "input",
+                      "derivative": str(refs[name]), "start": " ".join(["0"] * layout.n_nodes) if array else "0",
+                      "description": f"first time derivative (per s) of {name} over the next step, 0 if not set"}
+        if array:
+            attributes["variability"] = "discrete"
+        refs[f"der({name})"] = len(refs) + 1
+        element = SubElement(model_variables, "Float64", attributes)
+        if array:
+            SubElement(element, "Dimension", {"start": str(layout.n_nodes)})
     structure = SubElement(root, "ModelStructure")
     SubElement(structure, "Output", {"valueReference": str(refs["T"]), "dependencies": ""})
     SubElement(structure, "InitialUnknown", {"valueReference": str(refs["T"]),

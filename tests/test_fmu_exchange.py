@@ -15,7 +15,7 @@ from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.fmu_build import guard
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.model.building import parse_building
-from nodeforce.model.integrate import simulate
+from nodeforce.model.integrate import simulate, substeps
 from nodeforce.model.network import assemble
 from tests.importers import run_fmpy
 from tests.test_standalone import python_host_environment, run_c_host, scenario
@@ -30,7 +30,7 @@ def fmus(tmp_path_factory, testcell_data):
     return {kind: build_fmu(building, folder / f"{kind}.fmu", kind=kind) for kind in ("python", "standalone")}
 
 
-def test_the_default_run_is_a_day_of_backward_euler_steps_of_900_s(fmus, testcell, tmp_path):
+def test_the_default_run_is_a_day_of_900_s_steps_each_in_backward_euler_steps_of_max_step(fmus, testcell, tmp_path):
     fmu = fmus["standalone"]
     experiment = read_model_description(str(fmu)).defaultExperiment
     start, stop, step = (float(x) for x in (experiment.startTime, experiment.stopTime, experiment.stepSize))
@@ -41,7 +41,9 @@ def test_the_default_run_is_a_day_of_backward_euler_steps_of_900_s(fmus, testcel
     T = np.column_stack([result[name] for name in outputs])[1:]
     # the direct model: every input at its start value (0), nothing measured, 20 C everywhere
     network = assemble(testcell)
-    direct = simulate(testcell, network, np.zeros((97, len(network.input_names))), DT, warmup_days=0)
+    direct = simulate(testcell, network, np.zeros((97, len(network.input_names))), DT, warmup_days=0,
+                      substeps=substeps(DT))
+    assert substeps(DT) == 3
     assert np.abs(T - direct).max() < 1e-9
     assert 20.0 - direct[-1, 22] > 5.0  # the day moves the model: a 1-s run would not
     done, in_c = run_c_host(fmu, {}, {}, outputs, step, round((stop - start) / step), tmp_path)

@@ -23,12 +23,13 @@ def test_one_guard_binary_for_every_model(testcell_data, tmp_path):
             sizes = fmu.read("resources/guard.txt").decode().splitlines()[1]
             assert "binaries/linux64/NodalBuilding.pythonfmu.so" in fmu.namelist()
     assert binaries[0] == binaries[1] == guard.guard_binary()
-    # the sizes the guard reads are the model description's: nodes, other inputs, the Real
-    # parameters but the N start values (the building's properties)
+    # the sizes the guard reads are the model description's: nodes, other inputs, the fixed Real
+    # parameters but the N start values (the building's properties); max_step is the one tunable
     variables = read_model_description(str(path)).modelVariables
     inputs = [v.name for v in variables if v.causality == "input"]
     n = sum(name.startswith("T_forced[") for name in inputs)
-    reals = sum(v.causality == "parameter" and v.type == "Real" for v in variables)
+    reals = sum(v.causality == "parameter" and v.type == "Real" and v.variability == "fixed" for v in variables)
+    assert [v.name for v in variables if v.variability == "tunable"] == ["max_step"]
     assert sizes == f"sizes {n} {len(inputs) - n} {reals - n}" and n == 23 and reals - n == 27
 
 

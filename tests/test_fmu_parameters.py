@@ -57,9 +57,11 @@ def two_days(testcell, real_case):
 
 
 def run(instance, building, U, parameters):
-    """Node temperatures at t_1..t_N from T_start = 20 C, the inputs of row k+1 at step k."""
+    """Node temperatures at t_1..t_N from T_start = 20 C: before the step from t_k the inputs of row
+    k and their slope to row k+1, one backward-Euler step per row (max_step of the row's 900 s)."""
     names = [f"T[{i}]" for i in range(1, building.n_nodes + 1)]
-    return instance.run(900.0, parameters, {}, list(assemble(building).input_names), U[1:], names)
+    return instance.run(900.0, {**parameters, "max_step": 900.0}, {}, list(assemble(building).input_names), U[:-1],
+                        names, slopes=np.diff(U, axis=0) / 900.0)
 
 
 def test_every_property_is_a_fixed_parameter_with_unit_and_bounds_the_same_in_fmi2_and_fmi3(fmus, testcell):
