@@ -8,6 +8,7 @@ linear between samples, a heat input held at the power of the interval); the FMU
 makes one doStep the direct model's k sub-steps of a sample, or its one long step over a history.
 """
 import numpy as np
+import pandas as pd
 
 from nodeforce.model.integrate import (STEADY_STEP, forcing_schedule, held_inputs, history_block, history_inputs,
                                        steady_inputs, step_start, warmup_rows)
@@ -15,6 +16,48 @@ from nodeforce.model.integrate import (STEADY_STEP, forcing_schedule, held_input
 
 def node_names(prefix, ids):
     return [f"{prefix}[{i}]" for i in ids]
+
+
+def input_table(case, force=None, T_default=20.0):
+    """The FMU's inputs over a case, as an importer sets them, and its start values.
+
+    Row n holds what is set before the step from t_n (FMI's co-simulation semantics), in time
+    from t_0 (s): the weather and every other sampled input at t_n (linear between rows: give
+    FMPy `set_input_derivatives=True`); a zone's heat input, held over each step, the power of the
+    interval that starts at t_n, which the record logs at t_n+1 (`integrate.held_inputs`), NaN in
+    the last row (no step starts there); `T_forced[i]` for every node forced over the step from
+    t_n (the `force` mask, and every measured node over the case's burn-in) its measurement at
+    t_n, NaN elsewhere (a discrete input: held over the step, never interpolated).
+
+    Parameters
+    ----------
+    case : model.case.Case without a history (`history_steps` 0): an importer starts at t_0
+    force : (N,) bool, nodes forced to their measurements for the whole record; None: none
+    T_default : C, the start of a node nothing informs
+
+    Returns
+    -------
+    (DataFrame indexed by `time` (s from t_0), one column per FMU input variable;
+     {name: value} of the start values: `T_start[i]` of every node, `force[i]` true for the forced)
+    """
+    if case.history_steps:
+        raise ValueError("an input table starts at the first measurement: make the case without a history")
+    measured = case.measured
+    n_rows, n = measured.shape
+    schedule = forcing_schedule(np.zeros(n, dtype=bool) if force is None else force, measured, case.burn_in_steps)
+    # the step from t_n forces the nodes of schedule's row n+1, at the sample of t_n
+    over = np.vstack([schedule[1:], schedule[-1:]])
+    forced_ids = [int(i) + 1 for i in np.flatnonzero(schedule[1:].any(axis=0))]
+    held = held_inputs(case.building, case.input_names)
+    U = np.where(held, np.vstack([case.U[1:], np.full((1, len(held)), np.nan)]), case.U)
+    columns = {**dict(zip(case.input_names, U.T)),
+               **{f"T_forced[{i}]": np.where(over[:, i - 1], measured[:, i - 1], np.nan) for i in forced_ids}}
+    seconds = (case.times - case.times[0]).total_seconds().to_numpy()
+    table = pd.DataFrame(columns, index=pd.Index(seconds, name="time"))
+    start = case.start_state(T_default)
+    values = {**{f"T_start[{i}]": float(start[i - 1]) for i in range(1, len(start) + 1)},
+              **{f"force[{i}]": True for i in forced_ids}}
+    return table, values
 
 
 def simulate_fmu(instance, case, force=None, warmup_days=2, output_ids=None, T_default=20.0,
