@@ -51,7 +51,7 @@ def input_table(case, force=None, T_default=20.0):
     held = held_inputs(case.building, case.input_names)
     U = np.where(held, np.vstack([case.U[1:], np.full((1, len(held)), np.nan)]), case.U)
     columns = {**dict(zip(case.input_names, U.T)),
-               **{f"T_forced[{i}]": np.where(over[:, i - 1], measured[:, i - 1], np.nan) for i in forced_ids}}
+               **{f"T_forced[{i}]": np.where(over[:, i - 1], measured[:, i - 1], np.nan) for i in range(1, n + 1)}}
     seconds = (case.times - case.times[0]).total_seconds().to_numpy()
     table = pd.DataFrame(columns, index=pd.Index(seconds, name="time"))
     start = case.start_state(T_default)
