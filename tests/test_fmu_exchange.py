@@ -168,3 +168,15 @@ def test_outputs_read_one_per_call_are_the_step_s_outputs(fmus, tmp_path):
         slave.freeFMUstate(state)
         slave.terminate()
     assert restored == first and second != first
+
+
+def test_fmpy_applies_a_forced_nodes_measurement_at_every_step(fmus):
+    """pyproject.toml's FMPy lower bound: a discrete input re-applied before each step, the
+    sample of that step's start (FMPy 0.3.22 applied the first sample only, 0.3.21 each one a
+    step late). A forced node fed 10, 20, 30, 40 C ends each step at that step's sample."""
+    ramp = np.array([10.0, 20.0, 30.0, 40.0, 50.0])
+    signals = np.array(list(zip(np.arange(5) * DT, ramp)), dtype=[("time", float), ("T_forced[9]", float)])
+    result = simulate_fmu(str(fmus["standalone"]), input=signals, start_values={"force[9]": True},
+                          output=["T[9]", "T[23]"], stop_time=4 * DT, output_interval=DT)
+    assert np.array_equal(result["T[9]"][1:], ramp[:4])
+    assert len(np.unique(np.round(result["T[23]"][1:], 9))) == 4  # the air follows: the node is not merely recorded
