@@ -112,6 +112,8 @@ def calibrate(fmu, inputs_path, measurements_path, until=None, step=900.0, deriv
         seconds = seconds[measured.index <= pd.Timestamp(until)]
     air = measured[f"T{AIR}"].to_numpy()[1:len(seconds)]  # at t_1..t_N
     per_sample = round((seconds[1] - seconds[0]) / step)
+    if abs(per_sample * step - (seconds[1] - seconds[0])) > 1e-9:
+        raise SystemExit(f"--step {step:g}: not a divisor of the record's {seconds[1] - seconds[0]:g} s")
     scored = np.arange(len(air)) >= BURN_IN
     evaluations = []
 
