@@ -13,7 +13,7 @@ from xml.etree.ElementTree import Element, SubElement, indent, tostring
 
 from nodeforce.model.building import Boundary
 from nodeforce.model.effects import EFFECTS, fmu_parameters, properties
-from nodeforce.model.integrate import MAX_STEP
+from nodeforce.model.integrate import MAX_STEP, held_inputs
 from nodeforce.model.network import clock_input_names
 
 from .guard import GUARD_GLIBC, PYTHONFMU_GLIBC
@@ -72,8 +72,11 @@ def variables(layout, building, effect=None):
                       f"node {i} is forced to T_forced[{i}] where that is not NaN") for i in n]
     found += [Variable(f"T_start[{i}]", "parameter", "Real", "20", "degC",
                        f"temperature of node {i} at the start (a measured node: its measurement)") for i in n]
-    found += [Variable(name, "input", "Real", "0", *_input_meaning(building, name))
-              for name in layout.input_names]
+    # a zone's heat input is a power held over each step (model.integrate.held_inputs): discrete, as
+    # a measurement, so that an importer holds it from one sample to the next, never interpolates it
+    held = held_inputs(building, layout.input_names)
+    found += [Variable(name, "input", "Real", "0", *_input_meaning(building, name), discrete=bool(h))
+              for name, h in zip(layout.input_names, held)]
     found += [Variable(f"T_forced[{i}]", "input", "Real", "NaN", "degC",
                        f"measured temperature of node {i}, NaN if none; held between samples, "
                        "never interpolated", discrete=True) for i in n]
@@ -121,7 +124,8 @@ def _input_meaning(building, name):
         return "W/m2", f"solar irradiance on the outside face of {', '.join(faces)}"
     for zone in building.zones:
         if name in zone.heat_input:
-            return "W", f"measured heat input {name} of zone {zone.name}"
+            return "W", (f"measured heat input {name} of zone {zone.name}, the mean power over the step from "
+                         "the time it is set; held between samples, never interpolated")
         if zone.supply is not None and zone.supply.temperature == name:
             return "degC", f"supply air temperature of zone {zone.name}"
         if name in dict(zone.thermal_bridges):
@@ -267,12 +271,13 @@ def _variables3(root, declared, building, layout):
         k += n
     # FMI 3.0 has no call for input derivatives: each input's is an input of its own, declared
     # as its derivative (c/fmi3.c gives them to the FMI 2.0 instance's fmi2SetRealInputDerivatives)
+    discrete = {v.name.split("[")[0] for v in declared if v.causality == "input" and v.discrete}
     for name in list(layout.input_names) + ["T_forced"]:
         array = name == "T_forced"
         attributes = {"name": f"der({name})", "valueReference": str(len(refs) + 1), "causality": "input",
                       "derivative": str(refs[name]), "start": " ".join(["0"] * layout.n_nodes) if array else "0",
                       "description": f"first time derivative (per s) of {name} over the next step, 0 if not set"}
-        if array:
+        if name in discrete:
             attributes["variability"] = "discrete"
         refs[f"der({name})"] = len(refs) + 1
         element = SubElement(model_variables, "Float64", attributes)
