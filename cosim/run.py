@@ -25,9 +25,10 @@ def input_table(case, force=None, T_default=20.0):
     from t_0 (s): the weather and every other sampled input at t_n (linear between rows: give
     FMPy `set_input_derivatives=True`); a zone's heat input, held over each step, the power of the
     interval that starts at t_n, which the record logs at t_n+1 (`integrate.held_inputs`), NaN in
-    the last row (no step starts there); `T_forced[i]` for every node forced over the step from
-    t_n (the `force` mask, and every measured node over the case's burn-in) its measurement at
-    t_n, NaN elsewhere (a discrete input: held over the step, never interpolated).
+    the last row (no step starts there); `T_forced[i]` of every node: for a node forced over the
+    step from t_n (a node of the `force` mask, and every node over the case's burn-in) its
+    measurement at t_n (NaN where missing), NaN elsewhere; a discrete input, held over the step,
+    never interpolated.
 
     Parameters
     ----------
@@ -44,14 +45,15 @@ def input_table(case, force=None, T_default=20.0):
         raise ValueError("an input table starts at the first measurement: make the case without a history")
     measured = case.measured
     n_rows, n = measured.shape
-    schedule = forcing_schedule(np.zeros(n, dtype=bool) if force is None else force, measured, case.burn_in_steps)
-    # the step from t_n forces the nodes of schedule's row n+1, at the sample of t_n
-    over = np.vstack([schedule[1:], schedule[-1:]])
-    forced_ids = [int(i) + 1 for i in np.flatnonzero(schedule[1:].any(axis=0))]
+    # the nodes forced over the step from each row: the mask's, and over the burn-in's steps (to
+    # rows 1..B) every node; each at its sample, which the importer holds (NaN: computed)
+    member = np.zeros((n_rows, n), dtype=bool) if force is None else np.tile(np.asarray(force, dtype=bool), (n_rows, 1))
+    member[:case.burn_in_steps] = True
+    T_forced = np.where(member, measured, np.nan)
+    forced_ids = [int(i) + 1 for i in np.flatnonzero(np.isfinite(T_forced[:-1]).any(axis=0))]
     held = held_inputs(case.building, case.input_names)
     U = np.where(held, np.vstack([case.U[1:], np.full((1, len(held)), np.nan)]), case.U)
-    columns = {**dict(zip(case.input_names, U.T)),
-               **{f"T_forced[{i}]": np.where(over[:, i - 1], measured[:, i - 1], np.nan) for i in range(1, n + 1)}}
+    columns = {**dict(zip(case.input_names, U.T)), **{f"T_forced[{i}]": T_forced[:, i - 1] for i in range(1, n + 1)}}
     seconds = (case.times - case.times[0]).total_seconds().to_numpy()
     table = pd.DataFrame(columns, index=pd.Index(seconds, name="time"))
     start = case.start_state(T_default)
