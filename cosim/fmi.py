@@ -34,6 +34,13 @@ class Fmi2:
 
     def __init__(self, description):
         self.variables = {v.name: v for v in description.modelVariables}
+        # nodeforce's Python FMU written without a C compiler has no guard, and pythonfmu refuses
+        # fmi2SetRealInputDerivatives (canInterpolateInputs="false"): its slave keeps the inputs'
+        # derivatives as the values after the declared ones, in the inputs' order
+        # (fmu_build/variables.py, `derivatives`), which fmi2SetReal sets
+        self.derivatives_as_values = not description.coSimulation.canInterpolateInputs
+        inputs = [v.valueReference for v in description.modelVariables if v.causality == "input"]
+        self._derivative_offset = len(description.modelVariables) - min(inputs, default=0)
 
     def names(self, causality):
         return [name for name, v in self.variables.items() if v.causality == causality]
@@ -62,11 +69,17 @@ class Fmi2:
         first derivatives of the first `n_slopes` of them, step, get the outputs, through
         preallocated ctypes arrays (a step allocates nothing in Python)."""
         n_in, n_out = len(input_names), len(output_names)
-        d_refs = (fmi2ValueReference * n_slopes)(*self.refs(input_names[:n_slopes]))
+        refs = self.refs(input_names[:n_slopes])
+        if self.derivatives_as_values:
+            refs = [r + self._derivative_offset for r in refs]
+        d_refs = (fmi2ValueReference * n_slopes)(*refs)
         d_orders = (fmi2Integer * n_slopes)(*([1] * n_slopes))
         d_values = (fmi2Real * n_slopes)()
         d_view = np.ctypeslib.as_array(d_values) if n_slopes else None
-        set_derivatives = fmu.fmi2SetRealInputDerivatives
+        if self.derivatives_as_values:
+            set_derivatives = lambda c, r, n, _, v: fmu.fmi2SetReal(c, r, n, v)  # noqa: E731
+        else:
+            set_derivatives = fmu.fmi2SetRealInputDerivatives
         in_refs = (fmi2ValueReference * n_in)(*self.refs(input_names))
         in_values = (fmi2Real * n_in)()
         in_view = np.ctypeslib.as_array(in_values) if n_in else None
@@ -238,7 +251,8 @@ class FmuInstance:
         output_names : the outputs read after every step
         skip : steps whose outputs are not needed (a warm-up): not read at all
         slopes : (n_steps, n) first time derivatives (per s) of the first n inputs over each step
-            (fmi2SetRealInputDerivatives), or None: the inputs held over each step
+            (FMI 2.0 fmi2SetRealInputDerivatives, FMI 3.0 the `der(...)` inputs), or None: the
+            inputs held over each step
 
         Returns
         -------
