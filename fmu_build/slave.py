@@ -182,6 +182,9 @@ class NodalBuilding(Fmi2Slave):
         if not values[layout.max_step] > 0.0:
             return self._refuse(f"value reference {layout.max_step} (max_step) is {values[layout.max_step]} s: "
                                 "it must be > 0")
+        if step_size / values[layout.max_step] > _variables.MAX_SUBSTEPS:
+            return self._refuse(f"doStep of {step_size} s is more than {_variables.MAX_SUBSTEPS} steps of max_step = "
+                                f"{values[layout.max_step]} s: set max_step larger")
         k = max(1, int(np.ceil(step_size / values[layout.max_step] - 1e-9)))
         tau = step_size / k
         n_in = len(layout.input_names)

@@ -21,6 +21,10 @@ input derivatives): never declared, settable like the inputs.
 This file is copied into the Python FMU: standard library only, syntax of Python 3.6.
 """
 
+# The internal steps one doStep may take (h / max_step), at most: beyond, doStep is refused
+# (c/nodeforce_fmu.c's MAX_SUBSTEPS).
+MAX_SUBSTEPS = 10_000_000
+
 # What a call may do to a variable, by the slave's state (FMI 2.0 section 4.2.4, table 2).
 INSTANTIATED, INITIALISATION, STEPPING, TERMINATED = range(4)
 

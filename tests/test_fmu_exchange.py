@@ -180,3 +180,15 @@ def test_fmpy_applies_a_forced_nodes_measurement_at_every_step(fmus):
                           output=["T[9]", "T[23]"], stop_time=4 * DT, output_interval=DT)
     assert np.array_equal(result["T[9]"][1:], ramp[:4])
     assert len(np.unique(np.round(result["T[23]"][1:], 9))) == 4  # the air follows: the node is not merely recorded
+
+
+@pytest.mark.parametrize("kind", ["python", "standalone"])
+@pytest.mark.parametrize("max_step", [0.0, 1e-5])
+def test_a_step_max_step_cannot_cover_is_refused(fmus, kind, max_step):
+    """max_step must be > 0, and a doStep of more than 1e7 internal steps is refused, not run."""
+    with FmuInstance(fmus[kind]) as instance:
+        with pytest.raises(Exception) as refused:
+            instance.run(DT, {"max_step": max_step}, {}, [], np.zeros((1, 0)), ["T[23]"])
+        assert "doStep" in str(refused.value) or "fmi2DoStep" in str(refused.value)
+        # the instance runs again once max_step is one it can take
+        assert np.isfinite(instance.run(DT, {}, {}, [], np.zeros((1, 0)), ["T[23]"])).all()

@@ -28,6 +28,7 @@
 #include "variables.h"
 
 #define CACHED_PATTERNS 8
+#define MAX_SUBSTEPS 10000000 /* the internal steps of one doStep, at most (variables.py's) */
 
 typedef struct {
     double dt;
@@ -378,6 +379,11 @@ static fmi2Status step(Model *m, double h) {
     double *T = m->values + vr_T(&m->layout), *u = m->u, dt, s;
     Factors *f;
     for (i = 0; i < n; i++) m->imposed[i] = m->values[vr_force(&m->layout) + i] != 0.0 && isfinite(T_forced[i]);
+    if (h / m->values[vr_max_step(&m->layout)] > MAX_SUBSTEPS) {
+        log_error(m, "doStep of %g s is more than %d steps of max_step = %g s: set max_step larger", h, MAX_SUBSTEPS,
+                  m->values[vr_max_step(&m->layout)]);
+        return fmi2Error;
+    }
     steps = (int)ceil(h / m->values[vr_max_step(&m->layout)] - 1e-9);
     if (steps < 1) steps = 1;
     dt = h / steps;
