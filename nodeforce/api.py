@@ -143,7 +143,8 @@ def fmu_inputs(building, weather, measurements=None, force=(), burn_in_days=0, d
         start values, `T_start[i]` for every node and `force[i]` true for each node forced.
     """
     case = measured_case(building, weather, measurements, burn_in_days, decomposition, history_days=0)
-    return input_table(case, force_mask(case, [int(i) for i in force], SOURCE) if len(force) else None)
+    source = measurements.attrs.get("source", SOURCE) if measurements is not None else SOURCE
+    return input_table(case, force_mask(case, [int(i) for i in force], source) if len(force) else None)
 
 
 def open_fmu(path):

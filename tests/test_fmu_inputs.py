@@ -91,3 +91,10 @@ def test_forcing_without_measurements_is_refused(files, tmp_path, capsys):  # no
                  "-o", str(tmp_path / "x.csv")]) == 2
     assert "--force" in capsys.readouterr().err
     assert not (tmp_path / "x.csv").exists()
+
+
+def test_forcing_a_node_without_measurements_is_refused_naming_the_file(files, tmp_path, capsys):  # noqa: F811
+    assert main(["inputs", files["building"], "--weather", files["weather"], "--measurements", files["measurements"],
+                 "--force", "2", "-o", str(tmp_path / "x.csv")]) == 2
+    error = capsys.readouterr().err
+    assert files["measurements"] in error and "T2" in error and len(error.strip().splitlines()) == 1
