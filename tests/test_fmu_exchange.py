@@ -192,3 +192,4 @@ def test_a_step_max_step_cannot_cover_is_refused(fmus, kind, max_step):
         assert "doStep" in str(refused.value) or "fmi2DoStep" in str(refused.value)
         # the instance runs again once max_step is one it can take
         assert np.isfinite(instance.run(DT, {}, {}, [], np.zeros((1, 0)), ["T[23]"])).all()
+

@@ -177,6 +177,29 @@ def test_a_non_finite_weather_sample_is_an_error_named_and_timed(fmus, tmp_path,
     s.freeInstance()
 
 
+@pytest.mark.parametrize("kind", ("python", "standalone"))
+def test_input_derivatives_are_taken_for_inputs_only_first_order_and_finite(fmus, tmp_path, capfd, kind):
+    """fmi2SetRealInputDerivatives (canInterpolateInputs="true"): order 1 of an input or of
+    T_forced, finite; anything else is refused (fmi2Error) with the reason logged."""
+    assert read_model_description(str(fmus[kind])).coSimulation.canInterpolateInputs
+    s, vr, _ = slave(fmus[kind], tmp_path)
+    initialise(s, False)
+    s.exitInitializationMode()
+    for refs, order, value, says in (([vr["T[23]"]], [1], [0.1], "is an output"),
+                                     ([vr["max_step"]], [1], [0.1], "is not an input"),
+                                     ([vr["T_out"]], [2], [0.1], "order 2"),
+                                     ([vr["T_forced[9]"]], [1], [float("nan")], "only a finite first derivative")):
+        capfd.readouterr()
+        with pytest.raises(FMICallException) as refused:
+            s.setRealInputDerivatives(refs, order, value)
+        assert refused.value.status == 3
+        assert says in capfd.readouterr().out
+    s.setRealInputDerivatives([vr["T_out"], vr["T_forced[9]"]], [1, 1], [0.01, 0.0])
+    s.doStep(0.0, 900.0)
+    s.terminate()
+    s.freeInstance()
+
+
 @pytest.mark.parametrize("kind", ("python-fmi3", "standalone-fmi3"))
 def test_fmi3_messages_quote_fmi3_value_references(fmus, tmp_path, capfd, kind):
     s, vr, _ = slave(fmus[kind], tmp_path)
