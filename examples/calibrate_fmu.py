@@ -29,7 +29,8 @@ fits the record up to TIME (default: all of it) at communication steps of S seco
 900, the record's), prints the estimate with its standard deviation and writes
 OUT/estimate.json. `nodeforce diagnose model/data/testcell_miami.json --weather
 model/data/miami_tmy2.csv --measurements OUT/measurements.csv --burn-in-days 1 -o DIAGNOSIS`
-finds the same effect (tests/test_calibrate_fmu.py).
+finds the same effect (docs/fmu.md gives both numbers; tests/test_calibrate_fmu.py checks this
+script's against the real door).
 """
 import argparse
 import copy
