@@ -19,7 +19,7 @@ from ctypes import byref
 
 import numpy as np
 from fmpy import extract, read_model_description
-from fmpy.fmi2 import FMU2Slave, fmi2Boolean, fmi2Real, fmi2True, fmi2ValueReference
+from fmpy.fmi2 import FMU2Slave, fmi2Boolean, fmi2Integer, fmi2Real, fmi2True, fmi2ValueReference
 from fmpy.fmi3 import FMU3Slave, fmi3Boolean, fmi3Float64, fmi3ValueReference
 
 from nodeforce import tempdirs
@@ -34,6 +34,13 @@ class Fmi2:
 
     def __init__(self, description):
         self.variables = {v.name: v for v in description.modelVariables}
+        # nodeforce's Python FMU written without a C compiler has no guard, and pythonfmu refuses
+        # fmi2SetRealInputDerivatives (canInterpolateInputs="false"): its slave keeps the inputs'
+        # derivatives as the values after the declared ones, in the inputs' order
+        # (fmu_build/variables.py, `derivatives`), which fmi2SetReal sets
+        self.derivatives_as_values = not description.coSimulation.canInterpolateInputs
+        inputs = [v.valueReference for v in description.modelVariables if v.causality == "input"]
+        self._derivative_offset = len(description.modelVariables) - min(inputs, default=0)
 
     def names(self, causality):
         return [name for name, v in self.variables.items() if v.causality == causality]
@@ -57,10 +64,22 @@ class Fmi2:
             fmu.setReal(self.refs(reals), [float(v) for v in reals.values()])
         fmu.exitInitializationMode()
 
-    def stepper(self, fmu, input_names, output_names):
-        """step(time, dt, inputs row, outputs row or None): set the inputs, step, get the
-        outputs, through preallocated ctypes arrays (a step allocates nothing in Python)."""
+    def stepper(self, fmu, input_names, output_names, n_slopes=0):
+        """step(time, dt, inputs row, outputs row or None, slopes row): set the inputs and the
+        first derivatives of the first `n_slopes` of them, step, get the outputs, through
+        preallocated ctypes arrays (a step allocates nothing in Python)."""
         n_in, n_out = len(input_names), len(output_names)
+        refs = self.refs(input_names[:n_slopes])
+        if self.derivatives_as_values:
+            refs = [r + self._derivative_offset for r in refs]
+        d_refs = (fmi2ValueReference * n_slopes)(*refs)
+        d_orders = (fmi2Integer * n_slopes)(*([1] * n_slopes))
+        d_values = (fmi2Real * n_slopes)()
+        d_view = np.ctypeslib.as_array(d_values) if n_slopes else None
+        if self.derivatives_as_values:
+            set_derivatives = lambda c, r, n, _, v: fmu.fmi2SetReal(c, r, n, v)  # noqa: E731
+        else:
+            set_derivatives = fmu.fmi2SetRealInputDerivatives
         in_refs = (fmi2ValueReference * n_in)(*self.refs(input_names))
         in_values = (fmi2Real * n_in)()
         in_view = np.ctypeslib.as_array(in_values) if n_in else None
@@ -70,10 +89,13 @@ class Fmi2:
         component = fmu.component
         set_real, do_step, get_real = fmu.fmi2SetReal, fmu.fmi2DoStep, fmu.fmi2GetReal
 
-        def step(time, dt, row, out):
+        def step(time, dt, row, out, slopes=None):
             if n_in:
                 in_view[:] = row
                 set_real(component, in_refs, n_in, in_values)
+            if n_slopes:
+                d_view[:] = slopes
+                set_derivatives(component, d_refs, n_slopes, d_orders, d_values)
             do_step(component, time, dt, fmi2Boolean(fmi2True))
             if out is not None:
                 get_real(component, out_refs, n_out, out_values)
@@ -134,7 +156,19 @@ class Fmi3(Fmi2):
         self._set(fmu, reals, False)
         fmu.exitInitializationMode()
 
-    def stepper(self, fmu, input_names, output_names):
+    @staticmethod
+    def derivative_name(name):
+        """The FMI 3.0 input that is the derivative of input `name` (`der(T_out)`, `der(T_forced)[3]`)."""
+        array, _, index = name.partition("[")
+        return f"der({array})" + (f"[{index}" if index else "")
+
+    def stepper(self, fmu, input_names, output_names, n_slopes=0):
+        """As `Fmi2.stepper`; FMI 3.0 has no call for input derivatives, so the slopes are set as
+        the FMU's derivative inputs (`derivative_name`)."""
+        d_refs, d_buffer, d_positions = self.layout([self.derivative_name(n) for n in input_names[:n_slopes]])
+        d_refs = (fmi3ValueReference * len(d_refs))(*d_refs)
+        d_values = (fmi3Float64 * len(d_buffer))(*d_buffer)
+        d_view = np.ctypeslib.as_array(d_values) if n_slopes else None
         in_refs, in_buffer, in_positions = self.layout(input_names)
         out_refs, out_buffer, out_positions = self.layout(output_names)
         n_in, n_out = len(in_buffer), len(out_buffer)
@@ -148,10 +182,13 @@ class Fmi3(Fmi2):
         set_float, do_step, get_float = fmu.fmi3SetFloat64, fmu.fmi3DoStep, fmu.fmi3GetFloat64
         event, terminate, early, last = fmi3Boolean(), fmi3Boolean(), fmi3Boolean(), fmi3Float64()
 
-        def step(time, dt, row, out):
+        def step(time, dt, row, out, slopes=None):
             if n_in:
                 in_view[in_positions] = row
                 set_float(component, in_refs, len(in_refs), in_values, n_in)
+            if n_slopes:
+                d_view[d_positions] = slopes
+                set_float(component, d_refs, len(d_refs), d_values, len(d_view))
             do_step(component, time, dt, fmi3Boolean(True), byref(event), byref(terminate), byref(early),
                     byref(last))
             if out is not None:
@@ -201,7 +238,7 @@ class FmuInstance:
         return self.calls.names(causality)
 
     def run(self, dt, parameters, start_inputs, input_names, inputs, output_names, start_time=0.0,
-            skip=0):
+            skip=0, slopes=None):
         """Simulate from a fresh state; return the outputs after each step but the first `skip`.
 
         Parameters
@@ -213,6 +250,9 @@ class FmuInstance:
         inputs : (n_steps, len(input_names)) values, row k applied before step k
         output_names : the outputs read after every step
         skip : steps whose outputs are not needed (a warm-up): not read at all
+        slopes : (n_steps, n) first time derivatives (per s) of the first n inputs over each step
+            (FMI 2.0 fmi2SetRealInputDerivatives, FMI 3.0 the `der(...)` inputs), or None: the
+            inputs held over each step
 
         Returns
         -------
@@ -227,12 +267,14 @@ class FmuInstance:
         reals = {n: v for n, v in {**parameters, **start_inputs}.items() if n not in booleans}
         calls.initialise(fmu, start_time, booleans, reals)
         inputs = np.asarray(inputs, dtype=float)
-        step = calls.stepper(fmu, list(input_names), list(output_names))
+        n_slopes = 0 if slopes is None else np.shape(slopes)[1]
+        step = calls.stepper(fmu, list(input_names), list(output_names), n_slopes)
         outputs = np.empty((len(inputs) - skip, len(output_names)))
         steps = np.broadcast_to(np.asarray(dt, dtype=float), (len(inputs),))
         times = start_time + np.concatenate([[0.0], np.cumsum(steps)])
+        slopes = np.asarray(slopes, dtype=float) if n_slopes else [None] * len(inputs)
         for k, row in enumerate(inputs):
-            step(times[k], steps[k], row, outputs[k - skip] if k >= skip else None)
+            step(times[k], steps[k], row, outputs[k - skip] if k >= skip else None, slopes[k])
         fmu.terminate()
         return outputs
 

@@ -2,15 +2,64 @@
 
 The FMU knows one step; the warm-up, the initial measurements and the forcing mask are the
 driver's, and follow the same rules as `model.integrate.simulate`, so both give the same numbers.
+The driver speaks FMI's co-simulation semantics: before the step from t it sets the inputs at t
+and, through the input derivatives, their slope over the step (the direct model's inputs are
+linear between samples, a heat input held at the power of the interval); the FMU's `max_step`
+makes one doStep the direct model's k sub-steps of a sample, or its one long step over a history.
 """
 import numpy as np
+import pandas as pd
 
 from nodeforce.model.integrate import (STEADY_STEP, forcing_schedule, held_inputs, history_block, history_inputs,
-                                       steady_inputs, warmup_rows, within_steps)
+                                       steady_inputs, step_start, warmup_rows)
 
 
 def node_names(prefix, ids):
     return [f"{prefix}[{i}]" for i in ids]
+
+
+def input_table(case, force=None, T_default=20.0):
+    """The FMU's inputs over a case, as an importer sets them, and its start values.
+
+    Row n holds what is set before the step from t_n (FMI's co-simulation semantics), in time
+    from t_0 (s): the weather and every other sampled input at t_n (linear between rows: give
+    FMPy `set_input_derivatives=True`); a zone's heat input, held over each step, the power of the
+    interval that starts at t_n, which the record logs at t_n+1 (`integrate.held_inputs`), NaN in
+    the last row (no step starts there); `T_forced[i]` of every node: for a node forced over the
+    step from t_n (a node of the `force` mask, and every node over the case's burn-in) its
+    measurement at t_n (NaN where missing), NaN elsewhere; a discrete input, held over the step,
+    never interpolated.
+
+    Parameters
+    ----------
+    case : model.case.Case without a history (`history_steps` 0): an importer starts at t_0
+    force : (N,) bool, nodes forced to their measurements for the whole record; None: none
+    T_default : C, the start of a node nothing informs
+
+    Returns
+    -------
+    (DataFrame indexed by `time` (s from t_0), one column per FMU input variable;
+     {name: value} of the start values: `T_start[i]` of every node, `force[i]` true for the forced)
+    """
+    if case.history_steps:
+        raise ValueError("an input table starts at the first measurement: make the case without a history")
+    measured = case.measured
+    n_rows, n = measured.shape
+    # the nodes forced over the step from each row: the mask's, and over the burn-in's steps (to
+    # rows 1..B) every node; each at its sample, which the importer holds (NaN: computed)
+    member = np.zeros((n_rows, n), dtype=bool) if force is None else np.tile(np.asarray(force, dtype=bool), (n_rows, 1))
+    member[:case.burn_in_steps] = True
+    T_forced = np.where(member, measured, np.nan)
+    forced_ids = [int(i) + 1 for i in np.flatnonzero(np.isfinite(T_forced[:-1]).any(axis=0))]
+    held = held_inputs(case.building, case.input_names)
+    U = np.where(held, np.vstack([case.U[1:], np.full((1, len(held)), np.nan)]), case.U)
+    columns = {**dict(zip(case.input_names, U.T)), **{f"T_forced[{i}]": T_forced[:, i - 1] for i in range(1, n + 1)}}
+    seconds = (case.times - case.times[0]).total_seconds().to_numpy()
+    table = pd.DataFrame(columns, index=pd.Index(seconds, name="time"))
+    start = case.start_state(T_default)
+    values = {**{f"T_start[{i}]": float(start[i - 1]) for i in range(1, len(start) + 1)},
+              **{f"force[{i}]": True for i in forced_ids}}
+    return table, values
 
 
 def simulate_fmu(instance, case, force=None, warmup_days=2, output_ids=None, T_default=20.0,
@@ -48,26 +97,33 @@ def simulate_fmu(instance, case, force=None, warmup_days=2, output_ids=None, T_d
     H = case.history_steps  # a history stands in for the warm-up, in steps of its own (integrate.simulate)
     rows = H + warmup_rows(n_rows - H, case.dt, 0 if H else warmup_days)
     columns = np.array(forced_ids, dtype=int) - 1
-    # each sample's step in case.substeps steps, its inputs and imposed temperatures in between
-    # as the direct model has them (model.integrate.within_steps); T_forced NaN where not imposed
+    # the step to each row r starts from step_start's row r with the slope to row r (the direct
+    # model's within_steps); T_forced NaN (slope 0) where the schedule leaves a node computed there
+    held = held_inputs(case.building, case.input_names)
+    u_start, m_start = step_start(case.U, held), step_start(measured[:, columns])
+    imposed = schedule[:, columns]
+    m_start = np.where(imposed, m_start, np.nan)
+    m_slope = np.where(imposed, measured[:, columns] - m_start, 0.0)
     k = case.substeps
-    within = zip(within_steps(case.U, k, held_inputs(case.building, case.input_names)),
-                 within_steps(measured[:, columns], k))
-    inputs = np.stack([np.hstack([u[rows], np.where(schedule[rows][:, columns], imposed[rows], np.nan)])
-                       for u, imposed in within], axis=1).reshape(len(rows) * k, -1)
-    steps = np.full(len(inputs), case.dt / k)
+    inputs = np.hstack([u_start[rows], m_start[rows], np.full((len(rows), 1), case.dt / k)])
+    slopes = np.hstack([case.U[rows] - u_start[rows], m_slope[rows]]) / case.dt
+    steps = np.full(len(inputs), case.dt)
     block = history_block(case.dt)
     if H:
         coarse = history_inputs(case.U, H, case.dt)
-        inputs = np.vstack([np.hstack([coarse, np.full((len(coarse), len(columns)), np.nan)]), inputs])
+        inputs = np.vstack([np.hstack([coarse, np.full((len(coarse), len(columns)), np.nan),
+                                       np.full((len(coarse), 1), block * case.dt)]), inputs])
+        slopes = np.vstack([np.zeros((len(coarse), slopes.shape[1])), slopes])
         steps = np.concatenate([np.full(len(coarse), block * case.dt), steps])
     if case.steady_start:
-        u, held, values = steady_inputs(case.U, measured, schedule, case.dt)
-        inputs = np.vstack([np.concatenate([u, np.where(held[columns], values[columns], np.nan)]), inputs])
+        u, held_nodes, values = steady_inputs(case.U, measured, schedule, case.dt)
+        inputs = np.vstack([np.concatenate([u, np.where(held_nodes[columns], values[columns], np.nan), [STEADY_STEP]]),
+                            inputs])
+        slopes = np.vstack([np.zeros((1, slopes.shape[1])), slopes])
         steps = np.concatenate([[STEADY_STEP], steps])
     history = H // block
-    out = instance.run(steps, parameters, {},
-                       list(case.input_names) + node_names("T_forced", forced_ids),
-                       inputs, node_names("T", output_ids), skip=len(inputs) - (n_rows - 1 - H) * k - history)
+    names = list(case.input_names) + node_names("T_forced", forced_ids)
+    out = instance.run(steps, parameters, {}, names + ["max_step"], inputs, node_names("T", output_ids),
+                       skip=len(inputs) - (n_rows - 1 - H) - history, slopes=np.nan_to_num(slopes, nan=0.0))
     # a history's rows hold each of its steps' end state, as the direct model's do
-    return np.vstack([np.repeat(out[:history], block, axis=0), out[history:][k - 1::k]])
+    return np.vstack([np.repeat(out[:history], block, axis=0), out[history:]])

@@ -154,7 +154,7 @@ def _write(destination, files, building, effect, identifier, standalone, source_
     guid = description.content_guid(*(part for item in sorted(files.items()) for part in item))
     files["modelDescription.xml"] = description.model_description(
         model_interface(building, effect), building, guid, identifier, name, effect, standalone, source_files,
-        fmi=fmi)
+        fmi=fmi, interpolates=standalone or guarded)
     return description.write_fmu(destination, files)
 
 

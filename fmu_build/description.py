@@ -13,6 +13,7 @@ from xml.etree.ElementTree import Element, SubElement, indent, tostring
 
 from nodeforce.model.building import Boundary
 from nodeforce.model.effects import EFFECTS, fmu_parameters, properties
+from nodeforce.model.integrate import MAX_STEP, held_inputs
 from nodeforce.model.network import clock_input_names
 
 from .guard import GUARD_GLIBC, PYTHONFMU_GLIBC
@@ -33,6 +34,7 @@ UNITS = {
     "W/m2/K": ("CoefficientOfHeatTransfer", {"kg": "1", "s": "-3", "K": "-1"}),
     "1/h": ("AirChangeRate", {"s": "-1", "factor": str(1 / 3600)}),
     "m3/h": ("VolumeFlowRate", {"m": "3", "s": "-1", "factor": str(1 / 3600)}),
+    "s": ("Time", {"s": "1"}),
 }
 EFFECT_UNITS = {"C": "degC", "-": None}  # effects.Parameter.unit spellings that differ from FMI's
 LOG_CATEGORIES = ("logStatusWarning", "logStatusDiscard", "logStatusError", "logStatusFatal", "logAll")
@@ -60,6 +62,7 @@ class Variable:
     # interpolates: a measurement, whose NaN (not measured) must not leak into its neighbours
     discrete: bool = False
     bounds: tuple = ()  # (min, max) of a parameter an importer may set, or none
+    tunable: bool = False  # a parameter that may change between steps
 
 
 def variables(layout, building, effect=None):
@@ -69,13 +72,19 @@ def variables(layout, building, effect=None):
                       f"node {i} is forced to T_forced[{i}] where that is not NaN") for i in n]
     found += [Variable(f"T_start[{i}]", "parameter", "Real", "20", "degC",
                        f"temperature of node {i} at the start (a measured node: its measurement)") for i in n]
-    found += [Variable(name, "input", "Real", "0", *_input_meaning(building, name))
-              for name in layout.input_names]
+    # a zone's heat input is a power held over each step (model.integrate.held_inputs): discrete, as
+    # a measurement, so that an importer holds it from one sample to the next, never interpolates it
+    held = held_inputs(building, layout.input_names)
+    found += [Variable(name, "input", "Real", "0", *_input_meaning(building, name), discrete=bool(h))
+              for name, h in zip(layout.input_names, held)]
     found += [Variable(f"T_forced[{i}]", "input", "Real", "NaN", "degC",
                        f"measured temperature of node {i}, NaN if none; held between samples, "
                        "never interpolated", discrete=True) for i in n]
     found += [Variable(f"T[{i}]", "output", "Real", None, "degC", f"temperature of node {i}") for i in n]
-    return found + parameter_variables(building, effect)
+    return found + parameter_variables(building, effect) + [
+        Variable("max_step", "parameter", "Real", repr(MAX_STEP), "s",
+                 "the longest internal step (s): a doStep of h takes ceil(h / max_step) backward-Euler steps, "
+                 "the inputs linear within it", tunable=True)]
 
 
 def parameter_variables(building, effect=None):
@@ -115,7 +124,8 @@ def _input_meaning(building, name):
         return "W/m2", f"solar irradiance on the outside face of {', '.join(faces)}"
     for zone in building.zones:
         if name in zone.heat_input:
-            return "W", f"measured heat input {name} of zone {zone.name}"
+            return "W", (f"measured heat input {name} of zone {zone.name}, the mean power over the step from "
+                         "the time it is set; held between samples, never interpolated")
         if zone.supply is not None and zone.supply.temperature == name:
             return "degC", f"supply air temperature of zone {zone.name}"
         if name in dict(zone.thermal_bridges):
@@ -135,7 +145,7 @@ def initial_dependencies(layout):
 
 
 def model_description(layout, building, guid, identifier, name, effect=None, standalone=False,
-                      source_files=(), step=DEFAULT_STEP, span=DEFAULT_SPAN, fmi=2):
+                      source_files=(), step=DEFAULT_STEP, span=DEFAULT_SPAN, fmi=2, interpolates=True):
     """modelDescription.xml (bytes) of a model.
 
     Parameters
@@ -146,6 +156,8 @@ def model_description(layout, building, guid, identifier, name, effect=None, sta
     standalone : the FMU needs no Python; source_files : names under sources/ (FMI 2.0)
     step, span : default communication step and stop time (s) of the DefaultExperiment
     fmi : 2 (scalars) or 3 (`force`, `T_forced` and `T` as arrays of N; c/fmi3.c)
+    interpolates : the binary takes input derivatives (fmi2SetRealInputDerivatives): every FMU
+        but the Python one without its guard (pythonfmu refuses them). FMI 3.0 has no such call.
     """
     version, licence = nodeforce_version()
     header = {"fmiVersion": "2.0", "modelName": name, "guid": guid} if fmi == 2 else \
@@ -162,7 +174,8 @@ def model_description(layout, building, guid, identifier, name, effect=None, sta
                     "canHandleVariableCommunicationStepSize": "true",
                     "canBeInstantiatedOnlyOncePerProcess": "false"}
     if fmi == 2:
-        capabilities.update({"canInterpolateInputs": "false", "canNotUseMemoryManagementFunctions": "true",
+        capabilities.update({"canInterpolateInputs": "true" if interpolates else "false",
+                             "canNotUseMemoryManagementFunctions": "true",
                              "canGetAndSetFMUstate": "true", "canSerializeFMUstate": "true"})
     else:
         capabilities.update({"canGetAndSetFMUState": "true", "canSerializeFMUState": "true",
@@ -190,7 +203,7 @@ def _attributes(v):
     """The attributes of a variable's element that both FMI versions spell alike."""
     attributes = {"name": v.name, "description": v.description, "causality": v.causality}
     if v.causality == "parameter":
-        attributes.update(variability="fixed", initial="exact")
+        attributes.update(variability="tunable" if v.tunable else "fixed", initial="exact")
     if v.discrete:
         attributes["variability"] = "discrete"
     return attributes
@@ -256,6 +269,20 @@ def _variables3(root, declared, building, layout):
         if array:
             SubElement(element, "Dimension", {"start": str(n)})
         k += n
+    # FMI 3.0 has no call for input derivatives: each input's is an input of its own, declared
+    # as its derivative (c/fmi3.c gives them to the FMI 2.0 instance's fmi2SetRealInputDerivatives)
+    discrete = {v.name.split("[")[0] for v in declared if v.causality == "input" and v.discrete}
+    for name in list(layout.input_names) + ["T_forced"]:
+        array = name == "T_forced"
+        attributes = {"name": f"der({name})", "valueReference": str(len(refs) + 1), "causality": "input",
+                      "derivative": str(refs[name]), "start": " ".join(["0"] * layout.n_nodes) if array else "0",
+                      "description": f"first time derivative (per s) of {name} over the next step, 0 if not set"}
+        if name in discrete:
+            attributes["variability"] = "discrete"
+        refs[f"der({name})"] = len(refs) + 1
+        element = SubElement(model_variables, "Float64", attributes)
+        if array:
+            SubElement(element, "Dimension", {"start": str(layout.n_nodes)})
     structure = SubElement(root, "ModelStructure")
     SubElement(structure, "Output", {"valueReference": str(refs["T"]), "dependencies": ""})
     SubElement(structure, "InitialUnknown", {"valueReference": str(refs["T"]),
@@ -368,11 +395,16 @@ def documentation(name, standalone, guarded=True, python_minimum="3.10", fmi=2):
             "measurement); outputs <code>T[i]</code> (degC). The start values alone set the state at "
             "the start: give a measured node its measurement at t_0 as <code>T_start[i]</code>; no input "
             "applied at t_0 changes it. A Real set that is not finite is refused (Error, the variable and "
-            "the time logged), but <code>T_forced</code>'s NaN. One "
-            "<code>fmi2DoStep</code> of h seconds is one backward-Euler step with the inputs set "
-            "before it (the inputs at the end of the step).</p>\n"
-            "<p><code>T_forced[i]</code> is a discrete input: an importer that reads an input file "
-            "holds each sample until the next one, NaN included, and never interpolates it, so a "
+            "the time logged), but <code>T_forced</code>'s NaN. The inputs set before "
+            "<code>fmi2DoStep(t, h)</code> are those at t; with their first derivatives "
+            "(<code>fmi2SetRealInputDerivatives</code>, where <code>canInterpolateInputs</code> is true; "
+            "in FMI 3.0 the inputs <code>der(...)</code>) they are linear over the step, else held. "
+            "The step takes ceil(h / <code>max_step</code>) backward-Euler steps (<code>max_step</code>, "
+            f"a tunable parameter, {MAX_STEP:g} s), each with the inputs at its end. A heat input is "
+            "the mean power over the step.</p>\n"
+            "<p><code>T_forced[i]</code> and the heat inputs are discrete inputs: an importer that reads an "
+            "input file holds each sample until the next one, NaN included, and never interpolates it, so a "
             "gap means \"not measured\" over exactly the steps whose sample is NaN, in every importer. "
-            f"The default experiment is a day ({DEFAULT_SPAN:.0f} s) of {DEFAULT_STEP:.0f}-s steps, "
-            "the model's step.</p>\n</body></html>\n").encode()
+            f"The default experiment is a day ({DEFAULT_SPAN:.0f} s) of {DEFAULT_STEP:.0f}-s steps. "
+            "Without input derivatives, step at 1 minute: a held input lags by half a step.</p>\n"
+            "</body></html>\n").encode()

@@ -5,8 +5,12 @@ This file is copied into each FMU as `<module>.py`, with the physics package bes
 to the FMU's content, because pythonfmu imports the slave by module name and Python's module
 cache would otherwise run the first FMU's code for the second.
 
-Variables: `<module>_model/variables.py` (the layout the standalone FMU shares). One doStep of h
-seconds is one backward-Euler step with the inputs set before it. The state at the start is
+Variables: `<module>_model/variables.py` (the layout the standalone FMU shares). The inputs set
+before doStep(t, h) are those at t, and their first derivatives (set through the guard from
+fmi2SetRealInputDerivatives, zero when not given) make them linear over the step: doStep takes
+k = ceil(h / max_step) backward-Euler steps of h / k, each with the inputs and the imposed
+temperatures at its end, u(t) + u'(t) tau. The derivatives hold for that one step. A node with
+`force[i]` is imposed over the step where T_forced[i] at t is not NaN. The state at the start is
 `T_start[i]`, with the model of the parameters set before initialisation ends (the building's
 properties and an added effect's: `model.effects.fmu_parameters`). Calls the standard forbids,
 and a value set that is not finite (but a measurement's NaN), are refused with a logged reason,
@@ -85,7 +89,8 @@ class NodalBuilding(Fmi2Slave):
         start = _parameter_start(self.resources)
         self._parameter_start = np.array(list(start.values()), dtype=float)
         layout = self.layout = _variables.Layout(self.network.n_nodes, self.network.input_names, start)
-        self._values = np.zeros(layout.size)
+        self._values = np.zeros(layout.derivatives.stop)
+        self._values[layout.max_step] = _physics["integrate"].MAX_STEP
         self._values[layout.T_start] = 20.0
         self._values[layout.T_forced] = np.nan
         self._values[layout.T] = 20.0
@@ -174,13 +179,30 @@ class NodalBuilding(Fmi2Slave):
         if not step_size > 0.0:
             return self._refuse(f"doStep with communicationStepSize {step_size} s: it must be > 0")
         values, layout = self._values, self.layout
-        T_forced = values[layout.T_forced]
+        if not values[layout.max_step] > 0.0:
+            return self._refuse(f"value reference {layout.max_step} (max_step) is {values[layout.max_step]} s: "
+                                "it must be > 0")
+        if step_size / values[layout.max_step] > _variables.MAX_SUBSTEPS:
+            return self._refuse(f"doStep of {step_size} s is more than {_variables.MAX_SUBSTEPS} steps of max_step = "
+                                f"{values[layout.max_step]} s: set max_step larger")
+        k = max(1, int(np.ceil(step_size / values[layout.max_step] - 1e-9)))
+        tau = step_size / k
+        n_in = len(layout.input_names)
+        u, T_forced = values[layout.inputs], values[layout.T_forced]
+        du, dT_forced = values[layout.derivatives][:n_in], values[layout.derivatives][n_in:]
         forced = _physics["integrate"].imposed(self._force, T_forced) if self._any_forced else self._force
-        source = self.network.sources(values[layout.inputs])
-        stepper = self._steppers.get(step_size)
+        stepper = self._steppers.get(tau)
         if stepper is None:
-            stepper = self._steppers[step_size] = _physics["integrate"].ImplicitEuler(self.network, step_size)
-        values[layout.T] = stepper.step(values[layout.T], source, forced, T_forced)
+            stepper = self._steppers[tau] = _physics["integrate"].ImplicitEuler(self.network, tau)
+        T = values[layout.T]
+        varying = du.any()
+        source = None if varying else self.network.sources(u)
+        for j in range(1, k + 1):
+            s = j * tau
+            T = stepper.step(T, self.network.sources(u + du * s) if varying else source, forced,
+                             T_forced + dT_forced * s)
+        values[layout.T] = T
+        values[layout.derivatives] = 0.0  # the next step's are set before it, or it holds its inputs
         self._time = current_time + step_size
         return True
 

@@ -26,6 +26,7 @@ import numpy as np
 
 from nodeforce import tempdirs
 from nodeforce.model.effects import fmu_parameters, properties, with_fmu_parameters
+from nodeforce.model.integrate import MAX_STEP
 from nodeforce.model.network import assemble
 
 from .compiler import C_DIR, compile_library
@@ -174,10 +175,11 @@ def network_text(building, effect):
     p0, keys, terms = network_terms(building, effect)
     n, n_in = building.n_nodes, len(assemble(building).input_names)
     numbers = lambda values: " ".join(repr(float(v)) for v in np.ravel(values))
-    lines = ["nodeforce-network/3",
+    lines = ["nodeforce-network/4",
              f"sizes {n} {n_in} {len(p0)} {len(terms)} {len(keys)} {sum(len(s) for s, _, _ in terms)} "
              f"{sum(len(k) for _, k, _ in terms)}",
              f"p0 {numbers(p0)}",
+             f"max_step {MAX_STEP!r}",
              "products " + " ".join(f"{node} {a} {b}" for node, a, b in keys)]
     for subset, index, values in terms:
         lines.append(" ".join(map(str, ["term", len(subset), *subset, len(index)])))

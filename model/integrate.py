@@ -353,11 +353,29 @@ def held_inputs(building, input_names):
     return np.array([name in heat for name in input_names], dtype=bool)
 
 
+def step_start(values, held=None):
+    """(N_t+1, m): the value each step t_n -> t_n+1 starts from, in row n+1: v_n, or v_n+1 where a
+    column is `held` or either sample is missing (NaN: a forced node is imposed only where its
+    end sample exists). Row 0 is v_0 (no step ends there). Over the step the value goes linearly
+    from its start to v_n+1: `within_steps`; an FMU is given the start and the slope.
+
+    Parameters
+    ----------
+    values : (N_t+1, m) samples at t_0..t_N
+    held : (m,) bool, columns held at the step's end value (default none)
+    """
+    values = np.asarray(values, dtype=float)
+    start = values.copy()
+    apart = np.isfinite(values[:-1]) & np.isfinite(values[1:])
+    if held is not None:
+        apart &= ~np.asarray(held, dtype=bool)
+    start[1:] = np.where(apart, values[:-1], values[1:])
+    return start
+
+
 def within_steps(values, k, held=None):
     """The values at the end of each of the k sub-steps of every step t_n -> t_n+1: row n+1 of
-    the j-th array (j = 1..k) is (1 - j/k) v_n + (j/k) v_n+1, or v_n+1 where a column is `held`
-    or either sample is missing (NaN: a forced node is imposed only where its end sample exists).
-    Row 0 is v_0 (no step ends there).
+    the j-th array (j = 1..k) is (1 - j/k) s_n + (j/k) v_n+1, s_n the step's start (`step_start`).
 
     Parameters
     ----------
@@ -372,11 +390,7 @@ def within_steps(values, k, held=None):
     values = np.asarray(values, dtype=float)
     if k == 1:  # one step per sample: nothing in between
         return [values]
-    start = values.copy()
-    apart = np.isfinite(values[:-1]) & np.isfinite(values[1:])
-    if held is not None:
-        apart &= ~np.asarray(held, dtype=bool)
-    start[1:] = np.where(apart, values[:-1], values[1:])
+    start = step_start(values, held)
     return [start + (j / k) * (values - start) for j in range(1, k)] + [values]
 
 

@@ -11,10 +11,11 @@ from pathlib import Path
 
 from nodeforce import tempdirs
 from nodeforce.cosim.fmi import FmuInstance
-from nodeforce.cosim.run import simulate_fmu
+from nodeforce.cosim.run import input_table, simulate_fmu
 from nodeforce.diagnose import compare as _compare, loop as _loop
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga import locate as _locate
+from nodeforce.iotools.fmu_inputs import write_fmu_inputs
 from nodeforce.iotools.measurements import read_measurements
 from nodeforce.iotools.phases import read_phases
 from nodeforce.iotools.weather import read_weather
@@ -24,7 +25,8 @@ from nodeforce.model.errors import InputError
 from nodeforce.model.score import Objective
 
 __all__ = ["InputError", "read_building", "read_weather", "read_measurements", "read_phases", "measured_case",
-           "objective", "simulate", "write_fmu", "open_fmu", "simulate_fmu", "forcing_candidates",
+           "objective", "simulate", "write_fmu", "fmu_inputs", "write_fmu_inputs", "open_fmu", "simulate_fmu",
+           "forcing_candidates",
            "score_forcing", "locate", "diagnose", "Record", "compare"]
 
 # One record of a building among several in one diagnosis: case, source, name, fraction,
@@ -114,6 +116,35 @@ def write_fmu(building, path, standalone=False):
         The FMU written.
     """
     return build_fmu(building, path, kind="standalone" if standalone else "python")
+
+
+def fmu_inputs(building, weather, measurements=None, force=(), burn_in_days=0, decomposition="erbs"):
+    """The FMU's inputs over a record, as another tool sets them, and its start values
+    (docs/fmu.md): what `nodeforce inputs` writes.
+
+    Parameters
+    ----------
+    building : Building
+    weather : DataFrame from `read_weather`
+    measurements : DataFrame from `read_measurements`, optional
+        Sets the time grid (else the weather's), the start values and the forced nodes' inputs.
+    force : sequence of int
+        Node ids forced to their measurements over the whole record.
+    burn_in_days : float
+        Days after t_0 over which every measured node is forced (docs/model.md section 5).
+    decomposition : str
+        The split of a global horizontal irradiance alone (`nodeforce.model.solar.DECOMPOSITIONS`).
+
+    Returns
+    -------
+    (DataFrame, dict)
+        The table, indexed by `time` (s from t_0), one column per FMU input: row n is what is set
+        before the step from t_n (`nodeforce.cosim.run.input_table`); and {name: value} of the
+        start values, `T_start[i]` for every node and `force[i]` true for each node forced.
+    """
+    case = measured_case(building, weather, measurements, burn_in_days, decomposition, history_days=0)
+    source = measurements.attrs.get("source", SOURCE) if measurements is not None else SOURCE
+    return input_table(case, force_mask(case, [int(i) for i in force], source) if len(force) else None)
 
 
 def open_fmu(path):

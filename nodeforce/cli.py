@@ -93,6 +93,20 @@ def cmd_simulate(args):
             print(f"{zone} air: RMSE {m['rmse']:.3f} C against the measurements ({m['n']} scored steps)")
 
 
+def cmd_inputs(args):
+    from nodeforce.api import fmu_inputs, write_fmu_inputs
+    building = load_building(args.building)
+    if args.force and not args.measurements:
+        raise InputError("--force", args.force, "forcing needs --measurements to force nodes to")
+    table, start = fmu_inputs(building, read_weather(args.weather),
+                              read_measurements(args.measurements) if args.measurements else None,
+                              node_list("--force", args.force) if args.force else (), args.burn_in_days,
+                              args.decomposition)
+    start_path = write_fmu_inputs(args.output, table, start)
+    print(f"wrote {args.output}: {len(table.columns)} inputs at {len(table)} times (0 to {table.index[-1]:.0f} s); "
+          f"start values in {start_path}")
+
+
 def check_search_settings(args):
     """The GA's settings, refused with the option named rather than deep inside the search."""
     if args.population < 2:
@@ -467,6 +481,13 @@ def parser():
     start_arguments(s, 0.0)
     objective_argument(s)
     s.set_defaults(run=cmd_simulate)
+
+    s = sub.add_parser("inputs", help="the FMU's input table of a record and its start values, for another tool")
+    case_arguments(s, False, "the CSV to write (the start values go beside it, <stem>.start.json)")
+    s.add_argument("--force", help="node ids forced to their measurements, e.g. 1,7,9")
+    s.add_argument("--burn-in-days", type=float, default=0.0,
+                   help="days after the first measurement over which every measured node is forced (default 0)")
+    s.set_defaults(run=cmd_inputs)
 
     s = sub.add_parser("locate", help="search the forcing that best explains the measured air")
     case_arguments(s, True, "folder for locate.json")

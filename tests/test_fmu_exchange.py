@@ -15,7 +15,7 @@ from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.fmu_build import guard
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.model.building import parse_building
-from nodeforce.model.integrate import simulate
+from nodeforce.model.integrate import simulate, substeps
 from nodeforce.model.network import assemble
 from tests.importers import run_fmpy
 from tests.test_standalone import python_host_environment, run_c_host, scenario
@@ -30,7 +30,7 @@ def fmus(tmp_path_factory, testcell_data):
     return {kind: build_fmu(building, folder / f"{kind}.fmu", kind=kind) for kind in ("python", "standalone")}
 
 
-def test_the_default_run_is_a_day_of_backward_euler_steps_of_900_s(fmus, testcell, tmp_path):
+def test_the_default_run_is_a_day_of_900_s_steps_each_in_backward_euler_steps_of_max_step(fmus, testcell, tmp_path):
     fmu = fmus["standalone"]
     experiment = read_model_description(str(fmu)).defaultExperiment
     start, stop, step = (float(x) for x in (experiment.startTime, experiment.stopTime, experiment.stepSize))
@@ -41,7 +41,9 @@ def test_the_default_run_is_a_day_of_backward_euler_steps_of_900_s(fmus, testcel
     T = np.column_stack([result[name] for name in outputs])[1:]
     # the direct model: every input at its start value (0), nothing measured, 20 C everywhere
     network = assemble(testcell)
-    direct = simulate(testcell, network, np.zeros((97, len(network.input_names))), DT, warmup_days=0)
+    direct = simulate(testcell, network, np.zeros((97, len(network.input_names))), DT, warmup_days=0,
+                      substeps=substeps(DT))
+    assert substeps(DT) == 3
     assert np.abs(T - direct).max() < 1e-9
     assert 20.0 - direct[-1, 22] > 5.0  # the day moves the model: a 1-s run would not
     done, in_c = run_c_host(fmu, {}, {}, outputs, step, round((stop - start) / step), tmp_path)
@@ -166,3 +168,28 @@ def test_outputs_read_one_per_call_are_the_step_s_outputs(fmus, tmp_path):
         slave.freeFMUstate(state)
         slave.terminate()
     assert restored == first and second != first
+
+
+def test_fmpy_applies_a_forced_nodes_measurement_at_every_step(fmus):
+    """pyproject.toml's FMPy lower bound: a discrete input re-applied before each step, the
+    sample of that step's start (FMPy 0.3.22 applied the first sample only, 0.3.21 each one a
+    step late). A forced node fed 10, 20, 30, 40 C ends each step at that step's sample."""
+    ramp = np.array([10.0, 20.0, 30.0, 40.0, 50.0])
+    signals = np.array(list(zip(np.arange(5) * DT, ramp)), dtype=[("time", float), ("T_forced[9]", float)])
+    result = simulate_fmu(str(fmus["standalone"]), input=signals, start_values={"force[9]": True},
+                          output=["T[9]", "T[23]"], stop_time=4 * DT, output_interval=DT)
+    assert np.array_equal(result["T[9]"][1:], ramp[:4])
+    assert len(np.unique(np.round(result["T[23]"][1:], 9))) == 4  # the air follows: the node is not merely recorded
+
+
+@pytest.mark.parametrize("kind", ["python", "standalone"])
+@pytest.mark.parametrize("max_step", [0.0, 1e-5])
+def test_a_step_max_step_cannot_cover_is_refused(fmus, kind, max_step):
+    """max_step must be > 0, and a doStep of more than 1e7 internal steps is refused, not run."""
+    with FmuInstance(fmus[kind]) as instance:
+        with pytest.raises(Exception) as refused:
+            instance.run(DT, {"max_step": max_step}, {}, [], np.zeros((1, 0)), ["T[23]"])
+        assert "doStep" in str(refused.value) or "fmi2DoStep" in str(refused.value)
+        # the instance runs again once max_step is one it can take
+        assert np.isfinite(instance.run(DT, {}, {}, [], np.zeros((1, 0)), ["T[23]"])).all()
+

@@ -6,9 +6,12 @@ import zipfile
 import numpy as np
 from fmpy import read_model_description
 
+from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.fmu_build import guard
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.model.building import parse_building
+from nodeforce.model.integrate import simulate
+from nodeforce.model.network import assemble
 from tests.importers import run_fmpy
 
 
@@ -23,12 +26,13 @@ def test_one_guard_binary_for_every_model(testcell_data, tmp_path):
             sizes = fmu.read("resources/guard.txt").decode().splitlines()[1]
             assert "binaries/linux64/NodalBuilding.pythonfmu.so" in fmu.namelist()
     assert binaries[0] == binaries[1] == guard.guard_binary()
-    # the sizes the guard reads are the model description's: nodes, other inputs, the Real
-    # parameters but the N start values (the building's properties)
+    # the sizes the guard reads are the model description's: nodes, other inputs, the fixed Real
+    # parameters but the N start values (the building's properties); max_step is the one tunable
     variables = read_model_description(str(path)).modelVariables
     inputs = [v.name for v in variables if v.causality == "input"]
     n = sum(name.startswith("T_forced[") for name in inputs)
-    reals = sum(v.causality == "parameter" and v.type == "Real" for v in variables)
+    reals = sum(v.causality == "parameter" and v.type == "Real" and v.variability == "fixed" for v in variables)
+    assert [v.name for v in variables if v.variability == "tunable"] == ["max_step"]
     assert sizes == f"sizes {n} {len(inputs) - n} {reals - n}" and n == 23 and reals - n == 27
 
 
@@ -46,6 +50,17 @@ def test_without_a_c_compiler_the_python_fmu_is_written_unguarded(testcell_data,
         page = archive.read("documentation/index.html").decode()
     assert "resources/guard.txt" not in names and not any(n.endswith(".pythonfmu.so") for n in names)
     assert "without its guard" in page
+    # pythonfmu refuses input derivatives: the model description says so, and nodeforce's driver
+    # gives them to the slave as its values after the declared ones: the direct model, still
+    description = read_model_description(str(fmu))
+    assert description.coSimulation.canInterpolateInputs is False
+    building = parse_building(testcell_data)
+    U = np.column_stack([20 + 5 * np.sin(np.arange(97) / 10)] * 2 + [np.zeros(97)] * 7)
+    direct = simulate(building, assemble(building), U, 900.0, warmup_days=0, substeps=3)
+    with FmuInstance(fmu) as instance:
+        through = instance.run(900.0, {}, {}, list(assemble(building).input_names), U[:-1],
+                               [f"T[{i}]" for i in range(1, 24)], slopes=np.diff(U, axis=0) / 900.0)
+    assert np.abs(through - direct).max() < 1e-9 and np.ptp(direct[:, 22]) > 1.0
     # pythonfmu's own binary runs it as before
     T = run_fmpy(fmu, {"T_start[23]": 22.0}, {}, ["T[23]"], 900.0, 4)
     assert np.isfinite(T).all()

@@ -57,9 +57,11 @@ def two_days(testcell, real_case):
 
 
 def run(instance, building, U, parameters):
-    """Node temperatures at t_1..t_N from T_start = 20 C, the inputs of row k+1 at step k."""
+    """Node temperatures at t_1..t_N from T_start = 20 C: before the step from t_k the inputs of row
+    k and their slope to row k+1, one backward-Euler step per row (max_step of the row's 900 s)."""
     names = [f"T[{i}]" for i in range(1, building.n_nodes + 1)]
-    return instance.run(900.0, parameters, {}, list(assemble(building).input_names), U[1:], names)
+    return instance.run(900.0, {**parameters, "max_step": 900.0}, {}, list(assemble(building).input_names), U[:-1],
+                        names, slopes=np.diff(U, axis=0) / 900.0)
 
 
 def test_every_property_is_a_fixed_parameter_with_unit_and_bounds_the_same_in_fmi2_and_fmi3(fmus, testcell):
@@ -171,6 +173,29 @@ def test_a_non_finite_weather_sample_is_an_error_named_and_timed(fmus, tmp_path,
         set_reals(s, fmi3, [vr["T_forced"]], [float("nan")] * 23)
     else:
         set_reals(s, fmi3, [vr["T_forced[9]"]], [float("nan")])
+    s.terminate()
+    s.freeInstance()
+
+
+@pytest.mark.parametrize("kind", ("python", "standalone"))
+def test_input_derivatives_are_taken_for_inputs_only_first_order_and_finite(fmus, tmp_path, capfd, kind):
+    """fmi2SetRealInputDerivatives (canInterpolateInputs="true"): order 1 of an input or of
+    T_forced, finite; anything else is refused (fmi2Error) with the reason logged."""
+    assert read_model_description(str(fmus[kind])).coSimulation.canInterpolateInputs
+    s, vr, _ = slave(fmus[kind], tmp_path)
+    initialise(s, False)
+    s.exitInitializationMode()
+    for refs, order, value, says in (([vr["T[23]"]], [1], [0.1], "is an output"),
+                                     ([vr["max_step"]], [1], [0.1], "is not an input"),
+                                     ([vr["T_out"]], [2], [0.1], "order 2"),
+                                     ([vr["T_forced[9]"]], [1], [float("nan")], "only a finite first derivative")):
+        capfd.readouterr()
+        with pytest.raises(FMICallException) as refused:
+            s.setRealInputDerivatives(refs, order, value)
+        assert refused.value.status == 3
+        assert says in capfd.readouterr().out
+    s.setRealInputDerivatives([vr["T_out"], vr["T_forced[9]"]], [1, 1], [0.01, 0.0])
+    s.doStep(0.0, 900.0)
     s.terminate()
     s.freeInstance()
 

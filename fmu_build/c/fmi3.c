@@ -12,6 +12,12 @@
        3+N_IN            T_forced[N]     Float64 input, discrete       FMI 2.0: T_forced[1..N]
        4+N_IN            T[N]            Float64 output                FMI 2.0: T[1..N]
        5+N_IN ..         the other parameters (properties, an effect's), Float64, fixed
+       5+N_IN+N_PAR      max_step        Float64 parameter, tunable    FMI 2.0: max_step
+       6+N_IN+N_PAR ..   der(<input>)    Float64 inputs, derivative of each input
+       6+2N_IN+N_PAR     der(T_forced)[N] Float64 input, discrete, derivative of T_forced
+   FMI 3.0 has no fmi2SetRealInputDerivatives: the inputs' first derivatives are inputs of their
+   own, declared with the `derivative` attribute, which this file hands to the FMI 2.0 instance's
+   fmi2SetRealInputDerivatives (they hold for the next step, as there).
    The sizes come from resources/fmi3.txt ("nodeforce-fmi3/1", then "sizes N N_IN N_PAR"), the
    names from resources/names.txt. A get or set is checked here, by the FMI 2.0 rules of
    variables.h, so that a refusal names the FMI 3.0 value reference. No event mode, no
@@ -47,6 +53,7 @@ FMI2_EXPORT fmi2SerializedFMUstateSizeTYPE fmi2SerializedFMUstateSize;
 FMI2_EXPORT fmi2SerializeFMUstateTYPE fmi2SerializeFMUstate;
 FMI2_EXPORT fmi2DeSerializeFMUstateTYPE fmi2DeSerializeFMUstate;
 FMI2_EXPORT fmi2DoStepTYPE fmi2DoStep;
+FMI2_EXPORT fmi2SetRealInputDerivativesTYPE fmi2SetRealInputDerivatives;
 
 typedef struct {
     fmi2Component inner; /* the FMI 2.0 instance */
@@ -57,6 +64,7 @@ typedef struct {
     fmi3InstanceEnvironment environment;
     fmi3LogMessageCallback log;
     fmi2CallbackFunctions callbacks; /* the FMI 2.0 instance's, which log through `log` */
+    double *derivatives;             /* N_IN + N: der(<input>), der(T_forced) as set for the next step */
 } Adapter;
 
 /* An FMU state: the state and time beside the FMI 2.0 state. */
@@ -109,9 +117,19 @@ static int variable(const Layout *l, fmi3ValueReference vr, int *first, int *cou
     else if (r == T_forced || r == T_forced + 1) {
         *first = r == T_forced ? vr_T_forced(l) : vr_T(l);
         *count = l->n;
-    } else if (r < parameters + l->n_par) *first = vr_parameters(l) + (int)(r - parameters);
+    } else if (r <= parameters + l->n_par) *first = vr_parameters(l) + (int)(r - parameters); /* max_step last */
     else return NONE;
     return REAL;
+}
+
+/* Whether an FMI 3.0 value reference is a derivative input, and the FMI 2.0 value references
+   of the inputs it is the derivative of: first .. first+count-1. */
+static int is_derivative(const Layout *l, fmi3ValueReference vr, int *first, int *count) {
+    long r = (long)vr, base = 6 + l->n_in + l->n_par;
+    if (r < base || r > base + l->n_in) return 0;
+    *first = r < base + l->n_in ? vr_inputs(l) + (int)(r - base) : vr_T_forced(l);
+    *count = r < base + l->n_in ? 1 : l->n;
+    return 1;
 }
 
 /* The FMI 2.0 value references of an FMI 3.0 list of one type (time aside): malloc'ed, their
@@ -222,14 +240,79 @@ static fmi3Status transfer(Adapter *a, const fmi3ValueReference vr[], size_t nvr
     return status;
 }
 
+/* A get or set of derivative inputs only: the FMI 2.0 instance checks and takes a set
+   (fmi2SetRealInputDerivatives, order 1); a get answers what was set for the next step. */
+static fmi3Status derivatives(Adapter *a, const fmi3ValueReference vr[], size_t nvr, size_t nValues, double *values,
+                              int setting) {
+    size_t k, at = 0, total = 0;
+    int first, count, j;
+    fmi2ValueReference *refs;
+    fmi2Integer *orders;
+    fmi3Status status;
+    for (k = 0; k < nvr; k++) {
+        is_derivative(&a->layout, vr[k], &first, &count);
+        total += (size_t)count;
+    }
+    if (total != nValues) return refuse(a, "%zu values given for %zu", nValues, total);
+    refs = malloc(sizeof *refs * (total + 1));
+    orders = malloc(sizeof *orders * (total + 1));
+    if (!refs || !orders) {
+        free(refs);
+        free(orders);
+        return refuse(a, "out of memory");
+    }
+    for (k = 0; k < nvr; k++) {
+        is_derivative(&a->layout, vr[k], &first, &count);
+        for (j = 0; j < count; j++, at++) {
+            refs[at] = (fmi2ValueReference)(first + j);
+            orders[at] = 1;
+        }
+    }
+    status = setting ? (fmi3Status)fmi2SetRealInputDerivatives(a->inner, refs, total, orders, values) : fmi3OK;
+    for (k = 0; status <= fmi3Warning && k < total; k++) {
+        double *kept = a->derivatives + refs[k] - vr_inputs(&a->layout);
+        if (setting) *kept = values[k];
+        else values[k] = *kept;
+    }
+    free(refs);
+    free(orders);
+    return status;
+}
+
+/* A Float64 get or set: runs of derivative inputs and of the other variables, in turn. */
+static fmi3Status float64(Adapter *a, const fmi3ValueReference vr[], size_t nvr, size_t nValues, double *values,
+                          int setting) {
+    size_t k = 0, at = 0;
+    fmi3Status status = fmi3OK, next;
+    while (k < nvr) {
+        size_t j = k, size = 0;
+        int first, count, derivative = is_derivative(&a->layout, vr[k], &first, &count);
+        for (; j < nvr; j++) {
+            if (is_derivative(&a->layout, vr[j], &first, &count) != derivative) break;
+            if (!derivative && variable(&a->layout, vr[j], &first, &count) == NONE) count = 1;
+            size += (size_t)count;
+        }
+        if (j == nvr && k == 0) size = nValues; /* one run: transfer checks the count */
+        if (at + size > nValues) return refuse(a, "%zu values given for more", nValues);
+        next = derivative ? derivatives(a, vr + k, j - k, size, values + at, setting)
+                          : transfer(a, vr + k, j - k, REAL, size, values + at, setting);
+        if (next > status) status = next;
+        if (status > fmi3Warning) return status;
+        at += size;
+        k = j;
+    }
+    if (at != nValues) return refuse(a, "%zu values given for %zu", nValues, at);
+    return status;
+}
+
 FMI3_EXPORT fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                                       fmi3Float64 values[], size_t nValues) {
-    return transfer(instance, vr, nvr, REAL, nValues, values, 0);
+    return float64(instance, vr, nvr, nValues, values, 0);
 }
 
 FMI3_EXPORT fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr,
                                       const fmi3Float64 values[], size_t nValues) {
-    return transfer(instance, vr, nvr, REAL, nValues, (void *)values, 1);
+    return float64(instance, vr, nvr, nValues, (double *)values, 1);
 }
 
 /* force[N] is the only Boolean. */
@@ -299,6 +382,7 @@ FMI3_EXPORT fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fm
         free(a);
         return NULL;
     }
+    a->derivatives = calloc((size_t)(a->layout.n_in + a->layout.n) + 1, sizeof(double));
     uri = malloc(strlen(resourcePath) + 16);
     if (uri) {
         sprintf(uri, "%s%snames.txt", resourcePath,
@@ -320,9 +404,11 @@ FMI3_EXPORT fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fm
                                    visible ? fmi2True : fmi2False, loggingOn ? fmi2True : fmi2False);
     }
     free(uri);
-    if (!a->inner) {
+    if (!a->inner || !a->derivatives) {
+        if (a->inner) fmi2FreeInstance(a->inner);
         free_names(&a->layout);
         free(a->name);
+        free(a->derivatives);
         free(a);
         return NULL;
     }
@@ -335,6 +421,7 @@ FMI3_EXPORT void fmi3FreeInstance(fmi3Instance instance) {
     fmi2FreeInstance(a->inner);
     free_names(&a->layout);
     free(a->name);
+    free(a->derivatives);
     free(a);
 }
 
@@ -363,6 +450,7 @@ FMI3_EXPORT fmi3Status fmi3Reset(fmi3Instance instance) {
     Adapter *a = instance;
     fmi3Status status = moved(a, (fmi3Status)fmi2Reset(a->inner), INSTANTIATED);
     if (status <= fmi3Warning) a->time = 0.0;
+    memset(a->derivatives, 0, sizeof(double) * (size_t)(a->layout.n_in + a->layout.n));
     return status;
 }
 
@@ -374,6 +462,8 @@ FMI3_EXPORT fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentComm
     fmi3Status status = (fmi3Status)fmi2DoStep(a->inner, currentCommunicationPoint, communicationStepSize,
                                                noSetFMUStatePriorToCurrentPoint ? fmi2True : fmi2False);
     if (status <= fmi3Warning) a->time = currentCommunicationPoint + communicationStepSize;
+    /* as the FMI 2.0 instance's, the derivatives held for that step only */
+    memset(a->derivatives, 0, sizeof(double) * (size_t)(a->layout.n_in + a->layout.n));
     *eventHandlingNeeded = false;
     *terminateSimulation = false;
     *earlyReturn = false;

@@ -508,10 +508,26 @@ FMI2_EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2V
     return FORWARD(g, fmi2GetDirectionalDerivative(g->inner, u, nu, z, nz, dv, dz));
 }
 
+/* pythonfmu answers fmi2SetRealInputDerivatives with an error: the guard sets the derivatives as
+   the slave's undeclared values after the declared ones (fmu_build/variables.py, `derivatives`:
+   input or T_forced r at layout_size + r - vr_inputs). */
 FMI2_EXPORT fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                                    const fmi2Integer order[], const fmi2Real value[]) {
     Guard *g = c;
-    return FORWARD(g, fmi2SetRealInputDerivatives(g->inner, vr, nvr, order, value));
+    char message[512];
+    fmi2ValueReference *hidden;
+    fmi2Status status;
+    size_t k;
+    if (derivative_refusal(&g->layout, vr, nvr, order, value, g->state, g->time, message, sizeof message))
+        return refuse(g, message);
+    if (nvr == 0) return fmi2OK;
+    hidden = malloc(sizeof *hidden * nvr);
+    if (!hidden) return refuse(g, "out of memory");
+    for (k = 0; k < nvr; k++)
+        hidden[k] = (fmi2ValueReference)(layout_size(&g->layout) + (int)vr[k] - vr_inputs(&g->layout));
+    status = FORWARD(g, fmi2SetReal(g->inner, hidden, nvr, value));
+    free(hidden);
+    return status;
 }
 
 FMI2_EXPORT fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,

@@ -10,7 +10,11 @@
    the rows of forced nodes (force[i] and T_forced[i] not NaN) replaced by T+_i = T_forced[i],
    with M factorised once per pattern of imposed nodes and step size: LU within the profile of
    M reordered by reverse Cuthill-McKee (Profile below), O(N) per step on a building's network.
-   The state at the start is T_start.
+   The state at the start is T_start. The inputs set before doStep(t, h) are those at t, their
+   first derivatives (fmi2SetRealInputDerivatives; zero where none is set for this step) make
+   them linear over the step: doStep takes k = ceil(h / max_step) steps of h / k, each with the
+   inputs and T_forced at its end, u(t) + u'(t) tau; a forced node is imposed over the step
+   where T_forced at t is not NaN.
 
    Value references and the calls refused: variables.h (shared with the Python FMU's guard). */
 #include <math.h>
@@ -24,6 +28,7 @@
 #include "variables.h"
 
 #define CACHED_PATTERNS 8
+#define MAX_SUBSTEPS 10000000 /* the internal steps of one doStep, at most (variables.py's) */
 
 typedef struct {
     double dt;
@@ -46,6 +51,7 @@ typedef struct {
 typedef struct {
     int n, n_in, n_par, n_terms, n_products;
     double *p0;       /* n_par */
+    double max_step;  /* s: max_step's start */
     int *product;     /* n_products x 3: node, input a, input b */
     long *term_start; /* n_terms + 1: where each term's nonzeros begin */
     long *par_start;  /* n_terms + 1: where each term's parameters begin */
@@ -62,6 +68,8 @@ typedef struct {
     int state, size, clock;
     double time; /* the current communication point (s) */
     double *values, *start_values;
+    double *derivatives; /* n_in + n: d/dt of the inputs and of T_forced at the communication point */
+    double *u;           /* n_in: the inputs at the end of a sub-step */
     double *C, *A, *B, *q, *P; /* at the parameters' values */
     double *v, *work;
     unsigned char *imposed;
@@ -117,13 +125,13 @@ static int read_longs(FILE *f, long *x, long count) {
 /* The size of the block C, A, B, q, P. */
 static long term_size(const Network *net) { return (long)net->n * (2 + net->n + net->n_in) + net->n_products; }
 
-/* resources/network.txt: "nodeforce-network/3", "sizes N N_IN N_PAR N_TERMS N_PRODUCTS
-   N_PARAMETER_REFS N_NONZEROS", "p0 ...", "products (node a b) ...", then per term "term K
+/* resources/network.txt: "nodeforce-network/4", "sizes N N_IN N_PAR N_TERMS N_PRODUCTS
+   N_PARAMETER_REFS N_NONZEROS", "p0 ...", "max_step S" (the start of max_step, s), "products (node a b) ...", then per term "term K
    j_1 .. j_K COUNT" and COUNT pairs "index value" (index into the block C, A, B, q, P), "end". */
 static int read_network(Network *net, FILE *f) {
     long refs, nonzeros, k, count, at = 0, at_par = 0, size;
     int t, j;
-    if (!expect(f, "nodeforce-network/3") || !expect(f, "sizes") || !read_ints(f, &net->n, 1)
+    if (!expect(f, "nodeforce-network/4") || !expect(f, "sizes") || !read_ints(f, &net->n, 1)
         || !read_ints(f, &net->n_in, 1) || !read_ints(f, &net->n_par, 1) || !read_ints(f, &net->n_terms, 1)
         || !read_ints(f, &net->n_products, 1) || !read_longs(f, &refs, 1) || !read_longs(f, &nonzeros, 1)
         || net->n <= 0 || net->n_in < 0 || net->n_par < 0 || net->n_terms < 1 || net->n_products < 0 || refs < 0
@@ -141,6 +149,7 @@ static int read_network(Network *net, FILE *f) {
         || !net->value)
         return 0;
     if (!expect(f, "p0") || !read_doubles(f, net->p0, net->n_par)) return 0;
+    if (!expect(f, "max_step") || !read_doubles(f, &net->max_step, 1) || !(net->max_step > 0.0)) return 0;
     if (!expect(f, "products") || !read_ints(f, net->product, net->n_products * 3)) return 0;
     for (k = 0; k < net->n_products; k++) {
         const int *p = net->product + 3 * k;
@@ -360,30 +369,48 @@ static void forget_factors(Model *m) {
     }
 }
 
-static fmi2Status step(Model *m, double dt) {
+/* One doStep of h: k backward-Euler steps of h / k with the inputs and the imposed temperatures
+   at each one's end. */
+static fmi2Status step(Model *m, double h) {
     const Network *net = &m->net;
-    int n = net->n, i, k;
-    const double *u = m->values + vr_inputs(&m->layout), *T_forced = m->values + vr_T_forced(&m->layout);
-    double *T = m->values + vr_T(&m->layout);
+    int n = net->n, n_in = net->n_in, i, j, k, steps;
+    const double *u0 = m->values + vr_inputs(&m->layout), *T_forced = m->values + vr_T_forced(&m->layout);
+    const double *du = m->derivatives, *dT_forced = m->derivatives + n_in;
+    double *T = m->values + vr_T(&m->layout), *u = m->u, dt, s;
     Factors *f;
     for (i = 0; i < n; i++) m->imposed[i] = m->values[vr_force(&m->layout) + i] != 0.0 && isfinite(T_forced[i]);
+    if (h / m->values[vr_max_step(&m->layout)] > MAX_SUBSTEPS) {
+        log_error(m, "doStep of %g s is more than %d steps of max_step = %g s: set max_step larger", h, MAX_SUBSTEPS,
+                  m->values[vr_max_step(&m->layout)]);
+        return fmi2Error;
+    }
+    steps = (int)ceil(h / m->values[vr_max_step(&m->layout)] - 1e-9);
+    if (steps < 1) steps = 1;
+    dt = h / steps;
     f = factors(m, dt);
     if (!f) {
         log_error(m, "the step matrix is singular (or memory ran out)");
         return fmi2Error;
     }
-    for (i = 0; i < n; i++) { /* the sources */
-        long k_b;
-        m->v[i] = m->q[i];
-        for (k_b = m->b_start[i]; k_b < m->b_start[i + 1]; k_b++) m->v[i] += m->b_value[k_b] * u[m->b_column[k_b]];
+    for (j = 1; j <= steps; j++) {
+        s = j * dt;
+        for (k = 0; k < n_in; k++) u[k] = u0[k] + du[k] * s;
+        for (i = 0; i < n; i++) { /* the sources */
+            long k_b;
+            m->v[i] = m->q[i];
+            for (k_b = m->b_start[i]; k_b < m->b_start[i + 1]; k_b++) m->v[i] += m->b_value[k_b] * u[m->b_column[k_b]];
+        }
+        for (k = 0; k < net->n_products; k++) {
+            const int *p = net->product + 3 * k;
+            m->v[p[0]] += m->P[k] * u[p[1]] * u[p[2]];
+        }
+        for (i = 0; i < n; i++)
+            m->v[i] = m->imposed[i] ? T_forced[i] + dT_forced[i] * s : m->C[i] / dt * T[i] + m->v[i];
+        profile_solve(f, &m->profile, m->v, m->work, n);
+        for (i = 0; i < n; i++) T[i] = m->imposed[i] ? T_forced[i] + dT_forced[i] * s : m->v[i];
     }
-    for (k = 0; k < net->n_products; k++) {
-        const int *p = net->product + 3 * k;
-        m->v[p[0]] += m->P[k] * u[p[1]] * u[p[2]];
-    }
-    for (i = 0; i < n; i++) m->v[i] = m->imposed[i] ? T_forced[i] : m->C[i] / dt * T[i] + m->v[i];
-    profile_solve(f, &m->profile, m->v, m->work, n);
-    for (i = 0; i < n; i++) T[i] = m->imposed[i] ? T_forced[i] : m->v[i];
+    /* the next step's derivatives are set before it, or it holds its inputs */
+    memset(m->derivatives, 0, sizeof(double) * (size_t)(n_in + n));
     return fmi2OK;
 }
 
@@ -404,7 +431,7 @@ static void free_model(Model *m) {
     }
     free_network(&m->net);
     free_names(&m->layout);
-    free(m->name); free(m->values); free(m->start_values); free(m->C); free(m->v); free(m->work);
+    free(m->name); free(m->values); free(m->start_values); free(m->derivatives); free(m->u); free(m->C); free(m->v); free(m->work);
     free(m->imposed); free(m->profile.order); free(m->profile.first); free(m->profile.start);
     free(m->b_start); free(m->b_column); free(m->b_value);
     free(m);
@@ -449,6 +476,8 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
     m->size = layout_size(&m->layout);
     m->values = calloc((size_t)m->size, sizeof(double));
     m->start_values = calloc((size_t)m->size, sizeof(double));
+    m->derivatives = calloc((size_t)(m->net.n_in + m->net.n), sizeof(double));
+    m->u = calloc((size_t)m->net.n_in + 1, sizeof(double));
     m->C = calloc((size_t)term_size(&m->net), sizeof(double));
     m->A = m->C + m->net.n;
     m->B = m->A + m->net.n * m->net.n;
@@ -460,7 +489,7 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
     m->b_column = calloc((size_t)m->net.n * m->net.n_in + 1, sizeof(int));
     m->b_value = calloc((size_t)m->net.n * m->net.n_in + 1, sizeof(double));
     m->imposed = calloc((size_t)m->net.n, 1);
-    if (!m->values || !m->start_values || !m->C || !m->v || !m->work || !m->imposed || !m->b_start || !m->b_column
+    if (!m->values || !m->start_values || !m->derivatives || !m->u || !m->C || !m->v || !m->work || !m->imposed || !m->b_start || !m->b_column
         || !m->b_value || !order_network(m)) {
         free_model(m);
         return NULL;
@@ -471,6 +500,7 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
         m->start_values[vr_T(&m->layout) + i] = 20.0;
     }
     for (i = 0; i < m->net.n_par; i++) m->start_values[vr_parameters(&m->layout) + i] = m->net.p0[i];
+    m->start_values[vr_max_step(&m->layout)] = m->net.max_step;
     memcpy(m->values, m->start_values, (size_t)m->size * sizeof(double));
     forget_factors(m);
     m->state = INSTANTIATED;
@@ -523,6 +553,7 @@ FMI2_EXPORT fmi2Status fmi2Terminate(fmi2Component c) {
 FMI2_EXPORT fmi2Status fmi2Reset(fmi2Component c) {
     Model *m = c;
     memcpy(m->values, m->start_values, (size_t)m->size * sizeof(double));
+    memset(m->derivatives, 0, sizeof(double) * (size_t)(m->net.n_in + m->net.n));
     m->state = INSTANTIATED;
     m->time = 0.0;
     return fmi2OK;
@@ -653,9 +684,15 @@ FMI2_EXPORT fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2V
 
 FMI2_EXPORT fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                                    const fmi2Integer order[], const fmi2Real value[]) {
-    (void)vr; (void)nvr; (void)order; (void)value;
-    log_error(c, "input derivatives are not used (canInterpolateInputs is false)");
-    return fmi2Error;
+    Model *m = c;
+    char message[512];
+    size_t k;
+    if (derivative_refusal(&m->layout, vr, nvr, order, value, m->state, m->time, message, sizeof message)) {
+        log_error(m, "%s", message);
+        return fmi2Error;
+    }
+    for (k = 0; k < nvr; k++) m->derivatives[(int)vr[k] - vr_inputs(&m->layout)] = value[k];
+    return fmi2OK;
 }
 
 FMI2_EXPORT fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
@@ -673,6 +710,11 @@ FMI2_EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunication
     (void)noSetFMUStatePriorToCurrentPoint;
     if (step_refusal(m->state, communicationStepSize, reason, sizeof reason)) {
         log_error(m, "%s", reason);
+        return fmi2Error;
+    }
+    if (!(m->values[vr_max_step(&m->layout)] > 0.0)) {
+        log_error(m, "value reference %d (max_step) is %g s: it must be > 0", vr_max_step(&m->layout),
+                  m->values[vr_max_step(&m->layout)]);
         return fmi2Error;
     }
     status = step(m, communicationStepSize);

@@ -9,6 +9,7 @@
        T_forced[1..N]   Real inputs
        T[1..N]          Real outputs
        <parameters>     Real parameters, fixed (n_par): the building's properties, an effect's
+       max_step         Real parameter, tunable (s): the longest internal step of a doStep
    The names of the inputs and parameters, one a line, are resources/names.txt. A Real set must
    be finite, but T_forced's NaN ("not measured"). */
 #ifndef NODEFORCE_VARIABLES_H
@@ -34,7 +35,8 @@ static inline int vr_inputs(const Layout *l) { return 2 * l->n; }
 static inline int vr_T_forced(const Layout *l) { return vr_inputs(l) + l->n_in; }
 static inline int vr_T(const Layout *l) { return vr_T_forced(l) + l->n; }
 static inline int vr_parameters(const Layout *l) { return vr_T(l) + l->n; }
-static inline int layout_size(const Layout *l) { return vr_parameters(l) + l->n_par; }
+static inline int vr_max_step(const Layout *l) { return vr_parameters(l) + l->n_par; }
+static inline int layout_size(const Layout *l) { return vr_max_step(l) + 1; }
 
 /* The three counts "N N_IN N_PAR" of a layout; 0 if the text is not that (strtol, not
    sscanf, whose C99 name needs GLIBC_2.7: see glibc.h). */
@@ -78,6 +80,7 @@ static inline void free_names(Layout *l) {
 static inline void variable_name(const Layout *l, int r, char *name, size_t size) {
     const char *named = NULL;
     if (r >= vr_inputs(l) && r < vr_T_forced(l)) named = l->names ? l->names[r - vr_inputs(l)] : "an input";
+    else if (r == vr_max_step(l)) named = "max_step";
     else if (r >= vr_parameters(l)) named = l->names ? l->names[l->n_in + r - vr_parameters(l)] : "a parameter";
     if (named) snprintf(name, size, "%s", named);
     else if (r < vr_T_start(l)) snprintf(name, size, "force[%d]", r + 1);
@@ -97,7 +100,7 @@ static inline long refusal(const Layout *l, const fmi2ValueReference vr[], size_
     for (k = 0; k < nvr; k++) {
         int r = (int)vr[k];
         int boolean = r < l->n;
-        int fixed = r < vr_inputs(l) || r >= vr_parameters(l);
+        int fixed = r < vr_inputs(l) || (r >= vr_parameters(l) && r < vr_max_step(l));
         if (vr[k] >= (fmi2ValueReference)layout_size(l)) {
             snprintf(reason, size, "does not exist (0..%d)", layout_size(l) - 1);
             return (long)k;
@@ -138,6 +141,29 @@ static inline int refused2(const Layout *l, const fmi2ValueReference vr[], size_
     else snprintf(name, sizeof name, "none");
     snprintf(message, size, "value reference %u (%s) %s", vr[k], name, reason);
     return 1;
+}
+
+/* Why fmi2SetRealInputDerivatives is refused, in `message` (0 when it is not): only the first
+   derivative (order 1) of an input or of T_forced, finite, when the inputs may be set. */
+static inline int derivative_refusal(const Layout *l, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer order[],
+                                     const double value[], int state, double time, char *message, size_t size) {
+    size_t k;
+    char name[128];
+    for (k = 0; k < nvr; k++) {
+        if (refused2(l, vr + k, 1, NULL, 1, 1, state, time, message, size)) return 1;
+        if ((int)vr[k] < vr_inputs(l) || (int)vr[k] >= vr_T(l)) {
+            variable_name(l, (int)vr[k], name, sizeof name);
+            snprintf(message, size, "value reference %u (%s) is not an input: it has no input derivative", vr[k], name);
+            return 1;
+        }
+        if (order[k] != 1 || value[k] - value[k] != 0.0) {
+            variable_name(l, (int)vr[k], name, sizeof name);
+            snprintf(message, size, "value reference %u (%s): derivative of order %d set to %g at t = %.17g s: only a "
+                     "finite first derivative is used", vr[k], name, (int)order[k], value[k], time);
+            return 1;
+        }
+    }
+    return 0;
 }
 
 /* Why the standard forbids this doStep, written into reason; 0 when it may step. */
