@@ -129,7 +129,7 @@ def evidence(building, result):
     """The forcing evidence per component: the share of J above the noise that forcing its
     best-scoring measured node alone removes (`ga.parsimony.removed`), most first. A diagnosis
     calibrates the effects of the components it ranks highest, whether or not a fault is
-    located (`diagnose.candidates.physical`).
+    located (`diagnosis.candidates.physical`).
 
     Returns [{"component", "node", "J", "share"}]; components without a node the search forced
     are absent."""

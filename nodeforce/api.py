@@ -12,7 +12,7 @@ from pathlib import Path
 from nodeforce import tempdirs
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
-from nodeforce.diagnose import compare as _compare, loop as _loop
+from nodeforce.diagnosis import compare as _compare, loop as _loop
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga import locate as _locate
 from nodeforce.iotools.measurements import read_measurements
@@ -28,7 +28,7 @@ __all__ = ["InputError", "read_building", "read_weather", "read_measurements", "
            "score_forcing", "locate", "diagnose", "Record", "compare"]
 
 # One record of a building among several in one diagnosis: case, source, name, fraction,
-# calibration_end, phases (diagnose.loop.Record).
+# calibration_end, phases (diagnosis.loop.Record).
 Record = _loop.Record
 
 # The API's cases carry no file name: errors about their measurements say "measurements".
@@ -203,7 +203,8 @@ def locate(building, case, objective=None, workdir=None, **search):
                               source=SOURCE, **search)
 
 
-def diagnose(building, case, workdir, objective=None, **options):
+def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibration_end=None, phases=(), seed=0,
+             workers=None, fmu_kind="auto", noise=None, reference=None, population=30, generations=400):
     """The whole loop of `nodeforce diagnose`; writes its files in `workdir` and returns report.json's
     content (docs/guide.md, Output files).
 
@@ -219,18 +220,33 @@ def diagnose(building, case, workdir, objective=None, **options):
         Folder for report.json, report.md, the plots, building_after.json and model_after.fmu.
     objective : Objective, optional
         Default: the building's first zone.
-    **options
-        `nodeforce.diagnose.loop.diagnose`'s: fraction, calibration_end (a pandas Timestamp) and
-        phases (from `read_phases`) of a single case (a `Record` carries its own), seed, workers,
-        fmu_kind, noise, reference. Worker
-        processes as for `locate`.
+    fraction, calibration_end, phases
+        The calibration window of a single case: the first `fraction` of it by time, or up to
+        `calibration_end` (a pandas Timestamp); its phases (from `read_phases`). A `Record`
+        carries its own.
+    seed : int
+        Every random choice's (the forcing search, the screening).
+    workers : int, optional
+        Worker processes (default all cores), spawned as for `locate`.
+    fmu_kind : str
+        The FMUs built, run and written: "python", "standalone" (or their "-fmi3" forms), or
+        "auto", the standalone where a C compiler is at hand.
+    noise : float, optional
+        The air sensors' noise sd (C) where the user knows it; default estimated from the air.
+    reference : dict, optional
+        {"label", "rmse": {phase: K}}: another model's error, reported for scale.
+    population, generations : int
+        The forcing search's GA settings.
 
     Returns
     -------
     dict
     """
     with _folder(workdir) as folder:
-        return _loop.diagnose(building, case, objective or Objective.of(building), folder, source=SOURCE, **options)
+        return _loop.diagnose(building, case, objective or Objective.of(building), folder, source=SOURCE,
+                              fraction=fraction, calibration_end=calibration_end, phases=phases, seed=seed,
+                              workers=workers, fmu_kind=fmu_kind, noise=noise, reference=reference,
+                              population=population, generations=generations)
 
 
 def compare(models, workdir=None, phases=(), fmu_kind="python"):

@@ -210,9 +210,9 @@ def cmd_synth(args):
 
 
 def run_diagnosis(building, records, objective, out, args):
-    """The loop on `records` (diagnose.loop.Record), its summary printed."""
-    from nodeforce.diagnose.loop import diagnose
-    from nodeforce.diagnose.report import terminal_summary
+    """The loop on `records` (diagnosis.loop.Record), its summary printed."""
+    from nodeforce.diagnosis.loop import diagnose
+    from nodeforce.diagnosis.report import terminal_summary
     check_workers(args)
     out.mkdir(parents=True, exist_ok=True)
     report = diagnose(building, records, objective, out, seed=args.seed, workers=args.workers, fmu_kind=kind_of(args),
@@ -229,7 +229,7 @@ def check_fraction(option, fraction):
 
 def the_record(case, source, args):
     """The diagnosis' one record of --weather, --measurements and the window options."""
-    from nodeforce.diagnose.loop import Record
+    from nodeforce.diagnosis.loop import Record
     from nodeforce.iotools.phases import read_phases
     return Record(case, source, str(source), check_fraction("--calibration-fraction", args.calibration_fraction),
                   instant("--calibration-end", args.calibration_end) if args.calibration_end else None,
@@ -263,7 +263,7 @@ def record_fields(text):
 
 def records_of(building, args):
     """The records of a diagnosis: each --record, or the one of --weather and --measurements."""
-    from nodeforce.diagnose.loop import Record
+    from nodeforce.diagnosis.loop import Record
     from nodeforce.iotools.phases import read_phases
     if not args.record:
         if not (args.weather and args.measurements):
@@ -323,7 +323,7 @@ def cmd_diagnose(args):
 
 
 def cmd_compare(args):
-    from nodeforce.diagnose.compare import compare, write_compare
+    from nodeforce.diagnosis.compare import compare, write_compare
     from nodeforce.iotools.phases import read_phases
     weather, measurements = read_weather(args.weather), read_measurements(args.measurements)
     names = zone_list(args.objective) if args.objective else None

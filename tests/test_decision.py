@@ -5,8 +5,8 @@ apart, a physical effect with few parameters before a shape."""
 import numpy as np
 import pytest
 
-from nodeforce.diagnose.candidates import objection, preference
-from nodeforce.diagnose.selection import blocks, decide
+from nodeforce.diagnosis.candidates import objection, preference
+from nodeforce.diagnosis.selection import blocks, decide
 from nodeforce.model.building import parse_building
 from nodeforce.model.errors import InputError
 from nodeforce.model.score import Noise
@@ -132,7 +132,7 @@ BASE = [10.0, 10.0, 10.0, 10.0]
 
 
 def candidate(effect, target, parameters, days):
-    """A calibrated candidate's record as diagnose.loop.assess_all makes it, leaving J `days`
+    """A calibrated candidate's record as diagnosis.loop.assess_all makes it, leaving J `days`
     (C2) on each left-out day."""
     return {"effect": effect, "target": target, "parameters": parameters, "derived": {},
             "cv": {"blocks": list(days), "J": float(sum(days)), "n": N, "rmse": float(np.sqrt(sum(days) / N))}}

@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 from fmpy.validation import validate_fmu
 
-from nodeforce.diagnose.loop import diagnose
+from nodeforce.diagnosis.loop import diagnose
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.building import load_building, parse_building
 from nodeforce.model.case import prepare_case

@@ -11,8 +11,8 @@ import pytest
 
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
-from nodeforce.diagnose.calibrate import Candidate, calibrate
-from nodeforce.diagnose.candidates import calibration_start, limits, physical
+from nodeforce.diagnosis.calibrate import Candidate, calibrate
+from nodeforce.diagnosis.candidates import calibration_start, limits, physical
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.model.building import load_building, parse_building
 from nodeforce.model.case import Case

@@ -6,9 +6,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from nodeforce.diagnose.report import before_after_table, write_report
-from nodeforce.diagnose.report.formats import parameter_unit
-from nodeforce.diagnose.residuals import diagnostics
+from nodeforce.diagnosis.report import before_after_table, write_report
+from nodeforce.diagnosis.report.formats import parameter_unit
+from nodeforce.diagnosis.residuals import diagnostics
 from nodeforce.model.effects import EFFECTS
 
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -277,7 +277,7 @@ def test_write_report_times_without_offset_or_in_utc(tmp_path, tz):
 
 
 def test_a_long_effect_name_keeps_the_time_plots_legend_inside_the_figure(tmp_path, monkeypatch):
-    from nodeforce.diagnose.report import figures
+    from nodeforce.diagnosis.report import figures
     report, series = synthetic()
     report["effect"]["target"] = "living->west_facade_global_vertical_irradiance_measured"
     saved = []
@@ -292,7 +292,7 @@ def test_a_long_effect_name_keeps_the_time_plots_legend_inside_the_figure(tmp_pa
 
 
 def test_a_candidate_tried_again_on_top_is_judged_and_marked_in_its_own_round(tmp_path):
-    from nodeforce.diagnose.report import content
+    from nodeforce.diagnosis.report import content
     report, _ = synthetic()
     first = next(c for c in report["candidates"] if c["effect"] == "conductivity")
     again = {**copy.deepcopy(first), "on_top_of": ["conductivity@door"], "effect": "solar_absorptance",
@@ -349,7 +349,7 @@ def test_the_first_screen_gives_what_the_data_fix_not_the_parameters_they_cannot
 
 
 def test_the_decision_says_each_refusal_reason_once(tmp_path):
-    from nodeforce.diagnose.report.summary import chosen_sentence
+    from nodeforce.diagnosis.report.summary import chosen_sentence
     report, series = synthetic()
     gains = [("internal_gain@living", "Q = -2.81 W is a negative gain (a heat sink) [0, inf]"),
              ("daily_gain@living", "mean = -2.82 W is a negative gain (a heat sink) [0, inf]"),
@@ -379,7 +379,7 @@ def test_the_decision_says_each_refusal_reason_once(tmp_path):
 def test_the_phases_table_of_a_whole_house_keeps_the_chosen_candidates():
     """Beyond PHASE_COLUMNS candidates (a house of seven rooms tries 163) the table shows before,
     each round's chosen candidate and after; report.json keeps them all."""
-    from nodeforce.diagnose.report import tables
+    from nodeforce.diagnosis.report import tables
     labels = [f"conductivity@W{i}" for i in range(tables.PHASE_COLUMNS + 2)]
     rmse = {"before": 1.0, **{label: 0.9 for label in labels}, "gain@x (round 2)": 0.5, "after": 0.5}
     report = {"phases": [{"phase": "free float", "start": "2014-04-17T07:30:00+01:00", "end": None, "n": 10,

@@ -25,7 +25,7 @@ INSIDE = 1e-3
 
 
 # A scale parameter, or a derived quantity, is identifiable when its standard deviation is under
-# this fraction of its value (diagnose.calibrate).
+# this fraction of its value (diagnosis.calibrate).
 IDENTIFIABLE_RELATIVE = 0.25
 
 
@@ -39,7 +39,7 @@ EVIDENT = 0.25
 def physical(building, evidence, zones, measured_ids, located_nodes=()):
     """(effect, target) pairs every round calibrates, whatever the residual's statistics say: a
     building physicist's list of what could be wrong, which the cross-validated choice
-    (`diagnose.selection`) then judges.
+    (`diagnosis.selection`) then judges.
 
     - Every zone effect of each objective zone (`zone_effects`), and of any zone whose air the
       forcing search located.
@@ -150,7 +150,7 @@ def implausible(building, effect, target):
 
 # The shapes: a gain that follows the clock or an input column stands for a heat source the model
 # lacks, not for a physical effect of the building; tried only where no physical effect brings the
-# error to the noise, and chosen only where none fits as well (diagnose.selection.decide).
+# error to the noise, and chosen only where none fits as well (diagnosis.selection.decide).
 SHAPES = ("daily_gain", "proportional_gain")
 
 # Physical limits, tighter than the range a calibration explores (model.effects): a value
@@ -211,7 +211,7 @@ def limits(building, effect, target, name):
     return PHYSICAL_LIMITS.get((effect, name), (-math.inf, math.inf))
 
 
-# What the data fix where an effect's parameters trade off (`diagnose.calibrate.derived`): when
+# What the data fix where an effect's parameters trade off (`diagnosis.calibrate.derived`): when
 # it is determined, the parameters need not be one by one. A ground coupling's (U, T_ground) is
 # then one of the many pairs that give the flux, wherever it ended, a bound included; a node's
 # (C, H) must still be inside its range, where a bound means a node that is not there; a
@@ -229,8 +229,8 @@ def objection(building, effect, target, parameters, derived=None):
     identifiable from the data (unless the quantity its parameters trade off along is, TRADE_OFFS),
     or a value outside physical limits beyond its uncertainty (`LIMIT_STANDARD_DEVIATIONS`).
 
-    parameters : {name: {"value", "std", "identifiable", "on_bound"}} of `diagnose.calibrate`
-    derived : what the data determine besides (`diagnose.calibrate.derived`)
+    parameters : {name: {"value", "std", "identifiable", "on_bound"}} of `diagnosis.calibrate`
+    derived : what the data determine besides (`diagnosis.calibrate.derived`)
     """
     reasons = [implausible(building, effect, target)]
     key, bounds_waived = TRADE_OFFS.get(effect, (None, False))
@@ -256,12 +256,12 @@ def shapes(building, left, zones):
     profile where the residual follows the time of day, a gain proportional to each input column
     it follows (a heat input mis-measured, sun through an opening the model lacks), for each
     objective zone. None where the residual is white: nothing is left to explain. A round tries
-    them only where no physical candidate brings the error to the noise (`diagnose.loop`).
+    them only where no physical candidate brings the error to the noise (`diagnosis.loop`).
 
     Parameters
     ----------
     building : Building, the model the residual is of
-    left : `diagnose.residuals.diagnostics` of that residual
+    left : `diagnosis.residuals.diagnostics` of that residual
     zones : names of the objective zones
     """
     if left.get("white"):

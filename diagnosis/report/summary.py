@@ -19,7 +19,7 @@ from ...ga.parsimony import removed
 #: The most lines the first screen may take (the title included in report.md).
 FIRST_SCREEN_LINES = 10
 
-# One clause of a physical objection (`diagnose.candidates.objection`): "NAME = VALUE [+- STD] UNIT
+# One clause of a physical objection (`diagnosis.candidates.objection`): "NAME = VALUE [+- STD] UNIT
 # is WHAT [LOW, HIGH]" or "... ends on WHAT"; anything else is kept whole as its own reason.
 _CLAUSE = re.compile(r"^(?P<value>\w+ = \S+(?: \+- \S+)?(?: (?!is\b|ends\b)\S+)?) "
                      r"(?P<why>(?:is|ends on) .*?)(?: \[[^\]]*\])?$")

@@ -2,7 +2,7 @@
 
 The calibration window's scored steps (after the burn-in) are cut into blocks of whole days
 (`blocks`). Each candidate is fitted on all blocks but one and scored on the block left out, every
-block in turn (`diagnose.calibrate`): the simulation runs through the whole window, the left-out
+block in turn (`diagnosis.calibrate`): the simulation runs through the whole window, the left-out
 block's residuals are only left out of the least squares, so every block is predicted from the
 state the days before it left, as the validation window is. A day is the unit because a
 building's residual is correlated over hours and repeats with the sun: within a day, steps are
@@ -20,7 +20,7 @@ to, block by block:
    the falls to be nearly equal from day to day, while a real effect's size follows the weather
    (a ground coupling's drift shows on some days and hardly on others); the sensor noise is
    judged by its own yardstick instead, and the days by their consistency.
-2. Physics may still refuse it (`diagnose.candidates.objection`: a gain in a zone declared
+2. Physics may still refuse it (`diagnosis.candidates.objection`: a gain in a zone declared
    unoccupied, a parameter on its bound or not identifiable, a negative gain): then it is a
    suggestion, with its reason, never added.
 3. Among the admissible candidates that pass, the one-standard-error rule on every temperature
@@ -65,7 +65,7 @@ import math
 
 import numpy as np
 
-from nodeforce.diagnose.candidates import is_shape, objection, preference
+from nodeforce.diagnosis.candidates import is_shape, objection, preference
 from nodeforce.ga.parsimony import ROUNDING, noise_floor, noise_tolerance, tolerance
 from nodeforce.model.effects import bridge_parts
 from nodeforce.model.errors import InputError
@@ -128,7 +128,7 @@ def evidence(result):
     """Per-block J (C2) a candidate's choice reads: its objective air on each block left out of
     its fit (`cv.blocks`) and, where other nodes are sensed, their J over the same blocks
     (`sensors.blocks`), which no fit read, each sensor weighted by how well the model the
-    candidate is added to follows it (`diagnose.loop.Windows.sensor_weights`)."""
+    candidate is added to follows it (`diagnosis.loop.Windows.sensor_weights`)."""
     return np.asarray(result["cv"]["blocks"], dtype=float) + np.asarray(
         result.get("sensors", {}).get("blocks", 0.0), dtype=float)
 

@@ -5,18 +5,18 @@ on data the calibration did not see.
    record's first days are a burn-in (docs/model.md: every measured node forced, not scored), so
    the walls start from what the sensors saw rather than from the warm-up's replay of the first
    day, which a record with real history does not match; the calibration window's scored steps
-   are cut into blocks of whole days for the cross-validation (`diagnose.selection`).
+   are cut into blocks of whole days for the cross-validation (`diagnosis.selection`).
 2. Before: the building as described, simulated through its FMU; metrics on both windows, per
    objective zone and together.
 3. The forcing search (`ga.locate`) on the calibration window: which nodes it locates, and per
    component the share of J above the noise its forcing removes (the evidence).
-4. Rounds. Each calibrates every physical candidate (`diagnose.candidates.physical`: every zone
+4. Rounds. Each calibrates every physical candidate (`diagnosis.candidates.physical`: every zone
    effect of the objective zones, the component effects of the components the evidence ranks
    highest and of those no sensor sits in) on the direct model, the candidates in parallel
    worker processes, once on the whole calibration window and once per block left out
-   (`diagnose.calibrate`); where none brings the error to the noise, the shapes the residual's
-   statistics point at too (`diagnose.candidates.shapes`). One rule chooses
-   (`diagnose.selection.decide`: blocked cross-validation, the one-standard-error rule, the
+   (`diagnosis.calibrate`); where none brings the error to the noise, the shapes the residual's
+   statistics point at too (`diagnosis.candidates.shapes`). One rule chooses
+   (`diagnosis.selection.decide`: blocked cross-validation, the one-standard-error rule, the
    objections of physics), against the model the earlier rounds made. Rounds go on while the
    error left is above the noise and a candidate passes. The validation window plays no part in
    any choice: its before and after are an honest estimate. The decision of every round, its
@@ -25,8 +25,8 @@ on data the calibration did not see.
    every candidate's building file is written declaring its calibrated effect
    (`candidates/<effect>@<target>.json`, a later round's in `candidates/round<n>/`).
 6. The residual of the first objective zone on the validation window, before and after, is
-   described (`diagnose.residuals`): is it white, and which input or time of day does it follow.
-7. Given the experiment's phases, every model is scored on each (`diagnose.phases`), and an
+   described (`diagnosis.residuals`): is it white, and which input or time of day does it follow.
+7. Given the experiment's phases, every model is scored on each (`diagnosis.phases`), and an
    added effect that makes a phase worse is flagged in the decision's reason.
 """
 import json
@@ -42,13 +42,13 @@ from tqdm import tqdm
 from nodeforce import lifetime
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
-from nodeforce.diagnose.calibrate import Candidate, calibrate, sensitivity
-from nodeforce.diagnose.candidates import objection, physical, shaped_inputs, shapes
-from nodeforce.diagnose.loss import heat_loss
-from nodeforce.diagnose.report import write_report
-from nodeforce.diagnose.phases import phase_errors, worsened
-from nodeforce.diagnose.residuals import diagnostics as residual_diagnostics
-from nodeforce.diagnose.selection import at_noise, block_J, blocks as blocks_of, decide, label, on_block
+from nodeforce.diagnosis.calibrate import Candidate, calibrate, sensitivity
+from nodeforce.diagnosis.candidates import objection, physical, shaped_inputs, shapes
+from nodeforce.diagnosis.loss import heat_loss
+from nodeforce.diagnosis.report import write_report
+from nodeforce.diagnosis.phases import phase_errors, worsened
+from nodeforce.diagnosis.residuals import diagnostics as residual_diagnostics
+from nodeforce.diagnosis.selection import at_noise, block_J, blocks as blocks_of, decide, label, on_block
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.locate import check_measured, evaluator_kind, locate
 from nodeforce.model.effects import EFFECTS
@@ -179,7 +179,7 @@ class Windows:
     def block_J(self, runs):
         """J (C2) of `runs` on every block, the records' in order, each less the share of the
         file's numerical error (`model.numerical.share`) the other blocks hold, as a candidate's
-        left-out block is scored (`diagnose.calibrate`)."""
+        left-out block is scored (`diagnosis.calibrate`)."""
         residuals = [m[:k] - run[:k] for m, run, k in zip(self.measured, runs, self.ks)]
         errors = self.calibration_numerical() or [np.zeros_like(r) for r in residuals]
         r, e = (np.concatenate([a.ravel() for a in parts]) for parts in (residuals, errors))

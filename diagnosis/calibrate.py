@@ -4,10 +4,10 @@ Bounded least squares on the air-temperature residual of the calibration window 
 `least_squares`, trust region reflective), simulated by the direct model (`model.integrate`):
 the FMUs carry the same equations and are tested equal to it (tests/test_fmu3.py), and a
 diagnosis calibrates tens of candidates, each once on the whole calibration window and once per
-cross-validation block left out (`diagnose.selection`, each fold one Gauss-Newton step from the
+cross-validation block left out (`diagnosis.selection`, each fold one Gauss-Newton step from the
 whole window's optimum), so a simulation without an FMU's per-step calls is what makes that
 affordable. The chosen effect's FMU is built and written all
-the same (`diagnose.loop`). The covariance of the estimate is the linearised sandwich of
+the same (`diagnosis.loop`). The covariance of the estimate is the linearised sandwich of
 `model.significance`, which allows for the residual's correlation in time (the textbook
 s^2 (J^T J)^-1 assumes independent residuals and, on real records, is several times too tight).
 A parameter is called identifiable from the data when that estimate is tight enough to act on
@@ -20,15 +20,15 @@ from SALib.analyze import morris as morris_analyze
 from SALib.sample import morris as morris_sample
 from scipy.optimize import least_squares
 
-from nodeforce.diagnose.candidates import IDENTIFIABLE_RELATIVE, calibration_start
-from nodeforce.diagnose.selection import on_block
+from nodeforce.diagnosis.candidates import IDENTIFIABLE_RELATIVE, calibration_start
+from nodeforce.diagnosis.selection import on_block
 from nodeforce.model.case import as_cases
 from nodeforce.model.significance import bandwidth, parameter_covariance
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.hlc import heat_loss_coefficient
 from nodeforce.model.numerical import share
 
-log = logging.getLogger("nodeforce.diagnose")
+log = logging.getLogger("nodeforce.diagnosis")
 
 # A scale parameter is identifiable when its standard deviation is under IDENTIFIABLE_RELATIVE
 # of its value (candidates, which judges derived quantities by it too); a temperature (T_ground)
@@ -107,7 +107,7 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None):
     cases : Case, or a sequence of Cases: each record's calibration window
     objective : model.score.Objective
     blocks : (record index, (N_t,) bool mask of the steps of that record's window) of each
-        cross-validation block (`diagnose.selection`); a bare mask is a block of the first record
+        cross-validation block (`diagnosis.selection`); a bare mask is a block of the first record
     numerical : per case, the file's numerical error at the objective air (C, (N_t, zones):
         `model.numerical.discretisation_error`), or None
 

@@ -10,7 +10,7 @@ agree on the HLC, the report says the split is not the record's.
 """
 import math
 
-from nodeforce.diagnose.selection import label
+from nodeforce.diagnosis.selection import label
 from nodeforce.ga.parsimony import tolerance
 from nodeforce.model.hlc import heat_loss_coefficient
 
