@@ -36,7 +36,7 @@ import pandas as pd
 import pvlib
 
 from nodeforce import tempdirs
-from nodeforce.diagnosis.candidates import limits
+from nodeforce.diagnosis.policy import POLICY
 from nodeforce.iotools.typical_year import convert_typical_year, relocate
 from nodeforce.iotools.weather import read_weather
 from nodeforce.model.building import load_building, parse_building
@@ -400,7 +400,7 @@ def tuned_scale(spec, building, truth0, fine0, weather0, times, nodes, air):
 
 def max_scale(building, spec):
     """The largest scale keeping every parameter in the effect's range and within its physical
-    limits (`diagnosis.candidates.limits`: a record whose fault no building could have, a door 19
+    limits (`diagnosis.policy.Policy.limits`: a record whose fault no building could have, a door 19
     times as conductive as its wood, inside convection at a twentieth, tests a refusal, not a
     diagnosis), and the opening smaller than its wall. A fault that is still not subtle at that
     scale is as large as physics lets it be: its record says so by its before/noise."""
@@ -412,7 +412,7 @@ def max_scale(building, spec):
     base = neutral(building, spec)
     limit = 20.0
     for p, (low, high) in zip(effect.parameters, effect.bounds(building, spec.target)):
-        physical = limits(building, spec.effect, spec.target, p.name)
+        physical = POLICY.limits(building, spec.effect, spec.target, p.name)
         low, high = max(low, physical[0]), min(high, physical[1])
         if p.name in spec.full and p.name != "T_ground":
             delta = spec.full[p.name] - base[p.name]

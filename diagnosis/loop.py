@@ -43,12 +43,13 @@ from nodeforce import lifetime
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnosis.calibrate import Candidate, calibrate, sensitivity
-from nodeforce.diagnosis.candidates import objection, physical, shaped_inputs, shapes
+from nodeforce.diagnosis.candidates import physical, shaped_inputs, shapes
 from nodeforce.diagnosis.loss import heat_loss
 from nodeforce.diagnosis.report import write_report
 from nodeforce.diagnosis.phases import phase_errors, worsened
 from nodeforce.diagnosis.residuals import diagnostics as residual_diagnostics
-from nodeforce.diagnosis.selection import at_noise, block_J, blocks as blocks_of, decide, label, on_block
+from nodeforce.diagnosis.policy import POLICY
+from nodeforce.diagnosis.selection import block_J, blocks as blocks_of, decide, label, on_block
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.locate import check_measured, evaluator_kind, locate
 from nodeforce.model.effects import EFFECTS
@@ -56,10 +57,6 @@ from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
 from nodeforce.model.numerical import reference, share
 from nodeforce.model.score import Noise
-
-# Rounds of candidates at most: each adds one effect on top of the last, while the error left is
-# above the noise and a candidate passes; a record rarely supports three undeclared effects.
-MAX_ROUNDS = 3
 
 
 def split(case, source, fraction=None, end=None):
@@ -207,7 +204,7 @@ class Windows:
     def sensor_weights(self, building, bases, sigma):
         """Per record, each other sensor's weight in the choice: sigma^2 over its mean squared
         residual under the model the candidates are added to (`building`, or the record's
-        protocol's in `bases`), over the calibration window, at most 1.
+        protocol's in `bases`), over the calibration window (`Policy.sensor_weight`).
 
         A sensor the model follows to the noise counts fully. One it misses by far more (a real
         house's surface the model sees through a simplified wall, a heavy wall still carrying the
@@ -223,7 +220,7 @@ class Windows:
             model = bases[i] or building
             T = case.with_inputs(model).run(model)[:, np.asarray(ids) - 1]
             misfit = np.nanmean(np.square(self.sensed[i][:self.ks[i]] - T[:self.ks[i]]), axis=0)
-            out.append(np.minimum(1.0, sigma ** 2 / np.maximum(misfit, np.finfo(float).tiny)))
+            out.append(POLICY.sensor_weight(sigma, np.maximum(misfit, np.finfo(float).tiny)))
         return out
 
     def with_numerical(self, runs, building, bases, objective):
@@ -341,7 +338,7 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
     model = Model(building, before_runs, before, bases)
     windows = windows.with_numerical(before_runs, building, bases, objective)
     noise = Noise.of_records(windows.measured, noise).with_numerical(windows.numerical_rms())
-    sigma, floor = noise.sigma, noise.floor
+    sigma, floor_sd = noise.sigma, noise.floor_sd
 
     convergence = []
     search = dict(seed=seed, workers=workers, population=population, generations=generations, fmu_kind=fmu_kind,
@@ -379,9 +376,9 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
 
     measured_ids = sorted({i for case in windows.cases for i in case.measured_ids})
     added, rounds, results, runs, sensitivities = [], [], [], {}, {}
-    for number in range(MAX_ROUNDS):
+    for number in range(POLICY.max_rounds):
         base_blocks = windows.block_J(model.runs)
-        if number and at_noise(base_blocks.sum(), n, floor):
+        if number and POLICY.at_noise(base_blocks.sum(), n, floor_sd):
             break  # the error left is the noise's
         done = {label(a) for a in added}
         started = time.perf_counter()
@@ -390,13 +387,13 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
         tried, models, simulations = assessed(model, pairs, number)
         # shapes only where no physical candidate physics admits brings the error left to the
         # noise; the residual's statistics then choose which
-        if not any(at_noise(r["cv"]["J"], n, floor) and not objection(model.building, r["effect"], r["target"],
-                                                                      r["parameters"], r["derived"]) for r in tried):
+        if not any(POLICY.at_noise(r["cv"]["J"], n, floor_sd) and not POLICY.objection(
+                model.building, r["effect"], r["target"], r["parameters"], r["derived"]) for r in tried):
             pairs = [p for p in shapes(model.building, left_by(model), objective.zones) if "@".join(p) not in done]
             more, more_models, more_simulations = assessed(model, pairs, number)
             tried, simulations = tried + more, simulations + more_simulations
             models.update(more_models)
-        chosen, decision = decide(model.building, tried, base_blocks, sigma, n, windows.groups(), floor)
+        chosen, decision = decide(model.building, tried, base_blocks, sigma, n, windows.groups(), floor_sd)
         decision["cost"] = {"candidates": len(tried), "simulations": simulations,
                             "seconds": round(time.perf_counter() - started, 1)}
         rounds.append(decision)

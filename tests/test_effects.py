@@ -175,7 +175,7 @@ def test_an_effect_that_moves_an_input_column_keeps_the_fmu_inputs(tmp_path, rea
 
 
 def test_a_gain_in_a_zone_declared_unoccupied_is_implausible(testcell):
-    from nodeforce.diagnosis.candidates import implausible
+    from nodeforce.diagnosis.policy import implausible
     assert implausible(testcell, "internal_gain", "cell") is None  # occupancy not declared
     empty = testcell.edited(lambda d: d["zones"][0].update(occupied=False))
     assert "unoccupied" in implausible(empty, "internal_gain", "cell")
