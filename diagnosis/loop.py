@@ -287,7 +287,7 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers, weights)
         metrics = windows.metrics(objective, runs)
         sensor_blocks, sensor_residuals, readings, counted = windows.sensor_scores(sensed, weights)
         result = {"effect": effect, "target": target, "parameters": parameters, "derived": determined,
-                  **metrics,
+                  "physics": POLICY.facts(model.building, effect, target), **metrics,
                   "cv": {"blocks": scores, "J": sum(scores), "n": n, "rmse": float(np.sqrt(sum(scores) / n)),
                          "folds": [f["values"] for f in folds],
                          # each block's left-out residuals, in one order for every candidate
@@ -387,8 +387,8 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
         tried, models, simulations = assessed(model, pairs, number)
         # shapes only where no physical candidate physics admits brings the error left to the
         # noise; the residual's statistics then choose which
-        if not any(POLICY.at_noise(r["cv"]["J"], n, floor_sd) and not POLICY.objection(
-                model.building, r["effect"], r["target"], r["parameters"], r["derived"]) for r in tried):
+        if not any(POLICY.at_noise(r["cv"]["J"], n, floor_sd) and not POLICY.objection_of(
+                r["effect"], r["parameters"], r["derived"], r["physics"]) for r in tried):
             pairs = [p for p in shapes(model.building, left_by(model), objective.zones) if "@".join(p) not in done]
             more, more_models, more_simulations = assessed(model, pairs, number)
             tried, simulations = tried + more, simulations + more_simulations
@@ -398,6 +398,8 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
                             "seconds": round(time.perf_counter() - started, 1)}
         rounds.append(decision)
         on_top = {"on_top_of": [label(a) for a in added]} if added else {}
+        # the residuals themselves stay out (the decision keeps what the choice read of them, the
+        # distances of every two admissible candidates'): a house's would make report.json gigabytes
         results += [{**r, "cv": {k: v for k, v in r["cv"].items() if k != "left_out"},
                      "sensors": {k: v for k, v in r["sensors"].items() if k != "residuals"},
                      "round": number + 1, **on_top}

@@ -167,7 +167,25 @@ class Policy:
             return (-1.0 if column in heat_inputs else 0.0, math.inf)
         return self.physical_limits.get((effect, name), (-math.inf, math.inf))
 
+    def judged_parameters(self, effect):
+        """The parameters whose identifiability and limits decide for an effect (`judged`)."""
+        return self.judged.get(effect, tuple(p.name for p in EFFECTS[effect].parameters))
+
+    def facts(self, building, effect, target):
+        """What the choice reads of the building about one candidate, as report.json keeps it:
+        each judged parameter's physical limits ([low, high], None where unbounded), why the
+        file's description makes the effect implausible (None), and whether its target is one
+        component (`claim`)."""
+        return {"limits": {name: [None if math.isinf(v) else v for v in self.limits(building, effect, target, name)]
+                           for name in self.judged_parameters(effect)},
+                "implausible": implausible(building, effect, target),
+                "component": target in {c.name for c in building.components}}
+
     def objection(self, building, effect, target, parameters, derived=None):
+        """`objection_of` the candidate's `facts` in `building`."""
+        return self.objection_of(effect, parameters, derived, self.facts(building, effect, target))
+
+    def objection_of(self, effect, parameters, derived, facts):
         """Why a calibrated effect may not be added to the model, or None: a gain the building
         file's description rules out (`implausible`), a parameter on a bound of its search range
         or not identifiable from the data (unless the quantity its parameters trade off along
@@ -176,14 +194,16 @@ class Policy:
 
         parameters : {name: {"value", "std", "identifiable", "on_bound"}} of `diagnosis.calibrate`
         derived : what the data determine besides (`diagnosis.calibrate.derived`)
+        facts : what the building says of the candidate (`facts`)
         """
-        reasons = [implausible(building, effect, target)]
+        reasons = [facts["implausible"]]
         key, bounds_waived = self.trade_offs.get(effect, (None, False))
         fixed = (derived or {}).get(key)
         resolved = fixed is not None and fixed["std"] < self.identifiable_share * abs(fixed["value"])
-        for name in self.judged.get(effect, [p.name for p in EFFECTS[effect].parameters]):
+        for name in self.judged_parameters(effect):
             p, unit = parameters[name], EFFECTS[effect].parameter(name).unit
-            low, high = self.limits(building, effect, target, name)
+            low, high = (-math.inf if facts["limits"][name][0] is None else facts["limits"][name][0],
+                         math.inf if facts["limits"][name][1] is None else facts["limits"][name][1])
             if p.get("on_bound") and not (resolved and bounds_waived):
                 reasons.append(f"{name} = {p['value']:.3g} {unit} ends on a bound of its range")
             elif not p["identifiable"] and not resolved:
@@ -196,11 +216,11 @@ class Policy:
         return "; ".join(r for r in reasons if r) or None
 
     # ---- 4. the order
-    def claim(self, effect, target, components):
+    def claim(self, effect, component):
         """Sort key of what a choice claims, least first: a physical effect before a shape, fewer
-        parameters before more, a zone's effect before one component's (which says where);
-        `components` the building's component names."""
-        return (self.is_shape(effect), len(EFFECTS[effect].parameters)), target in components
+        parameters before more, a zone's effect before one component's (`component`: its target
+        is one, which says where)."""
+        return (self.is_shape(effect), len(EFFECTS[effect].parameters)), bool(component)
 
 
 def implausible(building, effect, target):

@@ -120,20 +120,25 @@ def evidence(result):
         result.get("sensors", {}).get("blocks", 0.0), dtype=float)
 
 
-def noise_difference(a, b, sigma):
-    """The standard deviation (C2) of the difference of two candidates' evidence (`evidence`) that
-    sensor noise of sd sigma (C) alone makes: J_a - J_b = sum (r_a - r_b)(r_a + r_b), and the
-    noise e of a measurement enters r_a + r_b twice, so the difference moves by 2 sum (r_a - r_b) e,
-    of sd 2 sigma |r_a - r_b|. `a`, `b`: the candidates' records; their residuals are the air's
-    left out (`cv.left_out`, C, every block's in one order) and the other sensors' on the blocks
-    (`sensors.residuals`); 0 where either lacks them."""
+def distance(a, b):
+    """|r_a - r_b| (C) of two candidates' residuals the evidence (`evidence`) is made of: the
+    air's left out (`cv.left_out`, C, every block's in one order) and the other sensors' on the
+    blocks (`sensors.residuals`); 0 where either lacks them."""
     def residuals(r):
         parts = [r["cv"].get("left_out"), r.get("sensors", {}).get("residuals", np.empty(0))]
         return None if parts[0] is None else np.concatenate([np.asarray(x, dtype=float) for x in parts])
     ra, rb = residuals(a), residuals(b)
     if ra is None or rb is None:
         return 0.0
-    return float(2.0 * sigma * np.linalg.norm(ra - rb))
+    return float(np.linalg.norm(ra - rb))
+
+
+def noise_difference(distance, sigma):
+    """The standard deviation (C2) of the difference of two candidates' evidence that sensor noise
+    of sd sigma (C) alone makes, given the `distance` |r_a - r_b| (C) of their residuals:
+    J_a - J_b = sum (r_a - r_b)(r_a + r_b), and the noise e of a measurement enters r_a + r_b
+    twice, so the difference moves by 2 sum (r_a - r_b) e, of sd 2 sigma |r_a - r_b|."""
+    return float(2.0 * sigma * distance)
 
 
 def parsimony(result, sigma, n):
@@ -174,7 +179,7 @@ def harmed(base, scores, floor_sd, groups):
     return out
 
 
-def decide(building, results, base, sigma, n, groups=(), floor_sd=None):
+def decide(building, results, base, sigma, n, groups=(), floor_sd=None, distances=None):
     """The decision record of one round (module docstring), its steps in order: 1. which
     candidates pass, 2. which of them physics refuses (suggestions), 3. the band of those the data
     cannot tell from the best, 4. the one of the band that claims least; with each candidate's
@@ -192,30 +197,41 @@ def decide(building, results, base, sigma, n, groups=(), floor_sd=None):
         numerical error (`model.score.Noise.floor_sd`), the yardstick of a fall of J: a candidate
         with a slow parameter fits part of that deterministic error as it fits a fault; sigma if
         None
+    distances : {label: {label: C}}, the `distance` of every two admissible candidates' residuals,
+        as the decision record keeps it (`inputs.distances`); computed from the residuals if None
     """
     base = np.asarray(base, dtype=float)
     floor_sd = sigma if floor_sd is None else floor_sd
     margin = POLICY.least_fall(float(base.sum()), floor_sd, n)
-    tests = {label(r): candidate_test(building, r, base, margin, floor_sd, groups) for r in results}
+    # what the building says of each candidate (its limits, ...): report.json keeps it as `physics`
+    for r in results:
+        if "physics" not in r:
+            r["physics"] = POLICY.facts(building, r["effect"], r["target"])
+    tests = {label(r): candidate_test(r, base, margin, floor_sd, groups) for r in results}
     passing = [r for r in results if tests[label(r)]["passes"]]  # 1.
     admissible = [r for r in passing if not tests[label(r)]["objection"]]  # 2.
     suggestions = [{"candidate": label(r), "reason": tests[label(r)]["objection"], "cv_rmse": r["cv"]["rmse"]}
                    for r in passing if tests[label(r)]["objection"]]
-    components = {c.name for c in building.components}
+    components = {r["target"] for r in results if r["physics"]["component"]}
     chosen, alike = None, []
     if admissible:
-        near = band(admissible, base, sigma, floor_sd, n, components)  # 3.
-        chosen = min(near, key=lambda r: (claim(r, components), evidence(r).sum()))  # 4.
+        if distances is None:
+            distances = {label(a): {label(b): distance(a, b) for b in admissible} for a in admissible}
+        near = band(admissible, base, sigma, floor_sd, n, distances)  # 3.
+        chosen = min(near, key=lambda r: (claim(r), evidence(r).sum()))  # 4.
         alike = [r for r in near if r is not chosen]
     # the candidates physics refused are in `suggestions`; the report says them grouped by reason
     reason = _reason(chosen, alike, results, passing, base, n, tests, margin, components)
     return chosen, {"chosen": label(chosen) if chosen else None, "reason": reason,
                     "cv_J_before": float(base.sum()), "blocks": len(base), "noise_margin": margin,
                     "standard_errors": POLICY.standard_errors, "suggestions": suggestions,
-                    "indistinct": [label(r) for r in alike], "candidates": tests}
+                    "indistinct": [label(r) for r in alike], "candidates": tests,
+                    # what the steps read besides the candidates' records: report.json can replay them
+                    "inputs": {"blocks_before": [float(b) for b in base], "sigma": sigma, "floor_sd": floor_sd,
+                               "n": n, "groups": list(groups), "distances": distances or {}}}
 
 
-def candidate_test(building, result, base, margin, floor_sd, groups):
+def candidate_test(result, base, margin, floor_sd, groups):
     """One candidate's test (steps 1 and 2): its cross-validated fall of J (C2) and the fall's
     standard error, what it needs (the noise's `margin`, C2, and `standard_errors` of its
     scatter), what the days other than its best gain, its evidence, whether it passes, the
@@ -226,7 +242,7 @@ def candidate_test(building, result, base, margin, floor_sd, groups):
     # the other days than its best must gain too: one day alone is no evidence
     others = down - float(np.max(base - blocks))
     harms = harmed(base, blocks, floor_sd, groups)
-    said = POLICY.objection(building, result["effect"], result["target"], result["parameters"], result.get("derived"))
+    said = POLICY.objection_of(result["effect"], result["parameters"], result.get("derived"), result["physics"])
     if harms:
         said = "; ".join(filter(None, [said, "it helps the records together but harms " + "; ".join(
             f"{h['record']} (its cross-validated J there rises by {-h['cv_fall']:.3g} C2, beyond the "
@@ -237,24 +253,26 @@ def candidate_test(building, result, base, margin, floor_sd, groups):
             "passes": bool(down > needed and others > 0), "harms": harms, "objection": said}
 
 
-def claim(result, components):
+def claim(result):
     """What a candidate's choice claims, least first (`Policy.claim`)."""
-    return POLICY.claim(result["effect"], result["target"], components)
+    return POLICY.claim(result["effect"], result["physics"]["component"])
 
 
-def band(admissible, base, sigma, floor_sd, n, components):
+def band(admissible, base, sigma, floor_sd, n, distances):
     """Step 3: the admissible candidates the data cannot tell from the best (the lowest evidence),
     the best among them: those whose evidence exceeds the best's by no more than
     `standard_errors` standard errors of the paired difference (its scatter from day to day, or
-    what the sensors' noise alone makes of it, `noise_difference`), at least the rounding; and,
+    what the sensors' noise alone makes of it, `noise_difference` of their `distances`), at least
+    the rounding; and,
     where the best claims more, by no more than the noise's tolerance (`parsimony`)."""
     best = min(admissible, key=lambda r: evidence(r).sum())
     rounding = POLICY.rounding(float(base.sum()))
 
     def close(r):
         worse, se = fall(evidence(r), evidence(best))
-        needed = max(POLICY.standard_errors * max(se, noise_difference(r, best, sigma)), rounding)
-        if claim(r, components) < claim(best, components):
+        needed = max(POLICY.standard_errors * max(se, noise_difference(distances[label(r)][label(best)], sigma)),
+                     rounding)
+        if claim(r) < claim(best):
             needed = max(needed, parsimony(best, floor_sd, n))
         return worse <= needed
     return [r for r in admissible if close(r)]

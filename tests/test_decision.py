@@ -119,12 +119,12 @@ def test_a_heater_node_is_judged_by_the_time_constant_the_data_fix_but_must_stay
 
 
 def test_physics_comes_before_shapes_and_fewer_parameters_before_more():
-    def claim(effect, target="cell"):
-        return POLICY.claim(effect, target, {"door", "floor"})
+    def claim(effect, component=False):
+        return POLICY.claim(effect, component)
     assert claim("conductivity") < claim("proportional_gain") < claim("daily_gain")
     assert claim("infiltration") < claim("ground_coupling")
     # and, claiming as much, the zone's effect before one component's
-    assert claim("envelope_conductance") < claim("conductivity", "door")
+    assert claim("envelope_conductance") < claim("conductivity", component=True)
 
 
 # --- decide() on hand-made candidates: the model without them predicts each of four left-out days
