@@ -71,7 +71,7 @@ def cmd_fmu(args):
 
 def cmd_simulate(args):
     from nodeforce.model.case import force_mask
-    from nodeforce.model.report import write_node_names, write_node_temperatures
+    from nodeforce.iotools.node_temperatures import write_node_names, write_node_temperatures
     if args.force and not args.measurements:
         raise InputError("--force", args.force, "forcing needs --measurements to force nodes to")
     building, case, objective = load_inputs(args)
