@@ -1,6 +1,7 @@
 """The report writer: the before/after table, report.md and its plots, from a report and series
 built by hand (two zones, a localisation, four candidates, the loop's decision)."""
 import copy
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -268,12 +269,24 @@ def test_write_report_from_an_almost_empty_report(tmp_path):
     assert "No candidate effect was tried" in md and "The loop recorded no decision" in md
 
 
-@pytest.mark.parametrize("tz", [None, "UTC"])
-def test_write_report_times_without_offset_or_in_utc(tmp_path, tz):
+@pytest.mark.parametrize("tz,label,first", [(None, "time", "2001-06-10 00:00"),
+                                             ("UTC", "time (UTC+00:00)", "2001-06-10 05:00")])
+def test_write_report_times_without_offset_or_in_utc(tmp_path, monkeypatch, tz, label, first):
+    """Times without an offset are plotted as they are, under "time"; times in UTC at their UTC
+    clock (the record's first time, 00:00 at UTC-05:00, at 05:00), the axis naming the offset."""
+    from nodeforce.diagnosis.report import figures
     report, series = synthetic()
     times = series["times"].tz_convert(tz) if tz else series["times"].tz_localize(None)
+    saved = {}
+    original = figures._save
+    monkeypatch.setattr(figures, "_save", lambda fig, path: saved.setdefault(Path(path).name, fig) and original(fig, path))
     check_report(tmp_path, report, dict(series, times=times, validation_start=times[96], scored_from=times[8]),
                  ALL_PLOTS)
+    for name in ("air_temperature.png", "residuals.png"):
+        axes = saved[name].axes
+        assert {ax.get_xlabel() for ax in axes if ax.get_xlabel()} == {label}, name
+    plotted = saved["air_temperature.png"].axes[0].get_lines()[0].get_xdata()[0]
+    assert pd.Timestamp(plotted).strftime("%Y-%m-%d %H:%M") == first
 
 
 def test_a_long_effect_name_keeps_the_time_plots_legend_inside_the_figure(tmp_path, monkeypatch):
