@@ -17,6 +17,7 @@ from nodeforce.fmu_build.build import build_fmu, fmu_kind as _fmu_kind
 from nodeforce.ga import locate as _locate
 from nodeforce.iotools.measurements import read_measurements
 from nodeforce.iotools.phases import read_phases
+from nodeforce.iotools.table import convert_table as _convert_table
 from nodeforce.iotools.weather import read_weather
 from nodeforce.model.building import Building, load_building
 from nodeforce.model.case import HISTORY_DAYS, force_mask, measured_case, simulate_building
@@ -24,7 +25,7 @@ from nodeforce.model.errors import InputError
 from nodeforce.model.score import Objective
 
 __all__ = ["InputError", "read_building", "read_weather", "read_measurements", "read_phases", "measured_case",
-           "read_case", "read_record", "objective", "simulate", "write_fmu", "open_fmu", "simulate_fmu", "forcing_candidates",
+           "read_case", "read_record", "objective", "synthesize", "convert_table", "simulate", "write_fmu", "open_fmu", "simulate_fmu", "forcing_candidates",
            "score_forcing", "locate", "diagnose", "Record", "compare"]
 
 # One record of a building among several in one diagnosis: case, source, name, fraction,
@@ -132,6 +133,52 @@ def read_record(building, weather, measurements, *, name=None, fraction=0.6, cal
                                decomposition=decomposition, history_days=history_days)
     return Record(case, str(measurements), name or Path(measurements).name.split(".")[0], fraction, calibration_end,
                   tuple(read_phases(phases)) if phases else (), building)
+
+
+def synthesize(building, weather, times, sensors, *, effects=(), noise_sd=0.0, seed=0, history_days=0.0,
+               decomposition="erbs"):
+    """What the sensors of a building would read under a weather, with effects its file does not
+    declare (`nodeforce synth`).
+
+    Parameters
+    ----------
+    building : Building
+    weather : DataFrame from `read_weather`, covering the history and `times`
+    times : uniform DatetimeIndex of the record
+    sensors : sequence of int
+        The node ids measured.
+    effects : sequence of (effect, target, {parameter: value})
+        Effects of `model.effects.EFFECTS` added to the building, each in turn (several faults at once).
+    noise_sd : float
+        Standard deviation (C) of the Gaussian sensor noise added.
+    seed : int
+        The noise's.
+    history_days, decomposition
+        Days of the weather simulated before the record; pvlib's split of ghi alone.
+
+    Returns
+    -------
+    DataFrame
+        Indexed by time, columns ``T<id>`` (C): a measurements file's content.
+    """
+    from nodeforce.model.effects import EFFECTS
+    from nodeforce.model.synth import pseudo_measurements
+    for effect, target, values in effects:
+        building = EFFECTS[effect].apply(building, target, values)
+    return pseudo_measurements(building, weather, times, list(sensors), noise_sd=noise_sd, seed=seed,
+                               history_days=history_days, decomposition=decomposition)
+
+
+def convert_table(path, names, origin, select, output, *, table=None, start=None, end=None, constant=None):
+    """Columns of a Modelica CombiTimeTable text file written as a weather or measurements CSV
+    (`nodeforce table`; the arguments are `nodeforce.iotools.table.convert_table`'s).
+
+    Returns
+    -------
+    DataFrame
+        What was written, indexed by time.
+    """
+    return _convert_table(path, names, origin, select, output, table=table, start=start, end=end, constant=constant)
 
 
 def simulate(building, weather, measurements=None, force=(), burn_in_days=0):

@@ -180,13 +180,13 @@ def effect_spec(text):
 def cmd_synth(args):
     import pandas as pd
     from nodeforce.model.effects import EFFECTS
-    from nodeforce.model.synth import pseudo_measurements
     building = api.read_building(args.building)
-    for text in args.effect or ():  # several faults at once: each applied in turn
-        effect, target, values = effect_spec(text)
-        if not EFFECTS[effect].applies(building, target):
+    effects = [effect_spec(text) for text in args.effect or ()]  # several faults at once: each applied in turn
+    applied = building
+    for effect, target, values in effects:
+        if not EFFECTS[effect].applies(applied, target):
             raise InputError("--effect", f"{effect}@{target}", f"does not apply to {args.building}")
-        building = EFFECTS[effect].apply(building, target, values)
+        applied = EFFECTS[effect].apply(applied, target, values)
     for option, value, ok in (("--days", args.days, args.days >= 1), ("--step", args.step, args.step > 0),
                               ("--noise", args.noise, args.noise >= 0),
                               ("--history-days", args.history_days, args.history_days >= 0)):
@@ -198,9 +198,9 @@ def cmd_synth(args):
     start = instant("--start", args.start)
     times = pd.date_range(start, periods=int(args.days * 86400 / args.step) + 1,
                           freq=pd.Timedelta(seconds=args.step), name="time")
-    frame = pseudo_measurements(building, api.read_weather(args.weather), times, node_list("--sensors", args.sensors),
-                                noise_sd=args.noise, seed=args.seed, history_days=args.history_days,
-                                decomposition=args.decomposition)
+    frame = api.synthesize(building, api.read_weather(args.weather), times, node_list("--sensors", args.sensors),
+                           effects=effects, noise_sd=args.noise, seed=args.seed, history_days=args.history_days,
+                           decomposition=args.decomposition)
     Path(args.output).parent.mkdir(parents=True, exist_ok=True)
     frame.round(4).to_csv(args.output, date_format="%Y-%m-%dT%H:%M:%S%z")
     print(f"wrote {args.output}: nodes {args.sensors}, {len(times)} times from {times[0].isoformat()}, "
@@ -327,10 +327,10 @@ def cmd_compare(args):
 
 
 def cmd_table(args):
-    from nodeforce.iotools.table import column_names, constants, convert_table, selection
-    written = convert_table(args.table_file, column_names(args.names, args.table_file), args.origin,
-                            selection(args.select), args.output, table=args.table, start=args.start,
-                            end=args.end, constant=constants(args.set) if args.set else None)
+    from nodeforce.iotools.table import column_names, constants, selection
+    written = api.convert_table(args.table_file, column_names(args.names, args.table_file), args.origin,
+                                selection(args.select), args.output, table=args.table, start=args.start,
+                                end=args.end, constant=constants(args.set) if args.set else None)
     print(f"wrote {args.output}: {', '.join(written.columns)} at {len(written)} times "
           f"({written.index[0].isoformat()} to {written.index[-1].isoformat()})")
 
