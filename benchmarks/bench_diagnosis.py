@@ -58,7 +58,7 @@ def result_path(out, name, draw):
 
 
 # The code and data a result depends on: the package (the loop), the records, the baseline, the Twin House.
-CODE = ("nodeforce", "model", "fmu_build", "cosim", "ga", "diagnose", "iotools", "benchmarks", "examples")
+CODE = ("nodeforce", "model", "fmu_build", "cosim", "ga", "diagnosis", "iotools", "benchmarks", "examples")
 
 
 def code_digest():
