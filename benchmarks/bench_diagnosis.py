@@ -1,6 +1,6 @@
 """Does the diagnosis name the effect a record carries? A benchmark of many records (issue 27).
 
-The records (`benchmarks/records.py`): the test cell under three typical years (pvlib's Miami,
+The records (`benchmarks/records.py`; their catalogue `benchmarks/catalogue.py`): the test cell under three typical years (pvlib's Miami,
 Greensboro and Sand Point files), 5 to 21 days at 10 to 60 min, 0.05 to 0.3 C of noise, read by
 the paper's sensors, by every node, or by the air alone with a PRBS heater; and the Twin House's
 living room under Greensboro's winter with its own sensors. Each carries one fault the building
@@ -43,7 +43,8 @@ sys.path.insert(0, str(ROOT))  # `benchmarks.records` when run as a script
 from tqdm import tqdm  # noqa: E402
 
 from benchmarks.baseline import baseline  # noqa: E402
-from benchmarks.records import PLAN, SCENARIOS, SPECS, SPECS_BY_NAME, quick_specs, record  # noqa: E402
+from benchmarks.catalogue import PLAN, SCENARIOS, SPECS, SPECS_BY_NAME, quick_specs  # noqa: E402
+from benchmarks.records import record  # noqa: E402
 from nodeforce.model.case import HISTORY_DAYS  # noqa: E402
 
 OUT = ROOT / "out" / "bench_diagnosis"
@@ -58,7 +59,7 @@ def result_path(out, name, draw):
 
 
 # The code and data a result depends on: the package (the loop), the records, the baseline, the Twin House.
-CODE = ("nodeforce", "model", "fmu_build", "cosim", "ga", "diagnose", "iotools", "benchmarks", "examples")
+CODE = ("nodeforce", "model", "fmu_build", "cosim", "ga", "diagnosis", "iotools", "benchmarks", "examples")
 
 
 def code_digest():
@@ -323,12 +324,12 @@ def scenarios_table():
     """Markdown: the records' scenarios, with the file's error on each one's record without a fault."""
     lines = ["| scenario | building | climate (typical year) | start | days | step | noise | sensors | weather before | faults |",
              "|---|---|---|---|---|---|---|---|---|---|"]
-    for name, (building, where, start, days, step, noise, sensors, objective, burn_in, before) in SCENARIOS.items():
+    for name, s in SCENARIOS.items():
         faults = ", ".join(entry.replace(" s", " (subtle)").replace(" L", " (strong)") for entry in PLAN[name])
         sensors = {"paper": "the paper's (1, 7, 9, 16, 17, 23)", "all": "every node",
-                   "air": "the air, PRBS heater 300 W", "own": "its own 10"}[sensors]
-        lines.append(f"| {name} | {building}{' (' + objective + ')' if objective else ''} | {where} | {start} | "
-                     f"{days} | {step} min | {noise} C | {sensors} | {before:g} days | {faults} |")
+                   "air": "the air, PRBS heater 300 W", "own": "its own 10"}[s.sensors]
+        lines.append(f"| {name} | {s.building}{' (' + s.objective + ')' if s.objective else ''} | {s.climate} | "
+                     f"{s.start} | {s.days} | {s.step_min} min | {s.noise} C | {sensors} | {s.before:g} days | {faults} |")
     return "\n".join(lines)
 
 

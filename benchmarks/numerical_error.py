@@ -18,7 +18,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.records import CALIBRATION_FRACTION, SPECS_BY_NAME, record  # noqa: E402
+from benchmarks.catalogue import CALIBRATION_FRACTION, SPECS_BY_NAME  # noqa: E402
+from benchmarks.records import record  # noqa: E402
 from nodeforce.model.numerical import refined  # noqa: E402
 
 CELLS = (2, 4)

@@ -15,12 +15,12 @@ from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.checkpoint import NAME as CHECKPOINT
 from nodeforce.fmu_build.compiler import find_compiler
 from nodeforce.ga.fitness import FmuFitness, RecordsFitness
-from nodeforce.ga.parsimony import EXPLAINED, removed
+from nodeforce.ga.parsimony import EXPLAINED
 from nodeforce.ga.search import PATIENCE, search
 from nodeforce.model.case import as_cases
 from nodeforce.model.errors import InputError
 from nodeforce.model.network import assemble
-from nodeforce.model.score import Noise
+from nodeforce.model.score import Noise, removed
 
 
 def evaluator_kind():
@@ -127,9 +127,9 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
 
 def evidence(building, result):
     """The forcing evidence per component: the share of J above the noise that forcing its
-    best-scoring measured node alone removes (`ga.parsimony.removed`), most first. A diagnosis
+    best-scoring measured node alone removes (`model.score.removed`), most first. A diagnosis
     calibrates the effects of the components it ranks highest, whether or not a fault is
-    located (`diagnose.candidates.physical`).
+    located (`diagnosis.candidates.physical`).
 
     Returns [{"component", "node", "J", "share"}]; components without a node the search forced
     are absent."""

@@ -63,6 +63,7 @@ from itertools import combinations
 from typing import Callable, Sequence
 
 from nodeforce.model import significance
+from nodeforce.model.score import removed
 
 Z_NOISE = 3.0
 EXPLAINED = 0.5
@@ -89,21 +90,14 @@ def noise_tolerance(noise_sigma: "float | None", n_residuals: "int | None") -> f
     return Z_NOISE * noise_sigma ** 2 * math.sqrt(2 * n_residuals)
 
 
-def noise_floor(noise_sigma: "float | None", n_residuals: "int | None") -> float:
+def noise_J(noise_sigma: "float | None", n_residuals: "int | None") -> float:
     """J (C2) of the noise alone, n sigma^2; 0 if the noise is unknown."""
     return 0.0 if noise_sigma is None else n_residuals * noise_sigma ** 2
 
 
-def removed(J_unforced: float, J: float, J_noise: float) -> float:
-    """The fraction of the error above the noise, J_unforced - J_noise, that a forcing of score J
-    (C2) removes (1: all of it; 0 or less: none)."""
-    above = J_unforced - J_noise
-    return (J_unforced - J) / above if above > 0 else 0.0
-
-
 def explains(J_unforced: float, J_min: float, noise_sigma: "float | None", n_residuals: "int | None") -> bool:
     """Whether the best forcing removes enough of the residual to locate a fault (docstring above)."""
-    return removed(J_unforced, J_min, noise_floor(noise_sigma, n_residuals)) >= 1 - EXPLAINED
+    return removed(J_unforced, J_min, noise_J(noise_sigma, n_residuals)) >= 1 - EXPLAINED
 
 
 def smallest_subset(J_many: Callable[[Sequence[tuple]], list], best: tuple, limit: float,

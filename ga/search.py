@@ -43,7 +43,7 @@ from tqdm import tqdm
 from nodeforce.ga import checkpoint as ckpt
 from nodeforce.ga.evaluation import FitnessCache, log, open_backend
 from nodeforce.ga.operators import bit_flip_mutation, one_point_crossover, roulette_selection
-from nodeforce.ga.parsimony import (ROUNDING, Paired, explains, forward_backward, noise_floor, noise_tolerance,
+from nodeforce.ga.parsimony import (ROUNDING, Paired, explains, forward_backward, noise_J, noise_tolerance,
                                     smallest_subset, tolerance)
 
 # Generations without a significant fall of the best J before the GA stops. Measured on the
@@ -343,7 +343,7 @@ def _answer(cache, nodes, noise_sigma, n_residuals, factory=None) -> dict:
         "tied_nodes": [[nodes[i] for i in group] for group in ties(J_single, J_unforced, tol)],
         "search": {"J_min": _json(J_min), "min_nodes": cache.describe(best),
                    "tolerance": _json(tol), "explains": explained,
-                   "J_noise": _json(noise_floor(noise_sigma, n_residuals))},
+                   "J_noise": _json(noise_J(noise_sigma, n_residuals))},
     }
 
 

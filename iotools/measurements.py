@@ -6,7 +6,8 @@ filled; the model handles a missing measurement where it uses one (docs/model.md
 
 from nodeforce.model.building import NODE_COLUMN
 from nodeforce.model.errors import InputError
-from .timetable import check_celsius, read_time_table
+from nodeforce.model.units import check_celsius
+from .timetable import read_time_table
 
 
 def read_measurements(path):
@@ -32,7 +33,7 @@ def read_measurements(path):
     InputError
         Naming the file and the column: the checks of `iotools.timetable.read_time_table` (time
         column, times, non-numeric cells), no measured column, kelvin-looking temperatures
-        (median above `iotools.timetable.KELVIN_MEDIAN`) in a `T<id>` column. Another name is
+        (median above `model.units.KELVIN_MEDIAN`) in a `T<id>` column. Another name is
         checked once the building has said it is a sensor's (`model.case.measured_matrix`): a
         column that names no node (a heat power put here) is told so, not that it looks like kelvin.
     """

@@ -2,7 +2,7 @@
 check the phases CSV, `time,phase`, a phase starting at its time and lasting until the next
 one starts (the last until the end of the record).
 
-The loop scores every candidate on every phase (`diagnose.loop`), so an effect that lowers the
+The loop scores every candidate on every phase (`diagnosis.loop`), so an effect that lowers the
 total error while making one phase worse is seen.
 """
 from dataclasses import dataclass

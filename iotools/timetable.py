@@ -16,10 +16,6 @@ import pandas as pd
 from nodeforce.model.errors import InputError
 from nodeforce.model.weather import utc_microseconds
 
-#: A temperature column whose median exceeds this (degrees C) is taken for kelvin: no climate or
-#: building has a median above 150 C, and no kelvin reading is below 150 K.
-KELVIN_MEDIAN = 150.0
-
 # The offset must follow a clock time, so a bare date's "-01" is not taken for one.
 _OFFSET = re.compile(r"[T ][\d:.,]+(Z|[+-]\d{2}(?::?\d{2})?)$")
 
@@ -85,26 +81,6 @@ def write_time_table(frame, path, float_format=None):
     out = frame.copy()
     out.index = pd.Index([t.isoformat() for t in frame.index], name="time")
     out.to_csv(path, float_format=float_format, lineterminator="\n")
-
-
-def check_celsius(frame, columns):
-    """Refuse temperature columns that look like kelvin (median above `KELVIN_MEDIAN`).
-
-    Parameters
-    ----------
-    frame : pandas.DataFrame
-        As returned by `read_time_table` (its `attrs["source"]` names the file).
-    columns : iterable of str
-        Temperature columns to check, degrees C; absent or all-missing columns pass.
-    """
-    for name in columns:
-        if name in frame and frame[name].notna().any():
-            median = float(frame[name].median())
-            if median > KELVIN_MEDIAN:
-                raise InputError(
-                    frame.attrs.get("source", "?"), name,
-                    f"median {median:.1f} looks like Kelvin; temperatures must be in degrees C",
-                )
 
 
 def check_increasing(source, times, where):

@@ -10,7 +10,8 @@ import numpy as np
 from nodeforce.model.errors import InputError
 from nodeforce.model.weather import IRRADIANCE_COLUMNS, REQUIRED_COLUMNS, TEMPERATURE_COLUMNS, utc_microseconds
 from .hourly import read_epw, to_mid_hour
-from .timetable import check_celsius, read_time_table
+from nodeforce.model.units import check_celsius
+from .timetable import read_time_table
 
 #: Irradiances (W/m2) below this are refused. Pyranometers read a few W/m2 below zero at night
 #: (thermal offset); those pass unchanged and the model clips incident solar at 0. A value far below

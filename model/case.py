@@ -16,12 +16,11 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import pandas as pd
 
-from nodeforce.iotools.timetable import check_celsius
-
 from .errors import InputError
 from .integrate import history_block, initial_state, simulate, steps_per_day, substeps
 from .building import DAY_TERMS
 from .network import assemble, clock_input_names, day_input, input_names
+from .units import check_celsius
 from .solar import (DECOMPOSITIONS, complete_irradiance, incident_irradiance, measured_irradiance, sky_temperature,
                     solar_position)
 from .weather import IRRADIANCE_COLUMNS, check_columns, weather_on_grid

@@ -6,7 +6,7 @@ an ordinary building that every command loads, and its FMU exposes the effect's 
 range), which targets it applies to, how it reads and writes the building, and which nodes'
 forcing points at it. Adding an effect is one record here (and its fields in the building file
 format, if it needs new ones). Which effects a diagnosis tries, and where a calibration starts,
-is the diagnosis' policy (`nodeforce.diagnose.candidates`), not physics.
+is the diagnosis' policy (`nodeforce.diagnosis.candidates`), not physics.
 
 A `thermal_bridge` target is a zone name for a bridge to the outdoor air, or `<zone>-><column>`
 for a bridge to a boundary temperature column (attic, cellar, neighbour); a `proportional_gain`

@@ -77,7 +77,7 @@ def share(residual, error, rows=None):
     discretises; between, the error's share the residual holds. A correction fitted to the
     residual plus s * error (measured minus the file's run moved s of the way to the continuum)
     is fitted to what the physics the file declares misses, not to what its discretisation makes
-    (`diagnose.calibrate`)."""
+    (`diagnosis.calibrate`)."""
     keep = np.isfinite(residual) & np.isfinite(error) & (True if rows is None else rows)
     e, r = error[keep], residual[keep]
     energy = float(e @ e)

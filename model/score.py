@@ -8,6 +8,13 @@ from .errors import InputError
 from .numerical import REFERENCE_STEP, REFINEMENT
 
 
+def removed(J_unforced, J, J_noise):
+    """The fraction of the error above the noise, J_unforced - J_noise, that a model (a forcing, a
+    correction) of score J (C2) removes (1: all of it; 0 or less: none)."""
+    above = J_unforced - J_noise
+    return (J_unforced - J) / above if above > 0 else 0.0
+
+
 def residuals(measured, simulated):
     """r_n = measured - simulated (C), only where a measurement exists."""
     r = np.asarray(measured, dtype=float) - np.asarray(simulated, dtype=float)
@@ -71,7 +78,7 @@ class Noise:
     is visible in them at all (on real records of precise sensors the signal's curvature over
     one step outweighs the white noise, and the error that matters is slow). Beside it, the
     building file's own numerical error at the air (`numerical`, RMS in C, `model.numerical`):
-    together they are what a right model of the file leaves (`floor`)."""
+    together they are what a right model of the file leaves (`floor_sd`, C)."""
     sigma: float | None
     given: bool = False
     lag1: float | None = None
@@ -82,7 +89,7 @@ class Noise:
         return replace(self, numerical=float(rms))
 
     @property
-    def floor(self):
+    def floor_sd(self):
         """The sd (C) of what a model right but for its discretisation leaves, sqrt(sigma^2 +
         numerical^2): the J a right correction brings the error to is n floor^2; None if the
         noise is unknown."""
@@ -134,12 +141,12 @@ class Noise:
         return (f"numerical error of the building file at the air: {self.numerical:.2g} C RMS over the calibration "
                 f"window (the file against itself {REFINEMENT} times finer in space and at steps of at most "
                 f"{REFERENCE_STEP:g} s); the choices count it beside the noise, an error floor of "
-                + (f"{self.floor:.2g} C" if self.floor is not None else "its own") + ": no correction of the physics "
+                + (f"{self.floor_sd:.2g} C" if self.floor_sd is not None else "its own") + ": no correction of the physics "
                 "is asked to explain it")
 
     def to_json(self):
         return {"sigma": self.sigma, "given": self.given, "lag1": self.lag1, "visible": self.visible,
-                "numerical": self.numerical, "floor": self.floor, "sentence": self.sentence(),
+                "numerical": self.numerical, "floor": self.floor_sd, "sentence": self.sentence(),
                 "numerical_sentence": self.numerical_sentence()}
 
 

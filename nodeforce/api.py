@@ -1,4 +1,4 @@
-"""The Python API: what a script needs, as thin functions over the modules the command line uses.
+"""The Python API: what a script needs; the command line (`nodeforce.cli`) is a thin layer over it.
 
 Read a building, its weather and measurements; make the measured case; simulate; write an FMU;
 open it and score a forcing (J) through it with FMPy; locate; diagnose. Every function is
@@ -12,25 +12,26 @@ from pathlib import Path
 from nodeforce import tempdirs
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import input_table, simulate_fmu
-from nodeforce.diagnose import compare as _compare, loop as _loop
-from nodeforce.fmu_build.build import build_fmu
+from nodeforce.diagnosis import compare as _compare, loop as _loop
+from nodeforce.fmu_build.build import build_fmu, fmu_kind as _fmu_kind
 from nodeforce.ga import locate as _locate
 from nodeforce.iotools.fmu_inputs import write_fmu_inputs
 from nodeforce.iotools.measurements import read_measurements
 from nodeforce.iotools.phases import read_phases
+from nodeforce.iotools.table import convert_table as _convert_table
 from nodeforce.iotools.weather import read_weather
-from nodeforce.model.building import load_building
-from nodeforce.model.case import force_mask, measured_case, simulate_building
+from nodeforce.model.building import Building, load_building
+from nodeforce.model.case import HISTORY_DAYS, force_mask, measured_case, simulate_building
 from nodeforce.model.errors import InputError
 from nodeforce.model.score import Objective
 
 __all__ = ["InputError", "read_building", "read_weather", "read_measurements", "read_phases", "measured_case",
-           "objective", "simulate", "write_fmu", "fmu_inputs", "write_fmu_inputs", "open_fmu", "simulate_fmu",
-           "forcing_candidates",
+           "read_case", "read_record", "objective", "synthesize", "convert_table", "simulate", "write_fmu",
+           "fmu_inputs", "write_fmu_inputs", "open_fmu", "simulate_fmu", "forcing_candidates",
            "score_forcing", "locate", "diagnose", "Record", "compare"]
 
 # One record of a building among several in one diagnosis: case, source, name, fraction,
-# calibration_end, phases (diagnose.loop.Record).
+# calibration_end, phases (diagnosis.loop.Record).
 Record = _loop.Record
 
 # The API's cases carry no file name: errors about their measurements say "measurements".
@@ -59,7 +60,7 @@ def read_building(path):
     return load_building(path)
 
 
-def objective(building, zones=None):
+def objective(building, zones=None, source="zones"):
     """The zones whose measured air J sums (docs/model.md section 6).
 
     Parameters
@@ -67,13 +68,119 @@ def objective(building, zones=None):
     building : Building
     zones : list of str, optional
         Zone names; default the building's first zone.
+    source : str
+        What an error about a zone names (the command line's option).
 
     Returns
     -------
     Objective
         `zones` and their `air_nodes` (node ids).
     """
-    return Objective.of(building, zones, source="zones")
+    return Objective.of(building, zones, source=source)
+
+
+def read_case(building, weather, measurements=None, *, burn_in_days=0, decomposition="erbs",
+              history_days=HISTORY_DAYS):
+    """The files of one record read and made its measured case: what every command that
+    simulates reads first.
+
+    Parameters
+    ----------
+    building : str or Path, or a Building already read
+    weather : str or Path
+        The weather CSV or EPW (`read_weather`).
+    measurements : str or Path, optional
+        The measurements CSV (`read_measurements`); None: a simulation without them.
+    burn_in_days, decomposition, history_days
+        `measured_case`'s: days forced after the first measurement, the pvlib model that splits
+        ghi alone, days of weather simulated before the record at most.
+
+    Returns
+    -------
+    (Building, Case)
+        The case's `assumptions` say what was assumed about the files (the weather's history).
+    """
+    building = building if isinstance(building, Building) else load_building(building)
+    case = measured_case(building, read_weather(weather), read_measurements(measurements) if measurements else None,
+                         burn_in_days, decomposition, history_days)
+    return building, case
+
+
+def read_record(building, weather, measurements, *, name=None, fraction=0.6, calibration_end=None, phases=None,
+                burn_in_days=0, decomposition="erbs", history_days=HISTORY_DAYS):
+    """One record of a building for `diagnose`, read from its files.
+
+    Parameters
+    ----------
+    building : str or Path, or a Building already read
+        The building as written for this record's protocol (its own supply flows, blinds): the
+        house the diagnosis corrects, or the same house node for node.
+    weather, measurements : str or Path
+        The record's files; errors about the measurements name their file.
+    name : str, optional
+        The record's name in the report; default the measurement file's name before its first dot.
+    fraction, calibration_end
+        The calibration window: the first `fraction` of the record by time, or up to
+        `calibration_end` (a pandas Timestamp, the row at or before it).
+    phases : str or Path, optional
+        The record's `time,phase` CSV (`read_phases`).
+    burn_in_days, decomposition, history_days
+        As `read_case`.
+
+    Returns
+    -------
+    Record
+    """
+    building, case = read_case(building, weather, measurements, burn_in_days=burn_in_days,
+                               decomposition=decomposition, history_days=history_days)
+    return Record(case, str(measurements), name or Path(measurements).name.split(".")[0], fraction, calibration_end,
+                  tuple(read_phases(phases)) if phases else (), building)
+
+
+def synthesize(building, weather, times, sensors, *, effects=(), noise_sd=0.0, seed=0, history_days=0.0,
+               decomposition="erbs"):
+    """What the sensors of a building would read under a weather, with effects its file does not
+    declare (`nodeforce synth`).
+
+    Parameters
+    ----------
+    building : Building
+    weather : DataFrame from `read_weather`, covering the history and `times`
+    times : uniform DatetimeIndex of the record
+    sensors : sequence of int
+        The node ids measured.
+    effects : sequence of (effect, target, {parameter: value})
+        Effects of `model.effects.EFFECTS` added to the building, each in turn (several faults at once).
+    noise_sd : float
+        Standard deviation (C) of the Gaussian sensor noise added.
+    seed : int
+        The noise's.
+    history_days, decomposition
+        Days of the weather simulated before the record; pvlib's split of ghi alone.
+
+    Returns
+    -------
+    DataFrame
+        Indexed by time, columns ``T<id>`` (C): a measurements file's content.
+    """
+    from nodeforce.model.effects import EFFECTS
+    from nodeforce.model.synth import pseudo_measurements
+    for effect, target, values in effects:
+        building = EFFECTS[effect].apply(building, target, values)
+    return pseudo_measurements(building, weather, times, list(sensors), noise_sd=noise_sd, seed=seed,
+                               history_days=history_days, decomposition=decomposition)
+
+
+def convert_table(path, names, origin, select, output, *, table=None, start=None, end=None, constant=None):
+    """Columns of a Modelica CombiTimeTable text file written as a weather or measurements CSV
+    (`nodeforce table`; the arguments are `nodeforce.iotools.table.convert_table`'s).
+
+    Returns
+    -------
+    DataFrame
+        What was written, indexed by time.
+    """
+    return _convert_table(path, names, origin, select, output, table=table, start=start, end=end, constant=constant)
 
 
 def simulate(building, weather, measurements=None, force=(), burn_in_days=0):
@@ -98,8 +205,8 @@ def simulate(building, weather, measurements=None, force=(), burn_in_days=0):
     return simulate_building(building, weather, measurements, force=force, burn_in_days=burn_in_days)
 
 
-def write_fmu(building, path, standalone=False):
-    """Write the building's FMI 2.0 co-simulation FMU (docs/fmu.md).
+def write_fmu(building, path, standalone=False, fmi=2):
+    """Write the building's co-simulation FMU (docs/fmu.md).
 
     Parameters
     ----------
@@ -109,13 +216,15 @@ def write_fmu(building, path, standalone=False):
     standalone : bool
         False: the Python FMU (pythonfmu), the one the search drives. True: the same model in C,
         no Python at run time (a C compiler is needed to export it).
+    fmi : int
+        The FMI version, 2 or 3.
 
     Returns
     -------
     Path
         The FMU written.
     """
-    return build_fmu(building, path, kind="standalone" if standalone else "python")
+    return build_fmu(building, path, kind=_fmu_kind("standalone" if standalone else "python", fmi))
 
 
 def fmu_inputs(building, weather, measurements=None, force=(), burn_in_days=0, decomposition="erbs"):
@@ -206,7 +315,7 @@ def score_forcing(instance, case, nodes, objective):
     return objective.J(objective.measured(case), air)
 
 
-def locate(building, case, objective=None, workdir=None, **search):
+def locate(building, case, objective=None, workdir=None, source=SOURCE, **search):
     """The forcing search of `nodeforce locate`: the content of locate.json (docs/guide.md).
 
     Parameters
@@ -218,6 +327,8 @@ def locate(building, case, objective=None, workdir=None, **search):
     workdir : str or Path, optional
         Folder for the FMU and the search's checkpoint (a run started again resumes); default a
         temporary folder, removed at the end.
+    source : str
+        What an error about the measurements names (their file).
     **search
         `nodeforce.ga.locate.locate`'s settings: nodes, include_algebraic, population,
         generations, pc, pm, patience, seeded, seed, workers, scheduler, fmu_kind, noise, progress.
@@ -231,10 +342,11 @@ def locate(building, case, objective=None, workdir=None, **search):
     """
     with _folder(workdir) as folder:
         return _locate.locate(building, case, objective or Objective.of(building), folder,
-                              source=SOURCE, **search)
+                              source=source, **search)
 
 
-def diagnose(building, case, workdir, objective=None, **options):
+def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibration_end=None, phases=(), seed=0,
+             workers=None, fmu_kind="python", noise=None, reference=None, population=30, generations=400):
     """The whole loop of `nodeforce diagnose`; writes its files in `workdir` and returns report.json's
     content (docs/guide.md, Output files).
 
@@ -250,18 +362,37 @@ def diagnose(building, case, workdir, objective=None, **options):
         Folder for report.json, report.md, the plots, building_after.json and model_after.fmu.
     objective : Objective, optional
         Default: the building's first zone.
-    **options
-        `nodeforce.diagnose.loop.diagnose`'s: fraction, calibration_end (a pandas Timestamp) and
-        phases (from `read_phases`) of a single case (a `Record` carries its own), seed, workers,
-        fmu_kind, noise, reference. Worker
-        processes as for `locate`.
+    fraction, calibration_end, phases
+        The calibration window of a single case: the first `fraction` of it by time, or up to
+        `calibration_end` (a pandas Timestamp); its phases (from `read_phases`). A `Record`
+        carries its own.
+    seed : int
+        Every random choice's (the forcing search, the screening).
+    workers : int, optional
+        Worker processes (default all cores), spawned as for `locate`.
+    fmu_kind : str
+        The FMUs built, run and written: "python" (the default, as on the command line),
+        "standalone" (or their "-fmi3" forms), or "auto", the standalone where a C compiler is at
+        hand. The candidates are fitted on the direct model, and the model they are measured
+        against runs through this FMU: the Python FMU repeats the direct model's arithmetic (to
+        1e-14 C), the C FMU differs by rounding (1e-12 C), which a candidate the data do not
+        determine can turn into another of its many equally good fits.
+    noise : float, optional
+        The air sensors' noise sd (C) where the user knows it; default estimated from the air.
+    reference : dict, optional
+        {"label", "rmse": {phase: K}}: another model's error, reported for scale.
+    population, generations : int
+        The forcing search's GA settings.
 
     Returns
     -------
     dict
     """
     with _folder(workdir) as folder:
-        return _loop.diagnose(building, case, objective or Objective.of(building), folder, source=SOURCE, **options)
+        return _loop.diagnose(building, case, objective or Objective.of(building), folder, source=SOURCE,
+                              fraction=fraction, calibration_end=calibration_end, phases=phases, seed=seed,
+                              workers=workers, fmu_kind=fmu_kind, noise=noise, reference=reference,
+                              population=population, generations=generations)
 
 
 def compare(models, workdir=None, phases=(), fmu_kind="python"):

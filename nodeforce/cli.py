@@ -9,16 +9,12 @@ from pathlib import Path
 
 import numpy as np
 
-from nodeforce import lifetime, tempdirs
+from nodeforce import api, lifetime, tempdirs
 from nodeforce.ga.checkpoint import NAME as CHECKPOINT, resume_hint
 from nodeforce.ga.search import PAPER, PATIENCE
-from nodeforce.model.building import load_building
-from nodeforce.model.case import HISTORY_DAYS, force_mask, measured_case
+from nodeforce.model.case import HISTORY_DAYS
 from nodeforce.model.errors import InputError
-from nodeforce.iotools.measurements import read_measurements
 from nodeforce.iotools.timetable import instant
-from nodeforce.iotools.weather import read_weather
-from nodeforce.model.score import Objective
 
 DATA = Path(str(files("nodeforce.model") / "data"))
 
@@ -40,16 +36,24 @@ def node_list(option, text):
 
 
 def load_inputs(args):
-    """The building, the case of its weather and measurements with its burn-in, and the objective."""
-    building = load_building(args.building)
-    weather = read_weather(args.weather)
-    measurements = read_measurements(args.measurements) if getattr(args, "measurements", None) else None
-    case = measured_case(building, weather, measurements, args.burn_in_days, args.decomposition,
-                         history(args))
-    for said in case.assumptions:
+    """The building, the case of its weather and measurements with its burn-in (`api.read_case`),
+    and the objective of --objective; what was assumed printed."""
+    building, case = api.read_case(args.building, args.weather, getattr(args, "measurements", None),
+                                   burn_in_days=args.burn_in_days, decomposition=args.decomposition,
+                                   history_days=history(args))
+    said_assumed(case.assumptions)
+    return building, case, objective_of(building, args)
+
+
+def said_assumed(assumptions):
+    for said in dict.fromkeys(assumptions):
         print(f"assumed: {said}")
-    objective = Objective.of(building, zone_list(args.objective) if getattr(args, "objective", None) else None)
-    return building, case, objective
+
+
+def objective_of(building, args):
+    """The objective of --objective (default the building's first zone)."""
+    return api.objective(building, zone_list(args.objective) if getattr(args, "objective", None) else None,
+                         source="--objective")
 
 
 def zone_list(text):
@@ -61,24 +65,20 @@ def zone_list(text):
 
 
 def cmd_fmu(args):
-    from nodeforce.fmu_build.build import build_fmu, fmu_kind
-    path = build_fmu(load_building(args.building), args.output,
-                     kind=fmu_kind("standalone" if args.standalone else "python", args.fmi))
+    path = api.write_fmu(api.read_building(args.building), args.output, standalone=args.standalone, fmi=args.fmi)
     print(f"wrote {path}")
 
 
 def cmd_simulate(args):
-    from nodeforce.cosim.fmi import FmuInstance
-    from nodeforce.cosim.run import simulate_fmu
-    from nodeforce.fmu_build.build import build_fmu, fmu_kind
-    from nodeforce.model.report import write_node_names, write_node_temperatures
+    from nodeforce.model.case import force_mask
+    from nodeforce.iotools.node_temperatures import write_node_names, write_node_temperatures
     if args.force and not args.measurements:
         raise InputError("--force", args.force, "forcing needs --measurements to force nodes to")
     building, case, objective = load_inputs(args)
     force = force_mask(case, node_list("--force", args.force), args.measurements) if args.force else None
     with tempdirs.folder("simulate") as tmp:
-        with FmuInstance(build_fmu(building, Path(tmp) / "model.fmu", kind=fmu_kind("python", args.fmi))) as instance:
-            T = simulate_fmu(instance, case, force)
+        with api.open_fmu(api.write_fmu(building, Path(tmp) / "model.fmu", fmi=args.fmi)) as instance:
+            T = api.simulate_fmu(instance, case, force)
     # the weather's history before the first measurement set the start; the output is the record's
     h = case.history_steps
     T, times = T[h:], case.times[h + 1:]
@@ -138,13 +138,11 @@ def check_workers(args):
 
 
 def cmd_locate(args):
-    from nodeforce.ga.locate import locate
     check_search_settings(args)
     strategy = search_strategy(args)
     building, case, objective = load_inputs(args)
     out = Path(args.output)
-    out.mkdir(parents=True, exist_ok=True)
-    result = locate(building, case, objective, out, source=args.measurements,
+    result = api.locate(building, case, objective, out, source=args.measurements,
                     nodes=node_list("--nodes", args.nodes) if args.nodes else None,
                     include_algebraic=args.include_algebraic, **strategy, seed=args.seed,
                     workers=args.workers, scheduler=args.scheduler, fmu_kind=kind_of(args), noise=noise(args))
@@ -196,13 +194,13 @@ def effect_spec(text):
 def cmd_synth(args):
     import pandas as pd
     from nodeforce.model.effects import EFFECTS
-    from nodeforce.model.synth import pseudo_measurements
-    building = load_building(args.building)
-    for text in args.effect or ():  # several faults at once: each applied in turn
-        effect, target, values = effect_spec(text)
-        if not EFFECTS[effect].applies(building, target):
+    building = api.read_building(args.building)
+    effects = [effect_spec(text) for text in args.effect or ()]  # several faults at once: each applied in turn
+    applied = building
+    for effect, target, values in effects:
+        if not EFFECTS[effect].applies(applied, target):
             raise InputError("--effect", f"{effect}@{target}", f"does not apply to {args.building}")
-        building = EFFECTS[effect].apply(building, target, values)
+        applied = EFFECTS[effect].apply(applied, target, values)
     for option, value, ok in (("--days", args.days, args.days >= 1), ("--step", args.step, args.step > 0),
                               ("--noise", args.noise, args.noise >= 0),
                               ("--history-days", args.history_days, args.history_days >= 0)):
@@ -214,9 +212,9 @@ def cmd_synth(args):
     start = instant("--start", args.start)
     times = pd.date_range(start, periods=int(args.days * 86400 / args.step) + 1,
                           freq=pd.Timedelta(seconds=args.step), name="time")
-    frame = pseudo_measurements(building, read_weather(args.weather), times, node_list("--sensors", args.sensors),
-                                noise_sd=args.noise, seed=args.seed, history_days=args.history_days,
-                                decomposition=args.decomposition)
+    frame = api.synthesize(building, api.read_weather(args.weather), times, node_list("--sensors", args.sensors),
+                           effects=effects, noise_sd=args.noise, seed=args.seed, history_days=args.history_days,
+                           decomposition=args.decomposition)
     Path(args.output).parent.mkdir(parents=True, exist_ok=True)
     frame.round(4).to_csv(args.output, date_format="%Y-%m-%dT%H:%M:%S%z")
     print(f"wrote {args.output}: nodes {args.sensors}, {len(times)} times from {times[0].isoformat()}, "
@@ -224,13 +222,12 @@ def cmd_synth(args):
 
 
 def run_diagnosis(building, records, objective, out, args):
-    """The loop on `records` (diagnose.loop.Record), its summary printed."""
-    from nodeforce.diagnose.loop import diagnose
-    from nodeforce.diagnose.report import terminal_summary
+    """The loop on `records` (`api.Record`s) through `api.diagnose`, its summary printed."""
+    from nodeforce.diagnosis.report import terminal_summary
     check_workers(args)
-    out.mkdir(parents=True, exist_ok=True)
-    report = diagnose(building, records, objective, out, seed=args.seed, workers=args.workers, fmu_kind=kind_of(args),
-                      reference=read_reference(args.reference) if args.reference else None, noise=noise(args))
+    report = api.diagnose(building, records, out, objective, seed=args.seed, workers=args.workers,
+                          fmu_kind=kind_of(args), noise=noise(args),
+                          reference=read_reference(args.reference) if args.reference else None)
     print(terminal_summary(report))
     print(f"wrote {out / 'report.json'}, {out / 'report.md'}, {out / 'building_after.json'}, {out / 'model_after.fmu'}")
 
@@ -239,15 +236,6 @@ def check_fraction(option, fraction):
     if not 0.0 < fraction < 1.0:
         raise InputError(option, fraction, "a fraction between 0 and 1")
     return fraction
-
-
-def the_record(case, source, args):
-    """The diagnosis' one record of --weather, --measurements and the window options."""
-    from nodeforce.diagnose.loop import Record
-    from nodeforce.iotools.phases import read_phases
-    return Record(case, source, str(source), check_fraction("--calibration-fraction", args.calibration_fraction),
-                  instant("--calibration-end", args.calibration_end) if args.calibration_end else None,
-                  tuple(read_phases(args.phases)) if args.phases else ())
 
 
 # The fields of --record: each a file or a window of one record; those not given take the option
@@ -276,43 +264,42 @@ def record_fields(text):
 
 
 def records_of(building, args):
-    """The records of a diagnosis: each --record, or the one of --weather and --measurements."""
-    from nodeforce.diagnose.loop import Record
-    from nodeforce.iotools.phases import read_phases
+    """The records of a diagnosis (`api.read_record`): each --record, or the one of --weather and
+    --measurements with the window options."""
     if not args.record:
         if not (args.weather and args.measurements):
             raise InputError("--weather", args.weather or "", "diagnose needs --weather and --measurements, "
                                                               "or one --record per record")
-        case = measured_case(building, read_weather(args.weather), read_measurements(args.measurements),
-                             args.burn_in_days, args.decomposition, history(args))
-        for said in case.assumptions:
-            print(f"assumed: {said}")
-        return [the_record(case, args.measurements, args)]
-    if args.weather or args.measurements:
+        fields = {"weather": args.weather, "measurements": args.measurements}
+        options = ("--calibration-fraction", "--calibration-end")
+    elif args.weather or args.measurements:
         raise InputError("--record", "weather", "give each record's weather and measurements in its --record, "
                                                 "not --weather or --measurements beside them")
-    records = []
-    for text in args.record:
-        f = record_fields(text)
-        try:
-            burn_in = float(f.get("burn-in-days", args.burn_in_days))
-            fraction = float(f.get("calibration-fraction", args.calibration_fraction))
-        except ValueError:
-            raise InputError("--record", "burn-in-days", f"a number of days, and calibration-fraction a number, "
-                                                         f"in {text!r}") from None
-        # a record run under another protocol (other flows, other blinds) reads the house as written for it
-        own = load_building(f["building"]) if "building" in f else building
-        case = measured_case(own, read_weather(f["weather"]), read_measurements(f["measurements"]), burn_in,
-                             args.decomposition, history(args))
-        end = f.get("calibration-end", args.calibration_end)
-        phases = f.get("phases", args.phases)
-        records.append(Record(case, f["measurements"], f.get("name", Path(f["measurements"]).name.split(".")[0]),
-                              check_fraction("--record calibration-fraction", fraction),
-                              instant("--record calibration-end", end) if end else None,
-                              tuple(read_phases(phases)) if phases else (), own))
-    for said in dict.fromkeys(a for r in records for a in r.case.assumptions):
-        print(f"assumed: {said}")
+    else:
+        options = ("--record calibration-fraction", "--record calibration-end")
+    records = [read_record(building, fields, options, args)
+               for fields in ([fields] if not args.record else map(record_fields, args.record))]
+    said_assumed(a for r in records for a in r.case.assumptions)
     return records
+
+
+def read_record(building, fields, options, args):
+    """One record of its --record `fields` (a field not given takes the option of its name);
+    `options` name the fraction and the end in errors."""
+    try:
+        burn_in = float(fields.get("burn-in-days", args.burn_in_days))
+        fraction = float(fields.get("calibration-fraction", args.calibration_fraction))
+    except ValueError:
+        text = ",".join(f"{key}={value}" for key, value in fields.items())
+        raise InputError("--record", "burn-in-days", f"a number of days, and calibration-fraction a number, "
+                                                     f"in {text!r}") from None
+    end = fields.get("calibration-end", args.calibration_end)
+    # a record run under another protocol (other flows, other blinds) reads the house as written for it
+    return api.read_record(fields.get("building", building), fields["weather"], fields["measurements"],
+                           name=fields.get("name"), fraction=check_fraction(options[0], fraction),
+                           calibration_end=instant(options[1], end) if end else None,
+                           phases=fields.get("phases", args.phases), burn_in_days=burn_in,
+                           decomposition=args.decomposition, history_days=history(args))
 
 
 def read_reference(path):
@@ -330,39 +317,34 @@ def read_reference(path):
 
 
 def cmd_diagnose(args):
-    building = load_building(args.building)
+    building = api.read_building(args.building)
     records = records_of(building, args)
-    objective = Objective.of(building, zone_list(args.objective) if args.objective else None)
-    run_diagnosis(building, records, objective, Path(args.output), args)
+    run_diagnosis(building, records, objective_of(building, args), Path(args.output), args)
 
 
 def cmd_compare(args):
-    from nodeforce.diagnose.compare import compare, write_compare
-    from nodeforce.iotools.phases import read_phases
-    weather, measurements = read_weather(args.weather), read_measurements(args.measurements)
-    names = zone_list(args.objective) if args.objective else None
+    weather, measurements = api.read_weather(args.weather), api.read_measurements(args.measurements)
     models = []
     for path in args.buildings:
-        building = load_building(path)
-        case = measured_case(building, weather, measurements, args.burn_in_days, args.decomposition,
-                             history(args))
-        models.append((path, building, case, Objective.of(building, names)))
-    for said in dict.fromkeys(a for _, _, case, _ in models for a in case.assumptions):
-        print(f"assumed: {said}")
-    result, series = compare(models, read_phases(args.phases) if args.phases else (), fmu_kind=args.fmu)
-    written = write_compare(Path(args.output), result, series)
+        building = api.read_building(path)
+        case = api.measured_case(building, weather, measurements, args.burn_in_days, args.decomposition,
+                                 history(args))
+        models.append((path, building, case, objective_of(building, args)))
+    said_assumed(a for _, _, case, _ in models for a in case.assumptions)
+    result = api.compare(models, Path(args.output), api.read_phases(args.phases) if args.phases else (),
+                         fmu_kind=args.fmu)
     for m in result["models"]:
         for zone, z in m["metrics"]["zones"].items():
             print(f"{m['building']}: {zone} air RMSE {z['rmse']:.3f} C (mean {z['mean']:+.3f}, sd {z['sd']:.3f}); "
                   f"heat loss coefficient {m['heat_loss_coefficient']:.1f} W/K")
-    print("wrote " + ", ".join(map(str, written)))
+    print("wrote " + ", ".join(str(Path(args.output) / name) for name in ("compare.json", "compare.md", "compare.png")))
 
 
 def cmd_table(args):
-    from nodeforce.iotools.table import column_names, constants, convert_table, selection
-    written = convert_table(args.table_file, column_names(args.names, args.table_file), args.origin,
-                            selection(args.select), args.output, table=args.table, start=args.start,
-                            end=args.end, constant=constants(args.set) if args.set else None)
+    from nodeforce.iotools.table import column_names, constants, selection
+    written = api.convert_table(args.table_file, column_names(args.names, args.table_file), args.origin,
+                                selection(args.select), args.output, table=args.table, start=args.start,
+                                end=args.end, constant=constants(args.set) if args.set else None)
     print(f"wrote {args.output}: {', '.join(written.columns)} at {len(written)} times "
           f"({written.index[0].isoformat()} to {written.index[-1].isoformat()})")
 
@@ -373,14 +355,13 @@ DEMO_COMMAND = ("nodeforce synth model/data/testcell_miami.json --weather model/
 
 
 def cmd_demo(args):
-    building = load_building(DATA / "testcell_miami.json")
-    measurements_path = DATA / "demo_measurements.csv"
-    case = measured_case(building, read_weather(DATA / "miami_tmy2.csv"), read_measurements(measurements_path),
-                         args.burn_in_days, history_days=history(args))
-    print(f"{building.name}: measurements {measurements_path.name} carry an effect the building file does "
+    building = api.read_building(DATA / "testcell_miami.json")
+    measurements = DATA / "demo_measurements.csv"
+    record = read_record(building, {"weather": DATA / "miami_tmy2.csv", "measurements": measurements},
+                         ("--calibration-fraction", "--calibration-end"), args)
+    print(f"{building.name}: measurements {measurements.name} carry an effect the building file does "
           f"not declare (made by: {DEMO_COMMAND})")
-    run_diagnosis(building, [the_record(case, measurements_path, args)],
-                  Objective.of(building), Path(args.output), args)
+    run_diagnosis(building, [record], api.objective(building), Path(args.output), args)
 
 
 def case_arguments(s, measurements_required, output_help, output_default=None):
@@ -578,7 +559,7 @@ def parser():
     s = sub.add_parser("demo", help="diagnose the bundled test cell, whose measurements carry an undeclared effect")
     s.add_argument("-o", "--output", default="out/demo")
     diagnosis_arguments(s)
-    s.set_defaults(run=cmd_demo)
+    s.set_defaults(run=cmd_demo, decomposition="erbs")
     return p
 
 

@@ -10,10 +10,10 @@ import pvlib
 import pytest
 
 from nodeforce.cli import locate_summary
-from nodeforce.diagnose.candidates import physical
-from nodeforce.diagnose.loop import diagnose
-from nodeforce.diagnose.loss import heat_loss
-from nodeforce.diagnose.report.tables import before_after_table
+from nodeforce.diagnosis.candidates import physical
+from nodeforce.diagnosis.loop import diagnose
+from nodeforce.diagnosis.loss import heat_loss
+from nodeforce.diagnosis.report.tables import before_after_table
 from nodeforce.ga.locate import locate
 from nodeforce.model.building import parse_building
 from nodeforce.model.case import prepare_case

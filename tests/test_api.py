@@ -1,6 +1,8 @@
 """The Python API (nodeforce.api): the FMU's score of a forcing equals the one computed by hand
 from the direct model, the search's candidates are the measured nodes but the air, and the API
 is loaded only when used."""
+import inspect
+import re
 import subprocess
 import sys
 
@@ -74,3 +76,43 @@ def test_compare_through_the_api_scores_each_model_as_its_own_fmu_run_does(demo,
         r = r[np.isfinite(r)]
         assert model["metrics"]["rmse"] == pytest.approx(np.sqrt(np.mean(r ** 2)), rel=1e-9)
     assert (tmp_path / "compare.json").exists() and (tmp_path / "compare.md").exists()
+
+
+API_PAGE = DATA.parents[1] / "docs" / "api.md"
+# A documented call, `name(arguments)` (a span may wrap a line).
+DOCUMENTED_CALL = re.compile(r"`([A-Za-z_][A-Za-z0-9_]*)\(([^`]*)\)`")
+
+
+def documented_calls():
+    """{name: [argument names]} of every function docs/api.md writes a call of: Python's own
+    (`help`) and a Building's methods (`node_names()`) left out, and "..." for arguments left
+    unsaid and "*" (keywords follow) not an argument."""
+    from nodeforce.model.building import Building
+    calls = {}
+    for name, arguments in DOCUMENTED_CALL.findall(API_PAGE.read_text(encoding="utf-8")):
+        if name == "help" or hasattr(Building, name):
+            continue
+        named = [a.split("=")[0].strip() for a in arguments.split(",") if a.strip() not in ("", "...", "*")]
+        calls[name] = sorted(set(calls.get(name, [])) | set(named))
+    return calls
+
+
+def test_the_api_page_lists_the_api():
+    """The page's list is the one the test below reads: every name the API exports is on it."""
+    assert set(documented_calls()) == set(nodeforce.api.__all__) - {"InputError"}
+
+
+@pytest.mark.parametrize("name", sorted(documented_calls()))
+def test_every_function_docs_api_gives_is_callable_as_written(name):
+    """`nodeforce.<name>` is the API's function (not a subpackage of the same name), and it takes
+    every argument the page writes, by the name the page gives it."""
+    import nodeforce.diagnosis.loop  # noqa: F401  a subpackage imported first must not shadow the API
+    found = getattr(nodeforce, name)
+    assert found is getattr(nodeforce.api, name) and callable(found)
+    parameters = inspect.signature(found).parameters
+    takes_any = any(p.kind is p.VAR_KEYWORD for p in parameters.values())
+    for argument in documented_calls()[name]:
+        if argument.startswith("**"):
+            assert takes_any, f"{name} takes no {argument}"
+        else:
+            assert argument in parameters, f"docs/api.md gives {name} an argument {argument!r} it does not take"

@@ -11,8 +11,10 @@ import pandas as pd
 import pytest
 
 from benchmarks.baseline import fit_one
-from benchmarks.records import (CELLS, FAULTS, FINE_STEP, STRONG_BAND, SUBTLE_BAND, Spec, at_scale, before_error,
-                                file_building, max_scale, record)
+from benchmarks.catalogue import FAULTS, Spec
+from benchmarks.records import record
+from benchmarks.sizing import STRONG_BAND, SUBTLE_BAND, before_error, max_scale
+from benchmarks.truth import CELLS, FINE_STEP, at_scale, faulty, file_building, fine_weather, record_times, truth_record
 from nodeforce.model.numerical import refined
 
 pytestmark = pytest.mark.slow  # each record is simulated at 1 min, and a few tuned
@@ -23,9 +25,10 @@ def small(fault="none", size="subtle", **changes):
     fields = dict(name=f"test/{fault}-{size}", building="testcell", climate="miami", start="06-03", days=6,
                   step_min=30, noise=0.1, sensors="paper")
     if fault != "none":
-        effect, target, full, expected = FAULTS[fault]
-        fields.update(effect=effect, target=target, full={**full, **({"T_ground": 24.0} if "T_ground" in full else {})},
-                      size=size, expected=expected)
+        f = FAULTS[fault]
+        fields.update(effect=f.effect, target=f.target,
+                      full={**f.full, **({"T_ground": 24.0} if "T_ground" in f.full else {})},
+                      size=size, expected=f.expected)
     return Spec(**{**fields, **changes})
 
 
@@ -56,15 +59,14 @@ def test_a_finer_step_changes_the_truth_little():
     at 1 min (the truth's way) and at 5 min (the same inputs): backward Euler's error is first
     order in the step, so the 1-min run's error is about a quarter of their difference (Richardson),
     under a hundredth of a degree."""
-    import benchmarks.records as records
     spec = small(days=5)
     building = file_building(spec)
-    times = records.record_times(spec)
-    weather = records.fine_weather(spec, building, times, {})
-    at_1 = records.truth_record(building, weather, times, [23])
+    times = record_times(spec)
+    weather = fine_weather(spec, building, times, {})
+    at_1 = truth_record(building, weather, times, [23])
     coarse = weather.iloc[::5]
     coarse.attrs["source"] = "5 min"
-    at_5 = records.truth_record(building, coarse, times, [23])
+    at_5 = truth_record(building, coarse, times, [23])
     assert FINE_STEP == 60 and np.abs(at_1 - at_5).max() / 4 < 0.01
 
 
@@ -106,8 +108,7 @@ def test_the_heater_is_held_over_each_record_step_and_the_schedule_is_its_hours(
         assert (inside == q[t1]).all()
     # the schedule is the truth's, not the file's
     assert "Q_schedule" not in r.weather and "Q_schedule" in r.truth.input_columns
-    import benchmarks.records as records
-    _, extra = records.faulty(refined(r.building, CELLS), r.spec, r.values)
+    _, extra = faulty(refined(r.building, CELLS), r.spec, r.values)
     day = pd.date_range(times[0], periods=1440, freq="1min")
     power = extra["Q_schedule"](day)
     assert power.sum() * 60 == pytest.approx(r.values["Q"] * 10 * 3600)

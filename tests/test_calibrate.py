@@ -1,11 +1,11 @@
-"""The cross-validation folds of a calibration (`diagnose.calibrate.fold`): a fold is the fit
+"""The cross-validation folds of a calibration (`diagnosis.calibrate.fold`): a fold is the fit
 without one day, one Gauss-Newton step from the whole window's optimum; checked against fits
 made afresh by scipy on the days it keeps."""
 import numpy as np
 import pytest
 from scipy.optimize import least_squares
 
-from nodeforce.diagnose.calibrate import fold
+from nodeforce.diagnosis.calibrate import fold
 
 DAYS, PER_DAY = 4, 100
 
@@ -57,7 +57,7 @@ def test_a_component_s_loss_is_what_its_layers_add_to_the_heat_loss_coefficient(
     coefficient computed apart: the HLC less that of the door with its layers at the factor's
     lower bound; it saturates behind the surface coefficients; its sd is the slope times the
     factor's sd (a central difference, apart from the forward one `derived` takes)."""
-    from nodeforce.diagnose.calibrate import Candidate, derived
+    from nodeforce.diagnosis.calibrate import Candidate, derived
     from nodeforce.model.effects import EFFECTS
     from nodeforce.model.hlc import heat_loss_coefficient
 
@@ -89,7 +89,7 @@ def test_a_ground_flux_s_spread_moves_the_face_with_the_parameters(testcell, wea
     `derived` reports it, is the gradient's with the face simulated again (central differences
     here, apart from the forward ones `derived` takes), not the (T_ground - T_face, U) that holds
     the face still, which reads it several times larger."""
-    from nodeforce.diagnose.calibrate import Candidate, derived, within_ranges
+    from nodeforce.diagnosis.calibrate import Candidate, derived, within_ranges
     from nodeforce.model.case import measured_case
     from nodeforce.model.synth import pseudo_measurements
 
@@ -119,7 +119,7 @@ def test_a_flux_the_data_fix_keeps_its_spread_where_the_valley_along_it_is_unbou
     ranges' uniform precision P (`within_ranges`), the flux's variance is, by Sherman-Morrison,
     sigma_q^2 a / (sigma_q^2 + a) with a = g' P^-1 g: at most sigma_q^2, whatever the valley; the
     linearised covariance alone, read by a gradient off the valley by 1e-3, gives tens of sigma_q."""
-    from nodeforce.diagnose.calibrate import within_ranges
+    from nodeforce.diagnosis.calibrate import within_ranges
 
     bounds = [(0.0, 20.0), (-10.0, 40.0)]
     U, T_ground, T_face, sigma_q = 0.13, 4.2, 25.0, 0.15
@@ -149,8 +149,8 @@ def test_a_fit_that_carries_the_files_numerical_error_finds_the_walls_of_the_fil
     left out is predicted to the rounding."""
     from dataclasses import replace
 
-    from nodeforce.diagnose.calibrate import Candidate, calibrate
-    from nodeforce.diagnose.selection import blocks
+    from nodeforce.diagnosis.calibrate import Candidate, calibrate
+    from nodeforce.diagnosis.selection import blocks
     from nodeforce.model.case import measured_case
     from nodeforce.model.effects import EFFECTS
     from nodeforce.model.numerical import discretisation_error, reference_case

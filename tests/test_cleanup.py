@@ -5,7 +5,7 @@ import os
 import pandas as pd
 import pytest
 
-from nodeforce.diagnose.loop import diagnose
+from nodeforce.diagnosis.loop import diagnose
 from nodeforce.model.case import prepare_case
 from nodeforce.model.errors import InputError
 from nodeforce.model.score import Objective

@@ -180,7 +180,7 @@ def test_diagnose_refuses_a_fraction_outside_0_1(files, capsys):
     assert err.startswith("nodeforce: --calibration-fraction: 1.2: ")
 
 
-def test_demo_runs_the_whole_loop_and_finds_the_ground_coupling(tmp_path, capsys):
+def test_demo_finds_the_ground_coupling_and_python_writes_the_same_report(tmp_path, capsys):
     assert main(["demo", "-o", str(tmp_path), "--workers", "1"]) == 0
     out = capsys.readouterr().out
     assert "validation" in out and "calibration" in out
@@ -213,6 +213,20 @@ def test_demo_runs_the_whole_loop_and_finds_the_ground_coupling(tmp_path, capsys
     assert report["after"]["validation"]["rmse"] < 0.5 * report["before"]["validation"]["rmse"]
     for name in ("report.md", "building_after.json", "model_after.fmu", "air_temperature.png"):
         assert (tmp_path / name).stat().st_size > 0
+    # the same inputs through Python: the same report.json, byte for byte, timings and folders aside
+    import nodeforce
+    building = nodeforce.read_building(DATA / "testcell_miami.json")
+    case = nodeforce.measured_case(building, nodeforce.read_weather(DATA / "miami_tmy2.csv"),
+                                   nodeforce.read_measurements(DATA / "demo_measurements.csv"), burn_in_days=1)
+    nodeforce.diagnose(building, case, tmp_path / "api", seed=0, workers=1)
+    cli, python = (untimed(folder / "report.json", folder) for folder in (tmp_path, tmp_path / "api"))
+    assert cli == python
+
+
+def untimed(path, folder):
+    """A report.json's text with its timings (`seconds`) set to 0 and its folder called OUT."""
+    text = path.read_text().replace(str(folder), "OUT")
+    return re.sub(r'"seconds": [0-9.e+-]+', '"seconds": 0', text)
 
 
 def test_locate_with_a_burn_in_points_at_the_floor_of_the_demo_data(tmp_path, capsys):

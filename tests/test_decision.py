@@ -5,8 +5,8 @@ apart, a physical effect with few parameters before a shape."""
 import numpy as np
 import pytest
 
-from nodeforce.diagnose.candidates import objection, preference
-from nodeforce.diagnose.selection import blocks, decide
+from nodeforce.diagnosis.policy import POLICY
+from nodeforce.diagnosis.selection import blocks, decide
 from nodeforce.model.building import parse_building
 from nodeforce.model.errors import InputError
 from nodeforce.model.score import Noise
@@ -23,34 +23,34 @@ def unoccupied(testcell_data):
 
 
 def test_a_parameter_the_data_do_not_determine_is_refused(testcell):
-    assert "not identifiable" in objection(testcell, "internal_gain", "cell",
+    assert "not identifiable" in POLICY.objection(testcell, "internal_gain", "cell",
                                            {"Q": parameter(50.0, 40.0, identifiable=False)})
-    assert objection(testcell, "internal_gain", "cell", {"Q": parameter(50.0, 4.0)}) is None
+    assert POLICY.objection(testcell, "internal_gain", "cell", {"Q": parameter(50.0, 4.0)}) is None
 
 
 def test_a_parameter_on_a_bound_of_its_range_is_refused(testcell):
-    assert "bound" in objection(testcell, "solar_absorptance", "roof",
+    assert "bound" in POLICY.objection(testcell, "solar_absorptance", "roof",
                                 {"alpha": parameter(1.0, 0.01, identifiable=False, on_bound=True)})
 
 
 def test_a_negative_gain_is_refused_where_physics_forbids_it(testcell):
     # the real air-only record's -545 +- 16 W: well determined, and a heat sink
-    assert "negative gain" in objection(testcell, "internal_gain", "cell", {"Q": parameter(-545.0, 16.0)})
+    assert "negative gain" in POLICY.objection(testcell, "internal_gain", "cell", {"Q": parameter(-545.0, 16.0)})
     # sun through an opening cannot take heat away; a heat input may be overstated, but not by more than itself
-    assert "negative gain" in objection(testcell, "proportional_gain", "cell->I_window", {"k": parameter(-0.3, 0.01)})
+    assert "negative gain" in POLICY.objection(testcell, "proportional_gain", "cell->I_window", {"k": parameter(-0.3, 0.01)})
 
 
 def test_a_factor_outside_physical_limits_is_refused(testcell):
-    assert "physical limits" in objection(testcell, "conductivity", "door", {"factor": parameter(15.0, 0.5)})
-    assert objection(testcell, "conductivity", "door", {"factor": parameter(3.4, 0.2)}) is None
+    assert "physical limits" in POLICY.objection(testcell, "conductivity", "door", {"factor": parameter(15.0, 0.5)})
+    assert POLICY.objection(testcell, "conductivity", "door", {"factor": parameter(3.4, 0.2)}) is None
 
 
 def test_a_physical_limit_is_judged_with_the_estimate_s_uncertainty(testcell):
     # the limit is ten times the declared conductivity: 11.4 +- 1.5 may be ten, 11.4 +- 0.5 is not
-    assert objection(testcell, "conductivity", "door", {"factor": parameter(11.4, 1.5)}) is None
-    assert "2 standard deviations" in objection(testcell, "conductivity", "door", {"factor": parameter(11.4, 0.5)})
+    assert POLICY.objection(testcell, "conductivity", "door", {"factor": parameter(11.4, 1.5)}) is None
+    assert "2 standard deviations" in POLICY.objection(testcell, "conductivity", "door", {"factor": parameter(11.4, 0.5)})
     # a gain of -3 +- 2 W may be no gain at all; -545 +- 16 W is a heat sink
-    assert objection(testcell, "internal_gain", "cell", {"Q": parameter(-3.0, 2.0)}) is None
+    assert POLICY.objection(testcell, "internal_gain", "cell", {"Q": parameter(-3.0, 2.0)}) is None
 
 
 def _with_inside_h(data, h_conv):
@@ -70,39 +70,39 @@ def test_a_convection_factor_is_judged_by_the_coefficient_it_gives_the_room(test
     # 0.15 of the cell's declared 5 W/m2/K is 0.75, air a room can have; 0.15 of ISO 6946's
     # 2.5 is 0.38, a room stiller than any natural convection leaves it
     factor = {"factor": parameter(0.15, 0.02)}
-    assert objection(testcell, "inside_convection", "cell", factor) is None
+    assert POLICY.objection(testcell, "inside_convection", "cell", factor) is None
     iso = _with_inside_h(testcell_data, {c["name"]: 2.5 for c in testcell_data["components"]})
-    assert "physical limits" in objection(iso, "inside_convection", "cell", factor)
+    assert "physical limits" in POLICY.objection(iso, "inside_convection", "cell", factor)
     # ten times the cell's 5 W/m2/K is a room in a gale
-    assert "physical limits" in objection(testcell, "inside_convection", "cell", {"factor": parameter(10.0, 0.5)})
+    assert "physical limits" in POLICY.objection(testcell, "inside_convection", "cell", {"factor": parameter(10.0, 0.5)})
 
 
 def test_a_conductivity_is_judged_by_the_heat_its_component_loses(testcell):
     # a door's loss saturates behind its surface coefficients: the factor is loose, the loss fixed
     loose = {"factor": parameter(7.1, 2.4, identifiable=False)}
     lost = {"component_loss": {"value": 4.0, "std": 0.2, "unit": "W/K"}}
-    assert objection(testcell, "conductivity", "door", loose, lost) is None
-    assert "not identifiable" in objection(testcell, "conductivity", "door", loose,
+    assert POLICY.objection(testcell, "conductivity", "door", loose, lost) is None
+    assert "not identifiable" in POLICY.objection(testcell, "conductivity", "door", loose,
                                            {"component_loss": {"value": 4.0, "std": 2.0, "unit": "W/K"}})
     # a factor on its bound is still a layer that is not there
     on_bound = {"factor": parameter(20.0, 9.0, identifiable=False, on_bound=True)}
-    assert "bound" in objection(testcell, "conductivity", "door", on_bound, lost)
+    assert "bound" in POLICY.objection(testcell, "conductivity", "door", on_bound, lost)
 
 
 def test_a_gain_in_a_zone_declared_unoccupied_is_refused(unoccupied):
     values = {"mean": parameter(46.0, 3.0), **{t: parameter(1.0, 5.0, identifiable=False)
                                                 for t in ("cos1", "sin1", "cos2", "sin2", "cos3", "sin3", "cos4", "sin4")}}
-    assert "unoccupied" in objection(unoccupied, "daily_gain", "cell", values)
+    assert "unoccupied" in POLICY.objection(unoccupied, "daily_gain", "cell", values)
 
 
 def test_a_ground_coupling_is_judged_by_the_flux_the_data_fix(testcell):
     # U and T_ground trade off: neither is determined, the heat flux they give is
     traded = {"U": parameter(0.8, 0.5, identifiable=False), "T_ground": parameter(24.0, 3.0, identifiable=False)}
     flux = {"ground_heat_flux": {"value": 4.0, "std": 0.3, "unit": "W/m2"}}
-    assert objection(testcell, "ground_coupling", "floor", traded, flux) is None
+    assert POLICY.objection(testcell, "ground_coupling", "floor", traded, flux) is None
     on_bound = {**traded, "T_ground": parameter(-10.0, 3000.0, identifiable=False, on_bound=True)}
-    assert objection(testcell, "ground_coupling", "floor", on_bound, flux) is None
-    assert "not identifiable" in objection(testcell, "ground_coupling", "floor", traded,
+    assert POLICY.objection(testcell, "ground_coupling", "floor", on_bound, flux) is None
+    assert "not identifiable" in POLICY.objection(testcell, "ground_coupling", "floor", traded,
                                            {"ground_heat_flux": {"value": 4.0, "std": 3.0, "unit": "W/m2"}})
 
 
@@ -110,17 +110,21 @@ def test_a_heater_node_is_judged_by_the_time_constant_the_data_fix_but_must_stay
     # C_h and H_h trade off along tau = C_h / H_h: neither is determined, tau is
     traded = {"C_h": parameter(9.4e4, 4.8e4, identifiable=False), "H_h": parameter(59.0, 39.0, identifiable=False)}
     tau = {"heater_time_constant": {"value": 1590.0, "std": 120.0, "unit": "s"}}
-    assert objection(testcell, "heat_input_lag", "cell", traded, tau) is None
-    assert "not identifiable" in objection(testcell, "heat_input_lag", "cell", traded,
+    assert POLICY.objection(testcell, "heat_input_lag", "cell", traded, tau) is None
+    assert "not identifiable" in POLICY.objection(testcell, "heat_input_lag", "cell", traded,
                                            {"heater_time_constant": {"value": 1590.0, "std": 900.0, "unit": "s"}})
     # a conductance on its bound is a node that is not there, whatever tau says
     on_bound = {**traded, "H_h": parameter(0.01, 0.0002, on_bound=True)}
-    assert "bound" in objection(testcell, "heat_input_lag", "cell", on_bound, tau)
+    assert "bound" in POLICY.objection(testcell, "heat_input_lag", "cell", on_bound, tau)
 
 
 def test_physics_comes_before_shapes_and_fewer_parameters_before_more():
-    assert preference("conductivity") < preference("proportional_gain") < preference("daily_gain")
-    assert preference("infiltration") < preference("ground_coupling")
+    def claim(effect, component=False):
+        return POLICY.claim(effect, component)
+    assert claim("conductivity") < claim("proportional_gain") < claim("daily_gain")
+    assert claim("infiltration") < claim("ground_coupling")
+    # and, claiming as much, the zone's effect before one component's
+    assert claim("envelope_conductance") < claim("conductivity", component=True)
 
 
 # --- decide() on hand-made candidates: the model without them predicts each of four left-out days
@@ -132,7 +136,7 @@ BASE = [10.0, 10.0, 10.0, 10.0]
 
 
 def candidate(effect, target, parameters, days):
-    """A calibrated candidate's record as diagnose.loop.assess_all makes it, leaving J `days`
+    """A calibrated candidate's record as diagnosis.loop.assess_all makes it, leaving J `days`
     (C2) on each left-out day."""
     return {"effect": effect, "target": target, "parameters": parameters, "derived": {},
             "cv": {"blocks": list(days), "J": float(sum(days)), "n": N, "rmse": float(np.sqrt(sum(days) / N))}}
@@ -176,7 +180,7 @@ def test_a_shape_must_gain_more_than_the_noise_could_to_beat_a_physical_effect(t
     file's numerical error beside the noise the band only widens. A gain of 1.2 C2 beats it."""
     physical = door([2.0, 2.2, 2.1, 2.3])
     for floor in (None, 0.128):
-        chosen, decision = decide(testcell, [daily([1.95, 2.15, 2.05, 2.25]), physical], BASE, SIGMA, N, floor=floor)
+        chosen, decision = decide(testcell, [daily([1.95, 2.15, 2.05, 2.25]), physical], BASE, SIGMA, N, floor_sd=floor)
         assert chosen is physical and decision["indistinct"] == ["daily_gain@cell"], decision["reason"]
     chosen, _ = decide(testcell, [daily([1.7, 1.9, 1.8, 2.0]), physical], BASE, SIGMA, N)
     assert chosen["effect"] == "daily_gain"
@@ -213,12 +217,12 @@ def test_a_fall_the_files_own_numerical_error_could_make_does_not_pass(testcell)
     alone (0.59 C2) that would pass; against the floor the noise and that error make together,
     sqrt(0.1^2 + 0.08^2) = 0.128 C (3 x 0.0164 x sqrt(384) = 0.96 C2), it does not."""
     noise = Noise(SIGMA).with_numerical(0.08)
-    assert noise.floor == pytest.approx(np.sqrt(SIGMA ** 2 + 0.08 ** 2))
-    base = N / 4 * noise.floor ** 2 * np.ones(4)
+    assert noise.floor_sd == pytest.approx(np.sqrt(SIGMA ** 2 + 0.08 ** 2))
+    base = N / 4 * noise.floor_sd ** 2 * np.ones(4)
     wall = door(base - 0.2)
     assert decide(testcell, [wall], base, SIGMA, N)[0] is not None
-    chosen, decision = decide(testcell, [wall], base, SIGMA, N, floor=noise.floor)
-    assert chosen is None and decision["noise_margin"] == pytest.approx(3 * noise.floor ** 2 * np.sqrt(2 * N))
+    chosen, decision = decide(testcell, [wall], base, SIGMA, N, floor_sd=noise.floor_sd)
+    assert chosen is None and decision["noise_margin"] == pytest.approx(3 * noise.floor_sd ** 2 * np.sqrt(2 * N))
 
 
 def test_a_fall_from_one_day_alone_or_that_the_days_disagree_on_does_not_pass(testcell):

@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 from fmpy.validation import validate_fmu
 
-from nodeforce.diagnose.loop import diagnose
+from nodeforce.diagnosis.loop import diagnose
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.building import load_building, parse_building
 from nodeforce.model.case import prepare_case
@@ -95,9 +95,14 @@ def test_diagnose_finds_the_undeclared_effect(tmp_path, testcell_data, testcell,
         scored = underside[report["period"]["calibration_scored_from"]:report["period"]["calibration"][1]]
         flux = truth["U"] * (truth["T_ground"] - scored.mean())
         assert report["effect"]["derived"]["ground_heat_flux"]["value"] == pytest.approx(flux, rel=0.15)
-    # the chosen effect is declared in a building file every command loads, and its FMU is valid
+    # the chosen effect is declared in a building file every command loads, at its calibrated
+    # values where the file as written declared others, and its FMU is valid
     after_building = load_building(tmp_path / "building_after.json")
-    assert after_building.n_nodes == 23
+    declared_after = EFFECTS[effect].read(after_building, target)
+    declared_before = EFFECTS[effect].read(testcell, target)
+    for name, p in report["effect"]["parameters"].items():
+        assert declared_after[name] == pytest.approx(p["value"]), name
+        assert declared_before[name] != pytest.approx(p["value"]), name
     # every candidate exists as a building file declaring its calibrated effect
     for c in report["candidates"]:
         declared = json.loads((tmp_path / "candidates" / f"{c['effect']}@{c['target']}.json").read_text())

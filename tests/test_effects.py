@@ -7,7 +7,7 @@ import pytest
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.fmu_build.build import build_fmu
-from nodeforce.diagnose.candidates import physical
+from nodeforce.diagnosis.candidates import physical
 from nodeforce.model.building import Boundary, parse_building
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
@@ -175,7 +175,7 @@ def test_an_effect_that_moves_an_input_column_keeps_the_fmu_inputs(tmp_path, rea
 
 
 def test_a_gain_in_a_zone_declared_unoccupied_is_implausible(testcell):
-    from nodeforce.diagnose.candidates import implausible
+    from nodeforce.diagnosis.policy import implausible
     assert implausible(testcell, "internal_gain", "cell") is None  # occupancy not declared
     empty = testcell.edited(lambda d: d["zones"][0].update(occupied=False))
     assert "unoccupied" in implausible(empty, "internal_gain", "cell")
@@ -187,7 +187,7 @@ def test_the_residual_left_chooses_the_shapes():
     """Shapes are the residual's to choose: a gain following each input it follows, a daily gain
     where it follows the clock, every input and the clock where it is structured but follows none
     (inputs of one kind are nearly collinear), nothing where it is white."""
-    from nodeforce.diagnose.candidates import shapes
+    from nodeforce.diagnosis.candidates import shapes
     from .test_zones import multizone_with_everything
     b = multizone_with_everything()
     left = {"white": False, "time_of_day": {"significant": False},

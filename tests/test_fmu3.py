@@ -11,7 +11,7 @@ from fmpy.validation import validate_fmu
 from nodeforce.cli import main
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
-from nodeforce.diagnose.calibrate import Candidate
+from nodeforce.diagnosis.calibrate import Candidate
 from nodeforce.fmu_build import guard
 from nodeforce.fmu_build.build import build_fmu, fmu_kind
 from nodeforce.model.building import parse_building

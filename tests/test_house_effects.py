@@ -11,8 +11,9 @@ import pytest
 
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
-from nodeforce.diagnose.calibrate import Candidate, calibrate
-from nodeforce.diagnose.candidates import calibration_start, limits, physical
+from nodeforce.diagnosis.calibrate import Candidate, calibrate
+from nodeforce.diagnosis.candidates import calibration_start, physical
+from nodeforce.diagnosis.policy import POLICY
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.model.building import load_building, parse_building
 from nodeforce.model.case import Case
@@ -217,8 +218,8 @@ def test_each_is_offered_where_the_building_has_what_it_acts_on(testcell):
     assert not {e for e, _ in physical(testcell, [], ["cell"], [])} & set(HOUSE_EFFECTS)
     # an open door starts where it carries something; the physical limits of the factors
     assert calibration_start(b, "interzone_air_exchange", "A|B")["V"] > 0
-    assert limits(b, "heat_input_factor", "B", "factor") == (0.5, 2.0)
-    assert limits(b, "supply_flow", "A", "factor") == (0.1, 10.0)
+    assert POLICY.limits(b, "heat_input_factor", "B", "factor") == (0.5, 2.0)
+    assert POLICY.limits(b, "supply_flow", "A", "factor") == (0.1, 10.0)
 
 
 def random_case(b, n_rows, seed):

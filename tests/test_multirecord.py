@@ -5,8 +5,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from nodeforce.diagnose.loop import Record, diagnose
-from nodeforce.diagnose.selection import harmed
+from nodeforce.diagnosis.loop import Record, diagnose
+from nodeforce.diagnosis.selection import harmed
 from nodeforce.model.building import parse_building
 from nodeforce.model.case import Case
 from nodeforce.model.effects import EFFECTS

@@ -1,9 +1,9 @@
-"""The phases file and each model's error phase by phase (iotools.phases, diagnose.phases)."""
+"""The phases file and each model's error phase by phase (iotools.phases, diagnosis.phases)."""
 import numpy as np
 import pandas as pd
 import pytest
 
-from nodeforce.diagnose.phases import phase_errors, worsened
+from nodeforce.diagnosis.phases import phase_errors, worsened
 from nodeforce.iotools.phases import read_phases
 from nodeforce.model.errors import InputError
 

@@ -1,14 +1,15 @@
 """The report writer: the before/after table, report.md and its plots, from a report and series
 built by hand (two zones, a localisation, four candidates, the loop's decision)."""
 import copy
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from nodeforce.diagnose.report import before_after_table, write_report
-from nodeforce.diagnose.report.formats import parameter_unit
-from nodeforce.diagnose.residuals import diagnostics
+from nodeforce.diagnosis.report import before_after_table, write_report
+from nodeforce.diagnosis.report.formats import parameter_unit
+from nodeforce.diagnosis.residuals import diagnostics
 from nodeforce.model.effects import EFFECTS
 
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -268,16 +269,28 @@ def test_write_report_from_an_almost_empty_report(tmp_path):
     assert "No candidate effect was tried" in md and "The loop recorded no decision" in md
 
 
-@pytest.mark.parametrize("tz", [None, "UTC"])
-def test_write_report_times_without_offset_or_in_utc(tmp_path, tz):
+@pytest.mark.parametrize("tz,label,first", [(None, "time", "2001-06-10 00:00"),
+                                             ("UTC", "time (UTC+00:00)", "2001-06-10 05:00")])
+def test_write_report_times_without_offset_or_in_utc(tmp_path, monkeypatch, tz, label, first):
+    """Times without an offset are plotted as they are, under "time"; times in UTC at their UTC
+    clock (the record's first time, 00:00 at UTC-05:00, at 05:00), the axis naming the offset."""
+    from nodeforce.diagnosis.report import figures
     report, series = synthetic()
     times = series["times"].tz_convert(tz) if tz else series["times"].tz_localize(None)
+    saved = {}
+    original = figures._save
+    monkeypatch.setattr(figures, "_save", lambda fig, path: saved.setdefault(Path(path).name, fig) and original(fig, path))
     check_report(tmp_path, report, dict(series, times=times, validation_start=times[96], scored_from=times[8]),
                  ALL_PLOTS)
+    for name in ("air_temperature.png", "residuals.png"):
+        axes = saved[name].axes
+        assert {ax.get_xlabel() for ax in axes if ax.get_xlabel()} == {label}, name
+    plotted = saved["air_temperature.png"].axes[0].get_lines()[0].get_xdata()[0]
+    assert pd.Timestamp(plotted).strftime("%Y-%m-%d %H:%M") == first
 
 
 def test_a_long_effect_name_keeps_the_time_plots_legend_inside_the_figure(tmp_path, monkeypatch):
-    from nodeforce.diagnose.report import figures
+    from nodeforce.diagnosis.report import figures
     report, series = synthetic()
     report["effect"]["target"] = "living->west_facade_global_vertical_irradiance_measured"
     saved = []
@@ -292,7 +305,7 @@ def test_a_long_effect_name_keeps_the_time_plots_legend_inside_the_figure(tmp_pa
 
 
 def test_a_candidate_tried_again_on_top_is_judged_and_marked_in_its_own_round(tmp_path):
-    from nodeforce.diagnose.report import content
+    from nodeforce.diagnosis.report import content
     report, _ = synthetic()
     first = next(c for c in report["candidates"] if c["effect"] == "conductivity")
     again = {**copy.deepcopy(first), "on_top_of": ["conductivity@door"], "effect": "solar_absorptance",
@@ -349,7 +362,7 @@ def test_the_first_screen_gives_what_the_data_fix_not_the_parameters_they_cannot
 
 
 def test_the_decision_says_each_refusal_reason_once(tmp_path):
-    from nodeforce.diagnose.report.summary import chosen_sentence
+    from nodeforce.diagnosis.report.summary import chosen_sentence
     report, series = synthetic()
     gains = [("internal_gain@living", "Q = -2.81 W is a negative gain (a heat sink) [0, inf]"),
              ("daily_gain@living", "mean = -2.82 W is a negative gain (a heat sink) [0, inf]"),
@@ -379,7 +392,7 @@ def test_the_decision_says_each_refusal_reason_once(tmp_path):
 def test_the_phases_table_of_a_whole_house_keeps_the_chosen_candidates():
     """Beyond PHASE_COLUMNS candidates (a house of seven rooms tries 163) the table shows before,
     each round's chosen candidate and after; report.json keeps them all."""
-    from nodeforce.diagnose.report import tables
+    from nodeforce.diagnosis.report import tables
     labels = [f"conductivity@W{i}" for i in range(tables.PHASE_COLUMNS + 2)]
     rmse = {"before": 1.0, **{label: 0.9 for label in labels}, "gain@x (round 2)": 0.5, "after": 0.5}
     report = {"phases": [{"phase": "free float", "start": "2014-04-17T07:30:00+01:00", "end": None, "n": 10,

@@ -6,7 +6,7 @@ import pandas as pd
 import pytest
 from scipy.signal import lfilter
 
-from nodeforce.diagnose.residuals import diagnostics, lag_text, longest_run
+from nodeforce.diagnosis.residuals import diagnostics, lag_text, longest_run
 
 STEP_HOURS = 0.25
 

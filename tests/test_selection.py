@@ -10,8 +10,8 @@ import pandas as pd
 import pvlib
 import pytest
 
-from nodeforce.diagnose.calibrate import Candidate, calibrate
-from nodeforce.diagnose.loop import diagnose
+from nodeforce.diagnosis.calibrate import Candidate, calibrate
+from nodeforce.diagnosis.loop import diagnose
 from nodeforce.iotools.typical_year import convert_typical_year, relocate
 from nodeforce.iotools.weather import read_weather
 from nodeforce.model.building import parse_building

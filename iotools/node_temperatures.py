@@ -1,9 +1,10 @@
-"""Writing results: node temperature tables and the names of their nodes."""
+"""Writing a simulation's node temperatures (`nodeforce simulate`): the time table and the names
+of its nodes."""
 from pathlib import Path
 
 import pandas as pd
 
-from nodeforce.iotools.timetable import write_time_table
+from .timetable import write_time_table
 
 
 def write_node_temperatures(path, times, T):

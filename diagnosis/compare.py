@@ -16,9 +16,9 @@ import numpy as np
 from nodeforce import tempdirs
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
-from nodeforce.diagnose.report.figures import plot_comparison
-from nodeforce.diagnose.report.formats import fmt_sig, fmt_temp
-from nodeforce.diagnose.report.tables import markdown
+from nodeforce.diagnosis.report.figures import plot_comparison
+from nodeforce.diagnosis.report.formats import fmt_sig, fmt_temp
+from nodeforce.diagnosis.report.tables import markdown
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.locate import check_measured
 from nodeforce.model.errors import InputError

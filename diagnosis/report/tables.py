@@ -225,7 +225,7 @@ PHASE_COLUMNS = 12
 
 def phases(report):
     """RMSE (C) of each phase of the record: before, every candidate, after; a value made worse
-    than before by the loop's margin (diagnose.phases.WORSE) is marked ▲."""
+    than before by the loop's margin (diagnosis.phases.WORSE) is marked ▲."""
     rows = report.get("phases") or []
     if not rows:
         return ""

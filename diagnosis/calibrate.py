@@ -4,14 +4,14 @@ Bounded least squares on the air-temperature residual of the calibration window 
 `least_squares`, trust region reflective), simulated by the direct model (`model.integrate`):
 the FMUs carry the same equations and are tested equal to it (tests/test_fmu3.py), and a
 diagnosis calibrates tens of candidates, each once on the whole calibration window and once per
-cross-validation block left out (`diagnose.selection`, each fold one Gauss-Newton step from the
+cross-validation block left out (`diagnosis.selection`, each fold one Gauss-Newton step from the
 whole window's optimum), so a simulation without an FMU's per-step calls is what makes that
 affordable. The chosen effect's FMU is built and written all
-the same (`diagnose.loop`). The covariance of the estimate is the linearised sandwich of
+the same (`diagnosis.loop`). The covariance of the estimate is the linearised sandwich of
 `model.significance`, which allows for the residual's correlation in time (the textbook
 s^2 (J^T J)^-1 assumes independent residuals and, on real records, is several times too tight).
 A parameter is called identifiable from the data when that estimate is tight enough to act on
-(`IDENTIFIABLE_*` below) and it did not end on a bound.
+(`diagnosis.policy.Policy.identifiable`) and it did not end on a bound.
 """
 import logging
 
@@ -20,20 +20,17 @@ from SALib.analyze import morris as morris_analyze
 from SALib.sample import morris as morris_sample
 from scipy.optimize import least_squares
 
-from nodeforce.diagnose.candidates import IDENTIFIABLE_RELATIVE, calibration_start
-from nodeforce.diagnose.selection import on_block
+from nodeforce.diagnosis.candidates import calibration_start
+from nodeforce.diagnosis.policy import POLICY
+from nodeforce.diagnosis.selection import on_block
 from nodeforce.model.case import as_cases
 from nodeforce.model.significance import bandwidth, parameter_covariance
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.hlc import heat_loss_coefficient
 from nodeforce.model.numerical import share
 
-log = logging.getLogger("nodeforce.diagnose")
+log = logging.getLogger("nodeforce.diagnosis")
 
-# A scale parameter is identifiable when its standard deviation is under IDENTIFIABLE_RELATIVE
-# of its value (candidates, which judges derived quantities by it too); a temperature (T_ground)
-# when its standard deviation is under this many kelvin.
-IDENTIFIABLE_KELVIN = 1.0
 MORRIS_TRAJECTORIES = 4
 # The step of a derived quantity's differences (`gradient`), as a fraction of a parameter's range:
 # the HLC and a ground coupling's flux are smooth in every parameter (a conductance in series, a
@@ -107,7 +104,7 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None):
     cases : Case, or a sequence of Cases: each record's calibration window
     objective : model.score.Objective
     blocks : (record index, (N_t,) bool mask of the steps of that record's window) of each
-        cross-validation block (`diagnose.selection`); a bare mask is a block of the first record
+        cross-validation block (`diagnosis.selection`); a bare mask is a block of the first record
     numerical : per case, the file's numerical error at the objective air (C, (N_t, zones):
         `model.numerical.discretisation_error`), or None
 
@@ -149,8 +146,7 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None):
     std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     result = {}
     for p, value, sd, bound in zip(candidate.parameters, fit.x, std, fit.active_mask):
-        tight = sd < (IDENTIFIABLE_KELVIN if p.unit == "C" else IDENTIFIABLE_RELATIVE * abs(value))
-        identifiable = bool(tight and bound == 0)
+        identifiable = bool(POLICY.identifiable(value, sd, p.unit) and bound == 0)
         if not identifiable:
             log.info("%s: %s = %.4g +- %.2g %s is not identifiable from these data%s", candidate.label,
                      p.name, value, sd, p.unit, " (it ended on a bound)" if bound else "")

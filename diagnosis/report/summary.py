@@ -14,12 +14,12 @@ from . import content
 from .content import metrics
 from .formats import NA, fmt_derived, fmt_parameters, fmt_temp, num
 from .tables import before_after_table, hlc_lines
-from ...ga.parsimony import removed
+from ...model.score import removed
 
 #: The most lines the first screen may take (the title included in report.md).
 FIRST_SCREEN_LINES = 10
 
-# One clause of a physical objection (`diagnose.candidates.objection`): "NAME = VALUE [+- STD] UNIT
+# One clause of a physical objection (`diagnosis.policy.Policy.objection`): "NAME = VALUE [+- STD] UNIT
 # is WHAT [LOW, HIGH]" or "... ends on WHAT"; anything else is kept whole as its own reason.
 _CLAUSE = re.compile(r"^(?P<value>\w+ = \S+(?: \+- \S+)?(?: (?!is\b|ends\b)\S+)?) "
                      r"(?P<why>(?:is|ends on) .*?)(?: \[[^\]]*\])?$")

@@ -2,7 +2,7 @@
 
 The calibration window's scored steps (after the burn-in) are cut into blocks of whole days
 (`blocks`). Each candidate is fitted on all blocks but one and scored on the block left out, every
-block in turn (`diagnose.calibrate`): the simulation runs through the whole window, the left-out
+block in turn (`diagnosis.calibrate`): the simulation runs through the whole window, the left-out
 block's residuals are only left out of the least squares, so every block is predicted from the
 state the days before it left, as the validation window is. A day is the unit because a
 building's residual is correlated over hours and repeats with the sun: within a day, steps are
@@ -12,7 +12,7 @@ not independent pieces of evidence, and days nearly are.
 to, block by block:
 
 1. It passes when that fall beats what noise alone gives, the change of J the sensors' noise
-   could make (`ga.parsimony.tolerance`), and what the days' disagreement gives: one standard
+   could make (`diagnosis.policy.Policy.least_fall`), and what the days' disagreement gives: one standard
    error of the fall computed from the per-block falls, blocks as the unit, so that residuals
    correlated within a day cannot fake significance; and when it does not come from one day
    alone (the other days together must gain too). A calibration window holds two to five days:
@@ -20,7 +20,7 @@ to, block by block:
    the falls to be nearly equal from day to day, while a real effect's size follows the weather
    (a ground coupling's drift shows on some days and hardly on others); the sensor noise is
    judged by its own yardstick instead, and the days by their consistency.
-2. Physics may still refuse it (`diagnose.candidates.objection`: a gain in a zone declared
+2. Physics may still refuse it (`diagnosis.policy.Policy.objection`: a gain in a zone declared
    unoccupied, a parameter on its bound or not identifiable, a negative gain): then it is a
    suggestion, with its reason, never added.
 3. Among the admissible candidates that pass, the one-standard-error rule on every temperature
@@ -65,16 +65,10 @@ import math
 
 import numpy as np
 
-from nodeforce.diagnose.candidates import is_shape, objection, preference
-from nodeforce.ga.parsimony import ROUNDING, noise_floor, noise_tolerance, tolerance
+from nodeforce.diagnosis.policy import POLICY
 from nodeforce.model.effects import bridge_parts
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
-
-# Standard errors of its day-to-day scatter a cross-validated fall must exceed, and that the one-
-# standard-error rule allows between candidates it cannot tell apart.
-STANDARD_ERRORS = 1.0
-MIN_BLOCKS = 2
 
 
 def blocks(n_steps, scored_from, dt, source="measurements"):
@@ -83,9 +77,9 @@ def blocks(n_steps, scored_from, dt, source="measurements"):
     to the last block."""
     day = steps_per_day(dt)
     n_blocks = (n_steps - scored_from) // day
-    if n_blocks < MIN_BLOCKS:
+    if n_blocks < POLICY.min_blocks:
         raise InputError(source, "time", f"a calibration window of {n_steps - scored_from} scored steps of {dt:g} s "
-                                         f"leaves no calibration window of {MIN_BLOCKS} whole days after the burn-in "
+                                         f"leaves no calibration window of {POLICY.min_blocks} whole days after the burn-in "
                                          "for the cross-validation: give a longer calibration window")
     index = np.arange(n_steps)
     starts = scored_from + day * np.arange(n_blocks)
@@ -106,13 +100,6 @@ def block_J(residuals, masks):
     return np.array([np.nansum(np.square(residuals[m])) for m in masks])
 
 
-def at_noise(J, n, sigma):
-    """Whether an error J (C2) on n residuals is what an error of sd sigma alone leaves (the
-    sensors' noise, and the file's own numerical error: `model.score.Noise.floor`): within the
-    noise tolerance of n sigma^2."""
-    return J <= noise_floor(sigma, n) + noise_tolerance(sigma, n)
-
-
 def label(result):
     return f"{result['effect']}@{result['target']}"
 
@@ -128,32 +115,37 @@ def evidence(result):
     """Per-block J (C2) a candidate's choice reads: its objective air on each block left out of
     its fit (`cv.blocks`) and, where other nodes are sensed, their J over the same blocks
     (`sensors.blocks`), which no fit read, each sensor weighted by how well the model the
-    candidate is added to follows it (`diagnose.loop.Windows.sensor_weights`)."""
+    candidate is added to follows it (`diagnosis.loop.Windows.sensor_weights`)."""
     return np.asarray(result["cv"]["blocks"], dtype=float) + np.asarray(
         result.get("sensors", {}).get("blocks", 0.0), dtype=float)
 
 
-def noise_difference(a, b, sigma):
-    """The standard deviation (C2) of the difference of two candidates' evidence (`evidence`) that
-    sensor noise of sd sigma (C) alone makes: J_a - J_b = sum (r_a - r_b)(r_a + r_b), and the
-    noise e of a measurement enters r_a + r_b twice, so the difference moves by 2 sum (r_a - r_b) e,
-    of sd 2 sigma |r_a - r_b|. `a`, `b`: the candidates' records; their residuals are the air's
-    left out (`cv.left_out`, C, every block's in one order) and the other sensors' on the blocks
-    (`sensors.residuals`); 0 where either lacks them."""
+def distance(a, b):
+    """|r_a - r_b| (C) of two candidates' residuals the evidence (`evidence`) is made of: the
+    air's left out (`cv.left_out`, C, every block's in one order) and the other sensors' on the
+    blocks (`sensors.residuals`); 0 where either lacks them."""
     def residuals(r):
         parts = [r["cv"].get("left_out"), r.get("sensors", {}).get("residuals", np.empty(0))]
         return None if parts[0] is None else np.concatenate([np.asarray(x, dtype=float) for x in parts])
     ra, rb = residuals(a), residuals(b)
     if ra is None or rb is None:
         return 0.0
-    return float(2.0 * sigma * np.linalg.norm(ra - rb))
+    return float(np.linalg.norm(ra - rb))
+
+
+def noise_difference(distance, sigma):
+    """The standard deviation (C2) of the difference of two candidates' evidence that sensor noise
+    of sd sigma (C) alone makes, given the `distance` |r_a - r_b| (C) of their residuals:
+    J_a - J_b = sum (r_a - r_b)(r_a + r_b), and the noise e of a measurement enters r_a + r_b
+    twice, so the difference moves by 2 sum (r_a - r_b) e, of sd 2 sigma |r_a - r_b|."""
+    return float(2.0 * sigma * distance)
 
 
 def parsimony(result, sigma, n):
     """The fall of evidence (C2) a candidate must add over one that claims less (a physical effect
     against a shape, fewer parameters against more, the zone's own effect against one
     component's) to be preferred to it: what the sensors' noise alone could make of J over the
-    residuals its evidence scores (`ga.parsimony.noise_tolerance`), the yardstick that admits a
+    residuals its evidence scores (`Policy.noise_change`), the yardstick that admits a
     candidate against the model (1.) and a forced node against fewer in the search. Its extra
     freedom fits what the file itself leaves (its coarser walls, a history it does not know) as
     well as the fault: a ground coupling against a constant gain, a daily profile against a
@@ -161,10 +153,10 @@ def parsimony(result, sigma, n):
     neither the days' scatter nor a fixed pair's noise (`noise_difference`) would call small. One
     wall's factor bends that wall's dynamics, where the file's coarse nodes err, as the envelope's
     cannot: on the air alone it fits that error too. `n`: the air's scored residuals."""
-    return noise_tolerance(sigma, n + result.get("sensors", {}).get("n_weighted", 0))
+    return POLICY.noise_change(sigma, n + result.get("sensors", {}).get("n_weighted", 0))
 
 
-def harmed(base, scores, floor, groups):
+def harmed(base, scores, floor_sd, groups):
     """The records a candidate harms: those on whose blocks its cross-validated J rises by more
     than the noise's tolerance of that record's J and one standard error of its per-block falls;
     [{"record", "cv_fall", "needed"}] (C2).
@@ -172,7 +164,7 @@ def harmed(base, scores, floor, groups):
     Parameters
     ----------
     base, scores : per-block J (C2) of the model without and with the candidate
-    floor : the sd (C) of what a right model of the file leaves (`decide`'s floor: the sensors'
+    floor_sd : the sd (C) of what a right model of the file leaves (`decide`'s: the sensors'
         noise and the file's own numerical error)
     groups : [{"record": name, "blocks": indices into base, "n": residuals they score}]
     """
@@ -181,16 +173,17 @@ def harmed(base, scores, floor, groups):
     for group in groups:
         rows = np.asarray(group["blocks"], dtype=int)
         down, se = fall(base[rows], scores[rows]) if len(rows) > 1 else (float((base[rows] - scores[rows]).sum()), 0.0)
-        needed = max(tolerance(float(base[rows].sum()), floor, group["n"]), STANDARD_ERRORS * se)
+        needed = max(POLICY.least_fall(float(base[rows].sum()), floor_sd, group["n"]), POLICY.standard_errors * se)
         if down < -needed:
             out.append({"record": group["record"], "cv_fall": down, "needed": needed})
     return out
 
 
-def decide(building, results, base, sigma, n, groups=(), floor=None):
-    """The decision record of one round (module docstring): the chosen candidate (or None), each
-    candidate's test, the candidates the data support but physics refuses (suggestions), those
-    the data cannot tell from the chosen, and the reason in words.
+def decide(building, results, base, sigma, n, groups=(), floor_sd=None, distances=None):
+    """The decision record of one round (module docstring), its steps in order: 1. which
+    candidates pass, 2. which of them physics refuses (suggestions), 3. the band of those the data
+    cannot tell from the best, 4. the one of the band that claims least; with each candidate's
+    test and the reason in words. The thresholds are `diagnosis.policy.POLICY`'s.
 
     Parameters
     ----------
@@ -200,61 +193,89 @@ def decide(building, results, base, sigma, n, groups=(), floor=None):
     sigma : the air sensors' noise sd (C), what a fixed pair's difference moves by (`noise_difference`)
     n : residuals the blocks score
     groups : the records the blocks come from (`harmed`), where there are several
-    floor : the sd (C) of what a right model of the file leaves, the noise and the file's own
-        numerical error (`model.score.Noise.floor`), the yardstick of a fall of J: a candidate
+    floor_sd : the sd (C) of what a right model of the file leaves, the noise and the file's own
+        numerical error (`model.score.Noise.floor_sd`), the yardstick of a fall of J: a candidate
         with a slow parameter fits part of that deterministic error as it fits a fault; sigma if
         None
+    distances : {label: {label: C}}, the `distance` of every two admissible candidates' residuals,
+        as the decision record keeps it (`inputs.distances`); computed from the residuals if None
     """
     base = np.asarray(base, dtype=float)
-    floor = sigma if floor is None else floor
-    margin = tolerance(float(base.sum()), floor, n)
-    tests = {}
+    floor_sd = sigma if floor_sd is None else floor_sd
+    margin = POLICY.least_fall(float(base.sum()), floor_sd, n)
+    # what the building says of each candidate (its limits, ...): report.json keeps it as `physics`
     for r in results:
-        down, se = fall(base, r["cv"]["blocks"])
-        needed = max(margin, STANDARD_ERRORS * se)
-        # the other days than its best must gain too: one day alone is no evidence
-        others = down - float(np.max(base - np.asarray(r["cv"]["blocks"])))
-        harms = harmed(base, r["cv"]["blocks"], floor, groups)
-        said = objection(building, r["effect"], r["target"], r["parameters"], r.get("derived"))
-        if harms:
-            said = "; ".join(filter(None, [said, "it helps the records together but harms " + "; ".join(
-                f"{h['record']} (its cross-validated J there rises by {-h['cv_fall']:.3g} C2, beyond the "
-                f"{h['needed']:.3g} C2 the noise and the day-to-day scatter could make)" for h in harms)
-                + ": a correction of the building must hold on every record of it"]))
-        tests[label(r)] = {"cv_fall": down, "cv_se": se, "needed": needed, "other_days": others,
-                           "evidence": float(evidence(r).sum()),
-                           "passes": bool(down > needed and others > 0), "harms": harms, "objection": said}
-    passing = [r for r in results if tests[label(r)]["passes"]]
-    admissible = [r for r in passing if not tests[label(r)]["objection"]]
+        if "physics" not in r:
+            r["physics"] = POLICY.facts(building, r["effect"], r["target"])
+    tests = {label(r): candidate_test(r, base, margin, floor_sd, groups) for r in results}
+    passing = [r for r in results if tests[label(r)]["passes"]]  # 1.
+    admissible = [r for r in passing if not tests[label(r)]["objection"]]  # 2.
     suggestions = [{"candidate": label(r), "reason": tests[label(r)]["objection"], "cv_rmse": r["cv"]["rmse"]}
                    for r in passing if tests[label(r)]["objection"]]
-    components = {c.name for c in building.components}
+    components = {r["target"] for r in results if r["physics"]["component"]}
     chosen, alike = None, []
     if admissible:
-        best = min(admissible, key=lambda r: evidence(r).sum())
-        rounding = ROUNDING * float(base.sum())
-
-        def claim(r):
-            # what a choice claims, least first: a physical effect before a shape, fewer parameters
-            # before more, the zone's own effect before one component's (which says where)
-            return preference(r["effect"]), r["target"] in components
-
-        def close(r):
-            # how much worse than the best it predicts the left-out days, and the scatter of that
-            worse, se = fall(evidence(r), evidence(best))
-            needed = max(STANDARD_ERRORS * max(se, noise_difference(r, best, sigma)), rounding)
-            if claim(r) < claim(best):
-                needed = max(needed, parsimony(best, floor, n))
-            return worse <= needed
-        near = [r for r in admissible if close(r)]
-        chosen = min(near, key=lambda r: (claim(r), evidence(r).sum()))
+        if distances is None:
+            distances = {label(a): {label(b): distance(a, b) for b in admissible} for a in admissible}
+        near = band(admissible, base, sigma, floor_sd, n, distances)  # 3.
+        chosen = min(near, key=lambda r: (claim(r), evidence(r).sum()))  # 4.
         alike = [r for r in near if r is not chosen]
     # the candidates physics refused are in `suggestions`; the report says them grouped by reason
     reason = _reason(chosen, alike, results, passing, base, n, tests, margin, components)
     return chosen, {"chosen": label(chosen) if chosen else None, "reason": reason,
                     "cv_J_before": float(base.sum()), "blocks": len(base), "noise_margin": margin,
-                    "standard_errors": STANDARD_ERRORS, "suggestions": suggestions,
-                    "indistinct": [label(r) for r in alike], "candidates": tests}
+                    "standard_errors": POLICY.standard_errors, "suggestions": suggestions,
+                    "indistinct": [label(r) for r in alike], "candidates": tests,
+                    # what the steps read besides the candidates' records: report.json can replay them
+                    "inputs": {"blocks_before": [float(b) for b in base], "sigma": sigma, "floor_sd": floor_sd,
+                               "n": n, "groups": list(groups), "distances": distances or {}}}
+
+
+def candidate_test(result, base, margin, floor_sd, groups):
+    """One candidate's test (steps 1 and 2): its cross-validated fall of J (C2) and the fall's
+    standard error, what it needs (the noise's `margin`, C2, and `standard_errors` of its
+    scatter), what the days other than its best gain, its evidence, whether it passes, the
+    records it harms and the objection of physics, None if none."""
+    blocks = np.asarray(result["cv"]["blocks"])
+    down, se = fall(base, blocks)
+    needed = max(margin, POLICY.standard_errors * se)
+    # the other days than its best must gain too: one day alone is no evidence
+    others = down - float(np.max(base - blocks))
+    harms = harmed(base, blocks, floor_sd, groups)
+    said = POLICY.objection_of(result["effect"], result["parameters"], result.get("derived"), result["physics"])
+    if harms:
+        said = "; ".join(filter(None, [said, "it helps the records together but harms " + "; ".join(
+            f"{h['record']} (its cross-validated J there rises by {-h['cv_fall']:.3g} C2, beyond the "
+            f"{h['needed']:.3g} C2 the noise and the day-to-day scatter could make)" for h in harms)
+            + ": a correction of the building must hold on every record of it"]))
+    return {"cv_fall": down, "cv_se": se, "needed": needed, "other_days": others,
+            "evidence": float(evidence(result).sum()),
+            "passes": bool(down > needed and others > 0), "harms": harms, "objection": said}
+
+
+def claim(result):
+    """What a candidate's choice claims, least first (`Policy.claim`)."""
+    return POLICY.claim(result["effect"], result["physics"]["component"])
+
+
+def band(admissible, base, sigma, floor_sd, n, distances):
+    """Step 3: the admissible candidates the data cannot tell from the best (the lowest evidence),
+    the best among them: those whose evidence exceeds the best's by no more than
+    `standard_errors` standard errors of the paired difference (its scatter from day to day, or
+    what the sensors' noise alone makes of it, `noise_difference` of their `distances`), at least
+    the rounding; and,
+    where the best claims more, by no more than the noise's tolerance (`parsimony`)."""
+    best = min(admissible, key=lambda r: evidence(r).sum())
+    rounding = POLICY.rounding(float(base.sum()))
+
+    def close(r):
+        worse, se = fall(evidence(r), evidence(best))
+        needed = max(POLICY.standard_errors * max(se, noise_difference(distances[label(r)][label(best)], sigma)),
+                     rounding)
+        if claim(r) < claim(best):
+            needed = max(needed, parsimony(best, floor_sd, n))
+        return worse <= needed
+    return [r for r in admissible if close(r)]
 
 
 def _reason(chosen, alike, results, passing, base, n, tests, margin, components):
@@ -266,10 +287,10 @@ def _reason(chosen, alike, results, passing, base, n, tests, margin, components)
     if not chosen:
         return (f"None of the {len(results)} candidates lowers the cross-validated J ({base.sum():.3g} C2 over "
                 f"{B} days) by more than the noise and the file's numerical error could ({margin:.3g} C2) and "
-                f"{STANDARD_ERRORS:g} standard error of its fall from day to day, on more days than one"
+                f"{POLICY.standard_errors:g} standard error of its fall from day to day, on more days than one"
                 + (f" ({len(passing)} do, and physics or a record they harm refuses each)" if passing else "") + ": no effect is added.")
     what = (f"an unexplained heat source, acting {acting(chosen)} ({chosen['effect']} on {chosen['target']})"
-            if is_shape(chosen["effect"]) else f"{chosen['effect']} on {chosen['target']}")
+            if POLICY.is_shape(chosen["effect"]) else f"{chosen['effect']} on {chosen['target']}")
     test = tests[label(chosen)]
     said = (f"{what[0].upper() + what[1:]} lowers the cross-validated J from {base.sum():.3g} to "
             f"{chosen['cv']['J']:.3g} C2 ({rmse_before:.3f} -> {chosen['cv']['rmse']:.3f} C; each of {B} days "
@@ -291,7 +312,7 @@ def _reason(chosen, alike, results, passing, base, n, tests, margin, components)
     elif others:
         said += (f". A correction of {' or '.join(dict.fromkeys(others))} alone explains the data as well: "
                  f"they do not place the fault in one component")
-    if is_shape(chosen["effect"]):
+    if POLICY.is_shape(chosen["effect"]):
         said += "; no physical effect comes within one standard error of it"
     return said + "."
 

@@ -10,8 +10,8 @@ agree on the HLC, the report says the split is not the record's.
 """
 import math
 
-from nodeforce.diagnose.selection import label
-from nodeforce.ga.parsimony import tolerance
+from nodeforce.diagnosis.selection import label
+from nodeforce.diagnosis.policy import POLICY
 from nodeforce.model.hlc import heat_loss_coefficient
 
 HLC = "heat_loss_coefficient"
@@ -55,13 +55,13 @@ def same_loss(chosen, tried, start, sigma):
     """The other candidates of `chosen`'s round that change the loss from the round's `start`
     ({"value", "std"}, W/K) as the chosen does: the same HLC, each well determined, and a
     cross-validated J the chosen's does not beat by more than the noise could
-    (`ga.parsimony.tolerance`).
+    (`diagnosis.policy.Policy.least_fall`).
     None of them when the chosen changes no loss (a gain, a mass)."""
     hlc = chosen["derived"].get(HLC)
     if not hlc or not moves(hlc, start):
         return []
     J, n = chosen["cv"]["J"], chosen["cv"]["n"]
-    margin = tolerance(J, sigma, n)
+    margin = POLICY.least_fall(J, sigma, n)
     return [r for r in tried if label(r) != label(chosen) and r["derived"].get(HLC)
             and agree(hlc, r["derived"][HLC]) and moves(r["derived"][HLC], start)
             and r["cv"]["J"] - J <= margin]

@@ -1,10 +1,12 @@
-"""Which effects a diagnosis tries, and where their calibrations start: the diagnosis' policy.
+"""Which effects a diagnosis tries, and where their calibrations start.
 
 Kept apart from the effect records (`nodeforce.model.effects`), which an FMU bundles: changing
-the policy changes no FMU and throws away no saved search.
+them changes no FMU and throws away no saved search. How many components are tried, which
+effects are shapes, and what physics refuses are the choice's (`diagnosis.policy`).
 """
 import math
 
+from nodeforce.diagnosis.policy import POLICY
 from nodeforce.model.effects import EFFECTS, bridge_parts, bridge_target, pair_parts
 from nodeforce.model.network import RHO_C_AIR
 
@@ -24,27 +26,16 @@ ZONE_START = {("internal_mass", "C_m"): 10.0,
 INSIDE = 1e-3
 
 
-# A scale parameter, or a derived quantity, is identifiable when its standard deviation is under
-# this fraction of its value (diagnose.calibrate).
-IDENTIFIABLE_RELATIVE = 0.25
-
-
-# The components whose effects every round calibrates besides the unmeasured ones: at least the
-# TOP_COMPONENTS whose forcing removes most of J above the noise, and any that removes EVIDENT of
-# it or more (ga.locate's `components`), whether or not the localisation calls a fault.
-TOP_COMPONENTS = 3
-EVIDENT = 0.25
-
-
 def physical(building, evidence, zones, measured_ids, located_nodes=()):
     """(effect, target) pairs every round calibrates, whatever the residual's statistics say: a
     building physicist's list of what could be wrong, which the cross-validated choice
-    (`diagnose.selection`) then judges.
+    (`diagnosis.selection`) then judges.
 
     - Every zone effect of each objective zone (`zone_effects`), and of any zone whose air the
       forcing search located.
     - The component effects (`component_effects`) of the components the forcing evidence ranks
-      highest (at least TOP_COMPONENTS, and any removing EVIDENT of J above the noise), and of
+      highest (at least `POLICY.top_components`, and any removing `POLICY.evident_share` of J
+      above the noise), and of
       every component of an objective zone that no sensor sits in: forcing cannot point at a
       component without a sensor; a calibration can.
 
@@ -59,7 +50,8 @@ def physical(building, evidence, zones, measured_ids, located_nodes=()):
     located = set(located_nodes)
     air_zones = list(zones) + [z.name for z in building.zones if z.air_node in located]
     pairs = [pair for name in dict.fromkeys(air_zones) for pair in zone_effects(building, name)]
-    ranked = [e["component"] for i, e in enumerate(evidence) if i < TOP_COMPONENTS or e["share"] >= EVIDENT]
+    ranked = [e["component"] for i, e in enumerate(evidence)
+              if i < POLICY.top_components or e["share"] >= POLICY.evident_share]
     measured = set(measured_ids)
     # a component of an objective zone: one of its faces faces the zone (a partition's either side)
     facing = {i for zone in zones for i in building.facing(zone)}
@@ -109,7 +101,7 @@ def component_effects(building, name):
     a glazing's transmittance where the component receives its sun."""
     nodes = set(building.component(name).node_ids)
     components = {c.name for c in building.components}
-    return [(effect.id, target) for effect in EFFECTS.values() if not is_shape(effect.id)
+    return [(effect.id, target) for effect in EFFECTS.values() if not POLICY.is_shape(effect.id)
             for target in effect.targets(building) if target in components
             and (target == name or nodes & set(effect.points_at(building, target)))]
 
@@ -138,130 +130,17 @@ def calibration_start(building, effect, target):
     return values
 
 
-def implausible(building, effect, target):
-    """Why the building file's own description makes an effect implausible, or None: a constant
-    gain in a zone the file declares unoccupied stands for a heat source the model lacks, not for
-    occupants, and the report must say so."""
-    if effect in ("internal_gain", "daily_gain") and building.zone(target).occupied is False:
-        return (f"{target} is declared unoccupied: the gain stands for a heat source the model lacks "
-                "(a heat input mis-measured, a flow of air or sun not modelled), not for occupants")
-    return None
-
-
-# The shapes: a gain that follows the clock or an input column stands for a heat source the model
-# lacks, not for a physical effect of the building; tried only where no physical effect brings the
-# error to the noise, and chosen only where none fits as well (diagnose.selection.decide).
-SHAPES = ("daily_gain", "proportional_gain")
-
-# Physical limits, tighter than the range a calibration explores (model.effects): a value
-# outside them, by more than its uncertainty (`LIMIT_STANDARD_DEVIATIONS`), is not a property of
-# a building but a fit compensating something else. A gain to
-# the air is a source, not a sink (a heat sink would be a cooler the file would declare); scales
-# of conductances within a factor of ten of what the file declares; inside convection within what
-# a room's air can do (`ROOM_CONVECTION`).
-PHYSICAL_LIMITS = {("internal_gain", "Q"): (0.0, math.inf),
-                   ("daily_gain", "mean"): (0.0, math.inf),
-                   ("conductivity", "factor"): (0.1, 10.0),
-                   ("envelope_conductance", "factor"): (0.1, 10.0),
-                   ("boundary_conductance", "factor"): (0.1, 10.0),
-                   ("supply_flow", "factor"): (0.1, 10.0),
-                   # a heater or meter off its reading by more than a factor of two is a fault
-                   # the building file should state, not a property to fit
-                   ("heat_input_factor", "factor"): (0.5, 2.0)}
-# The area-weighted mean convective coefficient of a room's surfaces, W/m2/K, that air can give.
-# Natural convection (Alamdari and Hammond's correlations for walls, floors and ceilings, stable
-# and unstable) gives a room about 0.6 with every surface within 0.1 K of its air, a stiller room
-# than a heated or free-floating one holds; forced convection at a hundred air changes an hour
-# (Fisher and Pedersen's ceiling-diffuser correlations) stays below 20, a facade's in a stiff wind.
-# A limit on the coefficient, not on the factor: a factor of 0.1 is 0.5 W/m2/K where a file
-# declares 5 on every face, 0.26 where it declares ISO 6946's 2.5 on walls and 0.7 on floors.
-ROOM_CONVECTION = (0.5, 20.0)
-# The parameters whose identifiability decides for an effect (default: all of them): a daily
-# profile's harmonics may each be near zero, and small next to their uncertainty, while the
-# profile and its mean are determined.
-JUDGED = {"daily_gain": ("mean",)}
-# Standard deviations of its estimate a value must lie beyond a physical limit to be refused: a
-# door at the limit of ten times its wood's conductivity, estimated at 11.4 +- 1.5, may well be at
-# ten; only an estimate whose two-sided 95 % interval leaves the physical range says it is not.
-LIMIT_STANDARD_DEVIATIONS = 2.0
-
-
-def is_shape(effect):
-    return effect in SHAPES
-
-
-def preference(effect):
-    """Sort key of the candidates a decision prefers where the data cannot tell them apart: a
-    physical effect before a shape, then fewer parameters before more."""
-    return (is_shape(effect), len(EFFECTS[effect].parameters))
-
-
-def limits(building, effect, target, name):
-    """The physical (low, high) of a parameter: PHYSICAL_LIMITS; for a proportional gain an
-    area of sun that cannot be negative (an irradiance column) or a share of a heat input that
-    cannot take away more than the input (k >= -1); for inside convection the factors that
-    bring the zone's mean declared coefficient into `ROOM_CONVECTION`."""
-    if effect == "inside_convection":
-        declared = building.mean_inside_convection(target)
-        return tuple(h / declared for h in ROOM_CONVECTION)
-    if effect == "proportional_gain":
-        _, column = bridge_parts(target)
-        heat_inputs = {c for z in building.zones for c in z.heat_input}
-        return (-1.0 if column in heat_inputs else 0.0, math.inf)
-    return PHYSICAL_LIMITS.get((effect, name), (-math.inf, math.inf))
-
-
-# What the data fix where an effect's parameters trade off (`diagnose.calibrate.derived`): when
-# it is determined, the parameters need not be one by one. A ground coupling's (U, T_ground) is
-# then one of the many pairs that give the flux, wherever it ended, a bound included; a node's
-# (C, H) must still be inside its range, where a bound means a node that is not there; a
-# component's conductivity factor, which trades off against nothing but saturates behind the
-# surface coefficients, is judged by the heat the component loses, and still refused on a bound.
-TRADE_OFFS = {"ground_coupling": ("ground_heat_flux", True),
-              "conductivity": ("component_loss", False),
-              "heat_input_lag": ("heater_time_constant", False),
-              "internal_mass": ("mass_time_constant", False)}
-
-
-def objection(building, effect, target, parameters, derived=None):
-    """Why a calibrated effect may not be added to the model, or None: a gain the building file's
-    description rules out (`implausible`), a parameter on a bound of its search range or not
-    identifiable from the data (unless the quantity its parameters trade off along is, TRADE_OFFS),
-    or a value outside physical limits beyond its uncertainty (`LIMIT_STANDARD_DEVIATIONS`).
-
-    parameters : {name: {"value", "std", "identifiable", "on_bound"}} of `diagnose.calibrate`
-    derived : what the data determine besides (`diagnose.calibrate.derived`)
-    """
-    reasons = [implausible(building, effect, target)]
-    key, bounds_waived = TRADE_OFFS.get(effect, (None, False))
-    fixed = (derived or {}).get(key)
-    resolved = fixed is not None and fixed["std"] < IDENTIFIABLE_RELATIVE * abs(fixed["value"])
-    for name in JUDGED.get(effect, [p.name for p in EFFECTS[effect].parameters]):
-        p, unit = parameters[name], EFFECTS[effect].parameter(name).unit
-        low, high = limits(building, effect, target, name)
-        if p.get("on_bound") and not (resolved and bounds_waived):
-            reasons.append(f"{name} = {p['value']:.3g} {unit} ends on a bound of its range")
-        elif not p["identifiable"] and not resolved:
-            reasons.append(f"{name} = {p['value']:.3g} +- {p['std']:.2g} {unit} is not identifiable from these data")
-        margin = LIMIT_STANDARD_DEVIATIONS * p["std"]
-        if not low - margin <= p["value"] <= high + margin:
-            what = "a negative gain (a heat sink)" if low == 0.0 and "gain" in effect else "outside physical limits"
-            reasons.append(f"{name} = {p['value']:.3g} +- {p['std']:.2g} {unit} is {what} [{low:.3g}, {high:.3g}] "
-                           f"by more than {LIMIT_STANDARD_DEVIATIONS:g} standard deviations")
-    return "; ".join(r for r in reasons if r) or None
-
-
 def shapes(building, left, zones):
     """The shapes (effect, target) the residual's statistics point at: a gain with a daily
     profile where the residual follows the time of day, a gain proportional to each input column
     it follows (a heat input mis-measured, sun through an opening the model lacks), for each
     objective zone. None where the residual is white: nothing is left to explain. A round tries
-    them only where no physical candidate brings the error to the noise (`diagnose.loop`).
+    them only where no physical candidate brings the error to the noise (`diagnosis.loop`).
 
     Parameters
     ----------
     building : Building, the model the residual is of
-    left : `diagnose.residuals.diagnostics` of that residual
+    left : `diagnosis.residuals.diagnostics` of that residual
     zones : names of the objective zones
     """
     if left.get("white"):

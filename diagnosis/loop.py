@@ -5,18 +5,18 @@ on data the calibration did not see.
    record's first days are a burn-in (docs/model.md: every measured node forced, not scored), so
    the walls start from what the sensors saw rather than from the warm-up's replay of the first
    day, which a record with real history does not match; the calibration window's scored steps
-   are cut into blocks of whole days for the cross-validation (`diagnose.selection`).
+   are cut into blocks of whole days for the cross-validation (`diagnosis.selection`).
 2. Before: the building as described, simulated through its FMU; metrics on both windows, per
    objective zone and together.
 3. The forcing search (`ga.locate`) on the calibration window: which nodes it locates, and per
    component the share of J above the noise its forcing removes (the evidence).
-4. Rounds. Each calibrates every physical candidate (`diagnose.candidates.physical`: every zone
+4. Rounds. Each calibrates every physical candidate (`diagnosis.candidates.physical`: every zone
    effect of the objective zones, the component effects of the components the evidence ranks
    highest and of those no sensor sits in) on the direct model, the candidates in parallel
    worker processes, once on the whole calibration window and once per block left out
-   (`diagnose.calibrate`); where none brings the error to the noise, the shapes the residual's
-   statistics point at too (`diagnose.candidates.shapes`). One rule chooses
-   (`diagnose.selection.decide`: blocked cross-validation, the one-standard-error rule, the
+   (`diagnosis.calibrate`); where none brings the error to the noise, the shapes the residual's
+   statistics point at too (`diagnosis.candidates.shapes`). One rule chooses
+   (`diagnosis.selection.decide`: blocked cross-validation, the one-standard-error rule, the
    objections of physics), against the model the earlier rounds made. Rounds go on while the
    error left is above the noise and a candidate passes. The validation window plays no part in
    any choice: its before and after are an honest estimate. The decision of every round, its
@@ -25,8 +25,8 @@ on data the calibration did not see.
    every candidate's building file is written declaring its calibrated effect
    (`candidates/<effect>@<target>.json`, a later round's in `candidates/round<n>/`).
 6. The residual of the first objective zone on the validation window, before and after, is
-   described (`diagnose.residuals`): is it white, and which input or time of day does it follow.
-7. Given the experiment's phases, every model is scored on each (`diagnose.phases`), and an
+   described (`diagnosis.residuals`): is it white, and which input or time of day does it follow.
+7. Given the experiment's phases, every model is scored on each (`diagnosis.phases`), and an
    added effect that makes a phase worse is flagged in the decision's reason.
 """
 import json
@@ -42,13 +42,14 @@ from tqdm import tqdm
 from nodeforce import lifetime
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
-from nodeforce.diagnose.calibrate import Candidate, calibrate, sensitivity
-from nodeforce.diagnose.candidates import objection, physical, shaped_inputs, shapes
-from nodeforce.diagnose.loss import heat_loss
-from nodeforce.diagnose.report import write_report
-from nodeforce.diagnose.phases import phase_errors, worsened
-from nodeforce.diagnose.residuals import diagnostics as residual_diagnostics
-from nodeforce.diagnose.selection import at_noise, block_J, blocks as blocks_of, decide, label, on_block
+from nodeforce.diagnosis.calibrate import Candidate, calibrate, sensitivity
+from nodeforce.diagnosis.candidates import physical, shaped_inputs, shapes
+from nodeforce.diagnosis.loss import heat_loss
+from nodeforce.diagnosis.report import write_report
+from nodeforce.diagnosis.phases import phase_errors, worsened
+from nodeforce.diagnosis.residuals import diagnostics as residual_diagnostics
+from nodeforce.diagnosis.policy import POLICY
+from nodeforce.diagnosis.selection import block_J, blocks as blocks_of, decide, label, on_block
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.locate import check_measured, evaluator_kind, locate
 from nodeforce.model.effects import EFFECTS
@@ -56,10 +57,6 @@ from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
 from nodeforce.model.numerical import reference, share
 from nodeforce.model.score import Noise
-
-# Rounds of candidates at most: each adds one effect on top of the last, while the error left is
-# above the noise and a candidate passes; a record rarely supports three undeclared effects.
-MAX_ROUNDS = 3
 
 
 def split(case, source, fraction=None, end=None):
@@ -179,7 +176,7 @@ class Windows:
     def block_J(self, runs):
         """J (C2) of `runs` on every block, the records' in order, each less the share of the
         file's numerical error (`model.numerical.share`) the other blocks hold, as a candidate's
-        left-out block is scored (`diagnose.calibrate`)."""
+        left-out block is scored (`diagnosis.calibrate`)."""
         residuals = [m[:k] - run[:k] for m, run, k in zip(self.measured, runs, self.ks)]
         errors = self.calibration_numerical() or [np.zeros_like(r) for r in residuals]
         r, e = (np.concatenate([a.ravel() for a in parts]) for parts in (residuals, errors))
@@ -207,7 +204,7 @@ class Windows:
     def sensor_weights(self, building, bases, sigma):
         """Per record, each other sensor's weight in the choice: sigma^2 over its mean squared
         residual under the model the candidates are added to (`building`, or the record's
-        protocol's in `bases`), over the calibration window, at most 1.
+        protocol's in `bases`), over the calibration window (`Policy.sensor_weight`).
 
         A sensor the model follows to the noise counts fully. One it misses by far more (a real
         house's surface the model sees through a simplified wall, a heavy wall still carrying the
@@ -223,7 +220,7 @@ class Windows:
             model = bases[i] or building
             T = case.with_inputs(model).run(model)[:, np.asarray(ids) - 1]
             misfit = np.nanmean(np.square(self.sensed[i][:self.ks[i]] - T[:self.ks[i]]), axis=0)
-            out.append(np.minimum(1.0, sigma ** 2 / np.maximum(misfit, np.finfo(float).tiny)))
+            out.append(POLICY.sensor_weight(sigma, np.maximum(misfit, np.finfo(float).tiny)))
         return out
 
     def with_numerical(self, runs, building, bases, objective):
@@ -290,7 +287,7 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers, weights)
         metrics = windows.metrics(objective, runs)
         sensor_blocks, sensor_residuals, readings, counted = windows.sensor_scores(sensed, weights)
         result = {"effect": effect, "target": target, "parameters": parameters, "derived": determined,
-                  **metrics,
+                  "physics": POLICY.facts(model.building, effect, target), **metrics,
                   "cv": {"blocks": scores, "J": sum(scores), "n": n, "rmse": float(np.sqrt(sum(scores) / n)),
                          "folds": [f["values"] for f in folds],
                          # each block's left-out residuals, in one order for every candidate
@@ -308,7 +305,8 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers, weights)
 def diagnose(building, records, objective, workdir, *, source="measurements", fraction=0.6, calibration_end=None,
              seed=0, workers=None, population=30, generations=400, fmu_kind="auto", reference=None,
              noise=None, phases=None):
-    """Run the whole loop; write the artifacts in `workdir`; return the report.json content.
+    """Run the whole loop, its stages in order (`prepare`, `localise`, `rounds`, `write`); write the
+    artifacts in `workdir`; return the report.json content.
 
     `records` is a Case (one record: `source`, `fraction`, `calibration_end` and `phases` are
     its) or a list of `Record`s of the same building, each with its own windows and phases: the
@@ -327,80 +325,124 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
             raise InputError(r.source, "name", f"two records are named {r.name!r}: each needs its own name")
         check_measured(objective, r.case, r.source)
     fmu_kind = evaluator_kind() if fmu_kind == "auto" else fmu_kind
-    windows = Windows.of(records, objective)
-    first = windows.cases[0]
-    n = windows.scored()
-    bases = [protocol(building, r) for r in records]
+    prepared = prepare(building, records, objective, workdir, fmu_kind, noise)
+    search = dict(seed=seed, workers=workers, population=population, generations=generations, fmu_kind=fmu_kind,
+                  noise=prepared.noise.sigma if prepared.noise.given else None)
+    located = localise(building, prepared, objective, workdir, search)
+    made = rounds(prepared, located.localization, objective, workdir, seed, workers)
+    return write(building, prepared, located, made, objective, workdir, fmu_kind, reference)
 
+
+@dataclass
+class Prepared:
+    """What every stage reads (`prepare`): the records, their windows (with the file's numerical
+    error), each record's protocol's building (`bases`, None: the building's), the model as
+    described (its runs over each record and its metrics), the noise, and the residuals the
+    blocks score (`n`)."""
+    records: list
+    windows: Windows
+    bases: list
+    model: Model
+    noise: Noise
+    n: int
+
+
+@dataclass
+class Located:
+    """The forcing search on every record's calibration window together (`localization`,
+    locate.json's content), on each record alone (`alone`, where there are several), and its best
+    J per generation (`convergence`)."""
+    localization: dict
+    alone: list
+    convergence: list
+
+
+@dataclass
+class Made:
+    """What the rounds made: the effects added, in order (their candidate records), each round's
+    decision record, every candidate tried (as report.json keeps it), their runs by label, the
+    Morris screening of each chosen effect, and the model they leave."""
+    added: list
+    decisions: list
+    results: list
+    runs: dict
+    sensitivities: dict
+    model: Model
+
+
+def prepare(building, records, objective, workdir, fmu_kind, noise):
+    """Stage 1: the records' windows; the building as described (each record's protocol's)
+    built as an FMU and run over each record (`model_before.fmu`); the file's own numerical error
+    beside it; the noise (C), `noise` if the user gave it."""
+    windows = Windows.of(records, objective)
+    bases = [protocol(building, r) for r in records]
     before_runs = []
     for i, (case, base) in enumerate(zip(windows.cases, bases)):
         name = "model_before.fmu" if base is None else f"model_before_{i + 1}.fmu"
         with FmuInstance(build_fmu(base or building, workdir / name, kind=fmu_kind)) as fmu:
             before_runs.append(simulate_fmu(fmu, case, output_ids=objective.air_nodes))
-    before = windows.metrics(objective, before_runs)
-    model = Model(building, before_runs, before, bases)
+    model = Model(building, before_runs, windows.metrics(objective, before_runs), bases)
     windows = windows.with_numerical(before_runs, building, bases, objective)
     noise = Noise.of_records(windows.measured, noise).with_numerical(windows.numerical_rms())
-    sigma, floor = noise.sigma, noise.floor
+    return Prepared(list(records), windows, bases, model, noise, windows.scored())
 
+
+def localise(building, prepared, objective, workdir, search):
+    """Stage 2: the forcing search (`ga.locate`) on every record's calibration window together,
+    a forcing applying to all; and on each record alone, reported: a record's own sensors
+    (experiment 2's surfaces) may point where the records together do not."""
+    windows, records, bases = prepared.windows, prepared.records, prepared.bases
     convergence = []
-    search = dict(seed=seed, workers=workers, population=population, generations=generations, fmu_kind=fmu_kind,
-                  noise=noise.sigma if noise.given else None)
-    # the forcing search on every record's calibration window together: a forcing applies to all
     localization = locate(building, windows.calibrations, objective, workdir, source=records[0].source,
                           protocols=bases, progress=lambda generation, total, J, unique: convergence.append((generation, J)),
                           **search)
-    # and on each record alone, reported: a record's own sensors (experiment 2's surfaces) may
-    # point where the records together do not
     alone = []
     for i, record in enumerate(records if len(records) > 1 else ()):
         into = workdir / "locate" / record.name
         into.mkdir(parents=True, exist_ok=True)
         alone.append(locate(building, [windows.calibrations[i]], objective, into, source=record.source,
                             protocols=[bases[i]], **search))
+    return Located(localization, alone, convergence)
 
+
+def rounds(prepared, localization, objective, workdir, seed, workers):
+    """Stage 3: rounds of candidates, `POLICY.max_rounds` at most, each on top of the last,
+    while the error left is above the noise and one is chosen (`selection.decide`)."""
+    windows, n, noise = prepared.windows, prepared.n, prepared.noise
     folder = workdir / "candidates"
     folder.mkdir(exist_ok=True)
-    k0, scored0 = windows.ks[0], windows.measured[0][:windows.ks[0]]
-
-    def left_by(model):
-        """What the model's residual on the first record's calibration window follows (an input,
-        the time of day)."""
-        shaped = shaped_inputs(model.building)
-        inputs = {name: values for name, values in zip(first.input_names, first.U[1:k0 + 1].T) if name in shaped}
-        return residual_diagnostics(windows.calibrations[0].times[1:], scored0[:, 0] - model.runs[0][:k0, 0], inputs)
-
-    def assessed(model, pairs, number):
-        # a later round's candidates, on top of the earlier choices, are building files of their own
-        into = folder / f"round{number + 1}" if number else folder
-        into.mkdir(exist_ok=True)
-        return assess_all(model, pairs, windows, objective, into, seed, workers,
-                          windows.sensor_weights(model.building, model.bases, sigma))
-
     measured_ids = sorted({i for case in windows.cases for i in case.measured_ids})
-    added, rounds, results, runs, sensitivities = [], [], [], {}, {}
-    for number in range(MAX_ROUNDS):
+    model, added, decisions, results, runs, sensitivities = prepared.model, [], [], [], {}, {}
+    for number in range(POLICY.max_rounds):
         base_blocks = windows.block_J(model.runs)
-        if number and at_noise(base_blocks.sum(), n, floor):
+        if number and POLICY.at_noise(base_blocks.sum(), n, noise.floor_sd):
             break  # the error left is the noise's
         done = {label(a) for a in added}
         started = time.perf_counter()
+        # a later round's candidates, on top of the earlier choices, are building files of their own
+        into = folder / f"round{number + 1}" if number else folder
+        into.mkdir(exist_ok=True)
+        weights = windows.sensor_weights(model.building, model.bases, noise.sigma)
         pairs = [p for p in physical(model.building, localization["components"], objective.zones,
                                      measured_ids, localization["best_nodes"]) if "@".join(p) not in done]
-        tried, models, simulations = assessed(model, pairs, number)
+        tried, models, simulations = assess_all(model, pairs, windows, objective, into, seed, workers, weights)
         # shapes only where no physical candidate physics admits brings the error left to the
         # noise; the residual's statistics then choose which
-        if not any(at_noise(r["cv"]["J"], n, floor) and not objection(model.building, r["effect"], r["target"],
-                                                                      r["parameters"], r["derived"]) for r in tried):
-            pairs = [p for p in shapes(model.building, left_by(model), objective.zones) if "@".join(p) not in done]
-            more, more_models, more_simulations = assessed(model, pairs, number)
+        if not any(POLICY.at_noise(r["cv"]["J"], n, noise.floor_sd) and not POLICY.objection_of(
+                r["effect"], r["parameters"], r["derived"], r["physics"]) for r in tried):
+            pairs = [p for p in shapes(model.building, left_by(windows, model), objective.zones)
+                     if "@".join(p) not in done]
+            more, more_models, more_simulations = assess_all(model, pairs, windows, objective, into, seed, workers,
+                                                             weights)
             tried, simulations = tried + more, simulations + more_simulations
             models.update(more_models)
-        chosen, decision = decide(model.building, tried, base_blocks, sigma, n, windows.groups(), floor)
+        chosen, decision = decide(model.building, tried, base_blocks, noise.sigma, n, windows.groups(), noise.floor_sd)
         decision["cost"] = {"candidates": len(tried), "simulations": simulations,
                             "seconds": round(time.perf_counter() - started, 1)}
-        rounds.append(decision)
+        decisions.append(decision)
         on_top = {"on_top_of": [label(a) for a in added]} if added else {}
+        # the residuals themselves stay out (the decision keeps what the choice read of them, the
+        # distances of every two admissible candidates'): a house's would make report.json gigabytes
         results += [{**r, "cv": {k: v for k, v in r["cv"].items() if k != "left_out"},
                      "sensors": {k: v for k, v in r["sensors"].items() if k != "residuals"},
                      "round": number + 1, **on_top}
@@ -415,85 +457,118 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
         sensitivities[label(chosen)] = sensitivity(screened, windows.calibrations, objective, seed=seed)
         added.append(chosen)
         model = models[label(chosen)]
+    return Made(added, decisions, results, runs, sensitivities, model)
 
-    left = left_by(model)
-    decision = {**rounds[0], "chosen": label(added[-1]) if added else None,
-                "reason": " ".join(f"Round {i + 1}: {d['reason']}" if len(rounds) > 1 else d["reason"]
-                                   for i, d in enumerate(rounds)),
-                "rounds": rounds, "structure_left": left["sentence"]}
-    after_building, after_runs, after = model.building, model.runs, model.metrics
-    effect = ({key: added[-1][key] for key in ("effect", "target", "parameters", "derived")} if added
-              else {"effect": "none", "target": None, "parameters": {}})
-    (workdir / "building_after.json").write_text(json.dumps(after_building.to_json(), indent=2) + "\n")
-    fmu_after = build_fmu(after_building, workdir / "model_after.fmu", kind=fmu_kind)
+
+def left_by(windows, model):
+    """What the model's residual on the first record's calibration window follows (an input, the
+    time of day)."""
+    first, k0 = windows.cases[0], windows.ks[0]
+    shaped = shaped_inputs(model.building)
+    inputs = {name: values for name, values in zip(first.input_names, first.U[1:k0 + 1].T) if name in shaped}
+    return residual_diagnostics(windows.calibrations[0].times[1:],
+                                windows.measured[0][:k0][:, 0] - model.runs[0][:k0, 0], inputs)
+
+
+def write(building, prepared, located, made, objective, workdir, fmu_kind, reference):
+    """Stage 4: the model the rounds leave written (`building_after.json`, `model_after.fmu`,
+    each protocol's building), report.json, report.md and the plots; returns report.json's content."""
+    windows, records, model, added = prepared.windows, prepared.records, made.model, made.added
+    decisions = made.decisions
+    decision = {**decisions[0], "chosen": label(added[-1]) if added else None,
+                "reason": " ".join(f"Round {i + 1}: {d['reason']}" if len(decisions) > 1 else d["reason"]
+                                   for i, d in enumerate(decisions)),
+                "rounds": decisions, "structure_left": left_by(windows, model)["sentence"]}
+    (workdir / "building_after.json").write_text(json.dumps(model.building.to_json(), indent=2) + "\n")
+    fmu_after = build_fmu(model.building, workdir / "model_after.fmu", kind=fmu_kind)
     # a record under another protocol: its own building as corrected, for `nodeforce compare`
     protocols_after = {i: workdir / f"building_after_record{i + 1}.json" for i, b in enumerate(model.bases) if b is not None}
     for i, path in protocols_after.items():
         path.write_text(json.dumps(model.bases[i].to_json(), indent=2) + "\n")
-
-    # every record's phases, each named with its record's name where there are several
-    by_phase = []
-    for i, (record, case) in enumerate(zip(records, windows.cases)):
-        rows = phase_errors(record.phases, case.times[1:], windows.measured[i],
-                            {"before": before_runs[i], **{key: r[i] for key, r in runs.items()}, "after": after_runs[i]},
-                            zones=objective.zones)
-        by_phase += [{**row, "phase": f"{record.name}: {row['phase']}", "record": record.name}
-                     if len(records) > 1 else row for row in rows]
+    by_phase = phase_rows(prepared, made, objective)
     if by_phase and added:
         decision["worsened_phases"] = worsened(by_phase, "before", "after")
         if decision["worsened_phases"]:
             decision["reason"] += (" It lowers the total error but makes the phase " + "; ".join(
                 f"{w['phase']} worse ({w['before']:.3f} C -> {w['after']:.3f} C)" for w in decision["worsened_phases"])
                 + ", which the total hides.")
-    times, k, measured = first.times, k0, windows.measured[0]
-    validation = slice(k, None)
-    residuals = {state: residual_diagnostics(times[1:][validation], measured[validation, 0] - run[0][validation, 0],
-                                             {name: values[validation] for name, values in
-                                              zip(first.input_names, first.U[1:].T)})
-                 for state, run in (("before", before_runs), ("after", after_runs))}
-    report = {
-        "period": period(windows, 0),
-        "objective": list(objective.zones),
-        "before": before,
-        "localization": localization,
-        "candidates": results,
-        "effects": [{key: a[key] for key in ("effect", "target", "parameters")} for a in added],
-        "decision": decision,
-        "effect": effect,
-        "after": after,
-        "heat_loss_coefficient": heat_loss(building, after_building, added, results, sigma),
-        "assumptions": list(dict.fromkeys(a for case in windows.cases for a in case.assumptions)),
-        "residuals": residuals,
-        "sensitivity": sensitivities,
-        "noise_sigma": sigma,
-        "noise": noise.to_json(),
-        "node_names": {str(i): name for i, name in building.node_names().items()},
-        "artifacts": {"building_after": str(workdir / "building_after.json"), "fmu_after": str(fmu_after)},
-    }
+    report = content(building, prepared, located, made, objective, decision, workdir, fmu_after)
     if len(records) > 1:
+        before_runs = prepared.model.runs
         report["records"] = [{"name": r.name, "measurements": str(r.source), "period": period(windows, i),
                               "before": windows.metrics(objective, before_runs, i),
-                              "after": windows.metrics(objective, after_runs, i),
-                              "localization": alone[i],
+                              "after": windows.metrics(objective, model.runs, i),
+                              "localization": located.alone[i],
                               **({"building_after": str(protocols_after[i])} if i in protocols_after else {})}
                              for i, r in enumerate(records)]
     if reference:
         report["reference"] = reference
     if by_phase:
         report["phases"] = by_phase
-    # plotted from the first measurement: the weather's history before it is not the record
-    h = first.history_steps
-    series = {"times": times[h + 1:], "validation_start": times[k + 1], "scored_from": times[first.burn_in_steps + 1],
-              "convergence": convergence,
-              "zones": {zone: {"air_node": air, "measured": measured[h:, j], "before": before_runs[0][h:, j],
-                               "after": after_runs[0][h:, j]}
-                        for j, (zone, air) in enumerate(zip(objective.zones, objective.air_nodes))},
-              "inputs": dict(zip(first.input_names, first.U[h + 1:].T))}
-    plots = write_report(workdir, report, series)
+    plots = write_report(workdir, report, plotted(prepared, located, made, objective))
     report["artifacts"]["plots"] = [str(p) for p in plots]
     report["artifacts"]["report"] = str(workdir / "report.md")
     (workdir / "report.json").write_text(json.dumps(report, indent=2, default=_plain) + "\n")
     return report
+
+
+def phase_rows(prepared, made, objective):
+    """Every model's error on every record's phases (`diagnosis.phases`), each phase named with its
+    record's name where there are several."""
+    windows, records, rows = prepared.windows, prepared.records, []
+    for i, (record, case) in enumerate(zip(records, windows.cases)):
+        runs = {"before": prepared.model.runs[i], **{key: r[i] for key, r in made.runs.items()},
+                "after": made.model.runs[i]}
+        rows += [{**row, "phase": f"{record.name}: {row['phase']}", "record": record.name} if len(records) > 1
+                 else row for row in phase_errors(record.phases, case.times[1:], windows.measured[i], runs,
+                                                  zones=objective.zones)]
+    return rows
+
+
+def content(building, prepared, located, made, objective, decision, workdir, fmu_after):
+    """report.json's content but for the records, the reference, the phases and the plots."""
+    windows, noise, added, model = prepared.windows, prepared.noise, made.added, made.model
+    first, k, measured = windows.cases[0], windows.ks[0], windows.measured[0]
+    validation = slice(k, None)
+    residuals = {state: residual_diagnostics(first.times[1:][validation], measured[validation, 0] - run[0][validation, 0],
+                                             {name: values[validation] for name, values in
+                                              zip(first.input_names, first.U[1:].T)})
+                 for state, run in (("before", prepared.model.runs), ("after", model.runs))}
+    effect = ({key: added[-1][key] for key in ("effect", "target", "parameters", "derived")} if added
+              else {"effect": "none", "target": None, "parameters": {}})
+    return {
+        "period": period(windows, 0),
+        "objective": list(objective.zones),
+        "before": prepared.model.metrics,
+        "localization": located.localization,
+        "candidates": made.results,
+        "effects": [{key: a[key] for key in ("effect", "target", "parameters")} for a in added],
+        "decision": decision,
+        "effect": effect,
+        "after": model.metrics,
+        "heat_loss_coefficient": heat_loss(building, model.building, added, made.results, noise.sigma),
+        "assumptions": list(dict.fromkeys(a for case in windows.cases for a in case.assumptions)),
+        "residuals": residuals,
+        "sensitivity": made.sensitivities,
+        "noise_sigma": noise.sigma,
+        "noise": noise.to_json(),
+        "node_names": {str(i): name for i, name in building.node_names().items()},
+        "artifacts": {"building_after": str(workdir / "building_after.json"), "fmu_after": str(fmu_after)},
+    }
+
+
+def plotted(prepared, located, made, objective):
+    """The series the plots draw, from the first measurement: the weather's history before it is
+    not the record."""
+    windows = prepared.windows
+    first, k, measured = windows.cases[0], windows.ks[0], windows.measured[0]
+    times, h = first.times, first.history_steps
+    return {"times": times[h + 1:], "validation_start": times[k + 1], "scored_from": times[first.burn_in_steps + 1],
+            "convergence": located.convergence,
+            "zones": {zone: {"air_node": air, "measured": measured[h:, j], "before": prepared.model.runs[0][h:, j],
+                             "after": made.model.runs[0][h:, j]}
+                      for j, (zone, air) in enumerate(zip(objective.zones, objective.air_nodes))},
+            "inputs": dict(zip(first.input_names, first.U[h + 1:].T))}
 
 
 def protocol(building, record):

@@ -1,0 +1,166 @@
+"""The catalogue of the benchmark's records: its scenarios (a building under a climate, measured
+for some days by some sensors), its faults, and which of them each scenario carries (`PLAN`),
+each record a `Spec` named `<scenario>/<fault>-<size>`."""
+from dataclasses import dataclass, field, fields
+
+BURN_IN_DAYS = 1  # the diagnosis' (the command line's default)
+CALIBRATION_FRACTION = 0.6  # the diagnosis' default: the rest validates
+
+
+@dataclass(frozen=True)
+class Spec:
+    """One record: where, when, how measured, and what the file lacks.
+
+    effect : a registry id, "none", or beyond the catalogue "scheduled_gain" (W `full["Q"]` from
+        `full["on"]` to `full["off"]` h local time) or "opening" (`full["area"]` m2 of glazing
+        on the component `target`, its sun to the floor)
+    target : the effect's target (a zone, a component, `zone->column`)
+    full : the effect's parameters at scale 1 (others as declared)
+    expected : (effect, target) pairs a right answer may name (default: (effect, target));
+        look-alikes that are one equation count as one (an air change and a bridge to the outdoor air)
+    """
+    name: str
+    building: str  # "testcell" or "twinhouse"
+    climate: str
+    start: str  # month-day of the record's first time, in the climate's typical year
+    days: int
+    step_min: int
+    noise: float  # C
+    sensors: str  # "paper", "all", "air" (the test cell's air with a PRBS heater) or "own" (the file's sensors)
+    effect: str = "none"
+    target: str = ""
+    full: dict = field(default_factory=dict)
+    size: str = ""  # "subtle", "strong", "" (no effect)
+    expected: tuple = ()
+    objective: str = ""  # zone whose air is the objective (default the first)
+    burn_in: int = BURN_IN_DAYS  # days the diagnosis forces every measured node and scores nothing
+    before: float = 14.0  # days of the weather before the record the diagnosis reads (its history)
+
+    def __hash__(self):  # `full` is a dict: the record's name and fields, as printed, identify it
+        return hash(repr(self))
+
+    @property
+    def answers(self):
+        """The (effect, target) pairs counted right as a first effect; () for a record without fault."""
+        if self.effect == "none":
+            return ()
+        return tuple(self.expected) or ((self.effect, self.target),)
+
+@dataclass(frozen=True)
+class Scenario:
+    """A building under a climate, measured: its file ("testcell" or "twinhouse"), the typical
+    year, the record's first month-day, days and step (min), the sensors' noise (C) and set
+    (`Spec.sensors`), the objective zone ("": the first), the diagnosis' burn-in and the days of
+    weather before the record it reads (`Spec`'s fields of the same names)."""
+    building: str
+    climate: str
+    start: str
+    days: int
+    step_min: int
+    noise: float
+    sensors: str
+    objective: str
+    burn_in: int
+    before: float
+
+
+@dataclass(frozen=True)
+class Fault:
+    """What a record's file lacks: an effect (a registry id, or "scheduled_gain", "opening"), its
+    target, its parameters at scale 1 (`Spec.full`) and the answers counted right besides it."""
+    effect: str
+    target: str
+    full: dict
+    expected: tuple = ()
+
+
+# -- the benchmark's records ----------------------------------------------------------------
+# Scenarios: (building, climate, start, days, step min, noise C, sensors, objective, burn-in days,
+# days of weather before the record the diagnosis reads). The look-alikes sit side by side in one
+# scenario (an air change, a bridge, an envelope factor, inside convection; a door and a wall),
+# each size of each effect appears somewhere, every scenario has a record without a fault. The
+# Twin House's walls are heavy and none is measured: its burn-in is `make twinhouse`'s three days,
+# and its weather starts six days before the record, as the real experiment 1's file does. The
+# weather before the record varies as users' files do: six weeks, a month, a fortnight or a week
+# before the measurements, three days, or none (the file starts with them).
+SCENARIOS = {
+    "mia-jun": Scenario("testcell", "miami", "06-01", 7, 15, 0.1, "paper", "", 1, 14),
+    "gso-jan": Scenario("testcell", "greensboro", "01-10", 14, 30, 0.2, "all", "", 1, 30),
+    "sdp-jul": Scenario("testcell", "sandpoint", "07-05", 10, 10, 0.05, "paper", "", 1, 14),
+    "gso-apr": Scenario("testcell", "greensboro", "04-01", 21, 60, 0.3, "paper", "", 1, 0),
+    "mia-dec": Scenario("testcell", "miami", "12-01", 5, 20, 0.15, "all", "", 1, 7),
+    "sdp-feb-air": Scenario("testcell", "sandpoint", "02-01", 14, 30, 0.15, "air", "", 1, 45),
+    "mia-jan-air": Scenario("testcell", "miami", "01-15", 7, 10, 0.25, "air", "", 1, 3),
+    "twin-gso-feb": Scenario("twinhouse", "greensboro", "02-01", 14, 30, 0.15, "own", "living", 3, 6),
+}
+AIR_OUT = (("infiltration", "cell"), ("thermal_bridge", "cell"))  # one equation: a conductance air -> outdoor air
+FAULTS = {  # name: Fault
+    "ground": Fault("ground_coupling", "floor", {"U": 3.0, "T_ground": None}, ()),
+    "infiltration": Fault("infiltration", "cell", {"n": 2.0}, AIR_OUT),
+    "bridge": Fault("thermal_bridge", "cell", {"UA": 15.0}, AIR_OUT),
+    "envelope": Fault("envelope_conductance", "cell", {"factor": 2.0}, ()),
+    # weaker inside convection: a factor up to the registry's 20 never makes a strong error in the cell
+    "convection": Fault("inside_convection", "cell", {"factor": 0.4}, ()),
+    "door": Fault("conductivity", "door", {"factor": 3.0}, ()),
+    "wall": Fault("conductivity", "east_wall", {"factor": 3.0}, ()),
+    "roof-alpha": Fault("solar_absorptance", "roof", {"alpha": 0.9}, ()),
+    "window-tau": Fault("solar_transmittance", "window", {"tau": 0.3}, ()),
+    "gain": Fault("internal_gain", "cell", {"Q": 100.0}, ()),
+    "daily": Fault("daily_gain", "cell", {"mean": 80.0, "cos1": -60.0, "sin1": -40.0, "cos2": 20.0}, ()),
+    "east-sun": Fault("proportional_gain", "cell->I_east_wall", {"k": 0.5}, ()),
+    "mass": Fault("internal_mass", "cell", {"C_m": 4e5, "H_m": 25.0}, ()),
+    "lag": Fault("heat_input_lag", "cell", {"C_h": 1.2e5, "H_h": 15.0}, ()),
+    "split": Fault("heat_input_split", "cell", {"f_r": 0.8}, ()),
+    "schedule": Fault("scheduled_gain", "cell", {"Q": 150.0, "on": 8.0, "off": 18.0}, (("daily_gain", "cell"),)),
+    "opening": Fault("opening", "south_wall", {"area": 0.6},
+                (("proportional_gain", "cell->I_south_wall"), ("solar_transmittance", "window"))),
+    # the Twin House's living room
+    "W8": Fault("conductivity", "W8", {"factor": 2.0}, ()),
+    "shading": Fault("shading_transmittance", "living", {"f": 0.3}, ()),
+    "living-mass": Fault("internal_mass", "living", {"C_m": 1.5e6, "H_m": 150.0}, ()),
+}
+GROUND = {"mia-jun": 24.0, "mia-dec": 15.0, "sdp-jul": 5.0}  # C, the ground below the cell, away from its air
+PLAN = {  # scenario: [fault or "none", size "s" subtle / "L" strong]
+    "mia-jun": ["none", "infiltration s", "bridge s", "envelope s", "convection s", "door s", "wall s",
+                "ground s", "schedule s", "opening s"],
+    # every node measured in winter: the door (1.6 m2) ten times as conductive, or the inside
+    # convection a tenth, the most physics allows (`max_scale`), stay subtle here
+    "gso-jan": ["none", "infiltration L", "bridge L", "envelope L", "convection s", "door s", "wall L",
+                "roof-alpha s", "window-tau s", "mass s"],
+    "sdp-jul": ["none", "ground L", "roof-alpha L", "window-tau L", "gain s", "daily s", "east-sun s",
+                "schedule L", "opening L"],
+    "gso-apr": ["none", "gain L", "daily L", "east-sun L", "mass L", "infiltration s", "envelope s", "convection s"],
+    "mia-dec": ["none", "door s", "wall s", "ground s", "bridge s", "opening s", "schedule s"],
+    "sdp-feb-air": ["none", "lag s", "split L", "mass s", "envelope L", "infiltration L", "convection L", "gain s"],
+    "mia-jan-air": ["none", "lag L", "split s", "mass L", "envelope s", "schedule L"],
+    # a Twin House diagnosis takes some 20 times a test cell's (docs/benchmark_diagnosis.md): four records
+    # (and 100 air capacities of furniture, the registry's bound, stay subtle)
+    "twin-gso-feb": ["none", "W8 L", "shading s", "living-mass s"],
+}
+
+
+def make_specs():
+    """Every record of the benchmark, named `<scenario>/<fault>-<size>`."""
+    specs = []
+    for scenario, entries in PLAN.items():
+        common = {f.name: getattr(SCENARIOS[scenario], f.name) for f in fields(Scenario)}
+        for entry in entries:
+            name, _, size = entry.partition(" ")
+            if name == "none":
+                specs.append(Spec(name=f"{scenario}/none", **common))
+                continue
+            fault = FAULTS[name]
+            full = {**fault.full, "T_ground": GROUND[scenario]} if "T_ground" in fault.full else fault.full
+            specs.append(Spec(name=f"{scenario}/{name}-{size}", effect=fault.effect, target=fault.target, full=full,
+                              size={"s": "subtle", "L": "strong"}[size], expected=fault.expected, **common))
+    return specs
+
+SPECS = make_specs()
+SPECS_BY_NAME = {s.name: s for s in SPECS}
+QUICK = ("mia-jun/none", "mia-jun/door-s", "gso-jan/infiltration-L", "sdp-jul/schedule-L", "sdp-feb-air/lag-s",
+         "mia-dec/opening-s", "gso-apr/mass-L", "twin-gso-feb/W8-L")
+
+
+def quick_specs():
+    """Eight records across the scenarios, sizes and sensor sets, for development (`--quick`)."""
+    return [SPECS_BY_NAME[name] for name in QUICK]

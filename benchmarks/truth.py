@@ -1,0 +1,240 @@
+"""The truth of a benchmark record: the building file discretised finer and simulated at the
+minute from a long past, with its fault, read by the record's sensors (benchmarks/records.py
+says why each choice)."""
+import functools
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pvlib
+
+from nodeforce import tempdirs
+from nodeforce.iotools.typical_year import convert_typical_year, relocate
+from nodeforce.iotools.weather import read_weather
+from nodeforce.model.building import load_building, parse_building
+from nodeforce.model.case import prepare_case
+from nodeforce.model.effects import EFFECTS
+from nodeforce.model.integrate import simulate
+from nodeforce.model.network import assemble
+from nodeforce.model.solar import incident_irradiance, solar_position
+
+ROOT = Path(__file__).resolve().parents[1]
+TESTCELL = ROOT / "model" / "data" / "testcell.json"
+TWINHOUSE = ROOT / "examples" / "twinhouse_n2" / "building.json"
+PVLIB_DATA = Path(pvlib.__file__).parent / "data"
+CLIMATES = {"miami": "12839.tm2", "greensboro": "723170TYA.CSV", "sandpoint": "703165TY.csv"}
+CELLS = 2  # cells of the truth per stretch between two of the file's nodes or layer boundaries
+FINE_STEP = 60.0  # s, the truth's step
+# Days of weather the truth is simulated over before the record: the building's past, longer than
+# any diagnosis reads (`Spec.before`). Its own start (the steady state of that weather's first day)
+# is then forgotten: the test cell's slowest mode, its floor's (14.7 days), keeps e^-6 of it.
+TRUTH_HISTORY_DAYS = 90
+PAPER_SENSORS = (1, 7, 9, 16, 17, 23)  # the test cell's (Lauret et al., Table 1)
+HEATER = 300.0  # W, the air-only records' PRBS heater
+PRBS_SWITCH = 0.15  # probability the heater switches at a record step
+
+
+@functools.lru_cache(maxsize=None)
+def climate(name):
+    """(site {latitude, longitude, altitude, timezone}, hourly weather) of a typical year pvlib bundles."""
+    with tempdirs.folder("bench-weather") as tmp:
+        csv = Path(tmp) / f"{name}.csv"
+        site = convert_typical_year(PVLIB_DATA / CLIMATES[name], csv)
+        weather = read_weather(csv)
+    weather.attrs["source"] = f"{CLIMATES[name]} (pvlib)"
+    return site, weather
+
+
+def file_building(spec):
+    """The building file the diagnosis reads: the test cell or the Twin House at the climate's
+    site; the air-only test cell with its heater declared and measured."""
+    site, _ = climate(spec.climate)
+    path = TESTCELL if spec.building == "testcell" else TWINHOUSE
+    building = load_building(path)
+    data = relocate(building.to_json(), site)
+    if spec.sensors == "air":
+        data["zones"][0]["heat_input"] = "Q_heat"
+    return parse_building(data, source=f"{path.name} at {spec.climate}")
+
+
+def neutral(building, spec):
+    """The effect's parameters as the file declares them."""
+    if spec.effect in EFFECTS:
+        return EFFECTS[spec.effect].read(building, spec.target)
+    return {name: 0.0 for name in spec.full if name in ("Q", "area")}
+
+
+def at_scale(building, spec, scale):
+    """{parameter: value} of the effect at `scale` (0: as declared, 1: `spec.full`)."""
+    base = neutral(building, spec)
+    values = dict(spec.full)
+    for name, full in spec.full.items():
+        if name in base and name not in ("T_ground", "on", "off"):
+            values[name] = base[name] + scale * (full - base[name])
+    return values
+
+
+def faulty(truth, spec, values):
+    """(truth building with the fault, extra weather columns it reads {name: callable(times)})."""
+    if spec.effect == "none":
+        return truth, {}
+    if spec.effect in EFFECTS:
+        return EFFECTS[spec.effect].apply(truth, spec.target, values), {}
+    zone = spec.objective or truth.zones[0].name
+    if spec.effect == "scheduled_gain":
+        def schedule(times, tz=truth.site["timezone"]):
+            local = times.tz_convert(tz)
+            hour = local.hour + local.minute / 60
+            return np.where((hour >= values["on"]) & (hour < values["off"]), values["Q"], 0.0)
+
+        def add(data):
+            z = next(z for z in data["zones"] if z["name"] == zone)
+            inputs = z.get("heat_input") or []
+            z["heat_input"] = [*([inputs] if isinstance(inputs, str) else inputs), "Q_schedule"]
+        return truth.edited(add), {"Q_schedule": schedule}
+    if spec.effect == "opening":
+        return opened(truth, spec.target, values["area"]), {}
+    raise ValueError(f"unknown effect {spec.effect!r}")
+
+
+def opened(building, wall, area):
+    """The building with `area` m2 of the wall `wall` replaced by a 4 mm glazing (transmittance
+    0.8, its sun to the zone's floor, the wall's surface coefficients): an opening the file does
+    not have."""
+    def change(data):
+        raw = next(c for c in data["components"] if c["name"] == wall)
+        raw["area"] -= area
+        floor = next(c["name"] for c in data["components"] if c["tilt"] == 180 and c["inside"]["zone"] == raw["inside"]["zone"])
+        data["materials"]["bench_glass"] = {"conductivity": 1.0, "density": 2500.0, "specific_heat": 750.0}
+        ids = [n["id"] for c in data["components"] for n in c["nodes"]]
+        ids += [i for z in data["zones"] for i in (z["air_node"], z["radiant_node"])]
+        top = max(ids)
+        outside = {k: v for k, v in raw["outside"].items() if k != "irradiance"}
+        outside["solar_absorptance"] = 0.1
+        data["components"].append({
+            "name": f"{wall}_opening", "area": area, "tilt": raw["tilt"], "azimuth": raw["azimuth"],
+            "layers": [["bench_glass", 0.004]],
+            "nodes": [{"id": top + 1, "depth": 0.0}, {"id": top + 2, "depth": 0.004}],
+            "inside": dict(raw["inside"]), "outside": outside,
+            "solar_transmittance": 0.8, "transmitted_solar_to": floor})
+    return building.edited(change)
+
+
+def record_times(spec):
+    """The record's time grid (tz-aware, the climate's local standard time)."""
+    site, weather = climate(spec.climate)
+    start = pd.Timestamp(f"{weather.index[0].year}-{spec.start}T00:00").tz_localize(weather.index.tz)
+    return pd.date_range(start, periods=spec.days * 1440 // spec.step_min + 1, freq=f"{spec.step_min}min", name="time")
+
+
+def fine_weather(spec, building, times, extra):
+    """The weather at 1 min from `TRUTH_HISTORY_DAYS` before `times` to its end: the typical year
+    (`cyclic` where that reaches before its start) linearly interpolated, the columns the file
+    reads (heat inputs held over each record step), and the truth's `extra` columns."""
+    site, hourly = climate(spec.climate)
+    start = times[0] - pd.Timedelta(days=TRUTH_HISTORY_DAYS)
+    hourly = cyclic(hourly, start - pd.Timedelta(hours=1))
+    grid = pd.date_range(start, times[-1], freq=f"{FINE_STEP:g}s", name="time")
+    fine = hourly.reindex(hourly.index.union(grid)).interpolate("time").reindex(grid)
+    for name, values in own_columns(spec, building, grid, fine).items():
+        fine[name] = values
+    for name, function in extra.items():
+        fine[name] = function(grid)
+    fine.attrs["source"] = f"{spec.name} weather"
+    return fine
+
+
+def cyclic(hourly, start):
+    """The typical year from `start` on: where `start` falls before its first row, its last
+    rows, a year earlier, come before it, as a simulation program reads a typical year."""
+    if start >= hourly.index[0]:
+        return hourly
+    period = hourly.index[-1] - hourly.index[0] + (hourly.index[1] - hourly.index[0])
+    earlier = hourly[hourly.index - period >= start]
+    earlier.index = earlier.index - period
+    return pd.concat([earlier, hourly])
+
+
+def read_by_diagnosis(weather, times, before):
+    """The part of the truth's weather the diagnosis reads: from `before` days before `times`."""
+    out = weather[weather.index >= times[0] - pd.Timedelta(days=before)]
+    out.attrs = dict(weather.attrs)
+    return out
+
+
+def held(values_at_steps, coarse, grid):
+    """Values on the record step grid `coarse`, held over each step (the step's end value over
+    (t_k, t_k+1]) and read on the finer `grid`."""
+    k = np.ceil(((grid - coarse[0]).total_seconds().to_numpy()) / (coarse[1] - coarse[0]).total_seconds() - 1e-9)
+    return np.asarray(values_at_steps)[np.clip(k.astype(int), 0, len(coarse) - 1)]
+
+
+def prbs(n, seed, power=HEATER, p=PRBS_SWITCH):
+    """A pseudo-random binary heater sequence (W) of n steps: on/off, switching with probability p."""
+    rng = np.random.default_rng(seed)
+    return power * (np.cumsum(rng.random(n) < p) % 2)
+
+
+def own_columns(spec, building, grid, fine):
+    """{column: values on `grid`} the file's building reads beside the weather: the air-only
+    test cell's heater; the Twin House's heaters (a PRBS in the objective room, constant in the
+    others), supply, cellar and attic temperatures, measured irradiances and closed shading."""
+    step = pd.Timedelta(minutes=spec.step_min)
+    coarse = pd.date_range(grid[0], grid[-1], freq=step)
+    seed = record_seed(spec.name, 99)
+    columns = {}
+    if spec.building == "testcell":
+        if spec.sensors == "air":
+            columns["Q_heat"] = held(prbs(len(coarse), seed), coarse, grid)
+        return columns
+    site = building.site
+    position = solar_position(grid, site["latitude"], site["longitude"], site["altitude"])
+    for face, azimuth in (("north", 0.0), ("east", 90.0), ("south", 180.0), ("west", 270.0)):
+        columns[f"Solar_radiation_global_vertical_{face}"] = incident_irradiance(
+            position, fine["ghi"].to_numpy(), fine["dni"].to_numpy(), fine["dhi"].to_numpy(), 90.0, azimuth,
+            site["ground_albedo"])
+    objective = spec.objective or building.zones[0].name
+    for i, z in enumerate(building.zones):
+        for name in z.heat_input:
+            if z.name == objective and name == z.heat_input[0]:
+                columns[name] = held(prbs(len(coarse), seed, power=500.0), coarse, grid)
+            else:
+                columns[name] = 0.0 if name == "HeatInputKitchen" else 150.0
+    t_out = fine["T_out"].to_numpy()
+    columns.update({"vent_SUA_corr_AT": 20.0, "cellar_AT": 15.0, "attic_east_AT": t_out + 3.0, "shading_south": 0.0})
+    return {k: np.broadcast_to(np.asarray(v, dtype=float), (len(grid),)).copy()
+            for k, v in columns.items() if k in building.input_columns}
+
+
+def measured_nodes(spec, building):
+    if spec.sensors == "paper":
+        return list(PAPER_SENSORS)
+    if spec.sensors == "air":
+        return [building.zones[0].air_node]
+    if spec.sensors == "own":
+        return sorted(set(building.sensors.values()))
+    radiant = {z.radiant_node for z in building.zones}
+    return [i for i in range(1, building.own_nodes + 1) if i not in radiant]
+
+
+def truth_record(truth, weather, times, nodes):
+    """(len(times), len(nodes)) noiseless temperatures (C) of `nodes` of the truth at `times`,
+    simulated at `FINE_STEP` over `weather`'s span (the history before `times` included),
+    from the steady state of its first day."""
+    empty = pd.DataFrame(index=weather.index)
+    empty.attrs["source"] = "truth"
+    case = prepare_case(truth, weather, empty)
+    T = simulate(truth, assemble(truth), case.U, case.dt, warmup_days=1, include_start=True, steady_start=True)
+    rows = weather.index.get_indexer(times)
+    return T[rows][:, np.array(nodes) - 1]
+
+
+def frame(values, times, nodes, source):
+    out = pd.DataFrame(values, index=pd.DatetimeIndex(times, name="time"), columns=[f"T{i}" for i in nodes])
+    out.attrs["source"] = source
+    return out
+
+
+def record_seed(name, draw):
+    """The record's noise seed: its name and draw, independent of the order records are run in."""
+    return int.from_bytes(name.encode(), "little") % 2 ** 31 * 7 + draw
