@@ -94,15 +94,13 @@ def cmd_simulate(args):
 
 
 def cmd_inputs(args):
-    from nodeforce.api import fmu_inputs, write_fmu_inputs
-    building = load_building(args.building)
     if args.force and not args.measurements:
         raise InputError("--force", args.force, "forcing needs --measurements to force nodes to")
-    table, start = fmu_inputs(building, read_weather(args.weather),
-                              read_measurements(args.measurements) if args.measurements else None,
-                              node_list("--force", args.force) if args.force else (), args.burn_in_days,
-                              args.decomposition)
-    start_path = write_fmu_inputs(args.output, table, start)
+    table, start = api.fmu_inputs(api.read_building(args.building), api.read_weather(args.weather),
+                                  api.read_measurements(args.measurements) if args.measurements else None,
+                                  node_list("--force", args.force) if args.force else (), args.burn_in_days,
+                                  args.decomposition)
+    start_path = api.write_fmu_inputs(args.output, table, start)
     print(f"wrote {args.output}: {len(table.columns)} inputs at {len(table)} times (0 to {table.index[-1]:.0f} s); "
           f"start values in {start_path}")
 
