@@ -23,7 +23,7 @@ from .integrate import history_block, initial_state, simulate, steps_per_day, su
 from .building import DAY_TERMS
 from .network import assemble, clock_input_names, day_input, input_names
 from .solar import (DECOMPOSITIONS, complete_irradiance, incident_irradiance, measured_irradiance, sky_temperature,
-                    solar_position)
+                    solar_position, transmitted_irradiance)
 from .weather import IRRADIANCE_COLUMNS, check_columns, weather_on_grid
 
 
@@ -112,6 +112,7 @@ class Case:
         """
         columns = dict(zip(self.input_names, self.U.T))
         columns.update(clock_inputs(building, self.times))
+        columns.update(schedule_inputs(building, self.times))
         names = input_names(building)
         absent = [n for n in names if n not in columns]
         if absent:
@@ -179,6 +180,15 @@ def clock_inputs(building, times):
         return {}
     tau = clock_hours(times, building.site["timezone"], building.source)
     return {day_input(t): day_basis(tau, t) for t in DAY_TERMS}
+
+
+def schedule_inputs(building, times):
+    """{schedule name: values at `times`} of the schedules the building reads as inputs
+    (`Building.schedule_inputs`), on the site's local clock (docs/model.md section 1.2)."""
+    if not building.schedule_inputs:
+        return {}
+    clock_hours(times[:1], building.site["timezone"], building.source)  # a time zone that is none
+    return {name: building.schedules[name].on(times, building.site["timezone"]) for name in building.schedule_inputs}
 
 
 def measured_matrix(building, measurements, times):
@@ -278,6 +288,10 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
         measured_sun = measured_irradiance(c, w.columns)
         if measured_sun is None:
             computed.append(c)
+        elif c.angular is not None:
+            raise InputError(source, measured_sun, f"{c.name} declares an angular_transmittance, which needs the "
+                                                   "direct and diffuse sun apart: its irradiance is computed from "
+                                                   "ghi, dni, dhi, not read from a measured column")
         else:
             columns[c.irradiance_input] = w[measured_sun].to_numpy(float)
     assumptions = []
@@ -297,7 +311,12 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
         for c in computed:
             columns[f"I_{c.name}"] = incident_irradiance(position, ghi, dni, dhi, c.tilt, c.azimuth,
                                                          site["ground_albedo"])
+            if c.angular is not None:
+                a = c.angular
+                columns[c.transmitted_input] = transmitted_irradiance(
+                    position, ghi, dni, dhi, c.tilt, c.azimuth, site["ground_albedo"], a.angles, a.factors, a.diffuse)
     columns.update(clock_inputs(building, times))
+    columns.update(schedule_inputs(building, times))
     names = input_names(building)
     U = np.column_stack([np.asarray(columns[n], dtype=float) for n in names])
     missing = ~np.isfinite(U)

@@ -55,7 +55,9 @@ def input_names(building):
     """The input vector's names, in the order of the columns of B."""
     irradiance = tuple(dict.fromkeys(c.irradiance_input for c in building.exterior_components))
     named = tuple(n for n in building.input_columns if n not in irradiance)
-    return ("T_out", "T_sky") + irradiance + named + clock_input_names(building)
+    transmitted = tuple(c.transmitted_input for c in building.components if c.angular is not None)
+    return (("T_out", "T_sky") + irradiance + named + clock_input_names(building) + transmitted
+            + building.schedule_inputs)
 
 
 def clock_input_names(building):
@@ -103,8 +105,12 @@ def assemble(building, names=None):
         A[j, i] += g
 
     def to_temperature(node, g, temperature):
-        """A conductance g (W/K) from a node to a temperature: a number (C) or an input column."""
+        """A conductance g (W/K) from a node to a temperature: a number (C), an input column or a
+        schedule of the file (a constant one a number)."""
         A[node, node] -= g
+        schedule = building.schedules.get(temperature) if isinstance(temperature, str) else None
+        if schedule is not None and schedule.is_constant:
+            temperature = schedule.value
         if isinstance(temperature, str):
             B[node, col[temperature]] += g
         else:
@@ -143,13 +149,14 @@ def assemble(building, names=None):
         if c.solar_transmittance is not None:
             receiver = building.component(c.transmitted_solar_to).node_ids[0] - 1
             transmitted = c.solar_transmittance * c.area
+            sun = col[c.transmitted_input]
             if c.shading:
                 # tau A I (s + f (1 - s)): a closed shading (s = 0) still lets in the part f
                 f = building.zone(c.inside.zone).shading_transmittance
-                products.append((receiver, col[c.irradiance_input], col[c.shading], transmitted * (1.0 - f)))
-                B[receiver, col[c.irradiance_input]] += transmitted * f
+                products.append((receiver, sun, col[c.shading], transmitted * (1.0 - f)))
+                B[receiver, sun] += transmitted * f
             else:
-                B[receiver, col[c.irradiance_input]] += transmitted
+                B[receiver, sun] += transmitted
 
     for z in building.zones:
         air, radiant = z.air_node - 1, z.radiant_node - 1
@@ -167,6 +174,14 @@ def assemble(building, names=None):
             to_temperature(air, UA if to == "outdoor" else UA * building.boundary_factor(to),
                            "T_out" if to == "outdoor" else to)
         q[air] += z.internal_gain
+        for gain in z.gains:
+            # P s(t): the radiant fraction to the radiant node, the rest to the air
+            schedule = building.schedules.get(gain.schedule) if gain.schedule is not None else None
+            for node, part in ((air, 1.0 - gain.radiant_fraction), (radiant, gain.radiant_fraction)):
+                if schedule is None or schedule.is_constant:
+                    q[node] += part * gain.power * (1.0 if schedule is None else schedule.value)
+                else:
+                    B[node, col[gain.schedule]] += part * gain.power
         for term, W in z.daily_gain:
             B[air, col[day_input(term)]] += W
         for column, k in z.proportional_gains:
