@@ -23,7 +23,7 @@ from nodeforce.model.case import force_mask, measured_case, simulate_building
 from nodeforce.model.errors import InputError
 from nodeforce.model.score import Objective
 
-__all__ = ["InputError", "read_building", "read_weather", "read_measurements", "read_phases", "measured_case",
+__all__ = ["InputError", "read_building", "convert_idf", "read_weather", "read_measurements", "read_phases", "measured_case",
            "objective", "simulate", "write_fmu", "open_fmu", "simulate_fmu", "forcing_candidates",
            "score_forcing", "locate", "diagnose", "Record", "compare"]
 
@@ -55,6 +55,28 @@ def read_building(path):
         physically impossible.
     """
     return load_building(path)
+
+
+def convert_idf(path):
+    """An EnergyPlus model (IDF) as a validated building file (docs/guide.md, `nodeforce convert`).
+
+    Returns
+    -------
+    Building
+        Its `to_json()` is the building file; its `data["not_modelled"]` lists what the IDF held
+        that the file does not, one line per object.
+
+    Raises
+    ------
+    InputError
+        Naming the IDF, the object and the field: an IDF the conversion cannot read.
+    """
+    from nodeforce.iotools.energyplus import convert
+    from nodeforce.model.building import check_schema, parse_building
+    data = convert(path)
+    building = parse_building(data, source=str(path))
+    check_schema(data, str(path))
+    return building
 
 
 def objective(building, zones=None):
