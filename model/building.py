@@ -478,6 +478,7 @@ def _site(check, site):
         "altitude": check.number(site, "altitude", "site", default=0.0),
         "timezone": site.get("timezone", "UTC"),
         "ground_albedo": check.number(site, "ground_albedo", "site", default=0.2, low=0, high=1),
+        "air_density": check.number(site, "air_density", "site", default=1.2, low=0, low_open=True, high=2),
     }
 
 

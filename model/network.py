@@ -20,7 +20,9 @@ import numpy as np
 from .building import DAY_TERMS, Adiabatic, Boundary, Exterior, Surface
 from .discretise import capacities, conductances
 
-RHO_C_AIR = 1.2 * 1005.0  # J/m3/K
+AIR_DENSITY = 1.2  # kg/m3, a building file's default (site.air_density)
+C_AIR = 1005.0  # J/kg/K
+RHO_C_AIR = AIR_DENSITY * C_AIR  # J/m3/K
 
 
 @dataclass(frozen=True)
@@ -76,9 +78,17 @@ def sky_view_factor(tilt):
     return (1.0 + np.cos(np.radians(tilt))) / 2.0
 
 
-def air_conductance(flow):
-    """(rho c)_air V / 3600 (W/K) of an air flow V (m3/h)."""
-    return RHO_C_AIR * flow / 3600.0
+def air_density_at(altitude, T=20.0):
+    """Density of dry air (kg/m3) at an altitude (m) and a temperature (C): the standard
+    atmosphere's pressure p = 101325 (1 - 2.25577e-5 z)^5.2559 Pa (as EnergyPlus takes its site's
+    barometric pressure from its elevation), rho = p / (287.05 (T + 273.15))."""
+    p = 101325.0 * (1.0 - 2.25577e-5 * altitude) ** 5.2559
+    return p / (287.05 * (T + 273.15))
+
+
+def air_conductance(flow, density=AIR_DENSITY):
+    """(rho c)_air V / 3600 (W/K) of an air flow V (m3/h) of air of a density (kg/m3)."""
+    return density * C_AIR * flow / 3600.0
 
 
 def assemble(building, names=None):
@@ -158,18 +168,19 @@ def assemble(building, names=None):
             else:
                 B[receiver, sun] += transmitted
 
+    rho = building.site.get("air_density", AIR_DENSITY)
     for z in building.zones:
         air, radiant = z.air_node - 1, z.radiant_node - 1
-        C[air] += RHO_C_AIR * z.volume
-        to_temperature(air, air_conductance(z.volume * z.air_change_rate), "T_out")
+        C[air] += rho * C_AIR * z.volume
+        to_temperature(air, air_conductance(z.volume * z.air_change_rate, rho), "T_out")
         if z.supply is not None:
-            to_temperature(air, air_conductance(z.supply.flow * z.supply.flow_factor), z.supply.temperature)
+            to_temperature(air, air_conductance(z.supply.flow * z.supply.flow_factor, rho), z.supply.temperature)
         for inflow in z.airflow_from:
-            g = air_conductance(inflow.flow)
+            g = air_conductance(inflow.flow, rho)
             A[air, air] -= g
             A[air, building.zone(inflow.zone).air_node - 1] += g
         for other, flow in z.air_exchange:
-            link(air, building.zone(other).air_node - 1, air_conductance(flow))
+            link(air, building.zone(other).air_node - 1, air_conductance(flow, rho))
         for to, UA in z.thermal_bridges:
             to_temperature(air, UA if to == "outdoor" else UA * building.boundary_factor(to),
                            "T_out" if to == "outdoor" else to)
