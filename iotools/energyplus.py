@@ -16,6 +16,7 @@ import numpy as np
 
 from ..model import geometry, glazing
 from ..model.errors import InputError
+from ..model.network import air_density_at
 
 MIN_VERSION, SCHEMA_MIN = (8, 5), (8, 9, 0)
 
@@ -23,13 +24,14 @@ MIN_VERSION, SCHEMA_MIN = (8, 5), (8, 9, 0)
 @dataclass(frozen=True)
 class Films:
     """Surface coefficients the nodal model holds constant (W/m2/K), where EnergyPlus computes
-    them each step: ISO 6946's convective coefficients inside (by the direction of heat flow a
-    face sees in heating: down through a floor, up through a ceiling) and outside (4 + 4 v at its
-    standard wind, 4 m/s; 4 where EnergyPlus says NoWind), and the linearised long-wave exchange
-    4 sigma eps T_m^3 of a face of emissivity eps at T_m."""
+    them each step: the convective coefficients inside of ISO 13791 / 13792 for a room's
+    temperature (heat flowing up from a floor the transmitted sun warms, down to a ceiling under
+    the warm air; 2.5 on walls), outside ISO 6946's 4 + 4 v at its standard wind, 4 m/s (4 where
+    EnergyPlus says NoWind), and the linearised long-wave exchange 4 sigma eps T_m^3 of a face
+    of emissivity eps at T_m."""
     inside_wall: float = 2.5
-    inside_floor: float = 0.7
-    inside_ceiling: float = 5.0
+    inside_floor: float = 5.0
+    inside_ceiling: float = 0.7
     outside_wind: float = 20.0
     outside_still: float = 4.0
     T_inside: float = 293.15  # K
@@ -192,9 +194,10 @@ class _Converter:
             tz = "UTC" if hours == 0 else f"Etc/GMT{'-' if zone_h > 0 else '+'}{hours}"
         else:
             tz = f"{'+' if zone_h >= 0 else '-'}{hours:02d}:{minutes:02d}"
+        altitude = self.r.number(loc, "elevation", default=0.0, low=-300, high=8000)
         return {"latitude": self.r.number(loc, "latitude", low=-90, high=90),
                 "longitude": self.r.number(loc, "longitude", low=-180, high=180),
-                "altitude": self.r.number(loc, "elevation", default=0.0), "timezone": tz}
+                "altitude": altitude, "timezone": tz, "air_density": round(air_density_at(altitude), 5)}
 
     def geometry_rules(self):
         rules = self.r.all("GlobalGeometryRules")
