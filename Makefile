@@ -3,7 +3,7 @@ PYTHON ?= python3
 VENV ?= .venv
 BIN := $(VENV)/bin
 
-.PHONY: demo test check venv system-deps benchmark clean twinhouse twinhouse-living
+.PHONY: demo test check venv system-deps benchmark clean twinhouse twinhouse-living bestest
 
 $(BIN)/nodeforce: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -32,6 +32,13 @@ test: venv system-deps
 # The edit-test loop: everything but the searches, diagnoses and importer runs (under a minute).
 check: venv
 	$(PYTEST) -m "not slow"
+
+# ASHRAE 140 free-float cases (examples/bestest/README.md, docs/model.md section 10): NREL's
+# EnergyPlus models edited as the standard defines each case, converted by `nodeforce convert`,
+# simulated over the Denver year; the table beside the reference range, out/bestest/results.csv
+# and out/bestest/bestest.png
+bestest: venv
+	$(BIN)/python examples/bestest/run.py out/bestest
 
 # Twin House N2 (examples/twinhouse_n2/README.md, docs/real-data.md): the measurements the
 # repository carries (examples/twinhouse_n2/data/, read compressed) converted; the whole house
