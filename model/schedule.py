@@ -63,4 +63,4 @@ class Schedule:
         midnight = np.asarray(hour) == 0
         shifted = local - np.where(midnight, 1, 0) * np.timedelta64(1, "s")
         hour = np.where(midnight, 24.0, hour)
-        return self.at(np.asarray(shifted.month), np.asarray(shifted.day), np.asarray(shifted.weekday), hour)
+        return self.at(np.asarray(shifted.month), np.asarray(shifted.day), np.asarray(shifted.day_of_week), hour)

@@ -1,0 +1,257 @@
+"""nodeforce convert (iotools/energyplus.py) against hand calculations from the IDF text of NREL's
+BESTEST case 600 (examples/bestest/data), its refusals, and the physics it rests on
+(model/geometry.py, model/glazing.py, model/schedule.py)."""
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from nodeforce.api import convert_idf
+from nodeforce.iotools.energyplus import compress_schedule
+from nodeforce.model import geometry, glazing
+from nodeforce.model.building import parse_building
+from nodeforce.model.errors import InputError
+from nodeforce.model.network import air_density_at, assemble, input_names
+from nodeforce.model.schedule import Schedule
+
+DATA = Path(__file__).resolve().parents[1] / "examples" / "bestest" / "data"
+CASE600 = DATA / "case_en_600.idf"
+
+
+@pytest.fixture(scope="module")
+def case600():
+    return convert_idf(CASE600)
+
+
+# ---- geometry ---------------------------------------------------------------------------
+SOUTH = [[0, 0, 2.7], [0, 0, 0], [8, 0, 0], [8, 0, 2.7]]  # case 600's south wall, counterclockwise
+
+
+def test_area_and_orientation_of_a_wall():
+    assert geometry.area(SOUTH) == pytest.approx(8 * 2.7)
+    assert geometry.azimuth_tilt(geometry.outward_normal(SOUTH)) == pytest.approx((180.0, 90.0))
+    # listed clockwise, the same vertices face north
+    assert geometry.azimuth_tilt(geometry.outward_normal(SOUTH, counterclockwise=False))[0] == pytest.approx(0.0)
+
+
+def test_relative_north_turns_the_azimuth():
+    turned = geometry.rotate_z(SOUTH, 30.0)
+    assert geometry.azimuth_tilt(geometry.outward_normal(turned))[0] == pytest.approx(210.0)
+
+
+def test_volume_of_a_box():
+    box = [[[8, 0, 2.7], [8, 0, 0], [8, 6, 0], [8, 6, 2.7]], [[8, 6, 0], [8, 0, 0], [0, 0, 0], [0, 6, 0]],
+           [[8, 6, 2.7], [8, 6, 0], [0, 6, 0], [0, 6, 2.7]], [[8, 0, 2.7], [8, 6, 2.7], [0, 6, 2.7], [0, 0, 2.7]],
+           SOUTH, [[0, 6, 2.7], [0, 6, 0], [0, 0, 0], [0, 0, 2.7]]]
+    assert geometry.enclosed_volume(box) == pytest.approx(8 * 6 * 2.7)
+
+
+# ---- glazing -----------------------------------------------------------------------------
+def test_pane_at_normal_incidence_is_its_data():
+    T, R = glazing.pane_at(0.86156, 0.07846, 0.0)
+    assert (float(T), float(R)) == pytest.approx((0.86156, 0.07846), abs=1e-9)
+
+
+def test_two_panes_interreflect():
+    T, R = 0.86156, 0.07846
+    assert float(glazing.stack_transmittance([(T, R), (T, R)], 0.0)) == pytest.approx(T * T / (1 - R * R))
+    assert float(glazing.stack_transmittance([(T, R), (T, R)], 90.0)) == 0.0
+
+
+def test_transmittance_falls_with_incidence_and_its_diffuse_mean():
+    angles = np.arange(0, 91, 5)
+    T = glazing.stack_transmittance([(0.86156, 0.07846)] * 2, angles)
+    assert np.all(np.diff(T) <= 1e-12)
+    assert glazing.hemispherical(lambda a: np.ones_like(a)) == pytest.approx(1.0, abs=1e-3)
+    # a clear double glazing lets in some 0.85 of its normal transmittance from a diffuse sky
+    assert 0.8 < glazing.hemispherical(lambda a: glazing.stack_transmittance([(0.86156, 0.07846)] * 2, a)) / T[0] < 0.9
+
+
+def test_gap_conductance_is_conduction_and_radiation_when_still():
+    d = 0.013  # a 13 mm gap is below convection's onset: Nu = 1 within 5 %
+    k = glazing.AIR_CONDUCTIVITY[0] + glazing.AIR_CONDUCTIVITY[1] * glazing.GAP_T_MEAN
+    h_r = 4 * glazing.SIGMA * glazing.GAP_T_MEAN ** 3 / (2 / 0.84 - 1)
+    assert glazing.gap_conductance(d, 2.0, 0.84, 0.84) == pytest.approx(k / d + h_r, rel=0.05)
+
+
+# ---- schedules ---------------------------------------------------------------------------
+NIGHT = Schedule(name="night", days=(("d", ((7.0, 1.0), (18.0, 0.04), (24.0, 1.0))),),
+                 periods=(((12, 31), ("d",) * 7),))
+
+
+def test_schedule_value_holds_until_its_hour():
+    hours = np.array([0.5, 6.99, 7.0, 7.01, 17.5, 18.0, 18.5, 24.0])
+    ones = np.ones_like(hours, dtype=int)
+    assert list(NIGHT.at(ones, ones, ones * 2, hours)) == [1, 1, 1, 0.04, 0.04, 0.04, 1, 1]
+
+
+def test_schedule_on_the_local_clock():
+    times = pd.date_range("2017-06-01 13:00", periods=2, freq="h", tz="UTC")  # 06:00 and 07:00 at UTC-7
+    assert list(NIGHT.on(times, "Etc/GMT+7")) == [1.0, 1.0]
+    assert list(NIGHT.on(times + pd.Timedelta("30min"), "Etc/GMT+7")) == [1.0, 0.04]
+
+
+def test_compressed_schedule_reads_back():
+    """A weekday / weekend profile over a year, compressed and read back on the same calendar."""
+    days = pd.date_range("2017-01-01", "2017-12-31", freq="D")
+    values = np.array([[1.0 if (d.weekday() < 5 and 8 <= h < 18) else 0.2 for h in range(24)] for d in days])
+    data = compress_schedule(values, 2017)
+    assert len(data["periods"]) == 1 and data["periods"][0]["through"] == "12-31"
+    building = minimal_building(schedules={"s": data})
+    hours = pd.date_range("2017-01-01 00:30", "2017-12-31 23:30", freq="h", tz="UTC")
+    assert np.array_equal(building.schedules["s"].on(hours, "UTC"), values.ravel())
+
+
+def minimal_building(**extra):
+    data = {"format": "nodal-building/1", "site": {"latitude": 45, "longitude": 5},
+            "materials": {"m": {"conductivity": 1.0, "density": 1000, "specific_heat": 1000}},
+            "zones": [{"name": "z", "volume": 10.0}],
+            "components": [{"name": "w", "area": 10.0, "tilt": 90, "azimuth": 0, "layers": [["m", 0.1]],
+                            "nodes": {"max_spacing": 0.1}, "inside": {"zone": "z", "h_conv": 2.5, "h_rad": 5},
+                            "outside": {"type": "adiabatic"}}]}
+    data.update(extra)
+    return parse_building(data)
+
+
+def test_scheduled_gain_splits_between_air_and_radiant_node():
+    b = minimal_building(schedules={"s": {"days": {"d": [[12, 0.0], [24, 1.0]]},
+                                          "periods": [{"through": "12-31", "week": ["d"] * 7}]},
+                                    "c": {"constant": 0.5}})
+    b = b.edited(lambda d: d["zones"][0].update(gains=[{"name": "g", "power": 100, "radiant_fraction": 0.3,
+                                                        "schedule": "s"},
+                                                       {"name": "k", "power": 40, "radiant_fraction": 0.5,
+                                                        "schedule": "c"}]))
+    net = assemble(b)
+    z = b.zones[0]
+    j = input_names(b).index("s")
+    assert net.B[z.air_node - 1, j] == pytest.approx(70.0) and net.B[z.radiant_node - 1, j] == pytest.approx(30.0)
+    assert net.q[z.air_node - 1] == pytest.approx(10.0) and net.q[z.radiant_node - 1] == pytest.approx(10.0)
+
+
+def test_air_density_scales_the_air_capacity():
+    assert air_density_at(0.0) == pytest.approx(1.204, abs=1e-3)
+    # at Denver's 1611 m the standard atmosphere's pressure is 83.4 kPa
+    assert air_density_at(1611.0) == pytest.approx(83.42e3 / (287.05 * 293.15), rel=1e-3)
+    thin = minimal_building().edited(lambda d: d["site"].update(air_density=1.0))
+    air = thin.zones[0].air_node - 1
+    assert assemble(thin).C[air] == pytest.approx(1.0 * 1005 * 10.0)
+    assert assemble(minimal_building()).C[air] == pytest.approx(1.2 * 1005 * 10.0)
+
+
+# ---- case 600 against the IDF text -------------------------------------------------------
+def test_case600_site_zone_and_flows(case600):
+    assert case600.site["latitude"] == 39.76 and case600.site["timezone"] == "Etc/GMT+7"
+    z = case600.zones[0]
+    assert z.volume == pytest.approx(129.6)  # the IDF's volume field
+    assert z.air_change_rate == pytest.approx(0.5)  # AirChanges/Hour 0.5, schedule always 1
+    (gain,) = z.gains
+    assert (gain.power, gain.radiant_fraction, gain.schedule) == (200.0, 0.6, None)
+
+
+def test_case600_areas_and_orientations(case600):
+    c = {k.name: k for k in case600.components}
+    # the south wall 8 x 2.7 m less its two 3 x 2 m windows
+    assert c["ZONE SURFACE SOUTH"].area == pytest.approx(21.6 - 12.0)
+    assert c["ZONE SUBSURFACE 1"].area == pytest.approx(6.0)
+    for name, azimuth, tilt in (("ZONE SURFACE SOUTH", 180, 90), ("ZONE SURFACE EAST", 90, 90),
+                                ("ZONE SURFACE WEST", 270, 90), ("ZONE SURFACE NORTH", 0, 90),
+                                ("ZONE SURFACE ROOF", None, 0), ("ZONE SURFACE FLOOR", None, 180)):
+        assert c[name].tilt == pytest.approx(tilt)
+        if azimuth is not None:
+            assert c[name].azimuth == pytest.approx(azimuth)
+
+
+def test_case600_layers_inside_first_and_u_value(case600):
+    wall = case600.component("ZONE SURFACE EAST")
+    # LTWALL: WOOD SIDING-1 (outside), FIBERGLASS QUILT-1, PLASTERBOARD-1
+    assert [round(t, 6) for _, t in wall.layers] == [0.012, 0.066, 0.009]
+    R = sum(t / m.conductivity for m, t in wall.layers)
+    assert R == pytest.approx(0.012 / 0.16 + 0.066 / 0.04 + 0.009 / 0.14)
+    C = sum(t * m.density * m.specific_heat for m, t in wall.layers)
+    assert C == pytest.approx(0.012 * 950 * 840 + 0.066 * 12 * 840 + 0.009 * 530 * 900)
+    floor = case600.component("ZONE SURFACE FLOOR")
+    # R-25 INSULATION (NoMass, 25.075 m2K/W) under the timber: its resistance kept, no capacity
+    assert sum(t / m.conductivity for m, t in floor.layers) == pytest.approx(0.025 / 0.14 + 25.075)
+    assert floor.outside.temperature == "ground temperature"
+    assert case600.schedules["ground temperature"].value == 10.0  # the IDF's monthly 10 C
+
+
+def test_case600_window(case600):
+    w = case600.component("ZONE SUBSURFACE 1")
+    T, R = 0.86156, 0.07846
+    assert w.solar_transmittance == pytest.approx(T * T / (1 - R * R), abs=1e-6)
+    assert w.transmitted_solar_to == "ZONE SURFACE FLOOR"
+    assert w.angular.factors[0] == 1.0 and w.angular.factors[-1] == 0.0
+    assert w.outside.solar_absorptance == pytest.approx(1 - w.solar_transmittance - glazing.stack_reflectance([(T, R)] * 2),
+                                                        abs=1e-5)
+
+
+def test_case600_lists_what_it_does_not_hold(case600):
+    lines = case600.data["not_modelled"]
+    assert any(line.startswith("ZoneHVAC:IdealLoadsAirSystem Zone HVAC Ideal Loads Air System 1") for line in lines)
+    assert any(line.startswith("ZoneControl:Thermostat") for line in lines)
+    assert not any(line.startswith(("Output:", "Material", "Zone ")) for line in lines)
+
+
+# ---- refusals ------------------------------------------------------------------------------
+TEXT = CASE600.read_text()
+
+
+def edited(replace_from, replace_to):
+    assert replace_from in TEXT
+    return TEXT.replace(replace_from, replace_to, 1)
+
+
+BAD = {
+    "no version": (edited("Version,\n  9.3;", ""), "Version"),
+    "old version": (edited("Version,\n  9.3;", "Version,\n  7.2;"), "older than 8.5"),
+    "no site": (edited("Site:Location,", "Site:Locationx,"), "(file)"),
+    "unknown material": (edited("  FIBERGLASS QUILT-1,                     !- Layer 2",
+                                "  NO SUCH MATERIAL,                     !- Layer 2"), "Construction 'LTWALL', field Layer 2"),
+    "unknown zone": (edited("  ZONE ONE,                               !- Zone Name\n  Outdoors",
+                            "  NO ZONE,                               !- Zone Name\n  Outdoors"), "names no Zone"),
+    "unsupported boundary": (edited("  Ground,                                 !- Outside Boundary Condition",
+                                    "  OtherSideCoefficients,                  !- Outside Boundary Condition"),
+                             "is not read"),
+    "zone multiplier": (edited("  1,                                      !- Multiplier\n",
+                               "  2,                                      !- Multiplier\n"), "Multiplier"),
+    "unknown window surface": (edited("  ZONE SURFACE SOUTH,                     !- Building Surface Name",
+                                      "  NO SURFACE,                     !- Building Surface Name"), "Building Surface Name"),
+    "unknown schedule": (edited("  Always On Ruleset Fractional,           !- Schedule Name",
+                                "  No Such Schedule,           !- Schedule Name"), "No Such Schedule"),
+    "flow method": (edited("  AirChanges/Hour,", "  Flow/Person,"), "Design Flow Rate Calculation Method"),
+}
+
+
+@pytest.mark.parametrize("kind", BAD)
+def test_bad_idf_is_one_line_naming_the_object_and_field(kind, tmp_path):
+    text, expected = BAD[kind]
+    path = tmp_path / "bad.idf"
+    path.write_text(text)
+    with pytest.raises(InputError) as e:
+        convert_idf(path)
+    message = str(e.value)
+    assert "\n" not in message and str(path) in message and expected in message
+
+
+def test_scheduled_air_flow_is_refused():
+    """950FF as published: its night ventilation varies by the hour."""
+    with pytest.raises(InputError, match="BESTEST Night Vent' varies in time"):
+        convert_idf(DATA / "950FF_test_output.idf")
+
+
+def test_cli_convert(tmp_path):
+    nodeforce = Path(sys.executable).parent / "nodeforce"
+    out = tmp_path / "b.json"
+    done = subprocess.run([nodeforce, "convert", CASE600, "-o", out], capture_output=True, text=True)
+    assert done.returncode == 0
+    assert "not modelled: ZoneHVAC:IdealLoadsAirSystem" in done.stdout
+    assert json.loads(out.read_text())["not_modelled"]
+    bad = tmp_path / "bad.idf"
+    bad.write_text(BAD["unknown zone"][0])
+    done = subprocess.run([nodeforce, "convert", bad, "-o", out], capture_output=True, text=True)
+    assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1
