@@ -176,11 +176,12 @@ class NodalBuilding(Fmi2Slave):
         values, layout = self._values, self.layout
         T_forced = values[layout.T_forced]
         forced = _physics["integrate"].imposed(self._force, T_forced) if self._any_forced else self._force
-        source = self.network.sources(values[layout.inputs])
+        u = values[layout.inputs]
+        source = self.network.sources(u)
         stepper = self._steppers.get(step_size)
         if stepper is None:
             stepper = self._steppers[step_size] = _physics["integrate"].ImplicitEuler(self.network, step_size)
-        values[layout.T] = stepper.step(values[layout.T], source, forced, T_forced)
+        values[layout.T] = stepper.step(values[layout.T], source, forced, T_forced, self.network.switched_diagonal(u))
         self._time = current_time + step_size
         return True
 

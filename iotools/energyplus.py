@@ -554,9 +554,11 @@ class _Converter:
         data = {"name": z.name, "volume": round(volume, 6), "_floor_area": floor}
         exterior = sum(s["area"] for s in own if s["boundary"].lower() == "outdoors")
         walls = sum(s["area"] for s in own if s["boundary"].lower() == "outdoors" and s["type"].lower() == "wall")
-        flow = self.air_flows(z, volume, floor, exterior, walls)
+        flow, scheduled = self.air_flows(z, volume, floor, exterior, walls)
         if flow:
             data["air_change_rate"] = flow / volume
+        if scheduled:
+            data["ventilation"] = scheduled
         gains = self.gains(z, floor)
         if gains:
             data["gains"] = gains
@@ -576,8 +578,9 @@ class _Converter:
         return [v for k, v in fields.items() if k != "name" and not _blank(v)]
 
     def air_flows(self, z, volume, floor, exterior, walls):
-        """The zone's constant outdoor air flow (m3/h) from its design flow rate objects."""
-        total = 0.0
+        """The zone's constant outdoor air flow (m3/h) from its design flow rate objects, and its
+        scheduled ones (the building file's `ventilation`)."""
+        total, scheduled = 0.0, []
         for kind in FLOWS:
             for o in self.r.all(kind):
                 if z.name not in self._targets(o, "zone_or_zonelist_name") and \
@@ -611,13 +614,15 @@ class _Converter:
                     if limits:
                         self.not_modelled.append(f"{kind} {o.name}: its controls ({', '.join(limits)}) not held; "
                                                  "the flow runs as scheduled")
-                value = self.constant_schedule_value(self.r.text(o, "schedule_name"), o, "Schedule Name") \
-                    if not _blank(o.get("schedule_name")) else 1.0
+                name = self.r.text(o, "schedule_name")
+                value = self.constant_schedule_value(name, o, "Schedule Name") if name else 1.0
                 if value is None:
-                    self.r.fail(o, "Schedule Name", f"{o.get('schedule_name')!r} varies in time: the building file's "
-                                                    "air flows are constant (docs/model.md section 1)")
-                total += flow * A * value
-        return total
+                    if np.min([v for p in self.schedules[name]["days"].values() for _, v in p]) < 0:
+                        self.r.fail(o, "Schedule Name", f"{name!r} takes negative values: an air flow is >= 0")
+                    scheduled.append({"name": o.name, "flow": flow * A, "schedule": name})
+                else:
+                    total += flow * A * value
+        return total, scheduled
 
     def gains(self, z, floor):
         out = []

@@ -106,6 +106,15 @@ class Gain:
 
 
 @dataclass(frozen=True)
+class Ventilation:
+    """An outdoor air flow into a zone that follows a schedule (docs/model.md section 3.4): flow
+    m3/h times its schedule's value, leaving at the zone's air temperature."""
+    name: str
+    flow: float  # m3/h at a schedule value of 1
+    schedule: str | None = None  # None: always 1
+
+
+@dataclass(frozen=True)
 class AngularTransmittance:
     """A glazing's transmittance relative to its normal-incidence one (docs/model.md section 4.1):
     factors at angles of incidence (deg, increasing from 0, factor 1 at 0) for the direct sun, and
@@ -139,6 +148,7 @@ class Zone:
     heat_input_factor: float = 1.0  # the heat its heat input columns deliver, per W they read
     air_exchange: tuple = ()  # (other zone, m3/h each way): air through an open internal door
     gains: tuple = ()  # Gain records
+    ventilation: tuple = ()  # Ventilation records
     mass_node: int | None = None  # ids of the nodes those two add (docs/model.md section 7)
     heater_node: int | None = None
 
@@ -247,7 +257,7 @@ class Building:
     def schedule_inputs(self):
         """Names of the schedules the network reads as inputs (the non-constant ones its gains and
         boundary temperatures use), in order of appearance; their values come from the file."""
-        names = [g.schedule for z in self.zones for g in z.gains if g.schedule is not None]
+        names = [g.schedule for z in self.zones for g in z.gains + z.ventilation if g.schedule is not None]
         names += [c.outside.temperature for c in self.components
                   if isinstance(c.outside, Boundary) and isinstance(c.outside.temperature, str)]
         return tuple(n for n in dict.fromkeys(names) if n in self.schedules and not self.schedules[n].is_constant)
@@ -560,6 +570,21 @@ def _gains(check, z, where, schedules):
     return tuple(gains)
 
 
+def _ventilation(check, z, where, schedules):
+    flows = []
+    for k, v in enumerate(check.sequence(z, "ventilation", where, optional=True)):
+        vw = f"{where}.ventilation[{k}]"
+        schedule = check.text(v, "schedule", vw, optional=True)
+        if schedule is not None and schedule not in schedules:
+            check.fail(f"{vw}.schedule", f"names no schedule of the file ({schedule!r})")
+        if schedule is not None and not schedules[schedule].is_constant and any(
+                value < 0 for _, profile in schedules[schedule].days for _, value in profile):
+            check.fail(f"{vw}.schedule", f"{schedule!r} takes negative values: an air flow is >= 0")
+        flows.append(Ventilation(name=check.text(v, "name", vw), flow=check.number(v, "flow", vw, low=0),
+                                 schedule=schedule))
+    return tuple(flows)
+
+
 def _angular(check, c, where):
     raw = c.get("angular_transmittance")
     if raw is None:
@@ -664,6 +689,7 @@ def _zone(check, z, where, zone_names, explicit, next_id, schedules):
         heat_input_factor=check.number(z, "heat_input_factor", where, default=1.0, low=0),
         air_exchange=exchange,
         gains=_gains(check, z, where, schedules),
+        ventilation=_ventilation(check, z, where, schedules),
         **lumped,
     )
 

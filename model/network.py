@@ -33,6 +33,7 @@ class Network:
     q: np.ndarray  # (N,) W
     input_names: tuple  # names of the columns of B
     products: tuple = ()  # (node index, input a, input b, coefficient): coefficient u_a u_b W
+    switched: tuple = ()  # (node index, input j, g): a conductance g u_j (W/K) from the node to T_out
 
     @property
     def n_nodes(self):
@@ -42,6 +43,17 @@ class Network:
     def algebraic(self):
         """Boolean mask of the nodes with no capacity (radiant nodes)."""
         return self.C == 0.0
+
+    def switched_diagonal(self, U):
+        """(N,) or (n_rows, N): what the switched conductances g u_j add to the diagonal of -A (W/K)
+        for one input vector or rows of inputs; None when the network has none."""
+        if not self.switched:
+            return None
+        U = np.asarray(U, dtype=float)
+        D = np.zeros(U.shape[:-1] + (self.n_nodes,))
+        for node, j, g in self.switched:
+            D[..., node] += g * U[..., j]
+        return D
 
     def sources(self, U):
         """B u + q + the products of inputs (W), for one input vector u (n_inputs,) or for rows
@@ -105,7 +117,7 @@ def assemble(building, names=None):
     A = np.zeros((n, n))
     B = np.zeros((n, len(names)))
     q = np.zeros(n)
-    products = []
+    products, switched = [], []
 
     def link(i, j, g):
         """A conductance g (W/K) between nodes i and j (0-based)."""
@@ -175,6 +187,16 @@ def assemble(building, names=None):
         to_temperature(air, air_conductance(z.volume * z.air_change_rate, rho), "T_out")
         if z.supply is not None:
             to_temperature(air, air_conductance(z.supply.flow * z.supply.flow_factor, rho), z.supply.temperature)
+        for v in z.ventilation:
+            schedule = building.schedules.get(v.schedule) if v.schedule is not None else None
+            if schedule is None or schedule.is_constant:
+                to_temperature(air, air_conductance(v.flow * (1.0 if schedule is None else schedule.value), rho), "T_out")
+            else:
+                # g s(t) (T_out - T_air): the conductance follows the schedule (`Network.switched`),
+                # its T_out term is a product of two inputs
+                g = air_conductance(v.flow, rho)
+                switched.append((air, col[v.schedule], g))
+                products.append((air, col[v.schedule], col["T_out"], g))
         for inflow in z.airflow_from:
             g = air_conductance(inflow.flow, rho)
             A[air, air] -= g
@@ -215,7 +237,7 @@ def assemble(building, names=None):
             for name in z.heat_input:
                 B[air, col[name]] += gain * (1.0 - f_r)
                 B[radiant, col[name]] += gain * f_r
-    return Network(C=C, A=A, B=B, q=q, input_names=names, products=tuple(products))
+    return Network(C=C, A=A, B=B, q=q, input_names=names, products=tuple(products), switched=tuple(switched))
 
 
 def face_heat_flux(building, network, T, U, component, face):

@@ -4,14 +4,18 @@ README.md) by the edits the standard defines, through idfkit, so that `nodeforce
 
 - 600FF: case 600 (data/case_en_600.idf, EnergyPlus 9.3) without its thermostat and ideal loads
   (the standard's free float: no heating or cooling);
+- 650FF: 600FF with case 950FF's night ventilation (its infiltration object and schedules: the
+  vent's 1703 m3/h and the infiltration's 0.5 air changes an hour from 18:00 to 07:00, the
+  infiltration alone by day);
 - 900FF: case 950FF (data/950FF_test_output.idf, EnergyPlus 8.8: case 900's heavy walls and floor,
   free-floating) with case 900's constant infiltration, 0.5 air changes an hour, in place of the
-  night ventilation of 950.
+  night ventilation of 950;
+- 950FF: case 950FF as published.
 
-    python examples/bestest/cases.py OUT_FOLDER     writes OUT_FOLDER/600FF.idf, 900FF.idf
+    python examples/bestest/cases.py OUT_FOLDER     writes OUT_FOLDER/<case>.idf
 
-650FF and 950FF need a ventilation scheduled by the hour, which the building file's constant air
-flows cannot hold: `nodeforce convert` refuses them (docs/guide.md).
+
+
 """
 import sys
 from pathlib import Path
@@ -35,6 +39,32 @@ def case_600ff():
     return free_float(idfkit.load_idf(str(DATA / "case_en_600.idf")))
 
 
+def night_ventilation():
+    """Case 950FF's night ventilation: its infiltration object and the schedules it needs."""
+    return idfkit.load_idf(str(DATA / "950FF_test_output.idf"), version=(8, 9, 0))
+
+
+def case_650ff():
+    doc, vent = case_600ff(), night_ventilation()
+    for obj in list(doc["ZoneInfiltration:DesignFlowRate"]):
+        doc.removeidfobject(obj)
+    (infiltration,) = vent["ZoneInfiltration:DesignFlowRate"]
+    year = vent.getobject("SCHEDULE:YEAR", infiltration.schedule_name)
+    # the 8.8 file numbers a year's weeks (schedule_week_name_1, ...); 9.3 lists them
+    fields = year.to_dict()
+    weeks = [{f: fields[f"{f}_{k}"] for f in ("schedule_week_name", "start_month", "start_day", "end_month", "end_day")}
+             for k in range(1, 54) if f"schedule_week_name_{k}" in fields]
+    week_objs = [vent.getobject("SCHEDULE:WEEK:DAILY", w["schedule_week_name"]) for w in weeks]
+    days = {d for w in week_objs for k, d in w.to_dict().items() if k != "name"}
+    for obj in [vent.getobject("SCHEDULETYPELIMITS", year.schedule_type_limits_name), *week_objs,
+                *(vent.getobject("SCHEDULE:DAY:INTERVAL", d) for d in days), infiltration]:
+        if doc.getobject(obj.obj_type.upper(), obj.name) is None:
+            doc.add(obj.obj_type, obj.name, {k: v for k, v in obj.to_dict().items() if k != "name"})
+    doc.add("Schedule:Year", year.name, {"schedule_type_limits_name": year.schedule_type_limits_name,
+                                          "schedule_weeks": weeks})
+    return doc
+
+
 def case_900ff():
     doc = free_float(idfkit.load_idf(str(DATA / "950FF_test_output.idf"), version=(8, 9, 0)))
     for infiltration in doc["ZoneInfiltration:DesignFlowRate"]:
@@ -45,7 +75,11 @@ def case_900ff():
     return doc
 
 
-CASES = {"600FF": case_600ff, "900FF": case_900ff}
+def case_950ff():
+    return free_float(night_ventilation())
+
+
+CASES = {"600FF": case_600ff, "900FF": case_900ff, "650FF": case_650ff, "950FF": case_950ff}
 
 
 def main(out):
