@@ -238,12 +238,6 @@ def test_bad_idf_is_one_line_naming_the_object_and_field(kind, tmp_path):
     assert "\n" not in message and str(path) in message and expected in message
 
 
-def test_scheduled_air_flow_is_refused():
-    """950FF as published: its night ventilation varies by the hour."""
-    with pytest.raises(InputError, match="BESTEST Night Vent' varies in time"):
-        convert_idf(DATA / "950FF_test_output.idf")
-
-
 def test_cli_convert(tmp_path):
     nodeforce = Path(sys.executable).parent / "nodeforce"
     out = tmp_path / "b.json"
@@ -255,3 +249,54 @@ def test_cli_convert(tmp_path):
     bad.write_text(BAD["unknown zone"][0])
     done = subprocess.run([nodeforce, "convert", bad, "-o", out], capture_output=True, text=True)
     assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1
+
+
+# ---- scheduled ventilation ---------------------------------------------------------------
+def test_scheduled_ventilation_steady_states(tmp_path):
+    """A zone of light adiabatic walls, 100 W and 100 m3/h of outdoor air at 0 C by night
+    (schedule 1) and a quarter of it by day: each half day ends at the steady state
+    T_air = Q / (s g), g = rho c V / 3600, with the switched conductance."""
+    from nodeforce.iotools.weather import read_weather
+    from nodeforce.model.case import simulate_building
+    light = {"conductivity": 1.0, "density": 1.0, "specific_heat": 100.0}
+    b = minimal_building(
+        materials={"m": light},
+        schedules={"night": {"days": {"d": [[6, 1.0], [18, 0.25], [24, 1.0]]},
+                             "periods": [{"through": "12-31", "week": ["d"] * 7}]}})
+    b = b.edited(lambda d: d["zones"][0].update(internal_gain=100.0, ventilation=[
+        {"name": "vent", "flow": 100.0, "schedule": "night"}]))
+    times = pd.date_range("2017-03-01", periods=3 * 24 * 4 + 1, freq="15min", tz="UTC")
+    path = tmp_path / "w.csv"
+    pd.DataFrame({"time": [t.isoformat() for t in times], "T_out": 0.0, "ghi": 0.0, "dni": 0.0,
+                  "dhi": 0.0}).to_csv(path, index=False)
+    T = simulate_building(b, read_weather(path))
+    air = pd.Series(T[f"T{b.zones[0].air_node}"].to_numpy(), index=times[1:])
+    g = 1.2 * 1005 * 100 / 3600
+    assert air[pd.Timestamp("2017-03-02 17:45", tz="UTC")] == pytest.approx(100 / (0.25 * g), rel=1e-3)
+    assert air[pd.Timestamp("2017-03-03 05:45", tz="UTC")] == pytest.approx(100 / g, rel=1e-3)
+
+
+def test_standalone_fmu_refuses_a_switched_conductance():
+    from nodeforce.fmu_build.standalone import network_terms
+    b = minimal_building(schedules={"s": {"days": {"d": [[12, 0.0], [24, 1.0]]},
+                                          "periods": [{"through": "12-31", "week": ["d"] * 7}]}})
+    b = b.edited(lambda d: d["zones"][0].update(ventilation=[{"name": "v", "flow": 10.0, "schedule": "s"}]))
+    with pytest.raises(InputError, match="follows a schedule"):
+        network_terms(b, None)
+
+
+def test_650ff_converts_its_night_ventilation(tmp_path):
+    sys.path.insert(0, str(DATA.parent))
+    import cases
+    import idfkit
+    path = tmp_path / "650FF.idf"
+    idfkit.save_idf(cases.case_650ff(), str(path))
+    b = convert_idf(path)
+    z = b.zones[0]
+    assert z.air_change_rate == 0.0
+    (vent,) = z.ventilation
+    assert vent.flow == pytest.approx(0.4911 * 3600)  # Flow/Zone 0.4911 m3/s
+    s = b.schedules[vent.schedule]
+    hours = np.array([6.5, 7.5, 17.5, 18.5])
+    ones = np.ones(4, dtype=int)
+    assert list(s.at(ones, ones, ones, hours)) == pytest.approx([1, 0.0366524122655392, 0.0366524122655392, 1])
