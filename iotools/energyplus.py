@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model import geometry, glazing
+from ..model import convection, geometry, glazing
 from ..model.errors import InputError
 from ..model.network import air_density_at
 
@@ -26,14 +26,16 @@ class Films:
     """Surface coefficients the nodal model holds constant (W/m2/K), where EnergyPlus computes
     them each step: the convective coefficients inside of ISO 13791 / 13792 for a room's
     temperature (heat flowing up from a floor the transmitted sun warms, down to a ceiling under
-    the warm air; 2.5 on walls), outside ISO 6946's 4 + 4 v at its standard wind, 4 m/s (4 where
-    EnergyPlus says NoWind), and the linearised long-wave exchange 4 sigma eps T_m^3 of a face
-    of emissivity eps at T_m."""
+    the warm air; 2.5 on walls); outside EnergyPlus's DOE-2 model (`model.convection.doe2`) at
+    each face's height, roughness and the site's terrain for a weather station's wind of `wind`
+    m/s (ISO 6946's reference, 4 m/s), natural convection alone where EnergyPlus says NoWind, at
+    a face-to-air difference of `delta_T`; and the linearised long-wave exchange 4 sigma eps T_m^3
+    of a face of emissivity eps at T_m."""
     inside_wall: float = 2.5
     inside_floor: float = 5.0
     inside_ceiling: float = 0.7
-    outside_wind: float = 20.0
-    outside_still: float = 4.0
+    wind: float = 4.0  # m/s at the weather station
+    delta_T: float = 5.0  # K
     T_inside: float = 293.15  # K
     T_outside: float = 283.15  # K
     ground: float = 1000.0  # a face held at the ground's temperature, as EnergyPlus holds it
@@ -48,6 +50,12 @@ class Films:
 
     def radiative(self, emissivity, T):
         return 4 * glazing.SIGMA * emissivity * T ** 3
+
+    def outside_convection(self, tilt, height, roughness, wind_exposed, terrain):
+        """h_c of an exterior face: DOE-2 at the local wind, or natural convection without wind."""
+        if not wind_exposed:
+            return convection.natural_convection(tilt, self.delta_T)
+        return convection.doe2(tilt, convection.wind_at_height(self.wind, height, terrain), roughness, self.delta_T)
 
 
 FILMS = Films()
@@ -213,6 +221,10 @@ class _Converter:
         north = self.r.number(buildings[0], "north_axis", default=0.0) if buildings else 0.0
         self.ccw, self.relative, self.rect_relative, self.north = (
             direction == "counterclockwise", system == "relative", rect == "relative", north)
+        terrain = self.r.text(buildings[0], "terrain", "Suburbs").lower() if buildings else "suburbs"
+        if terrain not in convection.TERRAIN:
+            self.r.fail(buildings[0], "Terrain", f"{terrain!r} is none of EnergyPlus's terrains")
+        self.terrain = terrain
 
     def schedule(self, name, referrer, field):
         """The building file's name of an IDF schedule, converted once (its values over a year on
@@ -326,10 +338,16 @@ class _Converter:
         return MASSLESS_THICKNESS
 
     def _faces(self, o):
+        """Emissivity, solar absorptance and DOE-2 roughness multiplier of a layer's face (EnergyPlus's
+        defaults where a field is blank; an air gap is no face EnergyPlus would put outermost)."""
         if o.obj_type.upper() == "MATERIAL:AIRGAP":
-            return {"emissivity": 0.9, "solar": 0.7}
+            return {"emissivity": 0.9, "solar": 0.7, "roughness": convection.ROUGHNESS["mediumrough"]}
+        roughness = self.r.text(o, "roughness", "MediumRough").lower()
+        if roughness not in convection.ROUGHNESS:
+            self.r.fail(o, "Roughness", f"{roughness!r} is none of EnergyPlus's roughnesses")
         return {"emissivity": self.r.number(o, "thermal_absorptance", default=0.9, low=0, low_open=True, high=1),
-                "solar": self.r.number(o, "solar_absorptance", default=0.7, low=0, high=1)}
+                "solar": self.r.number(o, "solar_absorptance", default=0.7, low=0, high=1),
+                "roughness": convection.ROUGHNESS[roughness]}
 
     def opaque_material(self, o):
         name = o.name
@@ -363,11 +381,12 @@ class _Converter:
             self.materials[name] = {"conductivity": 0.003 / R, "density": GLASS_DENSITY,
                                     "specific_heat": GLASS_SPECIFIC_HEAT}
             tau = glazing.simple_glazing_transmittance(U, shgc)
-            h_o = FILMS.outside_wind + FILMS.radiative(0.84, FILMS.T_outside)
+            h_o = FILMS.outside_convection(90.0, 1.5, 1.0, True, "country") + FILMS.radiative(0.84, FILMS.T_outside)
             inward = (1 / (1 / U - 1 / h_out)) / (1 / (1 / U - 1 / h_out) + h_o)
             alpha = min(1 - tau, max(0.0, (shgc - tau) / inward))
-            faces = {"emissivity": 0.84, "solar": alpha}
-            return [[name, 0.003]], faces, faces, {"tau": tau, "angular": None}
+            faces = {"emissivity": 0.84, "solar": alpha, "roughness": 1.0}
+            return [[name, 0.003]], faces, {"emissivity": 0.84, "solar": tau + alpha}, {
+                "tau": tau, "inner_alpha": 0.0, "angular": None}
         panes, layers = [], []
         for k, o in enumerate(objs):
             kind = o.obj_type.upper()
@@ -402,9 +421,16 @@ class _Converter:
         tau = float(glazing.stack_transmittance(pairs, 0.0))
         factors = [float(glazing.stack_transmittance(pairs, a)) / tau for a in glazing.ANGLES]
         diffuse = glazing.hemispherical(lambda a: glazing.stack_transmittance(pairs, a)) / tau
-        alpha = 1 - tau - glazing.stack_reflectance(pairs)
-        outer, inner = {"emissivity": panes[0][2], "solar": alpha}, {"emissivity": panes[-1][3], "solar": 0.0}
-        return layers, outer, inner, {"tau": tau, "angular": {"angles": list(glazing.ANGLES), "factors": factors,
+        # each pane's absorbed sun goes to the face it is nearer: the outer half of the panes to the
+        # outside face, the inner half to the inside face (the middle pane of three split)
+        absorbed = glazing.pane_absorptances(pairs)
+        n = len(absorbed)
+        alpha = sum(absorbed[:n // 2]) + (absorbed[n // 2] / 2 if n % 2 else 0.0)
+        inner_alpha = sum(absorbed[(n + 1) // 2:]) + (absorbed[n // 2] / 2 if n % 2 else 0.0)
+        # seen from the room, a glazing takes the diffuse sun it does not reflect (out, or into its panes)
+        outer = {"emissivity": panes[0][2], "solar": alpha, "roughness": 1.0}  # glass is very smooth
+        inner = {"emissivity": panes[-1][3], "solar": 1 - glazing.stack_reflectance(pairs[::-1])}
+        return layers, outer, inner, {"tau": tau, "inner_alpha": inner_alpha, "angular": {"angles": list(glazing.ANGLES), "factors": factors,
                                                               "diffuse": diffuse}}
 
     # ---- zones, surfaces ----------------------------------------------------------------
@@ -470,7 +496,8 @@ class _Converter:
                                            other=self.r.text(s, "outside_boundary_condition_object"),
                                            sun=boundary == "Outdoors", wind=boundary == "Outdoors",
                                            construction=self.r.text(s, "construction_name"), vertices=None,
-                                           area=length * other, azimuth=azimuth, tilt=tilt)
+                                           area=length * other, azimuth=azimuth, tilt=tilt,
+                                           height=self._rect_height(s, zone, stype, other, tilt))
         if not out:
             self.r.fail(None, "BuildingSurface:Detailed", "missing: the model has no heat transfer surface")
         for s in out.values():
@@ -478,6 +505,7 @@ class _Converter:
                 normal = geometry.outward_normal(s["vertices"], self.ccw)
                 s["azimuth"], s["tilt"] = geometry.azimuth_tilt(normal)
                 s["area"] = geometry.area(s["vertices"])
+                s["height"] = float(np.mean(s["vertices"][:, 2]))
             s["subsurfaces"] = []
         for kind in SUBSURFACES:
             for w in self.r.all(kind):
@@ -500,6 +528,13 @@ class _Converter:
                                                   construction=self.r.text(w, "construction_name"),
                                                   other=self.r.text(w, "outside_boundary_condition_object")))
         return out
+
+    def _rect_height(self, s, zone, stype, other, tilt):
+        """Centroid height (m) of a rectangular surface: its starting corner's z plus half its rise."""
+        z0 = self.r.number(s, "starting_z_coordinate", default=0.0)
+        if self.rect_relative:
+            z0 += self.r.number(zone, "z_origin", default=0.0)
+        return z0 + 0.5 * other * np.sin(np.radians(tilt))
 
     def zone_of(self, obj, field):
         name = self.r.text(obj, field)
@@ -720,6 +755,8 @@ class _Converter:
                     c["transmitted_solar_to"] = None  # set once every component is known (`receivers`)
                     if glass["angular"] is not None and "exterior" == w_outside["type"]:
                         c["angular_transmittance"] = glass["angular"]
+                    if glass["inner_alpha"] > 0 and "exterior" == w_outside["type"]:
+                        c["inner_solar_absorptance"] = round(glass["inner_alpha"], 6)
                     if w_outside["type"] != "exterior":
                         del c["solar_transmittance"], c["transmitted_solar_to"]
                 comps.append(c)
@@ -731,12 +768,12 @@ class _Converter:
                 "layers": [[m, t] for m, t in reversed(layers)], "nodes": {"max_spacing": MAX_SPACING},
                 "inside": {"zone": s["zone"], "h_conv": FILMS.inside_convection(s["tilt"]),
                            "h_rad": round(FILMS.radiative(inner["emissivity"], FILMS.T_inside), 4)},
-                "outside": outside, "_zone": s["zone"], "_type": s["type"].lower()}
+                "outside": outside, "_zone": s["zone"], "_type": s["type"].lower(), "_absorbs": inner["solar"]}
 
     def outside(self, s, boundary, outer, surfaces, done, subsurface=None):
         obj = s["obj"]
         if boundary == "outdoors":
-            h = FILMS.outside_wind if s["wind"] else FILMS.outside_still
+            h = round(FILMS.outside_convection(s["tilt"], s["height"], outer["roughness"], s["wind"], self.terrain), 4)
             return {"type": "exterior", "h_conv": h, "h_rad": round(FILMS.radiative(outer["emissivity"], FILMS.T_outside), 4),
                     "solar_absorptance": outer["solar"] if s["sun"] else 0.0}
         if boundary == "ground":
@@ -775,17 +812,28 @@ class _Converter:
                                              layers[::-1], inner, {"type": "adiabatic"}))
 
     def receivers(self, components):
-        """The transmitted sun of a zone's windows lands on its largest floor (its largest surface
-        if it has no floor): EnergyPlus's FullInteriorAndExterior puts the direct sun there."""
+        """Where the sun a zone's windows let in lands, as EnergyPlus's FullInteriorAndExterior
+        distributes it (Engineering Reference, interior solar distribution): the direct sun on the
+        zone's largest floor (its largest opaque surface if it has none), which absorbs its solar
+        absorptance alpha_f of it; the rest reflected diffusely onto every inside surface in
+        proportion to its area times its absorptance, A_i alpha_i / sum_j A_j alpha_j, the
+        glazings' share leaving the zone. Applied to the diffuse sun too (the building file has
+        one transmitted input per glazing)."""
         for c in components:
             if "transmitted_solar_to" not in c:
                 continue
-            own = [k for k in components if k["_zone"] == c["_zone"] and k["inside"]["zone"] == c["_zone"]
-                   and "solar_transmittance" not in k]
-            floors = [k for k in own if k["_type"] == "floor"] or own
-            c["transmitted_solar_to"] = max(floors, key=lambda k: k["area"])["name"]
+            own = [k for k in components if k["_zone"] == c["_zone"] and k["inside"]["zone"] == c["_zone"]]
+            opaque = [k for k in own if "solar_transmittance" not in k]
+            floors = [k for k in opaque if k["_type"] == "floor"] or opaque
+            floor = max(floors, key=lambda k: k["area"])
+            c["transmitted_solar_to"] = floor["name"]
+            total = sum(k["area"] * k["_absorbs"] for k in own)
+            reflected = 1 - floor["_absorbs"]
+            shares = {k["name"]: reflected * k["area"] * k["_absorbs"] / total for k in opaque if k["_absorbs"] > 0}
+            shares[floor["name"]] = shares.get(floor["name"], 0.0) + floor["_absorbs"]
+            c["solar_distribution"] = {name: round(f, 6) for name, f in shares.items()}
         for c in components:
-            c.pop("_zone"), c.pop("_type")
+            c.pop("_zone"), c.pop("_type"), c.pop("_absorbs")
 
     def list_not_modelled(self):
         for obj in self.r.doc.all_objects:

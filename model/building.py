@@ -170,6 +170,16 @@ class Component:
     conductivity_factor: float = 1.0  # scale on the conductances between its nodes
     capacity_factor: float = 1.0  # scale on the heat capacities of its nodes
     angular: AngularTransmittance | None = None  # the transmittance with the angle of incidence
+    solar_distribution: tuple = ()  # (component, fraction) of the transmitted sun; () all to transmitted_solar_to
+    inner_solar_absorptance: float = 0.0  # part of the sun on the outside face absorbed at the inside face
+
+    @property
+    def receivers(self):
+        """((component, fraction), ...) of the sun a glazing lets in: its `solar_distribution`, or
+        all of it to `transmitted_solar_to`; () for an opaque component."""
+        if self.solar_transmittance is None:
+            return ()
+        return self.solar_distribution or ((self.transmitted_solar_to, 1.0),)
 
     @property
     def transmitted_input(self):
@@ -394,6 +404,9 @@ def parse_building(data, source="<building>"):
         if c.transmitted_solar_to is not None and c.transmitted_solar_to not in names:
             check.fail(f"components[{i}].transmitted_solar_to",
                        f"names no component ({c.transmitted_solar_to!r})")
+        for name, _ in c.solar_distribution:
+            if name not in names:
+                check.fail(f"components[{i}].solar_distribution.{name}", f"names no component ({name!r})")
     _check_proportional_columns(check, zones, components)
     _check_air_exchanges(check, zones)
     boundary_factors = _boundary_factors(check, data, zones, components)
@@ -825,7 +838,33 @@ def _component(check, c, where, materials, zone_names, sensor_depths):
         conductivity_factor=check.number(c, "conductivity_factor", where, default=1.0, low=0, low_open=True),
         capacity_factor=check.number(c, "capacity_factor", where, default=1.0, low=0),
         angular=_angular(check, c, where),
+        solar_distribution=_distribution(check, c, where, tau),
+        inner_solar_absorptance=_inner_absorptance(check, c, where),
     )
+
+
+def _inner_absorptance(check, c, where):
+    if "inner_solar_absorptance" not in c:
+        return 0.0
+    if not (isinstance(c.get("outside"), dict) and c["outside"].get("type") == "exterior"):
+        check.fail(f"{where}.inner_solar_absorptance", "only a component with an exterior outside face has one")
+    return check.number(c, "inner_solar_absorptance", where, low=0, high=1)
+
+
+def _distribution(check, c, where, tau):
+    raw = c.get("solar_distribution")
+    if raw is None:
+        return ()
+    where = f"{where}.solar_distribution"
+    if tau is None:
+        check.fail(where, "only a glazed component (with a solar_transmittance) has one")
+    if not isinstance(raw, dict) or not raw:
+        check.fail(where, 'must be {"component": fraction, ...}')
+    fractions = tuple((name, check.number(raw, name, where, low=0, high=1)) for name in raw)
+    if sum(f for _, f in fractions) > 1 + 1e-9:
+        check.fail(where, f"the fractions add up to {sum(f for _, f in fractions):g}: at most 1 (the rest leaves "
+                          "through the glazings)")
+    return fractions
 
 
 def _explicit_ids(check, raw_zones, components):

@@ -148,3 +148,28 @@ def simple_glazing_films(U):
     to include (Engineering Reference, "Simple Window Model", step 2)."""
     h_in = 0.359073 * np.log(U) + 6.949915 if U < 5.85 else 1.788041 * U - 2.886625
     return float(h_in), 0.025342 * U + 29.163853
+
+
+def pane_absorptances(panes):
+    """Solar absorptance of each pane of a stack (outside first) at normal incidence, each
+    (T0, R0) the same on both faces, of the sun falling on the outermost pane: with f_k and b_k
+    the flux falling on pane k from outside and from inside, f_1 = 1 and b_N = 0,
+
+        f_k+1 = T_k f_k + R_k b_k,    b_k-1 = T_k b_k + R_k f_k,    A_k = (1 - T_k - R_k)(f_k + b_k)
+
+    every interreflection counted (a linear system of the 2N fluxes)."""
+    n = len(panes)
+    # unknowns: f_1..f_N, b_1..b_N
+    M, v = np.zeros((2 * n, 2 * n)), np.zeros(2 * n)
+    M[0, 0], v[0] = 1.0, 1.0  # f_1 = 1
+    M[1, 2 * n - 1] = 1.0  # b_N = 0
+    row = 2
+    for k, (T, R) in enumerate(panes):
+        if k + 1 < n:  # f_k+1 = T f_k + R b_k
+            M[row, k + 1], M[row, k], M[row, n + k] = 1.0, -T, -R
+            row += 1
+        if k > 0:  # b_k-1 = T b_k + R f_k
+            M[row, n + k - 1], M[row, n + k], M[row, k] = 1.0, -T, -R
+            row += 1
+    flux = np.linalg.solve(M, v)
+    return [(1 - T - R) * (flux[k] + flux[n + k]) for k, (T, R) in enumerate(panes)]

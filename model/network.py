@@ -162,6 +162,8 @@ def assemble(building, names=None):
             B[e, col["T_out"]] += c.area * (out.h_conv + out.h_rad * (1.0 - F)) * envelope
             B[e, col["T_sky"]] += c.area * out.h_rad * F * envelope
             B[e, col[c.irradiance_input]] += c.area * out.solar_absorptance
+            # a glazing's inner panes absorb part of the sun at the inside face (docs/model.md 4.1)
+            B[idx[0], col[c.irradiance_input]] += c.area * c.inner_solar_absorptance
         elif isinstance(out, Surface):
             to_zone(e, c.area, out)
         elif isinstance(out, Boundary):
@@ -169,16 +171,17 @@ def assemble(building, names=None):
         else:
             assert isinstance(out, Adiabatic)
         if c.solar_transmittance is not None:
-            receiver = building.component(c.transmitted_solar_to).node_ids[0] - 1
-            transmitted = c.solar_transmittance * c.area
             sun = col[c.transmitted_input]
-            if c.shading:
-                # tau A I (s + f (1 - s)): a closed shading (s = 0) still lets in the part f
-                f = building.zone(c.inside.zone).shading_transmittance
-                products.append((receiver, sun, col[c.shading], transmitted * (1.0 - f)))
-                B[receiver, sun] += transmitted * f
-            else:
-                B[receiver, sun] += transmitted
+            for name, fraction in c.receivers:
+                receiver = building.component(name).node_ids[0] - 1
+                transmitted = c.solar_transmittance * c.area * fraction
+                if c.shading:
+                    # tau A I (s + f (1 - s)): a closed shading (s = 0) still lets in the part f
+                    f = building.zone(c.inside.zone).shading_transmittance
+                    products.append((receiver, sun, col[c.shading], transmitted * (1.0 - f)))
+                    B[receiver, sun] += transmitted * f
+                else:
+                    B[receiver, sun] += transmitted
 
     rho = building.site.get("air_density", AIR_DENSITY)
     for z in building.zones:

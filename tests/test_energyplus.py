@@ -186,8 +186,36 @@ def test_case600_window(case600):
     assert w.solar_transmittance == pytest.approx(T * T / (1 - R * R), abs=1e-6)
     assert w.transmitted_solar_to == "ZONE SURFACE FLOOR"
     assert w.angular.factors[0] == 1.0 and w.angular.factors[-1] == 0.0
-    assert w.outside.solar_absorptance == pytest.approx(1 - w.solar_transmittance - glazing.stack_reflectance([(T, R)] * 2),
-                                                        abs=1e-5)
+    # each pane absorbs a = 1 - T - R of what falls on it: the outer pane 1 + T R / (1 - R^2) of
+    # the sun, the inner T / (1 - R^2)
+    a = 1 - T - R
+    assert w.outside.solar_absorptance == pytest.approx(a * (1 + T * R / (1 - R * R)), abs=1e-6)
+    assert w.inner_solar_absorptance == pytest.approx(a * T / (1 - R * R), abs=1e-6)
+
+
+def test_case600_interior_solar_distribution(case600):
+    """The floor absorbs 0.6 of the direct sun; the 0.4 it reflects spreads over every inside
+    surface as area x absorptance, the windows' share (12 m2 x 1 - R_back) leaving."""
+    w = case600.component("ZONE SUBSURFACE 1")
+    shares = dict(w.solar_distribution)
+    T, R = 0.86156, 0.07846
+    glazing_take = 1 - (R + T * T * R / (1 - R * R))
+    S = (48 + 48 + 16.2 + 16.2 + 21.6 + 9.6) * 0.6 + 12 * glazing_take
+    assert shares["ZONE SURFACE FLOOR"] == pytest.approx(0.6 + 0.4 * 48 * 0.6 / S, abs=1e-5)
+    assert shares["ZONE SURFACE ROOF"] == pytest.approx(0.4 * 48 * 0.6 / S, abs=1e-5)
+    assert 1 - sum(shares.values()) == pytest.approx(0.4 * 12 * glazing_take / S, abs=1e-5)
+
+
+def test_case600_exterior_convection_is_doe2_at_the_reference_wind(case600):
+    from nodeforce.model import convection
+    wall = case600.component("ZONE SURFACE EAST")
+    # WOOD SIDING-1 is Rough (R_f 1.67), the wall's centroid 1.35 m up, the site's terrain Country
+    v = 4.0 * (270 / 10) ** 0.14 * (1.35 / 270) ** 0.14
+    h_n = 1.31 * 5.0 ** (1 / 3)
+    windward = h_n + 1.67 * (np.hypot(h_n, 3.26 * v ** 0.89) - h_n)
+    leeward = h_n + 1.67 * (np.hypot(h_n, 3.55 * v ** 0.617) - h_n)
+    assert wall.outside.h_conv == pytest.approx((windward + leeward) / 2, abs=1e-3)
+    assert convection.wind_at_height(4.0, 10.0) == pytest.approx(4.0)
 
 
 def test_case600_lists_what_it_does_not_hold(case600):
@@ -300,3 +328,23 @@ def test_650ff_converts_its_night_ventilation(tmp_path):
     hours = np.array([6.5, 7.5, 17.5, 18.5])
     ones = np.ones(4, dtype=int)
     assert list(s.at(ones, ones, ones, hours)) == pytest.approx([1, 0.0366524122655392, 0.0366524122655392, 1])
+
+
+def test_inner_absorptance_and_distribution_in_the_network():
+    b = minimal_building(components=[
+        {"name": "w", "area": 10.0, "tilt": 90, "azimuth": 180, "layers": [["m", 0.1]], "nodes": {"max_spacing": 0.1},
+         "inside": {"zone": "z", "h_conv": 2.5, "h_rad": 5}, "outside": {"type": "exterior", "h_conv": 10, "h_rad": 4,
+                                                                       "solar_absorptance": 0.1},
+         "solar_transmittance": 0.5, "transmitted_solar_to": "f", "solar_distribution": {"f": 0.7, "w": 0.2},
+         "inner_solar_absorptance": 0.05},
+        {"name": "f", "area": 20.0, "tilt": 180, "azimuth": 0, "layers": [["m", 0.1]], "nodes": {"max_spacing": 0.1},
+         "inside": {"zone": "z", "h_conv": 2.5, "h_rad": 5}, "outside": {"type": "adiabatic"}}])
+    net = assemble(b)
+    j = input_names(b).index("I_w")
+    w, f = b.component("w"), b.component("f")
+    assert net.B[f.node_ids[0] - 1, j] == pytest.approx(0.5 * 10 * 0.7)
+    # the glazing's own inside face: 0.2 of what it lets in, and 0.05 of the sun on it
+    assert net.B[w.node_ids[0] - 1, j] == pytest.approx(0.5 * 10 * 0.2 + 10 * 0.05)
+    assert net.B[w.node_ids[-1] - 1, j] == pytest.approx(10 * 0.1)
+    with pytest.raises(InputError, match="at most 1"):
+        b.edited(lambda d: d["components"][0].update(solar_distribution={"f": 0.9, "w": 0.2}))
