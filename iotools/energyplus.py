@@ -24,29 +24,24 @@ MIN_VERSION, SCHEMA_MIN = (8, 5), (8, 9, 0)
 @dataclass(frozen=True)
 class Films:
     """Surface coefficients the nodal model holds constant (W/m2/K), where EnergyPlus computes
-    them each step: the convective coefficients inside of ISO 13791 / 13792 for a room's
-    temperature (heat flowing up from a floor the transmitted sun warms, down to a ceiling under
-    the warm air; 2.5 on walls); outside EnergyPlus's DOE-2 model (`model.convection.doe2`) at
+    them each step: inside, the IDF's inside algorithm (TARP, EnergyPlus's default, or Simple:
+    `model.convection.tarp_inside`, `simple_inside`) at a face-to-air difference of `delta_T`,
+    every face warmer than the air (a floor the sun warms, a ceiling under the warm air); outside EnergyPlus's DOE-2 model (`model.convection.doe2`) at
     each face's height, roughness and the site's terrain for a weather station's wind of `wind`
     m/s (ISO 6946's reference, 4 m/s), natural convection alone where EnergyPlus says NoWind, at
     a face-to-air difference of `delta_T`; and the linearised long-wave exchange 4 sigma eps T_m^3
     of a face of emissivity eps at T_m."""
-    inside_wall: float = 2.5
-    inside_floor: float = 5.0
-    inside_ceiling: float = 0.7
     wind: float = 4.0  # m/s at the weather station
     delta_T: float = 5.0  # K
     T_inside: float = 293.15  # K
     T_outside: float = 283.15  # K
     ground: float = 1000.0  # a face held at the ground's temperature, as EnergyPlus holds it
 
-    def inside_convection(self, tilt):
+    def inside_convection(self, tilt, algorithm="tarp"):
         """h_c of an inside face of a component whose outside faces `tilt` (deg)."""
-        if tilt >= 150:  # a floor: its inside face looks up
-            return self.inside_floor
-        if tilt <= 30:  # a roof or ceiling
-            return self.inside_ceiling
-        return self.inside_wall
+        if algorithm == "simple":
+            return convection.simple_inside(tilt)
+        return round(float(convection.tarp_inside(tilt, self.delta_T)), 4)
 
     def radiative(self, emissivity, T):
         return 4 * glazing.SIGMA * emissivity * T ** 3
@@ -88,7 +83,7 @@ SCHEDULES = ("Schedule:Compact", "Schedule:Constant", "Schedule:Year", "Schedule
 READ = set(("Version", "Site:Location", "GlobalGeometryRules", "Building", "Zone", "ZoneList", "Construction",
             "Material", "Material:NoMass", "Material:AirGap", "WindowMaterial:Glazing", "WindowMaterial:Gas",
             "WindowMaterial:SimpleGlazingSystem", "Site:GroundTemperature:BuildingSurface", "Timestep",
-            "InternalMass") + SURFACES + tuple(SIMPLE_SURFACES) + SUBSURFACES + GAINS + FLOWS + SCHEDULES)
+            "InternalMass", "SurfaceConvectionAlgorithm:Inside", "SurfaceConvectionAlgorithm:Outside") + SURFACES + tuple(SIMPLE_SURFACES) + SUBSURFACES + GAINS + FLOWS + SCHEDULES)
 # Objects about the run and its reports, not the building
 NOT_PHYSICS = ("Output", "OutputControl", "LifeCycleCost", "Meter", "RunPeriod", "SimulationControl", "Sizing:Parameters",
                "UtilityCost", "ComponentCost", "CurrencyType")
@@ -225,6 +220,25 @@ class _Converter:
         if terrain not in convection.TERRAIN:
             self.r.fail(buildings[0], "Terrain", f"{terrain!r} is none of EnergyPlus's terrains")
         self.terrain = terrain
+        inside = self.r.all("SurfaceConvectionAlgorithm:Inside")
+        self.default_inside = self.r.text(inside[0], "algorithm", "TARP") if inside else "TARP"
+        outside = self.r.all("SurfaceConvectionAlgorithm:Outside")
+        algorithm = self.r.text(outside[0], "algorithm", "DOE-2") if outside else "DOE-2"
+        self.notes.append(f"outside convection EnergyPlus's DOE-2 at a {FILMS.wind:g} m/s station wind and a "
+                          f"{FILMS.delta_T:g} K face-to-air difference" +
+                          ("" if algorithm.lower() == "doe-2" else f" (the IDF's {algorithm} evaluated as DOE-2)"))
+
+    def inside_algorithm(self, zone_name):
+        """'simple' or 'tarp': the zone's inside convection algorithm (its own field, else the
+        IDF's SurfaceConvectionAlgorithm:Inside); any other is evaluated as TARP, and said so."""
+        zone = self.zone_objs[zone_name.upper()]
+        algorithm = self.r.text(zone, "zone_inside_convection_algorithm", "") or self.default_inside
+        if algorithm.lower() not in ("simple", "tarp"):
+            note = f"the inside convection algorithm {algorithm} evaluated as TARP"
+            if note not in self.notes:
+                self.notes.append(note)
+            return "tarp"
+        return algorithm.lower()
 
     def schedule(self, name, referrer, field):
         """The building file's name of an IDF schedule, converted once (its values over a year on
@@ -766,7 +780,7 @@ class _Converter:
         # EnergyPlus lists a construction's layers outside first; the building file inside first
         return {"name": name, "area": round(area, 6), "tilt": round(s["tilt"], 6), "azimuth": round(s["azimuth"] % 360, 6),
                 "layers": [[m, t] for m, t in reversed(layers)], "nodes": {"max_spacing": MAX_SPACING},
-                "inside": {"zone": s["zone"], "h_conv": FILMS.inside_convection(s["tilt"]),
+                "inside": {"zone": s["zone"], "h_conv": FILMS.inside_convection(s["tilt"], self.inside_algorithm(s["zone"])),
                            "h_rad": round(FILMS.radiative(inner["emissivity"], FILMS.T_inside), 4)},
                 "outside": outside, "_zone": s["zone"], "_type": s["type"].lower(), "_absorbs": inner["solar"]}
 
@@ -796,7 +810,7 @@ class _Converter:
                                 f"{other_name!r} names {other['other']!r} back, not this surface")
                 done.add(other_name.upper())  # one partition for the pair
                 other_zone = other["zone"]
-            h_c = FILMS.inside_convection(180.0 - s["tilt"])
+            h_c = FILMS.inside_convection(180.0 - s["tilt"], self.inside_algorithm(other_zone))
             return {"type": "zone", "zone": other_zone, "h_conv": h_c,
                     "h_rad": round(FILMS.radiative(outer["emissivity"], FILMS.T_inside), 4)}
         self.r.fail(obj, "Outside Boundary Condition", f"{s['boundary']!r} is not read (Outdoors, Ground, Adiabatic, "

@@ -51,3 +51,33 @@ def doe2(tilt, speed, roughness=1.0, delta_T=5.0, windward=None):
     if windward is None:
         return 0.5 * (h(*WINDWARD) + h(*LEEWARD))
     return h(*(WINDWARD if windward else LEEWARD))
+
+
+def tarp_inside(tilt, delta_T, warmer=True):
+    """TARP's natural convection (W/m2/K) on an inside face whose component's outside faces `tilt`
+    deg (a floor 180: its inside face looks up), at |T_s - T_air| = delta_T K, the face `warmer`
+    than the air or not: 1.31 dT^(1/3) on a wall; on a face looking up and warmer (or looking down
+    and cooler) the unstable 9.482 dT^(1/3) / (7.238 - |cos|), else the stable
+    1.810 dT^(1/3) / (1.382 + |cos|)."""
+    c = abs(np.cos(np.radians(tilt)))
+    root = abs(delta_T) ** (1 / 3)
+    if c < 1e-6:
+        return 1.31 * root
+    looks_up = tilt > 90
+    if looks_up == warmer:
+        return 9.482 * root / (7.238 - c)
+    return 1.810 * root / (1.382 + c)
+
+
+# EnergyPlus's Simple inside algorithm: constant coefficients, W/m2/K (vertical; horizontal and
+# tilted, unstable and stable)
+SIMPLE_INSIDE = {"vertical": 3.076, "horizontal": (4.040, 0.948), "tilted": (3.870, 2.281)}
+
+
+def simple_inside(tilt, warmer=True):
+    """EnergyPlus's Simple inside coefficient of a face (arguments as `tarp_inside`)."""
+    c = abs(np.cos(np.radians(tilt)))
+    if c < 1e-6:
+        return SIMPLE_INSIDE["vertical"]
+    unstable, stable = SIMPLE_INSIDE["horizontal" if c > 0.99 else "tilted"]
+    return unstable if (tilt > 90) == warmer else stable

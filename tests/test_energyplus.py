@@ -348,3 +348,21 @@ def test_inner_absorptance_and_distribution_in_the_network():
     assert net.B[w.node_ids[-1] - 1, j] == pytest.approx(10 * 0.1)
     with pytest.raises(InputError, match="at most 1"):
         b.edited(lambda d: d["components"][0].update(solar_distribution={"f": 0.9, "w": 0.2}))
+
+
+def test_inside_convection_is_tarp_at_the_stated_difference(case600):
+    """Case 600 declares TARP inside: 1.31 dT^(1/3) on a wall, the unstable form on the floor
+    (a warm face looking up), the stable one on the ceiling (a warm face looking down)."""
+    r = 5.0 ** (1 / 3)
+    assert case600.component("ZONE SURFACE EAST").inside.h_conv == pytest.approx(1.31 * r, abs=1e-3)
+    assert case600.component("ZONE SURFACE FLOOR").inside.h_conv == pytest.approx(9.482 * r / 6.238, abs=1e-3)
+    assert case600.component("ZONE SURFACE ROOF").inside.h_conv == pytest.approx(1.810 * r / 2.382, abs=1e-3)
+
+
+def test_simple_inside_algorithm_gives_energyplus_constants(tmp_path):
+    path = tmp_path / "simple.idf"
+    path.write_text(TEXT.replace("SurfaceConvectionAlgorithm:Inside,\n  TARP;", "SurfaceConvectionAlgorithm:Inside,\n  Simple;"))
+    assert "Simple;" in path.read_text()
+    b = convert_idf(path)
+    assert b.component("ZONE SURFACE EAST").inside.h_conv == 3.076
+    assert b.component("ZONE SURFACE FLOOR").inside.h_conv == 4.040
