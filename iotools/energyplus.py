@@ -16,6 +16,7 @@ import numpy as np
 
 from ..model import convection, geometry, glazing
 from ..model.errors import InputError
+from ..model.gains import PEOPLE_T, people_sensible_heat
 from ..model.network import air_density_at
 
 MIN_VERSION, SCHEMA_MIN = (8, 5), (8, 9, 0)
@@ -113,6 +114,11 @@ def load_idf(path):
         raise InputError(path, "(file)", f"not a readable IDF: {message}") from None
 
 
+def _field(obj, field):
+    """A field's value, None where the object's type has no such field (idfkit refuses the name)."""
+    return obj.to_dict().get(field)
+
+
 def _blank(value):
     return value is None or (isinstance(value, str) and value.strip() == "")
 
@@ -141,7 +147,7 @@ class _Reader:
         raise InputError(self.source, f"{where}, field {field}", problem)
 
     def number(self, obj, field, default=None, low=None, low_open=False, high=None):
-        value = obj.get(field) if hasattr(obj, "get") else getattr(obj, field, None)
+        value = _field(obj, field)
         if _blank(value):
             if default is None:
                 self.fail(obj, _label(field), "missing: a number is needed")
@@ -161,7 +167,7 @@ class _Reader:
         return value
 
     def text(self, obj, field, default=""):
-        value = obj.get(field) if hasattr(obj, "get") else getattr(obj, field, None)
+        value = _field(obj, field)
         return default if _blank(value) else str(value).strip()
 
 
@@ -184,6 +190,11 @@ class _Converter:
         self.schedules = {}
         self.not_modelled = []
         self.notes = []
+
+    def note(self, text):
+        """An assumption the file's description states, once."""
+        if text not in self.notes:
+            self.notes.append(text)
 
     # ---- site, rules, schedules ---------------------------------------------------------
     def site(self):
@@ -584,7 +595,7 @@ class _Converter:
         multiplier = self.r.number(z, "multiplier", default=1.0)
         if multiplier != 1:
             self.r.fail(z, "Multiplier", f"{multiplier:g}: a zone multiplier is not held by the building file")
-        volume_field = z.get("volume")
+        volume_field = _field(z, "volume")
         if _blank(volume_field) or str(volume_field).lower() == "autocalculate":
             polygons = [s["vertices"] for s in own if s["vertices"] is not None]
             if len(polygons) != len(own):
@@ -595,7 +606,7 @@ class _Converter:
         else:
             volume = self.r.number(z, "volume", low=0, low_open=True)
         floor = sum(s["area"] for s in own if s["type"].lower() == "floor")
-        floor_field = z.get("floor_area")
+        floor_field = _field(z, "floor_area")
         if not _blank(floor_field) and str(floor_field).lower() != "autocalculate":
             floor = self.r.number(z, "floor_area", low=0, low_open=True)
         self.zone_volume = getattr(self, "zone_volume", {})
@@ -668,7 +679,8 @@ class _Converter:
                 if value is None:
                     if np.min([v for p in self.schedules[name]["days"].values() for _, v in p]) < 0:
                         self.r.fail(o, "Schedule Name", f"{name!r} takes negative values: an air flow is >= 0")
-                    scheduled.append({"name": o.name, "flow": flow * A, "schedule": name})
+                    if flow * A > 0:
+                        scheduled.append({"name": o.name, "flow": flow * A, "schedule": name})
                 else:
                     total += flow * A * value
         return total, scheduled
@@ -710,11 +722,11 @@ class _Converter:
                 out.append(gain)
         return [g for g in out if g is not None]
 
-    def _gain_schedule(self, gain, o):
-        name = self.r.text(o, "schedule_name")
+    def _gain_schedule(self, gain, o, field="schedule_name"):
+        name = self.r.text(o, field)
         if not name:
             return
-        value = self.constant_schedule_value(name, o, "Schedule Name")
+        value = self.constant_schedule_value(name, o, _label(field))
         if value is None:
             gain["schedule"] = name
         else:
@@ -730,17 +742,20 @@ class _Converter:
             n = floor / self.r.number(o, "floor_area_per_person", low=0, low_open=True)
         else:
             self.r.fail(o, "Number of People Calculation Method", f"{method!r} is not read")
-        sensible = o.get("sensible_heat_fraction")
-        if _blank(sensible) or str(sensible).lower() == "autocalculate":
-            self.r.fail(o, "Sensible Heat Fraction", "autocalculate: EnergyPlus's split by the room's temperature is "
-                                                     "not held; give the fraction")
         activity = self.constant_schedule_value(self.r.text(o, "activity_level_schedule_name"), o,
                                                 "Activity Level Schedule Name")
         if activity is None:
             self.r.fail(o, "Activity Level Schedule Name", "varies in time: a gain has one schedule; give a constant activity")
-        gain = {"name": o.name, "power": n * activity * float(sensible),
+        sensible = _field(o, "sensible_heat_fraction")
+        if _blank(sensible) or str(sensible).lower() == "autocalculate":
+            # EnergyPlus's polynomial in the activity and the zone's air, at the converter's air temperature
+            heat = people_sensible_heat(activity)
+            self.note(f"a person's sensible heat EnergyPlus's polynomial at {PEOPLE_T:g} C")
+        else:
+            heat = activity * self.r.number(o, "sensible_heat_fraction", low=0, high=1)
+        gain = {"name": o.name, "power": n * heat,
                 "radiant_fraction": self.r.number(o, "fraction_radiant", default=0.0, low=0, high=1)}
-        self._gain_schedule(gain, o)
+        self._gain_schedule(gain, o, "number_of_people_schedule_name")
         return gain
 
     def components(self, surfaces):

@@ -366,3 +366,60 @@ def test_simple_inside_algorithm_gives_energyplus_constants(tmp_path):
     b = convert_idf(path)
     assert b.component("ZONE SURFACE EAST").inside.h_conv == 3.076
     assert b.component("ZONE SURFACE FLOOR").inside.h_conv == 4.040
+
+
+# ---- several zones (examples/multizone/three_zones.idf) ----------------------------------
+MULTIZONE = Path(__file__).resolve().parents[1] / "examples" / "multizone" / "three_zones.idf"
+
+
+@pytest.fixture(scope="module")
+def three_zones():
+    return convert_idf(MULTIZONE)
+
+
+def test_three_zones_geometry(three_zones):
+    b = three_zones
+    assert [z.name for z in b.zones] == ["WEST OFFICE", "EAST OFFICE", "CORRIDOR"]
+    # the corridor's volume is autocalculated: 12 x 3 x 3 m from its surfaces
+    assert b.zone("CORRIDOR").volume == pytest.approx(108.0)
+    # the building's north axis turns every face 30 deg east; the east office's origin moves its walls
+    assert b.component("WEST SOUTH WALL").azimuth == pytest.approx(210.0)
+    assert b.component("EAST EAST WALL").azimuth == pytest.approx(120.0)
+    assert b.component("CORRIDOR NORTH WALL").azimuth == pytest.approx(30.0)
+    # a Window of 2 x 1.4 m, multiplier 2, on the east office's 6 x 3 m south wall
+    assert b.component("EAST SOUTH WINDOW").area == pytest.approx(5.6)
+    assert b.component("EAST SOUTH WALL").area == pytest.approx(18.0 - 5.6)
+
+
+def test_three_zones_one_partition_per_pair(three_zones):
+    names = {c.name for c in three_zones.components}
+    assert {"WEST TO EAST", "WEST TO CORRIDOR", "EAST TO CORRIDOR"} <= names
+    assert not names & {"EAST TO WEST", "CORRIDOR TO WEST", "CORRIDOR TO EAST"}
+    p = three_zones.component("WEST TO EAST")
+    assert (p.inside.zone, p.outside.zone) == ("WEST OFFICE", "EAST OFFICE")
+    # INT WALL: GYPSUM, STUD GAP (R 0.18), GYPSUM
+    assert sum(t / m.conductivity for m, t in p.layers) == pytest.approx(2 * 0.013 / 0.16 + 0.18)
+
+
+def test_three_zones_gains_and_flows(three_zones):
+    from nodeforce.model.gains import people_sensible_heat
+    b = three_zones
+    (people,) = b.zone("WEST OFFICE").gains
+    assert people.power == pytest.approx(4 * people_sensible_heat(120.0)) and people.schedule == "OFFICE"
+    (lights,) = b.zone("EAST OFFICE").gains
+    assert (lights.power, lights.radiant_fraction) == pytest.approx((10 * 30, 0.4 + 0.2))  # W/m2 x floor
+    (equipment,) = b.zone("CORRIDOR").gains
+    # 400 W less its 10 % latent; its 0.3 radiant of the whole is 1/3 of the sensible
+    assert (equipment.power, equipment.radiant_fraction) == pytest.approx((360.0, 0.3 / 0.9))
+    for z in b.zones:  # the zone list's 0.3 air changes an hour
+        assert z.air_change_rate == pytest.approx(0.3)
+    (vent,) = b.zone("CORRIDOR").ventilation
+    assert (vent.flow, vent.schedule) == (pytest.approx(0.03 * 3600), "NIGHT VENT")
+    office = b.schedules["OFFICE"]
+    # 2017-04-03 is a Monday, 04-08 a Saturday
+    assert list(office.at(np.array([4, 4, 4]), np.array([3, 3, 8]), np.array([0, 0, 5]),
+                          np.array([7.5, 12.0, 12.0]))) == [0.1, 1.0, 0.1]
+    assert b.schedules["ground temperature"].at(np.array([7]), np.array([15]), np.array([0]), np.array([1.0]))[0] == 16
+    lines = b.data["not_modelled"]
+    assert any(l.startswith("ThermostatSetpoint:SingleHeating WEST HEATING SETPOINT") for l in lines)
+    assert any(l.startswith("Shading:Building:Detailed SOUTH OVERHANG") for l in lines)
