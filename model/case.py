@@ -184,11 +184,30 @@ def clock_inputs(building, times):
 
 def schedule_inputs(building, times):
     """{schedule name: values at `times`} of the schedules the building reads as inputs
-    (`Building.schedule_inputs`), on the site's local clock (docs/model.md section 1.2)."""
+    (`Building.schedule_inputs`), on the site's local clock (docs/model.md section 1.2): at t_n,
+    the schedule's mean over the step (t_n-1, t_n] of the uniform `times` (a heat gain's energy
+    over the step, held by the integration as a heat input is), at the first time its value."""
     if not building.schedule_inputs:
         return {}
     clock_hours(times[:1], building.site["timezone"], building.source)  # a time zone that is none
-    return {name: building.schedules[name].on(times, building.site["timezone"]) for name in building.schedule_inputs}
+    if len(times) < 2:
+        return {name: building.schedules[name].on(times, building.site["timezone"]) for name in building.schedule_inputs}
+    dt = (times[1] - times[0]).total_seconds()
+    k = max(1, int(np.ceil(dt / SCHEDULE_RESOLUTION)))
+    # k points evenly inside each step, read once for all steps
+    offsets = [pd.Timedelta(seconds=dt * (j + 0.5) / k - dt) for j in range(k)]
+    out = {}
+    for name in building.schedule_inputs:
+        s = building.schedules[name]
+        means = np.mean([s.on(times + o, building.site["timezone"]) for o in offsets], axis=0)
+        means[0] = s.on(times[:1], building.site["timezone"])[0]
+        out[name] = means
+    return out
+
+
+# The finest step of a schedule a step's mean resolves (s): EnergyPlus's schedules change on the
+# minute at the finest, a quarter hour in most files
+SCHEDULE_RESOLUTION = 60.0
 
 
 def measured_matrix(building, measurements, times):

@@ -350,10 +350,12 @@ def substeps(dt):
 def held_inputs(building, input_names):
     """(n_inputs,) bool: the inputs held over each step, the zones' heat inputs: a power logged at
     t_n+1 is the heat delivered over the step that ends there (energy / dt), the value the
-    backward Euler step reads. Every other input (temperatures, irradiances, shading, the clock)
-    is a sample of a quantity that varies in between, linear between samples within a step."""
-    heat = {name for z in building.zones for name in z.heat_input}
-    return np.array([name in heat for name in input_names], dtype=bool)
+    backward Euler step reads; and the schedules, whose input at t_n+1 is their mean over that
+    step (`model.case.schedule_inputs`). Every other input (temperatures, irradiances, shading,
+    the clock) is a sample of a quantity that varies in between, linear between samples within a
+    step."""
+    held = {name for z in building.zones for name in z.heat_input} | set(building.schedule_inputs)
+    return np.array([name in held for name in input_names], dtype=bool)
 
 
 def within_steps(values, k, held=None):
