@@ -50,6 +50,7 @@ from nodeforce.diagnose.phases import phase_errors, worsened
 from nodeforce.diagnose.residuals import diagnostics as residual_diagnostics
 from nodeforce.diagnose.selection import at_noise, block_J, blocks as blocks_of, decide, label, on_block
 from nodeforce.fmu_build.build import build_fmu
+from nodeforce.iotools.energyplus_corrections import idf_of, write_corrections
 from nodeforce.ga.locate import check_measured, evaluator_kind, locate
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
@@ -479,6 +480,10 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
                              for i, r in enumerate(records)]
     if reference:
         report["reference"] = reference
+    idf = idf_of(building)
+    if idf is not None:  # a converted EnergyPlus model: its corrections written back into it
+        report["energyplus"] = write_corrections(building, after_building, added, idf, workdir / "model_after.idf")
+        report["artifacts"]["idf_after"] = report["energyplus"]["idf_after"]
     if by_phase:
         report["phases"] = by_phase
     # plotted from the first measurement: the weather's history before it is not the record

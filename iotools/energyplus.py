@@ -485,6 +485,7 @@ class _Converter:
         if self.schedules:
             data["schedules"] = self.schedules
         data["not_modelled"] = self.not_modelled
+        data["energyplus"] = {"idf": self.r.source}
         return data
 
     def zone_transform(self, zone):

@@ -57,8 +57,10 @@ def read_building(path):
     return load_building(path)
 
 
-def convert_idf(path):
-    """An EnergyPlus model (IDF) as a validated building file (docs/guide.md, `nodeforce convert`).
+def convert_idf(path, output=None):
+    """An EnergyPlus model (IDF) as a validated building file (docs/guide.md, `nodeforce convert`),
+    written to `output` if given (its `energyplus.idf` then the IDF's path from the file's folder,
+    which `diagnose` writes its corrections back into).
 
     Returns
     -------
@@ -73,9 +75,16 @@ def convert_idf(path):
     """
     from nodeforce.iotools.energyplus import convert
     from nodeforce.model.building import check_schema, parse_building
+    import json
+    import os
     data = convert(path)
-    building = parse_building(data, source=str(path))
+    if output is not None:
+        data["energyplus"]["idf"] = os.path.relpath(Path(path).resolve(), Path(output).resolve().parent)
+    building = parse_building(data, source=str(output if output is not None else path))
     check_schema(data, str(path))
+    if output is not None:
+        Path(output).parent.mkdir(parents=True, exist_ok=True)
+        Path(output).write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
     return building
 
 

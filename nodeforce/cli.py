@@ -69,9 +69,7 @@ def cmd_fmu(args):
 
 def cmd_convert(args):
     from nodeforce.api import convert_idf
-    building = convert_idf(args.idf)
-    Path(args.output).parent.mkdir(parents=True, exist_ok=True)
-    Path(args.output).write_text(json.dumps(building.to_json(), indent=1) + "\n", encoding="utf-8")
+    building = convert_idf(args.idf, args.output)
     for line in building.data["not_modelled"]:
         print(f"not modelled: {line}")
     print(f"wrote {args.output}: {len(building.zones)} zones, {len(building.components)} components, "

@@ -423,3 +423,46 @@ def test_three_zones_gains_and_flows(three_zones):
     lines = b.data["not_modelled"]
     assert any(l.startswith("ThermostatSetpoint:SingleHeating WEST HEATING SETPOINT") for l in lines)
     assert any(l.startswith("Shading:Building:Detailed SOUTH OVERHANG") for l in lines)
+
+
+# ---- corrections written back (model_after.idf) ------------------------------------------
+def test_corrections_written_back_and_read_again(tmp_path):
+    """Case 600 corrected by five effects: model_after.idf holds each in its object, and converted
+    again it is the corrected building; an effect no object holds is said so."""
+    import idfkit
+    from nodeforce.iotools.energyplus_corrections import write_corrections
+    from nodeforce.model.effects import EFFECTS
+    before = convert_idf(CASE600, tmp_path / "600.json")
+    effects = [("infiltration", "ZONE ONE", {"n": 1.2}), ("internal_gain", "ZONE ONE", {"Q": 150.0}),
+               ("conductivity", "ZONE SURFACE EAST", {"factor": 2.0}),
+               ("solar_transmittance", "ZONE SUBSURFACE 1", {"tau": 0.6}),
+               ("internal_mass", "ZONE ONE", {"C_m": 2e6, "H_m": 50.0}),
+               ("inside_convection", "ZONE ONE", {"factor": 2.0})]
+    after = before
+    for effect, target, values in effects:
+        after = EFFECTS[effect].apply(after, target, values)
+    out = tmp_path / "model_after.idf"
+    result = write_corrections(before, after, [{"effect": e, "target": t} for e, t, _ in effects],
+                               CASE600, out)
+    doc = idfkit.load_idf(str(out))
+    infiltration = doc.getobject("ZONEINFILTRATION:DESIGNFLOWRATE", "Space Infiltration Design Flow Rate 1")
+    assert float(infiltration.air_changes_per_hour) == pytest.approx(1.2)
+    gain = doc.getobject("OTHEREQUIPMENT", "nodeforce gain ZONE ONE")
+    assert float(gain.design_level) == pytest.approx(150.0) and float(gain.fraction_radiant) == 0.0
+    east = doc.getobject("BUILDINGSURFACE:DETAILED", "ZONE SURFACE EAST")
+    construction = doc.getobject("CONSTRUCTION", east.construction_name)
+    assert float(doc.getobject("MATERIAL", construction.layer_2).conductivity) == pytest.approx(2 * 0.04)
+    # the other walls keep LTWALL
+    assert doc.getobject("BUILDINGSURFACE:DETAILED", "ZONE SURFACE WEST").construction_name == "LTWALL"
+    assert [line.split(":")[0] for line in result["not_written"]] == ["inside_convection on ZONE ONE"]
+    # converted again, the IDF is the corrected building
+    again = convert_idf(out)
+    assert again.zones[0].air_change_rate == pytest.approx(1.2)
+    assert {g.name: g.power for g in again.zones[0].gains}["nodeforce gain ZONE ONE"] == pytest.approx(150.0)
+    wall, wall0 = again.component("ZONE SURFACE EAST"), before.component("ZONE SURFACE EAST")
+    R, R0 = (sum(t / m.conductivity for m, t in c.layers) for c in (wall, wall0))
+    assert R == pytest.approx(R0 / 2)
+    assert again.component("ZONE SUBSURFACE 1").solar_transmittance == pytest.approx(0.6, abs=1e-5)
+    mass = again.component("nodeforce mass ZONE ONE")
+    assert sum(t * m.density * m.specific_heat for m, t in mass.layers) * mass.area == pytest.approx(2e6)
+    assert mass.area * mass.inside.h_conv == pytest.approx(50.0, rel=1e-3)

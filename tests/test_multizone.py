@@ -41,3 +41,37 @@ def test_three_zones_diagnosed_end_to_end(tmp_path):
         if z["name"] != "EAST OFFICE":
             assert z["air_change_rate"] == pytest.approx(0.3)
     assert report["after"]["validation"]["rmse"] < report["before"]["validation"]["rmse"] / 3
+
+
+def test_case600_corrections_written_back(tmp_path):
+    """Case 600 converted; a record made by `nodeforce synth` with 1.2 air changes an hour where
+    the IDF says 0.5; the diagnosis writes model_after.idf with the zone's infiltration object
+    changed, every other object as written, and report.md names the change."""
+    import idfkit
+    from nodeforce.cli import main
+    from nodeforce.iotools.measurements import read_measurements
+    idf = ROOT / "examples" / "bestest" / "data" / "case_en_600.idf"
+    building = convert_idf(idf, tmp_path / "600.json")
+    convert_typical_year(ROOT / "examples" / "bestest" / "data" / "725650TYCST.epw", tmp_path / "w.csv", year=2017)
+    assert main(["synth", str(tmp_path / "600.json"), "--weather", str(tmp_path / "w.csv"), "--start",
+                 "2017-03-06T00:00-07:00", "--days", "5", "--step", "3600", "--sensors",
+                 str(building.zones[0].air_node), "--noise", "0.05", "--effect", "infiltration@ZONE ONE:n=1.2",
+                 "-o", str(tmp_path / "m.csv")]) == 0
+    weather, measured = read_weather(tmp_path / "w.csv"), read_measurements(tmp_path / "m.csv")
+    case = prepare_case(building, weather, measured, history_days=14).with_burn_in(1)
+    report = diagnose(building, case, Objective.of(building), tmp_path / "out", seed=0, fmu_kind="python",
+                      population=12, generations=10)
+    assert report["effect"]["effect"] == "infiltration"
+    doc = idfkit.load_idf(str(tmp_path / "out" / "model_after.idf"))
+    infiltration = doc.getobject("ZONEINFILTRATION:DESIGNFLOWRATE", "Space Infiltration Design Flow Rate 1")
+    assert float(infiltration.air_changes_per_hour) == pytest.approx(1.2, abs=0.05)
+    (change,) = report["energyplus"]["changes"]
+    assert (change["object"], change["field"], change["old"]) == (
+        "ZoneInfiltration:DesignFlowRate", "air_changes_per_hour", 0.5)
+    assert "ZoneInfiltration:DesignFlowRate Space Infiltration Design Flow Rate 1, air_changes_per_hour: 0.5 ->" in (
+        tmp_path / "out" / "report.md").read_text()
+    # every other object as written: the IDF's text outside that object unchanged
+    original = idf.read_text(encoding="latin-1").splitlines()
+    written = (tmp_path / "out" / "model_after.idf").read_text(encoding="latin-1").splitlines()
+    assert len(original) == len(written)
+    assert sum(a != b for a, b in zip(original, written)) <= 12
