@@ -327,7 +327,7 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
         if names.count(r.name) > 1:
             raise InputError(r.source, "name", f"two records are named {r.name!r}: each needs its own name")
         check_measured(objective, r.case, r.source)
-    fmu_kind = evaluator_kind() if fmu_kind == "auto" else fmu_kind
+    fmu_kind = evaluator_kind(building) if fmu_kind == "auto" else fmu_kind
     windows = Windows.of(records, objective)
     first = windows.cases[0]
     n = windows.scored()

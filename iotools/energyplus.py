@@ -870,8 +870,9 @@ class _Converter:
             kind = obj.obj_type
             if kind.upper() in {k.upper() for k in READ} or kind.startswith(NOT_PHYSICS):
                 continue
-            name = getattr(obj, "name", "") or ""
-            self.not_modelled.append(f"{kind} {name}: not held by the building file".replace("  ", " "))
+            # an object without a name (ZoneHVAC:EquipmentConnections) is known by its first field
+            name = next((str(v) for v in obj.to_dict().values() if not _blank(v)), "")
+            self.not_modelled.append(f"{kind} {name}: not held by the building file")
 
 
 YEAR = 2017  # the calendar on which the schedules' weekdays are read (its 1 January is a Sunday)

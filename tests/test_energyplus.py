@@ -311,6 +311,8 @@ def test_standalone_fmu_refuses_a_switched_conductance():
     b = b.edited(lambda d: d["zones"][0].update(ventilation=[{"name": "v", "flow": 10.0, "schedule": "s"}]))
     with pytest.raises(InputError, match="follows a schedule"):
         network_terms(b, None)
+    from nodeforce.ga.locate import evaluator_kind
+    assert evaluator_kind(b) == "python"  # "auto" never picks the FMU that cannot run it
 
 
 def test_650ff_converts_its_night_ventilation(tmp_path):
