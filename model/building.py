@@ -61,6 +61,7 @@ class Exterior:
     h_rad: float  # W/m2/K
     solar_absorptance: float  # -
     irradiance: str | None = None  # input column of the measured irradiance on the face, W/m2
+    sky_view_factor: float | None = None  # part of the long-wave exchange with the sky; None: (1 + cos tilt) / 2
 
 
 @dataclass(frozen=True)
@@ -750,7 +751,9 @@ def _outside(check, raw, where, zone_names):
         return Exterior(h_conv=check.number(raw, "h_conv", where, low=0),
                         h_rad=check.number(raw, "h_rad", where, low=0),
                         solar_absorptance=check.number(raw, "solar_absorptance", where, low=0, high=1),
-                        irradiance=check.text(raw, "irradiance", where, optional=True))
+                        irradiance=check.text(raw, "irradiance", where, optional=True),
+                        sky_view_factor=(check.number(raw, "sky_view_factor", where, low=0, high=1)
+                                         if "sky_view_factor" in raw else None))
     if kind == "zone":
         return _surface(check, raw, where, zone_names)
     if kind == "boundary":

@@ -90,6 +90,16 @@ def sky_view_factor(tilt):
     return (1.0 + np.cos(np.radians(tilt))) / 2.0
 
 
+def sky_fraction_energyplus(tilt, ground_view=None):
+    """The part of a face's long-wave exchange that is with the sky as EnergyPlus takes it
+    (Engineering Reference, "Exterior/External Longwave Radiation"): its sky view F_sky (1 less
+    its view factor to the ground, (1 + cos tilt) / 2 where not given) of which the part
+    beta = sqrt((1 + cos tilt) / 2) is the sky and the rest the air near the ground, F_sky beta."""
+    cos = np.cos(np.radians(tilt))
+    F_sky = (1.0 + cos) / 2.0 if ground_view is None else 1.0 - ground_view
+    return F_sky * np.sqrt((1.0 + cos) / 2.0)
+
+
 def air_density_at(altitude, T=20.0):
     """Density of dry air (kg/m3) at an altitude (m) and a temperature (C): the standard
     atmosphere's pressure p = 101325 (1 - 2.25577e-5 z)^5.2559 Pa (as EnergyPlus takes its site's
@@ -157,7 +167,7 @@ def assemble(building, names=None):
             link(idx[k], idx[k + 1], c.area * g * c.conductivity_factor * envelope)
         to_zone(idx[0], c.area, c.inside)
         if isinstance(out, Exterior):
-            F = sky_view_factor(c.tilt)
+            F = sky_view_factor(c.tilt) if out.sky_view_factor is None else out.sky_view_factor
             A[e, e] -= c.area * (out.h_conv + out.h_rad) * envelope
             B[e, col["T_out"]] += c.area * (out.h_conv + out.h_rad * (1.0 - F)) * envelope
             B[e, col["T_sky"]] += c.area * out.h_rad * F * envelope

@@ -352,6 +352,27 @@ def test_inner_absorptance_and_distribution_in_the_network():
         b.edited(lambda d: d["components"][0].update(solar_distribution={"f": 0.9, "w": 0.2}))
 
 
+def test_sky_fraction_is_energyplus_sky_and_air_split(case600):
+    """A wall of view factor to ground 0.5 sees the sky over 0.5 of its view, of which
+    beta = sqrt(1/2) is the sky itself; a roof all sky."""
+    from nodeforce.model.network import sky_fraction_energyplus
+    assert case600.component("ZONE SURFACE EAST").outside.sky_view_factor == pytest.approx(0.5 * np.sqrt(0.5), abs=1e-6)
+    assert case600.component("ZONE SURFACE ROOF").outside.sky_view_factor == pytest.approx(1.0)
+    assert sky_fraction_energyplus(90.0) == pytest.approx(0.5 * np.sqrt(0.5))
+    assert sky_fraction_energyplus(60.0, ground_view=0.2) == pytest.approx(0.8 * np.sqrt(0.75))
+
+
+def test_declared_sky_fraction_in_the_network():
+    b = minimal_building(components=[
+        {"name": "w", "area": 10.0, "tilt": 90, "azimuth": 180, "layers": [["m", 0.1]], "nodes": {"max_spacing": 0.1},
+         "inside": {"zone": "z", "h_conv": 2.5, "h_rad": 5},
+         "outside": {"type": "exterior", "h_conv": 10, "h_rad": 4, "solar_absorptance": 0.1, "sky_view_factor": 0.3}}])
+    net, names = assemble(b), input_names(b)
+    e = b.component("w").node_ids[-1] - 1
+    assert net.B[e, names.index("T_sky")] == pytest.approx(10 * 4 * 0.3)
+    assert net.B[e, names.index("T_out")] == pytest.approx(10 * (10 + 4 * 0.7))
+
+
 def test_inside_convection_is_tarp_at_the_stated_difference(case600):
     """Case 600 declares TARP inside: 1.31 dT^(1/3) on a wall, the unstable form on the floor
     (a warm face looking up), the stable one on the ceiling (a warm face looking down)."""
