@@ -26,7 +26,7 @@ def denver(tmp_path_factory):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("case", ["600FF", "650FF", "900FF", "950FF"])
+@pytest.mark.parametrize("case", ["600FF", "650FF", "900FF", "950FF", "680FF", "980FF"])
 def test_free_float_case_against_ashrae_140(case, denver, tmp_path):
     path = tmp_path / f"{case}.idf"
     idfkit.save_idf(cases.CASES[case](), str(path))

@@ -10,7 +10,11 @@ README.md) by the edits the standard defines, through idfkit, so that `nodeforce
 - 900FF: case 950FF (data/950FF_test_output.idf, EnergyPlus 8.8: case 900's heavy walls and floor,
   free-floating) with case 900's constant infiltration, 0.5 air changes an hour, in place of the
   night ventilation of 950;
-- 950FF: case 950FF as published.
+- 950FF: case 950FF as published;
+- 680FF and 980FF: 600FF and 900FF with the standard's increased insulation, as NREL's
+  BESTEST-GSR measure sets it (`set_wall_roof_insulation`: the exterior wall's second layer
+  0.25 m of foam, 0.04 W/m/K, 10 kg/m3, 1400 J/kg/K; the roof's 0.4 m of fiberglass quilt,
+  0.04 W/m/K, 12 kg/m3, 840 J/kg/K).
 
     python examples/bestest/cases.py OUT_FOLDER     writes OUT_FOLDER/<case>.idf
 
@@ -79,7 +83,35 @@ def case_950ff():
     return free_float(night_ventilation())
 
 
-CASES = {"600FF": case_600ff, "900FF": case_900ff, "650FF": case_650ff, "950FF": case_950ff}
+# The standard's increased insulation (cases 680 and 980): the exterior wall's and the roof's
+# second layer, outside first, (thickness m, conductivity W/m/K, density kg/m3, specific heat J/kg/K)
+WALL_INSULATION = (0.25, 0.04, 10.0, 1400.0)
+ROOF_INSULATION = (0.4, 0.04, 12.0, 840.0)
+
+
+def increased_insulation(doc):
+    for surface in doc["BuildingSurface:Detailed"]:
+        kind = str(surface.surface_type).lower()
+        if str(surface.outside_boundary_condition).lower() != "outdoors" or kind not in ("wall", "roof"):
+            continue
+        construction = doc.getobject("CONSTRUCTION", surface.construction_name)
+        material = doc.getobject("MATERIAL", construction.layer_2)
+        thickness, conductivity, density, specific_heat = WALL_INSULATION if kind == "wall" else ROOF_INSULATION
+        material.thickness, material.conductivity = thickness, conductivity
+        material.density, material.specific_heat = density, specific_heat
+    return doc
+
+
+def case_680ff():
+    return increased_insulation(case_600ff())
+
+
+def case_980ff():
+    return increased_insulation(case_900ff())
+
+
+CASES = {"600FF": case_600ff, "900FF": case_900ff, "650FF": case_650ff, "950FF": case_950ff,
+         "680FF": case_680ff, "980FF": case_980ff}
 
 
 def main(out):
