@@ -114,9 +114,22 @@ def load_idf(path):
         raise InputError(path, "(file)", f"not a readable IDF: {message}") from None
 
 
+# Fields EnergyPlus renamed when it added spaces (9.6 on): the name read first, then its later one
+RENAMED = {"zone_or_zonelist_name": "zone_or_zonelist_or_space_or_spacelist_name",
+           "watts_per_zone_floor_area": "watts_per_floor_area",
+           "power_per_zone_floor_area": "power_per_floor_area",
+           "flow_per_zone_floor_area": "flow_rate_per_floor_area",
+           "people_per_zone_floor_area": "people_per_floor_area",
+           "zone_floor_area_per_person": "floor_area_per_person"}
+
+
 def _field(obj, field):
-    """A field's value, None where the object's type has no such field (idfkit refuses the name)."""
-    return obj.to_dict().get(field)
+    """A field's value (by its name in the IDF's version), None where the object's type has no such
+    field (idfkit refuses the name)."""
+    fields = obj.to_dict()
+    if field not in fields and field in RENAMED:
+        return fields.get(RENAMED[field])
+    return fields.get(field)
 
 
 def _blank(value):
@@ -618,8 +631,6 @@ class _Converter:
         floor_field = _field(z, "floor_area")
         if not _blank(floor_field) and str(floor_field).lower() != "autocalculate":
             floor = self.r.number(z, "floor_area", low=0, low_open=True)
-        self.zone_volume = getattr(self, "zone_volume", {})
-        self.zone_volume[z.name.upper()] = volume
         data = {"name": z.name, "volume": round(volume, 6), "_floor_area": floor}
         exterior = sum(s["area"] for s in own if s["boundary"].lower() == "outdoors")
         walls = sum(s["area"] for s in own if s["boundary"].lower() == "outdoors" and s["type"].lower() == "wall")
@@ -775,7 +786,6 @@ class _Converter:
             done.add(key)
             obj = s["obj"]
             boundary = s["boundary"].lower()
-            height = None
             layers, outer, inner, _ = self.layers(s["construction"], obj, "Construction Name")
             outside = self.outside(s, boundary, outer, surfaces, done)
             net = s["area"] - sum(w["area"] for w in s["subsurfaces"])

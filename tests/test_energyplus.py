@@ -489,3 +489,19 @@ def test_corrections_written_back_and_read_again(tmp_path):
     mass = again.component("nodeforce mass ZONE ONE")
     assert sum(t * m.density * m.specific_heat for m, t in mass.layers) * mass.area == pytest.approx(2e6)
     assert mass.area * mass.inside.h_conv == pytest.approx(50.0, rel=1e-3)
+
+
+def test_the_same_model_in_energyplus_25_converts_the_same(tmp_path, three_zones):
+    """three_zones.idf brought to EnergyPlus 25.2 (its fields renamed for spaces, new ones at
+    their defaults) is the same building file."""
+    import idfkit
+    from benchmarks.bench_energyplus import to_energyplus_25
+    path = tmp_path / "three_zones_25.idf"
+    idfkit.save_idf(to_energyplus_25(idfkit.load_idf(str(MULTIZONE))), str(path))
+    assert tuple(idfkit.get_idf_version(str(path))[:2]) == (25, 2)
+    later = convert_idf(path)
+    for z, z0 in zip(later.zones, three_zones.zones):
+        assert (z.name, z.volume, z.air_change_rate, z.gains, z.ventilation) == (
+            z0.name, z0.volume, z0.air_change_rate, z0.gains, z0.ventilation)
+    assert [(c.name, c.area, c.azimuth) for c in later.components] == [
+        (c.name, c.area, c.azimuth) for c in three_zones.components]
