@@ -48,7 +48,8 @@ def main(out):
     subprocess.run([sys.executable, "-m", "nodeforce.iotools.typical_year", "convert",
                     cases.DATA / "725650TYCST.epw", weather, "--year", "2017"], check=True, stdout=subprocess.DEVNULL)
     air, rows = {}, []
-    for name in cases.CASES:
+    for k, name in enumerate(cases.CASES, start=1):
+        print(f"[{k}/{len(cases.CASES)}] {name}: nodeforce convert, nodeforce simulate over the year", flush=True)
         run("convert", out / f"{name}.idf", "-o", out / f"{name}.json")
         run("simulate", out / f"{name}.json", "--weather", weather, "-o", out / f"{name}_sim.csv")
         air[name] = zone_air(out / f"{name}_sim.csv")
