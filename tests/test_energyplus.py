@@ -1,5 +1,5 @@
-"""nodeforce convert (iotools/energyplus.py) against hand calculations from the IDF text of NREL's
-BESTEST case 600 (examples/bestest/data), its refusals, and the physics it rests on
+"""nodeforce convert (iotools/energyplus.py) against hand calculations from the IDF text of
+nodeforce's own ASHRAE 140 case 600 (examples/bestest/case600.idf), its refusals, and the physics it rests on
 (model/geometry.py, model/glazing.py, model/schedule.py)."""
 import json
 import subprocess
@@ -18,8 +18,8 @@ from nodeforce.model.errors import InputError
 from nodeforce.model.network import air_density_at, assemble, input_names
 from nodeforce.model.schedule import Schedule
 
-DATA = Path(__file__).resolve().parents[1] / "examples" / "bestest" / "data"
-CASE600 = DATA / "case_en_600.idf"
+BESTEST = Path(__file__).resolve().parents[1] / "examples" / "bestest"
+CASE600 = BESTEST / "case600.idf"
 
 
 @pytest.fixture(scope="module")
@@ -155,36 +155,36 @@ def test_case600_site_zone_and_flows(case600):
 def test_case600_areas_and_orientations(case600):
     c = {k.name: k for k in case600.components}
     # the south wall 8 x 2.7 m less its two 3 x 2 m windows
-    assert c["ZONE SURFACE SOUTH"].area == pytest.approx(21.6 - 12.0)
-    assert c["ZONE SUBSURFACE 1"].area == pytest.approx(6.0)
-    for name, azimuth, tilt in (("ZONE SURFACE SOUTH", 180, 90), ("ZONE SURFACE EAST", 90, 90),
-                                ("ZONE SURFACE WEST", 270, 90), ("ZONE SURFACE NORTH", 0, 90),
-                                ("ZONE SURFACE ROOF", None, 0), ("ZONE SURFACE FLOOR", None, 180)):
+    assert c["SOUTH WALL"].area == pytest.approx(21.6 - 12.0)
+    assert c["SOUTH WINDOW WEST"].area == pytest.approx(6.0)
+    for name, azimuth, tilt in (("SOUTH WALL", 180, 90), ("EAST WALL", 90, 90),
+                                ("WEST WALL", 270, 90), ("NORTH WALL", 0, 90),
+                                ("ROOF", None, 0), ("FLOOR", None, 180)):
         assert c[name].tilt == pytest.approx(tilt)
         if azimuth is not None:
             assert c[name].azimuth == pytest.approx(azimuth)
 
 
 def test_case600_layers_inside_first_and_u_value(case600):
-    wall = case600.component("ZONE SURFACE EAST")
-    # LTWALL: WOOD SIDING-1 (outside), FIBERGLASS QUILT-1, PLASTERBOARD-1
+    wall = case600.component("EAST WALL")
+    # LIGHT WALL: WOOD SIDING (outside), WALL FIBERGLASS QUILT, PLASTERBOARD 12 MM
     assert [round(t, 6) for _, t in wall.layers] == [0.012, 0.066, 0.009]
     R = sum(t / m.conductivity for m, t in wall.layers)
     assert R == pytest.approx(0.012 / 0.16 + 0.066 / 0.04 + 0.009 / 0.14)
     C = sum(t * m.density * m.specific_heat for m, t in wall.layers)
     assert C == pytest.approx(0.012 * 950 * 840 + 0.066 * 12 * 840 + 0.009 * 530 * 900)
-    floor = case600.component("ZONE SURFACE FLOOR")
-    # R-25 INSULATION (NoMass, 25.075 m2K/W) under the timber: its resistance kept, no capacity
+    floor = case600.component("FLOOR")
+    # FLOOR INSULATION (NoMass, 25.075 m2K/W) under the timber: its resistance kept, no capacity
     assert sum(t / m.conductivity for m, t in floor.layers) == pytest.approx(0.025 / 0.14 + 25.075)
     assert floor.outside.temperature == "ground temperature"
     assert case600.schedules["ground temperature"].value == 10.0  # the IDF's monthly 10 C
 
 
 def test_case600_window(case600):
-    w = case600.component("ZONE SUBSURFACE 1")
+    w = case600.component("SOUTH WINDOW WEST")
     T, R = 0.86156, 0.07846
     assert w.solar_transmittance == pytest.approx(T * T / (1 - R * R), abs=1e-6)
-    assert w.transmitted_solar_to == "ZONE SURFACE FLOOR"
+    assert w.transmitted_solar_to == "FLOOR"
     assert w.angular.factors[0] == 1.0 and w.angular.factors[-1] == 0.0
     # each pane absorbs a = 1 - T - R of what falls on it: the outer pane 1 + T R / (1 - R^2) of
     # the sun, the inner T / (1 - R^2)
@@ -196,20 +196,20 @@ def test_case600_window(case600):
 def test_case600_interior_solar_distribution(case600):
     """The floor absorbs 0.6 of the direct sun; the 0.4 it reflects spreads over every inside
     surface as area x absorptance, the windows' share (12 m2 x 1 - R_back) leaving."""
-    w = case600.component("ZONE SUBSURFACE 1")
+    w = case600.component("SOUTH WINDOW WEST")
     shares = dict(w.solar_distribution)
     T, R = 0.86156, 0.07846
     glazing_take = 1 - (R + T * T * R / (1 - R * R))
     S = (48 + 48 + 16.2 + 16.2 + 21.6 + 9.6) * 0.6 + 12 * glazing_take
-    assert shares["ZONE SURFACE FLOOR"] == pytest.approx(0.6 + 0.4 * 48 * 0.6 / S, abs=1e-5)
-    assert shares["ZONE SURFACE ROOF"] == pytest.approx(0.4 * 48 * 0.6 / S, abs=1e-5)
+    assert shares["FLOOR"] == pytest.approx(0.6 + 0.4 * 48 * 0.6 / S, abs=1e-5)
+    assert shares["ROOF"] == pytest.approx(0.4 * 48 * 0.6 / S, abs=1e-5)
     assert 1 - sum(shares.values()) == pytest.approx(0.4 * 12 * glazing_take / S, abs=1e-5)
 
 
 def test_case600_exterior_convection_is_doe2_at_the_reference_wind(case600):
     from nodeforce.model import convection
-    wall = case600.component("ZONE SURFACE EAST")
-    # WOOD SIDING-1 is Rough (R_f 1.67), the wall's centroid 1.35 m up, the site's terrain Country
+    wall = case600.component("EAST WALL")
+    # WOOD SIDING is Rough (R_f 1.67), the wall's centroid 1.35 m up, the site's terrain Country
     v = 4.0 * (270 / 10) ** 0.14 * (1.35 / 270) ** 0.14
     h_n = 1.31 * 5.0 ** (1 / 3)
     windward = h_n + 1.67 * (np.hypot(h_n, 3.26 * v ** 0.89) - h_n)
@@ -218,11 +218,29 @@ def test_case600_exterior_convection_is_doe2_at_the_reference_wind(case600):
     assert convection.wind_at_height(4.0, 10.0) == pytest.approx(4.0)
 
 
-def test_case600_lists_what_it_does_not_hold(case600):
-    lines = case600.data["not_modelled"]
-    assert any(line.startswith("ZoneHVAC:IdealLoadsAirSystem Zone HVAC Ideal Loads Air System 1") for line in lines)
-    assert any(line.startswith("ZoneControl:Thermostat") for line in lines)
-    assert not any(line.startswith(("Output:", "Material", "Zone ")) for line in lines)
+WITH_HVAC = CASE600.read_text() + """
+ZoneHVAC:IdealLoadsAirSystem,
+  IDEAL LOADS,                  !- Name
+  ,                             !- Availability Schedule Name
+  SUPPLY NODE,                  !- Zone Supply Air Node Name
+  ;                             !- Zone Exhaust Air Node Name
+
+ThermostatSetpoint:SingleHeating,
+  HEAT AT 20,                   !- Name
+  CONTINUOUS;                   !- Setpoint Temperature Schedule Name
+"""
+
+
+def test_case600_lists_what_it_does_not_hold(tmp_path):
+    """case600.idf holds nothing the building file lacks; a thermostat and an
+    ideal loads system added to it are listed, one line each."""
+    assert convert_idf(CASE600).data["not_modelled"] == []
+    path = tmp_path / "hvac.idf"
+    path.write_text(WITH_HVAC)
+    lines = convert_idf(path).data["not_modelled"]
+    assert [line.split(":")[0] + ":" + line.split(":")[1].split()[0] for line in lines] == [
+        "ZoneHVAC:IdealLoadsAirSystem", "ThermostatSetpoint:SingleHeating"]
+    assert lines[0].startswith("ZoneHVAC:IdealLoadsAirSystem IDEAL LOADS")
 
 
 # ---- refusals ------------------------------------------------------------------------------
@@ -238,19 +256,19 @@ BAD = {
     "no version": (edited("Version,\n  9.3;", ""), "Version"),
     "old version": (edited("Version,\n  9.3;", "Version,\n  7.2;"), "older than 8.5"),
     "no site": (edited("Site:Location,", "Site:Locationx,"), "(file)"),
-    "unknown material": (edited("  FIBERGLASS QUILT-1,                     !- Layer 2",
-                                "  NO SUCH MATERIAL,                     !- Layer 2"), "Construction 'LTWALL', field Layer 2"),
-    "unknown zone": (edited("  ZONE ONE,                               !- Zone Name\n  Outdoors",
-                            "  NO ZONE,                               !- Zone Name\n  Outdoors"), "names no Zone"),
-    "unsupported boundary": (edited("  Ground,                                 !- Outside Boundary Condition",
-                                    "  OtherSideCoefficients,                  !- Outside Boundary Condition"),
+    "unknown material": (edited("  WALL FIBERGLASS QUILT,        !- Layer 2",
+                                "  NO SUCH MATERIAL,             !- Layer 2"), "Construction 'LIGHT WALL', field Layer 2"),
+    "unknown zone": (edited("  CASE 600 ZONE,                !- Zone Name\n  Outdoors",
+                            "  NO ZONE,                      !- Zone Name\n  Outdoors"), "names no Zone"),
+    "unsupported boundary": (edited("  Ground,                       !- Outside Boundary Condition",
+                                    "  OtherSideCoefficients,        !- Outside Boundary Condition"),
                              "is not read"),
-    "zone multiplier": (edited("  1,                                      !- Multiplier\n",
-                               "  2,                                      !- Multiplier\n"), "Multiplier"),
-    "unknown window surface": (edited("  ZONE SURFACE SOUTH,                     !- Building Surface Name",
-                                      "  NO SURFACE,                     !- Building Surface Name"), "Building Surface Name"),
-    "unknown schedule": (edited("  Always On Ruleset Fractional,           !- Schedule Name",
-                                "  No Such Schedule,           !- Schedule Name"), "No Such Schedule"),
+    "zone multiplier": (edited("  1,                            !- Multiplier\n  2.7,",
+                               "  2,                            !- Multiplier\n  2.7,"), "Multiplier"),
+    "unknown window surface": (edited("  SOUTH WALL,                   !- Building Surface Name",
+                                      "  NO SURFACE,                   !- Building Surface Name"), "Building Surface Name"),
+    "unknown schedule": (edited("  CONTINUOUS,                   !- Schedule Name",
+                                "  No Such Schedule,             !- Schedule Name"), "No Such Schedule"),
     "flow method": (edited("  AirChanges/Hour,", "  Flow/Person,"), "Design Flow Rate Calculation Method"),
 }
 
@@ -268,8 +286,9 @@ def test_bad_idf_is_one_line_naming_the_object_and_field(kind, tmp_path):
 
 def test_cli_convert(tmp_path):
     nodeforce = Path(sys.executable).parent / "nodeforce"
-    out = tmp_path / "b.json"
-    done = subprocess.run([nodeforce, "convert", CASE600, "-o", out], capture_output=True, text=True)
+    out, idf = tmp_path / "b.json", tmp_path / "hvac.idf"
+    idf.write_text(WITH_HVAC)
+    done = subprocess.run([nodeforce, "convert", idf, "-o", out], capture_output=True, text=True)
     assert done.returncode == 0
     assert "not modelled: ZoneHVAC:IdealLoadsAirSystem" in done.stdout
     assert json.loads(out.read_text())["not_modelled"]
@@ -316,20 +335,41 @@ def test_standalone_fmu_refuses_a_switched_conductance():
 
 
 def test_650ff_converts_its_night_ventilation(tmp_path):
-    sys.path.insert(0, str(DATA.parent))
+    """650FF is case600.idf with the standard's vent fan: 1703.16 m3/h from 18:00 to 07:00, the
+    0.5 air changes an hour of infiltration kept all day."""
+    sys.path.insert(0, str(BESTEST))
     import cases
     import idfkit
     path = tmp_path / "650FF.idf"
     idfkit.save_idf(cases.case_650ff(), str(path))
     b = convert_idf(path)
     z = b.zones[0]
-    assert z.air_change_rate == 0.0
+    assert z.air_change_rate == pytest.approx(0.5)
     (vent,) = z.ventilation
-    assert vent.flow == pytest.approx(0.4911 * 3600)  # Flow/Zone 0.4911 m3/s
+    assert vent.flow == pytest.approx(1703.16)  # m3/h
     s = b.schedules[vent.schedule]
     hours = np.array([6.5, 7.5, 17.5, 18.5])
     ones = np.ones(4, dtype=int)
-    assert list(s.at(ones, ones, ones, hours)) == pytest.approx([1, 0.0366524122655392, 0.0366524122655392, 1])
+    assert list(s.at(ones, ones, ones, hours)) == [1, 0, 0, 1]
+
+
+def test_900ff_high_mass_layers(tmp_path):
+    """900FF: the walls' concrete block, foam and siding, the floor's slab over 1.007 m of
+    insulation; the roof as 600."""
+    sys.path.insert(0, str(BESTEST))
+    import cases
+    import idfkit
+    path = tmp_path / "900FF.idf"
+    idfkit.save_idf(cases.case_900ff(), str(path))
+    b = convert_idf(path)
+    wall = b.component("EAST WALL")
+    assert [round(t, 6) for _, t in wall.layers] == [0.1, 0.0615, 0.009]
+    C = sum(t * m.density * m.specific_heat for m, t in wall.layers)
+    assert C == pytest.approx(0.1 * 1400 * 1000 + 0.0615 * 10 * 1400 + 0.009 * 530 * 900)
+    floor = b.component("FLOOR")
+    assert sum(t / m.conductivity for m, t in floor.layers) == pytest.approx(0.08 / 1.13 + 1.007 / 0.04)
+    roof, roof600 = b.component("ROOF"), convert_idf(CASE600).component("ROOF")
+    assert roof.layers == roof600.layers
 
 
 def test_inner_absorptance_and_distribution_in_the_network():
@@ -356,8 +396,8 @@ def test_sky_fraction_is_energyplus_sky_and_air_split(case600):
     """A wall of view factor to ground 0.5 sees the sky over 0.5 of its view, of which
     beta = sqrt(1/2) is the sky itself; a roof all sky."""
     from nodeforce.model.network import sky_fraction_energyplus
-    assert case600.component("ZONE SURFACE EAST").outside.sky_view_factor == pytest.approx(0.5 * np.sqrt(0.5), abs=1e-6)
-    assert case600.component("ZONE SURFACE ROOF").outside.sky_view_factor == pytest.approx(1.0)
+    assert case600.component("EAST WALL").outside.sky_view_factor == pytest.approx(0.5 * np.sqrt(0.5), abs=1e-6)
+    assert case600.component("ROOF").outside.sky_view_factor == pytest.approx(1.0)
     assert sky_fraction_energyplus(90.0) == pytest.approx(0.5 * np.sqrt(0.5))
     assert sky_fraction_energyplus(60.0, ground_view=0.2) == pytest.approx(0.8 * np.sqrt(0.75))
 
@@ -377,9 +417,9 @@ def test_inside_convection_is_tarp_at_the_stated_difference(case600):
     """Case 600 declares TARP inside: 1.31 dT^(1/3) on a wall, the unstable form on the floor
     (a warm face looking up), the stable one on the ceiling (a warm face looking down)."""
     r = 5.0 ** (1 / 3)
-    assert case600.component("ZONE SURFACE EAST").inside.h_conv == pytest.approx(1.31 * r, abs=1e-3)
-    assert case600.component("ZONE SURFACE FLOOR").inside.h_conv == pytest.approx(9.482 * r / 6.238, abs=1e-3)
-    assert case600.component("ZONE SURFACE ROOF").inside.h_conv == pytest.approx(1.810 * r / 2.382, abs=1e-3)
+    assert case600.component("EAST WALL").inside.h_conv == pytest.approx(1.31 * r, abs=1e-3)
+    assert case600.component("FLOOR").inside.h_conv == pytest.approx(9.482 * r / 6.238, abs=1e-3)
+    assert case600.component("ROOF").inside.h_conv == pytest.approx(1.810 * r / 2.382, abs=1e-3)
 
 
 def test_simple_inside_algorithm_gives_energyplus_constants(tmp_path):
@@ -387,8 +427,8 @@ def test_simple_inside_algorithm_gives_energyplus_constants(tmp_path):
     path.write_text(TEXT.replace("SurfaceConvectionAlgorithm:Inside,\n  TARP;", "SurfaceConvectionAlgorithm:Inside,\n  Simple;"))
     assert "Simple;" in path.read_text()
     b = convert_idf(path)
-    assert b.component("ZONE SURFACE EAST").inside.h_conv == 3.076
-    assert b.component("ZONE SURFACE FLOOR").inside.h_conv == 4.040
+    assert b.component("EAST WALL").inside.h_conv == 3.076
+    assert b.component("FLOOR").inside.h_conv == 4.040
 
 
 # ---- several zones (examples/multizone/three_zones.idf) ----------------------------------
@@ -456,11 +496,11 @@ def test_corrections_written_back_and_read_again(tmp_path):
     from nodeforce.iotools.energyplus_corrections import write_corrections
     from nodeforce.model.effects import EFFECTS
     before = convert_idf(CASE600, tmp_path / "600.json")
-    effects = [("infiltration", "ZONE ONE", {"n": 1.2}), ("internal_gain", "ZONE ONE", {"Q": 150.0}),
-               ("conductivity", "ZONE SURFACE EAST", {"factor": 2.0}),
-               ("solar_transmittance", "ZONE SUBSURFACE 1", {"tau": 0.6}),
-               ("internal_mass", "ZONE ONE", {"C_m": 2e6, "H_m": 50.0}),
-               ("inside_convection", "ZONE ONE", {"factor": 2.0})]
+    effects = [("infiltration", "CASE 600 ZONE", {"n": 1.2}), ("internal_gain", "CASE 600 ZONE", {"Q": 150.0}),
+               ("conductivity", "EAST WALL", {"factor": 2.0}),
+               ("solar_transmittance", "SOUTH WINDOW WEST", {"tau": 0.6}),
+               ("internal_mass", "CASE 600 ZONE", {"C_m": 2e6, "H_m": 50.0}),
+               ("inside_convection", "CASE 600 ZONE", {"factor": 2.0})]
     after = before
     for effect, target, values in effects:
         after = EFFECTS[effect].apply(after, target, values)
@@ -468,25 +508,25 @@ def test_corrections_written_back_and_read_again(tmp_path):
     result = write_corrections(before, after, [{"effect": e, "target": t} for e, t, _ in effects],
                                CASE600, out)
     doc = idfkit.load_idf(str(out))
-    infiltration = doc.getobject("ZONEINFILTRATION:DESIGNFLOWRATE", "Space Infiltration Design Flow Rate 1")
+    infiltration = doc.getobject("ZONEINFILTRATION:DESIGNFLOWRATE", "INFILTRATION")
     assert float(infiltration.air_changes_per_hour) == pytest.approx(1.2)
-    gain = doc.getobject("OTHEREQUIPMENT", "nodeforce gain ZONE ONE")
+    gain = doc.getobject("OTHEREQUIPMENT", "nodeforce gain CASE 600 ZONE")
     assert float(gain.design_level) == pytest.approx(150.0) and float(gain.fraction_radiant) == 0.0
-    east = doc.getobject("BUILDINGSURFACE:DETAILED", "ZONE SURFACE EAST")
+    east = doc.getobject("BUILDINGSURFACE:DETAILED", "EAST WALL")
     construction = doc.getobject("CONSTRUCTION", east.construction_name)
     assert float(doc.getobject("MATERIAL", construction.layer_2).conductivity) == pytest.approx(2 * 0.04)
-    # the other walls keep LTWALL
-    assert doc.getobject("BUILDINGSURFACE:DETAILED", "ZONE SURFACE WEST").construction_name == "LTWALL"
-    assert [line.split(":")[0] for line in result["not_written"]] == ["inside_convection on ZONE ONE"]
+    # the other walls keep LIGHT WALL
+    assert doc.getobject("BUILDINGSURFACE:DETAILED", "WEST WALL").construction_name == "LIGHT WALL"
+    assert [line.split(":")[0] for line in result["not_written"]] == ["inside_convection on CASE 600 ZONE"]
     # converted again, the IDF is the corrected building
     again = convert_idf(out)
     assert again.zones[0].air_change_rate == pytest.approx(1.2)
-    assert {g.name: g.power for g in again.zones[0].gains}["nodeforce gain ZONE ONE"] == pytest.approx(150.0)
-    wall, wall0 = again.component("ZONE SURFACE EAST"), before.component("ZONE SURFACE EAST")
+    assert {g.name: g.power for g in again.zones[0].gains}["nodeforce gain CASE 600 ZONE"] == pytest.approx(150.0)
+    wall, wall0 = again.component("EAST WALL"), before.component("EAST WALL")
     R, R0 = (sum(t / m.conductivity for m, t in c.layers) for c in (wall, wall0))
     assert R == pytest.approx(R0 / 2)
-    assert again.component("ZONE SUBSURFACE 1").solar_transmittance == pytest.approx(0.6, abs=1e-5)
-    mass = again.component("nodeforce mass ZONE ONE")
+    assert again.component("SOUTH WINDOW WEST").solar_transmittance == pytest.approx(0.6, abs=1e-5)
+    mass = again.component("nodeforce mass CASE 600 ZONE")
     assert sum(t * m.density * m.specific_heat for m, t in mass.layers) * mass.area == pytest.approx(2e6)
     assert mass.area * mass.inside.h_conv == pytest.approx(50.0, rel=1e-3)
 

@@ -1,105 +1,109 @@
-"""The ASHRAE 140 free-float cases as EnergyPlus models, made from NREL's published IDFs (data/,
-README.md) by the edits the standard defines, through idfkit, so that `nodeforce convert` is what
-`make bestest` tests:
+"""The ASHRAE 140 free-float cases as EnergyPlus models, all made from nodeforce's own case 600
+(case600.idf, written from ANSI/ASHRAE Standard 140-2020 section 7.2.1) by the edits the standard
+defines for each case, through idfkit, so that `nodeforce convert` is what `make bestest` tests:
 
-- 600FF: case 600 (data/case_en_600.idf, EnergyPlus 9.3) without its thermostat and ideal loads
-  (the standard's free float: no heating or cooling);
-- 650FF: 600FF with case 950FF's night ventilation (its infiltration object and schedules: the
-  vent's 1703 m3/h and the infiltration's 0.5 air changes an hour from 18:00 to 07:00, the
-  infiltration alone by day);
-- 900FF: case 950FF (data/950FF_test_output.idf, EnergyPlus 8.8: case 900's heavy walls and floor,
-  free-floating) with case 900's constant infiltration, 0.5 air changes an hour, in place of the
-  night ventilation of 950;
-- 950FF: case 950FF as published;
-- 680FF and 980FF: 600FF and 900FF with the standard's increased insulation, as NREL's
-  BESTEST-GSR measure sets it (`set_wall_roof_insulation`: the exterior wall's second layer
-  0.25 m of foam, 0.04 W/m/K, 10 kg/m3, 1400 J/kg/K; the roof's 0.4 m of fiberglass quilt,
-  0.04 W/m/K, 12 kg/m3, 840 J/kg/K).
+- 600FF: case600.idf as written (no thermostat, no heating or cooling);
+- 900FF: the high-mass case: the exterior walls' concrete block and foam, the floor's concrete
+  slab over its insulation (the roof and the windows as 600);
+- 650FF and 950FF: 600FF and 900FF with the night ventilation: a fan of 1703.16 m3/h from 18:00
+  to 07:00, besides the infiltration, no fan heat;
+- 680FF and 980FF: 600FF and 900FF with the increased insulation (the exterior walls' and the
+  roof's insulating layer thickened, as NREL's BESTEST-GSR measure `set_wall_roof_insulation`
+  sets it).
 
     python examples/bestest/cases.py OUT_FOLDER     writes OUT_FOLDER/<case>.idf
-
-
-
 """
 import sys
 from pathlib import Path
 
 import idfkit
 
-DATA = Path(__file__).with_name("data")
-# What a free-floating case has no use for: the zone's thermostat and its ideal loads system
-HVAC = ("ZoneControl:Thermostat", "ThermostatSetpoint:DualSetpoint", "ZoneHVAC:EquipmentConnections",
-        "ZoneHVAC:EquipmentList", "ZoneHVAC:IdealLoadsAirSystem", "NodeList", "OutdoorAir:Node")
+CASE600 = Path(__file__).with_name("case600.idf")
+ZONE = "CASE 600 ZONE"
 
-
-def free_float(doc):
-    for kind in HVAC:
-        for obj in list(doc[kind]):
-            doc.removeidfobject(obj)
-    return doc
-
-
-def case_600ff():
-    return free_float(idfkit.load_idf(str(DATA / "case_en_600.idf")))
-
-
-def night_ventilation():
-    """Case 950FF's night ventilation: its infiltration object and the schedules it needs."""
-    return idfkit.load_idf(str(DATA / "950FF_test_output.idf"), version=(8, 9, 0))
-
-
-def case_650ff():
-    doc, vent = case_600ff(), night_ventilation()
-    for obj in list(doc["ZoneInfiltration:DesignFlowRate"]):
-        doc.removeidfobject(obj)
-    (infiltration,) = vent["ZoneInfiltration:DesignFlowRate"]
-    year = vent.getobject("SCHEDULE:YEAR", infiltration.schedule_name)
-    # the 8.8 file numbers a year's weeks (schedule_week_name_1, ...); 9.3 lists them
-    fields = year.to_dict()
-    weeks = [{f: fields[f"{f}_{k}"] for f in ("schedule_week_name", "start_month", "start_day", "end_month", "end_day")}
-             for k in range(1, 54) if f"schedule_week_name_{k}" in fields]
-    week_objs = [vent.getobject("SCHEDULE:WEEK:DAILY", w["schedule_week_name"]) for w in weeks]
-    days = {d for w in week_objs for k, d in w.to_dict().items() if k != "name"}
-    for obj in [vent.getobject("SCHEDULETYPELIMITS", year.schedule_type_limits_name), *week_objs,
-                *(vent.getobject("SCHEDULE:DAY:INTERVAL", d) for d in days), infiltration]:
-        if doc.getobject(obj.obj_type.upper(), obj.name) is None:
-            doc.add(obj.obj_type, obj.name, {k: v for k, v in obj.to_dict().items() if k != "name"})
-    doc.add("Schedule:Year", year.name, {"schedule_type_limits_name": year.schedule_type_limits_name,
-                                          "schedule_weeks": weeks})
-    return doc
-
-
-def case_900ff():
-    doc = free_float(idfkit.load_idf(str(DATA / "950FF_test_output.idf"), version=(8, 9, 0)))
-    for infiltration in doc["ZoneInfiltration:DesignFlowRate"]:
-        infiltration.schedule_name = "Always On Continuous"
-        infiltration.design_flow_rate_calculation_method = "AirChanges/Hour"
-        infiltration.design_flow_rate = ""
-        infiltration.air_changes_per_hour = 0.5
-    return doc
-
-
-def case_950ff():
-    return free_float(night_ventilation())
-
-
-# The standard's increased insulation (cases 680 and 980): the exterior wall's and the roof's
-# second layer, outside first, (thickness m, conductivity W/m/K, density kg/m3, specific heat J/kg/K)
+# Case 900's high-mass layers (thickness m, conductivity W/m/K, density kg/m3, specific heat J/kg/K),
+# ASHRAE 140-2020 section 7.2.2 (case 900)
+CONCRETE_BLOCK = (0.100, 0.510, 1400.0, 1000.0)
+FOAM_INSULATION = (0.0615, 0.040, 10.0, 1400.0)
+CONCRETE_SLAB = (0.080, 1.130, 1400.0, 1000.0)
+HEAVY_FLOOR_INSULATION = 1.007 / 0.040  # m2K/W: 1.007 m at 0.040 W/m/K, its capacity negligible
+# Cases 650 and 950: the vent fan's flow (m3/s) and when it runs
+NIGHT_VENT_FLOW = 1703.16 / 3600
+NIGHT_VENT_OFF, NIGHT_VENT_ON = "07:00", "18:00"
+# Cases 680 and 980: the exterior wall's and the roof's insulating (second) layer, outside first
 WALL_INSULATION = (0.25, 0.04, 10.0, 1400.0)
 ROOF_INSULATION = (0.4, 0.04, 12.0, 840.0)
 
 
-def increased_insulation(doc):
-    for surface in doc["BuildingSurface:Detailed"]:
-        kind = str(surface.surface_type).lower()
-        if str(surface.outside_boundary_condition).lower() != "outdoors" or kind not in ("wall", "roof"):
-            continue
-        construction = doc.getobject("CONSTRUCTION", surface.construction_name)
-        material = doc.getobject("MATERIAL", construction.layer_2)
-        thickness, conductivity, density, specific_heat = WALL_INSULATION if kind == "wall" else ROOF_INSULATION
-        material.thickness, material.conductivity = thickness, conductivity
-        material.density, material.specific_heat = density, specific_heat
+def material(doc, name, layer, roughness="Rough"):
+    thickness, conductivity, density, specific_heat = layer
+    doc.add("Material", name, {"roughness": roughness, "thickness": thickness, "conductivity": conductivity,
+                               "density": density, "specific_heat": specific_heat, "thermal_absorptance": 0.9,
+                               "solar_absorptance": 0.6, "visible_absorptance": 0.6})
+
+
+def surfaces(doc, kind):
+    return [s for s in doc["BuildingSurface:Detailed"] if str(s.surface_type).lower() == kind]
+
+
+def case_600ff():
+    return idfkit.load_idf(str(CASE600))
+
+
+def high_mass(doc):
+    """Case 900: the exterior walls and the floor of concrete; the roof, windows and all else as 600."""
+    material(doc, "CONCRETE BLOCK", CONCRETE_BLOCK, "Smooth")
+    material(doc, "FOAM INSULATION", FOAM_INSULATION)
+    material(doc, "CONCRETE SLAB", CONCRETE_SLAB, "Smooth")
+    doc.add("Material:NoMass", "HEAVY FLOOR INSULATION",
+            {"roughness": "Rough", "thermal_resistance": HEAVY_FLOOR_INSULATION, "thermal_absorptance": 0.9,
+             "solar_absorptance": 0.6, "visible_absorptance": 0.6})
+    doc.add("Construction", "HEAVY WALL", {"outside_layer": "WOOD SIDING", "layer_2": "FOAM INSULATION",
+                                           "layer_3": "CONCRETE BLOCK"})
+    doc.add("Construction", "HEAVY FLOOR", {"outside_layer": "HEAVY FLOOR INSULATION", "layer_2": "CONCRETE SLAB"})
+    for wall in surfaces(doc, "wall"):
+        wall.construction_name = "HEAVY WALL"
+    for floor in surfaces(doc, "floor"):
+        floor.construction_name = "HEAVY FLOOR"
     return doc
+
+
+def night_ventilation(doc):
+    """Cases 650 and 950: the vent fan on from 18:00 to 07:00, off by day, the infiltration kept."""
+    doc.add("Schedule:Compact", "NIGHT VENT", {"schedule_type_limits_name": "Fraction", "data": [
+        {"field": "Through: 12/31"}, {"field": "For: AllDays"},
+        {"field": f"Until: {NIGHT_VENT_OFF}"}, {"field": "1"},
+        {"field": f"Until: {NIGHT_VENT_ON}"}, {"field": "0"},
+        {"field": "Until: 24:00"}, {"field": "1"}]})
+    doc.add("ZoneVentilation:DesignFlowRate", "NIGHT VENT FAN", {
+        "zone_or_zonelist_name": ZONE, "schedule_name": "NIGHT VENT", "design_flow_rate_calculation_method": "Flow/Zone",
+        "design_flow_rate": NIGHT_VENT_FLOW, "ventilation_type": "Intake", "fan_pressure_rise": 0.0,
+        "fan_total_efficiency": 1.0, "constant_term_coefficient": 1.0, "temperature_term_coefficient": 0.0,
+        "velocity_term_coefficient": 0.0, "velocity_squared_term_coefficient": 0.0})
+    return doc
+
+
+def increased_insulation(doc):
+    """Cases 680 and 980: the exterior walls' and the roof's second layer, outside first, thickened."""
+    for kind, layer in (("wall", WALL_INSULATION), ("roof", ROOF_INSULATION)):
+        constructions = {s.construction_name for s in surfaces(doc, kind)
+                         if str(s.outside_boundary_condition).lower() == "outdoors"}
+        for name in constructions:
+            m = doc.getobject("MATERIAL", doc.getobject("CONSTRUCTION", name).layer_2)
+            m.thickness, m.conductivity, m.density, m.specific_heat = layer
+    return doc
+
+
+def case_900ff():
+    return high_mass(case_600ff())
+
+
+def case_650ff():
+    return night_ventilation(case_600ff())
+
+
+def case_950ff():
+    return night_ventilation(case_900ff())
 
 
 def case_680ff():
