@@ -33,12 +33,13 @@ test: venv system-deps
 check: venv
 	$(PYTEST) -m "not slow"
 
-# ASHRAE 140 free-float cases (examples/bestest/README.md, docs/model.md section 10): NREL's
-# EnergyPlus models edited as the standard defines each case, converted by `nodeforce convert`,
-# simulated over the Denver year; the table beside the reference range, out/bestest/results.csv
-# and out/bestest/bestest.png
+# ASHRAE 140 free-float cases (examples/bestest/README.md, docs/model.md section 10): nodeforce's
+# own case 600 IDF edited as the standard defines each case, converted by `nodeforce convert`,
+# simulated over the standard's Denver year, which the user supplies
+# (make bestest WEATHER=path/to/725650TYCST.epw); the table beside the reference range,
+# out/bestest/results.csv and out/bestest/bestest.png
 bestest: venv
-	$(BIN)/python examples/bestest/run.py out/bestest
+	@$(BIN)/python examples/bestest/run.py out/bestest "$(WEATHER)"
 
 # Twin House N2 (examples/twinhouse_n2/README.md, docs/real-data.md): the measurements the
 # repository carries (examples/twinhouse_n2/data/, read compressed) converted; the whole house

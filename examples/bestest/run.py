@@ -2,7 +2,10 @@
 `nodeforce simulate` over the standard's Denver year, their hourly zone air's minimum, maximum
 and mean beside the reference programs' range (ASHRAE 140-2020, Tables B8-5a, b, c).
 
-    python examples/bestest/run.py OUT        writes OUT/results.csv, OUT/bestest.png
+    python examples/bestest/run.py OUT WEATHER    writes OUT/results.csv, OUT/bestest.png
+
+WEATHER is the standard's Denver weather, 725650TYCST.epw, distributed with ASHRAE 140; the
+repository does not carry it, the user supplies it.
 """
 import subprocess
 import sys
@@ -41,12 +44,12 @@ def zone_air(sim):
     return pd.read_csv(sim, index_col=0, parse_dates=True)[column]
 
 
-def main(out):
+def main(out, epw):
     out = Path(out)
     cases.main(out)
     weather = out / "weather.csv"
     subprocess.run([sys.executable, "-m", "nodeforce.iotools.typical_year", "convert",
-                    cases.DATA / "725650TYCST.epw", weather, "--year", "2017"], check=True, stdout=subprocess.DEVNULL)
+                    epw, weather, "--year", "2017"], check=True, stdout=subprocess.DEVNULL)
     air, rows = {}, []
     for k, name in enumerate(cases.CASES, start=1):
         print(f"[{k}/{len(cases.CASES)}] {name}: nodeforce convert, nodeforce simulate over the year", flush=True)
@@ -89,4 +92,9 @@ def plot(air, path):
 
 
 if __name__ == "__main__":
-    main(sys.argv[1])
+    if len(sys.argv) != 3 or not sys.argv[2]:
+        sys.exit(print("make bestest needs ASHRAE 140's Denver weather (725650TYCST.epw, distributed with the "
+                       "standard): make bestest WEATHER=path/to/725650TYCST.epw", file=sys.stderr) or 2)
+    if not Path(sys.argv[2]).is_file():
+        sys.exit(print(f"{sys.argv[2]}: no such weather file (ASHRAE 140's 725650TYCST.epw)", file=sys.stderr) or 2)
+    main(sys.argv[1], sys.argv[2])
