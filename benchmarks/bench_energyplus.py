@@ -1,16 +1,22 @@
 """EnergyPlus as a second reference (issue 44, item 5): the same IDF run by EnergyPlus 25.2
 (pyenergyplus-lbnl, an optional dependency: `pip install -e '.[energyplus]'`) and by nodeforce
-(`nodeforce convert`, the direct model), free-floating over the Denver year of examples/bestest;
-per zone the hourly air's RMSE and mean difference (nodeforce - EnergyPlus) and each program's
-minimum, maximum and mean. docs/performance.md carries the table.
+(`nodeforce convert`, the direct model), free-floating over a Denver year: the ASHRAE 140 cases
+made from examples/bestest/case600.idf and examples/multizone/three_zones.idf; per zone the hourly
+air's RMSE and mean difference (nodeforce - EnergyPlus) and each program's minimum, maximum and
+mean. docs/performance.md carries the table.
 
-    python benchmarks/bench_energyplus.py [OUT]          (default out/bench_energyplus)
+    python benchmarks/bench_energyplus.py [OUT] [--weather EPW]     (default out/bench_energyplus)
+
+The weather is, unless --weather names another EPW, the Denver TMY3 year the installed
+pyenergyplus package ships (pyenergyplus/data/weather/USA_CO_Denver-Aurora-Buckley.AFB.724695_TMY3.epw),
+found at run time.
 
 An IDF is brought to 25.2 by copying every object by its field names into a 25.2 document
 (idfkit; the fields 25.2 renamed mapped, its new ones left to their defaults) and replacing the
 run's own objects (run period, simulation control, outputs, shadow calculation, costs) with a
 free-floating year and the zones' mean air temperature, hourly.
 """
+import argparse
 import sys
 from pathlib import Path
 
@@ -27,7 +33,7 @@ from nodeforce.iotools.typical_year import convert_typical_year  # noqa: E402
 from nodeforce.iotools.weather import read_weather  # noqa: E402
 from nodeforce.model.case import simulate_building  # noqa: E402
 
-EPW = ROOT / "examples" / "bestest" / "data" / "725650TYCST.epw"
+PACKAGE_WEATHER = Path("data") / "weather" / "USA_CO_Denver-Aurora-Buckley.AFB.724695_TMY3.epw"
 YEAR = 2017
 # The run's own objects, replaced; HVAC and thermostats go too: both programs run free-floating
 DROP = ("Version", "ShadowCalculation", "RunPeriod", "SimulationControl", "Sizing", "Output", "OutputControl",
@@ -76,7 +82,13 @@ def to_energyplus_25(doc):
     return new
 
 
-def energyplus(doc, folder):
+def package_weather():
+    """The Denver TMY3 EPW inside the installed pyenergyplus package."""
+    import pyenergyplus
+    return Path(pyenergyplus.__file__).parent / PACKAGE_WEATHER
+
+
+def energyplus(doc, folder, epw):
     """{zone (upper case): hourly mean air (C), hour ending 01:00..24:00} of EnergyPlus 25.2's run."""
     from pyenergyplus.api import EnergyPlusAPI
     folder.mkdir(parents=True, exist_ok=True)
@@ -84,7 +96,7 @@ def energyplus(doc, folder):
     idfkit.save_idf(to_energyplus_25(doc), str(idf))
     api = EnergyPlusAPI()
     state = api.state_manager.new_state()
-    if api.runtime.run_energyplus(state, ["-w", str(EPW), "-d", str(folder), "-r", str(idf)]) != 0:
+    if api.runtime.run_energyplus(state, ["-w", str(epw), "-d", str(folder), "-r", str(idf)]) != 0:
         raise RuntimeError(f"EnergyPlus failed: {folder / 'eplusout.err'}")
     api.state_manager.delete_state(state)
     table = pd.read_csv(folder / "eplusout.csv")
@@ -99,10 +111,10 @@ def nodeforce(path, weather):
     return {z.name.upper(): T[f"T{z.air_node}"].to_numpy(float) for z in building.zones}
 
 
-def main(out):
+def main(out, epw):
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    convert_typical_year(EPW, out / "weather.csv", year=YEAR)
+    convert_typical_year(epw, out / "weather.csv", year=YEAR)
     weather = read_weather(out / "weather.csv")
     models = {name: make for name, make in cases.CASES.items()}
     models["three_zones"] = lambda: idfkit.load_idf(str(ROOT / "examples" / "multizone" / "three_zones.idf"))
@@ -111,7 +123,7 @@ def main(out):
         doc = make()
         idfkit.save_idf(doc, str(out / f"{name}.idf"))
         ours = nodeforce(out / f"{name}.idf", weather)
-        theirs = energyplus(doc, out / name)
+        theirs = energyplus(doc, out / name, epw)
         for zone, T in ours.items():
             # EnergyPlus's hour ending at k+1 h is the mean over the hour nodeforce samples at k+0.5 h
             E = theirs[zone][1:len(T) + 1]
@@ -127,4 +139,14 @@ def main(out):
 
 
 if __name__ == "__main__":
-    main(sys.argv[1] if len(sys.argv) > 1 else ROOT / "out" / "bench_energyplus")
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("out", nargs="?", default=ROOT / "out" / "bench_energyplus", type=Path)
+    parser.add_argument("--weather", type=Path, help="an EPW (default: pyenergyplus's Denver TMY3)")
+    args = parser.parse_args()
+    try:
+        epw = args.weather or package_weather()
+    except ImportError:
+        sys.exit(print("bench_energyplus needs EnergyPlus: pip install -e '.[energyplus]'", file=sys.stderr) or 2)
+    if not epw.is_file():
+        sys.exit(print(f"{epw}: no such weather file", file=sys.stderr) or 2)
+    main(args.out, epw)
