@@ -3,7 +3,7 @@ PYTHON ?= python3
 VENV ?= .venv
 BIN := $(VENV)/bin
 
-.PHONY: demo test check venv system-deps benchmark clean twinhouse twinhouse-living
+.PHONY: demo test check venv system-deps benchmark clean twinhouse twinhouse-living bestest
 
 $(BIN)/nodeforce: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -32,6 +32,14 @@ test: venv system-deps
 # The edit-test loop: everything but the searches, diagnoses and importer runs (under a minute).
 check: venv
 	$(PYTEST) -m "not slow"
+
+# ASHRAE 140 free-float cases (examples/bestest/README.md, docs/model.md section 10): nodeforce's
+# own case 600 IDF edited as the standard defines each case, converted by `nodeforce convert`,
+# simulated over the standard's Denver year, which the user supplies
+# (make bestest WEATHER=path/to/725650TYCST.epw); the table beside the reference range,
+# out/bestest/results.csv and out/bestest/bestest.png
+bestest: venv
+	@$(BIN)/python examples/bestest/run.py out/bestest "$(WEATHER)"
 
 # Twin House N2 (examples/twinhouse_n2/README.md, docs/real-data.md): the measurements the
 # repository carries (examples/twinhouse_n2/data/, read compressed) converted; the whole house

@@ -51,6 +51,7 @@ from nodeforce.diagnosis.residuals import diagnostics as residual_diagnostics
 from nodeforce.diagnosis.policy import POLICY
 from nodeforce.diagnosis.selection import block_J, blocks as blocks_of, decide, label, on_block
 from nodeforce.fmu_build.build import build_fmu
+from nodeforce.iotools.energyplus_corrections import idf_of, write_corrections
 from nodeforce.ga.locate import check_measured, evaluator_kind, locate
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
@@ -324,7 +325,7 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
         if names.count(r.name) > 1:
             raise InputError(r.source, "name", f"two records are named {r.name!r}: each needs its own name")
         check_measured(objective, r.case, r.source)
-    fmu_kind = evaluator_kind() if fmu_kind == "auto" else fmu_kind
+    fmu_kind = evaluator_kind(building) if fmu_kind == "auto" else fmu_kind
     prepared = prepare(building, records, objective, workdir, fmu_kind, noise)
     search = dict(seed=seed, workers=workers, population=population, generations=generations, fmu_kind=fmu_kind,
                   noise=prepared.noise.sigma if prepared.noise.given else None)
@@ -503,6 +504,10 @@ def write(building, prepared, located, made, objective, workdir, fmu_kind, refer
                              for i, r in enumerate(records)]
     if reference:
         report["reference"] = reference
+    idf = idf_of(building)
+    if idf is not None:  # a converted EnergyPlus model: its corrections written back into it
+        report["energyplus"] = write_corrections(building, model.building, added, idf, workdir / "model_after.idf")
+        report["artifacts"]["idf_after"] = report["energyplus"]["idf_after"]
     if by_phase:
         report["phases"] = by_phase
     plots = write_report(workdir, report, plotted(prepared, located, made, objective))

@@ -119,6 +119,12 @@ def _input_meaning(building, name):
         function, h = name.removeprefix("day_")[:3], name.removeprefix("day_")[3:]
         return None, (f"{function}(2 pi {h} tau / 24 h), tau the local clock time of day (h) at the site "
                       f"({building.site['timezone']}), the basis of the zones' daily gains")
+    if name in building.schedule_inputs:
+        return None, f"schedule {name} of the building file, on the site's local clock"
+    glazings = [c.name for c in building.components if c.angular is not None and c.transmitted_input == name]
+    if glazings:
+        return "W/m2", (f"sun {glazings[0]} lets in per m2 over its normal-incidence transmittance (its angular "
+                        "transmittance applied)")
     faces = [c.name for c in building.exterior_components if c.irradiance_input == name]
     if faces:
         return "W/m2", f"solar irradiance on the outside face of {', '.join(faces)}"

@@ -199,8 +199,9 @@ class NodalBuilding(Fmi2Slave):
         source = None if varying else self.network.sources(u)
         for j in range(1, k + 1):
             s = j * tau
-            T = stepper.step(T, self.network.sources(u + du * s) if varying else source, forced,
-                             T_forced + dT_forced * s)
+            u_s = u + du * s if varying else u
+            T = stepper.step(T, self.network.sources(u_s) if varying else source, forced,
+                             T_forced + dT_forced * s, self.network.switched_diagonal(u_s))
         values[layout.T] = T
         values[layout.derivatives] = 0.0  # the next step's are set before it, or it holds its inputs
         self._time = current_time + step_size

@@ -23,11 +23,15 @@ from nodeforce.model.network import assemble
 from nodeforce.model.score import Noise, removed
 
 
-def evaluator_kind():
+def evaluator_kind(building=None):
     """The FMU kind the search drives for `fmu_kind="auto"`: the standalone FMU where a C compiler
     is at hand (it is compiled at export), else the Python FMU. Measured (benchmarks/bench_scale.py,
     docs/performance.md): a simulation of a new mask costs at least 1.7 times less through the
-    standalone FMU than through the Python FMU, from the test cell's 23 nodes to 2,922."""
+    standalone FMU than through the Python FMU, from the test cell's 23 nodes to 2,922. A building
+    with a scheduled air flow runs the Python FMU: the standalone steps one constant matrix."""
+    if building is not None and any(v.schedule is not None and not building.schedules[v.schedule].is_constant
+                                    for z in building.zones for v in z.ventilation):
+        return "python"
     return "standalone" if find_compiler() else "python"
 
 
@@ -97,7 +101,7 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
     cases = as_cases(case)
     protocols = list(protocols) if protocols is not None else [None] * len(cases)
     candidates = chromosome_nodes(building, cases, objective, source, nodes, include_algebraic)
-    kind = evaluator_kind() if fmu_kind == "auto" else fmu_kind
+    kind = evaluator_kind(building) if fmu_kind == "auto" else fmu_kind
     # one FMU per building a record runs under: `building`'s only where a record runs it
     names = ["model.fmu" if own is None else f"model_{k + 1}.fmu" for k, own in enumerate(protocols)]
     built = {}

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field, replace
 
 from .discretise import generated_depths
 from .errors import InputError
+from .schedule import WEEKDAYS, Schedule
 
 FORMAT = "nodal-building/1"
 OUTSIDE_TYPES = ("exterior", "adiabatic", "zone", "boundary")
@@ -60,6 +61,7 @@ class Exterior:
     h_rad: float  # W/m2/K
     solar_absorptance: float  # -
     irradiance: str | None = None  # input column of the measured irradiance on the face, W/m2
+    sky_view_factor: float | None = None  # part of the long-wave exchange with the sky; None: (1 + cos tilt) / 2
 
 
 @dataclass(frozen=True)
@@ -95,6 +97,35 @@ class Lumped:
 
 
 @dataclass(frozen=True)
+class Gain:
+    """A scheduled heat gain (docs/model.md section 3.4): power W times its schedule's value, the
+    radiant fraction to the radiant node, the rest to the air."""
+    name: str
+    power: float  # W at a schedule value of 1
+    radiant_fraction: float = 0.0  # -
+    schedule: str | None = None  # None: always 1
+
+
+@dataclass(frozen=True)
+class Ventilation:
+    """An outdoor air flow into a zone that follows a schedule (docs/model.md section 3.4): flow
+    m3/h times its schedule's value, leaving at the zone's air temperature."""
+    name: str
+    flow: float  # m3/h at a schedule value of 1
+    schedule: str | None = None  # None: always 1
+
+
+@dataclass(frozen=True)
+class AngularTransmittance:
+    """A glazing's transmittance relative to its normal-incidence one (docs/model.md section 4.1):
+    factors at angles of incidence (deg, increasing from 0, factor 1 at 0) for the direct sun, and
+    one factor for the diffuse sky and ground."""
+    angles: tuple  # deg
+    factors: tuple  # -
+    diffuse: float  # -
+
+
+@dataclass(frozen=True)
 class Zone:
     name: str
     volume: float  # m3
@@ -117,6 +148,8 @@ class Zone:
     shading_transmittance: float = 0.0  # part of its glazings' sun a closed shading still lets in
     heat_input_factor: float = 1.0  # the heat its heat input columns deliver, per W they read
     air_exchange: tuple = ()  # (other zone, m3/h each way): air through an open internal door
+    gains: tuple = ()  # Gain records
+    ventilation: tuple = ()  # Ventilation records
     mass_node: int | None = None  # ids of the nodes those two add (docs/model.md section 7)
     heater_node: int | None = None
 
@@ -137,6 +170,26 @@ class Component:
     shading: str | None = None  # input column in 0..1 multiplying the transmittance
     conductivity_factor: float = 1.0  # scale on the conductances between its nodes
     capacity_factor: float = 1.0  # scale on the heat capacities of its nodes
+    angular: AngularTransmittance | None = None  # the transmittance with the angle of incidence
+    solar_distribution: tuple = ()  # (component, fraction) of the transmitted sun; () all to transmitted_solar_to
+    inner_solar_absorptance: float = 0.0  # part of the sun on the outside face absorbed at the inside face
+
+    @property
+    def receivers(self):
+        """((component, fraction), ...) of the sun a glazing lets in: its `solar_distribution`, or
+        all of it to `transmitted_solar_to`; () for an opaque component."""
+        if self.solar_transmittance is None:
+            return ()
+        return self.solar_distribution or ((self.transmitted_solar_to, 1.0),)
+
+    @property
+    def transmitted_input(self):
+        """Name of the input of the sun a glazing lets in (W/m2 of glazing, before its normal
+        transmittance): `It_<component>` where its transmittance varies with the angle of
+        incidence, else its face's irradiance input."""
+        if self.angular is None:
+            return self.irradiance_input
+        return f"It_{self.name}"
 
     @property
     def thickness(self):
@@ -161,6 +214,7 @@ class Building:
     sensors: dict = field(default_factory=dict)  # sensor name -> node id
     flux_sensors: dict = field(default_factory=dict)  # sensor name -> (component, "inside" or "outside")
     boundary_factors: dict = field(default_factory=dict)  # boundary column -> factor on its conductances
+    schedules: dict = field(default_factory=dict)  # name -> Schedule
     source: str = field(default="<building>", compare=False)
     data: dict = field(default_factory=dict, compare=False, repr=False)  # the JSON it was read from
 
@@ -208,7 +262,16 @@ class Building:
                 names.append(c.outside.irradiance)
             if c.shading:
                 names.append(c.shading)
-        return tuple(dict.fromkeys(names))
+        return tuple(n for n in dict.fromkeys(names) if n not in self.schedules)
+
+    @property
+    def schedule_inputs(self):
+        """Names of the schedules the network reads as inputs (the non-constant ones its gains and
+        boundary temperatures use), in order of appearance; their values come from the file."""
+        names = [g.schedule for z in self.zones for g in z.gains + z.ventilation if g.schedule is not None]
+        names += [c.outside.temperature for c in self.components
+                  if isinstance(c.outside, Boundary) and isinstance(c.outside.temperature, str)]
+        return tuple(n for n in dict.fromkeys(names) if n in self.schedules and not self.schedules[n].is_constant)
 
     @property
     def boundary_columns(self):
@@ -314,6 +377,7 @@ def parse_building(data, source="<building>"):
     if data.get("format") != FORMAT:
         check.fail("format", f"must be {FORMAT!r}, found {data.get('format')!r}")
     site = _site(check, data.get("site"))
+    schedules = _schedules(check, data.get("schedules", {}))
     materials = _materials(check, check.mapping(data, "materials", "(top level)"))
     raw_zones = check.sequence(data, "zones", "(top level)")
     if not raw_zones:
@@ -333,7 +397,7 @@ def parse_building(data, source="<building>"):
     if not explicit:
         for c in components:
             c["node_ids"] = tuple(next(next_id) for _ in c["depths"])
-    zones = tuple(_zone(check, z, f"zones[{i}]", zone_names, explicit, next_id)
+    zones = tuple(_zone(check, z, f"zones[{i}]", zone_names, explicit, next_id, schedules)
                   for i, z in enumerate(raw_zones))
     components = tuple(Component(**c) for c in components)
     names = {c.name for c in components}
@@ -341,6 +405,9 @@ def parse_building(data, source="<building>"):
         if c.transmitted_solar_to is not None and c.transmitted_solar_to not in names:
             check.fail(f"components[{i}].transmitted_solar_to",
                        f"names no component ({c.transmitted_solar_to!r})")
+        for name, _ in c.solar_distribution:
+            if name not in names:
+                check.fail(f"components[{i}].solar_distribution.{name}", f"names no component ({name!r})")
     _check_proportional_columns(check, zones, components)
     _check_air_exchanges(check, zones)
     boundary_factors = _boundary_factors(check, data, zones, components)
@@ -352,7 +419,7 @@ def parse_building(data, source="<building>"):
                if name not in flux_sensors}
     return Building(name=str(data.get("name", "")), site=site, zones=zones, components=components,
                     sensors=sensors, flux_sensors=flux_sensors, boundary_factors=boundary_factors,
-                    source=source, data=copy.deepcopy(data))
+                    schedules=schedules, source=source, data=copy.deepcopy(data))
 
 
 class _Checker:
@@ -435,6 +502,7 @@ def _site(check, site):
         "altitude": check.number(site, "altitude", "site", default=0.0),
         "timezone": site.get("timezone", "UTC"),
         "ground_albedo": check.number(site, "ground_albedo", "site", default=0.2, low=0, high=1),
+        "air_density": check.number(site, "air_density", "site", default=1.2, low=0, low_open=True, high=2),
     }
 
 
@@ -452,7 +520,106 @@ def _materials(check, raw):
     return materials
 
 
-def _zone(check, z, where, zone_names, explicit, next_id):
+def _schedules(check, raw):
+    """{name: Schedule} of the file's `schedules` (docs/model.md section 1.2)."""
+    if not isinstance(raw, dict):
+        check.fail("schedules", "must be an object {name: schedule}")
+    return {name: _schedule(check, name, s, f"schedules.{name}") for name, s in raw.items()}
+
+
+def _schedule(check, name, raw, where):
+    if not isinstance(raw, dict) or ("constant" in raw) == ("periods" in raw):
+        check.fail(where, 'must be {"constant": value} or {"days": {profile: [[until h, value], ...]}, '
+                          '"periods": [{"through": "MM-DD", "week": [7 profile names, Monday first]}]}')
+    if "constant" in raw:
+        return Schedule(name=name, constant=check.number(raw, "constant", where))
+    days = check.mapping(raw, "days", where)
+    profiles = []
+    for profile, pairs in days.items():
+        pw = f"{where}.days.{profile}"
+        if not isinstance(pairs, list) or not pairs:
+            check.fail(pw, "must be a non-empty list of [until hour, value]")
+        untils = []
+        for k, pair in enumerate(pairs):
+            if not (isinstance(pair, list) and len(pair) == 2):
+                check.fail(f"{pw}[{k}]", "must be [until hour, value]")
+            untils.append(check.number({"until": pair[0]}, "until", f"{pw}[{k}]", low=0, low_open=True, high=24))
+            check.number({"value": pair[1]}, "value", f"{pw}[{k}]")
+        if any(b <= a for a, b in zip(untils, untils[1:])) or untils[-1] != 24:
+            check.fail(pw, "the hours until which each value holds must increase and end at 24")
+        profiles.append((profile, tuple((float(u), float(v)) for u, v in pairs)))
+    periods, last = [], 0
+    for k, period in enumerate(check.sequence(raw, "periods", where)):
+        pw = f"{where}.periods[{k}]"
+        through = period.get("through") if isinstance(period, dict) else None
+        match = re.fullmatch(r"(\d\d)-(\d\d)", through) if isinstance(through, str) else None
+        if not match or not (1 <= int(match[1]) <= 12 and 1 <= int(match[2]) <= 31):
+            check.fail(f"{pw}.through", f"must be a date MM-DD, found {through!r}")
+        month, day = int(match[1]), int(match[2])
+        if month * 100 + day <= last:
+            check.fail(f"{pw}.through", "the periods' dates must increase")
+        last = month * 100 + day
+        week = period.get("week")
+        if not (isinstance(week, list) and len(week) == len(WEEKDAYS)):
+            check.fail(f"{pw}.week", "must list 7 profile names, Monday first")
+        for d, profile in zip(WEEKDAYS, week):
+            if profile not in days:
+                check.fail(f"{pw}.week", f"{d}: names no profile of days ({profile!r})")
+        periods.append(((month, day), tuple(week)))
+    if last != 1231:
+        check.fail(f"{where}.periods", "the last period must run through 12-31")
+    return Schedule(name=name, days=tuple(profiles), periods=tuple(periods))
+
+
+def _gains(check, z, where, schedules):
+    gains = []
+    for k, g in enumerate(check.sequence(z, "gains", where, optional=True)):
+        gw = f"{where}.gains[{k}]"
+        schedule = check.text(g, "schedule", gw, optional=True)
+        if schedule is not None and schedule not in schedules:
+            check.fail(f"{gw}.schedule", f"names no schedule of the file ({schedule!r})")
+        gains.append(Gain(name=check.text(g, "name", gw), power=check.number(g, "power", gw),
+                          radiant_fraction=check.number(g, "radiant_fraction", gw, default=0.0, low=0, high=1),
+                          schedule=schedule))
+    return tuple(gains)
+
+
+def _ventilation(check, z, where, schedules):
+    flows = []
+    for k, v in enumerate(check.sequence(z, "ventilation", where, optional=True)):
+        vw = f"{where}.ventilation[{k}]"
+        schedule = check.text(v, "schedule", vw, optional=True)
+        if schedule is not None and schedule not in schedules:
+            check.fail(f"{vw}.schedule", f"names no schedule of the file ({schedule!r})")
+        if schedule is not None and not schedules[schedule].is_constant and any(
+                value < 0 for _, profile in schedules[schedule].days for _, value in profile):
+            check.fail(f"{vw}.schedule", f"{schedule!r} takes negative values: an air flow is >= 0")
+        flows.append(Ventilation(name=check.text(v, "name", vw), flow=check.number(v, "flow", vw, low=0),
+                                 schedule=schedule))
+    return tuple(flows)
+
+
+def _angular(check, c, where):
+    raw = c.get("angular_transmittance")
+    if raw is None:
+        return None
+    where = f"{where}.angular_transmittance"
+    if c.get("solar_transmittance") is None:
+        check.fail(where, "only a glazed component (with a solar_transmittance) has one")
+    if not isinstance(raw, dict):
+        check.fail(where, 'must be {"angles": [deg], "factors": [-], "diffuse": -}')
+    angles, factors = check.sequence(raw, "angles", where), check.sequence(raw, "factors", where)
+    if len(angles) != len(factors) or len(angles) < 2:
+        check.fail(where, "angles and factors must be lists of one length, at least 2")
+    angles = [check.number({"a": a}, "a", f"{where}.angles[{k}]", low=0, high=90) for k, a in enumerate(angles)]
+    factors = [check.number({"f": f}, "f", f"{where}.factors[{k}]", low=0) for k, f in enumerate(factors)]
+    if angles[0] != 0 or any(b <= a for a, b in zip(angles, angles[1:])):
+        check.fail(f"{where}.angles", "must start at 0 and increase")
+    return AngularTransmittance(angles=tuple(angles), factors=tuple(factors),
+                                diffuse=check.number(raw, "diffuse", where, low=0))
+
+
+def _zone(check, z, where, zone_names, explicit, next_id, schedules):
     if not isinstance(z, dict):
         check.fail(where, "must be an object")
     heat_input = z.get("heat_input")
@@ -535,6 +702,8 @@ def _zone(check, z, where, zone_names, explicit, next_id):
         shading_transmittance=check.number(z, "shading_transmittance", where, default=0.0, low=0, high=1),
         heat_input_factor=check.number(z, "heat_input_factor", where, default=1.0, low=0),
         air_exchange=exchange,
+        gains=_gains(check, z, where, schedules),
+        ventilation=_ventilation(check, z, where, schedules),
         **lumped,
     )
 
@@ -582,7 +751,9 @@ def _outside(check, raw, where, zone_names):
         return Exterior(h_conv=check.number(raw, "h_conv", where, low=0),
                         h_rad=check.number(raw, "h_rad", where, low=0),
                         solar_absorptance=check.number(raw, "solar_absorptance", where, low=0, high=1),
-                        irradiance=check.text(raw, "irradiance", where, optional=True))
+                        irradiance=check.text(raw, "irradiance", where, optional=True),
+                        sky_view_factor=(check.number(raw, "sky_view_factor", where, low=0, high=1)
+                                         if "sky_view_factor" in raw else None))
     if kind == "zone":
         return _surface(check, raw, where, zone_names)
     if kind == "boundary":
@@ -669,7 +840,34 @@ def _component(check, c, where, materials, zone_names, sensor_depths):
         shading=shading,
         conductivity_factor=check.number(c, "conductivity_factor", where, default=1.0, low=0, low_open=True),
         capacity_factor=check.number(c, "capacity_factor", where, default=1.0, low=0),
+        angular=_angular(check, c, where),
+        solar_distribution=_distribution(check, c, where, tau),
+        inner_solar_absorptance=_inner_absorptance(check, c, where),
     )
+
+
+def _inner_absorptance(check, c, where):
+    if "inner_solar_absorptance" not in c:
+        return 0.0
+    if not (isinstance(c.get("outside"), dict) and c["outside"].get("type") == "exterior"):
+        check.fail(f"{where}.inner_solar_absorptance", "only a component with an exterior outside face has one")
+    return check.number(c, "inner_solar_absorptance", where, low=0, high=1)
+
+
+def _distribution(check, c, where, tau):
+    raw = c.get("solar_distribution")
+    if raw is None:
+        return ()
+    where = f"{where}.solar_distribution"
+    if tau is None:
+        check.fail(where, "only a glazed component (with a solar_transmittance) has one")
+    if not isinstance(raw, dict) or not raw:
+        check.fail(where, 'must be {"component": fraction, ...}')
+    fractions = tuple((name, check.number(raw, name, where, low=0, high=1)) for name in raw)
+    if sum(f for _, f in fractions) > 1 + 1e-9:
+        check.fail(where, f"the fractions add up to {sum(f for _, f in fractions):g}: at most 1 (the rest leaves "
+                          "through the glazings)")
+    return fractions
 
 
 def _explicit_ids(check, raw_zones, components):

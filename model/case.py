@@ -22,7 +22,7 @@ from .building import DAY_TERMS
 from .network import assemble, clock_input_names, day_input, input_names
 from .units import check_celsius
 from .solar import (DECOMPOSITIONS, complete_irradiance, incident_irradiance, measured_irradiance, sky_temperature,
-                    solar_position)
+                    solar_position, transmitted_irradiance)
 from .weather import IRRADIANCE_COLUMNS, check_columns, weather_on_grid
 
 
@@ -111,6 +111,7 @@ class Case:
         """
         columns = dict(zip(self.input_names, self.U.T))
         columns.update(clock_inputs(building, self.times))
+        columns.update(schedule_inputs(building, self.times))
         names = input_names(building)
         absent = [n for n in names if n not in columns]
         if absent:
@@ -178,6 +179,34 @@ def clock_inputs(building, times):
         return {}
     tau = clock_hours(times, building.site["timezone"], building.source)
     return {day_input(t): day_basis(tau, t) for t in DAY_TERMS}
+
+
+def schedule_inputs(building, times):
+    """{schedule name: values at `times`} of the schedules the building reads as inputs
+    (`Building.schedule_inputs`), on the site's local clock (docs/model.md section 1.2): at t_n,
+    the schedule's mean over the step (t_n-1, t_n] of the uniform `times` (a heat gain's energy
+    over the step, held by the integration as a heat input is), at the first time its value."""
+    if not building.schedule_inputs:
+        return {}
+    clock_hours(times[:1], building.site["timezone"], building.source)  # a time zone that is none
+    if len(times) < 2:
+        return {name: building.schedules[name].on(times, building.site["timezone"]) for name in building.schedule_inputs}
+    dt = (times[1] - times[0]).total_seconds()
+    k = max(1, int(np.ceil(dt / SCHEDULE_RESOLUTION)))
+    # k points evenly inside each step, read once for all steps
+    offsets = [pd.Timedelta(seconds=dt * (j + 0.5) / k - dt) for j in range(k)]
+    out = {}
+    for name in building.schedule_inputs:
+        s = building.schedules[name]
+        means = np.mean([s.on(times + o, building.site["timezone"]) for o in offsets], axis=0)
+        means[0] = s.on(times[:1], building.site["timezone"])[0]
+        out[name] = means
+    return out
+
+
+# The finest step of a schedule a step's mean resolves (s): EnergyPlus's schedules change on the
+# minute at the finest, a quarter hour in most files
+SCHEDULE_RESOLUTION = 60.0
 
 
 def measured_matrix(building, measurements, times):
@@ -277,6 +306,10 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
         measured_sun = measured_irradiance(c, w.columns)
         if measured_sun is None:
             computed.append(c)
+        elif c.angular is not None:
+            raise InputError(source, measured_sun, f"{c.name} declares an angular_transmittance, which needs the "
+                                                   "direct and diffuse sun apart: its irradiance is computed from "
+                                                   "ghi, dni, dhi, not read from a measured column")
         else:
             columns[c.irradiance_input] = w[measured_sun].to_numpy(float)
     assumptions = []
@@ -296,7 +329,12 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
         for c in computed:
             columns[f"I_{c.name}"] = incident_irradiance(position, ghi, dni, dhi, c.tilt, c.azimuth,
                                                          site["ground_albedo"])
+            if c.angular is not None:
+                a = c.angular
+                columns[c.transmitted_input] = transmitted_irradiance(
+                    position, ghi, dni, dhi, c.tilt, c.azimuth, site["ground_albedo"], a.angles, a.factors, a.diffuse)
     columns.update(clock_inputs(building, times))
+    columns.update(schedule_inputs(building, times))
     names = input_names(building)
     U = np.column_stack([np.asarray(columns[n], dtype=float) for n in names])
     missing = ~np.isfinite(U)

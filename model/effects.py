@@ -122,7 +122,7 @@ def _transmittance_write(data, target, values):
 
 
 def _receiver_nodes(building, target):
-    return building.component(building.component(target).transmitted_solar_to).node_ids
+    return tuple(i for name, _ in building.component(target).receivers for i in building.component(name).node_ids)
 
 
 # thermal bridge: a conductance UA from a zone's air to the outdoor air or a boundary column
@@ -246,7 +246,7 @@ def _shading_targets(building):
 
 def _shading_receivers(building, target):
     return tuple(i for c in shaded_glazings(building, target)
-                 for i in building.component(c.transmitted_solar_to).node_ids)
+                 for name, _ in c.receivers for i in building.component(name).node_ids)
 
 
 # boundary conductance: one factor on every conductance from the building to a boundary column

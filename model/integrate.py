@@ -196,18 +196,20 @@ class ImplicitEuler:
         self._partition = None
         self._solvers = OrderedDict()
 
-    def solver(self, forced):
+    def solver(self, forced, switched=None):
         """The solve of M with the rows of the `forced` nodes (bool mask) replaced by unit rows
-        (a callable v -> T), and the indices of those nodes."""
-        key = forced.tobytes()
+        (a callable v -> T), and the indices of those nodes; `switched` (N,) adds the switched
+        conductances of the step to M's diagonal (W/K; one factorisation per distinct value)."""
+        key = forced.tobytes() + (b"" if switched is None else switched.tobytes())
         found = self._solvers.get(key)
         if found is None:
+            M = self._M if switched is None else self._M + np.diag(switched)
             if self.condensed:
                 if self._partition is None:  # from the unforced pattern, which every mask shares
                     self._partition = Partition(self._M)
-                solve = CondensedSolve(self._M, self._partition, forced)
+                solve = CondensedSolve(M, self._partition, forced)
             else:
-                solve = DenseSolve(unit_rows(self._M.copy(), forced))
+                solve = DenseSolve(unit_rows(M.copy(), forced))
             found = self._solvers[key] = (solve, np.flatnonzero(forced))
             if len(self._solvers) > self.CACHED_MASKS:
                 self._solvers.popitem(last=False)
@@ -215,7 +217,7 @@ class ImplicitEuler:
             self._solvers.move_to_end(key)
         return found
 
-    def step(self, T, source, forced, T_forced):
+    def step(self, T, source, forced, T_forced, switched=None):
         """Temperatures (C) at t_n+1 from T at t_n.
 
         Parameters
@@ -224,10 +226,11 @@ class ImplicitEuler:
         source : (N,) `B u^n+1 + q` (W)
         forced : (N,) bool, nodes imposed this step (their measurement exists at t_n+1)
         T_forced : (N,) imposed temperatures (C); read only where `forced`
+        switched : (N,) the switched conductances at t_n+1 (`Network.switched_diagonal`), or None
         """
         v = self.c_dt * T
         v += source
-        solve, index = self.solver(forced)
+        solve, index = self.solver(forced, switched)
         if not len(index):
             return solve(v)
         T_imposed = T_forced[index]
@@ -347,10 +350,12 @@ def substeps(dt):
 def held_inputs(building, input_names):
     """(n_inputs,) bool: the inputs held over each step, the zones' heat inputs: a power logged at
     t_n+1 is the heat delivered over the step that ends there (energy / dt), the value the
-    backward Euler step reads. Every other input (temperatures, irradiances, shading, the clock)
-    is a sample of a quantity that varies in between, linear between samples within a step."""
-    heat = {name for z in building.zones for name in z.heat_input}
-    return np.array([name in heat for name in input_names], dtype=bool)
+    backward Euler step reads; and the schedules, whose input at t_n+1 is their mean over that
+    step (`model.case.schedule_inputs`). Every other input (temperatures, irradiances, shading,
+    the clock) is a sample of a quantity that varies in between, linear between samples within a
+    step."""
+    held = {name for z in building.zones for name in z.heat_input} | set(building.schedule_inputs)
+    return np.array([name in held for name in input_names], dtype=bool)
 
 
 def step_start(values, held=None):
@@ -444,29 +449,33 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     forced = forcing_schedule(force, measured, burn_in_steps)
     H = history_steps
     # the record's steps from t_H: a history's rows are stepped apart (below)
-    sources = [network.sources(u) for u in within_steps(U[H:], substeps, held_inputs(building, network.input_names))]
+    inputs = within_steps(U[H:], substeps, held_inputs(building, network.input_names))
+    sources = [network.sources(u) for u in inputs]
+    switched = [network.switched_diagonal(u) for u in inputs] if network.switched else [None] * len(inputs)
     imposed_at = within_steps(measured[H:], substeps)
     stepper = ImplicitEuler(network, dt / substeps) if stepper is None else stepper
     T = initial_state(building, measured[0], T_default)
     if steady_start:
         u, held, values = steady_inputs(U, measured, forced, dt)
         steady_stepper = ImplicitEuler(network, STEADY_STEP) if steady_stepper is None else steady_stepper
-        T = steady_stepper.step(T, network.sources(u), held, values)
+        T = steady_stepper.step(T, network.sources(u), held, values, network.switched_diagonal(u))
     out = np.empty((n_rows, n))
     out[0] = T
     if H:
         block = history_block(dt)
         history_stepper = ImplicitEuler(network, block * dt) if history_stepper is None else history_stepper
         free, nothing = np.zeros(n, dtype=bool), np.full(n, np.nan)
-        for b, source in enumerate(network.sources(history_inputs(U, H, dt))):
-            T = history_stepper.step(T, source, free, nothing)
+        means = history_inputs(U, H, dt)
+        for b, (source, u) in enumerate(zip(network.sources(means), means)):
+            T = history_stepper.step(T, source, free, nothing, network.switched_diagonal(u))
             out[b * block + 1:(b + 1) * block + 1] = T
     # the warm-up's replay stands in for a history the record lacks
     rows = H + warmup_rows(n_rows - H, dt, 0 if H else warmup_days)
     start = len(rows) - (n_rows - 1 - H)  # the step that reaches t_H+1
     for k, row in enumerate(rows):
-        for source, imposed_values in zip(sources, imposed_at):
-            T = stepper.step(T, source[row - H], forced[row], imposed_values[row - H])
+        for source, imposed_values, g in zip(sources, imposed_at, switched):
+            T = stepper.step(T, source[row - H], forced[row], imposed_values[row - H],
+                             None if g is None else g[row - H])
         if k >= start - 1:
             out[H + k - start + 1] = T
     return out if include_start else out[1:]

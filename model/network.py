@@ -20,7 +20,9 @@ import numpy as np
 from .building import DAY_TERMS, Adiabatic, Boundary, Exterior, Surface
 from .discretise import capacities, conductances
 
-RHO_C_AIR = 1.2 * 1005.0  # J/m3/K
+AIR_DENSITY = 1.2  # kg/m3, a building file's default (site.air_density)
+C_AIR = 1005.0  # J/kg/K
+RHO_C_AIR = AIR_DENSITY * C_AIR  # J/m3/K
 
 
 @dataclass(frozen=True)
@@ -31,6 +33,7 @@ class Network:
     q: np.ndarray  # (N,) W
     input_names: tuple  # names of the columns of B
     products: tuple = ()  # (node index, input a, input b, coefficient): coefficient u_a u_b W
+    switched: tuple = ()  # (node index, input j, g): a conductance g u_j (W/K) from the node to T_out
 
     @property
     def n_nodes(self):
@@ -40,6 +43,17 @@ class Network:
     def algebraic(self):
         """Boolean mask of the nodes with no capacity (radiant nodes)."""
         return self.C == 0.0
+
+    def switched_diagonal(self, U):
+        """(N,) or (n_rows, N): what the switched conductances g u_j add to the diagonal of -A (W/K)
+        for one input vector or rows of inputs; None when the network has none."""
+        if not self.switched:
+            return None
+        U = np.asarray(U, dtype=float)
+        D = np.zeros(U.shape[:-1] + (self.n_nodes,))
+        for node, j, g in self.switched:
+            D[..., node] += g * U[..., j]
+        return D
 
     def sources(self, U):
         """B u + q + the products of inputs (W), for one input vector u (n_inputs,) or for rows
@@ -55,7 +69,9 @@ def input_names(building):
     """The input vector's names, in the order of the columns of B."""
     irradiance = tuple(dict.fromkeys(c.irradiance_input for c in building.exterior_components))
     named = tuple(n for n in building.input_columns if n not in irradiance)
-    return ("T_out", "T_sky") + irradiance + named + clock_input_names(building)
+    transmitted = tuple(c.transmitted_input for c in building.components if c.angular is not None)
+    return (("T_out", "T_sky") + irradiance + named + clock_input_names(building) + transmitted
+            + building.schedule_inputs)
 
 
 def clock_input_names(building):
@@ -74,9 +90,27 @@ def sky_view_factor(tilt):
     return (1.0 + np.cos(np.radians(tilt))) / 2.0
 
 
-def air_conductance(flow):
-    """(rho c)_air V / 3600 (W/K) of an air flow V (m3/h)."""
-    return RHO_C_AIR * flow / 3600.0
+def sky_fraction_energyplus(tilt, ground_view=None):
+    """The part of a face's long-wave exchange that is with the sky as EnergyPlus takes it
+    (Engineering Reference, "Exterior/External Longwave Radiation"): its sky view F_sky (1 less
+    its view factor to the ground, (1 + cos tilt) / 2 where not given) of which the part
+    beta = sqrt((1 + cos tilt) / 2) is the sky and the rest the air near the ground, F_sky beta."""
+    cos = np.cos(np.radians(tilt))
+    F_sky = (1.0 + cos) / 2.0 if ground_view is None else 1.0 - ground_view
+    return F_sky * np.sqrt((1.0 + cos) / 2.0)
+
+
+def air_density_at(altitude, T=20.0):
+    """Density of dry air (kg/m3) at an altitude (m) and a temperature (C): the standard
+    atmosphere's pressure p = 101325 (1 - 2.25577e-5 z)^5.2559 Pa (as EnergyPlus takes its site's
+    barometric pressure from its elevation), rho = p / (287.05 (T + 273.15))."""
+    p = 101325.0 * (1.0 - 2.25577e-5 * altitude) ** 5.2559
+    return p / (287.05 * (T + 273.15))
+
+
+def air_conductance(flow, density=AIR_DENSITY):
+    """(rho c)_air V / 3600 (W/K) of an air flow V (m3/h) of air of a density (kg/m3)."""
+    return density * C_AIR * flow / 3600.0
 
 
 def assemble(building, names=None):
@@ -93,7 +127,7 @@ def assemble(building, names=None):
     A = np.zeros((n, n))
     B = np.zeros((n, len(names)))
     q = np.zeros(n)
-    products = []
+    products, switched = [], []
 
     def link(i, j, g):
         """A conductance g (W/K) between nodes i and j (0-based)."""
@@ -103,8 +137,12 @@ def assemble(building, names=None):
         A[j, i] += g
 
     def to_temperature(node, g, temperature):
-        """A conductance g (W/K) from a node to a temperature: a number (C) or an input column."""
+        """A conductance g (W/K) from a node to a temperature: a number (C), an input column or a
+        schedule of the file (a constant one a number)."""
         A[node, node] -= g
+        schedule = building.schedules.get(temperature) if isinstance(temperature, str) else None
+        if schedule is not None and schedule.is_constant:
+            temperature = schedule.value
         if isinstance(temperature, str):
             B[node, col[temperature]] += g
         else:
@@ -129,11 +167,13 @@ def assemble(building, names=None):
             link(idx[k], idx[k + 1], c.area * g * c.conductivity_factor * envelope)
         to_zone(idx[0], c.area, c.inside)
         if isinstance(out, Exterior):
-            F = sky_view_factor(c.tilt)
+            F = sky_view_factor(c.tilt) if out.sky_view_factor is None else out.sky_view_factor
             A[e, e] -= c.area * (out.h_conv + out.h_rad) * envelope
             B[e, col["T_out"]] += c.area * (out.h_conv + out.h_rad * (1.0 - F)) * envelope
             B[e, col["T_sky"]] += c.area * out.h_rad * F * envelope
             B[e, col[c.irradiance_input]] += c.area * out.solar_absorptance
+            # a glazing's inner panes absorb part of the sun at the inside face (docs/model.md 4.1)
+            B[idx[0], col[c.irradiance_input]] += c.area * c.inner_solar_absorptance
         elif isinstance(out, Surface):
             to_zone(e, c.area, out)
         elif isinstance(out, Boundary):
@@ -141,32 +181,53 @@ def assemble(building, names=None):
         else:
             assert isinstance(out, Adiabatic)
         if c.solar_transmittance is not None:
-            receiver = building.component(c.transmitted_solar_to).node_ids[0] - 1
-            transmitted = c.solar_transmittance * c.area
-            if c.shading:
-                # tau A I (s + f (1 - s)): a closed shading (s = 0) still lets in the part f
-                f = building.zone(c.inside.zone).shading_transmittance
-                products.append((receiver, col[c.irradiance_input], col[c.shading], transmitted * (1.0 - f)))
-                B[receiver, col[c.irradiance_input]] += transmitted * f
-            else:
-                B[receiver, col[c.irradiance_input]] += transmitted
+            sun = col[c.transmitted_input]
+            for name, fraction in c.receivers:
+                receiver = building.component(name).node_ids[0] - 1
+                transmitted = c.solar_transmittance * c.area * fraction
+                if c.shading:
+                    # tau A I (s + f (1 - s)): a closed shading (s = 0) still lets in the part f
+                    f = building.zone(c.inside.zone).shading_transmittance
+                    products.append((receiver, sun, col[c.shading], transmitted * (1.0 - f)))
+                    B[receiver, sun] += transmitted * f
+                else:
+                    B[receiver, sun] += transmitted
 
+    rho = building.site.get("air_density", AIR_DENSITY)
     for z in building.zones:
         air, radiant = z.air_node - 1, z.radiant_node - 1
-        C[air] += RHO_C_AIR * z.volume
-        to_temperature(air, air_conductance(z.volume * z.air_change_rate), "T_out")
+        C[air] += rho * C_AIR * z.volume
+        to_temperature(air, air_conductance(z.volume * z.air_change_rate, rho), "T_out")
         if z.supply is not None:
-            to_temperature(air, air_conductance(z.supply.flow * z.supply.flow_factor), z.supply.temperature)
+            to_temperature(air, air_conductance(z.supply.flow * z.supply.flow_factor, rho), z.supply.temperature)
+        for v in z.ventilation:
+            schedule = building.schedules.get(v.schedule) if v.schedule is not None else None
+            if schedule is None or schedule.is_constant:
+                to_temperature(air, air_conductance(v.flow * (1.0 if schedule is None else schedule.value), rho), "T_out")
+            else:
+                # g s(t) (T_out - T_air): the conductance follows the schedule (`Network.switched`),
+                # its T_out term is a product of two inputs
+                g = air_conductance(v.flow, rho)
+                switched.append((air, col[v.schedule], g))
+                products.append((air, col[v.schedule], col["T_out"], g))
         for inflow in z.airflow_from:
-            g = air_conductance(inflow.flow)
+            g = air_conductance(inflow.flow, rho)
             A[air, air] -= g
             A[air, building.zone(inflow.zone).air_node - 1] += g
         for other, flow in z.air_exchange:
-            link(air, building.zone(other).air_node - 1, air_conductance(flow))
+            link(air, building.zone(other).air_node - 1, air_conductance(flow, rho))
         for to, UA in z.thermal_bridges:
             to_temperature(air, UA if to == "outdoor" else UA * building.boundary_factor(to),
                            "T_out" if to == "outdoor" else to)
         q[air] += z.internal_gain
+        for gain in z.gains:
+            # P s(t): the radiant fraction to the radiant node, the rest to the air
+            schedule = building.schedules.get(gain.schedule) if gain.schedule is not None else None
+            for node, part in ((air, 1.0 - gain.radiant_fraction), (radiant, gain.radiant_fraction)):
+                if schedule is None or schedule.is_constant:
+                    q[node] += part * gain.power * (1.0 if schedule is None else schedule.value)
+                else:
+                    B[node, col[gain.schedule]] += part * gain.power
         for term, W in z.daily_gain:
             B[air, col[day_input(term)]] += W
         for column, k in z.proportional_gains:
@@ -189,7 +250,7 @@ def assemble(building, names=None):
             for name in z.heat_input:
                 B[air, col[name]] += gain * (1.0 - f_r)
                 B[radiant, col[name]] += gain * f_r
-    return Network(C=C, A=A, B=B, q=q, input_names=names, products=tuple(products))
+    return Network(C=C, A=A, B=B, q=q, input_names=names, products=tuple(products), switched=tuple(switched))
 
 
 def face_heat_flux(building, network, T, U, component, face):

@@ -186,3 +186,23 @@ def decompose(ghi, zenith, model="erbs"):
     out = function(ghi, zenith, times)
     return {"ghi": ghi, "dni": out["dni"], "dhi": out["dhi"]}
 
+
+
+def transmitted_irradiance(position, ghi, dni, dhi, tilt, azimuth, albedo, angles, factors, diffuse):
+    """The sun a glazing lets in per m2, relative to its normal-incidence transmittance (W/m2,
+    docs/model.md section 4.1): the direct sun times the factor at its angle of incidence (linear
+    between the tabulated angles, 0 beyond 90 deg) plus the isotropic sky's and the ground's diffuse
+    sun times the diffuse factor,
+
+        I_t = f(theta) dni max(cos theta, 0) + f_d [dhi (1 + cos beta) / 2 + ghi rho_g (1 - cos beta) / 2]
+
+    Parameters as `incident_irradiance`; angles (deg) and factors (-) the glazing's table, diffuse
+    its factor for diffuse sun (-)."""
+    zenith = np.asarray(position["apparent_zenith"], dtype=float)
+    theta = np.asarray(pvlib.irradiance.aoi(tilt, azimuth, zenith, np.asarray(position["azimuth"], dtype=float)))
+    f = np.interp(theta, list(angles) + [90.0 + 1e-9], list(factors) + [0.0], right=0.0)
+    beta = np.radians(tilt)
+    beam = np.asarray(dni, dtype=float) * np.maximum(np.cos(np.radians(theta)), 0.0)
+    sky = np.asarray(dhi, dtype=float) * (1 + np.cos(beta)) / 2 + np.asarray(ghi, dtype=float) * albedo * (1 - np.cos(beta)) / 2
+    sun = f * np.where(zenith < 90, beam, 0.0) + diffuse * sky
+    return np.where(np.isfinite(sun) & (sun > 0.0), sun, 0.0)

@@ -25,7 +25,7 @@ from nodeforce.model.case import HISTORY_DAYS, force_mask, measured_case, simula
 from nodeforce.model.errors import InputError
 from nodeforce.model.score import Objective
 
-__all__ = ["InputError", "read_building", "read_weather", "read_measurements", "read_phases", "measured_case",
+__all__ = ["InputError", "read_building", "convert_idf", "read_weather", "read_measurements", "read_phases", "measured_case",
            "read_case", "read_record", "objective", "synthesize", "convert_table", "simulate", "write_fmu",
            "fmu_inputs", "write_fmu_inputs", "open_fmu", "simulate_fmu", "forcing_candidates",
            "score_forcing", "locate", "diagnose", "Record", "compare"]
@@ -58,6 +58,37 @@ def read_building(path):
         physically impossible.
     """
     return load_building(path)
+
+
+def convert_idf(path, output=None):
+    """An EnergyPlus model (IDF) as a validated building file (docs/guide.md, `nodeforce convert`),
+    written to `output` if given (its `energyplus.idf` then the IDF's path from the file's folder,
+    which `diagnose` writes its corrections back into).
+
+    Returns
+    -------
+    Building
+        Its `to_json()` is the building file; its `data["not_modelled"]` lists what the IDF held
+        that the file does not, one line per object.
+
+    Raises
+    ------
+    InputError
+        Naming the IDF, the object and the field: an IDF the conversion cannot read.
+    """
+    from nodeforce.iotools.energyplus import convert
+    from nodeforce.model.building import check_schema, parse_building
+    import json
+    import os
+    data = convert(path)
+    if output is not None:
+        data["energyplus"]["idf"] = os.path.relpath(Path(path).resolve(), Path(output).resolve().parent)
+    building = parse_building(data, source=str(output if output is not None else path))
+    check_schema(data, str(path))
+    if output is not None:
+        Path(output).parent.mkdir(parents=True, exist_ok=True)
+        Path(output).write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
+    return building
 
 
 def objective(building, zones=None, source="zones"):

@@ -69,6 +69,14 @@ def cmd_fmu(args):
     print(f"wrote {path}")
 
 
+def cmd_convert(args):
+    building = api.convert_idf(args.idf, args.output)
+    for line in building.data["not_modelled"]:
+        print(f"not modelled: {line}")
+    print(f"wrote {args.output}: {len(building.zones)} zones, {len(building.components)} components, "
+          f"{building.n_nodes} nodes")
+
+
 def cmd_simulate(args):
     from nodeforce.model.case import force_mask
     from nodeforce.iotools.node_temperatures import write_node_names, write_node_temperatures
@@ -452,6 +460,11 @@ def parser():
     s.add_argument("--standalone", action="store_true", help="C, no Python at run time (needs a C compiler)")
     fmi_argument(s)
     s.set_defaults(run=cmd_fmu)
+
+    s = sub.add_parser("convert", help="an EnergyPlus model (IDF) as a building file")
+    s.add_argument("idf")
+    s.add_argument("-o", "--output", required=True, help="the building file (JSON) to write")
+    s.set_defaults(run=cmd_convert)
 
     s = sub.add_parser("simulate", help="simulate a building through its FMU")
     case_arguments(s, False, "the CSV of node temperatures to write", output_default="sim.csv")

@@ -89,6 +89,26 @@ def residual_lines(report):
             "filled in.", ""] + lines + ["", tables.residual_diagnostics(report)]
 
 
+def energyplus_lines(report):
+    """The corrections written back into the EnergyPlus model (model_after.idf): each object
+    changed or added, old and new values, and what no EnergyPlus object holds."""
+    ep = report.get("energyplus")
+    if not ep:
+        return []
+    lines = ["## The EnergyPlus model", "", f"The corrections written into {Path(ep['idf_after']).name}:", ""]
+    for c in ep["changes"]:
+        if c["field"] == "(new object)":
+            fields = ", ".join(f"{k} {v:.6g}" if isinstance(v, float) else f"{k} {v}" for k, v in c["new"].items())
+            lines.append(f"- new {c['object']} {c['name']}: {fields}")
+        else:
+            new = f"{c['new']:.6g}" if isinstance(c["new"], float) else c["new"]
+            lines.append(f"- {c['object']} {c['name']}, {c['field']}: {c['old']} -> {new}")
+    lines += [f"- not written: {line}" for line in ep["not_written"]]
+    if not ep["changes"] and not ep["not_written"]:
+        lines.append("- nothing: no effect was added")
+    return lines + [""]
+
+
 def write_markdown(out_dir, report, plots, notes):
     """Write out_dir/report.md; `plots` {key: path} and `notes` {key: why absent} of the figures."""
     def figure(key, caption):
@@ -173,6 +193,7 @@ def write_markdown(out_dir, report, plots, notes):
         md += ["## Sensitivity of J to the parameters (Morris elementary effects)", "",
                "μ* is the mean absolute elementary effect of a parameter on J, σ their spread "
                "(σ/μ* near or above 1: non-linear or interacting).", "", sensitivity, ""]
+    md += energyplus_lines(report)
     artifacts = {k: v for k, v in (report.get("artifacts") or {}).items() if k != "plots" and v}
     if artifacts:
         md += ["## Files", ""] + [f"- {k}: [{_relative(v, out_dir)}]({_relative(v, out_dir)})"

@@ -1,0 +1,935 @@
+"""An EnergyPlus model (IDF) into a nodal-building file (`nodeforce convert`, docs/guide.md).
+
+The IDF is read by idfkit (its epJSON schemas of EnergyPlus 8.9 to 26.x); a file of EnergyPlus
+8.5 to 8.8 is read against the 8.9 schema, which the transitions 8.5 -> 8.9 leave unchanged for
+every object this module reads. What the building file holds is mapped (docs/guide.md lists each
+object and field); what it cannot hold (HVAC, thermostats, EMS, shading devices, airflow
+networks, a term of an air flow) is listed, one line per object, in the file's `not_modelled`;
+an object the conversion needs and cannot read is an `InputError` naming the file, the object,
+the field and the problem. The physics of the mapping (geometry, glazing) is `model.geometry` and
+`model.glazing`; the coefficients EnergyPlus computes each step and the nodal model holds
+constant are `FILMS`.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model import convection, geometry, glazing
+from ..model.errors import InputError
+from ..model.gains import PEOPLE_T, people_sensible_heat
+from ..model.network import air_density_at, sky_fraction_energyplus
+
+MIN_VERSION, SCHEMA_MIN = (8, 5), (8, 9, 0)
+
+
+@dataclass(frozen=True)
+class Films:
+    """Surface coefficients the nodal model holds constant (W/m2/K), where EnergyPlus computes
+    them each step: inside, the IDF's inside algorithm (TARP, EnergyPlus's default, or Simple:
+    `model.convection.tarp_inside`, `simple_inside`) at a face-to-air difference of `delta_T`,
+    every face warmer than the air (a floor the sun warms, a ceiling under the warm air); outside EnergyPlus's DOE-2 model (`model.convection.doe2`) at
+    each face's height, roughness and the site's terrain for a weather station's wind of `wind`
+    m/s (ISO 6946's reference, 4 m/s), natural convection alone where EnergyPlus says NoWind, at
+    a face-to-air difference of `delta_T`; and the linearised long-wave exchange 4 sigma eps T_m^3
+    of a face of emissivity eps at T_m."""
+    wind: float = 4.0  # m/s at the weather station
+    delta_T: float = 5.0  # K
+    T_inside: float = 293.15  # K
+    T_outside: float = 283.15  # K
+    ground: float = 1000.0  # a face held at the ground's temperature, as EnergyPlus holds it
+
+    def inside_convection(self, tilt, algorithm="tarp"):
+        """h_c of an inside face of a component whose outside faces `tilt` (deg)."""
+        if algorithm == "simple":
+            return convection.simple_inside(tilt)
+        return round(float(convection.tarp_inside(tilt, self.delta_T)), 4)
+
+    def radiative(self, emissivity, T):
+        return 4 * glazing.SIGMA * emissivity * T ** 3
+
+    def outside_convection(self, tilt, height, roughness, wind_exposed, terrain):
+        """h_c of an exterior face: DOE-2 at the local wind, or natural convection without wind."""
+        if not wind_exposed:
+            return convection.natural_convection(tilt, self.delta_T)
+        return convection.doe2(tilt, convection.wind_at_height(self.wind, height, terrain), roughness, self.delta_T)
+
+
+FILMS = Films()
+# Glass, where EnergyPlus gives a pane no density or specific heat (it neglects a pane's capacity)
+GLASS_DENSITY, GLASS_SPECIFIC_HEAT = 2500.0, 840.0  # kg/m3, J/kg/K
+# A massless layer (Material:NoMass, Material:AirGap) is written as a layer this thick with its
+# resistance and no capacity: only thickness / conductivity matters
+MASSLESS_THICKNESS = 0.001  # m
+MAX_SPACING = 0.025  # m, the largest cell of a generated component
+AIR_DENSITY, AIR_SPECIFIC_HEAT = 1.2, 1006.0  # a gas gap's capacity, kg/m3 and J/kg/K
+# EnergyPlus's ground temperature where the IDF gives none (its Site:GroundTemperature:BuildingSurface default)
+DEFAULT_GROUND = 18.0  # C
+
+SURFACES = ("BuildingSurface:Detailed", "Wall:Detailed", "RoofCeiling:Detailed", "Floor:Detailed")
+SIMPLE_SURFACES = {  # type: (surface type, outside boundary)
+    "Wall:Exterior": ("Wall", "Outdoors"), "Wall:Adiabatic": ("Wall", "Adiabatic"),
+    "Wall:Underground": ("Wall", "Ground"), "Wall:Interzone": ("Wall", "Interzone"),
+    "Roof": ("Roof", "Outdoors"), "Ceiling:Adiabatic": ("Ceiling", "Adiabatic"),
+    "Ceiling:Interzone": ("Ceiling", "Interzone"), "Floor:GroundContact": ("Floor", "Ground"),
+    "Floor:Adiabatic": ("Floor", "Adiabatic"), "Floor:Interzone": ("Floor", "Interzone"),
+}
+SUBSURFACES = ("FenestrationSurface:Detailed", "Window", "Door", "GlazedDoor", "Window:Interzone",
+               "Door:Interzone", "GlazedDoor:Interzone")
+GAINS = ("People", "Lights", "ElectricEquipment", "GasEquipment", "HotWaterEquipment", "SteamEquipment",
+         "OtherEquipment")
+FLOWS = ("ZoneInfiltration:DesignFlowRate", "ZoneVentilation:DesignFlowRate")
+SCHEDULES = ("Schedule:Compact", "Schedule:Constant", "Schedule:Year", "Schedule:Week:Daily",
+             "Schedule:Week:Compact", "Schedule:Day:Interval", "Schedule:Day:Hourly", "Schedule:Day:List",
+             "ScheduleTypeLimits")
+READ = set(("Version", "Site:Location", "GlobalGeometryRules", "Building", "Zone", "ZoneList", "Construction",
+            "Material", "Material:NoMass", "Material:AirGap", "WindowMaterial:Glazing", "WindowMaterial:Gas",
+            "WindowMaterial:SimpleGlazingSystem", "Site:GroundTemperature:BuildingSurface", "Timestep",
+            "InternalMass", "SurfaceConvectionAlgorithm:Inside", "SurfaceConvectionAlgorithm:Outside") + SURFACES + tuple(SIMPLE_SURFACES) + SUBSURFACES + GAINS + FLOWS + SCHEDULES)
+# Objects about the run and its reports, not the building
+NOT_PHYSICS = ("Output", "OutputControl", "LifeCycleCost", "Meter", "RunPeriod", "SimulationControl", "Sizing:Parameters",
+               "UtilityCost", "ComponentCost", "CurrencyType")
+
+
+def load_idf(path):
+    """The idfkit document of an IDF; InputError naming the file for one that cannot be read."""
+    import idfkit
+    try:
+        version = idfkit.get_idf_version(str(path))
+    except FileNotFoundError:
+        raise InputError(path, "file", "not found") from None
+    except Exception as e:
+        raise InputError(path, "Version", f"no EnergyPlus version could be read ({e})") from None
+    if version is None:
+        raise InputError(path, "Version", "the file has no Version object")
+    override = None
+    if tuple(version[:2]) < SCHEMA_MIN[:2]:
+        if tuple(version[:2]) < MIN_VERSION:
+            raise InputError(path, "Version", f"EnergyPlus {'.'.join(map(str, version[:2]))} is older than 8.5: "
+                                              "bring the file to a later version (EnergyPlus's IDFVersionUpdater)")
+        override = SCHEMA_MIN
+    try:
+        return idfkit.load_idf(str(path), version=override)
+    except Exception as e:
+        message = str(e).splitlines()[0] if str(e) else type(e).__name__
+        raise InputError(path, "(file)", f"not a readable IDF: {message}") from None
+
+
+# Fields EnergyPlus renamed when it added spaces (9.6 on): the name read first, then its later one
+RENAMED = {"zone_or_zonelist_name": "zone_or_zonelist_or_space_or_spacelist_name",
+           "watts_per_zone_floor_area": "watts_per_floor_area",
+           "power_per_zone_floor_area": "power_per_floor_area",
+           "flow_per_zone_floor_area": "flow_rate_per_floor_area",
+           "people_per_zone_floor_area": "people_per_floor_area",
+           "zone_floor_area_per_person": "floor_area_per_person"}
+
+
+def _field(obj, field):
+    """A field's value (by its name in the IDF's version), None where the object's type has no such
+    field (idfkit refuses the name)."""
+    fields = obj.to_dict()
+    if field not in fields and field in RENAMED:
+        return fields.get(RENAMED[field])
+    return fields.get(field)
+
+
+def _blank(value):
+    return value is None or (isinstance(value, str) and value.strip() == "")
+
+
+class _Reader:
+    """The document's objects by type and name, and fields that fail with the file and object."""
+
+    def __init__(self, doc, source):
+        self.doc, self.source = doc, source
+        self.by_name = {}
+        for obj in doc.all_objects:
+            self.by_name.setdefault(obj.obj_type.upper(), {})[str(getattr(obj, "name", "") or "").upper()] = obj
+
+    def all(self, kind):
+        return [o for o in self.doc.all_objects if o.obj_type.upper() == kind.upper()]
+
+    def get(self, kinds, name, referrer, field):
+        for kind in ((kinds,) if isinstance(kinds, str) else kinds):
+            obj = self.by_name.get(kind.upper(), {}).get(str(name).upper())
+            if obj is not None:
+                return obj
+        self.fail(referrer, field, f"names no {' or '.join((kinds,) if isinstance(kinds, str) else kinds)} ({name!r})")
+
+    def fail(self, obj, field, problem):
+        where = f"{obj.obj_type} {getattr(obj, 'name', '')!r}".strip() if obj is not None else "(file)"
+        raise InputError(self.source, f"{where}, field {field}", problem)
+
+    def number(self, obj, field, default=None, low=None, low_open=False, high=None):
+        value = _field(obj, field)
+        if _blank(value):
+            if default is None:
+                self.fail(obj, _label(field), "missing: a number is needed")
+            return float(default)
+        if isinstance(value, str):
+            if value.strip().lower() in ("autocalculate", "autosize"):
+                self.fail(obj, _label(field), f"{value}: the converter needs the number")
+            try:
+                value = float(value)
+            except ValueError:
+                self.fail(obj, _label(field), f"{value!r} is not a number")
+        value = float(value)
+        if low is not None and (value <= low if low_open else value < low):
+            self.fail(obj, _label(field), f"{value:g} must be {'>' if low_open else '>='} {low:g}")
+        if high is not None and value > high:
+            self.fail(obj, _label(field), f"{value:g} must be <= {high:g}")
+        return value
+
+    def text(self, obj, field, default=""):
+        value = _field(obj, field)
+        return default if _blank(value) else str(value).strip()
+
+
+def _label(field):
+    """An idfkit field name as EnergyPlus's documentation writes it."""
+    return " ".join(w.capitalize() for w in field.split("_"))
+
+
+def convert(path):
+    """The building file's JSON (a dict) of the EnergyPlus model at `path`; InputError for an IDF
+    the conversion cannot read (docs/guide.md lists each refusal)."""
+    doc = load_idf(path)
+    return _Converter(_Reader(doc, str(path))).building()
+
+
+class _Converter:
+    def __init__(self, reader):
+        self.r = reader
+        self.materials = {}
+        self.schedules = {}
+        self.not_modelled = []
+        self.notes = []
+
+    def note(self, text):
+        """An assumption the file's description states, once."""
+        if text not in self.notes:
+            self.notes.append(text)
+
+    # ---- site, rules, schedules ---------------------------------------------------------
+    def site(self):
+        locations = self.r.all("Site:Location")
+        if not locations:
+            self.r.fail(None, "Site:Location", "missing: the sun's position needs the site")
+        loc = locations[0]
+        zone_h = self.r.number(loc, "time_zone", low=-12, high=14)
+        hours, minutes = int(abs(zone_h)), int(round(abs(zone_h) % 1 * 60))
+        if minutes == 0:
+            tz = "UTC" if hours == 0 else f"Etc/GMT{'-' if zone_h > 0 else '+'}{hours}"
+        else:
+            tz = f"{'+' if zone_h >= 0 else '-'}{hours:02d}:{minutes:02d}"
+        altitude = self.r.number(loc, "elevation", default=0.0, low=-300, high=8000)
+        return {"latitude": self.r.number(loc, "latitude", low=-90, high=90),
+                "longitude": self.r.number(loc, "longitude", low=-180, high=180),
+                "altitude": altitude, "timezone": tz, "air_density": round(air_density_at(altitude), 5)}
+
+    def geometry_rules(self):
+        rules = self.r.all("GlobalGeometryRules")
+        if not rules:
+            self.r.fail(None, "GlobalGeometryRules", "missing: the vertices' order and coordinates need it")
+        g = rules[0]
+        direction = self.r.text(g, "vertex_entry_direction", "Counterclockwise").lower()
+        if direction not in ("counterclockwise", "clockwise"):
+            self.r.fail(g, "Vertex Entry Direction", f"{direction!r} is neither Counterclockwise nor Clockwise")
+        system = self.r.text(g, "coordinate_system", "Relative").lower()
+        rect = self.r.text(g, "rectangular_surface_coordinate_system", "Relative").lower()
+        buildings = self.r.all("Building")
+        north = self.r.number(buildings[0], "north_axis", default=0.0) if buildings else 0.0
+        self.ccw, self.relative, self.rect_relative, self.north = (
+            direction == "counterclockwise", system == "relative", rect == "relative", north)
+        terrain = self.r.text(buildings[0], "terrain", "Suburbs").lower() if buildings else "suburbs"
+        if terrain not in convection.TERRAIN:
+            self.r.fail(buildings[0], "Terrain", f"{terrain!r} is none of EnergyPlus's terrains")
+        self.terrain = terrain
+        inside = self.r.all("SurfaceConvectionAlgorithm:Inside")
+        self.default_inside = self.r.text(inside[0], "algorithm", "TARP") if inside else "TARP"
+        outside = self.r.all("SurfaceConvectionAlgorithm:Outside")
+        algorithm = self.r.text(outside[0], "algorithm", "DOE-2") if outside else "DOE-2"
+        self.notes.append(f"outside convection EnergyPlus's DOE-2 at a {FILMS.wind:g} m/s station wind and a "
+                          f"{FILMS.delta_T:g} K face-to-air difference" +
+                          ("" if algorithm.lower() == "doe-2" else f" (the IDF's {algorithm} evaluated as DOE-2)"))
+
+    def inside_algorithm(self, zone_name):
+        """'simple' or 'tarp': the zone's inside convection algorithm (its own field, else the
+        IDF's SurfaceConvectionAlgorithm:Inside); any other is evaluated as TARP, and said so."""
+        zone = self.zone_objs[zone_name.upper()]
+        algorithm = self.r.text(zone, "zone_inside_convection_algorithm", "") or self.default_inside
+        if algorithm.lower() not in ("simple", "tarp"):
+            note = f"the inside convection algorithm {algorithm} evaluated as TARP"
+            if note not in self.notes:
+                self.notes.append(note)
+            return "tarp"
+        return algorithm.lower()
+
+    def schedule(self, name, referrer, field):
+        """The building file's name of an IDF schedule, converted once (its values over a year on
+        the IDF's time step, as day profiles by date and day of the week)."""
+        if name in self.schedules:
+            return name
+        import idfkit.schedules as S
+        obj = self.r.get(("Schedule:Compact", "Schedule:Constant", "Schedule:Year"), name, referrer, field)
+        ts = self.timesteps
+        try:
+            if obj.obj_type.upper() == "SCHEDULE:YEAR":
+                values = self._year_values(obj, ts)
+            else:
+                values = np.asarray(S.values(obj, year=YEAR, timestep=ts, document=self.r.doc), dtype=float)
+        except InputError:
+            raise
+        except Exception as e:
+            self.r.fail(obj, "(values)", f"could not be evaluated ({str(e).splitlines()[0] if str(e) else type(e).__name__})")
+        self.schedules[name] = compress_schedule(values.reshape(-1, 24 * ts), YEAR)
+        return name
+
+    def _year_values(self, obj, ts):
+        """A Schedule:Year's values: each week schedule over its dates (idfkit reads the weeks)."""
+        import datetime
+
+        import idfkit.schedules as S
+        days = (datetime.date(YEAR + 1, 1, 1) - datetime.date(YEAR, 1, 1)).days
+        out = np.full((days, 24 * ts), np.nan)
+        fields = obj.to_dict()
+        weeks = fields.get("schedule_weeks")
+        if not isinstance(weeks, list):  # the fields as numbered in the IDD
+            weeks, k = [], 1
+            while not _blank(fields.get(f"schedule_week_name_{k}")):
+                weeks.append({f: fields.get(f"{f}_{k}") for f in ("schedule_week_name", "start_month", "start_day",
+                                                                   "end_month", "end_day")})
+                k += 1
+        for k, w in enumerate(weeks, start=1):
+            week = self.r.get(("Schedule:Week:Daily", "Schedule:Week:Compact"), w["schedule_week_name"],
+                              obj, f"Schedule:Week Name {k}")
+            try:
+                start = datetime.date(YEAR, int(float(w["start_month"])), int(float(w["start_day"])))
+                end = datetime.date(YEAR, int(float(w["end_month"])), int(float(w["end_day"])))
+            except (TypeError, ValueError) as e:
+                self.r.fail(obj, f"Start Month {k}", f"not a date ({e})")
+            values = np.asarray(S.values(week, year=YEAR, timestep=ts, document=self.r.doc), dtype=float)
+            first, last = (start - datetime.date(YEAR, 1, 1)).days, (end - datetime.date(YEAR, 1, 1)).days
+            out[first:last + 1] = values.reshape(-1, 24 * ts)[first:last + 1]
+        if np.isnan(out).any():
+            self.r.fail(obj, "Start Month", "the weeks do not cover every day of the year")
+        return out.ravel()
+
+    def constant_schedule_value(self, name, referrer, field):
+        """The one value of a schedule that has one (None if it varies)."""
+        s = self.schedules[self.schedule(name, referrer, field)]
+        return s["constant"] if "constant" in s else None
+
+    def ground_schedule(self):
+        if "ground temperature" in self.schedules:
+            return "ground temperature"
+        objs = self.r.all("Site:GroundTemperature:BuildingSurface")
+        months = ("january", "february", "march", "april", "may", "june", "july", "august", "september",
+                  "october", "november", "december")
+        if objs:
+            temps = [self.r.number(objs[0], f"{m}_ground_temperature", default=DEFAULT_GROUND) for m in months]
+        else:
+            temps = [DEFAULT_GROUND] * 12
+            self.notes.append(f"no Site:GroundTemperature:BuildingSurface: the ground is at EnergyPlus's default "
+                              f"{DEFAULT_GROUND:g} C all year")
+        ends = ("01-31", "02-28", "03-31", "04-30", "05-31", "06-30", "07-31", "08-31", "09-30", "10-31",
+                "11-30", "12-31")
+        if len(set(temps)) == 1:
+            self.schedules["ground temperature"] = {"constant": temps[0]}
+        else:
+            self.schedules["ground temperature"] = {
+                "days": {m: [[24, t]] for m, t in zip(months, temps)},
+                "periods": [{"through": e, "week": [m] * 7} for m, e in zip(months, ends)]}
+        return "ground temperature"
+
+    # ---- constructions -----------------------------------------------------------------
+    def layers(self, construction_name, referrer, field, height=None):
+        """(layers outside first as [[material, thickness]], outer Layer info, inner Layer info,
+        glazing or None) of a Construction."""
+        c = self.r.get("Construction", construction_name, referrer, field)
+        names = [v for v in c.to_dict().values()][1:]
+        names = [n for n in names if not _blank(n)]
+        if not names:
+            self.r.fail(c, "Outside Layer", "missing: a construction needs a layer")
+        kinds = ("Material", "Material:NoMass", "Material:AirGap", "WindowMaterial:Glazing", "WindowMaterial:Gas",
+                 "WindowMaterial:SimpleGlazingSystem")
+        objs = []
+        for k, n in enumerate(names):
+            for kind in kinds:
+                obj = self.r.by_name.get(kind.upper(), {}).get(n.upper())
+                if obj is not None:
+                    break
+            if obj is None:
+                self.r.fail(c, "Outside Layer" if k == 0 else f"Layer {k + 1}",
+                            f"names no material this converter reads ({n!r}; it reads {', '.join(kinds)})")
+            objs.append(obj)
+        window = [o.obj_type.upper().startswith("WINDOWMATERIAL") for o in objs]
+        if any(window) and not all(window):
+            self.r.fail(c, "Outside Layer", "mixes window and opaque materials")
+        if all(window):
+            return self.glazing_layers(c, objs, height)
+        layers = [[self.opaque_material(o), self._thickness(o)] for o in objs]
+        return layers, self._faces(objs[0]), self._faces(objs[-1]), None
+
+    def _thickness(self, o):
+        if o.obj_type.upper() == "MATERIAL":
+            return self.r.number(o, "thickness", low=0, low_open=True)
+        return MASSLESS_THICKNESS
+
+    def _faces(self, o):
+        """Emissivity, solar absorptance and DOE-2 roughness multiplier of a layer's face (EnergyPlus's
+        defaults where a field is blank; an air gap is no face EnergyPlus would put outermost)."""
+        if o.obj_type.upper() == "MATERIAL:AIRGAP":
+            return {"emissivity": 0.9, "solar": 0.7, "roughness": convection.ROUGHNESS["mediumrough"]}
+        roughness = self.r.text(o, "roughness", "MediumRough").lower()
+        if roughness not in convection.ROUGHNESS:
+            self.r.fail(o, "Roughness", f"{roughness!r} is none of EnergyPlus's roughnesses")
+        return {"emissivity": self.r.number(o, "thermal_absorptance", default=0.9, low=0, low_open=True, high=1),
+                "solar": self.r.number(o, "solar_absorptance", default=0.7, low=0, high=1),
+                "roughness": convection.ROUGHNESS[roughness]}
+
+    def opaque_material(self, o):
+        name = o.name
+        if name in self.materials:
+            return name
+        kind = o.obj_type.upper()
+        if kind == "MATERIAL":
+            self.materials[name] = {"conductivity": self.r.number(o, "conductivity", low=0, low_open=True),
+                                    "density": self.r.number(o, "density", low=0, low_open=True),
+                                    "specific_heat": self.r.number(o, "specific_heat", low=100)}
+        else:
+            R = self.r.number(o, "thermal_resistance", low=0, low_open=True)
+            self.materials[name] = {"conductivity": MASSLESS_THICKNESS / R, "density": 0.0, "specific_heat": 0.0}
+        return name
+
+    def glazing_layers(self, c, objs, height):
+        """A window construction: its panes and gaps as layers, U's parts, its solar transmittance
+        at normal incidence, its angular table (layered glazing) and its outer face's absorptance."""
+        kinds = [o.obj_type.upper() for o in objs]
+        if "WINDOWMATERIAL:SIMPLEGLAZINGSYSTEM" in kinds:
+            if len(objs) != 1:
+                self.r.fail(c, "Outside Layer", "a simple glazing system is a construction's only layer")
+            o = objs[0]
+            U = self.r.number(o, "u_factor", low=0, low_open=True, high=7)
+            shgc = self.r.number(o, "solar_heat_gain_coefficient", low=0, low_open=True, high=1)
+            h_in, h_out = glazing.simple_glazing_films(U)
+            R = 1 / U - 1 / h_in - 1 / h_out
+            if R <= 0:
+                self.r.fail(o, "U-Factor", f"{U:g} W/m2/K leaves no resistance for the glazing beside its films")
+            name = f"{o.name} (U {U:g})"
+            self.materials[name] = {"conductivity": 0.003 / R, "density": GLASS_DENSITY,
+                                    "specific_heat": GLASS_SPECIFIC_HEAT}
+            tau = glazing.simple_glazing_transmittance(U, shgc)
+            h_o = FILMS.outside_convection(90.0, 1.5, 1.0, True, "country") + FILMS.radiative(0.84, FILMS.T_outside)
+            inward = (1 / (1 / U - 1 / h_out)) / (1 / (1 / U - 1 / h_out) + h_o)
+            alpha = min(1 - tau, max(0.0, (shgc - tau) / inward))
+            faces = {"emissivity": 0.84, "solar": alpha, "roughness": 1.0}
+            return [[name, 0.003]], faces, {"emissivity": 0.84, "solar": tau + alpha}, {
+                "tau": tau, "inner_alpha": 0.0, "angular": None}
+        panes, layers = [], []
+        for k, o in enumerate(objs):
+            kind = o.obj_type.upper()
+            expected = "WINDOWMATERIAL:GLAZING" if k % 2 == 0 else "WINDOWMATERIAL:GAS"
+            if kind != expected:
+                self.r.fail(c, f"Layer {k + 1}", f"{o.name!r}: panes and gas gaps must alternate, a pane outermost "
+                                                 "and innermost")
+            if kind == "WINDOWMATERIAL:GLAZING":
+                if self.r.text(o, "optical_data_type", "SpectralAverage").lower() != "spectralaverage":
+                    self.r.fail(o, "Optical Data Type", "only SpectralAverage pane data are read")
+                T0 = self.r.number(o, "solar_transmittance_at_normal_incidence", low=0, low_open=True, high=1)
+                Rf = self.r.number(o, "front_side_solar_reflectance_at_normal_incidence", low=0, high=1)
+                thickness = self.r.number(o, "thickness", low=0, low_open=True)
+                panes.append((T0, Rf, self.r.number(o, "front_side_infrared_hemispherical_emissivity", default=0.84),
+                              self.r.number(o, "back_side_infrared_hemispherical_emissivity", default=0.84)))
+                name = o.name
+                self.materials.setdefault(name, {"conductivity": self.r.number(o, "conductivity", low=0, low_open=True),
+                                                 "density": GLASS_DENSITY, "specific_heat": GLASS_SPECIFIC_HEAT})
+                layers.append([name, thickness])
+            else:
+                if self.r.text(o, "gas_type", "Air").lower() != "air":
+                    self.r.fail(o, "Gas Type", f"{self.r.text(o, 'gas_type')}: only air gaps are read")
+                layers.append([o, self.r.number(o, "thickness", low=0, low_open=True)])
+        # a gap's conductance depends on the emissivities facing it and the pane's height
+        for k in range(1, len(layers), 2):
+            gap, d = layers[k]
+            h = glazing.gap_conductance(d, height or 1.5, panes[k // 2][3], panes[k // 2 + 1][2])
+            name = f"{gap.name} in {c.name}"
+            self.materials[name] = {"conductivity": h * d, "density": AIR_DENSITY, "specific_heat": AIR_SPECIFIC_HEAT}
+            layers[k] = [name, d]
+        pairs = [(T0, R0) for T0, R0, _, _ in panes]
+        tau = float(glazing.stack_transmittance(pairs, 0.0))
+        factors = [float(glazing.stack_transmittance(pairs, a)) / tau for a in glazing.ANGLES]
+        diffuse = glazing.hemispherical(lambda a: glazing.stack_transmittance(pairs, a)) / tau
+        # each pane's absorbed sun goes to the face it is nearer: the outer half of the panes to the
+        # outside face, the inner half to the inside face (the middle pane of three split)
+        absorbed = glazing.pane_absorptances(pairs)
+        n = len(absorbed)
+        alpha = sum(absorbed[:n // 2]) + (absorbed[n // 2] / 2 if n % 2 else 0.0)
+        inner_alpha = sum(absorbed[(n + 1) // 2:]) + (absorbed[n // 2] / 2 if n % 2 else 0.0)
+        # seen from the room, a glazing takes the diffuse sun it does not reflect (out, or into its panes)
+        outer = {"emissivity": panes[0][2], "solar": alpha, "roughness": 1.0}  # glass is very smooth
+        inner = {"emissivity": panes[-1][3], "solar": 1 - glazing.stack_reflectance(pairs[::-1])}
+        return layers, outer, inner, {"tau": tau, "inner_alpha": inner_alpha, "angular": {"angles": list(glazing.ANGLES), "factors": factors,
+                                                              "diffuse": diffuse}}
+
+    # ---- zones, surfaces ----------------------------------------------------------------
+    def building(self):
+        site = self.site()
+        self.geometry_rules()
+        steps = self.r.all("Timestep")
+        self.timesteps = int(self.r.number(steps[0], "number_of_timesteps_per_hour", default=6)) if steps else 6
+        zones = self.r.all("Zone")
+        if not zones:
+            self.r.fail(None, "Zone", "missing: the model has no zone")
+        self.zone_objs = {z.name.upper(): z for z in zones}
+        surfaces = self.surfaces()
+        zone_data = [self.zone(z, surfaces) for z in zones]
+        components = self.components(surfaces)
+        for z in zone_data:
+            z.pop("_floor_area")
+        self.internal_masses(components)
+        self.receivers(components)
+        self.list_not_modelled()
+        names = [b.name for b in self.r.all("Building")]
+        description = (f"Converted by nodeforce convert from {self.r.source} (EnergyPlus "
+                       f"{'.'.join(map(str, self.r.doc.version[:2]))}). Surface coefficients are the converter's "
+                       "constants (docs/guide.md, nodeforce convert); " + "; ".join(self.notes or ["no other assumption"]) + ".")
+        data = {"format": "nodal-building/1", "name": names[0] if names else "", "description": description,
+                "site": site, "materials": self.materials, "zones": zone_data, "components": components}
+        if self.schedules:
+            data["schedules"] = self.schedules
+        data["not_modelled"] = self.not_modelled
+        data["energyplus"] = {"idf": self.r.source}
+        return data
+
+    def zone_transform(self, zone):
+        """(origin m, rotation deg) that bring a zone's vertices to true-north coordinates."""
+        if not self.relative:
+            return np.zeros(3), self.north
+        origin = np.array([self.r.number(zone, f, default=0.0) for f in ("x_origin", "y_origin", "z_origin")])
+        return origin, self.north + self.r.number(zone, "direction_of_relative_north", default=0.0)
+
+    def surfaces(self):
+        """{upper name: dict} of every heat transfer surface: zone, kind, boundary, vertices (true
+        north, m) or area and orientation, construction, exposure."""
+        out = {}
+        for kind in SURFACES:
+            for s in self.r.all(kind):
+                zone = self.zone_of(s, "zone_name")
+                vertices = self.vertices(s, zone)
+                out[s.name.upper()] = dict(obj=s, zone=zone.name, type=self.r.text(s, "surface_type", kind.split(":")[0]),
+                                           boundary=self.r.text(s, "outside_boundary_condition"),
+                                           other=self.r.text(s, "outside_boundary_condition_object"),
+                                           sun=self.r.text(s, "sun_exposure", "SunExposed").lower() == "sunexposed",
+                                           wind=self.r.text(s, "wind_exposure", "WindExposed").lower() == "windexposed",
+                                           construction=self.r.text(s, "construction_name"), vertices=vertices,
+                                           ground_view=self._ground_view(s))
+        for kind, (stype, boundary) in SIMPLE_SURFACES.items():
+            for s in self.r.all(kind):
+                zone = self.zone_of(s, "zone_name")
+                _, turn = self.zone_transform(zone) if self.rect_relative else (None, self.north)
+                length = self.r.number(s, "length", low=0, low_open=True)
+                other = self.r.number(s, "height" if stype == "Wall" else "width", low=0, low_open=True)
+                tilt = self.r.number(s, "tilt_angle", default={"Wall": 90, "Roof": 0, "Ceiling": 0, "Floor": 180}[stype])
+                azimuth = (self.r.number(s, "azimuth_angle", default=0.0) + turn) % 360
+                out[s.name.upper()] = dict(obj=s, zone=zone.name, type=stype,
+                                           boundary=boundary if boundary != "Interzone" else "Surface",
+                                           other=self.r.text(s, "outside_boundary_condition_object"),
+                                           sun=boundary == "Outdoors", wind=boundary == "Outdoors",
+                                           construction=self.r.text(s, "construction_name"), vertices=None,
+                                           area=length * other, azimuth=azimuth, tilt=tilt,
+                                           height=self._rect_height(s, zone, stype, other, tilt))
+        if not out:
+            self.r.fail(None, "BuildingSurface:Detailed", "missing: the model has no heat transfer surface")
+        for s in out.values():
+            if s["vertices"] is not None:
+                normal = geometry.outward_normal(s["vertices"], self.ccw)
+                s["azimuth"], s["tilt"] = geometry.azimuth_tilt(normal)
+                s["area"] = geometry.area(s["vertices"])
+                s["height"] = float(np.mean(s["vertices"][:, 2]))
+            s["subsurfaces"] = []
+        for kind in SUBSURFACES:
+            for w in self.r.all(kind):
+                parent_name = self.r.text(w, "building_surface_name")
+                parent = out.get(parent_name.upper())
+                if parent is None:
+                    self.r.fail(w, "Building Surface Name", f"names no heat transfer surface ({parent_name!r})")
+                multiplier = self.r.number(w, "multiplier", default=1.0, low=1)
+                if kind == "FenestrationSurface:Detailed":
+                    zone = self.zone_objs[parent["zone"].upper()]
+                    area = geometry.area(self.vertices(w, zone)) * multiplier
+                    stype = self.r.text(w, "surface_type", "Window")
+                    height = np.ptp(self.vertices(w, zone)[:, 2]) or None
+                else:
+                    area = (self.r.number(w, "length", low=0, low_open=True) *
+                            self.r.number(w, "height", low=0, low_open=True) * multiplier)
+                    stype = kind.split(":")[0]
+                    height = self.r.number(w, "height", low=0, low_open=True)
+                parent["subsurfaces"].append(dict(obj=w, type=stype, area=area, height=height,
+                                                  construction=self.r.text(w, "construction_name"),
+                                                  other=self.r.text(w, "outside_boundary_condition_object")))
+        return out
+
+    def _ground_view(self, s):
+        """A surface's View Factor to Ground, None where autocalculated or absent."""
+        value = _field(s, "view_factor_to_ground")
+        if _blank(value) or str(value).lower() == "autocalculate":
+            return None
+        return self.r.number(s, "view_factor_to_ground", low=0, high=1)
+
+    def _rect_height(self, s, zone, stype, other, tilt):
+        """Centroid height (m) of a rectangular surface: its starting corner's z plus half its rise."""
+        z0 = self.r.number(s, "starting_z_coordinate", default=0.0)
+        if self.rect_relative:
+            z0 += self.r.number(zone, "z_origin", default=0.0)
+        return z0 + 0.5 * other * np.sin(np.radians(tilt))
+
+    def zone_of(self, obj, field):
+        name = self.r.text(obj, field)
+        zone = self.zone_objs.get(name.upper())
+        if zone is None:
+            self.r.fail(obj, _label(field), f"names no Zone ({name!r})")
+        return zone
+
+    def vertices(self, s, zone):
+        fields = s.to_dict()
+        if isinstance(fields.get("vertices"), list):
+            v = [[p["vertex_x_coordinate"], p["vertex_y_coordinate"], p["vertex_z_coordinate"]] for p in fields["vertices"]]
+        else:
+            v, k = [], 1
+            while f"vertex_{k}_x_coordinate" in fields and not _blank(fields[f"vertex_{k}_x_coordinate"]):
+                v.append([fields[f"vertex_{k}_{a}_coordinate"] for a in "xyz"])
+                k += 1
+        try:
+            v = np.array(v, dtype=float)
+        except (TypeError, ValueError):
+            self.r.fail(s, "Vertex 1 X-coordinate", "a vertex coordinate is not a number")
+        if len(v) < 3:
+            self.r.fail(s, "Number of Vertices", f"{len(v)} vertices: a surface needs at least 3")
+        if geometry.area(v) <= 1e-9:
+            self.r.fail(s, "Vertex 1 X-coordinate", "the vertices enclose no area")
+        origin, turn = self.zone_transform(zone)
+        return geometry.rotate_z(v + origin, turn)
+
+    def zone(self, z, surfaces):
+        own = [s for s in surfaces.values() if s["zone"].upper() == z.name.upper()]
+        if not own:
+            self.r.fail(z, "Name", "no surface belongs to this zone")
+        multiplier = self.r.number(z, "multiplier", default=1.0)
+        if multiplier != 1:
+            self.r.fail(z, "Multiplier", f"{multiplier:g}: a zone multiplier is not held by the building file")
+        volume_field = _field(z, "volume")
+        if _blank(volume_field) or str(volume_field).lower() == "autocalculate":
+            polygons = [s["vertices"] for s in own if s["vertices"] is not None]
+            if len(polygons) != len(own):
+                self.r.fail(z, "Volume", "autocalculated for a zone with rectangular surfaces: give the volume")
+            volume = geometry.enclosed_volume(polygons, self.ccw)
+            if volume <= 0:
+                self.r.fail(z, "Volume", "autocalculated from surfaces that enclose no volume: give the volume")
+        else:
+            volume = self.r.number(z, "volume", low=0, low_open=True)
+        floor = sum(s["area"] for s in own if s["type"].lower() == "floor")
+        floor_field = _field(z, "floor_area")
+        if not _blank(floor_field) and str(floor_field).lower() != "autocalculate":
+            floor = self.r.number(z, "floor_area", low=0, low_open=True)
+        data = {"name": z.name, "volume": round(volume, 6), "_floor_area": floor}
+        exterior = sum(s["area"] for s in own if s["boundary"].lower() == "outdoors")
+        walls = sum(s["area"] for s in own if s["boundary"].lower() == "outdoors" and s["type"].lower() == "wall")
+        flow, scheduled = self.air_flows(z, volume, floor, exterior, walls)
+        if flow:
+            data["air_change_rate"] = flow / volume
+        if scheduled:
+            data["ventilation"] = scheduled
+        gains = self.gains(z, floor)
+        if gains:
+            data["gains"] = gains
+        return data
+
+    def _targets(self, obj, field):
+        """The zones an object's Zone or ZoneList name field names."""
+        name = self.r.text(obj, field)
+        if name.upper() in self.zone_objs:
+            return [self.zone_objs[name.upper()].name]
+        zl = self.r.by_name.get("ZONELIST", {}).get(name.upper())
+        if zl is None:
+            self.r.fail(obj, _label(field), f"names no Zone or ZoneList ({name!r})")
+        fields = zl.to_dict()
+        if isinstance(fields.get("zones"), list):
+            return [d["zone_name"] for d in fields["zones"]]
+        return [v for k, v in fields.items() if k != "name" and not _blank(v)]
+
+    def air_flows(self, z, volume, floor, exterior, walls):
+        """The zone's constant outdoor air flow (m3/h) from its design flow rate objects, and its
+        scheduled ones (the building file's `ventilation`)."""
+        total, scheduled = 0.0, []
+        for kind in FLOWS:
+            for o in self.r.all(kind):
+                if z.name not in self._targets(o, "zone_or_zonelist_name") and \
+                        z.name.upper() not in [t.upper() for t in self._targets(o, "zone_or_zonelist_name")]:
+                    continue
+                method = self.r.text(o, "design_flow_rate_calculation_method", "Flow/Zone").lower()
+                per = {"flow/zone": ("design_flow_rate", 3600.0),
+                       "flow/area": ("flow_per_zone_floor_area", 3600.0 * floor),
+                       "flow/exteriorarea": ("flow_per_exterior_surface_area", 3600.0 * exterior),
+                       "flow/exteriorwallarea": ("flow_per_exterior_surface_area", 3600.0 * walls),
+                       "airchanges/hour": ("air_changes_per_hour", volume),
+                       "flow/person": ("flow_rate_per_person", None)}
+                if method not in per or per[method][1] is None:
+                    self.r.fail(o, "Design Flow Rate Calculation Method", f"{method!r} is not read (Flow/Zone, Flow/Area, "
+                                "Flow/ExteriorArea, Flow/ExteriorWallArea, AirChanges/Hour are)")
+                field, scale = per[method]
+                flow = self.r.number(o, field, low=0) * scale
+                A = self.r.number(o, "constant_term_coefficient", default=1.0)
+                dropped = [(label, self.r.number(o, f, default=0.0)) for label, f in (
+                    ("temperature term", "temperature_term_coefficient"), ("velocity term", "velocity_term_coefficient"),
+                    ("velocity squared term", "velocity_squared_term_coefficient"))]
+                dropped = [f"{label} {v:g}" for label, v in dropped if v != 0]
+                if dropped:
+                    self.not_modelled.append(f"{kind} {o.name}: {', '.join(dropped)} not held (the building file's "
+                                             f"air flows do not vary with temperature or wind); its constant term kept")
+                if kind == "ZoneVentilation:DesignFlowRate":
+                    limits = [_label(f) for f in ("minimum_indoor_temperature", "maximum_indoor_temperature",
+                                                  "delta_temperature", "minimum_outdoor_temperature",
+                                                  "maximum_outdoor_temperature", "maximum_wind_speed")
+                              if not _blank(o.get(f)) and f in o.to_dict()]
+                    if limits:
+                        self.not_modelled.append(f"{kind} {o.name}: its controls ({', '.join(limits)}) not held; "
+                                                 "the flow runs as scheduled")
+                name = self.r.text(o, "schedule_name")
+                value = self.constant_schedule_value(name, o, "Schedule Name") if name else 1.0
+                if value is None:
+                    if np.min([v for p in self.schedules[name]["days"].values() for _, v in p]) < 0:
+                        self.r.fail(o, "Schedule Name", f"{name!r} takes negative values: an air flow is >= 0")
+                    if flow * A > 0:
+                        scheduled.append({"name": o.name, "flow": flow * A, "schedule": name})
+                else:
+                    total += flow * A * value
+        return total, scheduled
+
+    def gains(self, z, floor):
+        out = []
+        for kind in GAINS:
+            for o in self.r.all(kind):
+                if z.name.upper() not in [t.upper() for t in self._targets(o, "zone_or_zonelist_name")]:
+                    continue
+                if kind == "People":
+                    out.append(self.people(o, floor))
+                    continue
+                if kind == "Lights":
+                    method_field, fields = "design_level_calculation_method", {
+                        "lightinglevel": "lighting_level", "watts/area": "watts_per_zone_floor_area"}
+                else:
+                    method_field, fields = "design_level_calculation_method", {
+                        "equipmentlevel": "design_level", "watts/area": "power_per_zone_floor_area"}
+                method = self.r.text(o, method_field).lower()
+                if method not in fields:
+                    self.r.fail(o, _label(method_field), f"{method!r} is not read ({', '.join(fields)} are)")
+                power = self.r.number(o, fields[method]) * (floor if method == "watts/area" else 1.0)
+                if kind == "Lights":
+                    radiant = self.r.number(o, "fraction_radiant", default=0.0) + self.r.number(o, "fraction_visible", default=0.0)
+                    returned = self.r.number(o, "return_air_fraction", default=0.0)
+                    if returned:
+                        self.not_modelled.append(f"Lights {o.name}: return air fraction {returned:g} given to the zone's "
+                                                 "air (no return air plenum in a free-floating model)")
+                    sensible = 1.0
+                else:
+                    radiant = self.r.number(o, "fraction_radiant", default=0.0)
+                    sensible = 1.0 - self.r.number(o, "fraction_latent", default=0.0) - self.r.number(o, "fraction_lost", default=0.0)
+                if sensible <= 0:
+                    out.append(None)
+                    continue
+                gain = {"name": o.name, "power": power * sensible, "radiant_fraction": min(1.0, radiant / sensible)}
+                self._gain_schedule(gain, o)
+                out.append(gain)
+        return [g for g in out if g is not None]
+
+    def _gain_schedule(self, gain, o, field="schedule_name"):
+        name = self.r.text(o, field)
+        if not name:
+            return
+        value = self.constant_schedule_value(name, o, _label(field))
+        if value is None:
+            gain["schedule"] = name
+        else:
+            gain["power"] *= value
+
+    def people(self, o, floor):
+        method = self.r.text(o, "number_of_people_calculation_method", "People").lower()
+        if method == "people":
+            n = self.r.number(o, "number_of_people", low=0)
+        elif method == "people/area":
+            n = self.r.number(o, "people_per_floor_area", low=0) * floor
+        elif method == "area/person":
+            n = floor / self.r.number(o, "floor_area_per_person", low=0, low_open=True)
+        else:
+            self.r.fail(o, "Number of People Calculation Method", f"{method!r} is not read")
+        activity = self.constant_schedule_value(self.r.text(o, "activity_level_schedule_name"), o,
+                                                "Activity Level Schedule Name")
+        if activity is None:
+            self.r.fail(o, "Activity Level Schedule Name", "varies in time: a gain has one schedule; give a constant activity")
+        sensible = _field(o, "sensible_heat_fraction")
+        if _blank(sensible) or str(sensible).lower() == "autocalculate":
+            # EnergyPlus's polynomial in the activity and the zone's air, at the converter's air temperature
+            heat = people_sensible_heat(activity)
+            self.note(f"a person's sensible heat EnergyPlus's polynomial at {PEOPLE_T:g} C")
+        else:
+            heat = activity * self.r.number(o, "sensible_heat_fraction", low=0, high=1)
+        gain = {"name": o.name, "power": n * heat,
+                "radiant_fraction": self.r.number(o, "fraction_radiant", default=0.0, low=0, high=1)}
+        self._gain_schedule(gain, o, "number_of_people_schedule_name")
+        return gain
+
+    def components(self, surfaces):
+        comps, done = [], set()
+        for key, s in surfaces.items():
+            if key in done:
+                continue
+            done.add(key)
+            obj = s["obj"]
+            boundary = s["boundary"].lower()
+            layers, outer, inner, _ = self.layers(s["construction"], obj, "Construction Name")
+            outside = self.outside(s, boundary, outer, surfaces, done)
+            net = s["area"] - sum(w["area"] for w in s["subsurfaces"])
+            if net <= 1e-9:
+                self.r.fail(obj, "Vertex 1 X-coordinate", f"its windows and doors ({s['area'] - net:.3f} m2) fill all "
+                                                          f"of its {s['area']:.3f} m2")
+            comps.append(self.component(obj.name, net, s, layers, inner, outside))
+            for w in s["subsurfaces"]:
+                height = w["height"]
+                layers, outer, inner, glass = self.layers(w["construction"], w["obj"], "Construction Name", height)
+                w_outside = self.outside(s, boundary, outer, surfaces, done, subsurface=w)
+                c = self.component(w["obj"].name, w["area"], s, layers, inner, w_outside)
+                if glass is not None:
+                    c["solar_transmittance"] = round(glass["tau"], 6)
+                    c["transmitted_solar_to"] = None  # set once every component is known (`receivers`)
+                    if glass["angular"] is not None and "exterior" == w_outside["type"]:
+                        c["angular_transmittance"] = glass["angular"]
+                    if glass["inner_alpha"] > 0 and "exterior" == w_outside["type"]:
+                        c["inner_solar_absorptance"] = round(glass["inner_alpha"], 6)
+                    if w_outside["type"] != "exterior":
+                        del c["solar_transmittance"], c["transmitted_solar_to"]
+                comps.append(c)
+        return comps
+
+    def component(self, name, area, s, layers, inner, outside):
+        # EnergyPlus lists a construction's layers outside first; the building file inside first
+        return {"name": name, "area": round(area, 6), "tilt": round(s["tilt"], 6), "azimuth": round(s["azimuth"] % 360, 6),
+                "layers": [[m, t] for m, t in reversed(layers)], "nodes": {"max_spacing": MAX_SPACING},
+                "inside": {"zone": s["zone"], "h_conv": FILMS.inside_convection(s["tilt"], self.inside_algorithm(s["zone"])),
+                           "h_rad": round(FILMS.radiative(inner["emissivity"], FILMS.T_inside), 4)},
+                "outside": outside, "_zone": s["zone"], "_type": s["type"].lower(), "_absorbs": inner["solar"]}
+
+    def outside(self, s, boundary, outer, surfaces, done, subsurface=None):
+        obj = s["obj"]
+        if boundary == "outdoors":
+            h = round(FILMS.outside_convection(s["tilt"], s["height"], outer["roughness"], s["wind"], self.terrain), 4)
+            ground = s.get("ground_view")
+            return {"type": "exterior", "h_conv": h, "h_rad": round(FILMS.radiative(outer["emissivity"], FILMS.T_outside), 4),
+                    "solar_absorptance": outer["solar"] if s["sun"] else 0.0,
+                    "sky_view_factor": round(float(sky_fraction_energyplus(s["tilt"], ground)), 6)}
+        if boundary == "ground":
+            return {"type": "boundary", "temperature": self.ground_schedule(), "h": FILMS.ground}
+        if boundary == "adiabatic":
+            return {"type": "adiabatic"}
+        if boundary in ("surface", "zone"):
+            other_name = s["other"]
+            if boundary == "zone":
+                zone = self.zone_objs.get(other_name.upper())
+                if zone is None:
+                    self.r.fail(obj, "Outside Boundary Condition Object", f"names no Zone ({other_name!r})")
+                other_zone = zone.name
+            else:
+                other = surfaces.get(other_name.upper())
+                if other is None:
+                    self.r.fail(obj, "Outside Boundary Condition Object", f"names no surface ({other_name!r})")
+                if other["other"].upper() != obj.name.upper():
+                    self.r.fail(obj, "Outside Boundary Condition Object",
+                                f"{other_name!r} names {other['other']!r} back, not this surface")
+                done.add(other_name.upper())  # one partition for the pair
+                other_zone = other["zone"]
+            h_c = FILMS.inside_convection(180.0 - s["tilt"], self.inside_algorithm(other_zone))
+            return {"type": "zone", "zone": other_zone, "h_conv": h_c,
+                    "h_rad": round(FILMS.radiative(outer["emissivity"], FILMS.T_inside), 4)}
+        self.r.fail(obj, "Outside Boundary Condition", f"{s['boundary']!r} is not read (Outdoors, Ground, Adiabatic, "
+                                                       "Surface, Zone are)")
+
+    def internal_masses(self, components):
+        for o in self.r.all("InternalMass"):
+            zone = self.zone_of(o, "zone_or_zonelist_name" if "zone_or_zonelist_name" in o.to_dict() else "zone_name")
+            layers, _, inner, _ = self.layers(self.r.text(o, "construction_name"), o, "Construction Name")
+            # EnergyPlus's internal mass sees the zone on one face, the other adiabatic
+            s = {"tilt": 90.0, "azimuth": 0.0, "zone": zone.name, "type": "internalmass"}
+            components.append(self.component(o.name, self.r.number(o, "surface_area", low=0, low_open=True), s,
+                                             layers[::-1], inner, {"type": "adiabatic"}))
+
+    def receivers(self, components):
+        """Where the sun a zone's windows let in lands, as EnergyPlus's FullInteriorAndExterior
+        distributes it (Engineering Reference, interior solar distribution): the direct sun on the
+        zone's largest floor (its largest opaque surface if it has none), which absorbs its solar
+        absorptance alpha_f of it; the rest reflected diffusely onto every inside surface in
+        proportion to its area times its absorptance, A_i alpha_i / sum_j A_j alpha_j, the
+        glazings' share leaving the zone. Applied to the diffuse sun too (the building file has
+        one transmitted input per glazing)."""
+        for c in components:
+            if "transmitted_solar_to" not in c:
+                continue
+            own = [k for k in components if k["_zone"] == c["_zone"] and k["inside"]["zone"] == c["_zone"]]
+            opaque = [k for k in own if "solar_transmittance" not in k]
+            floors = [k for k in opaque if k["_type"] == "floor"] or opaque
+            floor = max(floors, key=lambda k: k["area"])
+            c["transmitted_solar_to"] = floor["name"]
+            total = sum(k["area"] * k["_absorbs"] for k in own)
+            reflected = 1 - floor["_absorbs"]
+            shares = {k["name"]: reflected * k["area"] * k["_absorbs"] / total for k in opaque if k["_absorbs"] > 0}
+            shares[floor["name"]] = shares.get(floor["name"], 0.0) + floor["_absorbs"]
+            c["solar_distribution"] = {name: round(f, 6) for name, f in shares.items()}
+        for c in components:
+            c.pop("_zone"), c.pop("_type"), c.pop("_absorbs")
+
+    def list_not_modelled(self):
+        for obj in self.r.doc.all_objects:
+            kind = obj.obj_type
+            if kind.upper() in {k.upper() for k in READ} or kind.startswith(NOT_PHYSICS):
+                continue
+            # an object without a name (ZoneHVAC:EquipmentConnections) is known by its first field
+            name = next((str(v) for v in obj.to_dict().values() if not _blank(v)), "")
+            self.not_modelled.append(f"{kind} {name}: not held by the building file")
+
+
+YEAR = 2017  # the calendar on which the schedules' weekdays are read (its 1 January is a Sunday)
+
+
+def compress_schedule(days, year=YEAR):
+    """A building file's schedule from a year of values, (days, steps per day) on `year`'s
+    calendar: a constant where one value holds all year; else its distinct day profiles
+    ([[until h, value], ...], equal neighbours merged) and the periods of consecutive dates over
+    which each day of the week keeps one profile."""
+    import datetime
+    values = np.asarray(days, dtype=float)
+    if np.all(values == values.flat[0]):
+        return {"constant": float(values.flat[0])}
+    steps = values.shape[1]
+    profiles, names, periods = {}, {}, []
+    week, start = {}, datetime.date(year, 1, 1)
+    for k, row in enumerate(values):
+        key = tuple(row)
+        if key not in names:
+            names[key] = f"day {len(names) + 1}"
+            pairs = []
+            for j, v in enumerate(row):
+                if pairs and pairs[-1][1] == v:
+                    pairs[-1][0] = (j + 1) * 24 / steps
+                else:
+                    pairs.append([(j + 1) * 24 / steps, float(v)])
+            profiles[names[key]] = pairs
+        date = start + datetime.timedelta(days=k)
+        weekday = date.weekday()
+        if week.get(weekday, names[key]) != names[key]:
+            periods.append((date - datetime.timedelta(days=1), week))
+            week = {}
+        week[weekday] = names[key]
+    periods.append((start + datetime.timedelta(days=len(values) - 1), week))
+    out = []
+    for end, week in periods:
+        fill = next(iter(week.values()))
+        out.append({"through": f"{end.month:02d}-{end.day:02d}", "week": [week.get(d, fill) for d in range(7)]})
+    return {"days": profiles, "periods": out}

@@ -1,0 +1,83 @@
+"""Exterior convection as EnergyPlus's DOE-2 model gives it (Engineering Reference, "Outside
+Surface Heat Balance", DOE-2 model), evaluated once at a reference wind for the constant
+coefficient a building file holds (docs/model.md section 3.2). Speeds in m/s, heights in m,
+coefficients in W/m2/K, angles in degrees.
+"""
+import numpy as np
+
+# EnergyPlus's wind profile: (exponent alpha, boundary layer thickness delta m) of each terrain,
+# and of the weather station's (open country, at 10 m)
+TERRAIN = {"country": (0.14, 270.0), "suburbs": (0.22, 370.0), "city": (0.33, 460.0),
+           "ocean": (0.10, 210.0), "urban": (0.22, 370.0)}
+STATION_HEIGHT = 10.0
+# Surface roughness multipliers R_f of the DOE-2 model (EnergyPlus's Material Roughness)
+ROUGHNESS = {"veryrough": 2.17, "rough": 1.67, "mediumrough": 1.52, "mediumsmooth": 1.13, "smooth": 1.11,
+             "verysmooth": 1.00}
+# MoWiTT's forced convection on a smooth surface, h = a V^b, windward and leeward
+WINDWARD, LEEWARD = (3.26, 0.89), (3.55, 0.617)
+
+
+def wind_at_height(speed, height, terrain="country"):
+    """V_z = V_met (delta_met / z_met)^alpha_met (z / delta)^alpha: the weather station's wind
+    (at 10 m in open country) at a height z above the ground of a site's terrain."""
+    alpha_met, delta_met = TERRAIN["country"]
+    alpha, delta = TERRAIN[terrain.lower()]
+    return speed * (delta_met / STATION_HEIGHT) ** alpha_met * (max(height, 0.0) / delta) ** alpha
+
+
+def natural_convection(tilt, delta_T):
+    """TARP's natural convection (W/m2/K) on a face of `tilt` deg at |T_s - T_air| = delta_T K:
+    1.31 dT^(1/3) on a vertical face; on an inclined one the mean of the unstable (heat rising
+    from it) 9.482 dT^(1/3) / (7.238 - |cos tilt|) and stable 1.810 dT^(1/3) / (1.382 + |cos tilt|)."""
+    c = abs(np.cos(np.radians(tilt)))
+    root = abs(delta_T) ** (1 / 3)
+    if c < 1e-6:
+        return 1.31 * root
+    return 0.5 * (9.482 * root / (7.238 - c) + 1.810 * root / (1.382 + c))
+
+
+def doe2(tilt, speed, roughness=1.0, delta_T=5.0, windward=None):
+    """DOE-2's exterior convective coefficient h = h_n + R_f (h_glass - h_n), h_glass =
+    sqrt(h_n^2 + (a V^b)^2), at the local wind V (m/s), for a roughness multiplier R_f; a face is
+    windward or leeward as the wind turns, so, unless `windward` says which, the mean of the two
+    (a roof, within 10 deg of horizontal, is windward, as EnergyPlus takes it)."""
+    h_n = natural_convection(tilt, delta_T)
+
+    def h(a, b):
+        return h_n + roughness * (np.sqrt(h_n ** 2 + (a * speed ** b) ** 2) - h_n)
+
+    if windward is None and tilt <= 10:
+        windward = True
+    if windward is None:
+        return 0.5 * (h(*WINDWARD) + h(*LEEWARD))
+    return h(*(WINDWARD if windward else LEEWARD))
+
+
+def tarp_inside(tilt, delta_T, warmer=True):
+    """TARP's natural convection (W/m2/K) on an inside face whose component's outside faces `tilt`
+    deg (a floor 180: its inside face looks up), at |T_s - T_air| = delta_T K, the face `warmer`
+    than the air or not: 1.31 dT^(1/3) on a wall; on a face looking up and warmer (or looking down
+    and cooler) the unstable 9.482 dT^(1/3) / (7.238 - |cos|), else the stable
+    1.810 dT^(1/3) / (1.382 + |cos|)."""
+    c = abs(np.cos(np.radians(tilt)))
+    root = abs(delta_T) ** (1 / 3)
+    if c < 1e-6:
+        return 1.31 * root
+    looks_up = tilt > 90
+    if looks_up == warmer:
+        return 9.482 * root / (7.238 - c)
+    return 1.810 * root / (1.382 + c)
+
+
+# EnergyPlus's Simple inside algorithm: constant coefficients, W/m2/K (vertical; horizontal and
+# tilted, unstable and stable)
+SIMPLE_INSIDE = {"vertical": 3.076, "horizontal": (4.040, 0.948), "tilted": (3.870, 2.281)}
+
+
+def simple_inside(tilt, warmer=True):
+    """EnergyPlus's Simple inside coefficient of a face (arguments as `tarp_inside`)."""
+    c = abs(np.cos(np.radians(tilt)))
+    if c < 1e-6:
+        return SIMPLE_INSIDE["vertical"]
+    unstable, stable = SIMPLE_INSIDE["horizontal" if c > 0.99 else "tilted"]
+    return unstable if (tilt > 90) == warmer else stable

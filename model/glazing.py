@@ -1,0 +1,175 @@
+"""Glazing physics (docs/model.md section 4.1): a pane's and a stack of panes' solar
+transmittance with the angle of incidence, its hemispherical (diffuse) mean, the conductance of a
+gas gap, and the solar transmittance EnergyPlus's simple glazing model gives a (U, SHGC) pair.
+
+Angles in degrees, conductances in W/m2/K, transmittances and reflectances dimensionless.
+"""
+import numpy as np
+from scipy.optimize import brentq
+
+SIGMA = 5.670374419e-8  # W/m2/K4
+# Angles (deg) at which a glazing's transmittance is tabulated in a building file
+ANGLES = tuple(range(0, 91, 10))
+
+
+def pane_optics(T0, R0):
+    """(r, tau) of an uncoated pane from its solar transmittance T0 and reflectance R0 at normal
+    incidence: r the reflectance of one air-glass interface, tau the internal transmittance of the
+    glass, from T0 = (1 - r)^2 tau / (1 - r^2 tau^2) and R0 = r + r (1 - r)^2 tau^2 / (1 - r^2 tau^2)
+    (the pane's interreflections summed)."""
+    if not (0 < T0 < 1 and 0 <= R0 < 1 and T0 + R0 <= 1):
+        raise ValueError(f"a pane needs 0 < T < 1, 0 <= R < 1 and T + R <= 1 (T={T0}, R={R0})")
+
+    def tau_of(r):
+        if r == 0:
+            return T0
+        return (-(1 - r) ** 2 + np.sqrt((1 - r) ** 4 + 4 * T0 ** 2 * r ** 2)) / (2 * T0 * r ** 2)
+
+    def reflectance(r):
+        tau = tau_of(r)
+        return r + r * (1 - r) ** 2 * tau ** 2 / (1 - r ** 2 * tau ** 2) - R0
+
+    if R0 <= 1e-9:
+        return 0.0, T0
+    r = brentq(reflectance, 1e-12, R0)
+    return r, tau_of(r)
+
+
+def pane_at(T0, R0, angle):
+    """(T, R) of an uncoated pane at an angle of incidence (deg, 0 normal): Fresnel's interface
+    reflectances for s and p light at the refractive index r gives, the glass's absorption over the
+    refracted path (tau^(1 / cos theta')), the pane's interreflections, s and p averaged."""
+    r0, tau0 = pane_optics(T0, R0)
+    phi = np.radians(np.asarray(angle, dtype=float))
+    n = (1 + np.sqrt(r0)) / (1 - np.sqrt(r0))
+    phi_t = np.arcsin(np.sin(phi) / n)
+    tau = tau0 ** (1.0 / np.cos(phi_t))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rs = np.where(phi > 1e-9, (np.sin(phi - phi_t) / np.sin(phi + phi_t)) ** 2, r0)
+        rp = np.where(phi > 1e-9, (np.tan(phi - phi_t) / np.tan(phi + phi_t)) ** 2, r0)
+    rs, rp = np.where(phi >= np.pi / 2 - 1e-9, 1.0, rs), np.where(phi >= np.pi / 2 - 1e-9, 1.0, rp)
+    T = R = 0.0
+    for r in (rs, rp):
+        d = 1 - r ** 2 * tau ** 2
+        T = T + 0.5 * (1 - r) ** 2 * tau / d
+        R = R + 0.5 * (r + r * (1 - r) ** 2 * tau ** 2 / d)
+    return T, R
+
+
+def stack_transmittance(panes, angle):
+    """Solar transmittance of panes in series (outside first), each (T0, R0) at normal incidence
+    and the same on both faces, at an angle of incidence (deg): adding a pane behind a stack of
+    transmittance T, back reflectance R_b gives T T_k / (1 - R_b R_k) (interreflections between
+    them), R_b' = R_k + T_k^2 R_b / (1 - R_b R_k)."""
+    T, Rb = None, None
+    for T0, R0 in panes:
+        Tk, Rk = pane_at(T0, R0, angle)
+        if T is None:
+            T, Rb = Tk, Rk
+        else:
+            d = 1 - Rb * Rk  # 0 only at grazing incidence, where every pane reflects all
+            safe = np.where(d > 0, d, 1.0)
+            T, Rb = np.where(d > 0, T * Tk / safe, 0.0), np.where(d > 0, Rk + Tk ** 2 * Rb / safe, 1.0)
+    return T
+
+
+def stack_reflectance(panes):
+    """Front solar reflectance of panes in series (outside first) at normal incidence."""
+    R = T = None
+    for T0, R0 in panes:
+        if R is None:
+            T, R, Rb = T0, R0, R0
+        else:
+            d = 1 - Rb * R0
+            R, T, Rb = R + T ** 2 * R0 / d, T * T0 / d, R0 + T0 ** 2 * Rb / d
+    return R
+
+
+def hemispherical(transmittance, n=91):
+    """The diffuse (hemispherical) mean of an angular transmittance function f(angle deg),
+    2 integral_0^(pi/2) f(theta) cos theta sin theta d theta, by the trapezoid rule on n angles."""
+    theta = np.linspace(0.0, np.pi / 2, n)
+    return float(np.trapezoid(2 * np.asarray(transmittance(np.degrees(theta))) * np.cos(theta) * np.sin(theta), theta))
+
+
+def radiative_conductance(emissivity_1, emissivity_2, T_mean=283.15):
+    """h_r = 4 sigma T_m^3 / (1/e1 + 1/e2 - 1) (W/m2/K): the linearised long-wave exchange between
+    two parallel grey planes at a mean temperature T_m (K)."""
+    return 4 * SIGMA * T_mean ** 3 / (1 / emissivity_1 + 1 / emissivity_2 - 1)
+
+
+# The conductivity of air (W/m/K) at a temperature T (K), ISO 15099 / EnergyPlus's coefficients,
+# and what the gap's convection is evaluated at: the mean temperature and the difference across it
+AIR_CONDUCTIVITY = (2.873e-3, 7.76e-5)
+GAP_T_MEAN = 283.15  # K
+GAP_DELTA_T = 15.0  # K
+
+
+def gap_conductance(thickness, height, emissivity_1, emissivity_2, T_mean=GAP_T_MEAN, delta_T=GAP_DELTA_T):
+    """Conductance (W/m2/K) of an air gap of `thickness` m between two panes `height` m high:
+    conduction and convection, Nu k / d with ISO 15099's Nusselt number of a vertical cavity at
+    the Rayleigh number of (T_mean K, delta_T K), plus the radiative exchange of its two faces."""
+    k = AIR_CONDUCTIVITY[0] + AIR_CONDUCTIVITY[1] * T_mean
+    mu = 3.723e-6 + 4.94e-8 * T_mean  # Pa s
+    rho = 101325 * 0.02897 / (8.314462 * T_mean)  # kg/m3
+    cp = 1002.737 + 1.2324e-2 * T_mean  # J/kg/K
+    ra = rho ** 2 * thickness ** 3 * 9.81 * cp * delta_T / (mu * k * T_mean)
+    aspect = height / thickness
+    if ra > 5e4:
+        nu1 = 0.0673838 * ra ** (1 / 3)
+    elif ra > 1e4:
+        nu1 = 0.028154 * ra ** 0.4134
+    else:
+        nu1 = 1 + 1.7596678e-10 * ra ** 2.2984755
+    nu2 = 0.242 * (ra / aspect) ** 0.272
+    return max(nu1, nu2) * k / thickness + radiative_conductance(emissivity_1, emissivity_2, T_mean)
+
+
+def simple_glazing_transmittance(U, shgc):
+    """Solar transmittance at normal incidence of EnergyPlus's simple glazing system from its
+    U-factor (W/m2/K) and SHGC (Engineering Reference, "Simple Window Model", step 3): the
+    correlations for U >= 4.5 and U <= 3.4, linearly interpolated between."""
+    def low(s):
+        return 0.085775 * s ** 2 + 0.963954 * s - 0.084958 if s > 0.15 else 0.4104 * s
+
+    def high(s):
+        return 0.939998 * s ** 2 + 0.20332 * s
+
+    if U >= 4.5:
+        return high(shgc)
+    if U <= 3.4:
+        return low(shgc)
+    w = (U - 3.4) / 1.1
+    return (1 - w) * low(shgc) + w * high(shgc)
+
+
+def simple_glazing_films(U):
+    """(h_inside, h_outside) W/m2/K that EnergyPlus's simple glazing model takes its U-factor (W/m2/K)
+    to include (Engineering Reference, "Simple Window Model", step 2)."""
+    h_in = 0.359073 * np.log(U) + 6.949915 if U < 5.85 else 1.788041 * U - 2.886625
+    return float(h_in), 0.025342 * U + 29.163853
+
+
+def pane_absorptances(panes):
+    """Solar absorptance of each pane of a stack (outside first) at normal incidence, each
+    (T0, R0) the same on both faces, of the sun falling on the outermost pane: with f_k and b_k
+    the flux falling on pane k from outside and from inside, f_1 = 1 and b_N = 0,
+
+        f_k+1 = T_k f_k + R_k b_k,    b_k-1 = T_k b_k + R_k f_k,    A_k = (1 - T_k - R_k)(f_k + b_k)
+
+    every interreflection counted (a linear system of the 2N fluxes)."""
+    n = len(panes)
+    # unknowns: f_1..f_N, b_1..b_N
+    M, v = np.zeros((2 * n, 2 * n)), np.zeros(2 * n)
+    M[0, 0], v[0] = 1.0, 1.0  # f_1 = 1
+    M[1, 2 * n - 1] = 1.0  # b_N = 0
+    row = 2
+    for k, (T, R) in enumerate(panes):
+        if k + 1 < n:  # f_k+1 = T f_k + R b_k
+            M[row, k + 1], M[row, k], M[row, n + k] = 1.0, -T, -R
+            row += 1
+        if k > 0:  # b_k-1 = T b_k + R f_k
+            M[row, n + k - 1], M[row, n + k], M[row, k] = 1.0, -T, -R
+            row += 1
+    flux = np.linalg.solve(M, v)
+    return [(1 - T - R) * (flux[k] + flux[n + k]) for k, (T, R) in enumerate(panes)]

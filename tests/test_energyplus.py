@@ -1,0 +1,547 @@
+"""nodeforce convert (iotools/energyplus.py) against hand calculations from the IDF text of
+nodeforce's own ASHRAE 140 case 600 (examples/bestest/case600.idf), its refusals, and the physics it rests on
+(model/geometry.py, model/glazing.py, model/schedule.py)."""
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from nodeforce.api import convert_idf
+from nodeforce.iotools.energyplus import compress_schedule
+from nodeforce.model import geometry, glazing
+from nodeforce.model.building import parse_building
+from nodeforce.model.errors import InputError
+from nodeforce.model.network import air_density_at, assemble, input_names
+from nodeforce.model.schedule import Schedule
+
+BESTEST = Path(__file__).resolve().parents[1] / "examples" / "bestest"
+CASE600 = BESTEST / "case600.idf"
+
+
+@pytest.fixture(scope="module")
+def case600():
+    return convert_idf(CASE600)
+
+
+# ---- geometry ---------------------------------------------------------------------------
+SOUTH = [[0, 0, 2.7], [0, 0, 0], [8, 0, 0], [8, 0, 2.7]]  # case 600's south wall, counterclockwise
+
+
+def test_area_and_orientation_of_a_wall():
+    assert geometry.area(SOUTH) == pytest.approx(8 * 2.7)
+    assert geometry.azimuth_tilt(geometry.outward_normal(SOUTH)) == pytest.approx((180.0, 90.0))
+    # listed clockwise, the same vertices face north
+    assert geometry.azimuth_tilt(geometry.outward_normal(SOUTH, counterclockwise=False))[0] == pytest.approx(0.0)
+
+
+def test_relative_north_turns_the_azimuth():
+    turned = geometry.rotate_z(SOUTH, 30.0)
+    assert geometry.azimuth_tilt(geometry.outward_normal(turned))[0] == pytest.approx(210.0)
+
+
+def test_volume_of_a_box():
+    box = [[[8, 0, 2.7], [8, 0, 0], [8, 6, 0], [8, 6, 2.7]], [[8, 6, 0], [8, 0, 0], [0, 0, 0], [0, 6, 0]],
+           [[8, 6, 2.7], [8, 6, 0], [0, 6, 0], [0, 6, 2.7]], [[8, 0, 2.7], [8, 6, 2.7], [0, 6, 2.7], [0, 0, 2.7]],
+           SOUTH, [[0, 6, 2.7], [0, 6, 0], [0, 0, 0], [0, 0, 2.7]]]
+    assert geometry.enclosed_volume(box) == pytest.approx(8 * 6 * 2.7)
+
+
+# ---- glazing -----------------------------------------------------------------------------
+def test_pane_at_normal_incidence_is_its_data():
+    T, R = glazing.pane_at(0.86156, 0.07846, 0.0)
+    assert (float(T), float(R)) == pytest.approx((0.86156, 0.07846), abs=1e-9)
+
+
+def test_two_panes_interreflect():
+    T, R = 0.86156, 0.07846
+    assert float(glazing.stack_transmittance([(T, R), (T, R)], 0.0)) == pytest.approx(T * T / (1 - R * R))
+    assert float(glazing.stack_transmittance([(T, R), (T, R)], 90.0)) == 0.0
+
+
+def test_transmittance_falls_with_incidence_and_its_diffuse_mean():
+    angles = np.arange(0, 91, 5)
+    T = glazing.stack_transmittance([(0.86156, 0.07846)] * 2, angles)
+    assert np.all(np.diff(T) <= 1e-12)
+    assert glazing.hemispherical(lambda a: np.ones_like(a)) == pytest.approx(1.0, abs=1e-3)
+    # a clear double glazing lets in some 0.85 of its normal transmittance from a diffuse sky
+    assert 0.8 < glazing.hemispherical(lambda a: glazing.stack_transmittance([(0.86156, 0.07846)] * 2, a)) / T[0] < 0.9
+
+
+def test_gap_conductance_is_conduction_and_radiation_when_still():
+    d = 0.013  # a 13 mm gap is below convection's onset: Nu = 1 within 5 %
+    k = glazing.AIR_CONDUCTIVITY[0] + glazing.AIR_CONDUCTIVITY[1] * glazing.GAP_T_MEAN
+    h_r = 4 * glazing.SIGMA * glazing.GAP_T_MEAN ** 3 / (2 / 0.84 - 1)
+    assert glazing.gap_conductance(d, 2.0, 0.84, 0.84) == pytest.approx(k / d + h_r, rel=0.05)
+
+
+# ---- schedules ---------------------------------------------------------------------------
+NIGHT = Schedule(name="night", days=(("d", ((7.0, 1.0), (18.0, 0.04), (24.0, 1.0))),),
+                 periods=(((12, 31), ("d",) * 7),))
+
+
+def test_schedule_value_holds_until_its_hour():
+    hours = np.array([0.5, 6.99, 7.0, 7.01, 17.5, 18.0, 18.5, 24.0])
+    ones = np.ones_like(hours, dtype=int)
+    assert list(NIGHT.at(ones, ones, ones * 2, hours)) == [1, 1, 1, 0.04, 0.04, 0.04, 1, 1]
+
+
+def test_schedule_on_the_local_clock():
+    times = pd.date_range("2017-06-01 13:00", periods=2, freq="h", tz="UTC")  # 06:00 and 07:00 at UTC-7
+    assert list(NIGHT.on(times, "Etc/GMT+7")) == [1.0, 1.0]
+    assert list(NIGHT.on(times + pd.Timedelta("30min"), "Etc/GMT+7")) == [1.0, 0.04]
+
+
+def test_compressed_schedule_reads_back():
+    """A weekday / weekend profile over a year, compressed and read back on the same calendar."""
+    days = pd.date_range("2017-01-01", "2017-12-31", freq="D")
+    values = np.array([[1.0 if (d.weekday() < 5 and 8 <= h < 18) else 0.2 for h in range(24)] for d in days])
+    data = compress_schedule(values, 2017)
+    assert len(data["periods"]) == 1 and data["periods"][0]["through"] == "12-31"
+    building = minimal_building(schedules={"s": data})
+    hours = pd.date_range("2017-01-01 00:30", "2017-12-31 23:30", freq="h", tz="UTC")
+    assert np.array_equal(building.schedules["s"].on(hours, "UTC"), values.ravel())
+
+
+def minimal_building(**extra):
+    data = {"format": "nodal-building/1", "site": {"latitude": 45, "longitude": 5},
+            "materials": {"m": {"conductivity": 1.0, "density": 1000, "specific_heat": 1000}},
+            "zones": [{"name": "z", "volume": 10.0}],
+            "components": [{"name": "w", "area": 10.0, "tilt": 90, "azimuth": 0, "layers": [["m", 0.1]],
+                            "nodes": {"max_spacing": 0.1}, "inside": {"zone": "z", "h_conv": 2.5, "h_rad": 5},
+                            "outside": {"type": "adiabatic"}}]}
+    data.update(extra)
+    return parse_building(data)
+
+
+def test_scheduled_gain_splits_between_air_and_radiant_node():
+    b = minimal_building(schedules={"s": {"days": {"d": [[12, 0.0], [24, 1.0]]},
+                                          "periods": [{"through": "12-31", "week": ["d"] * 7}]},
+                                    "c": {"constant": 0.5}})
+    b = b.edited(lambda d: d["zones"][0].update(gains=[{"name": "g", "power": 100, "radiant_fraction": 0.3,
+                                                        "schedule": "s"},
+                                                       {"name": "k", "power": 40, "radiant_fraction": 0.5,
+                                                        "schedule": "c"}]))
+    net = assemble(b)
+    z = b.zones[0]
+    j = input_names(b).index("s")
+    assert net.B[z.air_node - 1, j] == pytest.approx(70.0) and net.B[z.radiant_node - 1, j] == pytest.approx(30.0)
+    assert net.q[z.air_node - 1] == pytest.approx(10.0) and net.q[z.radiant_node - 1] == pytest.approx(10.0)
+
+
+def test_air_density_scales_the_air_capacity():
+    assert air_density_at(0.0) == pytest.approx(1.204, abs=1e-3)
+    # at Denver's 1611 m the standard atmosphere's pressure is 83.4 kPa
+    assert air_density_at(1611.0) == pytest.approx(83.42e3 / (287.05 * 293.15), rel=1e-3)
+    thin = minimal_building().edited(lambda d: d["site"].update(air_density=1.0))
+    air = thin.zones[0].air_node - 1
+    assert assemble(thin).C[air] == pytest.approx(1.0 * 1005 * 10.0)
+    assert assemble(minimal_building()).C[air] == pytest.approx(1.2 * 1005 * 10.0)
+
+
+# ---- case 600 against the IDF text -------------------------------------------------------
+def test_case600_site_zone_and_flows(case600):
+    assert case600.site["latitude"] == 39.76 and case600.site["timezone"] == "Etc/GMT+7"
+    z = case600.zones[0]
+    assert z.volume == pytest.approx(129.6)  # the IDF's volume field
+    assert z.air_change_rate == pytest.approx(0.5)  # AirChanges/Hour 0.5, schedule always 1
+    (gain,) = z.gains
+    assert (gain.power, gain.radiant_fraction, gain.schedule) == (200.0, 0.6, None)
+
+
+def test_case600_areas_and_orientations(case600):
+    c = {k.name: k for k in case600.components}
+    # the south wall 8 x 2.7 m less its two 3 x 2 m windows
+    assert c["SOUTH WALL"].area == pytest.approx(21.6 - 12.0)
+    assert c["SOUTH WINDOW WEST"].area == pytest.approx(6.0)
+    for name, azimuth, tilt in (("SOUTH WALL", 180, 90), ("EAST WALL", 90, 90),
+                                ("WEST WALL", 270, 90), ("NORTH WALL", 0, 90),
+                                ("ROOF", None, 0), ("FLOOR", None, 180)):
+        assert c[name].tilt == pytest.approx(tilt)
+        if azimuth is not None:
+            assert c[name].azimuth == pytest.approx(azimuth)
+
+
+def test_case600_layers_inside_first_and_u_value(case600):
+    wall = case600.component("EAST WALL")
+    # LIGHT WALL: WOOD SIDING (outside), WALL FIBERGLASS QUILT, PLASTERBOARD 12 MM
+    assert [round(t, 6) for _, t in wall.layers] == [0.012, 0.066, 0.009]
+    R = sum(t / m.conductivity for m, t in wall.layers)
+    assert R == pytest.approx(0.012 / 0.16 + 0.066 / 0.04 + 0.009 / 0.14)
+    C = sum(t * m.density * m.specific_heat for m, t in wall.layers)
+    assert C == pytest.approx(0.012 * 950 * 840 + 0.066 * 12 * 840 + 0.009 * 530 * 900)
+    floor = case600.component("FLOOR")
+    # FLOOR INSULATION (NoMass, 25.075 m2K/W) under the timber: its resistance kept, no capacity
+    assert sum(t / m.conductivity for m, t in floor.layers) == pytest.approx(0.025 / 0.14 + 25.075)
+    assert floor.outside.temperature == "ground temperature"
+    assert case600.schedules["ground temperature"].value == 10.0  # the IDF's monthly 10 C
+
+
+def test_case600_window(case600):
+    w = case600.component("SOUTH WINDOW WEST")
+    T, R = 0.86156, 0.07846
+    assert w.solar_transmittance == pytest.approx(T * T / (1 - R * R), abs=1e-6)
+    assert w.transmitted_solar_to == "FLOOR"
+    assert w.angular.factors[0] == 1.0 and w.angular.factors[-1] == 0.0
+    # each pane absorbs a = 1 - T - R of what falls on it: the outer pane 1 + T R / (1 - R^2) of
+    # the sun, the inner T / (1 - R^2)
+    a = 1 - T - R
+    assert w.outside.solar_absorptance == pytest.approx(a * (1 + T * R / (1 - R * R)), abs=1e-6)
+    assert w.inner_solar_absorptance == pytest.approx(a * T / (1 - R * R), abs=1e-6)
+
+
+def test_case600_interior_solar_distribution(case600):
+    """The floor absorbs 0.6 of the direct sun; the 0.4 it reflects spreads over every inside
+    surface as area x absorptance, the windows' share (12 m2 x 1 - R_back) leaving."""
+    w = case600.component("SOUTH WINDOW WEST")
+    shares = dict(w.solar_distribution)
+    T, R = 0.86156, 0.07846
+    glazing_take = 1 - (R + T * T * R / (1 - R * R))
+    S = (48 + 48 + 16.2 + 16.2 + 21.6 + 9.6) * 0.6 + 12 * glazing_take
+    assert shares["FLOOR"] == pytest.approx(0.6 + 0.4 * 48 * 0.6 / S, abs=1e-5)
+    assert shares["ROOF"] == pytest.approx(0.4 * 48 * 0.6 / S, abs=1e-5)
+    assert 1 - sum(shares.values()) == pytest.approx(0.4 * 12 * glazing_take / S, abs=1e-5)
+
+
+def test_case600_exterior_convection_is_doe2_at_the_reference_wind(case600):
+    from nodeforce.model import convection
+    wall = case600.component("EAST WALL")
+    # WOOD SIDING is Rough (R_f 1.67), the wall's centroid 1.35 m up, the site's terrain Country
+    v = 4.0 * (270 / 10) ** 0.14 * (1.35 / 270) ** 0.14
+    h_n = 1.31 * 5.0 ** (1 / 3)
+    windward = h_n + 1.67 * (np.hypot(h_n, 3.26 * v ** 0.89) - h_n)
+    leeward = h_n + 1.67 * (np.hypot(h_n, 3.55 * v ** 0.617) - h_n)
+    assert wall.outside.h_conv == pytest.approx((windward + leeward) / 2, abs=1e-3)
+    assert convection.wind_at_height(4.0, 10.0) == pytest.approx(4.0)
+
+
+WITH_HVAC = CASE600.read_text() + """
+ZoneHVAC:IdealLoadsAirSystem,
+  IDEAL LOADS,                  !- Name
+  ,                             !- Availability Schedule Name
+  SUPPLY NODE,                  !- Zone Supply Air Node Name
+  ;                             !- Zone Exhaust Air Node Name
+
+ThermostatSetpoint:SingleHeating,
+  HEAT AT 20,                   !- Name
+  CONTINUOUS;                   !- Setpoint Temperature Schedule Name
+"""
+
+
+def test_case600_lists_what_it_does_not_hold(tmp_path):
+    """case600.idf holds nothing the building file lacks; a thermostat and an
+    ideal loads system added to it are listed, one line each."""
+    assert convert_idf(CASE600).data["not_modelled"] == []
+    path = tmp_path / "hvac.idf"
+    path.write_text(WITH_HVAC)
+    lines = convert_idf(path).data["not_modelled"]
+    assert [line.split(":")[0] + ":" + line.split(":")[1].split()[0] for line in lines] == [
+        "ZoneHVAC:IdealLoadsAirSystem", "ThermostatSetpoint:SingleHeating"]
+    assert lines[0].startswith("ZoneHVAC:IdealLoadsAirSystem IDEAL LOADS")
+
+
+# ---- refusals ------------------------------------------------------------------------------
+TEXT = CASE600.read_text()
+
+
+def edited(replace_from, replace_to):
+    assert replace_from in TEXT
+    return TEXT.replace(replace_from, replace_to, 1)
+
+
+BAD = {
+    "no version": (edited("Version,\n  9.3;", ""), "Version"),
+    "old version": (edited("Version,\n  9.3;", "Version,\n  7.2;"), "older than 8.5"),
+    "no site": (edited("Site:Location,", "Site:Locationx,"), "(file)"),
+    "unknown material": (edited("  WALL FIBERGLASS QUILT,        !- Layer 2",
+                                "  NO SUCH MATERIAL,             !- Layer 2"), "Construction 'LIGHT WALL', field Layer 2"),
+    "unknown zone": (edited("  CASE 600 ZONE,                !- Zone Name\n  Outdoors",
+                            "  NO ZONE,                      !- Zone Name\n  Outdoors"), "names no Zone"),
+    "unsupported boundary": (edited("  Ground,                       !- Outside Boundary Condition",
+                                    "  OtherSideCoefficients,        !- Outside Boundary Condition"),
+                             "is not read"),
+    "zone multiplier": (edited("  1,                            !- Multiplier\n  2.7,",
+                               "  2,                            !- Multiplier\n  2.7,"), "Multiplier"),
+    "unknown window surface": (edited("  SOUTH WALL,                   !- Building Surface Name",
+                                      "  NO SURFACE,                   !- Building Surface Name"), "Building Surface Name"),
+    "unknown schedule": (edited("  CONTINUOUS,                   !- Schedule Name",
+                                "  No Such Schedule,             !- Schedule Name"), "No Such Schedule"),
+    "flow method": (edited("  AirChanges/Hour,", "  Flow/Person,"), "Design Flow Rate Calculation Method"),
+}
+
+
+@pytest.mark.parametrize("kind", BAD)
+def test_bad_idf_is_one_line_naming_the_object_and_field(kind, tmp_path):
+    text, expected = BAD[kind]
+    path = tmp_path / "bad.idf"
+    path.write_text(text)
+    with pytest.raises(InputError) as e:
+        convert_idf(path)
+    message = str(e.value)
+    assert "\n" not in message and str(path) in message and expected in message
+
+
+def test_cli_convert(tmp_path):
+    nodeforce = Path(sys.executable).parent / "nodeforce"
+    out, idf = tmp_path / "b.json", tmp_path / "hvac.idf"
+    idf.write_text(WITH_HVAC)
+    done = subprocess.run([nodeforce, "convert", idf, "-o", out], capture_output=True, text=True)
+    assert done.returncode == 0
+    assert "not modelled: ZoneHVAC:IdealLoadsAirSystem" in done.stdout
+    assert json.loads(out.read_text())["not_modelled"]
+    bad = tmp_path / "bad.idf"
+    bad.write_text(BAD["unknown zone"][0])
+    done = subprocess.run([nodeforce, "convert", bad, "-o", out], capture_output=True, text=True)
+    assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1
+
+
+# ---- scheduled ventilation ---------------------------------------------------------------
+def test_scheduled_ventilation_steady_states(tmp_path):
+    """A zone of light adiabatic walls, 100 W and 100 m3/h of outdoor air at 0 C by night
+    (schedule 1) and a quarter of it by day: each half day ends at the steady state
+    T_air = Q / (s g), g = rho c V / 3600, with the switched conductance."""
+    from nodeforce.iotools.weather import read_weather
+    from nodeforce.model.case import simulate_building
+    light = {"conductivity": 1.0, "density": 1.0, "specific_heat": 100.0}
+    b = minimal_building(
+        materials={"m": light},
+        schedules={"night": {"days": {"d": [[6, 1.0], [18, 0.25], [24, 1.0]]},
+                             "periods": [{"through": "12-31", "week": ["d"] * 7}]}})
+    b = b.edited(lambda d: d["zones"][0].update(internal_gain=100.0, ventilation=[
+        {"name": "vent", "flow": 100.0, "schedule": "night"}]))
+    times = pd.date_range("2017-03-01", periods=3 * 24 * 4 + 1, freq="15min", tz="UTC")
+    path = tmp_path / "w.csv"
+    pd.DataFrame({"time": [t.isoformat() for t in times], "T_out": 0.0, "ghi": 0.0, "dni": 0.0,
+                  "dhi": 0.0}).to_csv(path, index=False)
+    T = simulate_building(b, read_weather(path))
+    air = pd.Series(T[f"T{b.zones[0].air_node}"].to_numpy(), index=times[1:])
+    g = 1.2 * 1005 * 100 / 3600
+    assert air[pd.Timestamp("2017-03-02 17:45", tz="UTC")] == pytest.approx(100 / (0.25 * g), rel=1e-3)
+    assert air[pd.Timestamp("2017-03-03 05:45", tz="UTC")] == pytest.approx(100 / g, rel=1e-3)
+
+
+def test_standalone_fmu_refuses_a_switched_conductance():
+    from nodeforce.fmu_build.standalone import network_terms
+    b = minimal_building(schedules={"s": {"days": {"d": [[12, 0.0], [24, 1.0]]},
+                                          "periods": [{"through": "12-31", "week": ["d"] * 7}]}})
+    b = b.edited(lambda d: d["zones"][0].update(ventilation=[{"name": "v", "flow": 10.0, "schedule": "s"}]))
+    with pytest.raises(InputError, match="follows a schedule"):
+        network_terms(b, None)
+    from nodeforce.ga.locate import evaluator_kind
+    assert evaluator_kind(b) == "python"  # "auto" never picks the FMU that cannot run it
+
+
+def test_650ff_converts_its_night_ventilation(tmp_path):
+    """650FF is case600.idf with the standard's vent fan: 1703.16 m3/h from 18:00 to 07:00, the
+    0.5 air changes an hour of infiltration kept all day."""
+    sys.path.insert(0, str(BESTEST))
+    import cases
+    import idfkit
+    path = tmp_path / "650FF.idf"
+    idfkit.save_idf(cases.case_650ff(), str(path))
+    b = convert_idf(path)
+    z = b.zones[0]
+    assert z.air_change_rate == pytest.approx(0.5)
+    (vent,) = z.ventilation
+    assert vent.flow == pytest.approx(1703.16)  # m3/h
+    s = b.schedules[vent.schedule]
+    hours = np.array([6.5, 7.5, 17.5, 18.5])
+    ones = np.ones(4, dtype=int)
+    assert list(s.at(ones, ones, ones, hours)) == [1, 0, 0, 1]
+
+
+def test_900ff_high_mass_layers(tmp_path):
+    """900FF: the walls' concrete block, foam and siding, the floor's slab over 1.007 m of
+    insulation; the roof as 600."""
+    sys.path.insert(0, str(BESTEST))
+    import cases
+    import idfkit
+    path = tmp_path / "900FF.idf"
+    idfkit.save_idf(cases.case_900ff(), str(path))
+    b = convert_idf(path)
+    wall = b.component("EAST WALL")
+    assert [round(t, 6) for _, t in wall.layers] == [0.1, 0.0615, 0.009]
+    C = sum(t * m.density * m.specific_heat for m, t in wall.layers)
+    assert C == pytest.approx(0.1 * 1400 * 1000 + 0.0615 * 10 * 1400 + 0.009 * 530 * 900)
+    floor = b.component("FLOOR")
+    assert sum(t / m.conductivity for m, t in floor.layers) == pytest.approx(0.08 / 1.13 + 1.007 / 0.04)
+    roof, roof600 = b.component("ROOF"), convert_idf(CASE600).component("ROOF")
+    assert roof.layers == roof600.layers
+
+
+def test_inner_absorptance_and_distribution_in_the_network():
+    b = minimal_building(components=[
+        {"name": "w", "area": 10.0, "tilt": 90, "azimuth": 180, "layers": [["m", 0.1]], "nodes": {"max_spacing": 0.1},
+         "inside": {"zone": "z", "h_conv": 2.5, "h_rad": 5}, "outside": {"type": "exterior", "h_conv": 10, "h_rad": 4,
+                                                                       "solar_absorptance": 0.1},
+         "solar_transmittance": 0.5, "transmitted_solar_to": "f", "solar_distribution": {"f": 0.7, "w": 0.2},
+         "inner_solar_absorptance": 0.05},
+        {"name": "f", "area": 20.0, "tilt": 180, "azimuth": 0, "layers": [["m", 0.1]], "nodes": {"max_spacing": 0.1},
+         "inside": {"zone": "z", "h_conv": 2.5, "h_rad": 5}, "outside": {"type": "adiabatic"}}])
+    net = assemble(b)
+    j = input_names(b).index("I_w")
+    w, f = b.component("w"), b.component("f")
+    assert net.B[f.node_ids[0] - 1, j] == pytest.approx(0.5 * 10 * 0.7)
+    # the glazing's own inside face: 0.2 of what it lets in, and 0.05 of the sun on it
+    assert net.B[w.node_ids[0] - 1, j] == pytest.approx(0.5 * 10 * 0.2 + 10 * 0.05)
+    assert net.B[w.node_ids[-1] - 1, j] == pytest.approx(10 * 0.1)
+    with pytest.raises(InputError, match="at most 1"):
+        b.edited(lambda d: d["components"][0].update(solar_distribution={"f": 0.9, "w": 0.2}))
+
+
+def test_sky_fraction_is_energyplus_sky_and_air_split(case600):
+    """A wall of view factor to ground 0.5 sees the sky over 0.5 of its view, of which
+    beta = sqrt(1/2) is the sky itself; a roof all sky."""
+    from nodeforce.model.network import sky_fraction_energyplus
+    assert case600.component("EAST WALL").outside.sky_view_factor == pytest.approx(0.5 * np.sqrt(0.5), abs=1e-6)
+    assert case600.component("ROOF").outside.sky_view_factor == pytest.approx(1.0)
+    assert sky_fraction_energyplus(90.0) == pytest.approx(0.5 * np.sqrt(0.5))
+    assert sky_fraction_energyplus(60.0, ground_view=0.2) == pytest.approx(0.8 * np.sqrt(0.75))
+
+
+def test_declared_sky_fraction_in_the_network():
+    b = minimal_building(components=[
+        {"name": "w", "area": 10.0, "tilt": 90, "azimuth": 180, "layers": [["m", 0.1]], "nodes": {"max_spacing": 0.1},
+         "inside": {"zone": "z", "h_conv": 2.5, "h_rad": 5},
+         "outside": {"type": "exterior", "h_conv": 10, "h_rad": 4, "solar_absorptance": 0.1, "sky_view_factor": 0.3}}])
+    net, names = assemble(b), input_names(b)
+    e = b.component("w").node_ids[-1] - 1
+    assert net.B[e, names.index("T_sky")] == pytest.approx(10 * 4 * 0.3)
+    assert net.B[e, names.index("T_out")] == pytest.approx(10 * (10 + 4 * 0.7))
+
+
+def test_inside_convection_is_tarp_at_the_stated_difference(case600):
+    """Case 600 declares TARP inside: 1.31 dT^(1/3) on a wall, the unstable form on the floor
+    (a warm face looking up), the stable one on the ceiling (a warm face looking down)."""
+    r = 5.0 ** (1 / 3)
+    assert case600.component("EAST WALL").inside.h_conv == pytest.approx(1.31 * r, abs=1e-3)
+    assert case600.component("FLOOR").inside.h_conv == pytest.approx(9.482 * r / 6.238, abs=1e-3)
+    assert case600.component("ROOF").inside.h_conv == pytest.approx(1.810 * r / 2.382, abs=1e-3)
+
+
+def test_simple_inside_algorithm_gives_energyplus_constants(tmp_path):
+    path = tmp_path / "simple.idf"
+    path.write_text(TEXT.replace("SurfaceConvectionAlgorithm:Inside,\n  TARP;", "SurfaceConvectionAlgorithm:Inside,\n  Simple;"))
+    assert "Simple;" in path.read_text()
+    b = convert_idf(path)
+    assert b.component("EAST WALL").inside.h_conv == 3.076
+    assert b.component("FLOOR").inside.h_conv == 4.040
+
+
+# ---- several zones (examples/multizone/three_zones.idf) ----------------------------------
+MULTIZONE = Path(__file__).resolve().parents[1] / "examples" / "multizone" / "three_zones.idf"
+
+
+@pytest.fixture(scope="module")
+def three_zones():
+    return convert_idf(MULTIZONE)
+
+
+def test_three_zones_geometry(three_zones):
+    b = three_zones
+    assert [z.name for z in b.zones] == ["WEST OFFICE", "EAST OFFICE", "CORRIDOR"]
+    # the corridor's volume is autocalculated: 12 x 3 x 3 m from its surfaces
+    assert b.zone("CORRIDOR").volume == pytest.approx(108.0)
+    # the building's north axis turns every face 30 deg east; the east office's origin moves its walls
+    assert b.component("WEST SOUTH WALL").azimuth == pytest.approx(210.0)
+    assert b.component("EAST EAST WALL").azimuth == pytest.approx(120.0)
+    assert b.component("CORRIDOR NORTH WALL").azimuth == pytest.approx(30.0)
+    # a Window of 2 x 1.4 m, multiplier 2, on the east office's 6 x 3 m south wall
+    assert b.component("EAST SOUTH WINDOW").area == pytest.approx(5.6)
+    assert b.component("EAST SOUTH WALL").area == pytest.approx(18.0 - 5.6)
+
+
+def test_three_zones_one_partition_per_pair(three_zones):
+    names = {c.name for c in three_zones.components}
+    assert {"WEST TO EAST", "WEST TO CORRIDOR", "EAST TO CORRIDOR"} <= names
+    assert not names & {"EAST TO WEST", "CORRIDOR TO WEST", "CORRIDOR TO EAST"}
+    p = three_zones.component("WEST TO EAST")
+    assert (p.inside.zone, p.outside.zone) == ("WEST OFFICE", "EAST OFFICE")
+    # INT WALL: GYPSUM, STUD GAP (R 0.18), GYPSUM
+    assert sum(t / m.conductivity for m, t in p.layers) == pytest.approx(2 * 0.013 / 0.16 + 0.18)
+
+
+def test_three_zones_gains_and_flows(three_zones):
+    from nodeforce.model.gains import people_sensible_heat
+    b = three_zones
+    (people,) = b.zone("WEST OFFICE").gains
+    assert people.power == pytest.approx(4 * people_sensible_heat(120.0)) and people.schedule == "OFFICE"
+    (lights,) = b.zone("EAST OFFICE").gains
+    assert (lights.power, lights.radiant_fraction) == pytest.approx((10 * 30, 0.4 + 0.2))  # W/m2 x floor
+    (equipment,) = b.zone("CORRIDOR").gains
+    # 400 W less its 10 % latent; its 0.3 radiant of the whole is 1/3 of the sensible
+    assert (equipment.power, equipment.radiant_fraction) == pytest.approx((360.0, 0.3 / 0.9))
+    for z in b.zones:  # the zone list's 0.3 air changes an hour
+        assert z.air_change_rate == pytest.approx(0.3)
+    (vent,) = b.zone("CORRIDOR").ventilation
+    assert (vent.flow, vent.schedule) == (pytest.approx(0.03 * 3600), "NIGHT VENT")
+    office = b.schedules["OFFICE"]
+    # 2017-04-03 is a Monday, 04-08 a Saturday
+    assert list(office.at(np.array([4, 4, 4]), np.array([3, 3, 8]), np.array([0, 0, 5]),
+                          np.array([7.5, 12.0, 12.0]))) == [0.1, 1.0, 0.1]
+    assert b.schedules["ground temperature"].at(np.array([7]), np.array([15]), np.array([0]), np.array([1.0]))[0] == 16
+    lines = b.data["not_modelled"]
+    assert any(l.startswith("ThermostatSetpoint:SingleHeating WEST HEATING SETPOINT") for l in lines)
+    assert any(l.startswith("Shading:Building:Detailed SOUTH OVERHANG") for l in lines)
+
+
+# ---- corrections written back (model_after.idf) ------------------------------------------
+def test_corrections_written_back_and_read_again(tmp_path):
+    """Case 600 corrected by five effects: model_after.idf holds each in its object, and converted
+    again it is the corrected building; an effect no object holds is said so."""
+    import idfkit
+    from nodeforce.iotools.energyplus_corrections import write_corrections
+    from nodeforce.model.effects import EFFECTS
+    before = convert_idf(CASE600, tmp_path / "600.json")
+    effects = [("infiltration", "CASE 600 ZONE", {"n": 1.2}), ("internal_gain", "CASE 600 ZONE", {"Q": 150.0}),
+               ("conductivity", "EAST WALL", {"factor": 2.0}),
+               ("solar_transmittance", "SOUTH WINDOW WEST", {"tau": 0.6}),
+               ("internal_mass", "CASE 600 ZONE", {"C_m": 2e6, "H_m": 50.0}),
+               ("inside_convection", "CASE 600 ZONE", {"factor": 2.0})]
+    after = before
+    for effect, target, values in effects:
+        after = EFFECTS[effect].apply(after, target, values)
+    out = tmp_path / "model_after.idf"
+    result = write_corrections(before, after, [{"effect": e, "target": t} for e, t, _ in effects],
+                               CASE600, out)
+    doc = idfkit.load_idf(str(out))
+    infiltration = doc.getobject("ZONEINFILTRATION:DESIGNFLOWRATE", "INFILTRATION")
+    assert float(infiltration.air_changes_per_hour) == pytest.approx(1.2)
+    gain = doc.getobject("OTHEREQUIPMENT", "nodeforce gain CASE 600 ZONE")
+    assert float(gain.design_level) == pytest.approx(150.0) and float(gain.fraction_radiant) == 0.0
+    east = doc.getobject("BUILDINGSURFACE:DETAILED", "EAST WALL")
+    construction = doc.getobject("CONSTRUCTION", east.construction_name)
+    assert float(doc.getobject("MATERIAL", construction.layer_2).conductivity) == pytest.approx(2 * 0.04)
+    # the other walls keep LIGHT WALL
+    assert doc.getobject("BUILDINGSURFACE:DETAILED", "WEST WALL").construction_name == "LIGHT WALL"
+    assert [line.split(":")[0] for line in result["not_written"]] == ["inside_convection on CASE 600 ZONE"]
+    # converted again, the IDF is the corrected building
+    again = convert_idf(out)
+    assert again.zones[0].air_change_rate == pytest.approx(1.2)
+    assert {g.name: g.power for g in again.zones[0].gains}["nodeforce gain CASE 600 ZONE"] == pytest.approx(150.0)
+    wall, wall0 = again.component("EAST WALL"), before.component("EAST WALL")
+    R, R0 = (sum(t / m.conductivity for m, t in c.layers) for c in (wall, wall0))
+    assert R == pytest.approx(R0 / 2)
+    assert again.component("SOUTH WINDOW WEST").solar_transmittance == pytest.approx(0.6, abs=1e-5)
+    mass = again.component("nodeforce mass CASE 600 ZONE")
+    assert sum(t * m.density * m.specific_heat for m, t in mass.layers) * mass.area == pytest.approx(2e6)
+    assert mass.area * mass.inside.h_conv == pytest.approx(50.0, rel=1e-3)
+
+
+def test_the_same_model_in_energyplus_25_converts_the_same(tmp_path, three_zones):
+    """three_zones.idf brought to EnergyPlus 25.2 (its fields renamed for spaces, new ones at
+    their defaults) is the same building file."""
+    import idfkit
+    from benchmarks.bench_energyplus import to_energyplus_25
+    path = tmp_path / "three_zones_25.idf"
+    idfkit.save_idf(to_energyplus_25(idfkit.load_idf(str(MULTIZONE))), str(path))
+    assert tuple(idfkit.get_idf_version(str(path))[:2]) == (25, 2)
+    later = convert_idf(path)
+    for z, z0 in zip(later.zones, three_zones.zones):
+        assert (z.name, z.volume, z.air_change_rate, z.gains, z.ventilation) == (
+            z0.name, z0.volume, z0.air_change_rate, z0.gains, z0.ventilation)
+    assert [(c.name, c.area, c.azimuth) for c in later.components] == [
+        (c.name, c.area, c.azimuth) for c in three_zones.components]
