@@ -571,13 +571,19 @@ def _schedule(check, name, raw, where):
     return Schedule(name=name, days=tuple(profiles), periods=tuple(periods))
 
 
+def _schedule_of(check, item, where, schedules):
+    """The name of the schedule `item` follows (None: constant), checked to be one of the file's."""
+    schedule = check.text(item, "schedule", where, optional=True)
+    if schedule is not None and schedule not in schedules:
+        check.fail(f"{where}.schedule", f"names no schedule of the file ({schedule!r})")
+    return schedule
+
+
 def _gains(check, z, where, schedules):
     gains = []
     for k, g in enumerate(check.sequence(z, "gains", where, optional=True)):
         gw = f"{where}.gains[{k}]"
-        schedule = check.text(g, "schedule", gw, optional=True)
-        if schedule is not None and schedule not in schedules:
-            check.fail(f"{gw}.schedule", f"names no schedule of the file ({schedule!r})")
+        schedule = _schedule_of(check, g, gw, schedules)
         gains.append(Gain(name=check.text(g, "name", gw), power=check.number(g, "power", gw),
                           radiant_fraction=check.number(g, "radiant_fraction", gw, default=0.0, low=0, high=1),
                           schedule=schedule))
@@ -588,9 +594,7 @@ def _ventilation(check, z, where, schedules):
     flows = []
     for k, v in enumerate(check.sequence(z, "ventilation", where, optional=True)):
         vw = f"{where}.ventilation[{k}]"
-        schedule = check.text(v, "schedule", vw, optional=True)
-        if schedule is not None and schedule not in schedules:
-            check.fail(f"{vw}.schedule", f"names no schedule of the file ({schedule!r})")
+        schedule = _schedule_of(check, v, vw, schedules)
         if schedule is not None and not schedules[schedule].is_constant and any(
                 value < 0 for _, profile in schedules[schedule].days for _, value in profile):
             check.fail(f"{vw}.schedule", f"{schedule!r} takes negative values: an air flow is >= 0")
