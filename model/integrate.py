@@ -451,7 +451,7 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     # the record's steps from t_H: a history's rows are stepped apart (below)
     inputs = within_steps(U[H:], substeps, held_inputs(building, network.input_names))
     sources = [network.sources(u) for u in inputs]
-    switched = [network.switched_diagonal(u) for u in inputs] if network.switched else [None] * len(inputs)
+    switched = [network.switched_diagonal(u) for u in inputs]  # None each where nothing switches
     imposed_at = within_steps(measured[H:], substeps)
     stepper = ImplicitEuler(network, dt / substeps) if stepper is None else stepper
     T = initial_state(building, measured[0], T_default)

@@ -169,7 +169,7 @@ def read_record(building, weather, measurements, *, name=None, fraction=0.6, cal
 
 
 def synthesize(building, weather, times, sensors, *, effects=(), noise_sd=0.0, seed=0, history_days=0.0,
-               decomposition="erbs"):
+               decomposition="erbs", source="effects"):
     """What the sensors of a building would read under a weather, with effects its file does not
     declare (`nodeforce synth`).
 
@@ -188,6 +188,8 @@ def synthesize(building, weather, times, sensors, *, effects=(), noise_sd=0.0, s
         The noise's.
     history_days, decomposition
         Days of the weather simulated before the record; pvlib's split of ghi alone.
+    source : str
+        What an error about an effect that does not apply names (the command line: `--effect`).
 
     Returns
     -------
@@ -197,6 +199,8 @@ def synthesize(building, weather, times, sensors, *, effects=(), noise_sd=0.0, s
     from nodeforce.model.effects import EFFECTS
     from nodeforce.model.synth import pseudo_measurements
     for effect, target, values in effects:
+        if not EFFECTS[effect].applies(building, target):
+            raise InputError(source, f"{effect}@{target}", f"does not apply to {building.source}")
         building = EFFECTS[effect].apply(building, target, values)
     return pseudo_measurements(building, weather, times, list(sensors), noise_sd=noise_sd, seed=seed,
                                history_days=history_days, decomposition=decomposition)

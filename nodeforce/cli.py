@@ -199,14 +199,8 @@ def effect_spec(text):
 
 def cmd_synth(args):
     import pandas as pd
-    from nodeforce.model.effects import EFFECTS
     building = api.read_building(args.building)
     effects = [effect_spec(text) for text in args.effect or ()]  # several faults at once: each applied in turn
-    applied = building
-    for effect, target, values in effects:
-        if not EFFECTS[effect].applies(applied, target):
-            raise InputError("--effect", f"{effect}@{target}", f"does not apply to {args.building}")
-        applied = EFFECTS[effect].apply(applied, target, values)
     for option, value, ok in (("--days", args.days, args.days >= 1), ("--step", args.step, args.step > 0),
                               ("--noise", args.noise, args.noise >= 0),
                               ("--history-days", args.history_days, args.history_days >= 0)):
@@ -220,7 +214,7 @@ def cmd_synth(args):
                           freq=pd.Timedelta(seconds=args.step), name="time")
     frame = api.synthesize(building, api.read_weather(args.weather), times, node_list("--sensors", args.sensors),
                            effects=effects, noise_sd=args.noise, seed=args.seed, history_days=args.history_days,
-                           decomposition=args.decomposition)
+                           decomposition=args.decomposition, source="--effect")
     Path(args.output).parent.mkdir(parents=True, exist_ok=True)
     frame.round(4).to_csv(args.output, date_format="%Y-%m-%dT%H:%M:%S%z")
     print(f"wrote {args.output}: nodes {args.sensors}, {len(times)} times from {times[0].isoformat()}, "
