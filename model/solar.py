@@ -113,19 +113,17 @@ def incident_irradiance(position, ghi, dni, dhi, tilt, azimuth, albedo):
         pvlib's isotropic `get_total_irradiance(...)["poa_global"]`, W/m2, with NaN and negative
         values set to 0: a missing weather sample contributes no sun (docs/model.md section 4).
     """
-    poa = pvlib.irradiance.get_total_irradiance(
-        tilt,
-        azimuth,
-        np.asarray(position["apparent_zenith"], dtype=float),
-        np.asarray(position["azimuth"], dtype=float),
-        np.asarray(dni, dtype=float),
-        np.asarray(ghi, dtype=float),
-        np.asarray(dhi, dtype=float),
-        albedo=albedo,
-        model="isotropic",
-    )["poa_global"]
-    poa = np.asarray(poa, dtype=float)
+    poa = np.asarray(_isotropic(position, ghi, dni, dhi, tilt, azimuth, albedo)["poa_global"], dtype=float)
     return np.where(np.isfinite(poa) & (poa > 0.0), poa, 0.0)
+
+
+def _isotropic(position, ghi, dni, dhi, tilt, azimuth, albedo):
+    """pvlib's isotropic-sky irradiance on a plane (W/m2): its `poa_global`, `poa_direct`, the
+    sky's and the ground's `poa_diffuse`, and `aoi` (deg)."""
+    return pvlib.irradiance.get_total_irradiance(
+        tilt, azimuth, np.asarray(position["apparent_zenith"], dtype=float),
+        np.asarray(position["azimuth"], dtype=float), np.asarray(dni, dtype=float),
+        np.asarray(ghi, dtype=float), np.asarray(dhi, dtype=float), albedo=albedo, model="isotropic")
 
 
 #: pvlib's decompositions of the global horizontal irradiance into its direct and diffuse parts
@@ -198,11 +196,9 @@ def transmitted_irradiance(position, ghi, dni, dhi, tilt, azimuth, albedo, angle
 
     Parameters as `incident_irradiance`; angles (deg) and factors (-) the glazing's table, diffuse
     its factor for diffuse sun (-)."""
+    poa = _isotropic(position, ghi, dni, dhi, tilt, azimuth, albedo)
     zenith = np.asarray(position["apparent_zenith"], dtype=float)
-    theta = np.asarray(pvlib.irradiance.aoi(tilt, azimuth, zenith, np.asarray(position["azimuth"], dtype=float)))
-    f = np.interp(theta, list(angles) + [90.0 + 1e-9], list(factors) + [0.0], right=0.0)
-    beta = np.radians(tilt)
-    beam = np.asarray(dni, dtype=float) * np.maximum(np.cos(np.radians(theta)), 0.0)
-    sky = np.asarray(dhi, dtype=float) * (1 + np.cos(beta)) / 2 + np.asarray(ghi, dtype=float) * albedo * (1 - np.cos(beta)) / 2
-    sun = f * np.where(zenith < 90, beam, 0.0) + diffuse * sky
+    f = np.interp(np.asarray(poa["aoi"], dtype=float), list(angles) + [90.0 + 1e-9], list(factors) + [0.0], right=0.0)
+    beam = np.where(zenith < 90, np.asarray(poa["poa_direct"], dtype=float), 0.0)
+    sun = f * beam + diffuse * np.asarray(poa["poa_diffuse"], dtype=float)
     return np.where(np.isfinite(sun) & (sun > 0.0), sun, 0.0)
