@@ -118,8 +118,8 @@ def incident_irradiance(position, ghi, dni, dhi, tilt, azimuth, albedo):
 
 
 def _isotropic(position, ghi, dni, dhi, tilt, azimuth, albedo):
-    """pvlib's isotropic-sky irradiance on a plane (W/m2): its `poa_global`, `poa_direct`, the
-    sky's and the ground's `poa_diffuse`, and `aoi` (deg)."""
+    """pvlib's isotropic-sky irradiance on a plane (W/m2): its `poa_global`, `poa_direct` and the
+    sky's and the ground's `poa_diffuse`."""
     return pvlib.irradiance.get_total_irradiance(
         tilt, azimuth, np.asarray(position["apparent_zenith"], dtype=float),
         np.asarray(position["azimuth"], dtype=float), np.asarray(dni, dtype=float),
@@ -198,7 +198,8 @@ def transmitted_irradiance(position, ghi, dni, dhi, tilt, azimuth, albedo, angle
     its factor for diffuse sun (-)."""
     poa = _isotropic(position, ghi, dni, dhi, tilt, azimuth, albedo)
     zenith = np.asarray(position["apparent_zenith"], dtype=float)
-    f = np.interp(np.asarray(poa["aoi"], dtype=float), list(angles) + [90.0 + 1e-9], list(factors) + [0.0], right=0.0)
+    theta = pvlib.irradiance.aoi(tilt, azimuth, zenith, np.asarray(position["azimuth"], dtype=float))
+    f = np.interp(np.asarray(theta, dtype=float), list(angles) + [90.0 + 1e-9], list(factors) + [0.0], right=0.0)
     beam = np.where(zenith < 90, np.asarray(poa["poa_direct"], dtype=float), 0.0)
     sun = f * beam + diffuse * np.asarray(poa["poa_diffuse"], dtype=float)
     return np.where(np.isfinite(sun) & (sun > 0.0), sun, 0.0)

@@ -5,7 +5,7 @@ import pandas as pd
 import pvlib
 import pytest
 
-from nodeforce.model.solar import incident_irradiance, sky_temperature, solar_position
+from nodeforce.model.solar import incident_irradiance, sky_temperature, solar_position, transmitted_irradiance
 
 SIGMA = 5.670374419e-8
 
@@ -75,3 +75,14 @@ def test_night_missing_and_negative_irradiance_give_zero():
     for tilt, azimuth in ((0.0, 180.0), (90.0, 90.0), (45.0, 270.0)):
         got = incident_irradiance(position, ghi, dni, dhi, tilt, azimuth, 0.2)
         assert np.array_equal(got, [0.0, 0.0, 0.0])
+
+
+def test_transmitted_sun_by_hand():
+    """A horizontal glazing, the sun 60 deg from the zenith: the direct part dni cos 60 times the
+    table's factor at 60 deg, the sky's diffuse times the diffuse factor; with the sun below the
+    horizon the diffuse alone (a dni the weather still gives then is not sun)."""
+    position = pd.DataFrame({"apparent_zenith": [60.0, 95.0], "azimuth": [180.0, 180.0]})
+    sun = transmitted_irradiance(position, ghi=[600.0, 50.0], dni=[1000.0, 200.0], dhi=[100.0, 50.0], tilt=0.0,
+                                 azimuth=180.0, albedo=0.2, angles=[0, 40, 60, 80], factors=[1, 0.98, 0.8, 0.3],
+                                 diffuse=0.85)
+    assert sun == pytest.approx([0.8 * 1000 * 0.5 + 0.85 * 100, 0.85 * 50], rel=1e-9)
