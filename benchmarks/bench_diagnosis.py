@@ -103,7 +103,8 @@ def diagnose_one(task):
         with tempdirs.folder("bench-diagnosis") as tmp, contextlib.redirect_stdout(io.StringIO()), \
                 contextlib.redirect_stderr(io.StringIO()):
             report = api.diagnose(r.building, case, tmp, objective=api.objective(r.building, r.zones), workers=1,
-                                  population=population, generations=generations, noise=r.spec.noise, seed=0)
+                                  population=population, generations=generations, noise=r.spec.noise,
+                                  seed=0).to_json()
         seconds = time.time() - t
         base = baseline(r.building, case.with_steady_start(), r.zones)
         hlc = report.get("heat_loss_coefficient") or {}

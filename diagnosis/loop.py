@@ -49,7 +49,8 @@ from nodeforce.diagnosis.report import write_report
 from nodeforce.diagnosis.phases import phase_errors, worsened
 from nodeforce.diagnosis.residuals import diagnostics as residual_diagnostics
 from nodeforce.diagnosis.policy import POLICY
-from nodeforce.diagnosis.selection import block_J, blocks as blocks_of, decide, label, on_block
+from nodeforce.diagnosis.result import CrossValidation, Diagnosis, Fit, RecordOutcome, SensorEvidence
+from nodeforce.diagnosis.selection import block_J, blocks as blocks_of, decide, on_block
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.iotools.energyplus_corrections import idf_of, write_corrections
 from nodeforce.ga.locate import check_measured, evaluator_kind, locate
@@ -85,15 +86,24 @@ def split(case, source, fraction=None, end=None):
     return k
 
 
+@dataclass
+class Assessed:
+    """One candidate calibrated and run (`assess`): its parameters ({name: {"value", "std", ...}}),
+    what the data determine besides, its objective air (N_t, zones) and other sensed nodes
+    (`Windows.sensors`) over each whole record, its cross-validation folds ({"values",
+    "residuals"} each) and the simulations it took."""
+    parameters: dict
+    determined: dict
+    runs: list
+    sensed: list
+    folds: list
+    simulations: int
+
+
 def assess(task):
     """Calibrate one candidate effect, with its cross-validation folds, and run it: a task for a
-    worker process.
-
-    Returns the calibrated parameters, what the data determine, the simulated objective air and
-    other sensed nodes (`Windows.sensors`) over each whole record, the folds and the simulations
-    it took; writes the
-    candidate's building file, declared at the calibrated values, in `folder`.
-    """
+    worker process. Returns its `Assessed`; writes the candidate's building file, declared at the
+    calibrated values, in `folder`."""
     building, bases, effect, target, folder, calibrations, cases, objective, blocks, sensors, numerical, seed = task
     candidate = Candidate(building, effect, target, protocols(bases, calibrations, cases))
     parameters, determined, folds = calibrate(candidate, calibrations, objective, blocks, numerical)
@@ -103,7 +113,7 @@ def assess(task):
               for case, ids in zip(cases, sensors)]
     calibrated = EFFECTS[effect].apply(building, target, {name: p["value"] for name, p in parameters.items()})
     (folder / f"{candidate.label}.json").write_text(json.dumps(calibrated.to_json(), indent=2) + "\n")
-    return parameters, determined, runs, sensed, folds, candidate.simulations
+    return Assessed(parameters, determined, runs, sensed, folds, candidate.simulations)
 
 
 def protocols(bases, *windows):
@@ -268,12 +278,13 @@ class Model:
                      [None if b is None else EFFECTS[effect].apply(b, target, values) for b in self.bases])
 
 
-def assess_all(model, pairs, windows, objective, folder, seed, workers, weights):
+def assess_all(model, pairs, windows, objective, folder, seed, workers, weights, number=1, on_top_of=()):
     """Each (effect, target) added to `model`, calibrated on every record's calibration window
     (t_0..t_k) with a fold per block, and run over each record, in parallel worker processes
-    (which end with this process: nodeforce.lifetime): the candidates' records, their `Model`s by
+    (which end with this process: nodeforce.lifetime): the candidates' `Fit`s, their `Model`s by
     label, and the simulations they took. `weights`: each record's other sensors' weights in the
-    choice (`Windows.sensor_weights`)."""
+    choice (`Windows.sensor_weights`); `number`: the round; `on_top_of`: the labels of the effects
+    `model` holds."""
     tasks = [(model.building, model.bases, effect, target, folder, windows.calibrations, windows.cases, objective,
               windows.blocks, windows.sensors, windows.calibration_numerical(), seed) for effect, target in pairs]
     n_workers = min(workers or os.cpu_count(), len(tasks))
@@ -283,23 +294,20 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers, weights)
                              disable=not sys.stderr.isatty()))
     n = windows.scored()
     results, models, simulations = [], {}, 0
-    for (effect, target), (parameters, determined, runs, sensed, folds, count) in zip(pairs, assessed):
-        scores = [float(np.nansum(np.square(f["residuals"]))) for f in folds]
-        metrics = windows.metrics(objective, runs)
-        sensor_blocks, sensor_residuals, readings, counted = windows.sensor_scores(sensed, weights)
-        result = {"effect": effect, "target": target, "parameters": parameters, "derived": determined,
-                  "physics": POLICY.facts(model.building, effect, target), **metrics,
-                  "cv": {"blocks": scores, "J": sum(scores), "n": n, "rmse": float(np.sqrt(sum(scores) / n)),
-                         "folds": [f["values"] for f in folds],
-                         # each block's left-out residuals, in one order for every candidate
-                         "left_out": np.concatenate([f["residuals"][np.isfinite(f["residuals"])] for f in folds])},
+    for (effect, target), a in zip(pairs, assessed):
+        metrics = windows.metrics(objective, a.runs)
+        sensor_blocks, sensor_residuals, readings, counted = windows.sensor_scores(a.sensed, weights)
+        fit = Fit(effect, target, a.parameters, a.determined, POLICY.facts(model.building, effect, target),
+                  CrossValidation([float(np.nansum(np.square(f["residuals"]))) for f in a.folds], n,
+                                  [f["values"] for f in a.folds],
+                                  # each block's left-out residuals, in one order for every candidate
+                                  np.concatenate([f["residuals"][np.isfinite(f["residuals"])] for f in a.folds])),
                   # the other sensors over the blocks, which no fit read
-                  "sensors": {"blocks": [float(v) for v in sensor_blocks], "J": float(sensor_blocks.sum()),
-                              "n": readings, "n_weighted": counted, "residuals": sensor_residuals}}
-        values = {name: p["value"] for name, p in parameters.items()}
-        models[label(result)] = model.adding(effect, target, values, runs, metrics)
-        results.append(result)
-        simulations += count
+                  SensorEvidence([float(v) for v in sensor_blocks], readings, counted, sensor_residuals),
+                  metrics, number, tuple(on_top_of))
+        models[fit.label] = model.adding(effect, target, fit.values, a.runs, metrics)
+        results.append(fit)
+        simulations += a.simulations
     return results, models, simulations
 
 
@@ -307,7 +315,7 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
              seed=0, workers=None, population=30, generations=400, fmu_kind="auto", reference=None,
              noise=None, phases=None):
     """Run the whole loop, its stages in order (`prepare`, `localise`, `rounds`, `write`); write the
-    artifacts in `workdir`; return the report.json content.
+    artifacts in `workdir`; return the `Diagnosis` (report.json is its `to_json()`).
 
     `records` is a Case (one record: `source`, `fraction`, `calibration_end` and `phases` are
     its) or a list of `Record`s of the same building, each with its own windows and phases: the
@@ -360,15 +368,19 @@ class Located:
 
 @dataclass
 class Made:
-    """What the rounds made: the effects added, in order (their candidate records), each round's
-    decision record, every candidate tried (as report.json keeps it), their runs by label, the
-    Morris screening of each chosen effect, and the model they leave."""
-    added: list
+    """What the rounds made: each round's `Decision`, every candidate tried (its `Fit`, as
+    report.json keeps it), their runs by label, the Morris screening of each chosen effect, and
+    the model they leave."""
     decisions: list
     results: list
     runs: dict
     sensitivities: dict
     model: Model
+
+    @property
+    def added(self):
+        """The effects added, in order (their `Fit`s)."""
+        return [d.chosen for d in self.decisions if d.chosen is not None]
 
 
 def prepare(building, records, objective, workdir, fmu_kind, noise):
@@ -418,7 +430,7 @@ def rounds(prepared, localization, objective, workdir, seed, workers):
         base_blocks = windows.block_J(model.runs)
         if number and POLICY.at_noise(base_blocks.sum(), n, noise.floor_sd):
             break  # the error left is the noise's
-        done = {label(a) for a in added}
+        done = [a.label for a in added]
         started = time.perf_counter()
         # a later round's candidates, on top of the earlier choices, are building files of their own
         into = folder / f"round{number + 1}" if number else folder
@@ -426,39 +438,37 @@ def rounds(prepared, localization, objective, workdir, seed, workers):
         weights = windows.sensor_weights(model.building, model.bases, noise.sigma)
         pairs = [p for p in physical(model.building, localization["components"], objective.zones,
                                      measured_ids, localization["best_nodes"]) if "@".join(p) not in done]
-        tried, models, simulations = assess_all(model, pairs, windows, objective, into, seed, workers, weights)
+        tried, models, simulations = assess_all(model, pairs, windows, objective, into, seed, workers, weights,
+                                                number + 1, done)
         # shapes only where no physical candidate physics admits brings the error left to the
         # noise; the residual's statistics then choose which
-        if not any(POLICY.at_noise(r["cv"]["J"], n, noise.floor_sd) and not POLICY.objection_of(
-                r["effect"], r["parameters"], r["derived"], r["physics"]) for r in tried):
+        if not any(POLICY.at_noise(r.cv.J, n, noise.floor_sd) and not POLICY.objection_of(
+                r.effect, r.parameters, r.derived, r.physics) for r in tried):
             pairs = [p for p in shapes(model.building, left_by(windows, model), objective.zones)
                      if "@".join(p) not in done]
             more, more_models, more_simulations = assess_all(model, pairs, windows, objective, into, seed, workers,
-                                                             weights)
+                                                             weights, number + 1, done)
             tried, simulations = tried + more, simulations + more_simulations
             models.update(more_models)
-        chosen, decision = decide(model.building, tried, base_blocks, noise.sigma, n, windows.groups(), noise.floor_sd)
-        decision["cost"] = {"candidates": len(tried), "simulations": simulations,
-                            "seconds": round(time.perf_counter() - started, 1)}
+        decision = decide(tried, base_blocks, noise.sigma, n, windows.groups(), noise.floor_sd)
+        decision.cost = {"candidates": len(tried), "simulations": simulations,
+                         "seconds": round(time.perf_counter() - started, 1)}
         decisions.append(decision)
-        on_top = {"on_top_of": [label(a) for a in added]} if added else {}
-        # the residuals themselves stay out (the decision keeps what the choice read of them, the
-        # distances of every two admissible candidates'): a house's would make report.json gigabytes
-        results += [{**r, "cv": {k: v for k, v in r["cv"].items() if k != "left_out"},
-                     "sensors": {k: v for k, v in r["sensors"].items() if k != "residuals"},
-                     "round": number + 1, **on_top}
+        # the residuals themselves go (the decision keeps what the choice read of them, the
+        # distances of every two admissible candidates'): a house's rounds would hold gigabytes
+        results += [replace(r, cv=replace(r.cv, left_out=None), sensors=replace(r.sensors, residuals=None))
                     for r in tried]
         runs.update({(key if not added else f"{key} (round {number + 1})"): m.runs for key, m in models.items()})
+        chosen = decision.chosen
         if not chosen:
             break
         # the Morris screening of the chosen effect's parameters, on the model it is added to: a
         # screening of every candidate would cost a quarter of a round's simulations
-        screened = Candidate(model.building, chosen["effect"], chosen["target"],
-                             protocols(model.bases, windows.calibrations))
-        sensitivities[label(chosen)] = sensitivity(screened, windows.calibrations, objective, seed=seed)
+        screened = Candidate(model.building, chosen.effect, chosen.target, protocols(model.bases, windows.calibrations))
+        sensitivities[chosen.label] = sensitivity(screened, windows.calibrations, objective, seed=seed)
         added.append(chosen)
-        model = models[label(chosen)]
-    return Made(added, decisions, results, runs, sensitivities, model)
+        model = models[chosen.label]
+    return Made(decisions, results, runs, sensitivities, model)
 
 
 def left_by(windows, model):
@@ -473,13 +483,9 @@ def left_by(windows, model):
 
 def write(building, prepared, located, made, objective, workdir, fmu_kind, reference):
     """Stage 4: the model the rounds leave written (`building_after.json`, `model_after.fmu`,
-    each protocol's building), report.json, report.md and the plots; returns report.json's content."""
+    each protocol's building, `model_after.idf` for a converted EnergyPlus model), the
+    `Diagnosis`, written as report.json, report.md and the plots; returns it."""
     windows, records, model, added = prepared.windows, prepared.records, made.model, made.added
-    decisions = made.decisions
-    decision = {**decisions[0], "chosen": label(added[-1]) if added else None,
-                "reason": " ".join(f"Round {i + 1}: {d['reason']}" if len(decisions) > 1 else d["reason"]
-                                   for i, d in enumerate(decisions)),
-                "rounds": decisions, "structure_left": left_by(windows, model)["sentence"]}
     (workdir / "building_after.json").write_text(json.dumps(model.building.to_json(), indent=2) + "\n")
     fmu_after = build_fmu(model.building, workdir / "model_after.fmu", kind=fmu_kind)
     # a record under another protocol: its own building as corrected, for `nodeforce compare`
@@ -487,34 +493,44 @@ def write(building, prepared, located, made, objective, workdir, fmu_kind, refer
     for i, path in protocols_after.items():
         path.write_text(json.dumps(model.bases[i].to_json(), indent=2) + "\n")
     by_phase = phase_rows(prepared, made, objective)
-    if by_phase and added:
-        decision["worsened_phases"] = worsened(by_phase, "before", "after")
-        if decision["worsened_phases"]:
-            decision["reason"] += (" It lowers the total error but makes the phase " + "; ".join(
-                f"{w['phase']} worse ({w['before']:.3f} C -> {w['after']:.3f} C)" for w in decision["worsened_phases"])
-                + ", which the total hides.")
-    report = content(building, prepared, located, made, objective, decision, workdir, fmu_after)
-    if len(records) > 1:
-        before_runs = prepared.model.runs
-        report["records"] = [{"name": r.name, "measurements": str(r.source), "period": period(windows, i),
-                              "before": windows.metrics(objective, before_runs, i),
-                              "after": windows.metrics(objective, model.runs, i),
-                              "localization": located.alone[i],
-                              **({"building_after": str(protocols_after[i])} if i in protocols_after else {})}
-                             for i, r in enumerate(records)]
-    if reference:
-        report["reference"] = reference
+    diagnosis = Diagnosis(
+        objective=list(objective.zones), period=period(windows, 0), before=prepared.model.metrics,
+        after=model.metrics, localization=located.localization, candidates=made.results, rounds=made.decisions,
+        structure_left=left_by(windows, model)["sentence"],
+        heat_loss=heat_loss(building, model.building, added, made.results, prepared.noise.sigma),
+        residuals=validation_residuals(prepared, made), sensitivity=made.sensitivities, noise=prepared.noise,
+        assumptions=list(dict.fromkeys(a for case in windows.cases for a in case.assumptions)),
+        node_names={str(i): name for i, name in building.node_names().items()},
+        artifacts={"building_after": str(workdir / "building_after.json"), "fmu_after": str(fmu_after)},
+        records=[RecordOutcome(r.name, str(r.source), period(windows, i),
+                               windows.metrics(objective, prepared.model.runs, i),
+                               windows.metrics(objective, model.runs, i), located.alone[i],
+                               str(protocols_after[i]) if i in protocols_after else None)
+                 for i, r in enumerate(records)] if len(records) > 1 else [],
+        worsened_phases=worsened(by_phase, "before", "after") if by_phase and added else None,
+        phases=by_phase or None, reference=reference or None)
     idf = idf_of(building)
     if idf is not None:  # a converted EnergyPlus model: its corrections written back into it
-        report["energyplus"] = write_corrections(building, model.building, added, idf, workdir / "model_after.idf")
-        report["artifacts"]["idf_after"] = report["energyplus"]["idf_after"]
-    if by_phase:
-        report["phases"] = by_phase
-    plots = write_report(workdir, report, plotted(prepared, located, made, objective))
-    report["artifacts"]["plots"] = [str(p) for p in plots]
-    report["artifacts"]["report"] = str(workdir / "report.md")
-    (workdir / "report.json").write_text(json.dumps(report, indent=2, default=_plain) + "\n")
-    return report
+        diagnosis.energyplus = write_corrections(building, model.building, [(a.effect, a.target) for a in added],
+                                                 idf, workdir / "model_after.idf")
+        diagnosis.artifacts["idf_after"] = diagnosis.energyplus["idf_after"]
+    plots = write_report(workdir, diagnosis.to_json(), plotted(prepared, located, made, objective))
+    diagnosis.artifacts["plots"] = [str(p) for p in plots]
+    diagnosis.artifacts["report"] = str(workdir / "report.md")
+    diagnosis.write(workdir / "report.json")
+    return diagnosis
+
+
+def validation_residuals(prepared, made):
+    """What the first objective zone's residual on the first record's validation window follows
+    (`diagnosis.residuals`), before and after."""
+    windows = prepared.windows
+    first, k, measured = windows.cases[0], windows.ks[0], windows.measured[0]
+    validation = slice(k, None)
+    return {state: residual_diagnostics(first.times[1:][validation], measured[validation, 0] - run[0][validation, 0],
+                                        {name: values[validation] for name, values in
+                                         zip(first.input_names, first.U[1:].T)})
+            for state, run in (("before", prepared.model.runs), ("after", made.model.runs))}
 
 
 def phase_rows(prepared, made, objective):
@@ -528,38 +544,6 @@ def phase_rows(prepared, made, objective):
                  else row for row in phase_errors(record.phases, case.times[1:], windows.measured[i], runs,
                                                   zones=objective.zones)]
     return rows
-
-
-def content(building, prepared, located, made, objective, decision, workdir, fmu_after):
-    """report.json's content but for the records, the reference, the phases and the plots."""
-    windows, noise, added, model = prepared.windows, prepared.noise, made.added, made.model
-    first, k, measured = windows.cases[0], windows.ks[0], windows.measured[0]
-    validation = slice(k, None)
-    residuals = {state: residual_diagnostics(first.times[1:][validation], measured[validation, 0] - run[0][validation, 0],
-                                             {name: values[validation] for name, values in
-                                              zip(first.input_names, first.U[1:].T)})
-                 for state, run in (("before", prepared.model.runs), ("after", model.runs))}
-    effect = ({key: added[-1][key] for key in ("effect", "target", "parameters", "derived")} if added
-              else {"effect": "none", "target": None, "parameters": {}})
-    return {
-        "period": period(windows, 0),
-        "objective": list(objective.zones),
-        "before": prepared.model.metrics,
-        "localization": located.localization,
-        "candidates": made.results,
-        "effects": [{key: a[key] for key in ("effect", "target", "parameters")} for a in added],
-        "decision": decision,
-        "effect": effect,
-        "after": model.metrics,
-        "heat_loss_coefficient": heat_loss(building, model.building, added, made.results, noise.sigma),
-        "assumptions": list(dict.fromkeys(a for case in windows.cases for a in case.assumptions)),
-        "residuals": residuals,
-        "sensitivity": made.sensitivities,
-        "noise_sigma": noise.sigma,
-        "noise": noise.to_json(),
-        "node_names": {str(i): name for i, name in building.node_names().items()},
-        "artifacts": {"building_after": str(workdir / "building_after.json"), "fmu_after": str(fmu_after)},
-    }
 
 
 def plotted(prepared, located, made, objective):
@@ -603,10 +587,3 @@ def period(windows, i):
                                      "blocks of whole days ('blocks') is left out of a fit in turn and "
                                      "predicted, and the choice is made on those predictions",
                       "validation": "reports before and after only; no part in any choice"}}
-
-
-def _plain(value):
-    """numpy scalars as plain JSON numbers."""
-    if isinstance(value, np.generic):
-        return value.item()
-    raise TypeError(f"{type(value).__name__} is not JSON")

@@ -10,7 +10,6 @@ agree on the HLC, the report says the split is not the record's.
 """
 import math
 
-from nodeforce.diagnosis.selection import label
 from nodeforce.diagnosis.policy import POLICY
 from nodeforce.model.hlc import heat_loss_coefficient
 
@@ -29,24 +28,24 @@ def heat_loss(before_building, after_building, added, results, sigma):
     Parameters
     ----------
     before_building, after_building : Building as described and as corrected
-    added : the loop's chosen candidate records, in order (their "derived" holds the HLC of the
-        model with the effect and its sd from the calibration's covariance)
-    results : every candidate record, each with the "round" it was tried in
+    added : the `Fit`s of the effects the loop added, in order (their `derived` holds the HLC of
+        the model with the effect and its sd from the calibration's covariance)
+    results : every candidate's `Fit`, each with the `round` it was tried in
     sigma : the air sensors' noise sd (C), which sets the change of J no test can tell apart
     """
     out = {"before": heat_loss_coefficient(before_building), "after": heat_loss_coefficient(after_building),
-           "after_sd": float(added[-1]["derived"][HLC]["std"]) if added else 0.0, "split": None}
-    rounds = [[r for r in results if r["round"] == number] for number in range(1, len(added) + 1)]
-    starts = [{"value": out["before"], "std": 0.0}] + [a["derived"][HLC] for a in added]
+           "after_sd": float(added[-1].derived[HLC]["std"]) if added else 0.0, "split": None}
+    rounds = [[r for r in results if r.round == number] for number in range(1, len(added) + 1)]
+    starts = [{"value": out["before"], "std": 0.0}] + [a.derived[HLC] for a in added]
     for chosen, start, tried in zip(added, starts, rounds):
         alike = same_loss(chosen, tried, start, sigma)
         if alike:
-            hlc = chosen["derived"][HLC]
+            hlc = chosen.derived[HLC]
             out["split"] = (f"The data fix the heat loss coefficient ({hlc['value']:.1f} ± {hlc['std']:.1f} W/K) "
                             f"but not how it splits among effects: "
-                            + ", ".join(f"{r['effect']} on {r['target']} ({r['derived'][HLC]['value']:.1f} W/K)"
+                            + ", ".join(f"{r.effect} on {r.target} ({r.derived[HLC]['value']:.1f} W/K)"
                                         for r in alike)
-                            + f" predict the left-out days as well as {chosen['effect']} on {chosen['target']} "
+                            + f" predict the left-out days as well as {chosen.effect} on {chosen.target} "
                               "with the same loss, so the split is the building file's, not the record's.")
     return out
 
@@ -57,14 +56,14 @@ def same_loss(chosen, tried, start, sigma):
     cross-validated J the chosen's does not beat by more than the noise could
     (`diagnosis.policy.Policy.least_fall`).
     None of them when the chosen changes no loss (a gain, a mass)."""
-    hlc = chosen["derived"].get(HLC)
+    hlc = chosen.derived.get(HLC)
     if not hlc or not moves(hlc, start):
         return []
-    J, n = chosen["cv"]["J"], chosen["cv"]["n"]
+    J, n = chosen.cv.J, chosen.cv.n
     margin = POLICY.least_fall(J, sigma, n)
-    return [r for r in tried if label(r) != label(chosen) and r["derived"].get(HLC)
-            and agree(hlc, r["derived"][HLC]) and moves(r["derived"][HLC], start)
-            and r["cv"]["J"] - J <= margin]
+    return [r for r in tried if r.label != chosen.label and r.derived.get(HLC)
+            and agree(hlc, r.derived[HLC]) and moves(r.derived[HLC], start)
+            and r.cv.J - J <= margin]
 
 
 def moves(a, start):

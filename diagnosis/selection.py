@@ -66,6 +66,7 @@ import math
 import numpy as np
 
 from nodeforce.diagnosis.policy import POLICY
+from nodeforce.diagnosis.result import Decision, Verdict
 from nodeforce.model.effects import bridge_parts
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
@@ -100,10 +101,6 @@ def block_J(residuals, masks):
     return np.array([np.nansum(np.square(residuals[m])) for m in masks])
 
 
-def label(result):
-    return f"{result['effect']}@{result['target']}"
-
-
 def fall(base, scores):
     """The fall of J from per-block J `base` to `scores` (C2) and its standard error from the
     per-block falls (blocks as the unit)."""
@@ -111,23 +108,10 @@ def fall(base, scores):
     return float(d.sum()), float(math.sqrt(len(d)) * d.std(ddof=1))
 
 
-def evidence(result):
-    """Per-block J (C2) a candidate's choice reads: its objective air on each block left out of
-    its fit (`cv.blocks`) and, where other nodes are sensed, their J over the same blocks
-    (`sensors.blocks`), which no fit read, each sensor weighted by how well the model the
-    candidate is added to follows it (`diagnosis.loop.Windows.sensor_weights`)."""
-    return np.asarray(result["cv"]["blocks"], dtype=float) + np.asarray(
-        result.get("sensors", {}).get("blocks", 0.0), dtype=float)
-
-
 def distance(a, b):
-    """|r_a - r_b| (C) of two candidates' residuals the evidence (`evidence`) is made of: the
-    air's left out (`cv.left_out`, C, every block's in one order) and the other sensors' on the
-    blocks (`sensors.residuals`); 0 where either lacks them."""
-    def residuals(r):
-        parts = [r["cv"].get("left_out"), r.get("sensors", {}).get("residuals", np.empty(0))]
-        return None if parts[0] is None else np.concatenate([np.asarray(x, dtype=float) for x in parts])
-    ra, rb = residuals(a), residuals(b)
+    """|r_a - r_b| (C) of two candidates' (`Fit`s) residuals their evidence (`Fit.evidence`) is
+    made of: the air's left out and the other sensors' on the blocks; 0 where either lacks them."""
+    ra, rb = a.residuals(), b.residuals()
     if ra is None or rb is None:
         return 0.0
     return float(np.linalg.norm(ra - rb))
@@ -153,7 +137,7 @@ def parsimony(result, sigma, n):
     neither the days' scatter nor a fixed pair's noise (`noise_difference`) would call small. One
     wall's factor bends that wall's dynamics, where the file's coarse nodes err, as the envelope's
     cannot: on the air alone it fits that error too. `n`: the air's scored residuals."""
-    return POLICY.noise_change(sigma, n + result.get("sensors", {}).get("n_weighted", 0))
+    return POLICY.noise_change(sigma, n + result.sensors.n_weighted)
 
 
 def harmed(base, scores, floor_sd, groups):
@@ -179,16 +163,15 @@ def harmed(base, scores, floor_sd, groups):
     return out
 
 
-def decide(building, results, base, sigma, n, groups=(), floor_sd=None, distances=None):
-    """The decision record of one round (module docstring), its steps in order: 1. which
-    candidates pass, 2. which of them physics refuses (suggestions), 3. the band of those the data
-    cannot tell from the best, 4. the one of the band that claims least; with each candidate's
-    test and the reason in words. The thresholds are `diagnosis.policy.POLICY`'s.
+def decide(results, base, sigma, n, groups=(), floor_sd=None, distances=None):
+    """The `Decision` of one round (module docstring), its steps in order: 1. which candidates
+    pass, 2. which of them physics refuses (suggestions), 3. the band of those the data cannot
+    tell from the best, 4. the one of the band that claims least; with each candidate's `Verdict`
+    and the reason in words. The thresholds are `diagnosis.policy.POLICY`'s.
 
     Parameters
     ----------
-    building : Building the candidates are added to
-    results : candidate records, each with "cv": {"blocks": per-block J (C2) fitted without it}
+    results : the candidates' `Fit`s
     base : per-block J (C2) of the model without them
     sigma : the air sensors' noise sd (C), what a fixed pair's difference moves by (`noise_difference`)
     n : residuals the blocks score
@@ -198,64 +181,57 @@ def decide(building, results, base, sigma, n, groups=(), floor_sd=None, distance
         with a slow parameter fits part of that deterministic error as it fits a fault; sigma if
         None
     distances : {label: {label: C}}, the `distance` of every two admissible candidates' residuals,
-        as the decision record keeps it (`inputs.distances`); computed from the residuals if None
+        as the decision keeps it (`inputs.distances`); computed from the residuals if None
     """
     base = np.asarray(base, dtype=float)
     floor_sd = sigma if floor_sd is None else floor_sd
     margin = POLICY.least_fall(float(base.sum()), floor_sd, n)
-    # what the building says of each candidate (its limits, ...): report.json keeps it as `physics`
-    for r in results:
-        if "physics" not in r:
-            r["physics"] = POLICY.facts(building, r["effect"], r["target"])
-    tests = {label(r): candidate_test(r, base, margin, floor_sd, groups) for r in results}
-    passing = [r for r in results if tests[label(r)]["passes"]]  # 1.
-    admissible = [r for r in passing if not tests[label(r)]["objection"]]  # 2.
-    suggestions = [{"candidate": label(r), "reason": tests[label(r)]["objection"], "cv_rmse": r["cv"]["rmse"]}
-                   for r in passing if tests[label(r)]["objection"]]
-    components = {r["target"] for r in results if r["physics"]["component"]}
+    verdicts = {r.label: candidate_test(r, base, margin, floor_sd, groups) for r in results}
+    passing = [r for r in results if verdicts[r.label].passes]  # 1.
+    admissible = [r for r in passing if not verdicts[r.label].objection]  # 2.
+    suggestions = [{"candidate": r.label, "reason": verdicts[r.label].objection, "cv_rmse": r.cv.rmse}
+                   for r in passing if verdicts[r.label].objection]
+    components = {r.target for r in results if r.physics["component"]}
     chosen, alike = None, []
     if admissible:
         if distances is None:
-            distances = {label(a): {label(b): distance(a, b) for b in admissible} for a in admissible}
+            distances = {a.label: {b.label: distance(a, b) for b in admissible} for a in admissible}
         near = band(admissible, base, sigma, floor_sd, n, distances)  # 3.
-        chosen = min(near, key=lambda r: (claim(r), evidence(r).sum()))  # 4.
+        chosen = min(near, key=lambda r: (claim(r), r.evidence().sum()))  # 4.
         alike = [r for r in near if r is not chosen]
     # the candidates physics refused are in `suggestions`; the report says them grouped by reason
-    reason = _reason(chosen, alike, results, passing, base, n, tests, margin, components)
-    return chosen, {"chosen": label(chosen) if chosen else None, "reason": reason,
-                    "cv_J_before": float(base.sum()), "blocks": len(base), "noise_margin": margin,
-                    "standard_errors": POLICY.standard_errors, "suggestions": suggestions,
-                    "indistinct": [label(r) for r in alike], "candidates": tests,
-                    # what the steps read besides the candidates' records: report.json can replay them
-                    "inputs": {"blocks_before": [float(b) for b in base], "sigma": sigma, "floor_sd": floor_sd,
-                               "n": n, "groups": list(groups), "distances": distances or {}}}
+    reason = _reason(chosen, alike, results, passing, base, n, verdicts, margin, components)
+    return Decision(chosen, reason, float(base.sum()), len(base), margin, POLICY.standard_errors, suggestions,
+                    [r.label for r in alike], verdicts,
+                    # what the steps read besides the candidates' fits: report.json can replay them
+                    {"blocks_before": [float(b) for b in base], "sigma": sigma, "floor_sd": floor_sd,
+                     "n": n, "groups": list(groups), "distances": distances or {}})
 
 
 def candidate_test(result, base, margin, floor_sd, groups):
-    """One candidate's test (steps 1 and 2): its cross-validated fall of J (C2) and the fall's
+    """One candidate's `Verdict` (steps 1 and 2): its cross-validated fall of J (C2) and the fall's
     standard error, what it needs (the noise's `margin`, C2, and `standard_errors` of its
     scatter), what the days other than its best gain, its evidence, whether it passes, the
     records it harms and the objection of physics, None if none."""
-    blocks = np.asarray(result["cv"]["blocks"])
+    blocks = np.asarray(result.cv.blocks)
     down, se = fall(base, blocks)
     needed = max(margin, POLICY.standard_errors * se)
     # the other days than its best must gain too: one day alone is no evidence
     others = down - float(np.max(base - blocks))
     harms = harmed(base, blocks, floor_sd, groups)
-    said = POLICY.objection_of(result["effect"], result["parameters"], result.get("derived"), result["physics"])
+    said = POLICY.objection_of(result.effect, result.parameters, result.derived, result.physics)
     if harms:
         said = "; ".join(filter(None, [said, "it helps the records together but harms " + "; ".join(
             f"{h['record']} (its cross-validated J there rises by {-h['cv_fall']:.3g} C2, beyond the "
             f"{h['needed']:.3g} C2 the noise and the day-to-day scatter could make)" for h in harms)
             + ": a correction of the building must hold on every record of it"]))
-    return {"cv_fall": down, "cv_se": se, "needed": needed, "other_days": others,
-            "evidence": float(evidence(result).sum()),
-            "passes": bool(down > needed and others > 0), "harms": harms, "objection": said}
+    return Verdict(down, se, needed, others, float(result.evidence().sum()), bool(down > needed and others > 0),
+                   harms, said)
 
 
 def claim(result):
     """What a candidate's choice claims, least first (`Policy.claim`)."""
-    return POLICY.claim(result["effect"], result["physics"]["component"])
+    return POLICY.claim(result.effect, result.physics["component"])
 
 
 def band(admissible, base, sigma, floor_sd, n, distances):
@@ -265,12 +241,12 @@ def band(admissible, base, sigma, floor_sd, n, distances):
     what the sensors' noise alone makes of it, `noise_difference` of their `distances`), at least
     the rounding; and,
     where the best claims more, by no more than the noise's tolerance (`parsimony`)."""
-    best = min(admissible, key=lambda r: evidence(r).sum())
+    best = min(admissible, key=lambda r: r.evidence().sum())
     rounding = POLICY.rounding(float(base.sum()))
 
     def close(r):
-        worse, se = fall(evidence(r), evidence(best))
-        needed = max(POLICY.standard_errors * max(se, noise_difference(distances[label(r)][label(best)], sigma)),
+        worse, se = fall(r.evidence(), best.evidence())
+        needed = max(POLICY.standard_errors * max(se, noise_difference(distances[r.label][best.label], sigma)),
                      rounding)
         if claim(r) < claim(best):
             needed = max(needed, parsimony(best, floor_sd, n))
@@ -278,7 +254,7 @@ def band(admissible, base, sigma, floor_sd, n, distances):
     return [r for r in admissible if close(r)]
 
 
-def _reason(chosen, alike, results, passing, base, n, tests, margin, components):
+def _reason(chosen, alike, results, passing, base, n, verdicts, margin, components):
     """The decision in words; `components` the building's component names."""
     B = len(base)
     rmse_before = math.sqrt(base.sum() / n)
@@ -289,40 +265,40 @@ def _reason(chosen, alike, results, passing, base, n, tests, margin, components)
                 f"{B} days) by more than the noise and the file's numerical error could ({margin:.3g} C2) and "
                 f"{POLICY.standard_errors:g} standard error of its fall from day to day, on more days than one"
                 + (f" ({len(passing)} do, and physics or a record they harm refuses each)" if passing else "") + ": no effect is added.")
-    what = (f"an unexplained heat source, acting {acting(chosen)} ({chosen['effect']} on {chosen['target']})"
-            if POLICY.is_shape(chosen["effect"]) else f"{chosen['effect']} on {chosen['target']}")
-    test = tests[label(chosen)]
+    what = (f"an unexplained heat source, acting {acting(chosen)} ({chosen.effect} on {chosen.target})"
+            if POLICY.is_shape(chosen.effect) else f"{chosen.effect} on {chosen.target}")
+    verdict = verdicts[chosen.label]
     said = (f"{what[0].upper() + what[1:]} lowers the cross-validated J from {base.sum():.3g} to "
-            f"{chosen['cv']['J']:.3g} C2 ({rmse_before:.3f} -> {chosen['cv']['rmse']:.3f} C; each of {B} days "
-            f"predicted by a fit to the others), beyond the {test['needed']:.3g} C2 that the noise, the file's "
+            f"{chosen.cv.J:.3g} C2 ({rmse_before:.3f} -> {chosen.cv.rmse:.3f} C; each of {B} days "
+            f"predicted by a fit to the others), beyond the {verdict.needed:.3g} C2 that the noise, the file's "
             f"numerical error and the day-to-day scatter could make; {len(passing)} of {len(results)} candidates pass")
-    sensed = chosen.get("sensors", {}).get("n", 0)
+    sensed = chosen.sensors.n
     if sensed and len(passing) > 1:
         said += (f"; among them it best predicts the air left out together with the other sensors over the "
-                 f"same days ({sensed} readings no fit read; J {evidence(chosen).sum():.3g} C2)")
+                 f"same days ({sensed} readings no fit read; J {chosen.evidence().sum():.3g} C2)")
     if alike:
         said += ("; within one standard error of the best, and so not told apart by these data: "
-                 + ", ".join(f"{r['effect']} on {r['target']} ({evidence(r).sum():.3g} C2)" for r in alike)
+                 + ", ".join(f"{r.effect} on {r.target} ({r.evidence().sum():.3g} C2)" for r in alike)
                  + (" (a physical effect, then fewer parameters, then a zone's effect before one component's, "
-                    "is preferred)" if any(evidence(r).sum() < evidence(chosen).sum() for r in alike) else ""))
-    others = [r["target"] for r in alike if r["target"] != chosen["target"] and r["target"] in components]
-    if others and chosen["target"] in components:
-        said += (f". The correction of {chosen['target']} cannot be told from that of "
+                    "is preferred)" if any(r.evidence().sum() < chosen.evidence().sum() for r in alike) else ""))
+    others = [r.target for r in alike if r.target != chosen.target and r.target in components]
+    if others and chosen.target in components:
+        said += (f". The correction of {chosen.target} cannot be told from that of "
                  f"{', '.join(dict.fromkeys(others))}: the fault may be in either")
     elif others:
         said += (f". A correction of {' or '.join(dict.fromkeys(others))} alone explains the data as well: "
                  f"they do not place the fault in one component")
-    if POLICY.is_shape(chosen["effect"]):
+    if POLICY.is_shape(chosen.effect):
         said += "; no physical effect comes within one standard error of it"
     return said + "."
 
 
 def acting(result):
     """How a shape's heat source acts, in words: with a daily profile, or in proportion to an input."""
-    values = {name: p["value"] for name, p in result["parameters"].items()}
-    if result["effect"] == "daily_gain":
+    values = result.values
+    if result.effect == "daily_gain":
         amplitude = math.hypot(values.get("cos1", 0.0), values.get("sin1", 0.0))
         return (f"with a daily profile (mean {values['mean']:.3g} W, first harmonic {amplitude:.3g} W) to the air "
-                f"of {result['target']}")
-    zone, column = bridge_parts(result["target"])
+                f"of {result.target}")
+    zone, column = bridge_parts(result.target)
     return f"in proportion to {column} (k = {values['k']:.3g}) to the air of {zone}"

@@ -25,20 +25,20 @@ def idf_of(building):
 
 
 def write_corrections(before, after, effects, idf, out):
-    """Write `out`, the IDF `idf` with the `effects` (the diagnosis's added effects: effect,
-    target, parameters) applied as `after` (the corrected building) holds them; return
+    """Write `out`, the IDF `idf` with the `effects` (the diagnosis's added effects, (effect,
+    target) pairs) applied as `after` (the corrected building) holds them; return
     {"idf_after", "changes": [{"object", "name", "field", "old", "new"}], "not_written": [str]}."""
     import idfkit
     doc = idfkit.load_idf(str(idf), preserve_formatting=True,
                           version=None if tuple(idfkit.get_idf_version(str(idf))[:2]) >= SCHEMA_MIN[:2] else SCHEMA_MIN)
     writer = _Writer(doc, before, after)
-    for e in effects:
-        handler = getattr(writer, e["effect"], None)
+    for effect, target in effects:
+        handler = getattr(writer, effect, None)
         if handler is None:
-            writer.not_written.append(f"{e['effect']} on {e['target']}: no EnergyPlus object holds it; "
+            writer.not_written.append(f"{effect} on {target}: no EnergyPlus object holds it; "
                                       "the corrected building file carries it")
         else:
-            handler(e["target"])
+            handler(target)
     idfkit.save_idf(doc, str(out))
     return {"idf_after": str(out), "changes": writer.changes, "not_written": writer.not_written}
 

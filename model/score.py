@@ -149,6 +149,11 @@ class Noise:
                 "numerical": self.numerical, "floor": self.floor_sd, "sentence": self.sentence(),
                 "numerical_sentence": self.numerical_sentence()}
 
+    @classmethod
+    def of_json(cls, d):
+        """The noise `to_json` wrote."""
+        return cls(d["sigma"], d["given"], d["lag1"], d["numerical"])
+
 
 @dataclass(frozen=True)
 class Objective:

@@ -382,8 +382,9 @@ def locate(building, case, objective=None, workdir=None, source=SOURCE, **search
 
 def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibration_end=None, phases=(), seed=0,
              workers=None, fmu_kind="python", noise=None, reference=None, population=30, generations=400):
-    """The whole loop of `nodeforce diagnose`; writes its files in `workdir` and returns report.json's
-    content (docs/guide.md, Output files).
+    """The whole loop of `nodeforce diagnose`; writes its files in `workdir` (docs/guide.md, Output
+    files) and returns the `Diagnosis`: `summary()` the first screen, `to_json()` report.json's
+    content, `added` the effects added, `rounds` each round's decision, `candidates` every fit.
 
     Parameters
     ----------
@@ -421,7 +422,7 @@ def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibrati
 
     Returns
     -------
-    dict
+    Diagnosis
     """
     with _folder(workdir) as folder:
         return _loop.diagnose(building, case, objective or Objective.of(building), folder, source=SOURCE,

@@ -223,12 +223,11 @@ def cmd_synth(args):
 
 def run_diagnosis(building, records, objective, out, args):
     """The loop on `records` (`api.Record`s) through `api.diagnose`, its summary printed."""
-    from nodeforce.diagnosis.report import terminal_summary
     check_workers(args)
-    report = api.diagnose(building, records, out, objective, seed=args.seed, workers=args.workers,
-                          fmu_kind=kind_of(args), noise=noise(args),
-                          reference=read_reference(args.reference) if args.reference else None)
-    print(terminal_summary(report))
+    diagnosis = api.diagnose(building, records, out, objective, seed=args.seed, workers=args.workers,
+                             fmu_kind=kind_of(args), noise=noise(args),
+                             reference=read_reference(args.reference) if args.reference else None)
+    print(diagnosis.summary())
     print(f"wrote {out / 'report.json'}, {out / 'report.md'}, {out / 'building_after.json'}, {out / 'model_after.fmu'}")
 
 

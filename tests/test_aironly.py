@@ -4,6 +4,8 @@ Every command takes them; `locate` says it has nothing to force; the candidate p
 the zone effects of docs/model.md section 7 where the residual asks for them, and the diagnosis
 recovers each from an air-only synthetic record; the report gives the heat loss coefficient;
 weather with `ghi` alone is split by a pvlib decomposition."""
+from dataclasses import replace
+
 import numpy as np
 import pandas as pd
 import pvlib
@@ -13,6 +15,7 @@ from nodeforce.cli import locate_summary
 from nodeforce.diagnosis.candidates import physical
 from nodeforce.diagnosis.loop import diagnose
 from nodeforce.diagnosis.loss import heat_loss
+from nodeforce.diagnosis.result import CrossValidation, Fit
 from nodeforce.diagnosis.report.tables import before_after_table
 from nodeforce.ga.locate import locate
 from nodeforce.model.building import parse_building
@@ -114,8 +117,9 @@ def test_an_air_only_record_calibrates_every_zone_effect_and_every_component(hea
 # -- the heat loss coefficient in the report ------------------------------------------------
 
 def record(effect, hlc, sd, J):
-    return {"effect": effect, "target": "cell", "derived": {"heat_loss_coefficient": {"value": hlc, "std": sd}},
-            "cv": {"J": J, "n": 100}, "round": 1}
+    """A round-1 candidate's fit of cross-validated J `J` (C2, one block) that makes the HLC `hlc`
+    +- `sd` (W/K)."""
+    return Fit(effect, "cell", {}, {"heat_loss_coefficient": {"value": hlc, "std": sd}}, {}, CrossValidation([J], 100))
 
 
 def test_the_report_says_when_the_data_fix_the_loss_but_not_its_split(heated):
@@ -136,9 +140,10 @@ def test_the_report_says_when_the_data_fix_the_loss_but_not_its_split(heated):
     assert "internal_gain" not in out["split"] and "inside_convection" not in out["split"]
     # an alternative that fits worse than the noise could make it, or loses differently, leaves
     # the split to the data
-    tried[1]["cv"]["J"] = 11.0
+    tried[1] = replace(tried[1], cv=CrossValidation([11.0], 100))
     assert heat_loss(heated, envelope, [chosen], tried, 0.1)["split"] is None
-    tried[1]["cv"]["J"], tried[1]["derived"]["heat_loss_coefficient"]["value"] = 10.3, hlc * 1.2
+    tried[1] = replace(tried[1], cv=CrossValidation([10.3], 100),
+                       derived={"heat_loss_coefficient": {"value": hlc * 1.2, "std": 0.06}})
     assert heat_loss(heated, envelope, [chosen], tried, 0.1)["split"] is None
     report = {"effect": {"effect": "none"}, "before": {}, "after": {}, "objective": ["cell"],
               "heat_loss_coefficient": out, "assumptions": ["ghi split by erbs"]}
@@ -231,7 +236,7 @@ def test_an_air_only_record_names_the_undeclared_zone_effect(heated, heated_weat
     from the first day's steady state, so no initial-state bias is left for a slow parameter to
     absorb)."""
     truth, case = air_only(heated, heated_weather, id=effect, values=values)
-    report = diagnose(heated, case.with_burn_in(1), Objective.of(heated), tmp_path, workers=2, noise=NOISE)
+    report = diagnose(heated, case.with_burn_in(1), Objective.of(heated), tmp_path, workers=2, noise=NOISE).to_json()
     assert [(e["effect"], e["target"]) for e in report["effects"]] == [(effect, "cell")], report["decision"]["reason"]
     first = report["effects"][0]
     assert report["after"]["validation"]["rmse"] < 1.2 * NOISE < 2 * NOISE < report["before"]["validation"]["rmse"]

@@ -16,6 +16,7 @@ from benchmarks.records import record
 from benchmarks.sizing import STRONG_BAND, SUBTLE_BAND, before_error, max_scale
 from benchmarks.truth import CELLS, FINE_STEP, at_scale, faulty, file_building, fine_weather, record_times, truth_record
 from nodeforce.model.numerical import refined
+from tests.test_replay import check_replay
 
 pytestmark = pytest.mark.slow  # each record is simulated at 1 min, and a few tuned
 
@@ -147,8 +148,11 @@ def test_look_alikes_of_a_mild_month_are_told_apart_by_the_other_sensors(name, t
     record's own fault comes first."""
     from nodeforce import api
     r = record(name, 0)
-    report = api.diagnose(r.building, r.case(), tmp_path, objective=api.objective(r.building, r.zones), workers=1,
-                          generations=30, noise=r.spec.noise, seed=0)
-    first = [(e["effect"], e["target"]) for e in report["effects"]][:1]
-    assert first and first[0] in r.spec.answers, report["decision"]["reason"]
-    assert report["after"]["validation"]["rmse"] < 1.5 * r.spec.noise
+    diagnosis = api.diagnose(r.building, r.case(), tmp_path, objective=api.objective(r.building, r.zones),
+                             workers=1, generations=30, noise=r.spec.noise, seed=0)
+    first = [(e.effect, e.target) for e in diagnosis.added][:1]
+    assert first and first[0] in r.spec.answers, diagnosis.rounds[0].reason
+    assert diagnosis.after["validation"]["rmse"] < 1.5 * r.spec.noise
+    # every round's choice, the fault's and the one after it that adds nothing, recomputed from
+    # report.json alone
+    assert len(check_replay(tmp_path / "report.json").rounds) >= 2

@@ -2,14 +2,19 @@
 J must beat the noise and the days' disagreement; physics refuses what the data cannot pin down
 or the building's description rules out; among the candidates one standard error cannot tell
 apart, a physical effect with few parameters before a shape."""
+import json
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
 from nodeforce.diagnosis.policy import POLICY
+from nodeforce.diagnosis.result import CrossValidation, Fit, SensorEvidence
 from nodeforce.diagnosis.selection import blocks, decide
 from nodeforce.model.building import parse_building
 from nodeforce.model.errors import InputError
 from nodeforce.model.score import Noise
+from tests.conftest import DATA
 
 
 def parameter(value, std, identifiable=True, on_bound=False):
@@ -135,11 +140,20 @@ N, SIGMA = 192, 0.1
 BASE = [10.0, 10.0, 10.0, 10.0]
 
 
+# the test cell as the fixture `testcell` reads it: what the building says of each candidate
+CELL = parse_building(json.loads((DATA / "testcell_miami.json").read_text()))
+
+
 def candidate(effect, target, parameters, days):
-    """A calibrated candidate's record as diagnosis.loop.assess_all makes it, leaving J `days`
-    (C2) on each left-out day."""
-    return {"effect": effect, "target": target, "parameters": parameters, "derived": {},
-            "cv": {"blocks": list(days), "J": float(sum(days)), "n": N, "rmse": float(np.sqrt(sum(days) / N))}}
+    """A calibrated candidate's `Fit`, leaving J `days` (C2) on each left-out day, what the test
+    cell says of it (`Policy.facts`) beside it, as diagnosis.loop.assess_all makes it."""
+    return Fit(effect, target, parameters, {}, POLICY.facts(CELL, effect, target), CrossValidation(list(days), N))
+
+
+def choose(results, base, sigma, n, **options):
+    """The round's (chosen fit, `Decision`)."""
+    decision = decide(results, base, sigma, n, **options)
+    return decision.chosen, decision
 
 
 def door(days, factor=3.0):
@@ -152,7 +166,7 @@ def daily(days):
                                                              "cos4", "sin4")}}, days)
 
 
-def test_blocks_are_whole_days_of_the_scored_steps(testcell):
+def test_blocks_are_whole_days_of_the_scored_steps():
     masks = blocks(4 * 96 + 30, 96, 900.0)
     assert masks.shape == (3, 4 * 96 + 30) and not masks[:, :96].any()
     assert (masks.sum(axis=0)[96:] == 1).all()  # every scored step in one block
@@ -161,45 +175,45 @@ def test_blocks_are_whole_days_of_the_scored_steps(testcell):
         blocks(2 * 96 + 50, 96, 900.0)
 
 
-def test_a_physical_effect_wins_over_a_shape_the_data_cannot_tell_from_it(testcell):
+def test_a_physical_effect_wins_over_a_shape_the_data_cannot_tell_from_it():
     physical, shape = door([2.0, 2.4, 1.9, 2.3]), daily([1.9, 2.2, 2.1, 2.0])
-    chosen, decision = decide(testcell, [shape, physical], BASE, SIGMA, N)
-    assert chosen["effect"] == "conductivity", decision["reason"]
-    assert decision["indistinct"] == ["daily_gain@cell"]
+    chosen, decision = choose([shape, physical], BASE, SIGMA, N)
+    assert chosen.effect == "conductivity", decision.reason
+    assert decision.indistinct == ["daily_gain@cell"]
     # where the shape predicts every day measurably better, it is chosen, and told as a heat source
     far = door([5.0, 5.5, 4.8, 5.2])
-    chosen, decision = decide(testcell, [shape, far], BASE, SIGMA, N)
-    assert chosen["effect"] == "daily_gain"
-    assert "an unexplained heat source, acting with a daily profile" in decision["reason"].lower()
+    chosen, decision = choose([shape, far], BASE, SIGMA, N)
+    assert chosen.effect == "daily_gain"
+    assert "an unexplained heat source, acting with a daily profile" in decision.reason.lower()
 
 
-def test_a_shape_must_gain_more_than_the_noise_could_to_beat_a_physical_effect(testcell):
+def test_a_shape_must_gain_more_than_the_noise_could_to_beat_a_physical_effect():
     """A daily profile that predicts every left-out day 0.05 C2 better than a door, alike from day
     to day (no scatter to widen the band), gains 0.2 C2: less than the 0.59 C2 the noise alone
     could make of J (3 x 0.01 x sqrt(384)), so the door, a physical effect, is chosen; with the
     file's numerical error beside the noise the band only widens. A gain of 1.2 C2 beats it."""
     physical = door([2.0, 2.2, 2.1, 2.3])
     for floor in (None, 0.128):
-        chosen, decision = decide(testcell, [daily([1.95, 2.15, 2.05, 2.25]), physical], BASE, SIGMA, N, floor_sd=floor)
-        assert chosen is physical and decision["indistinct"] == ["daily_gain@cell"], decision["reason"]
-    chosen, _ = decide(testcell, [daily([1.7, 1.9, 1.8, 2.0]), physical], BASE, SIGMA, N)
-    assert chosen["effect"] == "daily_gain"
+        chosen, decision = choose([daily([1.95, 2.15, 2.05, 2.25]), physical], BASE, SIGMA, N, floor_sd=floor)
+        assert chosen is physical and decision.indistinct == ["daily_gain@cell"], decision.reason
+    chosen, _ = choose([daily([1.7, 1.9, 1.8, 2.0]), physical], BASE, SIGMA, N)
+    assert chosen.effect == "daily_gain"
 
 
-def test_a_candidate_physics_refuses_is_never_added_but_suggested(testcell):
+def test_a_candidate_physics_refuses_is_never_added_but_suggested():
     sink = candidate("internal_gain", "cell", {"Q": parameter(-545.0, 16.0)}, [1.0, 1.0, 1.0, 1.0])
     weaker = door([4.0, 4.2, 3.9, 4.1])
-    chosen, decision = decide(testcell, [sink, weaker], BASE, SIGMA, N)
-    assert chosen["effect"] == "conductivity"
-    assert [s["candidate"] for s in decision["suggestions"]] == ["internal_gain@cell"]
+    chosen, decision = choose([sink, weaker], BASE, SIGMA, N)
+    assert chosen.effect == "conductivity"
+    assert [s["candidate"] for s in decision.suggestions] == ["internal_gain@cell"]
     # the reason says the choice; the refused candidate is in the suggestions, said once by the report
-    assert "negative gain" in decision["suggestions"][0]["reason"] and "internal_gain" not in decision["reason"]
+    assert "negative gain" in decision.suggestions[0]["reason"] and "internal_gain" not in decision.reason
     # alone, it leaves the model as it is
-    chosen, decision = decide(testcell, [sink], BASE, SIGMA, N)
-    assert chosen is None and decision["chosen"] is None
+    chosen, decision = choose([sink], BASE, SIGMA, N)
+    assert chosen is None and decision.chosen is None
 
 
-def test_noise_alone_never_passes(testcell):
+def test_noise_alone_never_passes():
     """A candidate fitted to the noise of a right model predicts the left-out days as the model
     does, give or take what the noise makes: over many draws, none passes."""
     rng = np.random.default_rng(3)
@@ -207,11 +221,11 @@ def test_noise_alone_never_passes(testcell):
     for _ in range(200):
         # a one-parameter fit to noise: each day's J moves by about 2 sigma^2 either way
         days = base + rng.normal(0.0, 2 * SIGMA ** 2, 4)
-        chosen, decision = decide(testcell, [door(days)], base, SIGMA, N)
-        assert chosen is None, decision["reason"]
+        chosen, decision = choose([door(days)], base, SIGMA, N)
+        assert chosen is None, decision.reason
 
 
-def test_a_fall_the_files_own_numerical_error_could_make_does_not_pass(testcell):
+def test_a_fall_the_files_own_numerical_error_could_make_does_not_pass():
     """A model right but for its coarse walls leaves, beside the noise, 0.08 C RMS that follows
     the weather; a wall's conductivity fits 0.8 C2 of it, alike every day. Against the noise
     alone (0.59 C2) that would pass; against the floor the noise and that error make together,
@@ -220,48 +234,48 @@ def test_a_fall_the_files_own_numerical_error_could_make_does_not_pass(testcell)
     assert noise.floor_sd == pytest.approx(np.sqrt(SIGMA ** 2 + 0.08 ** 2))
     base = N / 4 * noise.floor_sd ** 2 * np.ones(4)
     wall = door(base - 0.2)
-    assert decide(testcell, [wall], base, SIGMA, N)[0] is not None
-    chosen, decision = decide(testcell, [wall], base, SIGMA, N, floor_sd=noise.floor_sd)
-    assert chosen is None and decision["noise_margin"] == pytest.approx(3 * noise.floor_sd ** 2 * np.sqrt(2 * N))
+    assert decide([wall], base, SIGMA, N).chosen is not None
+    chosen, decision = choose([wall], base, SIGMA, N, floor_sd=noise.floor_sd)
+    assert chosen is None and decision.noise_margin == pytest.approx(3 * noise.floor_sd ** 2 * np.sqrt(2 * N))
 
 
-def test_a_fall_from_one_day_alone_or_that_the_days_disagree_on_does_not_pass(testcell):
+def test_a_fall_from_one_day_alone_or_that_the_days_disagree_on_does_not_pass():
     one_day = door([1.0, 10.0, 10.0, 10.0])  # 9 C2 of fall, far beyond the noise, all on one day
-    chosen, decision = decide(testcell, [one_day], BASE, SIGMA, N)
-    assert chosen is None and decision["candidates"]["conductivity@door"]["other_days"] <= 0
+    chosen, decision = choose([one_day], BASE, SIGMA, N)
+    assert chosen is None and decision.verdicts["conductivity@door"].other_days <= 0
     # a fall of 12 C2 that three days give and one takes back: within one standard error of itself
     disagree = door([2.0, 2.0, 2.0, 22.0])
-    chosen, decision = decide(testcell, [disagree], BASE, SIGMA, N)
-    test = decision["candidates"]["conductivity@door"]
-    assert chosen is None and test["cv_fall"] > decision["noise_margin"] and test["cv_fall"] < test["needed"]
+    chosen, decision = choose([disagree], BASE, SIGMA, N)
+    test = decision.verdicts["conductivity@door"]
+    assert chosen is None and test.cv_fall > decision.noise_margin and test.cv_fall < test.needed
     # the same fall, every day alike: chosen
-    chosen, _ = decide(testcell, [door([7.0, 7.0, 7.0, 7.0])], BASE, SIGMA, N)
-    assert chosen["effect"] == "conductivity"
+    chosen, _ = choose([door([7.0, 7.0, 7.0, 7.0])], BASE, SIGMA, N)
+    assert chosen.effect == "conductivity"
 
 
-def test_two_components_the_data_cannot_tell_apart_are_both_named(testcell):
+def test_two_components_the_data_cannot_tell_apart_are_both_named():
     wall = candidate("conductivity", "west_wall", {"factor": parameter(2.0, 0.2)}, [2.1, 2.0, 2.3, 2.2])
-    chosen, decision = decide(testcell, [door([2.0, 2.2, 2.1, 2.2]), wall], BASE, SIGMA, N)
-    assert chosen["target"] == "door"
-    assert "cannot be told from that of west_wall" in decision["reason"]
+    chosen, decision = choose([door([2.0, 2.2, 2.1, 2.2]), wall], BASE, SIGMA, N)
+    assert chosen.target == "door"
+    assert "cannot be told from that of west_wall" in decision.reason
 
 
-def test_a_zone_s_correction_comes_before_a_component_s_the_data_cannot_tell_from_it(testcell):
+def test_a_zone_s_correction_comes_before_a_component_s_the_data_cannot_tell_from_it():
     # the air alone: the west wall predicts the left-out days a little better than the envelope
     # factor, within one standard error; naming the wall would place the fault where the data did not
     wall = candidate("conductivity", "west_wall", {"factor": parameter(2.0, 0.2)}, [2.0, 2.2, 2.1, 2.2])
     envelope = candidate("envelope_conductance", "cell", {"factor": parameter(1.2, 0.02)}, [2.1, 2.0, 2.3, 2.2])
-    chosen, decision = decide(testcell, [wall, envelope], BASE, SIGMA, N)
-    assert chosen["effect"] == "envelope_conductance", decision["reason"]
-    assert decision["indistinct"] == ["conductivity@west_wall"]
-    assert "west_wall alone explains the data as well" in decision["reason"]
+    chosen, decision = choose([wall, envelope], BASE, SIGMA, N)
+    assert chosen.effect == "envelope_conductance", decision.reason
+    assert decision.indistinct == ["conductivity@west_wall"]
+    assert "west_wall alone explains the data as well" in decision.reason
     # where a component (the door) predicts every day clearly better, the data have placed it there
     worse = candidate("envelope_conductance", "cell", {"factor": parameter(1.2, 0.02)}, [4.0, 4.1, 4.0, 4.1])
-    chosen, decision = decide(testcell, [door([2.0, 2.2, 2.1, 2.2]), worse], BASE, SIGMA, N)
-    assert chosen["target"] == "door" and not decision["indistinct"]
+    chosen, decision = choose([door([2.0, 2.2, 2.1, 2.2]), worse], BASE, SIGMA, N)
+    assert chosen.target == "door" and not decision.indistinct
 
 
-def test_a_component_must_gain_more_than_the_noise_could_to_be_named_before_the_zone(testcell):
+def test_a_component_must_gain_more_than_the_noise_could_to_be_named_before_the_zone():
     """The west wall predicts every left-out day 0.1 C2 better than the envelope factor, alike
     from day to day: 0.4 C2, under the 0.59 C2 the noise could make of J (3 x 0.01 x sqrt(384)),
     and a wall's factor can bend its own wall's dynamics onto what the file's coarse walls miss,
@@ -269,21 +283,20 @@ def test_a_component_must_gain_more_than_the_noise_could_to_be_named_before_the_
     def wall(days):
         return candidate("conductivity", "west_wall", {"factor": parameter(2.0, 0.2)}, days)
     envelope = candidate("envelope_conductance", "cell", {"factor": parameter(1.2, 0.02)}, [2.1, 2.3, 2.2, 2.3])
-    chosen, decision = decide(testcell, [wall([2.0, 2.2, 2.1, 2.2]), envelope], BASE, SIGMA, N)
-    assert chosen is envelope and decision["indistinct"] == ["conductivity@west_wall"], decision["reason"]
-    chosen, decision = decide(testcell, [wall([1.8, 2.0, 1.9, 2.0]), envelope], BASE, SIGMA, N)
-    assert chosen["target"] == "west_wall" and not decision["indistinct"], decision["reason"]
+    chosen, decision = choose([wall([2.0, 2.2, 2.1, 2.2]), envelope], BASE, SIGMA, N)
+    assert chosen is envelope and decision.indistinct == ["conductivity@west_wall"], decision.reason
+    chosen, decision = choose([wall([1.8, 2.0, 1.9, 2.0]), envelope], BASE, SIGMA, N)
+    assert chosen.target == "west_wall" and not decision.indistinct, decision.reason
 
 
 def with_left_out(result, residuals):
     """The candidate with its left-out residuals (C, every block's in one order), its per-day J
     computed from them: four days of N / 4."""
     days = [float(np.sum(np.square(part))) for part in np.split(residuals, 4)]
-    return {**result, "cv": {**result["cv"], "blocks": days, "J": sum(days), "rmse": float(np.sqrt(sum(days) / N)),
-                             "left_out": residuals}}
+    return replace(result, cv=replace(result.cv, blocks=days, left_out=residuals))
 
 
-def test_two_corrections_the_noise_could_order_either_way_are_not_told_apart(testcell):
+def test_two_corrections_the_noise_could_order_either_way_are_not_told_apart():
     # an air change and an envelope factor predicting nearly the same air, 0.01 C apart at every
     # step: a J difference of N x 0.01^2 = 0.019 C2, alike on every day (no scatter), which
     # another draw of the noise would move by 2 x 0.1 x 0.01 x sqrt(192) = 0.028 C2 (one sd)
@@ -294,22 +307,22 @@ def test_two_corrections_the_noise_could_order_either_way_are_not_told_apart(tes
     envelope = candidate("envelope_conductance", "cell", {"factor": parameter(1.3, 0.05)}, BASE)
     near = with_left_out(air, noise + 0.01)
     best = with_left_out(envelope, noise)
-    chosen, decision = decide(testcell, [near, best], BASE, SIGMA, N)
-    assert decision["indistinct"], decision["reason"]
+    chosen, decision = choose([near, best], BASE, SIGMA, N)
+    assert decision.indistinct, decision.reason
     # 0.2 C apart: a J difference of 7.7 C2 against a noise sd of 0.55 C2: told apart
     far = with_left_out(air, noise + 0.2)
-    chosen, decision = decide(testcell, [far, best], BASE, SIGMA, N)
-    assert chosen["effect"] == "envelope_conductance" and not decision["indistinct"]
+    chosen, decision = choose([far, best], BASE, SIGMA, N)
+    assert chosen.effect == "envelope_conductance" and not decision.indistinct
 
 
 def with_sensors(result, residuals):
     """The candidate with the other sensors' residuals (C) over the four days, as assess_all
     records them: per-day J and the residuals in one order."""
     days = [float(np.sum(np.square(part))) for part in np.split(residuals, 4)]
-    return {**result, "sensors": {"blocks": days, "J": sum(days), "n": residuals.size, "residuals": residuals}}
+    return replace(result, sensors=SensorEvidence(days, residuals.size, residuals=residuals))
 
 
-def test_the_other_sensors_tell_apart_corrections_that_predict_the_same_air(testcell):
+def test_the_other_sensors_tell_apart_corrections_that_predict_the_same_air():
     # an air change and inside convection predicting the same air on the left-out days, 0.002 C
     # apart (the air alone leaves them to the noise); four surfaces measured with 0.1 C of noise:
     # inside convection's off by 0.1 C at every step
@@ -318,24 +331,24 @@ def test_the_other_sensors_tell_apart_corrections_that_predict_the_same_air(test
     surfaces = rng.normal(0.0, SIGMA, 4 * N)
     infiltration = with_left_out(candidate("infiltration", "cell", {"n": parameter(0.8, 0.05)}, BASE), air + 0.002)
     convection = with_left_out(candidate("inside_convection", "cell", {"factor": parameter(1.9, 0.1)}, BASE), air)
-    chosen, decision = decide(testcell, [with_sensors(convection, surfaces + 0.1),
+    chosen, decision = choose([with_sensors(convection, surfaces + 0.1),
                                          with_sensors(infiltration, surfaces)], BASE, SIGMA, N)
-    assert chosen["effect"] == "infiltration" and not decision["indistinct"], decision["reason"]
-    assert "other sensors" in decision["reason"]
+    assert chosen.effect == "infiltration" and not decision.indistinct, decision.reason
+    assert "other sensors" in decision.reason
     # surfaces 0.005 C apart: within what the noise makes of their difference (2 x 0.1 x 0.005 x
     # sqrt(768) = 0.028 C2 against 768 x 0.005^2 = 0.019 C2): not told apart, both named
-    chosen, decision = decide(testcell, [with_sensors(convection, surfaces + 0.005),
+    chosen, decision = choose([with_sensors(convection, surfaces + 0.005),
                                          with_sensors(infiltration, surfaces)], BASE, SIGMA, N)
-    assert decision["indistinct"], decision["reason"]
+    assert decision.indistinct, decision.reason
     # and the air alone cannot tell them apart
-    chosen, decision = decide(testcell, [convection, infiltration], BASE, SIGMA, N)
-    assert decision["indistinct"], decision["reason"]
+    chosen, decision = choose([convection, infiltration], BASE, SIGMA, N)
+    assert decision.indistinct, decision.reason
 
 
-def test_the_other_sensors_never_make_a_candidate_pass(testcell):
+def test_the_other_sensors_never_make_a_candidate_pass():
     # a door that predicts the surfaces perfectly but the left-out air no better than the model:
     # whether the air needs a correction is the objective's question, and the answer is no
     surfaces = np.random.default_rng(2).normal(0.0, SIGMA, 4 * N)
     flat = with_sensors(door(BASE), surfaces)
-    chosen, decision = decide(testcell, [flat], BASE, SIGMA, N)
-    assert chosen is None and not decision["candidates"]["conductivity@door"]["passes"]
+    chosen, decision = choose([flat], BASE, SIGMA, N)
+    assert chosen is None and not decision.verdicts["conductivity@door"].passes

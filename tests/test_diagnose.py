@@ -68,7 +68,7 @@ def measured_with(testcell_data, weather, effect=None, seed=5):
 
 def run(tmp_path, testcell_data, testcell, weather, measurements, workers=1):
     case = prepare_case(testcell, weather, measurements).with_burn_in(1)
-    return diagnose(testcell, case, Objective.of(testcell), tmp_path, seed=0, workers=workers)
+    return diagnose(testcell, case, Objective.of(testcell), tmp_path, seed=0, workers=workers).to_json()
 
 
 @pytest.mark.parametrize("effect", list(TRUTH))
@@ -141,12 +141,11 @@ def test_the_sun_a_closed_blind_lets_in_is_named_as_the_blind_not_as_a_gain(tmp_
     truth = EFFECTS["shading_transmittance"].apply(building, "cell", {"f": 0.3})
     measurements = pseudo_measurements(truth, drawn, record(), SENSORS, noise_sd=NOISE, seed=5, history_days=7)
     case = prepare_case(building, drawn, measurements).with_burn_in(1)
-    report = diagnose(building, case, Objective.of(building), tmp_path, seed=0, workers=2)
-    assert [(e["effect"], e["target"]) for e in report["effects"]] == [("shading_transmittance", "cell")], \
-        report["decision"]["reason"]
-    f = report["effect"]["parameters"]["f"]
+    diagnosis = diagnose(building, case, Objective.of(building), tmp_path, seed=0, workers=2)
+    assert [e.label for e in diagnosis.added] == ["shading_transmittance@cell"], diagnosis.rounds[0].reason
+    f = diagnosis.added[0].parameters["f"]
     assert f["identifiable"] and abs(f["value"] - 0.3) <= max(0.25 * 0.3, 3 * f["std"])
-    before, after = report["before"]["validation"]["rmse"], report["after"]["validation"]["rmse"]
+    before, after = diagnosis.before["validation"]["rmse"], diagnosis.after["validation"]["rmse"]
     assert after <= 1.5 * NOISE < before
 
 

@@ -505,7 +505,7 @@ def test_corrections_written_back_and_read_again(tmp_path):
     for effect, target, values in effects:
         after = EFFECTS[effect].apply(after, target, values)
     out = tmp_path / "model_after.idf"
-    result = write_corrections(before, after, [{"effect": e, "target": t} for e, t, _ in effects],
+    result = write_corrections(before, after, [(e, t) for e, t, _ in effects],
                                CASE600, out)
     doc = idfkit.load_idf(str(out))
     infiltration = doc.getobject("ZONEINFILTRATION:DESIGNFLOWRATE", "INFILTRATION")

@@ -42,7 +42,7 @@ def test_three_zones_diagnosed_end_to_end(tmp_path):
     case = prepare_case(building, weather, measured, history_days=14).with_burn_in(1)
     objective = Objective.of(building, [z.name for z in building.zones])
     report = diagnose(building, case, objective, tmp_path / "out", seed=0, fmu_kind="python",
-                      population=12, generations=10)
+                      population=12, generations=10).to_json()
     after = json.loads((tmp_path / "out" / "building_after.json").read_text())
     east = next(z for z in after["zones"] if z["name"] == "EAST OFFICE")
     assert east["air_change_rate"] == pytest.approx(1.2, abs=0.05)
@@ -69,7 +69,7 @@ def test_case600_corrections_written_back(tmp_path):
     weather, measured = read_weather(tmp_path / "w.csv"), read_measurements(tmp_path / "m.csv")
     case = prepare_case(building, weather, measured, history_days=14).with_burn_in(1)
     report = diagnose(building, case, Objective.of(building), tmp_path / "out", seed=0, fmu_kind="python",
-                      population=12, generations=10)
+                      population=12, generations=10).to_json()
     assert report["effect"]["effect"] == "infiltration"
     doc = idfkit.load_idf(str(tmp_path / "out" / "model_after.idf"))
     infiltration = doc.getobject("ZONEINFILTRATION:DESIGNFLOWRATE", "INFILTRATION")

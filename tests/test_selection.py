@@ -72,7 +72,7 @@ def record(building, weather, start, days, step, sensors=SENSORS, noise=0.1, eff
 
 def run(building, case, tmp_path, noise=None):
     return diagnose(building, case, Objective.of(building), tmp_path, seed=0, workers=2, generations=30,
-                    noise=noise)
+                    noise=noise).to_json()
 
 
 def added(report):

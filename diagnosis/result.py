@@ -1,0 +1,343 @@
+"""What the diagnosis makes, as typed records: a candidate's fit (`Fit`, with its cross-validation
+and the other sensors' evidence), a round's decision (`Decision`, each candidate's `Verdict`), and
+the whole diagnosis (`Diagnosis`), which reports itself (`summary()`, `to_json()`, `plots`).
+
+report.json is `Diagnosis.to_json()`; `Diagnosis.read` gives back every input of each round's
+choice from it (tests/test_replay.py recomputes the choices that way). What report.json leaves
+out are the residuals themselves (a house's would make it gigabytes): each decision keeps what the
+choice read of them, the distances of every two admissible candidates'.
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from nodeforce.model.score import Noise
+
+
+@dataclass
+class CrossValidation:
+    """A candidate's blocked cross-validation (`diagnosis.selection`): J (C2) on each block left
+    out of its fit, the residuals the blocks score (`n`), each fold's parameter values, and the
+    left-out residuals themselves (C, every block's in one order; None when read back from
+    report.json, which does not keep them)."""
+    blocks: list
+    n: int
+    folds: list = field(default_factory=list)
+    left_out: np.ndarray = None
+
+    @property
+    def J(self):
+        """J (C2) over every block left out."""
+        return float(sum(self.blocks))
+
+    @property
+    def rmse(self):
+        """The root mean square (C) of the left-out residuals."""
+        return float(np.sqrt(self.J / self.n))
+
+    def to_json(self):
+        return {"blocks": [float(b) for b in self.blocks], "J": self.J, "n": self.n, "rmse": self.rmse,
+                "folds": self.folds}
+
+    @classmethod
+    def of_json(cls, d):
+        return cls(d["blocks"], d["n"], d.get("folds", []))
+
+
+@dataclass
+class SensorEvidence:
+    """What a candidate fitted to the air alone predicts of the other sensors (a wall's surface, a
+    neighbouring zone's air) over the blocks: their weighted J (C2) per block, the readings (`n`),
+    what the noise counts of them (`n_weighted`, sum of the squared weights), and the weighted
+    residuals (C, None when read back from report.json)."""
+    blocks: list = field(default_factory=list)
+    n: int = 0
+    n_weighted: float = 0.0
+    residuals: np.ndarray = None
+
+    @property
+    def J(self):
+        """The weighted J (C2) over every block."""
+        return float(np.sum(self.blocks))
+
+    def to_json(self):
+        return {"blocks": [float(b) for b in self.blocks], "J": self.J, "n": self.n, "n_weighted": self.n_weighted}
+
+    @classmethod
+    def of_json(cls, d):
+        return cls(d["blocks"], d["n"], d["n_weighted"])
+
+
+@dataclass
+class Fit:
+    """One candidate effect calibrated on the calibration window (`diagnosis.calibrate`): its
+    parameters ({name: {"value", "std", "identifiable", "on_bound", ...}}), what the data determine
+    besides (`derived`), what the building says of it (`physics`, `Policy.facts`), its metrics on
+    both windows ({"calibration", "validation"}), its cross-validation, the other sensors'
+    evidence, the round it was tried in and the effects it was added on top of (labels)."""
+    effect: str
+    target: str
+    parameters: dict
+    derived: dict
+    physics: dict
+    cv: CrossValidation
+    sensors: SensorEvidence = field(default_factory=SensorEvidence)
+    metrics: dict = field(default_factory=dict)
+    round: int = 1
+    on_top_of: tuple = ()
+
+    @property
+    def label(self):
+        """"effect@target", the key of the decision, the runs and the sensitivity."""
+        return f"{self.effect}@{self.target}"
+
+    @property
+    def values(self):
+        """{name: value} of the calibrated parameters."""
+        return {name: p["value"] for name, p in self.parameters.items()}
+
+    def evidence(self):
+        """Per-block J (C2) the choice reads (`diagnosis.selection`): the objective air on each
+        block left out of its fit and the other sensors' weighted J over the same blocks, which no
+        fit read."""
+        return np.asarray(self.cv.blocks, dtype=float) + np.asarray(self.sensors.blocks or 0.0, dtype=float)
+
+    def residuals(self):
+        """The residuals (C) the evidence is made of, the air's left out then the other sensors',
+        None where not kept."""
+        if self.cv.left_out is None:
+            return None
+        return np.concatenate([np.asarray(self.cv.left_out, dtype=float),
+                               np.asarray(self.sensors.residuals if self.sensors.residuals is not None else [],
+                                          dtype=float)])
+
+    def effect_json(self, keys=("effect", "target", "parameters")):
+        """The effect as report.json's `effects` and `effect` say it."""
+        return {key: getattr(self, key) for key in keys}
+
+    def to_json(self):
+        return {"effect": self.effect, "target": self.target, "parameters": self.parameters, "derived": self.derived,
+                "physics": self.physics, **self.metrics, "cv": self.cv.to_json(), "sensors": self.sensors.to_json(),
+                "round": self.round, **({"on_top_of": list(self.on_top_of)} if self.on_top_of else {})}
+
+    @classmethod
+    def of_json(cls, d):
+        return cls(d["effect"], d["target"], d["parameters"], d["derived"], d["physics"],
+                   CrossValidation.of_json(d["cv"]), SensorEvidence.of_json(d["sensors"]),
+                   {w: d[w] for w in ("calibration", "validation") if w in d}, d["round"], tuple(d.get("on_top_of", ())))
+
+
+@dataclass
+class Verdict:
+    """One candidate's test in a round (`diagnosis.selection.candidate_test`): its cross-validated
+    fall of J (C2) and the fall's standard error, what it needs, what the days other than its best
+    gain, its evidence (C2), whether it passes, the records it harms and the objection of physics
+    (None if none)."""
+    cv_fall: float
+    cv_se: float
+    needed: float
+    other_days: float
+    evidence: float
+    passes: bool
+    harms: list
+    objection: str = None
+
+    def to_json(self):
+        return asdict(self)
+
+
+@dataclass
+class Decision:
+    """One round's decision (`diagnosis.selection.decide`): the candidate chosen (None), the reason
+    in words, the model's cross-validated J (C2) over its blocks, the noise's margin (C2), the
+    standard errors asked, the suggestions physics refused, the candidates the data cannot tell
+    from the chosen (labels), every candidate's verdict by label, what the steps read besides the
+    candidates (`inputs`: the model's per-block J, sigma, floor_sd, n, groups, distances), and
+    what the round cost."""
+    chosen: Fit
+    reason: str
+    cv_J_before: float
+    blocks: int
+    noise_margin: float
+    standard_errors: float
+    suggestions: list
+    indistinct: list
+    verdicts: dict
+    inputs: dict
+    cost: dict = None
+
+    def to_json(self):
+        return {"chosen": self.chosen.label if self.chosen else None, "reason": self.reason,
+                "cv_J_before": self.cv_J_before, "blocks": self.blocks, "noise_margin": self.noise_margin,
+                "standard_errors": self.standard_errors, "suggestions": self.suggestions,
+                "indistinct": self.indistinct, "candidates": {k: v.to_json() for k, v in self.verdicts.items()},
+                "inputs": self.inputs, **({"cost": self.cost} if self.cost is not None else {})}
+
+    @classmethod
+    def of_json(cls, d, chosen):
+        """The decision report.json records, `chosen` its chosen candidate's `Fit` (None)."""
+        return cls(chosen, d["reason"], d["cv_J_before"], d["blocks"], d["noise_margin"], d["standard_errors"],
+                   d["suggestions"], d["indistinct"], {k: Verdict(**v) for k, v in d["candidates"].items()},
+                   d["inputs"], d.get("cost"))
+
+
+@dataclass
+class RecordOutcome:
+    """One record of a diagnosis of several: its name, measurement file, windows (`period`), the
+    objective's metrics before and after on its windows, its own forcing search and, where it runs
+    under its own protocol, its corrected building file."""
+    name: str
+    measurements: str
+    period: dict
+    before: dict
+    after: dict
+    localization: dict
+    building_after: str = None
+
+    def to_json(self):
+        return {"name": self.name, "measurements": self.measurements, "period": self.period, "before": self.before,
+                "after": self.after, "localization": self.localization,
+                **({"building_after": self.building_after} if self.building_after else {})}
+
+    @classmethod
+    def of_json(cls, d):
+        return cls(**d)
+
+
+@dataclass
+class Diagnosis:
+    """A whole diagnosis (`nodeforce.diagnose`).
+
+    objective : the objective's zone names
+    period : the first record's windows and blocks (`diagnosis.loop.period`)
+    before, after : the objective's metrics ({"calibration", "validation"}, each per zone too) of
+        the building as described and as corrected, every record's windows together
+    localization : the forcing search's result on every record's calibration window (locate.json)
+    candidates : every candidate tried, every round's (`Fit`)
+    rounds : each round's `Decision`
+    structure_left : what the residual left after the last round follows, in words
+    heat_loss : the heat loss coefficient as described and as corrected (`diagnosis.loss`)
+    residuals : the validation residual's statistics before and after (`diagnosis.residuals`)
+    sensitivity : the Morris screening of each added effect's parameters, by label
+    noise : the air sensors' noise and the file's numerical error (`model.score.Noise`)
+    assumptions, node_names : what the cases assumed; the building's node names by id
+    artifacts : the files written (paths)
+    records : each record's outcome, where there are several (`RecordOutcome`)
+    worsened_phases, phases : the phases an added effect makes worse; every model's error per phase
+    reference : another model's error, for scale; energyplus : the corrections written back
+    """
+    objective: list
+    period: dict
+    before: dict
+    after: dict
+    localization: dict
+    candidates: list
+    rounds: list
+    structure_left: str
+    heat_loss: dict
+    residuals: dict
+    sensitivity: dict
+    noise: Noise
+    assumptions: list
+    node_names: dict
+    artifacts: dict
+    records: list = ()
+    worsened_phases: list = None
+    phases: list = None
+    reference: dict = None
+    energyplus: dict = None
+
+    @property
+    def added(self):
+        """The effects added, in order (their `Fit`s)."""
+        return [d.chosen for d in self.rounds if d.chosen is not None]
+
+    @property
+    def plots(self):
+        """The PNG figures written beside report.json."""
+        return [Path(p) for p in self.artifacts.get("plots", ())]
+
+    def decision_json(self):
+        """report.json's `decision`: the first round's record with the last effect chosen, every
+        round's reason, the rounds, what is left and the phases made worse."""
+        rounds = [d.to_json() for d in self.rounds]
+        added = self.added
+        out = {**rounds[0], "chosen": added[-1].label if added else None,
+               "reason": " ".join(f"Round {i + 1}: {d.reason}" if len(rounds) > 1 else d.reason
+                                  for i, d in enumerate(self.rounds)),
+               "rounds": rounds, "structure_left": self.structure_left}
+        if self.worsened_phases is not None:
+            out["worsened_phases"] = self.worsened_phases
+            if self.worsened_phases:
+                out["reason"] += (" It lowers the total error but makes the phase " + "; ".join(
+                    f"{w['phase']} worse ({w['before']:.3f} C -> {w['after']:.3f} C)" for w in self.worsened_phases)
+                    + ", which the total hides.")
+        return out
+
+    def to_json(self):
+        """report.json's content."""
+        added = self.added
+        out = {"period": self.period, "objective": list(self.objective), "before": self.before,
+               "localization": self.localization, "candidates": [c.to_json() for c in self.candidates],
+               "effects": [a.effect_json() for a in added], "decision": self.decision_json(),
+               "effect": (added[-1].effect_json(("effect", "target", "parameters", "derived")) if added
+                          else {"effect": "none", "target": None, "parameters": {}}),
+               "after": self.after, "heat_loss_coefficient": self.heat_loss, "assumptions": list(self.assumptions),
+               "residuals": self.residuals, "sensitivity": self.sensitivity, "noise_sigma": self.noise.sigma,
+               "noise": self.noise.to_json(), "node_names": self.node_names, "artifacts": self.artifacts}
+        if self.records:
+            out["records"] = [r.to_json() for r in self.records]
+        for key in ("reference", "energyplus", "phases"):
+            if getattr(self, key):
+                out[key] = getattr(self, key)
+        return out
+
+    def summary(self):
+        """The first screen: where the fault is, what was added and what the data determine of
+        it, the error before and after on the validation window, the heat loss coefficient, what
+        is left."""
+        from nodeforce.diagnosis.report import terminal_summary  # the report reads report.json's content
+        return terminal_summary(self.to_json())
+
+    def write(self, path):
+        """Write report.json."""
+        Path(path).write_text(json.dumps(self.to_json(), indent=2, default=_plain) + "\n")
+
+    def replay(self):
+        """Each round's `Decision` recomputed from what the diagnosis holds alone, with the policy
+        (`diagnosis.selection.decide`): the round's candidates' fits and what its decision read
+        besides (`Decision.inputs`). On a diagnosis read from report.json it is the check that
+        the report holds every input of the choice."""
+        from nodeforce.diagnosis.selection import decide  # the choice reads these records
+        out = []
+        for number, recorded in enumerate(self.rounds, start=1):
+            given = recorded.inputs
+            out.append(decide([c for c in self.candidates if c.round == number], given["blocks_before"],
+                              given["sigma"], given["n"], given["groups"], given["floor_sd"], given["distances"]))
+        return out
+
+    @classmethod
+    def read(cls, path):
+        """The diagnosis a report.json holds: every input of each round's choice but the residuals
+        themselves (each decision keeps their distances)."""
+        d = json.loads(Path(path).read_text())
+        candidates = [Fit.of_json(c) for c in d["candidates"]]
+        by_round = {(c.round, c.label): c for c in candidates}
+        rounds = [Decision.of_json(r, by_round.get((number, r["chosen"])))
+                  for number, r in enumerate(d["decision"]["rounds"], start=1)]
+        return cls(d["objective"], d["period"], d["before"], d["after"], d["localization"], candidates, rounds,
+                   d["decision"]["structure_left"], d["heat_loss_coefficient"], d["residuals"], d["sensitivity"],
+                   Noise.of_json(d["noise"]), d["assumptions"], d["node_names"], d["artifacts"],
+                   [RecordOutcome.of_json(r) for r in d.get("records", ())], d["decision"].get("worsened_phases"),
+                   d.get("phases"), d.get("reference"), d.get("energyplus"))
+
+
+def _plain(value):
+    """numpy scalars as plain JSON numbers."""
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"{type(value).__name__} is not JSON")
