@@ -15,6 +15,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from tests.test_replay import check_replay
+
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLE = REPO / "examples" / "twinhouse_n2"
 BUILDING = EXAMPLE / "building.json"
@@ -404,13 +406,15 @@ def test_diagnose_end_to_end_on_a_few_real_days(tmp_path):
     for side in ("before", "after"):
         for window in ("calibration", "validation"):
             assert math.isfinite(report[side][window]["rmse"]) and report[side][window]["n"] > 0, (side, window)
-    chosen = report["effect"]
-    if chosen["effect"] == "none":
-        for window in ("calibration", "validation"):
-            assert report["after"][window]["rmse"] == pytest.approx(report["before"][window]["rmse"])
-    else:
-        match = [c for c in report["candidates"]
-                 if (c["effect"], c["target"]) == (chosen["effect"], chosen["target"])]
-        assert len(match) == 1
-        assert report["after"]["validation"]["rmse"] == pytest.approx(match[0]["validation"]["rmse"])
-        assert report["after"]["validation"]["J"] < report["before"]["validation"]["J"]
+    # what it finds, as the whole experiment's diagnosis does (docs/real-data.md): the model lacks
+    # the sun the living room's closed blinds still let in, which the two days fix beyond the
+    # noise, and the validation day, which no choice read, confirms: its error falls by more than half
+    assert [(e["effect"], e["target"]) for e in report["effects"]] == [("shading_transmittance", "living")], \
+        report["decision"]["reason"]
+    f = report["effect"]["parameters"]["f"]
+    assert f["identifiable"] and 0.0 < f["value"] < 1.0
+    assert after < before / 2
+    match = [c for c in report["candidates"] if (c["effect"], c["target"]) == ("shading_transmittance", "living")
+             and c["round"] == 1]
+    assert len(match) == 1 and report["after"]["validation"]["rmse"] == pytest.approx(match[0]["validation"]["rmse"])
+    check_replay(out / "report.json")  # and the choice is recomputed from report.json alone
