@@ -406,9 +406,11 @@ def test_diagnose_end_to_end_on_a_few_real_days(tmp_path):
     for side in ("before", "after"):
         for window in ("calibration", "validation"):
             assert math.isfinite(report[side][window]["rmse"]) and report[side][window]["n"] > 0, (side, window)
-    # what it finds, as the whole experiment's diagnosis does (docs/real-data.md): the model lacks
-    # the sun the living room's closed blinds still let in, which the two days fix beyond the
-    # noise, and the validation day, which no choice read, confirms: its error falls by more than half
+    # what it finds: the model lacks sun in the living room, here the sun its closed blinds still
+    # let in (the whole experiment's diagnosis, docs/real-data.md, finds the same missing sun, as a
+    # gain following the west facade's irradiance, the blinds' leak a close second), which the two
+    # days fix beyond the noise, and the validation day, which no choice read, confirms: its error
+    # falls by more than half
     assert [(e["effect"], e["target"]) for e in report["effects"]] == [("shading_transmittance", "living")], \
         report["decision"]["reason"]
     f = report["effect"]["parameters"]["f"]
