@@ -284,7 +284,7 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers, weights,
     with tqdm(total=len(pairs), desc="calibrating candidate effects", unit="candidate",
               disable=not sys.stderr.isatty()) as bar:
         if cluster is not None:
-            assessed = cluster.map(assess, pairs, cluster.share(shared), done=bar.update)
+            assessed = cluster.map(assess, pairs, cluster.share(shared), done=lambda *_: bar.update())
             for outcome in assessed:
                 if isinstance(outcome, BaseException):
                     raise outcome

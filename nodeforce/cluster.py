@@ -80,7 +80,8 @@ class Cluster:
     def map(self, function, items, shared: "Shared | None" = None, done=None) -> list:
         """function(shared value, item) (function(item) without `shared`) for each item on the
         workers; per item its result or the exception that ended it (its own, or KilledWorker),
-        for the caller to judge. `done()` is called as each item ends (a progress bar's update).
+        for the caller to judge. `done(index, that)` is called as each item ends (a progress bar's
+        update, a result kept at once).
         Raises `lifetime.RunStopped` if the scheduler is lost."""
         from distributed import as_completed
 
@@ -103,7 +104,7 @@ class Cluster:
                         todo.append(i)
                         continue
                 if done is not None:
-                    done()
+                    done(i, results[i])
             if not todo:
                 break
             if shared is not None:
