@@ -87,7 +87,7 @@ class Cluster:
 
         results = [None] * len(items)
         todo = range(len(items))
-        for _ in range(SHARED_LOSSES):
+        for attempt in range(SHARED_LOSSES):
             extra = () if shared is None else (shared.future,)
             futures = {self.client.submit(function, *extra, items[i], pure=False): i for i in todo}
             todo = []
@@ -100,7 +100,7 @@ class Cluster:
                         raise lifetime.RunStopped(f"--scheduler: {self.address}: lost the Dask scheduler "
                                                   f"({type(exc).__name__})") from exc
                     results[i] = exc
-                    if shared is not None and shared.lost:
+                    if shared is not None and shared.lost and attempt < SHARED_LOSSES - 1:
                         todo.append(i)
                         continue
                 if done is not None:

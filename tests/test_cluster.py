@@ -1,5 +1,5 @@
-"""The diagnosis on a Dask cluster (`nodeforce.cluster`): the answer of the local run, and a
-worker lost in the middle of a round costs none. (The forcing search's own cluster tests are in
+"""The diagnosis on a Dask cluster (`nodeforce.cluster`): the answer of the local run, a worker
+lost in the middle of a round costs none, a lost scheduler stops it in one line. (The forcing search's own cluster tests are in
 test_search.py and test_faults.py.)
 
 The record: the test cell whose door conducts 0.78 W/m/K, not 0.23, six days of the door and the
@@ -11,6 +11,7 @@ import signal
 
 import pytest
 
+from nodeforce import lifetime
 from nodeforce.diagnosis.loop import diagnose
 from nodeforce.model.building import load_building, parse_building
 from nodeforce.model.effects import EFFECTS
@@ -18,6 +19,7 @@ from nodeforce.model.case import prepare_case
 from nodeforce.model.score import Objective
 from nodeforce.model.synth import pseudo_measurements
 from tests.conftest import record_times
+from tests.test_faults import dask_cluster
 
 pytestmark = pytest.mark.slow  # clusters and whole diagnoses: not in `make check`
 
@@ -78,9 +80,9 @@ def test_a_diagnosis_on_a_two_worker_cluster_gives_the_local_answer(door, local,
     assert sum(task["key"].startswith("assess-") for task in stream.data) == len(report["candidates"])
 
 
-def kill_at_first_candidate(done):
-    """In a worker process: the first candidate any worker starts kills its process outright
-    (SIGKILL, as a machine lost); the file `done` says it happened, so only once."""
+def kill_at_first_candidate(done, victim=None):
+    """In a worker process: the first candidate any worker starts kills `victim` (default its own
+    process) outright (SIGKILL, as a machine lost); the file `done` says it happened, so only once."""
     from nodeforce.diagnosis import loop
     assess = loop.assess
 
@@ -89,7 +91,7 @@ def kill_at_first_candidate(done):
             os.close(os.open(done, os.O_CREAT | os.O_EXCL))
         except FileExistsError:
             return assess(shared, pair)
-        os.kill(os.getpid(), signal.SIGKILL)
+        os.kill(victim or os.getpid(), signal.SIGKILL)
 
     loop.assess = killing
 
@@ -106,3 +108,16 @@ def test_a_worker_killed_in_the_middle_of_a_round_costs_no_answer(door, local, t
     # the scheduler gave its candidate to a worker alive: each one calibrated once to its end
     assert sum(task["key"].startswith("assess-") for task in stream.data) == len(report["candidates"])
     assert_same_answer(report, tmp_path / "out", local)
+
+
+def test_a_lost_scheduler_stops_the_diagnosis_in_one_line(door, tmp_path):
+    building, case = door
+    done = tmp_path / "killed"
+    with dask_cluster(tmp_path, 1) as (address, scheduler):
+        with distributed.Client(address) as client:
+            client.run(kill_at_first_candidate, str(done), scheduler.pid)
+        with pytest.raises(lifetime.RunStopped) as stopped:
+            diagnose(building, case, Objective.of(building), tmp_path / "out", seed=0, scheduler=address)
+    assert done.exists()  # lost in the round, its search done
+    [line] = str(stopped.value).splitlines()
+    assert line.startswith(f"--scheduler: {address}: lost the Dask scheduler (")
