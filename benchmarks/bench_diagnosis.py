@@ -22,6 +22,8 @@ Run:
     python benchmarks/bench_diagnosis.py --quick        # 8 records, one draw
     python benchmarks/bench_diagnosis.py --only 'gso-jan/*' --draws 1
     python benchmarks/bench_diagnosis.py --report       # the tables from the records already run
+    python benchmarks/bench_diagnosis.py --scheduler tcp://10.0.0.1:8786   # on a Dask cluster's workers,
+        # started with this checkout on their PYTHONPATH (they import benchmarks.records)
 """
 import argparse
 import contextlib
@@ -90,7 +92,7 @@ def finished(path, name):
 
 
 def diagnose_one(task):
-    """Generate one record, diagnose it with the loop and the baseline; write and return the result."""
+    """Generate one record, diagnose it with the loop and the baseline; return the result."""
     name, draw, path, population, generations, history_days = task
     from nodeforce import api, tempdirs
     started = time.time()
@@ -123,12 +125,24 @@ def diagnose_one(task):
             "hlc_truth": r.hlc_truth, "hlc_file": r.hlc_file, "generation_seconds": generated,
         }
     except Exception as error:  # a record that fails is reported, not cached: a rerun tries it again
-        return {"name": name, "draw": draw, "error": f"{type(error).__name__}: {error}"}
+        return failed(task, error)
+    return result
+
+
+def failed(task, error):
+    return {"name": task[0], "draw": task[1], "error": f"{type(error).__name__}: {error}"}
+
+
+def keep(task, result):
+    """Write a record's result where a rerun finds it (here, not on a cluster's worker: it may
+    not share this file system); a failed one is not kept."""
+    if "error" in result:
+        return
+    path = task[2]
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(".part")
     tmp.write_text(json.dumps(result, indent=1) + "\n")
     os.replace(tmp, path)
-    return result
 
 
 def rounded(decision, kept=8):
@@ -142,21 +156,32 @@ def rounded(decision, kept=8):
                      for k in best}}
 
 
-def run(tasks, workers):
-    """Each task in a worker process (2 by default), with a progress bar; the results in task order."""
+def run(tasks, workers, scheduler=None):
+    """Each task in a worker process (2 by default), or on the workers of the Dask cluster at
+    `scheduler`, with a progress bar; each result kept as it comes; the results as they came."""
     from concurrent.futures import as_completed
     from nodeforce import lifetime
+    from nodeforce.cluster import Cluster
     if not tasks:
         return []
-    with lifetime.worker_pool(min(workers, len(tasks))) as pool:
-        futures = {pool.submit(diagnose_one, t): t for t in tasks}
-        done = []
-        with tqdm(total=len(tasks), desc="diagnosing records", unit="diagnosis") as bar:
-            for future in as_completed(futures):
-                result = future.result()
-                done.append(result)
-                bar.set_postfix_str(result["name"] + (" FAILED" if "error" in result else ""))
-                bar.update()
+    done = []
+    with tqdm(total=len(tasks), desc="diagnosing records", unit="diagnosis") as bar:
+        def arrived(task, result):
+            if isinstance(result, BaseException):  # a record whose diagnosis killed its workers
+                result = failed(task, result)
+            keep(task, result)
+            done.append(result)
+            bar.set_postfix_str(result["name"] + (" FAILED" if "error" in result else ""))
+            bar.update()
+
+        if scheduler is not None:
+            with Cluster(scheduler) as cluster:
+                cluster.map(diagnose_one, tasks, done=lambda i, result: arrived(tasks[i], result))
+        else:
+            with lifetime.worker_pool(min(workers, len(tasks))) as pool:
+                futures = {pool.submit(diagnose_one, t): t for t in tasks}
+                for future in as_completed(futures):
+                    arrived(futures[future], future.result())
     return done
 
 
@@ -349,7 +374,7 @@ def write_docs(path, lines, args, elapsed):
         "# The diagnosis on many records (issue 27)", "",
         *(["A subset of the records; `make benchmark` writes the whole benchmark's tables here.", ""] if subset else []),
         "Made by", "", f"    {command}", "",
-        f"on {os.cpu_count()} cores, {args.workers} workers{timing}. The loop runs through the public API (`nodeforce.api.diagnose`) with the command line's "
+        f"on {'a Dask cluster' if args.scheduler else f'{os.cpu_count()} cores, {args.workers} workers'}{timing}. The loop runs through the public API (`nodeforce.api.diagnose`) with the command line's "
         f"settings: GA population {args.population}, at most {args.generations} generations (stopped at "
         "convergence), its own calibrations, seed 0, one worker per diagnosis, the sensors' noise given as "
         "a user states it.", "",
@@ -390,6 +415,9 @@ def main(argv=None):
     p.add_argument("--only", help="records whose name matches this glob, e.g. 'mia-jun/*' or '*door*'")
     p.add_argument("--draws", type=int, help="noise draws per record (default 3; 1 with --quick)")
     p.add_argument("--workers", type=int, default=2)
+    p.add_argument("--scheduler", help="a Dask scheduler address, tcp://host:port: the diagnoses on its workers "
+                                       "(started with this checkout on their PYTHONPATH) instead of --workers "
+                                       "processes")
     p.add_argument("--population", type=int, default=30)
     p.add_argument("--generations", type=int, default=400)
     p.add_argument("--out", type=Path, default=OUT)
@@ -415,9 +443,9 @@ def main(argv=None):
              for s in specs for d in range(draws)]
     todo = [t for t in tasks if args.fresh or not finished(t[2], t[0])] if not args.report else []
     print(f"{len(specs)} records x {draws} draws: {len(tasks) - len(todo)} done before, {len(todo)} to run "
-          f"on {args.workers} workers", flush=True)
+          f"on {args.scheduler or f'{args.workers} workers'}", flush=True)
     started = time.time()
-    fresh = {(r["name"], r["draw"]): r for r in run(todo, args.workers)}
+    fresh = {(r["name"], r["draw"]): r for r in run(todo, args.workers, args.scheduler)}
     elapsed = time.time() - started
     results = [fresh.get((t[0], t[1])) or (json.loads(t[2].read_text()) if finished(t[2], t[0]) else None)
                for t in tasks]

@@ -13,7 +13,8 @@ on data the calibration did not see.
 4. Rounds. Each calibrates every physical candidate (`diagnosis.candidates.physical`: every zone
    effect of the objective zones, the component effects of the components the evidence ranks
    highest and of those no sensor sits in) on the direct model, the candidates in parallel
-   worker processes, once on the whole calibration window and once per block left out
+   worker processes or on a Dask cluster's workers (`scheduler`, as the forcing search), once
+   on the whole calibration window and once per block left out
    (`diagnosis.calibrate`); where none brings the error to the noise, the shapes the residual's
    statistics point at too (`diagnosis.candidates.shapes`). One rule chooses
    (`diagnosis.selection.decide`: blocked cross-validation, the one-standard-error rule, the
@@ -35,11 +36,13 @@ import sys
 import time
 from contextlib import nullcontext
 from dataclasses import dataclass, replace
+from functools import partial
 
 import numpy as np
 from tqdm import tqdm
 
 from nodeforce import lifetime
+from nodeforce.cluster import Cluster
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnosis.calibrate import Candidate, calibrate, sensitivity
@@ -91,20 +94,23 @@ class Assessed:
     """One candidate calibrated and run (`assess`): its parameters ({name: {"value", "std", ...}}),
     what the data determine besides, its objective air (N_t, zones) and other sensed nodes
     (`Windows.sensors`) over each whole record, its cross-validation folds ({"values",
-    "residuals"} each) and the simulations it took."""
+    "residuals"} each), the simulations it took and its building file (JSON), declared at the
+    calibrated values: the caller writes it, as a Dask worker may not share its file system."""
     parameters: dict
     determined: dict
     runs: list
     sensed: list
     folds: list
     simulations: int
+    building: dict
 
 
-def assess(task):
+def assess(shared, pair):
     """Calibrate one candidate effect, with its cross-validation folds, and run it: a task for a
-    worker process. Returns its `Assessed`; writes the candidate's building file, declared at the
-    calibrated values, in `folder`."""
-    building, bases, effect, target, folder, calibrations, cases, objective, blocks, sensors, numerical, seed = task
+    worker process or a Dask worker; its `Assessed`. `shared`: what every candidate of the round
+    reads (`assess_all`); `pair`: the (effect, target)."""
+    building, bases, calibrations, cases, objective, blocks, sensors, numerical, seed = shared
+    effect, target = pair
     candidate = Candidate(building, effect, target, protocols(bases, calibrations, cases))
     parameters, determined, folds = calibrate(candidate, calibrations, objective, blocks, numerical)
     values = [parameters[p.name]["value"] for p in candidate.parameters]
@@ -112,8 +118,7 @@ def assess(task):
     sensed = [candidate.nodes(case, ids, values) if ids else np.empty((len(case.times) - 1, 0))
               for case, ids in zip(cases, sensors)]
     calibrated = EFFECTS[effect].apply(building, target, {name: p["value"] for name, p in parameters.items()})
-    (folder / f"{candidate.label}.json").write_text(json.dumps(calibrated.to_json(), indent=2) + "\n")
-    return Assessed(parameters, determined, runs, sensed, folds, candidate.simulations)
+    return Assessed(parameters, determined, runs, sensed, folds, candidate.simulations, calibrated.to_json())
 
 
 def protocols(bases, *windows):
@@ -278,20 +283,33 @@ class Model:
                      [None if b is None else EFFECTS[effect].apply(b, target, values) for b in self.bases])
 
 
-def assess_all(model, pairs, windows, objective, folder, seed, workers, weights, number=1, on_top_of=()):
+def assess_all(model, pairs, windows, objective, folder, seed, workers, weights, number=1, on_top_of=(),
+               cluster=None):
     """Each (effect, target) added to `model`, calibrated on every record's calibration window
     (t_0..t_k) with a fold per block, and run over each record, in parallel worker processes
-    (which end with this process: nodeforce.lifetime): the candidates' `Fit`s, their `Model`s by
-    label, and the simulations they took. `weights`: each record's other sensors' weights in the
-    choice (`Windows.sensor_weights`); `number`: the round; `on_top_of`: the labels of the effects
-    `model` holds."""
-    tasks = [(model.building, model.bases, effect, target, folder, windows.calibrations, windows.cases, objective,
-              windows.blocks, windows.sensors, windows.calibration_numerical(), seed) for effect, target in pairs]
-    n_workers = min(workers or os.cpu_count(), len(tasks))
-    with (lifetime.worker_pool(n_workers) if n_workers > 1 else nullcontext()) as pool:
-        assessed = list(tqdm((pool.map if pool else map)(assess, tasks), total=len(tasks),
-                             desc="calibrating candidate effects", unit="candidate",
-                             disable=not sys.stderr.isatty()))
+    (which end with this process: nodeforce.lifetime), or on the workers of `cluster` (a
+    `nodeforce.cluster.Cluster`), each candidate's building file written in `folder`: the
+    candidates' `Fit`s, their `Model`s by label, and the simulations they took. `weights`: each
+    record's other sensors' weights in the choice (`Windows.sensor_weights`); `number`: the round;
+    `on_top_of`: the labels of the effects `model` holds."""
+    shared = (model.building, model.bases, windows.calibrations, windows.cases, objective, windows.blocks,
+              windows.sensors, windows.calibration_numerical(), seed)
+    with tqdm(total=len(pairs), desc="calibrating candidate effects", unit="candidate",
+              disable=not sys.stderr.isatty()) as bar:
+        if cluster is not None:
+            assessed = cluster.map(assess, pairs, cluster.share(shared), done=lambda *_: bar.update())
+            for outcome in assessed:
+                if isinstance(outcome, BaseException):
+                    raise outcome
+        else:
+            n_workers = min(workers or os.cpu_count(), len(pairs))
+            with (lifetime.worker_pool(n_workers) if n_workers > 1 else nullcontext()) as pool:
+                assessed = []
+                for outcome in (pool.map if pool else map)(partial(assess, shared), pairs):
+                    assessed.append(outcome)
+                    bar.update()
+    for (effect, target), a in zip(pairs, assessed):
+        (folder / f"{effect}@{target}.json").write_text(json.dumps(a.building, indent=2) + "\n")
     n = windows.scored()
     results, models, simulations = [], {}, 0
     for (effect, target), a in zip(pairs, assessed):
@@ -312,7 +330,7 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers, weights,
 
 
 def diagnose(building, records, objective, workdir, *, source="measurements", fraction=0.6, calibration_end=None,
-             seed=0, workers=None, population=30, generations=400, fmu_kind="auto", reference=None,
+             seed=0, workers=None, scheduler=None, population=30, generations=400, fmu_kind="auto", reference=None,
              noise=None, phases=None):
     """Run the whole loop, its stages in order (`prepare`, `localise`, `rounds`, `write`); write the
     artifacts in `workdir`; return the `Diagnosis` (report.json is its `to_json()`).
@@ -325,7 +343,9 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
     `reference` ({"label", "rmse": {phase: K}}), another model's error, is reported for scale;
     `noise` (C) is the air sensors' noise sd if the user knows it, else it is estimated from
     every record's air. `fmu_kind`: the FMUs built, run and written (`ga.locate.locate`; "auto": the
-    standalone FMU where a C compiler is at hand)."""
+    standalone FMU where a C compiler is at hand). `scheduler` ("tcp://host:port"): the forcing
+    search and every round's candidates run on that Dask cluster's workers (`nodeforce.cluster`)
+    instead of `workers` processes; an unreachable one is an InputError before any work."""
     if not isinstance(records, (list, tuple)):
         records = [Record(records, source, source, fraction, calibration_end, tuple(phases or ()))]
     names = [r.name for r in records]
@@ -334,11 +354,13 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
             raise InputError(r.source, "name", f"two records are named {r.name!r}: each needs its own name")
         check_measured(objective, r.case, r.source)
     fmu_kind = evaluator_kind(building) if fmu_kind == "auto" else fmu_kind
-    prepared = prepare(building, records, objective, workdir, fmu_kind, noise)
-    search = dict(seed=seed, workers=workers, population=population, generations=generations, fmu_kind=fmu_kind,
-                  noise=prepared.noise.sigma if prepared.noise.given else None)
-    located = localise(building, prepared, objective, workdir, search)
-    made = rounds(prepared, located.localization, objective, workdir, seed, workers)
+    with Cluster(scheduler) if scheduler is not None else nullcontext() as cluster:
+        prepared = prepare(building, records, objective, workdir, fmu_kind, noise)
+        search = dict(seed=seed, workers=workers, scheduler=scheduler, population=population,
+                      generations=generations, fmu_kind=fmu_kind,
+                      noise=prepared.noise.sigma if prepared.noise.given else None)
+        located = localise(building, prepared, objective, workdir, search)
+        made = rounds(prepared, located.localization, objective, workdir, seed, workers, cluster)
     return write(building, prepared, located, made, objective, workdir, fmu_kind, reference)
 
 
@@ -418,9 +440,10 @@ def localise(building, prepared, objective, workdir, search):
     return Located(localization, alone, convergence)
 
 
-def rounds(prepared, localization, objective, workdir, seed, workers):
+def rounds(prepared, localization, objective, workdir, seed, workers, cluster=None):
     """Stage 3: rounds of candidates, `POLICY.max_rounds` at most, each on top of the last,
-    while the error left is above the noise and one is chosen (`selection.decide`)."""
+    while the error left is above the noise and one is chosen (`selection.decide`); the
+    candidates in `workers` processes or on `cluster`'s workers (`assess_all`)."""
     windows, n, noise = prepared.windows, prepared.n, prepared.noise
     folder = workdir / "candidates"
     folder.mkdir(exist_ok=True)
@@ -439,7 +462,7 @@ def rounds(prepared, localization, objective, workdir, seed, workers):
         pairs = [p for p in physical(model.building, localization["components"], objective.zones,
                                      measured_ids, localization["best_nodes"]) if "@".join(p) not in done]
         tried, models, simulations = assess_all(model, pairs, windows, objective, into, seed, workers, weights,
-                                                number + 1, done)
+                                                number + 1, done, cluster)
         # shapes only where no physical candidate physics admits brings the error left to the
         # noise; the residual's statistics then choose which
         if not any(POLICY.at_noise(r.cv.J, n, noise.floor_sd) and not POLICY.objection_of(
@@ -447,7 +470,7 @@ def rounds(prepared, localization, objective, workdir, seed, workers):
             pairs = [p for p in shapes(model.building, left_by(windows, model), objective.zones)
                      if "@".join(p) not in done]
             more, more_models, more_simulations = assess_all(model, pairs, windows, objective, into, seed, workers,
-                                                             weights, number + 1, done)
+                                                             weights, number + 1, done, cluster)
             tried, simulations = tried + more, simulations + more_simulations
             models.update(more_models)
         decision = decide(tried, base_blocks, noise.sigma, n, windows.groups(), noise.floor_sd)

@@ -25,10 +25,11 @@ import math
 import multiprocessing.util
 import pickle
 import threading
+from functools import partial
 from typing import Iterable, Sequence
 
 from nodeforce import lifetime
-from nodeforce.model.errors import InputError
+from nodeforce.cluster import Cluster
 
 log = logging.getLogger("nodeforce.ga")
 
@@ -182,82 +183,38 @@ def _dask_close(token: str) -> None:
         close_evaluator(_dask_evaluators.pop(key))
 
 
-CLIENT_LOGGERS = ("distributed.client", "distributed.batched")
-# Times a batch is submitted while the workers holding the evaluator factory are lost (a chunk
-# that kills every worker it runs on must not be retried for ever).
-FACTORY_LOSSES = 3
-
-
 class DaskBackend(_Backend):
-    """Chunks submitted to a dask.distributed scheduler at `address` ("tcp://host:port").
+    """Chunks mapped over the workers of a dask.distributed scheduler at `address`
+    ("tcp://host:port") through `nodeforce.cluster`, the factory shipped once to every worker.
 
-    A worker lost mid-task costs nothing: the scheduler gives its tasks to another worker (or
-    to the same one, restarted by its nanny), and if the factory was lost with it, it is shipped
-    again.  A lost scheduler stops the search (lifetime.RunStopped); its checkpoint resumes it.
+    A worker lost mid-task costs nothing (its tasks rerun, the factory is shipped again if it was
+    lost with it); a lost scheduler stops the search (lifetime.RunStopped); its checkpoint
+    resumes it.
     """
 
     def __init__(self, factory, address: str):
-        from distributed import Client
-
-        try:
-            self._client = Client(address, set_as_default=False, timeout="10s")
-            self._address = address
-        except (OSError, ValueError, TypeError) as e:
-            raise InputError("--scheduler", address, f"cannot reach a Dask scheduler there ({e})") from None
+        self._cluster = Cluster(address)
         self._token = factory_token(factory)
-        self._raw_factory = factory
-        self._ship_factory()
-        # The client's own logs are silenced while it serves the search: every failure it meets
-        # reaches the search as a future's exception, said in one line (a lost scheduler), and
-        # they would repeat it as tracebacks (a closed connection, the attempts to reconnect).
-        self._log_levels = {name: logging.getLogger(name).level for name in CLIENT_LOGGERS}
-        for name in CLIENT_LOGGERS:
-            logging.getLogger(name).setLevel(logging.CRITICAL + 1)
-
-    def _ship_factory(self):
-        # Once to every worker; tasks refer to it instead of carrying it each time.
-        [self._factory] = self._client.scatter([self._raw_factory], broadcast=True, hash=False)
+        self._task = partial(_dask_task, self._token)
+        self._factory = self._cluster.share(factory)
 
     @property
     def slots(self) -> int:
-        return max(1, sum(self._client.nthreads().values()))
+        return self._cluster.slots
 
     def run(self, chunks):
-        results = [None] * len(chunks)
-        todo = range(len(chunks))
-        for _ in range(FACTORY_LOSSES):
-            futures = {i: self._client.submit(_dask_task, self._token, self._factory, chunks[i], pure=False)
-                       for i in todo}
-            todo = []
-            for i, future in futures.items():
-                try:
-                    results[i] = future.result()
-                except EvaluatorSetupError:
-                    raise
-                except Exception as exc:  # KilledWorker and the like: the chunk was lost
-                    if self._client.status != "running":  # ... unless the scheduler was
-                        raise lifetime.RunStopped(f"--scheduler: {self._address}: lost the Dask scheduler "
-                                                  f"({type(exc).__name__})") from exc
-                    results[i] = exc
-                    if self._factory.status != "finished":
-                        todo.append(i)
-            if not todo:
-                break
-            # The workers holding the factory were lost (scattered data cannot be made again)
-            # and with it every task that needed it: ship it again and submit those again.
-            self._ship_factory()
+        results = self._cluster.map(self._task, chunks, self._factory)
+        for result in results:
+            if isinstance(result, EvaluatorSetupError):
+                raise result
         return results
 
     def close(self, abort=False):
         try:
             if not abort:  # the workers keep the evaluators of a stopped search, for its rerun
-                self._client.run(_dask_close, self._token)
+                self._cluster.run(_dask_close, self._token)
         finally:
-            try:
-                self._client.close()
-            finally:
-                for name, level in self._log_levels.items():
-                    logging.getLogger(name).setLevel(level)
+            self._cluster.close()
 
 
 def open_backend(factory, workers: "int | None", scheduler: "str | None"):

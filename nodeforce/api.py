@@ -381,7 +381,8 @@ def locate(building, case, objective=None, workdir=None, source=SOURCE, **search
 
 
 def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibration_end=None, phases=(), seed=0,
-             workers=None, fmu_kind="python", noise=None, reference=None, population=30, generations=400):
+             workers=None, scheduler=None, fmu_kind="python", noise=None, reference=None, population=30,
+             generations=400):
     """The whole loop of `nodeforce diagnose`; writes its files in `workdir` (docs/guide.md, Output
     files) and returns the `Diagnosis`: `summary()` the first screen, `to_json()` report.json's
     content, `added` the effects added, `rounds` each round's decision, `candidates` every fit.
@@ -406,6 +407,11 @@ def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibrati
         Every random choice's (the forcing search, the screening).
     workers : int, optional
         Worker processes (default all cores), spawned as for `locate`.
+    scheduler : str, optional
+        A Dask scheduler's address, "tcp://host:port": the forcing search and every round's
+        candidates run on its workers instead of `workers` processes (docs/performance.md). The
+        answer is the same; a worker lost midway costs none; a lost scheduler raises
+        `nodeforce.lifetime.RunStopped`, an unreachable one `InputError`.
     fmu_kind : str
         The FMUs built, run and written: "python" (the default, as on the command line),
         "standalone" (or their "-fmi3" forms), or "auto", the standalone where a C compiler is at
@@ -427,8 +433,8 @@ def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibrati
     with _folder(workdir) as folder:
         return _loop.diagnose(building, case, objective or Objective.of(building), folder, source=SOURCE,
                               fraction=fraction, calibration_end=calibration_end, phases=phases, seed=seed,
-                              workers=workers, fmu_kind=fmu_kind, noise=noise, reference=reference,
-                              population=population, generations=generations)
+                              workers=workers, scheduler=scheduler, fmu_kind=fmu_kind, noise=noise,
+                              reference=reference, population=population, generations=generations)
 
 
 def compare(models, workdir=None, phases=(), fmu_kind="python"):

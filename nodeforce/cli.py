@@ -225,7 +225,7 @@ def run_diagnosis(building, records, objective, out, args):
     """The loop on `records` (`api.Record`s) through `api.diagnose`, its summary printed."""
     check_workers(args)
     diagnosis = api.diagnose(building, records, out, objective, seed=args.seed, workers=args.workers,
-                             fmu_kind=kind_of(args), noise=noise(args),
+                             scheduler=args.scheduler, fmu_kind=kind_of(args), noise=noise(args),
                              reference=read_reference(args.reference) if args.reference else None)
     print(diagnosis.summary())
     print(f"wrote {out / 'report.json'}, {out / 'report.md'}, {out / 'building_after.json'}, {out / 'model_after.fmu'}")
@@ -395,6 +395,7 @@ def diagnosis_arguments(s):
     fmi_argument(s)
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--workers", type=int, help="processes (default: all cores)")
+    scheduler_argument(s)
     s.add_argument("--fmu", choices=("python", "standalone"), default="python", help="the FMU kind to run")
     s.add_argument("--calibration-fraction", type=float, default=0.6,
                    help="the first part of the record, by time, that calibrates; the rest validates")
@@ -406,6 +407,11 @@ def diagnosis_arguments(s):
                                     "every model is scored on each and a phase made worse is flagged")
     noise_argument(s)
     start_arguments(s, 1.0)
+
+
+def scheduler_argument(s):
+    s.add_argument("--scheduler", help="a Dask scheduler address, tcp://host:port: run on its workers "
+                                       "instead of --workers processes")
 
 
 def start_arguments(s, burn_in):
@@ -494,7 +500,7 @@ def parser():
     s.add_argument("--fmu", choices=("auto", "python", "standalone"), default="auto",
                    help="the FMU kind to run (auto: standalone if a C compiler is found, else python; "
                         "the standalone is the faster, docs/performance.md)")
-    s.add_argument("--scheduler", help="a Dask scheduler address, tcp://host:port")
+    scheduler_argument(s)
     fmi_argument(s)
     noise_argument(s)
     start_arguments(s, 0.0)

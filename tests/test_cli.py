@@ -141,6 +141,15 @@ def test_an_unreachable_scheduler_is_a_one_line_error(files, capsys):
     assert err.startswith("nodeforce: --scheduler: tcp://127.0.0.1:1: cannot reach a Dask scheduler")
 
 
+def test_a_diagnosis_says_its_scheduler_is_unreachable_before_any_work(files, capsys):
+    out = files["dir"] / "unreached"
+    err = error_of(capsys, ["diagnose", str(files["building"]), "--weather", str(files["weather"]),
+                            "--measurements", str(files["measurements"]), "-o", str(out),
+                            "--scheduler", "tcp://127.0.0.1:1"])
+    assert err.startswith("nodeforce: --scheduler: tcp://127.0.0.1:1: cannot reach a Dask scheduler")
+    assert not any(out.iterdir())  # no FMU built, no search begun
+
+
 def test_a_record_shorter_than_the_warm_up_is_refused_unless_the_weather_gives_a_history(files, capsys, tmp_path):
     short = rewrite_csv(files, "measurements", "short.csv", lambda f: f.iloc[:40])
     command = ["simulate", str(files["building"]), "--weather", str(files["weather"]), "--measurements", short]
