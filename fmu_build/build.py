@@ -34,7 +34,7 @@ SLAVE = Path(__file__).with_name("slave.py")
 VARIABLES = Path(__file__).with_name("variables.py")
 MODEL_DIR = Path(model.__file__).parent
 # The modules the FMU imports; weather and solar stay outside (their results are inputs).
-PHYSICS_MODULES = ("__init__", "errors", "building", "discretise", "schedule", "effects", "network", "integrate")
+PHYSICS_MODULES = ("__init__", "errors", "building", "building_file", "discretise", "schedule", "effects", "network", "integrate")
 
 
 FMI3_PLATFORM = "x86_64-linux"  # FMI 3.0's name of FMI 2.0's linux64

@@ -7,7 +7,7 @@ import pytest
 
 from nodeforce.diagnosis.policy import POLICY
 from nodeforce.diagnosis.selection import blocks, decide
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.errors import InputError
 from nodeforce.model.score import Noise
 

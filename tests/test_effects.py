@@ -8,7 +8,8 @@ from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.diagnosis.candidates import physical
-from nodeforce.model.building import Boundary, parse_building
+from nodeforce.model.building import Boundary
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import simulate

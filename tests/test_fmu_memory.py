@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from nodeforce.fmu_build.build import build_fmu, fmu_kind
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from tests.test_standalone import python_host_environment, run_c_host, scenario
 
 ERROR = 3  # fmi2Error and fmi3Error

@@ -15,7 +15,7 @@ from nodeforce.diagnosis.calibrate import Candidate, calibrate
 from nodeforce.diagnosis.candidates import calibration_start, physical
 from nodeforce.diagnosis.policy import POLICY
 from nodeforce.fmu_build.build import build_fmu
-from nodeforce.model.building import load_building, parse_building
+from nodeforce.model.building_file import load_building, parse_building
 from nodeforce.model.case import Case
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError

@@ -8,7 +8,9 @@ from pathlib import Path
 import jsonschema
 import pytest
 
-from nodeforce.model.building import Boundary, parse_building
+from nodeforce.model.building import Boundary
+
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
 

@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 
 from nodeforce.cli import main
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import measured_case, prepare_case
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError

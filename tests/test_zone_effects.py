@@ -10,7 +10,7 @@ from scipy.linalg import expm
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.fmu_build.build import build_fmu
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import Case
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
