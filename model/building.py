@@ -202,7 +202,8 @@ class Building:
     schedules: dict = field(default_factory=dict)  # name -> Schedule
     source: str = field(default="<building>", compare=False)
     data: dict = field(default_factory=dict, compare=False, repr=False)  # the JSON it was read from
-    # the function that read it, (data, source=) -> Building: an edit is read again the same way
+    # what reads an edit again, (data, source=) -> Building: `building_file.parse_building`, given by
+    # the reader itself so that the records import nothing of it
     reader: object = field(default=None, compare=False, repr=False)
 
     @property
@@ -320,7 +321,7 @@ class Building:
 
     def edited(self, change):
         """A new Building from this one's JSON changed in place by `change(data)`, read again
-        (validated) by the reader that read this one."""
+        (validated: its JSON Schema, then the rules it cannot state)."""
         data = self.to_json()
         change(data)
         return self.reader(data, source=self.source)
