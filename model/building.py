@@ -202,8 +202,8 @@ class Building:
     schedules: dict = field(default_factory=dict)  # name -> Schedule
     source: str = field(default="<building>", compare=False)
     data: dict = field(default_factory=dict, compare=False, repr=False)  # the JSON it was read from
-    # what reads an edit again, (data, source=) -> Building: `building_file.parse_building`, given by
-    # the reader itself so that the records import nothing of it
+    # what reads an edit again, (data, source=, edited_from=) -> Building: `building_file.parse_building`,
+    # given by the reader itself so that the records import nothing of it
     reader: object = field(default=None, compare=False, repr=False)
 
     @property
@@ -324,7 +324,7 @@ class Building:
         (validated: its JSON Schema, then the rules it cannot state)."""
         data = self.to_json()
         change(data)
-        return self.reader(data, source=self.source)
+        return self.reader(data, source=self.source, edited_from=self.data)
 
 
 def boundary_columns(zones, components):

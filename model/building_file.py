@@ -49,18 +49,22 @@ def load_building(path):
     return parse_building(data, source=str(path))
 
 
-def parse_building(data, source="<building>"):
+def parse_building(data, source="<building>", edited_from=None):
     """Validate a building description already parsed from JSON (the schema, then the rules it
-    cannot state); return a `Building`."""
-    check_schema(data, source)
+    cannot state); return a `Building`. `edited_from`: the description `data` is an edit of, which
+    follows the schema already (`Building.edited`)."""
+    check_schema(data, source, edited_from)
     return parse_checked(data, source)
 
 
-def check_schema(data, source):
-    """InputError naming the field where `data` does not follow the format's JSON Schema."""
-    error = _schema_error(data)
+def check_schema(data, source, edited_from=None):
+    """InputError naming the field where `data` does not follow the format's JSON Schema; of an
+    edit of `edited_from` (which does), the zones and components the edit changed, where it
+    changed nothing else: an effect's edit, read again at each step of a calibration."""
+    prefix, error = _schema_error(data, edited_from)
     if error is not None:
-        where = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in error.absolute_path).lstrip(".")
+        where = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in (*prefix, *error.absolute_path))
+        where = where.lstrip(".")
         path = list(error.absolute_schema_path)
         if "propertyNames" in path:  # a key at fault: name it
             where = f"{where}.{error.instance}".lstrip(".")
@@ -74,22 +78,40 @@ def check_schema(data, source):
         raise InputError(source, where or "(top level)", problem)
 
 
-def _schema_error(data):
+# the lists whose items an edit may change alone, and the schema's definition of an item
+ITEMS = {"zones": "zone", "components": "component"}
+
+
+def _schema_error(data, before):
+    """(path prefix, jsonschema's best error or None) of `data`, or of the items of ITEMS it
+    changed from `before` where nothing else differs: the top level of the schema asks nothing
+    of an item but its own definition."""
     import jsonschema  # here: an FMU at its declared parameters runs this module without it
-    return jsonschema.exceptions.best_match(_validator().iter_errors(data))
+    best = jsonschema.exceptions.best_match
+    if (not isinstance(data, dict) or not isinstance(before, dict) or data.keys() != before.keys()
+            or any(data[k] != before[k] for k in data if k not in ITEMS)
+            or any(not isinstance(data[k], list) or len(data[k]) != len(before[k]) for k in ITEMS if k in data)):
+        return (), best(_validator(None).iter_errors(data))
+    for key, definition in ITEMS.items():
+        for i, (new, old) in enumerate(zip(data.get(key, ()), before.get(key, ()))):
+            error = best(_validator(definition).iter_errors(new)) if new != old else None
+            if error is not None:
+                return (key, i), error
+    return (), None
 
 
-@functools.lru_cache(maxsize=1)
-def _validator():
-    """The format's JSON Schema validator. Python's json reads NaN and Infinity, which JSON has
-    no number for, and an id 1.0 is a float the parser cannot index by: a "number" is a finite
-    one and an "integer" an int here."""
+@functools.lru_cache(maxsize=None)
+def _validator(definition):
+    """The format's JSON Schema validator, of a whole file or of one of its `$defs`. Python's json
+    reads NaN and Infinity, which JSON has no number for, and an id 1.0 is a float the parser
+    cannot index by: a "number" is a finite one and an "integer" an int here."""
     import jsonschema
     base = jsonschema.Draft202012Validator
     types = base.TYPE_CHECKER.redefine_many({
         "number": lambda _, v: isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v),
         "integer": lambda _, v: isinstance(v, int) and not isinstance(v, bool)})
-    return jsonschema.validators.extend(base, type_checker=types)(SCHEMA)
+    schema = SCHEMA if definition is None else {"$defs": SCHEMA["$defs"], "$ref": f"#/$defs/{definition}"}
+    return jsonschema.validators.extend(base, type_checker=types)(schema)
 
 
 def parse_checked(data, source="<building>"):

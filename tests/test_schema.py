@@ -274,3 +274,20 @@ def test_a_node_id_is_a_json_integer(validator):
     assert errors(validator, data) == []  # JSON Schema's integer holds 1.0
     with pytest.raises(InputError, match=r"components\[4\]\.nodes\[0\]\.id: .* is not of type 'integer'"):
         parse_building(data, source="cell.json")
+
+
+@pytest.mark.parametrize("mutate", [
+    _unknown_outside_type, _negative_area, _missing_layers, _absorptance_1_5, _zero_conductivity,
+    _negative_air_change_rate, _latitude_100, _glazing_without_target, _wrong_format,
+    *(change for change, _, _ in SCHEMA_RULES.values()),
+], ids=lambda f: getattr(f, "__name__", "rule").strip("_"))
+def test_an_edit_is_refused_as_the_file_it_makes_would_be(mutate):
+    """An edit (an effect's, at each step of a calibration) is checked against the schema where it
+    changed the building only: with the same words as the whole file it makes."""
+    data = copy.deepcopy(TESTCELL)
+    mutate(data)
+    with pytest.raises(InputError) as whole:
+        parse_building(data, source="cell.json")
+    with pytest.raises(InputError) as edit:
+        parse_building(TESTCELL, source="cell.json").edited(mutate)
+    assert str(edit.value) == str(whole.value)
