@@ -18,7 +18,7 @@ sys.path.insert(0, str(ROOT))  # the C host's runner lives with the tests
 from fmpy import read_model_description  # noqa: E402
 
 from nodeforce.fmu_build.build import build_fmu  # noqa: E402
-from nodeforce.model.building import load_building  # noqa: E402
+from nodeforce.model.building_file import load_building  # noqa: E402
 from tests.test_standalone import python_host_environment, run_c_host  # noqa: E402
 
 BUILDINGS = {"test cell": ROOT / "model" / "data" / "testcell_miami.json",

@@ -43,7 +43,7 @@ import pandas as pd
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.fitness import FmuFitness, ModelFitness
 from nodeforce.iotools.weather import read_weather
-from nodeforce.model.building import load_building
+from nodeforce.model.building_file import load_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.integrate import CondensedSolve, DenseSolve, ImplicitEuler, Partition
 from nodeforce.model.network import assemble

@@ -51,7 +51,7 @@ from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.fitness import FmuFitness, ModelFitness
 from nodeforce.ga.locate import chromosome_nodes, locate
 from nodeforce.ga.search import PAPER, PATIENCE, search
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.integrate import initial_state, simulate, warmup_rows
 from nodeforce.model.network import assemble

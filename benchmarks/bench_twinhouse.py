@@ -17,7 +17,7 @@ from nodeforce.cosim.run import simulate_fmu
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.iotools.measurements import read_measurements
 from nodeforce.iotools.weather import read_weather
-from nodeforce.model.building import load_building
+from nodeforce.model.building_file import load_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.integrate import simulate
 from nodeforce.model.network import assemble

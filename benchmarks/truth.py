@@ -11,7 +11,7 @@ import pvlib
 from nodeforce import tempdirs
 from nodeforce.iotools.typical_year import convert_typical_year, relocate
 from nodeforce.iotools.weather import read_weather
-from nodeforce.model.building import load_building, parse_building
+from nodeforce.model.building_file import load_building, parse_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.integrate import simulate

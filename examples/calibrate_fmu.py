@@ -71,7 +71,7 @@ def door_case(folder, days, kind, seed):
     import pandas as pd
 
     import nodeforce
-    from nodeforce.model.building import parse_building
+    from nodeforce.model.building_file import parse_building
     from nodeforce.model.synth import pseudo_measurements
 
     data = json.loads((DATA / "testcell_miami.json").read_text())

@@ -34,7 +34,9 @@ SLAVE = Path(__file__).with_name("slave.py")
 VARIABLES = Path(__file__).with_name("variables.py")
 MODEL_DIR = Path(model.__file__).parent
 # The modules the FMU imports; weather and solar stay outside (their results are inputs).
-PHYSICS_MODULES = ("__init__", "errors", "building", "discretise", "schedule", "effects", "network", "integrate")
+PHYSICS_MODULES = ("__init__", "errors", "building", "building_file", "discretise", "schedule", "effects", "network",
+                   "integrate")
+SCHEMA = "data/nodal-building.schema.json"
 
 
 FMI3_PLATFORM = "x86_64-linux"  # FMI 3.0's name of FMI 2.0's linux64
@@ -90,6 +92,7 @@ def _build_python(building, destination, effect, fmi):
     effect_text = json.dumps({"effect": effect[0], "target": effect[1]}) if effect else ""
     sources = {f"{name}.py": (MODEL_DIR / f"{name}.py").read_text() for name in PHYSICS_MODULES}
     sources["variables.py"] = VARIABLES.read_text()
+    sources[SCHEMA] = (MODEL_DIR / SCHEMA).read_text()  # an importer's parameters edit the building: checked by it
     slave_text = SLAVE.read_text()
     module = "nodeforce_" + description.content_hash(building_text, effect_text, slave_text,
                                                      *sources.values())[:16]
@@ -101,6 +104,7 @@ def _build_python(building, destination, effect, fmi):
         package = tmp / f"{module}_model"
         package.mkdir()
         for name, text in sources.items():
+            (package / name).parent.mkdir(exist_ok=True)
             (package / name).write_text(text)
         (tmp / "building.json").write_text(building_text)
         resources = [package, tmp / "building.json"]

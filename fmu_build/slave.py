@@ -35,7 +35,7 @@ from pythonfmu import Fmi2Slave
 from pythonfmu.enums import Fmi2Status
 
 _physics = {name: importlib.import_module(f"{__name__}_model.{name}")
-            for name in ("building", "effects", "integrate", "network", "variables")}
+            for name in ("building_file", "effects", "integrate", "network", "variables")}
 _variables = _physics["variables"]
 
 
@@ -59,7 +59,7 @@ def _model(resources, values=()):
     """(building, network, steppers by dt) of the FMU's building with the parameters of `values`
     ((name, value) pairs, those that differ from the declared ones) set."""
     data, effect = _read(resources)
-    building = _physics["building"].parse_building(data, source="building.json")
+    building = _physics["building_file"].parse_checked(data, source="building.json")
     if not values:
         return building, _physics["network"].assemble(building), {}
     # the FMU's inputs are those of the building as declared, in its order: the effect's network

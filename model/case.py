@@ -402,7 +402,7 @@ def simulate_building(building, weather, measurements=None, force=(), warmup_day
 
     Parameters
     ----------
-    building : Building (`model.building.load_building`)
+    building : Building (`model.building_file.load_building`)
     weather : DataFrame from `nodeforce.iotools.weather.read_weather`
     measurements : DataFrame from `nodeforce.iotools.measurements.read_measurements`, or None; it sets the
         time grid, the initial state (where the weather does not start before it: `prepare_case`'s

@@ -16,7 +16,7 @@ from itertools import count
 
 import numpy as np
 
-from .building import parse_building
+from .building_file import parse_building
 
 REFINEMENT = 4  # cells of the reference per stretch between two of the file's nodes or layer boundaries
 REFERENCE_STEP = 60.0  # s, the reference's longest integration step

@@ -20,7 +20,8 @@ from nodeforce.iotools.measurements import read_measurements
 from nodeforce.iotools.phases import read_phases
 from nodeforce.iotools.table import convert_table as _convert_table
 from nodeforce.iotools.weather import read_weather
-from nodeforce.model.building import Building, load_building
+from nodeforce.model.building import Building
+from nodeforce.model.building_file import load_building
 from nodeforce.model.case import HISTORY_DAYS, force_mask, measured_case, simulate_building
 from nodeforce.model.errors import InputError
 from nodeforce.model.score import Objective
@@ -77,14 +78,13 @@ def convert_idf(path, output=None):
         Naming the IDF, the object and the field: an IDF the conversion cannot read.
     """
     from nodeforce.iotools.energyplus import convert
-    from nodeforce.model.building import check_schema, parse_building
+    from nodeforce.model.building_file import parse_building
     import json
     import os
     data = convert(path)
     if output is not None:
         data["energyplus"]["idf"] = os.path.relpath(Path(path).resolve(), Path(output).resolve().parent)
     building = parse_building(data, source=str(output if output is not None else path))
-    check_schema(data, str(path))
     if output is not None:
         Path(output).parent.mkdir(parents=True, exist_ok=True)
         Path(output).write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")

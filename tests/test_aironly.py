@@ -18,7 +18,7 @@ from nodeforce.diagnosis.loss import heat_loss
 from nodeforce.diagnosis.result import CrossValidation, Fit
 from nodeforce.diagnosis.report.tables import before_after_table
 from nodeforce.ga.locate import locate
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError

@@ -5,7 +5,7 @@ from pathlib import Path
 
 import pytest
 
-from nodeforce.model.building import load_building, parse_building
+from nodeforce.model.building_file import load_building, parse_building
 from nodeforce.model.errors import InputError
 
 TESTCELL = json.loads((Path(__file__).parents[1] / "model" / "data" / "testcell.json").read_text())

@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import measured_case
 from nodeforce.model.integrate import simulate
 from nodeforce.iotools.measurements import read_measurements

@@ -12,7 +12,7 @@ from nodeforce.cli import main
 from nodeforce.iotools.measurements import read_measurements
 from nodeforce.iotools.timetable import write_time_table
 from nodeforce.iotools.weather import read_weather
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import prepare_case, simulate_building
 from nodeforce.model.errors import InputError
 from nodeforce.model.synth import pseudo_measurements

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from nodeforce.cli import main
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import measured_case
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.integrate import simulate

@@ -11,7 +11,7 @@ import pytest
 from nodeforce.diagnosis.policy import POLICY
 from nodeforce.diagnosis.result import CrossValidation, Fit, SensorEvidence
 from nodeforce.diagnosis.selection import blocks, decide
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.errors import InputError
 from nodeforce.model.score import Noise
 from tests.conftest import DATA

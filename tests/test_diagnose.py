@@ -10,7 +10,7 @@ from fmpy.validation import validate_fmu
 
 from nodeforce.diagnosis.loop import diagnose
 from nodeforce.model.effects import EFFECTS
-from nodeforce.model.building import load_building, parse_building
+from nodeforce.model.building_file import load_building, parse_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.errors import InputError
 from nodeforce.model.score import Objective

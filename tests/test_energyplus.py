@@ -13,7 +13,7 @@ import pytest
 from nodeforce.api import convert_idf
 from nodeforce.iotools.energyplus import compress_schedule
 from nodeforce.model import geometry, glazing
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.errors import InputError
 from nodeforce.model.network import air_density_at, assemble, input_names
 from nodeforce.model.schedule import Schedule

@@ -24,7 +24,7 @@ from nodeforce import lifetime, tempdirs
 from nodeforce.cli import main
 from nodeforce.ga import checkpoint as ckpt
 from nodeforce.ga.search import search
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.synth import pseudo_measurements
 from tests.conftest import DATA, SENSORS, record_times
 from tests.test_search import NODES12, TWELVE, without_time

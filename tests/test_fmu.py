@@ -10,7 +10,7 @@ from fmpy.validation import validate_fmu
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.fmu_build.build import build_fmu
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.integrate import simulate
 from nodeforce.model.network import assemble
 

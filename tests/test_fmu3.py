@@ -14,7 +14,7 @@ from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnosis.calibrate import Candidate
 from nodeforce.fmu_build import guard
 from nodeforce.fmu_build.build import build_fmu, fmu_kind
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.integrate import simulate

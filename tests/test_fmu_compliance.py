@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from nodeforce.fmu_build.build import build_fmu
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from tests.importers import fmpy_validate, fmutool_check, run_ecos, run_fmpy, run_libcosim
 
 pytestmark = pytest.mark.slow  # searches, diagnoses or other importers: not in `make check`

@@ -14,7 +14,7 @@ from fmpy import read_model_description, simulate_fmu
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.fmu_build import guard
 from nodeforce.fmu_build.build import build_fmu
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.integrate import simulate, substeps
 from nodeforce.model.network import assemble
 from tests.importers import run_fmpy

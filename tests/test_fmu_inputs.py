@@ -12,7 +12,7 @@ from nodeforce.fmu_build.build import build_fmu
 from nodeforce.iotools.fmu_inputs import read_fmu_inputs
 from nodeforce.iotools.measurements import read_measurements
 from nodeforce.iotools.weather import read_weather
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import measured_case
 from nodeforce.model.integrate import simulate
 from nodeforce.model.network import assemble

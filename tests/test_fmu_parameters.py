@@ -294,7 +294,7 @@ def test_the_twin_houses_properties_through_the_standalone_fmu(tmp_path):
     """Every property of a real house at once, and one zone's alone, at values drawn within
     their bounds: the standalone FMU (its properties found in batches of nodes apart) against
     the direct model of the building with those values (267 nodes, shaded glazings)."""
-    from nodeforce.model.building import load_building
+    from nodeforce.model.building_file import load_building
     from nodeforce.model.effects import properties, with_fmu_parameters
     from tests.test_standalone import TWINHOUSE
     building = load_building(TWINHOUSE)

@@ -8,7 +8,7 @@ import sys
 import pytest
 
 from nodeforce.cli import main
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.synth import pseudo_measurements
 from tests.conftest import DATA, SENSORS, record_times
 

@@ -4,7 +4,7 @@ import copy
 import numpy as np
 import pytest
 
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.hlc import heat_loss_coefficient
 
 from .test_zones import RHO_C, two_zones

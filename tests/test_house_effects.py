@@ -15,7 +15,7 @@ from nodeforce.diagnosis.calibrate import Candidate, calibrate
 from nodeforce.diagnosis.candidates import calibration_start, physical
 from nodeforce.diagnosis.policy import POLICY
 from nodeforce.fmu_build.build import build_fmu
-from nodeforce.model.building import load_building, parse_building
+from nodeforce.model.building_file import load_building, parse_building
 from nodeforce.model.case import Case
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
@@ -203,8 +203,10 @@ def test_a_building_file_that_declares_them_round_trips_and_bad_ones_are_refused
     refused(lambda d: d["zones"][0]["air_exchange"].update(C=1.0), r"air_exchange\.C: names no zone")
     refused(lambda d: d["zones"][0]["air_exchange"].update(A=1.0), "a zone exchanges no air with itself")
     refused(lambda d: d["zones"][1].update(air_exchange={"A": 5.0}), "declared on both zones")
-    refused(lambda d: d["zones"][0].update(heat_input_factor=0.9), "no heat_input whose reading it would scale")
-    refused(lambda d: d["zones"][0]["supply"].update(flow_factor=-1.0), r"supply\.flow_factor: must be >= 0")
+    refused(lambda d: d["zones"][0].update(heat_input_factor=0.9),
+            r"zones\[0\]: 'heat_input' is a required property \(with heat_input_factor\)")
+    refused(lambda d: d["zones"][0]["supply"].update(flow_factor=-1.0),
+            r"supply\.flow_factor: -1\.0 is less than the minimum of 0")
 
 
 def test_each_is_offered_where_the_building_has_what_it_acts_on(testcell):

@@ -10,7 +10,7 @@ from nodeforce.ga import parsimony
 from nodeforce.ga.fitness import ModelFitness
 from nodeforce.ga.locate import chromosome_nodes, locate
 from nodeforce.ga.search import PAPER, search
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.score import Objective, noise_level

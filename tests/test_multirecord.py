@@ -7,7 +7,7 @@ import pytest
 
 from nodeforce.diagnosis.loop import Record, diagnose
 from nodeforce.diagnosis.selection import harmed
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import Case
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.integrate import simulate

@@ -5,7 +5,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from nodeforce.model.building import load_building
+from nodeforce.model.building_file import load_building
 from nodeforce.model.case import measured_case
 from nodeforce.model.hlc import heat_loss_coefficient
 from nodeforce.model.network import assemble

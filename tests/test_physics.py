@@ -7,7 +7,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from nodeforce.model.building import Boundary, Exterior, parse_building
+from nodeforce.model.building import Boundary, Exterior
+
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.discretise import capacities, conductances
 from nodeforce.model.integrate import simulate
 from nodeforce.model.network import assemble

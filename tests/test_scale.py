@@ -16,7 +16,9 @@ import jsonschema
 import numpy as np
 import pytest
 
-from nodeforce.model.building import Boundary, Exterior, load_building
+from nodeforce.model.building import Boundary, Exterior
+
+from nodeforce.model.building_file import load_building
 from nodeforce.model.hlc import heat_loss_coefficient
 from nodeforce.model.integrate import ImplicitEuler, simulate
 from nodeforce.model.network import RHO_C_AIR, assemble

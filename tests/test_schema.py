@@ -8,7 +8,9 @@ from pathlib import Path
 import jsonschema
 import pytest
 
-from nodeforce.model.building import Boundary, parse_building
+from nodeforce.model.building import Boundary
+
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
 
@@ -198,3 +200,94 @@ def test_wrong_file_is_refused_by_schema_and_parser(validator, mutate):
     assert errors(validator, data), "the schema accepts it"
     with pytest.raises(InputError):
         parse_building(data, source="cell.json")
+
+
+def _window(d):
+    return _component(d, "window")
+
+
+# The rules the parser once checked by hand and the schema now states: each refused by the
+# schema alone, and by parse_building naming the field (and, for a rule of fields that go
+# together, the field that asks for the other).
+SCHEMA_RULES = {
+    "shading on an opaque component": (lambda d: _component(d, "roof").update(shading="blind"),
+                                       "components[4]", "'solar_transmittance' is a required property (with shading)"),
+    "angular transmittance on an opaque component": (
+        lambda d: _component(d, "roof").update(angular_transmittance={"angles": [0, 60], "factors": [1, 0.5],
+                                                                       "diffuse": 0.8}),
+        "components[4]", "(with angular_transmittance)"),
+    "solar distribution on an opaque component": (
+        lambda d: _component(d, "roof").update(solar_distribution={"floor": 1.0}), "components[4]",
+        "(with solar_distribution)"),
+    "an empty solar distribution": (lambda d: _window(d).update(solar_distribution={}),
+                                    "components[6].solar_distribution", "should be non-empty"),
+    "inner absorptance behind an adiabatic face": (
+        lambda d: _component(d, "floor").update(inner_solar_absorptance=0.1), "components[7].outside.type",
+        "'exterior' was expected (with inner_solar_absorptance)"),
+    "a heater's lag without a heat input": (
+        lambda d: d["zones"][0].update(heat_input_lag={"capacity": 1.0, "conductance": 1.0}), "zones[0]",
+        "'heat_input' is a required property (with heat_input_lag)"),
+    "a heat input factor on a null heat input": (
+        lambda d: d["zones"][0].update(heat_input=None, heat_input_factor=0.9), "zones[0].heat_input",
+        "not be null (with heat_input_factor)"),
+    "an air node without its radiant node": (lambda d: d["zones"][0].pop("radiant_node"), "zones[0]",
+                                             "'radiant_node' is a dependency of 'air_node'"),
+    "a schedule's hour past 24": (
+        lambda d: d.update(schedules={"s": {"days": {"a": [[25, 1.0]]},
+                                            "periods": [{"through": "12-31", "week": ["a"] * 7}]}}),
+        "schedules.s.days.a[0][0]", "25 is greater than the maximum of 24"),
+    "a schedule's date in month 13": (
+        lambda d: d.update(schedules={"s": {"days": {"a": [[24, 1.0]]},
+                                            "periods": [{"through": "13-01", "week": ["a"] * 7}]}}),
+        "schedules.s.periods[0].through", "does not match"),
+    "a sensor named as a node column": (lambda d: d.update(sensors={"T7": {"zone": "cell"}}), "sensors.T7",
+                                        "must not look like a node column"),
+}
+
+
+@pytest.mark.parametrize("rule", SCHEMA_RULES)
+def test_rules_of_fields_are_the_schemas_and_name_the_field(validator, rule):
+    change, field, says = SCHEMA_RULES[rule]
+    data = copy.deepcopy(TESTCELL)
+    change(data)
+    assert errors(validator, data), "the schema accepts it"
+    with pytest.raises(InputError) as refused:
+        parse_building(data, source="cell.json")
+    assert (refused.value.source, refused.value.field) == ("cell.json", field)
+    assert says in refused.value.problem
+
+
+@pytest.mark.parametrize("value, says", [(float("nan"), "nan is not of type 'number'"),
+                                         (float("inf"), "inf is not of type 'number'")])
+def test_a_number_that_json_has_not_is_refused(value, says):
+    """Python's json reads NaN and Infinity, which a plain JSON Schema validator takes for numbers
+    and compares as false with any bound: the parser's schema refuses them."""
+    data = copy.deepcopy(TESTCELL)
+    data["zones"][0]["volume"] = value
+    with pytest.raises(InputError, match=r"zones\[0\]\.volume: " + says):
+        parse_building(data, source="cell.json")
+
+
+def test_a_node_id_is_a_json_integer(validator):
+    data = copy.deepcopy(TESTCELL)
+    _component(data, "roof")["nodes"][0]["id"] = float(_component(data, "roof")["nodes"][0]["id"])
+    assert errors(validator, data) == []  # JSON Schema's integer holds 1.0
+    with pytest.raises(InputError, match=r"components\[4\]\.nodes\[0\]\.id: .* is not of type 'integer'"):
+        parse_building(data, source="cell.json")
+
+
+@pytest.mark.parametrize("mutate", [
+    _unknown_outside_type, _negative_area, _missing_layers, _absorptance_1_5, _zero_conductivity,
+    _negative_air_change_rate, _latitude_100, _glazing_without_target, _wrong_format,
+    *(change for change, _, _ in SCHEMA_RULES.values()),
+], ids=lambda f: getattr(f, "__name__", "rule").strip("_"))
+def test_an_edit_is_refused_as_the_file_it_makes_would_be(mutate):
+    """An edit (an effect's, at each step of a calibration) is checked against the schema where it
+    changed the building only: with the same words as the whole file it makes."""
+    data = copy.deepcopy(TESTCELL)
+    mutate(data)
+    with pytest.raises(InputError) as whole:
+        parse_building(data, source="cell.json")
+    with pytest.raises(InputError) as edit:
+        parse_building(TESTCELL, source="cell.json").edited(mutate)
+    assert str(edit.value) == str(whole.value)

@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import Case
 from nodeforce.model.integrate import initial_state
 from nodeforce.model.score import Noise, Objective, noise_level

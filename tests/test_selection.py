@@ -14,7 +14,7 @@ from nodeforce.diagnosis.calibrate import Candidate, calibrate
 from nodeforce.diagnosis.loop import diagnose
 from nodeforce.iotools.typical_year import convert_typical_year, relocate
 from nodeforce.iotools.weather import read_weather
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.score import Objective

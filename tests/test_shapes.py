@@ -13,7 +13,8 @@ from nodeforce.cosim.run import simulate_fmu
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.iotools.measurements import read_measurements
 from nodeforce.iotools.weather import read_weather
-from nodeforce.model.building import DAY_TERMS, check_schema, parse_building
+from nodeforce.model.building import DAY_TERMS
+from nodeforce.model.building_file import check_schema, parse_building
 from nodeforce.model.case import clock_hours, prepare_case
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError

@@ -20,7 +20,7 @@ from fmpy.fmi2 import FMU2Slave
 
 from nodeforce.cosim.fmi import content_id
 from nodeforce.fmu_build.build import build_fmu
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.effects import EFFECTS
 from tests.importers import fmpy_validate, fmutool_check, run_ecos, run_fmpy, run_libcosim
 

@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 
 from nodeforce.cli import main
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import measured_case, prepare_case
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
@@ -66,9 +66,10 @@ def test_face_sensors_name_nodes_and_flux_sensors_name_none(testcell_data, testc
     assert "roof_flux" not in b.sensors and b.flux_sensors == {"roof_flux": ("roof", "inside"),
                                                                "roof_out_flux": ("roof", "outside")}
     for sensor, says in (({"component": "roof", "depth": 0.0, "quantity": "heat_flux"}, "at a face"),
-                         ({"component": "roof", "face": "top"}, "must be inside or outside"),
+                         ({"component": "roof", "face": "top"}, r"face: 'top' is not one of \['inside', 'outside'\]"),
                          ({"component": "roof", "face": "inside", "depth": 0.0}, "one of them"),
-                         ({"component": "roof", "face": "inside", "quantity": "power"}, "temperature or heat_flux")):
+                         ({"component": "roof", "face": "inside", "quantity": "power"},
+                          r"quantity: 'power' is not one of \['temperature', 'heat_flux'\]")):
         with pytest.raises(InputError, match=r"sensors\.s.*" + says):
             parse_building(with_sensors(testcell_data, {"s": sensor}))
 

@@ -282,7 +282,7 @@ def test_steady_heat_balance_of_the_30_C_phase(data, measured):
 # --- The model on the real data (need the lead's parser, the table command, diagnose) --------
 
 def test_the_file_loads_and_passes_the_schema(data):
-    from nodeforce.model.building import load_building
+    from nodeforce.model.building_file import load_building
     schema = json.loads((REPO / "model" / "data" / "nodal-building.schema.json").read_text())
     assert list(jsonschema.Draft202012Validator(schema).iter_errors(data)) == []
     b = load_building(BUILDING)
@@ -308,7 +308,7 @@ def write_weather(measured, path, start, end):
 def test_energy_balance_closes_every_step_on_real_days(tmp_path, data, measured):
     """Sum over nodes of C dT/dt equals the heat entering from outside at every step (implicit
     Euler: the flows at t_n+1), the flows written out by hand from the raw data and the JSON."""
-    from nodeforce.model.building import load_building
+    from nodeforce.model.building_file import load_building
     from nodeforce.model.case import prepare_case
     from nodeforce.model.integrate import simulate
     from nodeforce.model.network import assemble

@@ -6,7 +6,7 @@ import pandas as pd
 import pytest
 
 from nodeforce.iotools.weather import read_weather
-from nodeforce.model.building import parse_building
+from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.integrate import forcing_schedule, simulate
 from nodeforce.model.network import assemble

@@ -218,7 +218,7 @@ def weather(source=WEATHER):
 
 def write(out, storeys, offices, sensors_per_office):
     """Write building.json, weather.csv and sensors.txt in `out`; return the building file's path."""
-    from nodeforce.model.building import load_building
+    from nodeforce.model.building_file import load_building
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     path = out / "building.json"

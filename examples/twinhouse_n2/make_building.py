@@ -336,7 +336,7 @@ def text(data=None):
 def corrected(data, report_path):
     """The building data with the effects a diagnosis added (report.json's "effects", in order),
     each declared at its calibrated values."""
-    from nodeforce.model.building import parse_building
+    from nodeforce.model.building_file import parse_building
     from nodeforce.model.effects import EFFECTS
     model = parse_building(data)
     for added in json.loads(Path(report_path).read_text())["effects"]:

@@ -1,0 +1,500 @@
+"""Read and validate a building file (`"format": "nodal-building/1"`, docs/model.md section 1) into
+the building's records (`building.py`).
+
+Two checks, each rule in one of them, each failure an `InputError` naming the file and the field:
+the format's JSON Schema (`data/nodal-building.schema.json`: every field's type, whether it is
+required, its range, its allowed values, which fields go together, and no unknown field, so that
+a misspelt optional field is refused instead of silently defaulted), then by hand what a schema
+cannot say: the names one part gives of another (a layer's material, a face's zone, a window's
+receiving component, a schedule, a sensor's component), node ids 1..N with no gap, node depths
+within their component, schedules' hours and dates in order, fractions that add up.
+
+Nodes are given explicitly (`"nodes": [{"id", "depth"}]`) or generated from the layers
+(`"nodes": {"max_spacing": m}`), in which case the tool numbers every node: components in file
+order, each inside to outside, then each zone's air and radiant node.
+"""
+import copy
+import functools
+import json
+import math
+from dataclasses import replace
+from importlib.resources import files
+
+from .building import (DAY_TERMS, Adiabatic, AngularTransmittance, Boundary, Building, Component, Exterior, Gain,
+                       Inflow, Lumped, Material, Supply, Surface, Ventilation, Zone, boundary_columns)
+from .discretise import generated_depths
+from .errors import InputError
+from .schedule import WEEKDAYS, Schedule
+
+# Depths are given in metres with a few decimals; a node "at" the outside face may be
+# off by rounding only.
+DEPTH_TOLERANCE = 1e-9
+# A sensor's depth names the node nearest it within this distance (m): positions in a building
+# description are rounded to the millimetre.
+SENSOR_TOLERANCE = 1e-3
+# read when the module is: the FMU's copy of this package may be imported from a folder that is gone
+# by the time an importer's parameters edit the building
+SCHEMA = json.loads(files(__package__).joinpath("data/nodal-building.schema.json").read_text(encoding="utf-8"))
+
+
+def load_building(path):
+    """Read and validate a building file (`parse_building`); return a `Building`."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            data = json.load(f)
+    except FileNotFoundError:
+        raise InputError(path, "file", "not found") from None
+    except json.JSONDecodeError as e:
+        raise InputError(path, f"line {e.lineno}", f"not valid JSON ({e.msg})") from None
+    return parse_building(data, source=str(path))
+
+
+def parse_building(data, source="<building>", edited_from=None):
+    """Validate a building description already parsed from JSON (the schema, then the rules it
+    cannot state); return a `Building`. `edited_from`: the description `data` is an edit of, which
+    follows the schema already (`Building.edited`)."""
+    check_schema(data, source, edited_from)
+    return parse_checked(data, source)
+
+
+def check_schema(data, source, edited_from=None):
+    """InputError naming the field where `data` does not follow the format's JSON Schema; of an
+    edit of `edited_from` (which does), the zones and components the edit changed, where it
+    changed nothing else: an effect's edit, read again at each step of a calibration."""
+    prefix, error = _schema_error(data, edited_from)
+    if error is not None:
+        where = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in (*prefix, *error.absolute_path))
+        where = where.lstrip(".")
+        path = list(error.absolute_schema_path)
+        if "propertyNames" in path:  # a key at fault: name it
+            where = f"{where}.{error.instance}".lstrip(".")
+        problem = error.message
+        if error.validator in ("oneOf", "anyOf", "not") and "description" in error.schema:
+            # jsonschema's words for these quote the schema: its description says the rule instead
+            problem = (f"fits none of its forms. {error.schema['description']}" if error.validator != "not"
+                       else error.schema["description"])
+        if "dependentSchemas" in path:  # a rule of which fields go together: name the field asking
+            problem += f" (with {path[path.index('dependentSchemas') + 1]})"
+        raise InputError(source, where or "(top level)", problem)
+
+
+# the lists whose items an edit may change alone, and the schema's definition of an item
+ITEMS = {"zones": "zone", "components": "component"}
+
+
+def _schema_error(data, before):
+    """(path prefix, jsonschema's best error or None) of `data`, or of the items of ITEMS it
+    changed from `before` where nothing else differs: the top level of the schema asks nothing
+    of an item but its own definition."""
+    import jsonschema  # here: an FMU at its declared parameters runs this module without it
+    best = jsonschema.exceptions.best_match
+    if (not isinstance(data, dict) or not isinstance(before, dict) or data.keys() != before.keys()
+            or any(data[k] != before[k] for k in data if k not in ITEMS)
+            or any(not isinstance(data[k], list) or len(data[k]) != len(before[k]) for k in ITEMS if k in data)):
+        return (), best(_validator(None).iter_errors(data))
+    for key, definition in ITEMS.items():
+        for i, (new, old) in enumerate(zip(data.get(key, ()), before.get(key, ()))):
+            error = best(_validator(definition).iter_errors(new)) if new != old else None
+            if error is not None:
+                return (key, i), error
+    return (), None
+
+
+@functools.lru_cache(maxsize=None)
+def _validator(definition):
+    """The format's JSON Schema validator, of a whole file or of one of its `$defs`. Python's json
+    reads NaN and Infinity, which JSON has no number for, and an id 1.0 is a float the parser
+    cannot index by: a "number" is a finite one and an "integer" an int here."""
+    import jsonschema
+    base = jsonschema.Draft202012Validator
+    types = base.TYPE_CHECKER.redefine_many({
+        "number": lambda _, v: isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v),
+        "integer": lambda _, v: isinstance(v, int) and not isinstance(v, bool)})
+    schema = SCHEMA if definition is None else {"$defs": SCHEMA["$defs"], "$ref": f"#/$defs/{definition}"}
+    return jsonschema.validators.extend(base, type_checker=types)(schema)
+
+
+def parse_checked(data, source="<building>"):
+    """The `Building` of a description that follows the JSON Schema, with the rules the schema
+    cannot state checked; an edit of it is read by `parse_building`, the schema first. The FMU
+    reads its own copy of a file `parse_building` read this way (with its declared parameters its
+    host needs numpy only); anything else reads through `parse_building`."""
+    check = _Checker(source)
+    site = data["site"]
+    site = {"latitude": float(site["latitude"]), "longitude": float(site["longitude"]),
+            "altitude": float(site.get("altitude", 0.0)), "timezone": site.get("timezone", "UTC"),
+            "ground_albedo": float(site.get("ground_albedo", 0.2)), "air_density": float(site.get("air_density", 1.2))}
+    schedules = {name: _schedule(check, name, s, f"schedules.{name}") for name, s in data.get("schedules", {}).items()}
+    materials = {name: Material(conductivity=float(m["conductivity"]), density=float(m["density"]),
+                                specific_heat=float(m["specific_heat"])) for name, m in data["materials"].items()}
+    raw_zones, raw_components = data["zones"], data["components"]
+    zone_names = [z["name"] for z in raw_zones]
+    check.unique(zone_names, "zones", "zone name")
+    raw_sensors = data.get("sensors", {})
+    sensor_depths = _sensor_depths(check, raw_sensors, raw_components)
+    components = [_component(check, c, f"components[{i}]", materials, zone_names, sensor_depths)
+                  for i, c in enumerate(raw_components)]
+    check.unique([c["name"] for c in components], "components", "component name")
+    explicit = _explicit_ids(check, raw_zones, components)
+    next_id = iter(range(1, 10 ** 9))
+    if not explicit:
+        for c in components:
+            c["node_ids"] = tuple(next(next_id) for _ in c["depths"])
+    zones = tuple(_zone(check, z, f"zones[{i}]", zone_names, explicit, next_id, schedules)
+                  for i, z in enumerate(raw_zones))
+    components = tuple(Component(**c) for c in components)
+    names = {c.name for c in components}
+    for i, c in enumerate(components):
+        if c.transmitted_solar_to is not None and c.transmitted_solar_to not in names:
+            check.fail(f"components[{i}].transmitted_solar_to",
+                       f"names no component ({c.transmitted_solar_to!r})")
+        for name, _ in c.solar_distribution:
+            if name not in names:
+                check.fail(f"components[{i}].solar_distribution.{name}", f"names no component ({name!r})")
+    _check_proportional_columns(check, zones, components)
+    _check_air_exchanges(check, zones)
+    boundary_factors = _boundary_factors(check, data, zones, components)
+    _check_node_ids(check, zones, components)
+    zones = _number_added_nodes(zones, sum(len(c.node_ids) for c in components) + 2 * len(zones))
+    flux_sensors = {name: (raw["component"], raw["face"]) for name, raw in raw_sensors.items()
+                    if raw.get("quantity") == "heat_flux"}
+    sensors = {name: _sensor_node(check, name, raw, zones, components) for name, raw in raw_sensors.items()
+               if name not in flux_sensors}
+    return Building(name=str(data.get("name", "")), site=site, zones=zones, components=components,
+                    sensors=sensors, flux_sensors=flux_sensors, boundary_factors=boundary_factors,
+                    schedules=schedules, source=source, data=copy.deepcopy(data),
+                    reader=parse_building)
+
+
+class _Checker:
+    """Fails with the file and the field path."""
+
+    def __init__(self, source):
+        self.source = source
+
+    def fail(self, where, problem):
+        raise InputError(self.source, where, problem)
+
+    def unique(self, values, where, what):
+        seen = set()
+        for v in values:
+            if v in seen:
+                self.fail(where, f"{what} {v!r} appears twice")
+            seen.add(v)
+
+
+def _increasing(values):
+    return all(b > a for a, b in zip(values, values[1:]))
+
+
+def _schedule(check, name, raw, where):
+    if "constant" in raw:
+        return Schedule(name=name, constant=float(raw["constant"]))
+    days = raw["days"]
+    profiles = []
+    for profile, pairs in days.items():
+        untils = [u for u, _ in pairs]
+        if not _increasing(untils) or untils[-1] != 24:
+            check.fail(f"{where}.days.{profile}", "the hours until which each value holds must increase and end at 24")
+        profiles.append((profile, tuple((float(u), float(v)) for u, v in pairs)))
+    periods, last = [], 0
+    for k, period in enumerate(raw["periods"]):
+        pw = f"{where}.periods[{k}]"
+        month, day = (int(part) for part in period["through"].split("-"))
+        if month * 100 + day <= last:
+            check.fail(f"{pw}.through", "the periods' dates must increase")
+        last = month * 100 + day
+        for d, profile in zip(WEEKDAYS, period["week"]):
+            if profile not in days:
+                check.fail(f"{pw}.week", f"{d}: names no profile of days ({profile!r})")
+        periods.append(((month, day), tuple(period["week"])))
+    if last != 1231:
+        check.fail(f"{where}.periods", "the last period must run through 12-31")
+    return Schedule(name=name, days=tuple(profiles), periods=tuple(periods))
+
+
+def _schedule_of(check, item, where, schedules):
+    """The name of the schedule `item` follows (None: constant), checked to be one of the file's."""
+    schedule = item.get("schedule")
+    if schedule is not None and schedule not in schedules:
+        check.fail(f"{where}.schedule", f"names no schedule of the file ({schedule!r})")
+    return schedule
+
+
+def _gains(check, z, where, schedules):
+    return tuple(Gain(name=g["name"], power=float(g["power"]), radiant_fraction=float(g.get("radiant_fraction", 0.0)),
+                      schedule=_schedule_of(check, g, f"{where}.gains[{k}]", schedules))
+                 for k, g in enumerate(z.get("gains", ())))
+
+
+def _ventilation(check, z, where, schedules):
+    flows = []
+    for k, v in enumerate(z.get("ventilation", ())):
+        vw = f"{where}.ventilation[{k}]"
+        schedule = _schedule_of(check, v, vw, schedules)
+        if schedule is not None and not schedules[schedule].is_constant and any(
+                value < 0 for _, profile in schedules[schedule].days for _, value in profile):
+            check.fail(f"{vw}.schedule", f"{schedule!r} takes negative values: an air flow is >= 0")
+        flows.append(Ventilation(name=v["name"], flow=float(v["flow"]), schedule=schedule))
+    return tuple(flows)
+
+
+def _angular(check, c, where):
+    raw = c.get("angular_transmittance")
+    if raw is None:
+        return None
+    where = f"{where}.angular_transmittance"
+    angles, factors = [float(a) for a in raw["angles"]], [float(f) for f in raw["factors"]]
+    if len(angles) != len(factors):
+        check.fail(where, "angles and factors must be lists of one length")
+    if angles[0] != 0 or not _increasing(angles):
+        check.fail(f"{where}.angles", "must start at 0 and increase")
+    return AngularTransmittance(angles=tuple(angles), factors=tuple(factors), diffuse=float(raw["diffuse"]))
+
+
+def _zone(check, z, where, zone_names, explicit, next_id, schedules):
+    heat_input = z.get("heat_input")
+    heat_input = () if heat_input is None else (heat_input,) if isinstance(heat_input, str) else tuple(heat_input)
+    supply = z.get("supply")
+    if supply is not None:
+        supply = Supply(flow=float(supply["flow"]), temperature=_temperature(supply["temperature"]),
+                        flow_factor=float(supply.get("flow_factor", 1.0)))
+    for j, raw in enumerate(z.get("airflow_from", ())):
+        if raw["zone"] not in zone_names:
+            check.fail(f"{where}.airflow_from[{j}].zone", f"names no zone ({raw['zone']!r})")
+        if raw["zone"] == z["name"]:
+            check.fail(f"{where}.airflow_from[{j}].zone", "air cannot flow from a zone into itself")
+    daily = z.get("daily_gain")
+    exchange = z.get("air_exchange", {})
+    for other in exchange:
+        if other not in zone_names:
+            check.fail(f"{where}.air_exchange.{other}", f"names no zone ({other!r})")
+        if other == z["name"]:
+            check.fail(f"{where}.air_exchange.{other}", "a zone exchanges no air with itself")
+    if explicit:
+        air, radiant = z["air_node"], z["radiant_node"]
+    else:
+        air, radiant = next(next_id), next(next_id)
+    return Zone(
+        name=z["name"],
+        volume=float(z["volume"]),
+        air_node=air,
+        radiant_node=radiant,
+        air_change_rate=float(z.get("air_change_rate", 0.0)),
+        internal_gain=float(z.get("internal_gain", 0.0)),
+        heat_input=heat_input,
+        heat_input_radiative_fraction=float(z.get("heat_input_radiative_fraction", 0.0)),
+        supply=supply,
+        airflow_from=tuple(Inflow(zone=raw["zone"], flow=float(raw["flow"])) for raw in z.get("airflow_from", ())),
+        thermal_bridges=_floats(z.get("thermal_bridges", {})),
+        convection_factor=float(z.get("convection_factor", 1.0)),
+        occupied=z.get("occupied"),
+        daily_gain=() if daily is None else tuple((t, float(daily.get(t, 0.0))) for t in DAY_TERMS),
+        proportional_gains=_floats(z.get("proportional_gains", {})),
+        envelope_factor=float(z.get("envelope_factor", 1.0)),
+        shading_transmittance=float(z.get("shading_transmittance", 0.0)),
+        heat_input_factor=float(z.get("heat_input_factor", 1.0)),
+        air_exchange=_floats(exchange),
+        gains=_gains(check, z, where, schedules),
+        ventilation=_ventilation(check, z, where, schedules),
+        internal_mass=_lumped(z.get("internal_mass")),
+        heat_input_lag=_lumped(z.get("heat_input_lag")),
+    )
+
+
+def _floats(mapping):
+    """((key, value as float), ...) of a JSON object of numbers, in its order."""
+    return tuple((key, float(value)) for key, value in mapping.items())
+
+
+def _temperature(value):
+    """A temperature: C (a float), or the name of an input column or a schedule."""
+    return value if isinstance(value, str) else float(value)
+
+
+def _lumped(raw):
+    """The `Lumped` node a zone effect declares, or None."""
+    return None if raw is None else Lumped(capacity=float(raw["capacity"]), conductance=float(raw["conductance"]))
+
+
+def _number_added_nodes(zones, last):
+    """The zones with ids for the nodes their effects add: after the building's `last` node, zone
+    by zone in file order, its internal mass before its heater (docs/model.md section 7)."""
+    ids = iter(range(last + 1, 10 ** 9))
+    numbered = []
+    for z in zones:
+        mass = next(ids) if z.internal_mass is not None else None
+        heater = next(ids) if z.heat_input_lag is not None else None
+        numbered.append(replace(z, mass_node=mass, heater_node=heater))
+    return tuple(numbered)
+
+
+def _surface(check, raw, where, zone_names):
+    if raw["zone"] not in zone_names:
+        check.fail(f"{where}.zone", f"names no zone ({raw['zone']!r})")
+    return Surface(zone=raw["zone"], h_conv=float(raw["h_conv"]), h_rad=float(raw["h_rad"]))
+
+
+def _outside(check, raw, where, zone_names):
+    kind = raw["type"]
+    if kind == "exterior":
+        return Exterior(h_conv=float(raw["h_conv"]), h_rad=float(raw["h_rad"]),
+                        solar_absorptance=float(raw["solar_absorptance"]), irradiance=raw.get("irradiance"),
+                        sky_view_factor=float(raw["sky_view_factor"]) if "sky_view_factor" in raw else None)
+    if kind == "zone":
+        return _surface(check, raw, where, zone_names)
+    if kind == "boundary":
+        return Boundary(temperature=_temperature(raw["temperature"]), h=float(raw["h"]))
+    return Adiabatic()
+
+
+def _layers(check, c, where, materials):
+    for j, (material, _) in enumerate(c["layers"]):
+        if material not in materials:
+            check.fail(f"{where}.layers[{j}]", f"unknown material {material!r}")
+    return tuple((materials[material], float(thickness)) for material, thickness in c["layers"])
+
+
+def _depths(check, c, where, layers, sensor_depths):
+    """(explicit ids or None, depths) of a component's nodes."""
+    total = sum(t for _, t in layers)
+    raw_nodes = c["nodes"]
+    if isinstance(raw_nodes, dict):
+        return None, generated_depths([t for _, t in layers], float(raw_nodes["max_spacing"]),
+                                      raw_nodes.get("layer_boundaries", True), sensor_depths.get(c["name"], ()))
+    ids, depths = [node["id"] for node in raw_nodes], [float(node["depth"]) for node in raw_nodes]
+    for j, depth in enumerate(depths):
+        if depth > total + DEPTH_TOLERANCE:
+            check.fail(f"{where}.nodes[{j}].depth", f"{depth} m is outside the component (0 to {total:g} m)")
+    if not _increasing(depths):
+        check.fail(f"{where}.nodes", "depths must increase strictly from the inside face")
+    if abs(depths[0]) > DEPTH_TOLERANCE:
+        check.fail(f"{where}.nodes[0].depth", "the first node must be at depth 0 (the inside surface)")
+    if abs(depths[-1] - total) > DEPTH_TOLERANCE:
+        check.fail(f"{where}.nodes[{len(depths) - 1}].depth",
+                   f"the last node must be at the outside surface, {total:g} m")
+    depths[0], depths[-1] = 0.0, total
+    return tuple(ids), depths
+
+
+def _component(check, c, where, materials, zone_names, sensor_depths):
+    """The fields of a Component (node ids left out where the tool assigns them)."""
+    layers = _layers(check, c, where, materials)
+    ids, depths = _depths(check, c, where, layers, sensor_depths)
+    tau = c.get("solar_transmittance")
+    return dict(
+        name=c["name"],
+        area=float(c["area"]),
+        tilt=float(c["tilt"]),
+        azimuth=float(c["azimuth"]),
+        layers=layers,
+        node_ids=ids,
+        depths=tuple(depths),
+        inside=_surface(check, c["inside"], f"{where}.inside", zone_names),
+        outside=_outside(check, c["outside"], f"{where}.outside", zone_names),
+        solar_transmittance=None if tau is None else float(tau),
+        transmitted_solar_to=c["transmitted_solar_to"] if tau is not None else None,
+        shading=c.get("shading"),
+        conductivity_factor=float(c.get("conductivity_factor", 1.0)),
+        capacity_factor=float(c.get("capacity_factor", 1.0)),
+        angular=_angular(check, c, where),
+        solar_distribution=_distribution(check, c, where),
+        inner_solar_absorptance=float(c.get("inner_solar_absorptance", 0.0)),
+    )
+
+
+def _distribution(check, c, where):
+    fractions = _floats(c.get("solar_distribution", {}))
+    if sum(f for _, f in fractions) > 1 + 1e-9:
+        check.fail(f"{where}.solar_distribution", f"the fractions add up to {sum(f for _, f in fractions):g}: at most "
+                                                  "1 (the rest leaves through the glazings)")
+    return fractions
+
+
+def _explicit_ids(check, raw_zones, components):
+    """Whether the file numbers its nodes itself: every id given, or none."""
+    given = [c["node_ids"] is not None for c in components] + ["air_node" in z for z in raw_zones]
+    if any(given) and not all(given):
+        check.fail("nodes", "give every node id (explicit node lists and each zone's air_node and "
+                            "radiant_node) or none, for the tool to number them")
+    return all(given)
+
+
+def _sensor_depths(check, raw_sensors, raw_components):
+    """{component name: depths of the sensors declared on it}, for node generation (a face
+    always has a node)."""
+    names = {c["name"] for c in raw_components}
+    depths = {}
+    for name, raw in raw_sensors.items():
+        if "component" in raw:
+            if raw["component"] not in names:
+                check.fail(f"sensors.{name}.component", f"names no component ({raw['component']!r})")
+            if "depth" in raw:
+                depths.setdefault(raw["component"], []).append(float(raw["depth"]))
+    return depths
+
+
+def _sensor_node(check, name, raw, zones, components):
+    where = f"sensors.{name}"
+    if "zone" in raw:
+        zone = next((z for z in zones if z.name == raw["zone"]), None)
+        if zone is None:
+            check.fail(f"{where}.zone", f"names no zone ({raw['zone']!r})")
+        return zone.air_node
+    c = next(c for c in components if c.name == raw["component"])
+    if "face" in raw:
+        return c.node_ids[0] if raw["face"] == "inside" else c.node_ids[-1]
+    depth = raw["depth"]
+    k = min(range(len(c.depths)), key=lambda k: abs(c.depths[k] - depth))
+    if abs(c.depths[k] - depth) > SENSOR_TOLERANCE:
+        check.fail(f"{where}.depth", f"{c.name} has no node at {depth} m (nodes at "
+                                     f"{', '.join(f'{d:.3f}' for d in c.depths)} m)")
+    return c.node_ids[k]
+
+
+def _check_proportional_columns(check, zones, components):
+    """A proportional gain scales a heat input or a face's irradiance the building already reads."""
+    columns = [name for z in zones for name in z.heat_input]
+    columns += [c.irradiance_input for c in components if isinstance(c.outside, Exterior)]
+    for i, z in enumerate(zones):
+        for column, _ in z.proportional_gains:
+            if column not in columns:
+                check.fail(f"zones[{i}].proportional_gains.{column}",
+                           f"names no heat input or face irradiance of the building (one of: {', '.join(columns) or 'none'})")
+
+
+def _boundary_factors(check, data, zones, components):
+    """{column: factor} of `boundary_conductance_factors`: each a boundary column of the building."""
+    raw = data.get("boundary_conductance_factors", {})
+    columns = boundary_columns(zones, components)
+    for column in raw:
+        if column not in columns:
+            check.fail(f"boundary_conductance_factors.{column}", f"names no boundary temperature column of the "
+                                                                 f"building (one of: {', '.join(columns) or 'none'})")
+    return dict(_floats(raw))
+
+
+def _check_air_exchanges(check, zones):
+    """An exchange between two zones is declared on one of them only: declared on both, whether
+    one exchange or two is meant is not the tool's to guess."""
+    for i, z in enumerate(zones):
+        for other, _ in z.air_exchange:
+            if z.name in dict(next(o for o in zones if o.name == other).air_exchange):
+                check.fail(f"zones[{i}].air_exchange.{other}",
+                           f"the exchange between {z.name} and {other} is declared on both zones: declare it once")
+
+
+def _check_node_ids(check, zones, components):
+    ids = [z.air_node for z in zones] + [z.radiant_node for z in zones]
+    ids += [i for c in components for i in c.node_ids]
+    check.unique(ids, "nodes", "node id")
+    expected = set(range(1, len(ids) + 1))
+    if set(ids) != expected:
+        missing = sorted(expected - set(ids))
+        extra = sorted(set(ids) - expected)
+        detail = []
+        if missing:
+            detail.append(f"missing {missing[:5]}")
+        if extra:
+            detail.append(f"unexpected {extra[:5]}")
+        check.fail("nodes", f"node ids must be 1..{len(ids)} with no gap ({'; '.join(detail)})")
