@@ -13,7 +13,7 @@ import pytest
 
 from nodeforce import lifetime
 from nodeforce.diagnosis.loop import diagnose
-from nodeforce.model.building import load_building, parse_building
+from nodeforce.model.building_file import load_building, parse_building
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.case import prepare_case
 from nodeforce.model.score import Objective
