@@ -58,3 +58,15 @@ def test_a_diagnosis_of_two_faults_is_recomputed_round_by_round_from_report_json
     read = check_replay(tmp_path / "report.json")
     assert sorted(a.label for a in read.added) == ["conductivity@door", "infiltration@cell"]
     assert all(c.on_top_of == (read.added[0].label,) for c in read.candidates if c.round == 2)
+
+
+def test_a_benchmark_record_of_two_rounds_is_recomputed_from_report_json_alone(tmp_path):
+    """The benchmark's Saint-Denis July, a window passing more sun than declared, under its third
+    noise draw: the loop adds the window's transmittance, then, on top of it, the south wall's
+    conductivity; both rounds' choices recomputed from report.json."""
+    from benchmarks.records import record
+    r = record("sdp-jul/opening-L", 2)
+    nodeforce.diagnose(r.building, r.case(), tmp_path, objective=nodeforce.objective(r.building, r.zones),
+                       workers=1, generations=30, noise=r.spec.noise, seed=0)
+    read = check_replay(tmp_path / "report.json")
+    assert len(read.rounds) >= 2 and len(read.added) == 2
