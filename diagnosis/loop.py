@@ -448,12 +448,12 @@ def rounds(prepared, localization, objective, workdir, seed, workers, cluster=No
     folder = workdir / "candidates"
     folder.mkdir(exist_ok=True)
     measured_ids = sorted({i for case in windows.cases for i in case.measured_ids})
-    model, added, decisions, results, runs, sensitivities = prepared.model, [], [], [], {}, {}
+    model, decisions, results, runs, sensitivities = prepared.model, [], [], {}, {}
     for number in range(POLICY.max_rounds):
         base_blocks = windows.block_J(model.runs)
         if number and POLICY.at_noise(base_blocks.sum(), n, noise.floor_sd):
             break  # the error left is the noise's
-        done = [a.label for a in added]
+        done = [d.chosen.label for d in decisions]  # every earlier round chose: a round without a choice ends them
         started = time.perf_counter()
         # a later round's candidates, on top of the earlier choices, are building files of their own
         into = folder / f"round{number + 1}" if number else folder
@@ -481,7 +481,7 @@ def rounds(prepared, localization, objective, workdir, seed, workers, cluster=No
         # distances of every two admissible candidates'): a house's rounds would hold gigabytes
         results += [replace(r, cv=replace(r.cv, left_out=None), sensors=replace(r.sensors, residuals=None))
                     for r in tried]
-        runs.update({(key if not added else f"{key} (round {number + 1})"): m.runs for key, m in models.items()})
+        runs.update({(key if not number else f"{key} (round {number + 1})"): m.runs for key, m in models.items()})
         chosen = decision.chosen
         if not chosen:
             break
@@ -489,7 +489,6 @@ def rounds(prepared, localization, objective, workdir, seed, workers, cluster=No
         # screening of every candidate would cost a quarter of a round's simulations
         screened = Candidate(model.building, chosen.effect, chosen.target, protocols(model.bases, windows.calibrations))
         sensitivities[chosen.label] = sensitivity(screened, windows.calibrations, objective, seed=seed)
-        added.append(chosen)
         model = models[chosen.label]
     return Made(decisions, results, runs, sensitivities, model)
 
