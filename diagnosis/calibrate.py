@@ -11,9 +11,11 @@ the same (`diagnosis.loop`). The covariance of the estimate is the linearised sa
 `model.significance`, which allows for the residual's correlation in time (the textbook
 s^2 (J^T J)^-1 assumes independent residuals and, on real records, is several times too tight).
 A parameter is called identifiable from the data when that estimate is tight enough to act on
-(`diagnosis.policy.Policy.identifiable`) and it did not end on a bound.
+(`diagnosis.policy.Policy.identifiable`) and it did not end on a bound; one the data leave free
+is held at its physical prior where it has one and the data allow it (`calibrate`).
 """
 import logging
+from types import SimpleNamespace
 
 import numpy as np
 from SALib.analyze import morris as morris_analyze
@@ -98,6 +100,14 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None):
     wall's conductivity or absorptance, slow and weather-driven, would otherwise be fitted to what
     the file's coarse walls make, and chosen for it over the fault the record holds.
 
+    Where the data fix a combination of the parameters but leave one free that physics has a
+    prior for (`model.effects.Prior`: a ground coupling's T_ground, the site's deep ground), the
+    fit is made again with it held there, and kept unless the data reject the prior (a score
+    test, `score_statistic`, `Policy.holds_prior`): the free fit's end along the valley is wherever least squares
+    stopped (a ground at 0.2 C under a cell in Miami, its U a tenth of the truth's), and a
+    building file carrying it would carry that to every later record; the held value is what a
+    modeller would have written.
+
     Parameters
     ----------
     candidate : Candidate
@@ -110,7 +120,8 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None):
 
     Returns
     -------
-    dict {name: {"value", "std", "identifiable", "on_bound"}}; the quantities the data determine
+    dict {name: {"value", "std", "identifiable", "on_bound"}, and "prior": its source where held at
+    its prior (std 0)}; the quantities the data determine
     even where the parameters are not (see `derived`); and per block the parameter values fitted
     without it (`fold`) and the residuals (C, (N_t, zones) of its record, NaN off the block) they
     leave on it
@@ -134,7 +145,6 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None):
         r = raw(x)
         return r + share(r, error, rows) * error
 
-    fit = least_squares(residuals, x0, bounds=(lows, highs), x_scale="jac", method="trf")
     # each record's steps numbered apart from the others' by more than the HAC's lags: residuals
     # of two records are not correlated
     lags = bandwidth(cases[0].dt)
@@ -142,16 +152,30 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None):
     for h in have:
         steps.append(np.nonzero(h)[0] + offset)
         offset += len(h) + lags + 1
-    cov = parameter_covariance(fit.jac, fit.fun, np.concatenate(steps), lags)
+    steps = np.concatenate(steps)
+    fit = solve(residuals, x0, lows, highs)
+    cov = parameter_covariance(fit.jac, fit.fun, steps, lags)
+    priors = wanted_priors(candidate, cases, fit, cov)
+    if priors:
+        held = solve(residuals, x0, lows, highs, {i: prior.value for i, prior in priors.items()})
+        statistic = score_statistic(held, list(priors), residuals, candidate.bounds, steps, lags)
+        if POLICY.holds_prior(statistic, len(priors)):
+            fit, cov = held, parameter_covariance(held.jac, held.fun, steps, lags)
+            log.info("%s: %s, held at the physical prior: the data fix the parameters' combination only",
+                     candidate.label, ", ".join(f"{candidate.parameters[i].name} = {prior.value:.4g} "
+                                                f"{candidate.parameters[i].unit} ({prior.source})"
+                                                for i, prior in priors.items()))
+        else:
+            priors = {}
     std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     result = {}
-    for p, value, sd, bound in zip(candidate.parameters, fit.x, std, fit.active_mask):
-        identifiable = bool(POLICY.identifiable(value, sd, p.unit) and bound == 0)
-        if not identifiable:
+    for i, (p, value, sd, bound) in enumerate(zip(candidate.parameters, fit.x, std, fit.active_mask)):
+        identifiable = bool(POLICY.identifiable(value, sd, p.unit) and bound == 0 and i not in priors)
+        if not identifiable and i not in priors:
             log.info("%s: %s = %.4g +- %.2g %s is not identifiable from these data%s", candidate.label,
                      p.name, value, sd, p.unit, " (it ended on a bound)" if bound else "")
         result[p.name] = {"value": float(value), "std": float(sd), "identifiable": identifiable,
-                          "on_bound": bool(bound != 0)}
+                          "on_bound": bool(bound != 0), **({"prior": priors[i].source} if i in priors else {})}
     folds = []
     for record, block in blocks:
         train = ~np.concatenate([rows[h] for rows, h in zip(on_block([h.shape for h in have], record, block), have)])
@@ -162,6 +186,64 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None):
                         np.nan)
         folds.append({"values": [float(v) for v in x], "residuals": left})
     return result, derived(candidate, cases[0], fit.x, cov), folds
+
+
+def solve(residuals, x0, lows, highs, held=None):
+    """Bounded least squares of `residuals(x)` from x0 over the parameters not `held` ({index:
+    value}, those fixed at their value): its x, fun, jac and active_mask as scipy's, of every
+    parameter (a held one's Jacobian column zero, its active_mask 0)."""
+    held = held or {}
+    free = np.array([i not in held for i in range(len(x0))])
+    x = np.array(x0, dtype=float)
+    x[list(held)] = list(held.values())
+
+    def full(z):
+        out = x.copy()
+        out[free] = z
+        return out
+    fit = least_squares(lambda z: residuals(full(z)), x[free], bounds=(lows[free], highs[free]), x_scale="jac",
+                        method="trf")
+    jac = np.zeros((len(fit.fun), len(x)))
+    jac[:, free] = fit.jac
+    active = np.zeros(len(x), dtype=int)
+    active[free] = fit.active_mask
+    return SimpleNamespace(x=full(fit.x), fun=fit.fun, jac=jac, active_mask=active)
+
+
+def wanted_priors(candidate, cases, fit, cov):
+    """{index: model.effects.Prior} of the parameters the fit leaves free (not identifiable, or
+    on a bound) that physics has a prior for inside their range, where another parameter is
+    left: a ground coupling's T_ground, the flux fixed and U fitted to it. The prior reads the
+    outdoor air of the weather the `cases` hold, their history included."""
+    effect = EFFECTS[candidate.effect]
+    if effect.priors is None or len(candidate.parameters) < 2:
+        return {}
+    outdoor = np.concatenate([case.U[:, case.input_names.index("T_out")] for case in cases])
+    priors = effect.priors(candidate.building, candidate.target, outdoor)
+    std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    return {i: priors[p.name] for i, (p, (low, high)) in enumerate(zip(candidate.parameters, candidate.bounds))
+            if p.name in priors and low <= priors[p.name].value <= high
+            and not (POLICY.identifiable(fit.x[i], std[i], p.unit) and fit.active_mask[i] == 0)}
+
+
+def score_statistic(held, indices, residuals, bounds, steps, lags):
+    """The score (Lagrange multiplier) statistic of the parameters `indices` held at their priors,
+    in its one-step Wald form: the Gauss-Newton step of every parameter from the held fit, its
+    held components d and their HAC covariance V (`model.significance`), d' V^-1 d; chi-square
+    with as many degrees of freedom as parameters held where the priors are right. Read at the
+    held fit, not the free one: along a valley the free fit's linearisation is no guide to how
+    far its end is from the prior (T_ground +- 8600 K on a 50 K range). The held parameters'
+    Jacobian columns, which the held fit did not need, are differences of `STEP` of their ranges."""
+    jac = held.jac.copy()
+    for i in indices:
+        low, high = bounds[i]
+        h = STEP * (high - low) if held.x[i] + STEP * (high - low) <= high else -STEP * (high - low)
+        moved = held.x.copy()
+        moved[i] += h
+        jac[:, i] = (residuals(moved) - held.fun) / h
+    step = np.linalg.lstsq(jac, -held.fun, rcond=None)[0][indices]
+    cov = parameter_covariance(jac, held.fun, steps, lags)[np.ix_(indices, indices)]
+    return float(step @ np.linalg.pinv(cov) @ step)
 
 
 def fold(fit, train, lows, highs, residuals):
@@ -185,6 +267,8 @@ def fold(fit, train, lows, highs, residuals):
     # range. Nor is a step that leaves the range clipped parameter by parameter: where two
     # parameters trade off, the step runs along their valley, and clipping one alone (U to 0)
     # would leave the valley, and the fit, altogether
+    # (a parameter held at its prior has a Jacobian column of zeros: least squares' minimum-norm
+    # step leaves it where it is)
     free = fit.active_mask == 0
     if not free.any():
         return fit.x.copy()

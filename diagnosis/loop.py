@@ -503,12 +503,25 @@ def left_by(windows, model):
                                 windows.measured[0][:k0][:, 0] - model.runs[0][:k0, 0], inputs)
 
 
+def priors_stated(building, added):
+    """The building with a sentence in its description for each parameter of an added effect
+    (`Fit`s) held at its physical prior: a modeller reading the file learns which of its values
+    the data did not fix and where it comes from."""
+    said = [f"{fit.effect} on {fit.target}: {name} = {p['value']:.4g} {EFFECTS[fit.effect].parameter(name).unit}, "
+            f"held at {p['prior']}: the data fixed the effect, not {name} apart (nodeforce diagnose)."
+            for fit in added for name, p in fit.parameters.items() if p.get("prior")]
+    if not said:
+        return building
+    return building.edited(lambda data: data.update(description=" ".join([data.get("description", "")] + said).strip()))
+
+
 def write(building, prepared, located, made, objective, workdir, fmu_kind, reference):
     """Stage 4: the model the rounds leave written (`building_after.json`, `model_after.fmu`,
     each protocol's building, `model_after.idf` for a converted EnergyPlus model), the
     `Diagnosis`, written as report.json, report.md and the plots; returns it."""
     windows, records, model, added = prepared.windows, prepared.records, made.model, made.added
-    (workdir / "building_after.json").write_text(json.dumps(model.building.to_json(), indent=2) + "\n")
+    (workdir / "building_after.json").write_text(json.dumps(priors_stated(model.building, added).to_json(), indent=2)
+                                                 + "\n")
     fmu_after = build_fmu(model.building, workdir / "model_after.fmu", kind=fmu_kind)
     # a record under another protocol: its own building as corrected, for `nodeforce compare`
     protocols_after = {i: workdir / f"building_after_record{i + 1}.json" for i, b in enumerate(model.bases) if b is not None}

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 
 import numpy as np
+from scipy.stats import chi2
 
 from nodeforce.model.effects import EFFECTS, bridge_parts
 
@@ -103,6 +104,12 @@ class Policy:
                                             "heat_input_lag": ("heater_time_constant", False),
                                             "internal_mass": ("mass_time_constant", False)})
 
+    # -- priors (`diagnosis.calibrate`): where the data fix a combination of an effect's
+    # parameters but not each one, a parameter with a physical prior (`model.effects.Prior`) is
+    # held at it unless the data reject it at this level (the score test's p-value,
+    # dimensionless): the prior is what a modeller would write, and stands until shown wrong.
+    prior_level: float = 0.05
+
     # -- 3. the band
     # A difference of J below this share of the model's cross-validated J is the simulation's
     # rounding (dimensionless).
@@ -143,6 +150,12 @@ class Policy:
     def identifiable(self, value, sd, unit):
         """Whether an estimate `value` +- `sd` in `unit` is tight enough to act on."""
         return sd < (self.identifiable_kelvin if unit == "C" else self.identifiable_share * abs(value))
+
+    def holds_prior(self, statistic, held):
+        """Whether the data leave `held` parameters at their physical priors: the score
+        statistic (`diagnosis.calibrate.score_statistic`, chi-square with `held` degrees of
+        freedom) has a p-value of at least `prior_level`."""
+        return bool(chi2.sf(statistic, held) >= self.prior_level)
 
     def sensor_weight(self, sd, mean_square):
         """Sensors' weights in the evidence: sd^2 (C2) over each one's mean squared residual (C2,
@@ -189,8 +202,8 @@ class Policy:
         """Why a calibrated effect may not be added to the model, or None: a gain the building
         file's description rules out (`implausible`), a parameter on a bound of its search range
         or not identifiable from the data (unless the quantity its parameters trade off along
-        is, `trade_offs`), or a value outside physical limits beyond its uncertainty
-        (`limit_sds`).
+        is, `trade_offs`, or the calibration held it at its physical prior), or a value outside
+        physical limits beyond its uncertainty (`limit_sds`).
 
         parameters : {name: {"value", "std", "identifiable", "on_bound"}} of `diagnosis.calibrate`
         derived : what the data determine besides (`diagnosis.calibrate.derived`)
@@ -206,7 +219,7 @@ class Policy:
                          math.inf if facts["limits"][name][1] is None else facts["limits"][name][1])
             if p.get("on_bound") and not (resolved and bounds_waived):
                 reasons.append(f"{name} = {p['value']:.3g} {unit} ends on a bound of its range")
-            elif not p["identifiable"] and not resolved:
+            elif not p["identifiable"] and not resolved and not p.get("prior"):
                 reasons.append(f"{name} = {p['value']:.3g} +- {p['std']:.2g} {unit} is not identifiable from these data")
             margin = self.limit_sds * p["std"]
             if not low - margin <= p["value"] <= high + margin:

@@ -46,8 +46,11 @@ def convert_typical_year(src_path, dst_csv_path, year=2001):
     -------
     dict
         The site: `name`, `latitude`, `longitude` (degrees), `altitude` (m), `utc_offset`
-        (hours) and `timezone` (`Etc/GMT+5` style for whole-hour offsets, which is the fixed
-        local standard time of the file, else `+hh:mm`).
+        (hours), `timezone` (`Etc/GMT+5` style for whole-hour offsets, which is the fixed
+        local standard time of the file, else `+hh:mm`) and `ground_temperature` (C), the
+        year's mean air temperature: the ground a few metres down, where the seasons no longer
+        reach, stays near it (the deep-ground estimate a diagnosis holds a ground coupling's
+        temperature at where the data leave it free, docs/model.md section 7, Priors).
     """
     source = str(src_path)
     if year % 4 == 0 and (year % 100 != 0 or year % 400 == 0):
@@ -63,7 +66,7 @@ def convert_typical_year(src_path, dst_csv_path, year=2001):
     weather = to_mid_hour(end_of_hour, columns, cyclic=True)
     check_increasing(source, weather.index, where=lambda i: f"record {i + 1}")
     write_time_table(weather, dst_csv_path, float_format="%.6g")
-    return _site(meta)
+    return {**_site(meta), "ground_temperature": round(float(weather["T_out"].mean()), 2)}
 
 
 def relocate(building, metadata):
@@ -75,18 +78,19 @@ def relocate(building, metadata):
         Building description (`nodal-building/1`); not modified.
     metadata : dict
         Site as returned by `convert_typical_year`: `latitude`, `longitude` (degrees), `altitude`
-        (m) and `timezone`.
+        (m), `timezone` and, where given, `ground_temperature` (C).
 
     Returns
     -------
     dict
-        Deep copy of `building` with those four site fields replaced; the ground albedo and all
-        else kept.
+        Deep copy of `building` with those site fields replaced; the ground albedo and all else
+        kept.
     """
     moved = copy.deepcopy(building)
     site = moved.setdefault("site", {})
-    for key in ("latitude", "longitude", "altitude", "timezone"):
-        site[key] = metadata[key]
+    for key in ("latitude", "longitude", "altitude", "timezone", "ground_temperature"):
+        if key in metadata:
+            site[key] = metadata[key]
     return moved
 
 

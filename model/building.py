@@ -193,7 +193,7 @@ class Component:
 @dataclass(frozen=True)
 class Building:
     name: str
-    site: dict  # latitude, longitude (deg), altitude (m), timezone, ground_albedo
+    site: dict  # latitude, longitude (deg), altitude (m), timezone, ground_albedo, ground_temperature (C) if declared
     zones: tuple
     components: tuple
     sensors: dict = field(default_factory=dict)  # sensor name -> node id

@@ -124,6 +124,8 @@ def parse_checked(data, source="<building>"):
     site = {"latitude": float(site["latitude"]), "longitude": float(site["longitude"]),
             "altitude": float(site.get("altitude", 0.0)), "timezone": site.get("timezone", "UTC"),
             "ground_albedo": float(site.get("ground_albedo", 0.2)), "air_density": float(site.get("air_density", 1.2))}
+    if "ground_temperature" in data["site"]:
+        site["ground_temperature"] = float(data["site"]["ground_temperature"])
     schedules = {name: _schedule(check, name, s, f"schedules.{name}") for name, s in data.get("schedules", {}).items()}
     materials = {name: Material(conductivity=float(m["conductivity"]), density=float(m["density"]),
                                 specific_heat=float(m["specific_heat"])) for name, m in data["materials"].items()}

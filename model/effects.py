@@ -18,6 +18,8 @@ import re
 from dataclasses import dataclass
 from typing import Callable
 
+import numpy as np
+
 from .building import DAY_TERMS, Adiabatic, Boundary, Exterior, Surface
 from .network import RHO_C_AIR
 
@@ -34,6 +36,14 @@ class Parameter:
 
 
 @dataclass(frozen=True)
+class Prior:
+    """What physics expects of a parameter the data may leave free (C, or the parameter's unit),
+    and where that expectation comes from, in words a report can quote."""
+    value: float
+    source: str
+
+
+@dataclass(frozen=True)
 class Effect:
     id: str
     adds: str  # what it adds, in a few words
@@ -43,6 +53,9 @@ class Effect:
     write: Callable  # (JSON data, target, {name: value}) -> None: declare the values
     points_at: Callable  # (building, target) -> node ids whose forcing points at it; () none
     limits: Callable | None = None  # (building, target) -> {name: (low, high)} narrower than the parameters'
+    # (building, target, outdoor air (C) over the weather read) -> {name: Prior}: what physics
+    # expects of a parameter where the data fix a combination of the effect's parameters only
+    priors: Callable | None = None
 
     def applies(self, building, target):
         return target in self.targets(building)
@@ -107,6 +120,23 @@ def _ground_write(data, target, values):
     if values["U"] != 0:
         _component(data, target)["outside"] = {"type": "boundary", "temperature": float(values["T_ground"]),
                                                "h": float(values["U"])}
+
+
+def deep_ground_temperature(building, outdoor_air):
+    """The temperature (C) of the ground a few metres down, where the seasons no longer reach: the
+    site's `ground_temperature` where the building file declares one (a typical year's annual mean
+    air temperature, EnergyPlus's deep ground temperature), else the mean of the outdoor air
+    temperatures given (C, any shape; NaN ignored), the weather the diagnosis reads, a rougher
+    estimate of that annual mean the further the record is from spring or autumn."""
+    declared = building.site.get("ground_temperature")
+    if declared is not None:
+        return Prior(float(declared), "the site's ground temperature, as the building file declares it")
+    return Prior(float(np.nanmean(outdoor_air)), "the mean outdoor air temperature of the weather read (the "
+                                                 "records and their history), the deep-ground estimate")
+
+
+def _ground_priors(building, target, outdoor_air):
+    return {"T_ground": deep_ground_temperature(building, outdoor_air)}
 
 
 def _absorptance_write(data, target, values):
@@ -319,7 +349,7 @@ EFFECTS = {e.id: e for e in (
     Effect("ground_coupling", "a conductance from an adiabatic face to a ground temperature",
            (Parameter("U", "W/m2/K", 0.0, 20.0), Parameter("T_ground", "C", -10.0, 40.0)),
            lambda b: [c.name for c in b.components if isinstance(c.outside, Adiabatic)],
-           _ground_read, _ground_write, _own_nodes),
+           _ground_read, _ground_write, _own_nodes, priors=_ground_priors),
     Effect("infiltration", "an air change with the outside",
            (Parameter("n", "1/h", 0.0, 20.0),), _zones,
            *_zone_field("air_change_rate", "n"), _no_node),

@@ -1,11 +1,12 @@
 """The cross-validation folds of a calibration (`diagnosis.calibrate.fold`): a fold is the fit
 without one day, one Gauss-Newton step from the whole window's optimum; checked against fits
-made afresh by scipy on the days it keeps."""
+made afresh by scipy on the days it keeps; and the test that holds a parameter at its prior."""
 import numpy as np
 import pytest
 from scipy.optimize import least_squares
 
-from nodeforce.diagnosis.calibrate import fold
+from nodeforce.diagnosis.calibrate import fold, score_statistic, solve
+from nodeforce.diagnosis.policy import POLICY
 
 DAYS, PER_DAY = 4, 100
 
@@ -189,3 +190,27 @@ def test_a_fit_that_carries_the_files_numerical_error_finds_the_walls_of_the_fil
     found, left = fitted(continuum, [error])
     assert abs(found_alone - 1.0) > 3e-3 and found == pytest.approx(1.0, abs=1e-4)
     assert left < 1e-4 < left_alone
+
+
+def test_the_score_test_of_a_held_parameter_rejects_a_right_prior_at_its_level_and_a_wrong_one_always():
+    """Two parameters of a linear model trading off (columns 0.98 correlated), white noise: held
+    at its true value, the second parameter's prior is rejected in about `prior_level` of the
+    draws (the statistic is chi-square with one degree of freedom); held 3 sd away (of the free
+    fit's estimate) it is rejected nearly always."""
+    rng = np.random.default_rng(5)
+    n, truth = 400, np.array([1.0, 2.0])
+    t = np.linspace(0.0, 1.0, n)
+    A = np.column_stack([np.sin(3 * t) + 1.0, np.sin(3 * t) + 1.0 + 0.2 * np.cos(7 * t)])
+    lows, highs = np.array([-50.0, -50.0]), np.array([50.0, 50.0])
+    steps = np.arange(n)
+    sd = np.sqrt(np.linalg.inv(A.T @ A)[1, 1]) * 0.1
+    rejected = {0.0: 0, 3.0: 0}
+    draws = 400
+    for _ in range(draws):
+        y = A @ truth + rng.normal(0.0, 0.1, n)
+        for shift in rejected:
+            held = solve(lambda x: y - A @ x, np.zeros(2), lows, highs, {1: truth[1] + shift * sd})
+            statistic = score_statistic(held, [1], lambda x: y - A @ x, list(zip(lows, highs)), steps, 0)
+            rejected[shift] += not POLICY.holds_prior(statistic, 1)
+    assert abs(rejected[0.0] / draws - POLICY.prior_level) < 0.03
+    assert rejected[3.0] / draws > 0.8

@@ -217,7 +217,8 @@ def test_tmy2_conversion_round_trips_over_a_whole_year(miami):
     assert np.allclose(w["T_out"].to_numpy()[1:], (dry[:-1] + dry[1:]) / 2)
     assert meta == {"name": "Miami, FL (TMY2 12839)", "latitude": 25.8,
                     "longitude": pytest.approx(-80.2667, abs=1e-4), "altitude": 2.0,
-                    "utc_offset": -5.0, "timezone": "Etc/GMT+5"}
+                    "utc_offset": -5.0, "timezone": "Etc/GMT+5",
+                    "ground_temperature": pytest.approx(w["T_out"].mean(), abs=0.005)}
 
 
 def test_mid_hour_stamps_centre_the_sun_on_solar_noon(miami):
@@ -239,6 +240,11 @@ def test_tmy3_conversion_is_one_increasing_year(tmp_path):
     assert w.index[0] == pd.Timestamp("2001-01-01T00:30-05:00")
     assert w.index[-1] == pd.Timestamp("2001-12-31T23:30-05:00")
     assert meta["latitude"] == 36.1 and meta["altitude"] == 273.0
+    # the deep-ground estimate is the year's mean air, as read back from the file written (to its
+    # 6 digits), between the coldest and the warmest month's
+    assert meta["ground_temperature"] == pytest.approx(w["T_out"].mean(), abs=0.005)
+    monthly = w["T_out"].groupby(w.index.month).mean()
+    assert monthly.min() + 5.0 < meta["ground_temperature"] < monthly.max() - 5.0
 
 
 def test_relocate_copies_and_replaces_the_site_only():
@@ -253,6 +259,10 @@ def test_relocate_copies_and_replaces_the_site_only():
                              "timezone": "Etc/GMT+5", "ground_albedo": 0.3}
     moved["zones"][0]["name"] = "changed"
     assert building["zones"][0]["name"] == "z"
+    # a typical year's deep-ground estimate moves with the site
+    grounded = relocate(building, {"latitude": 25.8, "longitude": -80.3, "altitude": 2.0, "timezone": "Etc/GMT+5",
+                                   "ground_temperature": 24.3})
+    assert grounded["site"]["ground_temperature"] == 24.3 and "ground_temperature" not in building["site"]
 
 
 def test_command_line_reproduces_the_bundled_files(tmp_path):

@@ -81,10 +81,14 @@ def parameter_unit(effect_id, name):
 
 
 def fmt_parameters(effect_id, parameters, pm="±"):
-    """'U = 0.52 ± 0.03 W/m2/K, T_ground = 24 ± 9 C (not identifiable)'; '' for no parameter."""
+    """'U = 0.52 ± 0.03 W/m2/K, T_ground = 24 ± 9 C (not identifiable)', or 'T_ground = 24.31 C
+    (held at <the prior's source>)' for a parameter held at its physical prior; '' for no parameter."""
     parts = []
     for name, p in (parameters or {}).items():
         unit = parameter_unit(effect_id, name)
+        if p.get("prior"):
+            parts.append(f"{name} = {p['value']:.4g}" + (f" {unit}" if unit else "") + f" (held at {p['prior']})")
+            continue
         text = f"{name} = {fmt_value_std(p.get('value'), p.get('std'), pm)}" + (f" {unit}" if unit else "")
         if p.get("identifiable") is False:
             text += " (not identifiable)"
