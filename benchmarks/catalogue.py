@@ -101,8 +101,8 @@ FAULTS = {  # name: Fault
     "infiltration": Fault("infiltration", "cell", {"n": 2.0}, AIR_OUT),
     "bridge": Fault("thermal_bridge", "cell", {"UA": 15.0}, AIR_OUT),
     # the envelope's materials more conductive than declared (the registry's effect), and the
-    # materials with the outside films (the truth's file edited): the air alone cannot tell the
-    # two apart, and both are the zone's envelope, not one of its components
+    # materials with the outside films (the truth's file edited): both the zone's envelope, not one
+    # of its components
     "envelope": Fault("envelope_conductance", "cell", {"factor": 2.0}, ()),
     "envelope-films": Fault("envelope_films", "cell", {"factor": 2.0}, (("envelope_conductance", "cell"),)),
     # weaker inside convection: a factor up to the registry's 20 never makes a strong error in the cell
