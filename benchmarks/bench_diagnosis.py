@@ -388,7 +388,8 @@ def write_docs(path, lines, args, elapsed):
         "below: its history, docs/model.md 5.7), never the truth's whole past; the fault is an "
         "effect the file does not declare, applied with the registry's own `apply`, or a gain on a "
         "schedule (150 W from 08:00 to 18:00 at scale 1), or a south opening (0.6 m2 of glazing at scale "
-        "1, its sun to the floor); its size is tuned by simulating so that the file's validation RMSE is "
+        "1, its sun to the floor), or the envelope's materials and outside film coefficients both twice the "
+        "file's at scale 1 ('envelope-films'; 'envelope' is the registry's factor on the materials alone); its size is tuned by simulating so that the file's validation RMSE is "
         "2.2 x the noise (subtle, accepted 1.5 to 3) or 6 x (strong, 4 to 9); Gaussian noise, seeded by "
         "the record's name and draw. A fault is never scaled beyond its physical limits (a factor on a "
         "conductance within 0.1 to 10, a room's mean convective coefficient within 0.5 to 20 W/m2/K): where that limit comes before the "
@@ -401,7 +402,7 @@ def write_docs(path, lines, args, elapsed):
         "A first effect is right when it is the record's fault with its target; an air change and a "
         "bridge to the outdoor air are one equation and count as one; a schedule is right as a daily "
         "gain; the south opening as a gain proportional to the south wall's sun or as the south "
-        "window's transmittance; on a record without a fault, adding nothing is right. The baseline "
+        "window's transmittance; the envelope's materials and films as the zone's envelope factor; on a record without a fault, adding nothing is right. The baseline "
         "(`benchmarks/baseline.py`) fits each catalogue effect alone by least squares to the objective "
         "air on the calibration window and keeps the best by BIC if it falls by more than 10.", "",
     ]

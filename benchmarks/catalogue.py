@@ -12,8 +12,9 @@ class Spec:
     """One record: where, when, how measured, and what the file lacks.
 
     effect : a registry id, "none", or beyond the catalogue "scheduled_gain" (W `full["Q"]` from
-        `full["on"]` to `full["off"]` h local time) or "opening" (`full["area"]` m2 of glazing
-        on the component `target`, its sun to the floor)
+        `full["on"]` to `full["off"]` h local time), "opening" (`full["area"]` m2 of glazing
+        on the component `target`, its sun to the floor) or "envelope_films" (the zone `target`'s
+        envelope materials and outside film coefficients both `full["factor"]` times the file's)
     target : the effect's target (a zone, a component, `zone->column`)
     full : the effect's parameters at scale 1 (others as declared)
     expected : (effect, target) pairs a right answer may name (default: (effect, target));
@@ -66,8 +67,9 @@ class Scenario:
 
 @dataclass(frozen=True)
 class Fault:
-    """What a record's file lacks: an effect (a registry id, or "scheduled_gain", "opening"), its
-    target, its parameters at scale 1 (`Spec.full`) and the answers counted right besides it."""
+    """What a record's file lacks: an effect (a registry id, or "scheduled_gain", "opening",
+    "envelope_films"), its target, its parameters at scale 1 (`Spec.full`) and the answers
+    counted right besides it."""
     effect: str
     target: str
     full: dict
@@ -98,7 +100,11 @@ FAULTS = {  # name: Fault
     "ground": Fault("ground_coupling", "floor", {"U": 3.0, "T_ground": None}, ()),
     "infiltration": Fault("infiltration", "cell", {"n": 2.0}, AIR_OUT),
     "bridge": Fault("thermal_bridge", "cell", {"UA": 15.0}, AIR_OUT),
+    # the envelope's materials more conductive than declared (the registry's effect), and the
+    # materials with the outside films (the truth's file edited): both the zone's envelope, not one
+    # of its components
     "envelope": Fault("envelope_conductance", "cell", {"factor": 2.0}, ()),
+    "envelope-films": Fault("envelope_films", "cell", {"factor": 2.0}, (("envelope_conductance", "cell"),)),
     # weaker inside convection: a factor up to the registry's 20 never makes a strong error in the cell
     "convection": Fault("inside_convection", "cell", {"factor": 0.4}, ()),
     "door": Fault("conductivity", "door", {"factor": 3.0}, ()),
@@ -121,8 +127,8 @@ FAULTS = {  # name: Fault
 }
 GROUND = {"mia-jun": 24.0, "mia-dec": 15.0, "sdp-jul": 5.0}  # C, the ground below the cell, away from its air
 PLAN = {  # scenario: [fault or "none", size "s" subtle / "L" strong]
-    "mia-jun": ["none", "infiltration s", "bridge s", "envelope s", "convection s", "door s", "wall s",
-                "ground s", "schedule s", "opening s"],
+    "mia-jun": ["none", "infiltration s", "bridge s", "envelope s", "envelope-films s", "convection s", "door s",
+                "wall s", "ground s", "schedule s", "opening s"],
     # every node measured in winter: the door (1.6 m2) ten times as conductive, or the inside
     # convection a tenth, the most physics allows (`max_scale`), stay subtle here
     "gso-jan": ["none", "infiltration L", "bridge L", "envelope L", "convection s", "door s", "wall L",
@@ -131,8 +137,9 @@ PLAN = {  # scenario: [fault or "none", size "s" subtle / "L" strong]
                 "schedule L", "opening L"],
     "gso-apr": ["none", "gain L", "daily L", "east-sun L", "mass L", "infiltration s", "envelope s", "convection s"],
     "mia-dec": ["none", "door s", "wall s", "ground s", "bridge s", "opening s", "schedule s"],
-    "sdp-feb-air": ["none", "lag s", "split L", "mass s", "envelope L", "infiltration L", "convection L", "gain s"],
-    "mia-jan-air": ["none", "lag L", "split s", "mass L", "envelope s", "schedule L"],
+    "sdp-feb-air": ["none", "lag s", "split L", "mass s", "envelope L", "envelope-films L", "infiltration L",
+                    "convection L", "gain s"],
+    "mia-jan-air": ["none", "lag L", "split s", "mass L", "envelope s", "envelope-films s", "schedule L"],
     # a Twin House diagnosis takes some 20 times a test cell's (docs/benchmark_diagnosis.md): four records
     # (and 100 air capacities of furniture, the registry's bound, stay subtle)
     "twin-gso-feb": ["none", "W8 L", "shading s", "living-mass s"],

@@ -16,7 +16,9 @@ The truth is never the diagnosis' own model:
   record, a user's file that starts some days before the measurements, or with them;
 - the fault is an effect the file does not declare, applied to the truth with the registry's own
   `apply` (`model.effects.EFFECTS`), or one beyond the catalogue: a gain on a schedule, a gain
-  through an opening the file does not have;
+  through an opening the file does not have, an envelope whose materials and outside film
+  coefficients are both more conductive than declared (the registry's envelope factor scales the
+  materials alone);
 - Gaussian noise from a seeded generator, one seed per record and draw.
 
 The size of an effect is tuned by simulating: `subtle` puts the file's validation RMSE (noise

@@ -71,6 +71,9 @@ def max_scale(building, spec):
     if spec.effect not in EFFECTS:
         if spec.effect == "opening":
             return 0.9 * building.component(spec.target).area / spec.full["area"]
+        if spec.effect == "envelope_films":  # the envelope factor's physical limit on the whole path
+            high = POLICY.limits(building, "envelope_conductance", spec.target, "factor")[1]
+            return 0.95 * (high - 1.0) / (spec.full["factor"] - 1.0)
         return 20.0
     effect = EFFECTS[spec.effect]
     base = neutral(building, spec)

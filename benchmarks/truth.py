@@ -57,11 +57,16 @@ def file_building(spec):
     return parse_building(data, source=f"{path.name} at {spec.climate}")
 
 
+# the declared values of the parameters of the faults beyond the registry: no gain, no opening,
+# an envelope as declared
+BEYOND_NEUTRAL = {"Q": 0.0, "area": 0.0, "factor": 1.0}
+
+
 def neutral(building, spec):
     """The effect's parameters as the file declares them."""
     if spec.effect in EFFECTS:
         return EFFECTS[spec.effect].read(building, spec.target)
-    return {name: 0.0 for name in spec.full if name in ("Q", "area")}
+    return {name: BEYOND_NEUTRAL[name] for name in spec.full if name in BEYOND_NEUTRAL}
 
 
 def at_scale(building, spec, scale):
@@ -94,6 +99,8 @@ def faulty(truth, spec, values):
         return truth.edited(add), {"Q_schedule": schedule}
     if spec.effect == "opening":
         return opened(truth, spec.target, values["area"]), {}
+    if spec.effect == "envelope_films":
+        return with_envelope_films(truth, spec.target, values["factor"]), {}
     raise ValueError(f"unknown effect {spec.effect!r}")
 
 
@@ -117,6 +124,29 @@ def opened(building, wall, area):
             "nodes": [{"id": top + 1, "depth": 0.0}, {"id": top + 2, "depth": 0.004}],
             "inside": dict(raw["inside"]), "outside": outside,
             "solar_transmittance": 0.8, "transmitted_solar_to": floor})
+    return building.edited(change)
+
+
+def with_envelope_films(building, zone, factor):
+    """The building whose zone `zone` loses through its envelope `factor` times as much in every
+    part of the path: each component between the zone and the outdoors or a boundary has its
+    layers' materials `factor` times as conductive (its own copies of them, so that the partitions
+    sharing a material keep theirs) and its outside coefficients (h_conv and h_rad of an exterior
+    face, h of a boundary face) `factor` times the file's. Not the registry's
+    `envelope_conductance`, which scales the materials alone."""
+    def change(data):
+        for raw in data["components"]:
+            outside = raw["outside"]
+            if raw["inside"]["zone"] != zone or outside["type"] not in ("exterior", "boundary"):
+                continue
+            for layer in raw["layers"]:
+                own = f"{layer[0]}@{raw['name']}"
+                data["materials"][own] = {**data["materials"][layer[0]]}
+                data["materials"][own]["conductivity"] *= factor
+                layer[0] = own
+            for key in ("h_conv", "h_rad", "h"):
+                if key in outside:
+                    outside[key] *= factor
     return building.edited(change)
 
 

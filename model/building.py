@@ -129,7 +129,7 @@ class Zone:
     proportional_gains: tuple = ()  # (input column, k in W per unit of the column)
     internal_mass: Lumped | None = None  # furniture and undeclared mass, coupled to the air
     heat_input_lag: Lumped | None = None  # the heater's own capacity, between heat input and zone
-    envelope_factor: float = 1.0  # scale on the conductances of the zone's components to outside
+    envelope_factor: float = 1.0  # scale on the layer conductances of the zone's components to outside
     shading_transmittance: float = 0.0  # part of its glazings' sun a closed shading still lets in
     heat_input_factor: float = 1.0  # the heat its heat input columns deliver, per W they read
     air_exchange: tuple = ()  # (other zone, m3/h each way): air through an open internal door

@@ -383,8 +383,9 @@ EFFECTS = {e.id: e for e in (
            (Parameter("C_h", "J/K", 0.0, 1e8), Parameter("H_h", "W/K", 0.01, 1e5)),
            lambda b: [z.name for z in b.zones if z.heat_input],
            *_lumped_field("heat_input_lag", "C_h", "H_h"), _no_node, _lumped_limits("C_h")),
-    Effect("envelope_conductance", "one factor on the conductances of a zone's components to the outdoors "
-                                   "and to boundaries, their outside surface coefficients included",
+    Effect("envelope_conductance", "the envelope's materials conducting other than declared: one factor on "
+                                   "the layer conductances of a zone's components to the outdoors and to "
+                                   "boundaries, not their outside surface coefficients",
            (Parameter("factor", "-", 0.05, 20.0),), _envelope_targets,
            *_zone_field("envelope_factor", "factor"), _no_node),
     Effect("shading_transmittance", "the part of a glazing's sun that the zone's closed shading devices "

@@ -156,28 +156,30 @@ def assemble(building, names=None):
     for c in building.components:
         idx = [i - 1 for i in c.node_ids]
         e, out = idx[-1], c.outside
-        # a zone's envelope factor scales what separates it from the outdoors or a boundary, and a
-        # boundary column's factor what separates the building from that column
-        envelope = (building.zone(c.inside.zone).envelope_factor if isinstance(out, (Exterior, Boundary))
-                    else 1.0)
-        if isinstance(out, Boundary) and isinstance(out.temperature, str):
-            envelope *= building.boundary_factor(out.temperature)
+        # a zone's envelope factor is its envelope's materials conducting other than declared: it
+        # scales the layers of what separates the zone from the outdoors or a boundary, not the
+        # outside film coefficients (wind and sky are the `exterior`'s own physics). A boundary
+        # column's factor scales what separates the building from that column, films included.
+        materials = (building.zone(c.inside.zone).envelope_factor if isinstance(out, (Exterior, Boundary))
+                     else 1.0)
+        boundary = (building.boundary_factor(out.temperature)
+                    if isinstance(out, Boundary) and isinstance(out.temperature, str) else 1.0)
         C[idx] += c.area * capacities(c.layers, c.depths) * c.capacity_factor
         for k, g in enumerate(conductances(c.layers, c.depths)):
-            link(idx[k], idx[k + 1], c.area * g * c.conductivity_factor * envelope)
+            link(idx[k], idx[k + 1], c.area * g * c.conductivity_factor * materials * boundary)
         to_zone(idx[0], c.area, c.inside)
         if isinstance(out, Exterior):
             F = sky_view_factor(c.tilt) if out.sky_view_factor is None else out.sky_view_factor
-            A[e, e] -= c.area * (out.h_conv + out.h_rad) * envelope
-            B[e, col["T_out"]] += c.area * (out.h_conv + out.h_rad * (1.0 - F)) * envelope
-            B[e, col["T_sky"]] += c.area * out.h_rad * F * envelope
+            A[e, e] -= c.area * (out.h_conv + out.h_rad)
+            B[e, col["T_out"]] += c.area * (out.h_conv + out.h_rad * (1.0 - F))
+            B[e, col["T_sky"]] += c.area * out.h_rad * F
             B[e, col[c.irradiance_input]] += c.area * out.solar_absorptance
             # a glazing's inner panes absorb part of the sun at the inside face (docs/model.md 4.1)
             B[idx[0], col[c.irradiance_input]] += c.area * c.inner_solar_absorptance
         elif isinstance(out, Surface):
             to_zone(e, c.area, out)
         elif isinstance(out, Boundary):
-            to_temperature(e, c.area * out.h * envelope, out.temperature)
+            to_temperature(e, c.area * out.h * boundary, out.temperature)
         else:
             assert isinstance(out, Adiabatic)
         if c.solar_transmittance is not None:

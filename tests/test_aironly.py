@@ -123,7 +123,7 @@ def record(effect, hlc, sd, J):
 
 
 def test_the_report_says_when_the_data_fix_the_loss_but_not_its_split(heated):
-    """Infiltration and the envelope factor both move the loss to ~33 W/K and fit alike: the
+    """Infiltration and the envelope factor both move the loss to ~31 W/K and fit alike: the
     split is not the record's. A gain that fits as well moves no loss and is not part of it; a
     convection change whose HLC the data do not fix is not either."""
     before = heat_loss_coefficient(heated)

@@ -14,9 +14,14 @@ from benchmarks.baseline import fit_one
 from benchmarks.catalogue import FAULTS, Spec
 from benchmarks.records import record
 from benchmarks.sizing import STRONG_BAND, SUBTLE_BAND, before_error, max_scale
-from benchmarks.truth import CELLS, FINE_STEP, at_scale, faulty, file_building, fine_weather, record_times, truth_record
+from benchmarks.truth import (CELLS, FINE_STEP, at_scale, faulty, file_building, fine_weather, record_times, truth_record,
+                              with_envelope_films)
+from nodeforce.model.building_file import parse_building
+from nodeforce.model.hlc import heat_loss_coefficient
 from nodeforce.model.numerical import refined
+from tests.test_hlc import series
 from tests.test_replay import check_replay
+from tests.test_zone_effects import light_room
 
 pytestmark = pytest.mark.slow  # each record is simulated at 1 min, and a few tuned
 
@@ -137,6 +142,23 @@ def test_a_fault_is_never_scaled_beyond_what_a_building_could_have():
         value = at_scale(building, spec, max_scale(building, spec))[name]
         assert 0.1 <= value <= 10.0
         assert value > 9.0 or value < 0.2  # and the scale reaches near the limit, not short of it
+
+
+def test_the_envelope_films_fault_scales_the_materials_and_the_outside_films():
+    """The light room's one wall (A = 20 m2, 0.1 m of foam at 0.04 W/m/K, h_c 3 inside, h_ce 20
+    outside, no capacity) with the fault f: HLC = A / (1/h_c + R/f + 1/(f h_ce)), where the
+    registry's envelope factor gives A / (1/h_c + R/f + 1/h_ce); the file's own materials stay."""
+    b = parse_building(light_room())
+    f = 1.8
+    films = with_envelope_films(b, "room", f)
+    assert heat_loss_coefficient(films) == pytest.approx(series(20.0 * 3.0, f * 20.0 * 0.4, f * 20.0 * 20.0), rel=1e-12)
+    assert heat_loss_coefficient(films) == pytest.approx(20.0 / (1 / 3.0 + 2.5 / f + 1 / (f * 20.0)), rel=1e-12)
+    assert b.to_json()["materials"]["foam"]["conductivity"] == 0.04
+    assert with_envelope_films(b, "room", 1.0).to_json()["components"][0]["outside"]["h_conv"] == 20.0
+    # its size stops where the envelope factor's physical limit (10) does
+    spec = small("envelope-films")
+    building = file_building(spec)
+    assert at_scale(building, spec, max_scale(building, spec))["factor"] == pytest.approx(0.95 * 9.0 + 1.0)
 
 
 @pytest.mark.parametrize("name", ["mia-jun/ground-s", "mia-jun/infiltration-s"])

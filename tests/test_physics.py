@@ -115,17 +115,17 @@ def boundary_heat_in(building, T, u):
     Q = 0.0
     for c in building.components:
         e, out = T[c.node_ids[-1] - 1], c.outside
-        envelope = building.zone(c.inside.zone).envelope_factor  # scales the outside coefficients
         if isinstance(out, Exterior):
             F = (1 + np.cos(np.radians(c.tilt))) / 2
             I = u[out.irradiance or f"I_{c.name}"]
-            Q += c.area * (envelope * out.h_conv * (u["T_out"] - e)
-                           + envelope * out.h_rad * (F * (u["T_sky"] - e) + (1 - F) * (u["T_out"] - e))
+            # the envelope factor scales the materials, not these outside coefficients
+            Q += c.area * (out.h_conv * (u["T_out"] - e)
+                           + out.h_rad * (F * (u["T_sky"] - e) + (1 - F) * (u["T_out"] - e))
                            + out.solar_absorptance * I)
         elif isinstance(out, Boundary):
             T_b = u[out.temperature] if isinstance(out.temperature, str) else out.temperature
             factor = building.boundary_factors.get(out.temperature, 1.0)
-            Q += c.area * envelope * factor * out.h * (T_b - e)
+            Q += c.area * factor * out.h * (T_b - e)
         if c.solar_transmittance is not None:
             I = u[c.outside.irradiance or f"I_{c.name}"]
             s, f = (u[c.shading], building.zone(c.inside.zone).shading_transmittance) if c.shading else (1.0, 0.0)

@@ -10,6 +10,7 @@ from scipy.linalg import expm
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.fmu_build.build import build_fmu
+from nodeforce.model.building import Exterior
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import Case
 from nodeforce.model.effects import EFFECTS
@@ -108,15 +109,15 @@ def test_a_heater_with_no_capacity_and_an_undeclared_mass_change_nothing():
         assert np.abs(T[:, :b.n_nodes] - run(b, 500.0, 900.0, 96)).max() < 1e-9, effect
 
 
-def test_an_envelope_factor_of_one_is_the_building_and_the_hlc_scales_its_outward_conductances(testcell_data):
+def test_an_envelope_factor_of_one_is_the_building_and_it_scales_the_materials_not_the_films(testcell_data):
     b = parse_building(testcell_data)
     one = assemble(EFFECTS["envelope_conductance"].apply(b, "cell", {"factor": 1.0}))
     declared = assemble(b)
     for name in ("C", "A", "B", "q"):
         assert np.array_equal(getattr(one, name), getattr(declared, name)), name
-    # by hand: each exterior component's path outward (its layers in series with its outside
-    # coefficients) scaled by f, in series with the inside coefficients, which are not: the
-    # lead's hand sum of the test cell (test_hlc) with g_o scaled
+    # by hand: each exterior component's layers scaled by f (its materials f times as
+    # conductive), its outside and inside coefficients as declared: the lead's hand sum of the
+    # test cell (test_hlc) on a file whose exterior materials are edited
     f = 1.7
     data = copy.deepcopy(testcell_data)
     data["zones"][0]["air_change_rate"] = 0.4
@@ -124,13 +125,28 @@ def test_an_envelope_factor_of_one_is_the_building_and_the_hlc_scales_its_outwar
         if c["outside"]["type"] == "exterior":
             for layer in c["layers"]:
                 layer[0] = scaled_material(data, layer[0], f)
-            c["outside"]["h_conv"] *= f
-            c["outside"]["h_rad"] *= f
     expected = heat_loss_coefficient(parse_building(data))
     with_air_change = parse_building({**testcell_data, "zones": [dict(testcell_data["zones"][0], air_change_rate=0.4)]})
     by_factor = EFFECTS["envelope_conductance"].apply(with_air_change, "cell", {"factor": f})
     assert heat_loss_coefficient(by_factor) == pytest.approx(expected, rel=1e-12)
     assert heat_loss_coefficient(by_factor) > heat_loss_coefficient(with_air_change)
+
+
+def test_the_envelope_factor_leaves_the_outside_coefficients_in_the_matrices(testcell_data):
+    """Each exterior face's outside node keeps A (h_ce + h_re) to the outdoors: its T_out and T_sky
+    columns of B are the declared ones, and its diagonal moves by the change of its last layer's
+    link alone (f - 1) A G_last."""
+    b = parse_building(testcell_data)
+    f = 2.5
+    declared, scaled = assemble(b), assemble(EFFECTS["envelope_conductance"].apply(b, "cell", {"factor": f}))
+    for name in ("T_out", "T_sky"):
+        j = declared.input_names.index(name)
+        assert np.array_equal(scaled.B[:, j], declared.B[:, j]), name
+    for c in (c for c in b.components if isinstance(c.outside, Exterior)):
+        e, previous = c.node_ids[-1] - 1, c.node_ids[-2] - 1
+        g_last = declared.A[e, previous]  # A G of the link to the node before the outside one
+        assert scaled.A[e, previous] == pytest.approx(f * g_last, rel=1e-12), c.name
+        assert scaled.A[e, e] - declared.A[e, e] == pytest.approx(-(f - 1.0) * g_last, rel=1e-9), c.name
 
 
 def scaled_material(data, name, f):
@@ -141,14 +157,14 @@ def scaled_material(data, name, f):
 
 
 def test_the_light_rooms_hlc_is_its_wall_and_the_envelope_factor_scales_the_wall_only():
-    """One wall: air -- A h_c -- foam -- A h_ce -- outdoors; the factor scales the last two."""
+    """One wall: air -- A h_c -- foam -- A h_ce -- outdoors; the factor scales the foam alone:
+    HLC = A / (1/h_c + R / f + 1/h_ce), R = 0.1 m / 0.04 W/m/K."""
     b = parse_building(light_room(internal_mass={"capacity": 1e6, "conductance": 80.0},
                                   heat_input_lag={"capacity": 1e4, "conductance": 30.0}))
     assert heat_loss_coefficient(b) == pytest.approx(H_O, rel=1e-12)  # the added nodes lose nothing
     f = 0.6
     scaled = EFFECTS["envelope_conductance"].apply(b, "room", {"factor": f})
-    assert heat_loss_coefficient(scaled) == pytest.approx(
-        series(20.0 * 3.0, f * 20.0 * 0.04 / 0.1, f * 20.0 * 20.0), rel=1e-12)
+    assert heat_loss_coefficient(scaled) == pytest.approx(20.0 / (1 / 3.0 + 2.5 / f + 1 / 20.0), rel=1e-12)
 
 
 def test_added_nodes_are_numbered_after_the_last_named_and_never_measured(testcell_data):
