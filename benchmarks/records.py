@@ -26,10 +26,13 @@ included) at `SUBTLE` times the noise, `strong` at `STRONG` times, by a secant s
 effect's scale (its parameters moved from the declared values towards `full`).
 
 `record(name_or_spec, draw)` returns a `Record`: what a test or a script needs to diagnose it and
-to judge the answer. The truth is made in `benchmarks/truth.py`, the sizes in
+to judge the answer; `later_record(record)` the same building with the same fault measured again
+two to four weeks after it ends, on which a correction is judged beyond its record. The truth is made in `benchmarks/truth.py`, the sizes in
 `benchmarks/sizing.py`; `benchmarks/catalogue.py` lists the records (`SPECS`, `quick_specs()`).
 """
+import dataclasses
 import functools
+import hashlib
 import math
 from dataclasses import dataclass
 
@@ -107,3 +110,26 @@ def record(name_or_spec, draw=0, scale=None):
     return Record(spec=spec, draw=draw, building=building, truth=truth, weather=weather, measurements=noisy,
                   noiseless=clean, scale=scale, values=values, before_ratio=ratio,
                   hlc_truth=heat_loss_coefficient(truth), hlc_file=heat_loss_coefficient(building))
+
+
+# When a record's later record starts after its own end (days): the same building measured
+# again some weeks on, under other weather, the fault still there.
+LATER_DAYS = (14, 28)
+
+
+def later_spec(spec):
+    """The spec of the same building, fault, sensors, step and length starting two to four weeks
+    after `spec` ends, inside the typical year: the span drawn from the scenario's name (the part of the
+    record's name before "/"), so that a scenario's records are measured again on the same days,
+    the same every run."""
+    scenario = spec.name.split("/")[0]
+    seed = int.from_bytes(hashlib.sha1(scenario.encode()).digest()[:4], "little")
+    days = int(np.random.default_rng(seed).integers(LATER_DAYS[0], LATER_DAYS[1] + 1))
+    start = pd.Timestamp(f"2001-{spec.start}")  # any year without a 29 February: a month-day
+    start = min(start + pd.Timedelta(days=spec.days + days), pd.Timestamp("2001-12-31") - pd.Timedelta(days=spec.days))
+    return dataclasses.replace(spec, start=start.strftime("%m-%d"), name=f"{spec.name}+later")
+
+
+def later_record(r):
+    """The `Record` of `later_spec(r.spec)` under the same draw, its fault at `r`'s scale."""
+    return record(later_spec(r.spec), r.draw, scale=r.scale)

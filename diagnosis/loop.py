@@ -311,11 +311,12 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers, weights,
     for (effect, target), a in zip(pairs, assessed):
         (folder / f"{effect}@{target}.json").write_text(json.dumps(a.building, indent=2) + "\n")
     n = windows.scored()
+    sensed = {i for ids in windows.sensors for i in ids}
     results, models, simulations = [], {}, 0
     for (effect, target), a in zip(pairs, assessed):
         metrics = windows.metrics(objective, a.runs)
         sensor_blocks, sensor_residuals, readings, counted = windows.sensor_scores(a.sensed, weights)
-        fit = Fit(effect, target, a.parameters, a.determined, POLICY.facts(model.building, effect, target),
+        fit = Fit(effect, target, a.parameters, a.determined, POLICY.facts(model.building, effect, target, sensed),
                   CrossValidation([float(np.nansum(np.square(f["residuals"]))) for f in a.folds], n,
                                   [f["values"] for f in a.folds],
                                   # each block's left-out residuals, in one order for every candidate

@@ -15,8 +15,8 @@ The choice of a round, in order (docs/method.md, "Choosing an effect"; `diagnosi
    `standard_errors` standard errors of the paired difference (at least `rounding_share` of J),
    and by no more than `noise_change` where the best claims more, cannot be told from it.
 4. The order. Within the band the one that claims least is chosen (`claim`): a physical effect
-   before a shape (`shapes`), fewer parameters before more, a zone's effect before one
-   component's; then the lower evidence.
+   before a shape (`shapes`), fewer parameters before more, a zone's effect before that of one
+   component no sensor of which is measured; then the lower evidence.
 
 Rounds go on, `max_rounds` at most, while the error left is above the noise (`at_noise`) and a
 candidate passes. The yardsticks say their units: `noise_J` and `noise_change` are J (C2);
@@ -184,15 +184,18 @@ class Policy:
         """The parameters whose identifiability and limits decide for an effect (`judged`)."""
         return self.judged.get(effect, tuple(p.name for p in EFFECTS[effect].parameters))
 
-    def facts(self, building, effect, target):
+    def facts(self, building, effect, target, sensed=()):
         """What the choice reads of the building about one candidate, as report.json keeps it:
         each judged parameter's physical limits ([low, high], None where unbounded), why the
-        file's description makes the effect implausible (None), and whether its target is one
-        component (`claim`)."""
+        file's description makes the effect implausible (None), whether its target is one
+        component and whether one of that component's nodes is among the `sensed` node ids, the
+        other sensors the evidence reads (`claim`)."""
+        component = target in {c.name for c in building.components}
         return {"limits": {name: [None if math.isinf(v) else v for v in self.limits(building, effect, target, name)]
                            for name in self.judged_parameters(effect)},
                 "implausible": implausible(building, effect, target),
-                "component": target in {c.name for c in building.components}}
+                "component": component,
+                "sensed": component and bool(set(building.component(target).node_ids) & set(sensed))}
 
     def objection(self, building, effect, target, parameters, derived=None):
         """`objection_of` the candidate's `facts` in `building`."""
@@ -229,11 +232,15 @@ class Policy:
         return "; ".join(r for r in reasons if r) or None
 
     # ---- 4. the order
-    def claim(self, effect, component):
+    def claim(self, effect, component, sensed=False):
         """Sort key of what a choice claims, least first: a physical effect before a shape, fewer
-        parameters before more, a zone's effect before one component's (`component`: its target
-        is one, which says where)."""
-        return (self.is_shape(effect), len(EFFECTS[effect].parameters)), bool(component)
+        parameters before more, a zone's effect before one component's that no sensor of it
+        supports (`component`: its target is one, which says where; `sensed`: one of its nodes is
+        measured). A component's own sensor is in the evidence the band judges (the other
+        sensors, left out of every fit): where the zone's effect cannot be told from the
+        component's even so, the place is no more of a claim than the zone's, and the lower
+        evidence chooses; with air alone, nothing but the air speaks for the place."""
+        return (self.is_shape(effect), len(EFFECTS[effect].parameters)), bool(component) and not sensed
 
 
 def implausible(building, effect, target):

@@ -36,10 +36,12 @@ to, block by block:
    squared residual (at most 1): a surface the model cannot follow does not choose for the air.
    The candidates whose evidence exceeds the best's by no more than one standard error of that
    paired difference cannot be told apart from it, and among them a physical effect before a shape,
-   then fewer parameters before more, then a zone's effect before one component's, then the lower
-   evidence. A component's correction says where the fault is; where the zone's own (its envelope,
-   its air change) predicts as well, the data have not placed it there, and the components are
-   named beside the zone's effect instead (an air-only record cannot tell its walls apart). That
+   then fewer parameters before more, then a zone's effect before that of a component no sensor of
+   which is measured, then the lower evidence. A component's correction says where the fault is;
+   where the zone's own (its envelope, its air change) predicts as well and nothing but the air
+   speaks for the place, the data have not placed it there, and the components are named beside
+   the zone's effect instead (an air-only record cannot tell its walls apart); where the
+   component's own sensor is in the evidence, the lower evidence chooses. That
    standard error is the larger of two: the difference's scatter from block to block, and what the
    sensors' noise alone makes of it (`noise_difference`); against a candidate that claims less
    (a physical effect against a shape, fewer parameters, the zone's own effect against one
@@ -231,7 +233,7 @@ def candidate_test(result, base, margin, floor_sd, groups):
 
 def claim(result):
     """What a candidate's choice claims, least first (`Policy.claim`)."""
-    return POLICY.claim(result.effect, result.physics["component"])
+    return POLICY.claim(result.effect, result.physics["component"], result.physics.get("sensed", False))
 
 
 def band(admissible, base, sigma, floor_sd, n, distances):

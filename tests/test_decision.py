@@ -275,6 +275,27 @@ def test_a_zone_s_correction_comes_before_a_component_s_the_data_cannot_tell_fro
     assert chosen.target == "door" and not decision.indistinct
 
 
+def test_a_component_whose_own_sensor_is_in_the_evidence_is_chosen_by_evidence_not_after_the_zone():
+    """The same two candidates as above, the west wall a little better within one standard error:
+    with the wall's inside surface measured, its sensor has judged the place, and the lower
+    evidence chooses the wall; the envelope is named beside it. Without a sensor on it, the zone's effect comes first (the test above)."""
+    wall_nodes = CELL.component("west_wall").node_ids
+    sensed = lambda effect, target, parameters, days: Fit(  # noqa: E731
+        effect, target, parameters, {}, POLICY.facts(CELL, effect, target, sensed=wall_nodes[:1]),
+        CrossValidation(list(days), N))
+    wall = sensed("conductivity", "west_wall", {"factor": parameter(2.0, 0.2)}, [2.0, 2.2, 2.1, 2.2])
+    envelope = sensed("envelope_conductance", "cell", {"factor": parameter(1.2, 0.02)}, [2.1, 2.0, 2.3, 2.2])
+    assert wall.physics["sensed"] and not envelope.physics["sensed"]
+    chosen, decision = choose([wall, envelope], BASE, SIGMA, N)
+    assert chosen.target == "west_wall" and decision.indistinct == ["envelope_conductance@cell"], decision.reason
+    # a sensor on another component supports no place for this one
+    other = Fit("conductivity", "west_wall", {"factor": parameter(2.0, 0.2)}, {},
+                POLICY.facts(CELL, "conductivity", "west_wall", sensed=CELL.component("door").node_ids),
+                CrossValidation([2.0, 2.2, 2.1, 2.2], N))
+    assert not other.physics["sensed"]
+    assert choose([other, envelope], BASE, SIGMA, N)[0] is envelope
+
+
 def test_a_component_must_gain_more_than_the_noise_could_to_be_named_before_the_zone():
     """The west wall predicts every left-out day 0.1 C2 better than the envelope factor, alike
     from day to day: 0.4 C2, under the 0.59 C2 the noise could make of J (3 x 0.01 x sqrt(384)),
