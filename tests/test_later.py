@@ -1,12 +1,13 @@
 """A later record of the building, read for nothing but the final comparison: the diagnosis scores
 the building as written and as corrected on it as `nodeforce compare` does, reports it on the
-first screen and keeps it in report.json."""
+first screen and keeps it in report.json; a bad --later stops the command line at once."""
 import json
 
 import pandas as pd
 import pytest
 
 import nodeforce
+from nodeforce.cli import main
 from nodeforce.diagnosis.result import Diagnosis
 from tests.conftest import DATA, SENSORS
 
@@ -75,6 +76,19 @@ def test_the_later_record_is_on_the_first_screen_and_read_back(diagnosed):
     read = Diagnosis.read(folder / "out" / "report.json")
     assert read.later == diagnosis.later
     assert json.loads((folder / "out" / "report.json").read_text())["later"][0]["name"] == "july"
+
+
+def test_a_bad_later_record_is_a_one_line_error_naming_it(tmp_path, capsys):
+    base = ["diagnose", str(DATA / "testcell_miami.json"), "--weather", str(WEATHER), "--measurements",
+            str(DATA / "demo_measurements.csv"), "-o", str(tmp_path / "out")]
+    for later, said in ((f"weather={WEATHER},name=july", "--later: measurements: missing"),
+                        (f"weather={WEATHER},measurements={tmp_path / 'july.csv'}", f"{tmp_path / 'july.csv'}: file"),
+                        (f"weather={WEATHER},measurements={DATA / 'demo_measurements.csv'},phases=p.csv",
+                         "--later: phases: no such field")):
+        assert main(base + ["--later", later]) == 2
+        err = capsys.readouterr().err.strip()
+        assert "\n" not in err and said in err
+    assert not (tmp_path / "out").exists()  # refused before any work
 
 
 def later_of(name, before, after):
