@@ -119,3 +119,14 @@ def test_several_later_records_take_one_line_and_the_screen_stays_in_ten_lines()
     # without the later records the three keep a line each
     del report["later"]
     assert sum(line.startswith("The data determine for conductivity") for line in first_screen(report)) == 3
+
+
+def test_a_later_record_not_read_from_its_files_is_refused_before_any_work(tmp_path):
+    """The building as corrected needs the record's case prepared anew (measured_case of its
+    files), which a Record made from a case alone cannot give."""
+    building = nodeforce.read_building(DATA / "testcell_miami.json")
+    record = nodeforce.read_record(building, WEATHER, DATA / "demo_measurements.csv", burn_in_days=1)
+    bare = nodeforce.Record(record.case, "july.csv", "july")
+    with pytest.raises(nodeforce.InputError, match="july.csv: later: record july: .*read_record"):
+        nodeforce.diagnose(building, [record], tmp_path / "out", later=[bare])
+    assert not any((tmp_path / "out").iterdir())
