@@ -29,6 +29,9 @@ on data the calibration did not see.
    described (`diagnosis.residuals`): is it white, and which input or time of day does it follow.
 7. Given the experiment's phases, every model is scored on each (`diagnosis.phases`), and an
    added effect that makes a phase worse is flagged in the decision's reason.
+8. Given later records of the building (`later`), which no stage above reads, the building as
+   written and as corrected are scored on each as `nodeforce compare` scores them: whether the
+   correction holds beyond the records it was fitted and chosen on.
 """
 import json
 import os
@@ -47,16 +50,18 @@ from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnosis.calibrate import Candidate, calibrate, sensitivity
 from nodeforce.diagnosis.candidates import physical, shaped_inputs, shapes
+from nodeforce.diagnosis.compare import compare
 from nodeforce.diagnosis.loss import heat_loss
 from nodeforce.diagnosis.report import write_report
 from nodeforce.diagnosis.phases import phase_errors, worsened
 from nodeforce.diagnosis.residuals import diagnostics as residual_diagnostics
 from nodeforce.diagnosis.policy import POLICY
-from nodeforce.diagnosis.result import CrossValidation, Diagnosis, Fit, RecordOutcome, SensorEvidence
+from nodeforce.diagnosis.result import CrossValidation, Diagnosis, Fit, LaterRecord, RecordOutcome, SensorEvidence
 from nodeforce.diagnosis.selection import block_J, blocks as blocks_of, decide, on_block
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.iotools.energyplus_corrections import idf_of, write_corrections
 from nodeforce.ga.locate import check_measured, evaluator_kind, locate
+from nodeforce.model.case import measured_case
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
@@ -134,7 +139,10 @@ class Record:
     pandas Timestamp, else the `fraction` of it by time), its phases (iotools.phases.Phase) and,
     for a record run under another protocol than the building file's (other supply flows, other
     blinds), the building as written for that protocol (`building`, the case's): the same house,
-    node for node, to which every correction is added as to the building file."""
+    node for node, to which every correction is added as to the building file. `read_from`:
+    `measured_case`'s arguments but the building (the weather and measurements DataFrames, the
+    burn-in, ...) where it was read from files (`nodeforce.read_record`), from which a later
+    record's case is prepared for each building compared (`case_for`)."""
     case: object
     source: str = "measurements"
     name: str = None
@@ -142,6 +150,12 @@ class Record:
     calibration_end: object = None
     phases: tuple = ()
     building: object = None
+    read_from: dict = None
+
+    def case_for(self, building):
+        """The record's case as `nodeforce compare` prepares it for `building` (`measured_case`
+        of the files it was read from, its burn-in the same)."""
+        return measured_case(building, **self.read_from)
 
 
 @dataclass
@@ -332,7 +346,7 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers, weights,
 
 def diagnose(building, records, objective, workdir, *, source="measurements", fraction=0.6, calibration_end=None,
              seed=0, workers=None, scheduler=None, population=30, generations=400, fmu_kind="auto", reference=None,
-             noise=None, phases=None):
+             noise=None, phases=None, later=()):
     """Run the whole loop, its stages in order (`prepare`, `localise`, `rounds`, `write`); write the
     artifacts in `workdir`; return the `Diagnosis` (report.json is its `to_json()`).
 
@@ -346,14 +360,21 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
     every record's air. `fmu_kind`: the FMUs built, run and written (`ga.locate.locate`; "auto": the
     standalone FMU where a C compiler is at hand). `scheduler` ("tcp://host:port"): the forcing
     search and every round's candidates run on that Dask cluster's workers (`nodeforce.cluster`)
-    instead of `workers` processes; an unreachable one is an InputError before any work."""
+    instead of `workers` processes; an unreachable one is an InputError before any work.
+    `later`: `Record`s of the same building under the building file's protocol, read from their
+    files (`nodeforce.read_record`), which nothing but the final comparison reads (`scored_later`):
+    no fit, no choice, no cross-validation."""
     if not isinstance(records, (list, tuple)):
         records = [Record(records, source, source, fraction, calibration_end, tuple(phases or ()))]
-    names = [r.name for r in records]
-    for r in records:
+    names = [r.name for r in [*records, *later]]
+    for r in [*records, *later]:
         if names.count(r.name) > 1:
             raise InputError(r.source, "name", f"two records are named {r.name!r}: each needs its own name")
         check_measured(objective, r.case, r.source)
+    for r in later:
+        if r.read_from is None or protocol(building, r) is not None:
+            raise InputError(r.source, "later", f"record {r.name}: a later record is read from its files "
+                                                f"(read_record) for the building diagnosed, {building.source}")
     fmu_kind = evaluator_kind(building) if fmu_kind == "auto" else fmu_kind
     with Cluster(scheduler) if scheduler is not None else nullcontext() as cluster:
         prepared = prepare(building, records, objective, workdir, fmu_kind, noise)
@@ -362,7 +383,7 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
                       noise=prepared.noise.sigma if prepared.noise.given else None)
         located = localise(building, prepared, objective, workdir, search)
         made = rounds(prepared, located.localization, objective, workdir, seed, workers, cluster)
-    return write(building, prepared, located, made, objective, workdir, fmu_kind, reference)
+    return write(building, prepared, located, made, objective, workdir, fmu_kind, reference, later)
 
 
 @dataclass
@@ -516,13 +537,16 @@ def priors_stated(building, added):
     return building.edited(lambda data: data.update(description=" ".join([data.get("description", "")] + said).strip()))
 
 
-def write(building, prepared, located, made, objective, workdir, fmu_kind, reference):
+def write(building, prepared, located, made, objective, workdir, fmu_kind, reference, later=()):
     """Stage 4: the model the rounds leave written (`building_after.json`, `model_after.fmu`,
-    each protocol's building, `model_after.idf` for a converted EnergyPlus model), the
-    `Diagnosis`, written as report.json, report.md and the plots; returns it."""
+    each protocol's building, `model_after.idf` for a converted EnergyPlus model), scored on
+    each later record (`scored_later`), the `Diagnosis`, written as report.json, report.md and
+    the plots; returns it."""
     windows, records, model, added = prepared.windows, prepared.records, made.model, made.added
     (workdir / "building_after.json").write_text(json.dumps(priors_stated(model.building, added).to_json(), indent=2)
                                                  + "\n")
+    later = [scored_later(record, (building.source, building), (workdir / "building_after.json", model.building),
+                          objective, fmu_kind) for record in later]
     fmu_after = build_fmu(model.building, workdir / "model_after.fmu", kind=fmu_kind)
     # a record under another protocol: its own building as corrected, for `nodeforce compare`
     protocols_after = {i: workdir / f"building_after_record{i + 1}.json" for i, b in enumerate(model.bases) if b is not None}
@@ -544,7 +568,7 @@ def write(building, prepared, located, made, objective, workdir, fmu_kind, refer
                                str(protocols_after[i]) if i in protocols_after else None)
                  for i, r in enumerate(records)] if len(records) > 1 else [],
         worsened_phases=worsened(by_phase, "before", "after") if by_phase and added else None,
-        phases=by_phase or None, reference=reference or None)
+        phases=by_phase or None, reference=reference or None, later=later)
     idf = idf_of(building)
     if idf is not None:  # a converted EnergyPlus model: its corrections written back into it
         diagnosis.energyplus = write_corrections(building, model.building, [(a.effect, a.target) for a in added],
@@ -555,6 +579,16 @@ def write(building, prepared, located, made, objective, workdir, fmu_kind, refer
     diagnosis.artifacts["report"] = str(workdir / "report.md")
     diagnosis.write(workdir / "report.json")
     return diagnosis
+
+
+def scored_later(record, written, corrected, objective, fmu_kind):
+    """The later `record` scored as `nodeforce compare` scores it (`diagnosis.compare`): the
+    building as written and as corrected, each (path, Building), run through its FMU on the
+    record's case prepared for it; their `LaterRecord`."""
+    result, _ = compare([(path, b, record.case_for(b), objective) for path, b in (written, corrected)],
+                        fmu_kind=fmu_kind)
+    before, after = (m["metrics"] for m in result["models"])
+    return LaterRecord(record.name, str(record.source), result["record"], result["scored_from"], before, after)
 
 
 def validation_residuals(prepared, made):

@@ -209,6 +209,28 @@ class RecordOutcome:
 
 
 @dataclass
+class LaterRecord:
+    """A later record of the building, which no fit, choice or cross-validation read, scored after
+    the rounds as `nodeforce compare` scores it (`diagnosis.compare`): its name, measurement
+    file, span (`record`, [start, end]), the first time scored (after its burn-in), and the
+    objective's metrics (`Objective.metrics`: RMSE, mean, sd, n, C, overall and per zone) of the
+    building as written (`before`) and as corrected (`after`)."""
+    name: str
+    measurements: str
+    record: list
+    scored_from: str
+    before: dict
+    after: dict
+
+    def to_json(self):
+        return asdict(self)
+
+    @classmethod
+    def of_json(cls, d):
+        return cls(**d)
+
+
+@dataclass
 class Diagnosis:
     """A whole diagnosis (`nodeforce.diagnose`).
 
@@ -229,6 +251,7 @@ class Diagnosis:
     records : each record's outcome, where there are several (`RecordOutcome`)
     worsened_phases, phases : the phases an added effect makes worse; every model's error per phase
     reference : another model's error, for scale; energyplus : the corrections written back
+    later : each later record's score as written and as corrected (`LaterRecord`), read by nothing else
     """
     objective: list
     period: dict
@@ -250,6 +273,7 @@ class Diagnosis:
     phases: list = None
     reference: dict = None
     energyplus: dict = None
+    later: list = ()
 
     @property
     def added(self):
@@ -291,6 +315,8 @@ class Diagnosis:
                "noise": self.noise.to_json(), "node_names": self.node_names, "artifacts": self.artifacts}
         if self.records:
             out["records"] = [r.to_json() for r in self.records]
+        if self.later:
+            out["later"] = [r.to_json() for r in self.later]
         for key in ("reference", "energyplus", "phases"):
             if getattr(self, key):
                 out[key] = getattr(self, key)
@@ -333,7 +359,8 @@ class Diagnosis:
                    d["decision"]["structure_left"], d["heat_loss_coefficient"], d["residuals"], d["sensitivity"],
                    Noise.of_json(d["noise"]), d["assumptions"], d["node_names"], d["artifacts"],
                    [RecordOutcome.of_json(r) for r in d.get("records", ())], d["decision"].get("worsened_phases"),
-                   d.get("phases"), d.get("reference"), d.get("energyplus"))
+                   d.get("phases"), d.get("reference"), d.get("energyplus"),
+                   [LaterRecord.of_json(r) for r in d.get("later", ())])
 
 
 def _plain(value):

@@ -31,8 +31,8 @@ __all__ = ["InputError", "read_building", "convert_idf", "read_weather", "read_m
            "fmu_inputs", "write_fmu_inputs", "open_fmu", "simulate_fmu", "forcing_candidates",
            "score_forcing", "locate", "diagnose", "Record", "compare"]
 
-# One record of a building among several in one diagnosis: case, source, name, fraction,
-# calibration_end, phases (diagnosis.loop.Record).
+# One record of a building among several in one diagnosis, or a later one: case, source, name,
+# fraction, calibration_end, phases, building, read_from (diagnosis.loop.Record).
 Record = _loop.Record
 
 # The API's cases carry no file name: errors about their measurements say "measurements".
@@ -161,11 +161,15 @@ def read_record(building, weather, measurements, *, name=None, fraction=0.6, cal
     Returns
     -------
     Record
+        Its `read_from` keeps the files as read, from which `diagnose` prepares a later record's
+        case for the building as corrected.
     """
-    building, case = read_case(building, weather, measurements, burn_in_days=burn_in_days,
-                               decomposition=decomposition, history_days=history_days)
-    return Record(case, str(measurements), name or Path(measurements).name.split(".")[0], fraction, calibration_end,
-                  tuple(read_phases(phases)) if phases else (), building)
+    building = building if isinstance(building, Building) else load_building(building)
+    read_from = {"weather": read_weather(weather), "measurements": read_measurements(measurements),
+                 "burn_in_days": burn_in_days, "decomposition": decomposition, "history_days": history_days}
+    return Record(measured_case(building, **read_from), str(measurements),
+                  name or Path(measurements).name.split(".")[0], fraction, calibration_end,
+                  tuple(read_phases(phases)) if phases else (), building, read_from)
 
 
 def synthesize(building, weather, times, sensors, *, effects=(), noise_sd=0.0, seed=0, history_days=0.0,
@@ -382,7 +386,7 @@ def locate(building, case, objective=None, workdir=None, source=SOURCE, **search
 
 def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibration_end=None, phases=(), seed=0,
              workers=None, scheduler=None, fmu_kind="python", noise=None, reference=None, population=30,
-             generations=400):
+             generations=400, later=()):
     """The whole loop of `nodeforce diagnose`; writes its files in `workdir` (docs/guide.md, Output
     files) and returns the `Diagnosis`: `summary()` the first screen, `to_json()` report.json's
     content, `added` the effects added, `rounds` each round's decision, `candidates` every fit.
@@ -425,6 +429,11 @@ def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibrati
         {"label", "rmse": {phase: K}}: another model's error, reported for scale.
     population, generations : int
         The forcing search's GA settings.
+    later : list of Record, optional
+        Later records of the same building, each from `read_record` (the building diagnosed, the
+        diagnosis's burn-in), which no fit, choice or cross-validation reads: after the rounds the
+        building as written and as corrected are scored on each as `compare` scores them
+        (`Diagnosis.later`, report.json's `later`, a line of the first screen).
 
     Returns
     -------
@@ -434,7 +443,8 @@ def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibrati
         return _loop.diagnose(building, case, objective or Objective.of(building), folder, source=SOURCE,
                               fraction=fraction, calibration_end=calibration_end, phases=phases, seed=seed,
                               workers=workers, scheduler=scheduler, fmu_kind=fmu_kind, noise=noise,
-                              reference=reference, population=population, generations=generations)
+                              reference=reference, population=population, generations=generations,
+                              later=list(later))
 
 
 def compare(models, workdir=None, phases=(), fmu_kind="python"):

@@ -221,12 +221,13 @@ def cmd_synth(args):
           f"noise {args.noise} C" + (f", with {' and '.join(args.effect)} not in {args.building}" if args.effect else ""))
 
 
-def run_diagnosis(building, records, objective, out, args):
-    """The loop on `records` (`api.Record`s) through `api.diagnose`, its summary printed."""
+def run_diagnosis(building, records, objective, out, args, later=()):
+    """The loop on `records` (`api.Record`s) through `api.diagnose`, its summary printed;
+    `later`: the records read for the final comparison alone."""
     check_workers(args)
     diagnosis = api.diagnose(building, records, out, objective, seed=args.seed, workers=args.workers,
                              scheduler=args.scheduler, fmu_kind=kind_of(args), noise=noise(args),
-                             reference=read_reference(args.reference) if args.reference else None)
+                             reference=read_reference(args.reference) if args.reference else None, later=later)
     print(diagnosis.summary())
     print(f"wrote {out / 'report.json'}, {out / 'report.md'}, {out / 'building_after.json'}, {out / 'model_after.fmu'}")
 
@@ -241,24 +242,28 @@ def check_fraction(option, fraction):
 # of the same name.
 RECORD_FIELDS = ("name", "building", "weather", "measurements", "calibration-end", "calibration-fraction", "phases",
                  "burn-in-days")
+# The fields of --later: a later record is read for the final comparison alone, under the building
+# diagnosed and the diagnosis's burn-in, so it has no window, phases or protocol of its own.
+LATER_FIELDS = ("name", "weather", "measurements")
 
 
-def record_fields(text):
-    """{field: value} of one --record, "weather=W,measurements=M,calibration-end=T,..."."""
+def record_fields(text, option="--record", allowed=RECORD_FIELDS):
+    """{field: value} of one --record (or `option`, whose fields are `allowed`),
+    "weather=W,measurements=M,calibration-end=T,..."."""
     fields = {}
     for part in (p for p in text.split(",") if p.strip()):
         key, equals, value = part.partition("=")
         key = key.strip()
         if not equals or not value.strip():
-            raise InputError("--record", part, "must read FIELD=VALUE (fields: " + ", ".join(RECORD_FIELDS) + ")")
-        if key not in RECORD_FIELDS:
-            raise InputError("--record", key, "no such field; the fields are " + ", ".join(RECORD_FIELDS))
+            raise InputError(option, part, "must read FIELD=VALUE (fields: " + ", ".join(allowed) + ")")
+        if key not in allowed:
+            raise InputError(option, key, "no such field; the fields are " + ", ".join(allowed))
         if key in fields:
-            raise InputError("--record", key, f"given twice in {text!r}")
+            raise InputError(option, key, f"given twice in {text!r}")
         fields[key] = value.strip()
     for key in ("weather", "measurements"):
         if key not in fields:
-            raise InputError("--record", key, f"missing in {text!r}: every record names its weather and measurements")
+            raise InputError(option, key, f"missing in {text!r}: every record names its weather and measurements")
     return fields
 
 
@@ -280,6 +285,17 @@ def records_of(building, args):
                for fields in ([fields] if not args.record else map(record_fields, args.record))]
     said_assumed(a for r in records for a in r.case.assumptions)
     return records
+
+
+def later_of(building, args):
+    """The later records of --later (`api.read_record` under the building diagnosed, with the
+    diagnosis's burn-in), read before any work so that a bad one stops the run at once."""
+    later = [api.read_record(building, fields["weather"], fields["measurements"], name=fields.get("name"),
+                             burn_in_days=args.burn_in_days, decomposition=args.decomposition,
+                             history_days=history(args))
+             for fields in (record_fields(text, "--later", LATER_FIELDS) for text in args.later or ())]
+    said_assumed(a for r in later for a in r.case.assumptions)
+    return later
 
 
 def read_record(building, fields, options, args):
@@ -318,7 +334,7 @@ def read_reference(path):
 def cmd_diagnose(args):
     building = api.read_building(args.building)
     records = records_of(building, args)
-    run_diagnosis(building, records, objective_of(building, args), Path(args.output), args)
+    run_diagnosis(building, records, objective_of(building, args), Path(args.output), args, later_of(building, args))
 
 
 def cmd_compare(args):
@@ -515,6 +531,11 @@ def parser():
                    help="one record of the building, instead of --weather and --measurements; repeat it for "
                         "several: weather=W,measurements=M[,name=N][,calibration-end=T][,calibration-fraction=F]"
                         "[,phases=P][,burn-in-days=D] (a field not given takes the option of its name)")
+    s.add_argument("--later", action="append",
+                   help="a later record of the building, read for nothing but the final comparison (no fit, "
+                        "no choice, no cross-validation): the building as written and as corrected scored on "
+                        "it as by compare, with the diagnosis's burn-in; repeat it for several: "
+                        "weather=W,measurements=M[,name=N]")
     s.add_argument("-o", "--output", required=True, help="folder for report.json, report.md, building_after.json")
     decomposition_argument(s)
     diagnosis_arguments(s)

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from . import content, summary, tables
 from ..phases import WORSE
-from .formats import NA, fmt_search, fmt_sig, num
+from .formats import NA, fmt_search, fmt_sig, num, time_text
 
 
 def _relative(path, out_dir):
@@ -139,6 +139,10 @@ def write_markdown(out_dir, report, plots, notes):
         md += [f"- record {r['name']} ({r['measurements']}): calibration {content.period_text(r, 'calibration')}, "
                f"{len(r['period']['blocks'])} blocks; validation {content.period_text(r, 'validation')}"
                for r in report["records"]]
+    md += [f"- later record {r['name']} ({r['measurements']}): {time_text(r['record'][0])} to "
+           f"{time_text(r['record'][1])}, scored from {time_text(r['scored_from'])}: no fit, choice or "
+           f"cross-validation read it; the building as written and as corrected were scored on it after the rounds, "
+           f"as `nodeforce compare` scores them" for r in report.get("later") or ()]
     md += [f"- {report['noise'][key]}" for key in ("sentence", "numerical_sentence") if (report.get("noise") or {}).get(key)]
     md += ["", "## Before and after", "",
            "Residual r = T_air measured - T_air simulated (a positive mean: the model is too cold); "

@@ -4,7 +4,8 @@ The first screen answers, in at most ten lines, what a modeller asks first: wher
 (with the forcing's evidence), what was added, what the data determine about it (the quantities
 they fix; parameters they cannot fix are in the candidates table, never here), the error before
 and after on the validation window, the heat loss coefficient as described and as corrected,
-and what is left. It reads report.json and decides nothing.
+the error as written and as corrected on the later records no choice read, and what is left. It
+reads report.json and decides nothing.
 """
 from __future__ import annotations
 
@@ -130,23 +131,38 @@ def left_line(report):
     return text + "."
 
 
+def later_line(report):
+    """The RMSE of the objective's air on the later records, which no choice read, as written and
+    as corrected; None without later records."""
+    later = report.get("later") or []
+    if len(later) == 1:
+        r = later[0]
+        return (f"Later record {r['name']}: RMSE {fmt_temp(r['before'].get('rmse'))} as written -> "
+                f"{fmt_temp(r['after'].get('rmse'))} C as corrected (no choice read it)")
+    if later:
+        return ("Later records: " + ", ".join(f"{r['name']} {_change(r['before'].get('rmse'), r['after'].get('rmse'))}"
+                                              for r in later)
+                + " (RMSE as written -> as corrected; no choice read them)")
+    return None
+
+
 def first_screen(report, pm="+-"):
     """The first screen's lines (at most FIRST_SCREEN_LINES - 2: report.md adds its title and a
-    blank line), each opening with its label ('Fault:', 'Added:', ...)."""
+    blank line), each opening with its label ('Fault:', 'Added:', ...). What the data determine
+    of several effects takes a line each, or one together where the screen would overflow."""
     effects = added_effects(report)
-    lines = [where_line(report) + "."]
     if effects:
-        lines.append("Added: " + ", then ".join(content.effect_name(e.get("effect"), e.get("target"))
-                                                for e in effects) + ".")
-        for e in effects:
-            of = f" for {e.get('effect')}" if len(effects) > 1 else ""
-            lines.append(f"The data determine{of}: {determined(e, pm)}.")
+        added = ["Added: " + ", then ".join(content.effect_name(e.get("effect"), e.get("target"))
+                                            for e in effects) + "."]
+        said = [(f" for {e.get('effect')}" if len(effects) > 1 else "", determined(e, pm)) for e in effects]
+        determine = [f"The data determine{of}: {text}." for of, text in said]
     else:
-        lines.append("Added: nothing: " + chosen_sentence(report))
-    lines.append(error_line(report) + ".")
-    hlc = hlc_line(report, pm)
-    lines += [hlc + "."] if hlc else []
-    return lines + [left_line(report)]
+        added, determine = ["Added: nothing: " + chosen_sentence(report)], []
+    rest = [error_line(report), hlc_line(report, pm), later_line(report)]
+    rest = [line + "." for line in rest if line]
+    if 2 + len(determine) + len(rest) + 1 > FIRST_SCREEN_LINES - 2:
+        determine = ["The data determine: " + "; ".join(f"{of.strip()}: {text}" for of, text in said) + "."]
+    return [where_line(report) + ".", *added, *determine, *rest, left_line(report)]
 
 
 def terminal_summary(report):
