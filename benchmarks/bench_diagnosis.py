@@ -432,7 +432,10 @@ def write_docs(path, lines, args, elapsed):
         "A first effect is right when it is the record's fault with its target; an air change and a "
         "bridge to the outdoor air are one equation and count as one; a schedule is right as a daily "
         "gain; the south opening as a gain proportional to the south wall's sun or as the south "
-        "window's transmittance; the envelope's materials and films as the zone's envelope factor; on a record without a fault, adding nothing is right. The baseline "
+        "window's transmittance; the envelope's materials and films as the zone's envelope factor or its "
+        "conductance to the outdoor air (an air change, a bridge: with the films scaled as the layers, the "
+        "share of the sun the envelope passes on is as declared, and only the sun tells them apart); on a "
+        "record without a fault, adding nothing is right. The baseline "
         "(`benchmarks/baseline.py`) fits each catalogue effect alone by least squares to the objective "
         "air on the calibration window and keeps the best by BIC if it falls by more than 10.", "",
     ]
