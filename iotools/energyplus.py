@@ -64,6 +64,10 @@ MAX_SPACING = 0.025  # m, the largest cell of a generated component
 AIR_DENSITY, AIR_SPECIFIC_HEAT = 1.2, 1006.0  # a gas gap's capacity, kg/m3 and J/kg/K
 # EnergyPlus's ground temperature where the IDF gives none (its Site:GroundTemperature:BuildingSurface default)
 DEFAULT_GROUND = 18.0  # C
+# ... and its Site:GroundTemperature:Deep's, for a month the object leaves blank
+DEFAULT_DEEP_GROUND = 16.0  # C
+MONTHS = ("january", "february", "march", "april", "may", "june", "july", "august", "september", "october",
+          "november", "december")
 
 SURFACES = ("BuildingSurface:Detailed", "Wall:Detailed", "RoofCeiling:Detailed", "Floor:Detailed")
 SIMPLE_SURFACES = {  # type: (surface type, outside boundary)
@@ -83,7 +87,8 @@ SCHEDULES = ("Schedule:Compact", "Schedule:Constant", "Schedule:Year", "Schedule
              "ScheduleTypeLimits")
 READ = set(("Version", "Site:Location", "GlobalGeometryRules", "Building", "Zone", "ZoneList", "Construction",
             "Material", "Material:NoMass", "Material:AirGap", "WindowMaterial:Glazing", "WindowMaterial:Gas",
-            "WindowMaterial:SimpleGlazingSystem", "Site:GroundTemperature:BuildingSurface", "Timestep",
+            "WindowMaterial:SimpleGlazingSystem", "Site:GroundTemperature:BuildingSurface",
+            "Site:GroundTemperature:Deep", "Timestep",
             "InternalMass", "SurfaceConvectionAlgorithm:Inside", "SurfaceConvectionAlgorithm:Outside") + SURFACES + tuple(SIMPLE_SURFACES) + SUBSURFACES + GAINS + FLOWS + SCHEDULES)
 # Objects about the run and its reports, not the building
 NOT_PHYSICS = ("Output", "OutputControl", "LifeCycleCost", "Meter", "RunPeriod", "SimulationControl", "Sizing:Parameters",
@@ -222,9 +227,17 @@ class _Converter:
         else:
             tz = f"{'+' if zone_h >= 0 else '-'}{hours:02d}:{minutes:02d}"
         altitude = self.r.number(loc, "elevation", default=0.0, low=-300, high=8000)
-        return {"latitude": self.r.number(loc, "latitude", low=-90, high=90),
+        site = {"latitude": self.r.number(loc, "latitude", low=-90, high=90),
                 "longitude": self.r.number(loc, "longitude", low=-180, high=180),
                 "altitude": altitude, "timezone": tz, "air_density": round(air_density_at(altitude), 5)}
+        # the deep ground's months average to the temperature a diagnosis holds a ground
+        # coupling's at where the data fix its flux only (docs/model.md section 7, Priors)
+        deep = self.r.all("Site:GroundTemperature:Deep")
+        if deep:
+            site["ground_temperature"] = float(np.mean(
+                [self.r.number(deep[0], f"{m}_deep_ground_temperature", default=DEFAULT_DEEP_GROUND, low=-60, high=60)
+                 for m in MONTHS]))
+        return site
 
     def geometry_rules(self):
         rules = self.r.all("GlobalGeometryRules")
@@ -323,10 +336,8 @@ class _Converter:
         if "ground temperature" in self.schedules:
             return "ground temperature"
         objs = self.r.all("Site:GroundTemperature:BuildingSurface")
-        months = ("january", "february", "march", "april", "may", "june", "july", "august", "september",
-                  "october", "november", "december")
         if objs:
-            temps = [self.r.number(objs[0], f"{m}_ground_temperature", default=DEFAULT_GROUND) for m in months]
+            temps = [self.r.number(objs[0], f"{m}_ground_temperature", default=DEFAULT_GROUND) for m in MONTHS]
         else:
             temps = [DEFAULT_GROUND] * 12
             self.notes.append(f"no Site:GroundTemperature:BuildingSurface: the ground is at EnergyPlus's default "
@@ -337,8 +348,8 @@ class _Converter:
             self.schedules["ground temperature"] = {"constant": temps[0]}
         else:
             self.schedules["ground temperature"] = {
-                "days": {m: [[24, t]] for m, t in zip(months, temps)},
-                "periods": [{"through": e, "week": [m] * 7} for m, e in zip(months, ends)]}
+                "days": {m: [[24, t]] for m, t in zip(MONTHS, temps)},
+                "periods": [{"through": e, "week": [m] * 7} for m, e in zip(MONTHS, ends)]}
         return "ground temperature"
 
     # ---- constructions -----------------------------------------------------------------

@@ -545,3 +545,16 @@ def test_the_same_model_in_energyplus_25_converts_the_same(tmp_path, three_zones
             z0.name, z0.volume, z0.air_change_rate, z0.gains, z0.ventilation)
     assert [(c.name, c.area, c.azimuth) for c in later.components] == [
         (c.name, c.area, c.azimuth) for c in three_zones.components]
+
+
+def test_the_deep_ground_temperature_of_the_idf_is_the_sites_ground_temperature(tmp_path):
+    """Site:GroundTemperature:Deep's twelve months average to the site's `ground_temperature` (the
+    prior a diagnosis holds a ground coupling's temperature at); a month left blank is EnergyPlus's
+    16 C; without the object the site declares none."""
+    assert "ground_temperature" not in convert_idf(CASE600).site
+    months = [8.0, 8.5, 10.0, 12.0, 14.0, 16.0, 17.5, 17.0, 15.0, 13.0, 10.5]  # December left blank
+    path = tmp_path / "deep.idf"
+    path.write_text(CASE600.read_text() + "\nSite:GroundTemperature:Deep,\n"
+                    + "".join(f"  {t},\n" for t in months) + "  ;\n")
+    site = convert_idf(path).site
+    assert site["ground_temperature"] == pytest.approx((sum(months) + 16.0) / 12, abs=1e-12)
