@@ -155,7 +155,7 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None):
     steps = np.concatenate(steps)
     fit = solve(residuals, x0, lows, highs)
     cov = parameter_covariance(fit.jac, fit.fun, steps, lags)
-    priors = wanted_priors(candidate, cases, fit, cov)
+    priors = wanted_priors(candidate, cases, identified(candidate, fit, cov))
     if priors:
         held = solve(residuals, x0, lows, highs, {i: prior.value for i, prior in priors.items()})
         statistic = score_statistic(held, list(priors), residuals, candidate.bounds, steps, lags)
@@ -169,8 +169,9 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None):
             priors = {}
     std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     result = {}
-    for i, (p, value, sd, bound) in enumerate(zip(candidate.parameters, fit.x, std, fit.active_mask)):
-        identifiable = bool(POLICY.identifiable(value, sd, p.unit) and bound == 0 and i not in priors)
+    for i, (p, value, sd, bound, fixed) in enumerate(zip(candidate.parameters, fit.x, std, fit.active_mask,
+                                                         identified(candidate, fit, cov))):
+        identifiable = bool(fixed and i not in priors)
         if not identifiable and i not in priors:
             log.info("%s: %s = %.4g +- %.2g %s is not identifiable from these data%s", candidate.label,
                      p.name, value, sd, p.unit, " (it ended on a bound)" if bound else "")
@@ -210,9 +211,17 @@ def solve(residuals, x0, lows, highs, held=None):
     return SimpleNamespace(x=full(fit.x), fun=fit.fun, jac=jac, active_mask=active)
 
 
-def wanted_priors(candidate, cases, fit, cov):
-    """{index: model.effects.Prior} of the parameters the fit leaves free (not identifiable, or
-    on a bound) that physics has a prior for inside their range, where another parameter is
+def identified(candidate, fit, cov):
+    """Per parameter, whether the data fix it: its estimate tight enough to act on
+    (`Policy.identifiable`, sd from `cov`) and not on a bound."""
+    std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    return [bool(POLICY.identifiable(value, sd, p.unit) and bound == 0)
+            for p, value, sd, bound in zip(candidate.parameters, fit.x, std, fit.active_mask)]
+
+
+def wanted_priors(candidate, cases, fixed):
+    """{index: model.effects.Prior} of the parameters the fit leaves free (`fixed`, per parameter:
+    `identified`) that physics has a prior for inside their range, where another parameter is
     left: a ground coupling's T_ground, the flux fixed and U fitted to it. The prior reads the
     outdoor air of the weather the `cases` hold, their history included."""
     effect = EFFECTS[candidate.effect]
@@ -220,10 +229,8 @@ def wanted_priors(candidate, cases, fit, cov):
         return {}
     outdoor = np.concatenate([case.U[:, case.input_names.index("T_out")] for case in cases])
     priors = effect.priors(candidate.building, candidate.target, outdoor)
-    std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     return {i: priors[p.name] for i, (p, (low, high)) in enumerate(zip(candidate.parameters, candidate.bounds))
-            if p.name in priors and low <= priors[p.name].value <= high
-            and not (POLICY.identifiable(fit.x[i], std[i], p.unit) and fit.active_mask[i] == 0)}
+            if p.name in priors and low <= priors[p.name].value <= high and not fixed[i]}
 
 
 def score_statistic(held, indices, residuals, bounds, steps, lags):
@@ -236,8 +243,7 @@ def score_statistic(held, indices, residuals, bounds, steps, lags):
     Jacobian columns, which the held fit did not need, are differences of `STEP` of their ranges."""
     jac = held.jac.copy()
     for i in indices:
-        low, high = bounds[i]
-        h = STEP * (high - low) if held.x[i] + STEP * (high - low) <= high else -STEP * (high - low)
+        h = step_inside(held.x[i], *bounds[i])
         moved = held.x.copy()
         moved[i] += h
         jac[:, i] = (residuals(moved) - held.fun) / h
@@ -365,6 +371,12 @@ def within_ranges(cov, bounds):
     return np.outer(scale, scale) * ((vectors * (values / (1.0 + values))) @ vectors.T)
 
 
+def step_inside(value, low, high):
+    """A difference step of `STEP` of the range (low, high), away from `value` into the range."""
+    h = STEP * (high - low)
+    return h if value + h <= high else -h
+
+
 def gradient(f, x, bounds):
     """f(x) and its gradient over the parameters (units of f per unit of each), by differences of
     STEP of each parameter's range, taken inside the `bounds`."""
@@ -372,8 +384,7 @@ def gradient(f, x, bounds):
     at = f(x)
     slope = np.zeros(len(x))
     for j, (low, high) in enumerate(bounds):
-        h = STEP * (high - low)
-        h = h if x[j] + h <= high else -h
+        h = step_inside(x[j], low, high)
         moved = x.copy()
         moved[j] += h
         change = f(moved) - at
