@@ -131,10 +131,17 @@ def read_case(building, weather, measurements=None, *, burn_in_days=0, decomposi
     (Building, Case)
         The case's `assumptions` say what was assumed about the files (the weather's history).
     """
+    building, read_from = _read(building, weather, measurements, burn_in_days, decomposition, history_days)
+    return building, measured_case(building, **read_from)
+
+
+def _read(building, weather, measurements, burn_in_days, decomposition, history_days):
+    """The building (read, unless given read) and the other arguments of `measured_case`, its
+    files read: what `read_case` makes a case of, and what a `Record` keeps (`read_from`)."""
     building = building if isinstance(building, Building) else load_building(building)
-    case = measured_case(building, read_weather(weather), read_measurements(measurements) if measurements else None,
-                         burn_in_days, decomposition, history_days)
-    return building, case
+    return building, {"weather": read_weather(weather),
+                      "measurements": read_measurements(measurements) if measurements else None,
+                      "burn_in_days": burn_in_days, "decomposition": decomposition, "history_days": history_days}
 
 
 def read_record(building, weather, measurements, *, name=None, fraction=0.6, calibration_end=None, phases=None,
@@ -164,9 +171,7 @@ def read_record(building, weather, measurements, *, name=None, fraction=0.6, cal
         Its `read_from` keeps the files as read, from which `diagnose` prepares a later record's
         case for the building as corrected.
     """
-    building = building if isinstance(building, Building) else load_building(building)
-    read_from = {"weather": read_weather(weather), "measurements": read_measurements(measurements),
-                 "burn_in_days": burn_in_days, "decomposition": decomposition, "history_days": history_days}
+    building, read_from = _read(building, weather, measurements, burn_in_days, decomposition, history_days)
     return Record(measured_case(building, **read_from), str(measurements),
                   name or Path(measurements).name.split(".")[0], fraction, calibration_end,
                   tuple(read_phases(phases)) if phases else (), building, read_from)
