@@ -46,7 +46,7 @@ from tqdm import tqdm  # noqa: E402
 
 from benchmarks.baseline import baseline  # noqa: E402
 from benchmarks.catalogue import PLAN, SCENARIOS, SPECS, SPECS_BY_NAME, quick_specs  # noqa: E402
-from benchmarks.records import later_record, record  # noqa: E402
+from benchmarks.records import later_record, later_spec, record  # noqa: E402
 from nodeforce.model.case import HISTORY_DAYS  # noqa: E402
 
 OUT = ROOT / "out" / "bench_diagnosis"
@@ -99,6 +99,7 @@ def diagnose_one(task):
     try:
         r = record(name, draw)
         case = r.case(history_days)
+        later = later_of(r, history_days)
         generated = time.time() - started
         t = time.time()
         # the loop's own lines (its findings, the candidates' fits) would bury the progress bar
@@ -106,10 +107,9 @@ def diagnose_one(task):
                 contextlib.redirect_stderr(io.StringIO()):
             report = api.diagnose(r.building, case, tmp, objective=api.objective(r.building, r.zones), workers=1,
                                   population=population, generations=generations, noise=r.spec.noise,
-                                  seed=0).to_json()
-            corrected = api.read_building(Path(tmp) / "building_after.json")
+                                  seed=0, later=[later]).to_json()
         seconds = time.time() - t
-        later = carried(r, corrected, history_days)
+        scored, = report["later"]
         base = baseline(r.building, case.with_steady_start(), r.zones)
         hlc = report.get("heat_loss_coefficient") or {}
         result = {
@@ -124,24 +124,24 @@ def diagnose_one(task):
                      "rounds": [rounded(d) for d in report.get("decision", {}).get("rounds", [])]},
             "baseline": {k: base[k] for k in ("effect", "target", "values", "delta_bic", "validation_rmse",
                                               "candidates", "seconds")},
-            "hlc_truth": r.hlc_truth, "hlc_file": r.hlc_file, "generation_seconds": generated, "later": later,
+            "hlc_truth": r.hlc_truth, "hlc_file": r.hlc_file, "generation_seconds": generated,
+            "later": {"start": later_spec(r.spec).start,
+                      "written": scored["before"]["rmse"], "corrected": scored["after"]["rmse"]},
         }
     except Exception as error:  # a record that fails is reported, not cached: a rerun tries it again
         return failed(task, error)
     return result
 
 
-def carried(r, corrected, history_days):
-    """The file as written and as corrected (`corrected`, building_after.json) scored on the record's
-    later record (`records.later_record`), which no choice read: {"start" (month-day), "written",
-    "corrected"} RMSE (C) of the objective air over it, as `nodeforce compare` gives them."""
+def later_of(r, history_days):
+    """The record's later record (`records.later_record`) as the diagnosis reads one (`api.Record`,
+    `later=`): no fit or choice reads it; the diagnosis scores the file as written and as
+    corrected on it, as `nodeforce compare` does."""
     from nodeforce import api
     later = later_record(r)
-    objective = api.objective(r.building, r.zones)
-    result = api.compare([(name, b, later.case(history_days, building=b), objective)
-                          for name, b in (("written", r.building), ("corrected", corrected))])
-    written, fixed = (m["metrics"]["rmse"] for m in result["models"])
-    return {"start": later.spec.start, "written": written, "corrected": fixed}
+    read_from = {"weather": later.weather, "measurements": later.measurements, "burn_in_days": later.spec.burn_in,
+                 "history_days": history_days}
+    return api.Record(later.case(history_days), later.spec.name, later.spec.name, read_from=read_from)
 
 
 def held(r):
