@@ -1,25 +1,42 @@
 """The catalogue of the benchmark's records: its scenarios (a building under a climate, measured
 for some days by some sensors), its faults, and which of them each scenario carries (`PLAN`),
 each record a `Spec` named `<scenario>/<fault>-<size>`."""
-from dataclasses import dataclass, field, fields
+import dataclasses
+from dataclasses import dataclass, fields
 
 BURN_IN_DAYS = 1  # the diagnosis' (the command line's default)
 CALIBRATION_FRACTION = 0.6  # the diagnosis' default: the rest validates
 
 
 @dataclass(frozen=True)
-class Spec:
-    """One record: where, when, how measured, and what the file lacks.
+class Fault:
+    """What a record's file lacks: an effect (a registry id, or beyond the catalogue
+    "scheduled_gain": W `full["Q"]` from `full["on"]` to `full["off"]` h local time; "opening":
+    `full["area"]` m2 of glazing on the component `target`, its sun to the floor;
+    "envelope_films": the zone `target`'s envelope materials and outside film coefficients both
+    `full["factor"]` times the file's), its target (a zone, a component, `zone->column`), its
+    parameters at scale 1 (others as declared) and the (effect, target) pairs a right answer may
+    name (default: (effect, target)): look-alikes that are one equation count as one (an air
+    change and a bridge to the outdoor air)."""
+    effect: str
+    target: str
+    full: dict
+    expected: tuple = ()
 
-    effect : a registry id, "none", or beyond the catalogue "scheduled_gain" (W `full["Q"]` from
-        `full["on"]` to `full["off"]` h local time), "opening" (`full["area"]` m2 of glazing
-        on the component `target`, its sun to the floor) or "envelope_films" (the zone `target`'s
-        envelope materials and outside film coefficients both `full["factor"]` times the file's)
-    target : the effect's target (a zone, a component, `zone->column`)
-    full : the effect's parameters at scale 1 (others as declared)
-    expected : (effect, target) pairs a right answer may name (default: (effect, target));
-        look-alikes that are one equation count as one (an air change and a bridge to the outdoor air)
-    """
+    @property
+    def answers(self):
+        """The (effect, target) pairs that name this fault."""
+        return tuple(self.expected) or ((self.effect, self.target),)
+
+    @property
+    def label(self):
+        return f"{self.effect}@{self.target}"
+
+
+@dataclass(frozen=True)
+class Spec:
+    """One record: where, when, how measured, and what the file lacks (`faults`: none, one, or
+    two together, each moved from the file's values towards its `full` by one common scale)."""
     name: str
     building: str  # "testcell" or "twinhouse"
     climate: str
@@ -28,24 +45,24 @@ class Spec:
     step_min: int
     noise: float  # C
     sensors: str  # "paper", "all", "air" (the test cell's air with a PRBS heater) or "own" (the file's sensors)
-    effect: str = "none"
-    target: str = ""
-    full: dict = field(default_factory=dict)
-    size: str = ""  # "subtle", "strong", "" (no effect)
-    expected: tuple = ()
+    faults: tuple = ()  # Fault
+    size: str = ""  # "subtle", "strong", "" (no fault)
     objective: str = ""  # zone whose air is the objective (default the first)
     burn_in: int = BURN_IN_DAYS  # days the diagnosis forces every measured node and scores nothing
     before: float = 14.0  # days of the weather before the record the diagnosis reads (its history)
 
-    def __hash__(self):  # `full` is a dict: the record's name and fields, as printed, identify it
+    def __hash__(self):  # a fault's `full` is a dict: the record's name and fields, as printed, identify it
         return hash(repr(self))
 
     @property
     def answers(self):
-        """The (effect, target) pairs counted right as a first effect; () for a record without fault."""
-        if self.effect == "none":
-            return ()
-        return tuple(self.expected) or ((self.effect, self.target),)
+        """The (effect, target) pairs counted right as a first effect: those of any of its faults."""
+        return tuple(a for f in self.faults for a in f.answers)
+
+    @property
+    def label(self):
+        """"none", or the faults, "effect@target + ..."."""
+        return " + ".join(f.label for f in self.faults) or "none"
 
 @dataclass(frozen=True)
 class Scenario:
@@ -63,17 +80,6 @@ class Scenario:
     objective: str
     burn_in: int
     before: float
-
-
-@dataclass(frozen=True)
-class Fault:
-    """What a record's file lacks: an effect (a registry id, or "scheduled_gain", "opening",
-    "envelope_films"), its target, its parameters at scale 1 (`Spec.full`) and the answers
-    counted right besides it."""
-    effect: str
-    target: str
-    full: dict
-    expected: tuple = ()
 
 
 # -- the benchmark's records ----------------------------------------------------------------
@@ -130,17 +136,21 @@ FAULTS = {  # name: Fault
     "living-mass": Fault("internal_mass", "living", {"C_m": 1.5e6, "H_m": 150.0}, ()),
 }
 GROUND = {"mia-jun": 24.0, "mia-dec": 15.0, "sdp-jul": 5.0}  # C, the ground below the cell, away from its air
-PLAN = {  # scenario: [fault or "none", size "s" subtle / "L" strong]
+# Two faults together (`a+b`): a component whose inside surface a sensor reads and an effect no
+# sensor reads (a component without one, the zone's air), at steps of 10 to 60 min; both must
+# be found.
+PLAN = {  # scenario: [fault, or faults joined by "+", or "none"; size "s" subtle / "L" strong]
     "mia-jun": ["none", "infiltration s", "bridge s", "envelope s", "envelope-films s", "convection s", "door s",
-                "wall s", "ground s", "schedule s", "opening s"],
+                "wall s", "ground s", "schedule s", "opening s", "door+roof-alpha s"],
     # every node measured in winter: the door (1.6 m2) ten times as conductive, or the inside
     # convection a tenth, the most physics allows (`max_scale`), stay subtle here
     "gso-jan": ["none", "infiltration L", "bridge L", "envelope L", "convection s", "door s", "wall L",
                 "roof-alpha s", "window-tau s", "mass s"],
     "sdp-jul": ["none", "ground L", "roof-alpha L", "window-tau L", "gain s", "daily s", "east-sun s",
-                "schedule L", "opening L"],
-    "gso-apr": ["none", "gain L", "daily L", "east-sun L", "mass L", "infiltration s", "envelope s", "convection s"],
-    "mia-dec": ["none", "door s", "wall s", "ground s", "bridge s", "opening s", "schedule s"],
+                "schedule L", "opening L", "door+window-tau L"],
+    "gso-apr": ["none", "gain L", "daily L", "east-sun L", "mass L", "infiltration s", "envelope s", "convection s",
+                "wall+infiltration L"],
+    "mia-dec": ["none", "door s", "wall s", "ground s", "bridge s", "opening s", "schedule s", "door+bridge s"],
     "sdp-feb-air": ["none", "lag s", "split L", "mass s", "envelope L", "envelope-films L", "infiltration L",
                     "convection L", "gain s"],
     "mia-jan-air": ["none", "lag L", "split s", "mass L", "envelope s", "envelope-films s", "schedule L"],
@@ -151,19 +161,19 @@ PLAN = {  # scenario: [fault or "none", size "s" subtle / "L" strong]
 
 
 def make_specs():
-    """Every record of the benchmark, named `<scenario>/<fault>-<size>`."""
+    """Every record of the benchmark, named `<scenario>/<fault>[+<fault>]-<size>`."""
     specs = []
     for scenario, entries in PLAN.items():
         common = {f.name: getattr(SCENARIOS[scenario], f.name) for f in fields(Scenario)}
         for entry in entries:
-            name, _, size = entry.partition(" ")
-            if name == "none":
+            names, _, size = entry.partition(" ")
+            if names == "none":
                 specs.append(Spec(name=f"{scenario}/none", **common))
                 continue
-            fault = FAULTS[name]
-            full = {**fault.full, "T_ground": GROUND[scenario]} if "T_ground" in fault.full else fault.full
-            specs.append(Spec(name=f"{scenario}/{name}-{size}", effect=fault.effect, target=fault.target, full=full,
-                              size={"s": "subtle", "L": "strong"}[size], expected=fault.expected, **common))
+            faults = tuple(dataclasses.replace(FAULTS[n], full={**FAULTS[n].full, "T_ground": GROUND[scenario]})
+                           if "T_ground" in FAULTS[n].full else FAULTS[n] for n in names.split("+"))
+            specs.append(Spec(name=f"{scenario}/{names}-{size}", faults=faults, size={"s": "subtle", "L": "strong"}[size],
+                              **common))
     return specs
 
 SPECS = make_specs()

@@ -14,16 +14,16 @@ The truth is never the diagnosis' own model:
   step's end, which is what a model stepping at the record's step reads: `model.integrate`), so
   both read the same inputs; the diagnosis reads the weather from `Spec.before` days before the
   record, a user's file that starts some days before the measurements, or with them;
-- the fault is an effect the file does not declare, applied to the truth with the registry's own
+- the fault is an effect the file does not declare (or two of them together), applied to the truth with the registry's own
   `apply` (`model.effects.EFFECTS`), or one beyond the catalogue: a gain on a schedule, a gain
   through an opening the file does not have, an envelope whose materials and outside film
   coefficients are both more conductive than declared (the registry's envelope factor scales the
   materials alone);
 - Gaussian noise from a seeded generator, one seed per record and draw.
 
-The size of an effect is tuned by simulating: `subtle` puts the file's validation RMSE (noise
+The size of a fault is tuned by simulating: `subtle` puts the file's validation RMSE (noise
 included) at `SUBTLE` times the noise, `strong` at `STRONG` times, by a secant search on the
-effect's scale (its parameters moved from the declared values towards `full`).
+faults' common scale (their parameters moved from the declared values towards `full`).
 
 `record(name_or_spec, draw)` returns a `Record`: what a test or a script needs to diagnose it and
 to judge the answer; `later_record(record)` the same building with the same fault measured again
@@ -56,8 +56,8 @@ class Record:
     weather: pd.DataFrame  # what the diagnosis reads: 1-min, every column the file names
     measurements: pd.DataFrame  # the record: columns T<id>, the step's grid, noise added
     noiseless: pd.DataFrame  # the same without noise
-    scale: float  # the effect's scale (0: none)
-    values: dict  # the effect's parameters in the truth
+    scale: float  # the faults' common scale (0: none)
+    values: list  # each fault's parameters in the truth, {name: value}
     before_ratio: float  # the file's validation RMSE on the noiseless record, with the noise added in quadrature, / noise
     hlc_truth: float  # W/K, the truth's heat loss coefficient (W/K)
     hlc_file: float
@@ -88,7 +88,7 @@ def _noiseless(spec, scale=None):
     weather0 = read_by_diagnosis(fine0, times, spec.before)
     if scale is None:
         scale, ratio = tuned_scale(spec, building, truth0, fine0, weather0, times, nodes, air)
-    values = at_scale(building, spec, scale) if spec.effect != "none" else {}
+    values = at_scale(building, spec, scale)
     truth, extra = faulty(truth0, spec, values)
     weather = fine_weather(spec, building, times, extra) if extra else fine0
     clean = frame(truth_record(truth, weather, times, nodes), times, nodes, f"{spec.name} (noiseless)")
@@ -99,7 +99,7 @@ def _noiseless(spec, scale=None):
 def record(name_or_spec, draw=0, scale=None):
     """The record `name_or_spec` (a name of `SPECS` or a `Spec`) under noise draw `draw`.
 
-    `scale` fixes the effect's scale (skipping the tuning); None tunes it to the spec's size.
+    `scale` fixes the faults' scale (skipping the tuning); None tunes it to the spec's size.
     The diagnosis reads `building`, `weather` and `measurements`; the truth and the rest judge it.
     """
     spec = name_or_spec if isinstance(name_or_spec, Spec) else SPECS_BY_NAME[name_or_spec]

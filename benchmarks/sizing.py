@@ -30,7 +30,7 @@ def tuned_scale(spec, building, truth0, fine0, weather0, times, nodes, air):
     """The effect's scale whose noiseless validation error e puts sqrt(e^2 + noise^2) at the
     size's ratio to the noise: a secant search on log(e) against log(scale). `fine0`: the truth's
     weather; `weather0`: the part the diagnosis reads."""
-    if spec.effect == "none":
+    if not spec.faults:
         return 0.0, 1.0
     target = SUBTLE if spec.size == "subtle" else STRONG
     band = SUBTLE_BAND if spec.size == "subtle" else STRONG_BAND
@@ -63,26 +63,32 @@ def tuned_scale(spec, building, truth0, fine0, weather0, times, nodes, air):
 
 
 def max_scale(building, spec):
-    """The largest scale keeping every parameter in the effect's range and within its physical
-    limits (`diagnosis.policy.Policy.limits`: a record whose fault no building could have, a door 19
-    times as conductive as its wood, inside convection at a twentieth, tests a refusal, not a
-    diagnosis), and the opening smaller than its wall. A fault that is still not subtle at that
-    scale is as large as physics lets it be: its record says so by its before/noise."""
-    if spec.effect not in EFFECTS:
-        if spec.effect == "opening":
-            return 0.9 * building.component(spec.target).area / spec.full["area"]
-        if spec.effect == "envelope_films":  # the envelope factor's physical limit on the whole path
-            high = POLICY.limits(building, "envelope_conductance", spec.target, "factor")[1]
-            return 0.95 * (high - 1.0) / (spec.full["factor"] - 1.0)
+    """The largest scale keeping every parameter of every fault of the spec in its effect's range
+    and within its physical limits (`diagnosis.policy.Policy.limits`: a record whose fault no
+    building could have, a door 19 times as conductive as its wood, inside convection at a
+    twentieth, tests a refusal, not a diagnosis), and the opening smaller than its wall. A fault
+    that is still not subtle at that scale is as large as physics lets it be: its record says so
+    by its before/noise."""
+    return min(fault_max_scale(building, fault) for fault in spec.faults)
+
+
+def fault_max_scale(building, fault):
+    """`max_scale` of one fault."""
+    if fault.effect not in EFFECTS:
+        if fault.effect == "opening":
+            return 0.9 * building.component(fault.target).area / fault.full["area"]
+        if fault.effect == "envelope_films":  # the envelope factor's physical limit on the whole path
+            high = POLICY.limits(building, "envelope_conductance", fault.target, "factor")[1]
+            return 0.95 * (high - 1.0) / (fault.full["factor"] - 1.0)
         return 20.0
-    effect = EFFECTS[spec.effect]
-    base = neutral(building, spec)
+    effect = EFFECTS[fault.effect]
+    base = neutral(building, fault)
     limit = 20.0
-    for p, (low, high) in zip(effect.parameters, effect.bounds(building, spec.target)):
-        physical = POLICY.limits(building, spec.effect, spec.target, p.name)
+    for p, (low, high) in zip(effect.parameters, effect.bounds(building, fault.target)):
+        physical = POLICY.limits(building, fault.effect, fault.target, p.name)
         low, high = max(low, physical[0]), min(high, physical[1])
-        if p.name in spec.full and p.name != "T_ground":
-            delta = spec.full[p.name] - base[p.name]
+        if p.name in fault.full and p.name != "T_ground":
+            delta = fault.full[p.name] - base[p.name]
             if delta > 0:
                 limit = min(limit, (high - base[p.name]) / delta)
             elif delta < 0:

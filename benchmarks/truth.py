@@ -62,31 +62,42 @@ def file_building(spec):
 BEYOND_NEUTRAL = {"Q": 0.0, "area": 0.0, "factor": 1.0}
 
 
-def neutral(building, spec):
-    """The effect's parameters as the file declares them."""
-    if spec.effect in EFFECTS:
-        return EFFECTS[spec.effect].read(building, spec.target)
-    return {name: BEYOND_NEUTRAL[name] for name in spec.full if name in BEYOND_NEUTRAL}
+def neutral(building, fault):
+    """The fault's parameters as the file declares them."""
+    if fault.effect in EFFECTS:
+        return EFFECTS[fault.effect].read(building, fault.target)
+    return {name: BEYOND_NEUTRAL[name] for name in fault.full if name in BEYOND_NEUTRAL}
 
 
 def at_scale(building, spec, scale):
-    """{parameter: value} of the effect at `scale` (0: as declared, 1: `spec.full`)."""
-    base = neutral(building, spec)
-    values = dict(spec.full)
-    for name, full in spec.full.items():
-        if name in base and name not in ("T_ground", "on", "off"):
-            values[name] = base[name] + scale * (full - base[name])
-    return values
+    """[{parameter: value}] of each of the spec's faults at `scale` (0: as declared, 1: its `full`)."""
+    out = []
+    for fault in spec.faults:
+        base = neutral(building, fault)
+        values = dict(fault.full)
+        for name, full in fault.full.items():
+            if name in base and name not in ("T_ground", "on", "off"):
+                values[name] = base[name] + scale * (full - base[name])
+        out.append(values)
+    return out
 
 
 def faulty(truth, spec, values):
-    """(truth building with the fault, extra weather columns it reads {name: callable(times)})."""
-    if spec.effect == "none":
-        return truth, {}
-    if spec.effect in EFFECTS:
-        return EFFECTS[spec.effect].apply(truth, spec.target, values), {}
-    zone = spec.objective or truth.zones[0].name
-    if spec.effect == "scheduled_gain":
+    """(truth building with the spec's faults at `values` (`at_scale`), extra weather columns it
+    reads {name: callable(times)})."""
+    extra = {}
+    for fault, v in zip(spec.faults, values):
+        truth, more = with_fault(truth, fault, v, spec.objective or truth.zones[0].name)
+        extra.update(more)
+    return truth, extra
+
+
+def with_fault(truth, fault, values, zone):
+    """(truth with one fault at `values`, extra weather columns it reads); a scheduled gain goes
+    to `zone`."""
+    if fault.effect in EFFECTS:
+        return EFFECTS[fault.effect].apply(truth, fault.target, values), {}
+    if fault.effect == "scheduled_gain":
         def schedule(times, tz=truth.site["timezone"]):
             local = times.tz_convert(tz)
             hour = local.hour + local.minute / 60
@@ -97,11 +108,11 @@ def faulty(truth, spec, values):
             inputs = z.get("heat_input") or []
             z["heat_input"] = [*([inputs] if isinstance(inputs, str) else inputs), "Q_schedule"]
         return truth.edited(add), {"Q_schedule": schedule}
-    if spec.effect == "opening":
-        return opened(truth, spec.target, values["area"]), {}
-    if spec.effect == "envelope_films":
-        return with_envelope_films(truth, spec.target, values["factor"]), {}
-    raise ValueError(f"unknown effect {spec.effect!r}")
+    if fault.effect == "opening":
+        return opened(truth, fault.target, values["area"]), {}
+    if fault.effect == "envelope_films":
+        return with_envelope_films(truth, fault.target, values["factor"]), {}
+    raise ValueError(f"unknown effect {fault.effect!r}")
 
 
 def opened(building, wall, area):
