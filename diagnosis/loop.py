@@ -19,7 +19,8 @@ on data the calibration did not see.
    statistics point at too (`diagnosis.candidates.shapes`). One rule chooses
    (`diagnosis.selection.decide`: blocked cross-validation, the one-standard-error rule, the
    objections of physics), against the model the earlier rounds made. Rounds go on while the
-   error left is above the noise and a candidate passes. The validation window plays no part in
+   error left is above the noise, at the air or at a component's own sensors (a second fault
+   the air no longer points at), and a candidate passes. The validation window plays no part in
    any choice: its before and after are an honest estimate. The decision of every round, its
    margins, its cost and its reason go into report.json, which the report reads.
 5. The chosen model is built as an FMU and written (`model_after.fmu`, `building_after.json`);
@@ -34,6 +35,7 @@ on data the calibration did not see.
    correction holds beyond the records it was fitted and chosen on.
 """
 import json
+import math
 import os
 import sys
 import time
@@ -56,7 +58,8 @@ from nodeforce.diagnosis.report import write_report
 from nodeforce.diagnosis.phases import phase_errors, worsened
 from nodeforce.diagnosis.residuals import diagnostics as residual_diagnostics
 from nodeforce.diagnosis.policy import POLICY
-from nodeforce.diagnosis.result import CrossValidation, Diagnosis, Fit, LaterRecord, RecordOutcome, SensorEvidence
+from nodeforce.diagnosis.result import (CrossValidation, Diagnosis, Fit, LaterRecord, OwnSensors, RecordOutcome,
+                                        SensorEvidence)
 from nodeforce.diagnosis.selection import block_J, blocks as blocks_of, decide, on_block
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.iotools.energyplus_corrections import idf_of, write_corrections
@@ -175,6 +178,7 @@ class Windows:
     sensors: list
     sensed: list
     numerical: list = None
+    sensor_numerical: list = None
 
     @classmethod
     def of(cls, records, objective):
@@ -231,35 +235,89 @@ class Windows:
                 int(sum(np.isfinite(r).sum() for r, _ in parts)),
                 float(sum((np.isfinite(r) * w ** 2).sum() for r, w in parts)))
 
-    def sensor_weights(self, building, bases, sigma):
-        """Per record, each other sensor's weight in the choice: sigma^2 over its mean squared
-        residual under the model the candidates are added to (`building`, or the record's
-        protocol's in `bases`), over the calibration window (`Policy.sensor_weight`).
-
-        A sensor the model follows to the noise counts fully. One it misses by far more (a real
-        house's surface the model sees through a simplified wall, a heavy wall still carrying the
-        start the model does not know) counts as a measurement whose error is that misfit: its
-        residual is mostly what no candidate is about, and unweighted it would choose, among the
-        explanations of the air, the one that mends it (on the real Twin House, a west-sun gain
-        in the living room whose validation error doubled)."""
+    def sensed_by(self, model):
+        """Per record, `model`'s temperatures (C, (N_t, len(sensors))) at the other sensed nodes,
+        under the record's protocol's building (`Model.bases`)."""
         out = []
-        for i, (case, ids) in enumerate(zip(self.cases, self.sensors)):
+        for case, ids, base in zip(self.cases, self.sensors, model.bases):
+            building = base or model.building
+            out.append(case.with_inputs(building).run(building)[:, np.asarray(ids, dtype=int) - 1] if ids
+                       else np.empty((len(case.times) - 1, 0)))
+        return out
+
+    def sensor_weights(self, runs, sigma):
+        """Per record, each other sensor's weight in the choice: sigma^2 over the least mean
+        squared residual (over the calibration window) that any of `runs` leaves there
+        (`Policy.sensor_weight`); `runs`: the model's and each candidate's other sensed nodes
+        (`sensed_by`, `Assessed.sensed`), one (N_t, len(sensors)) per record each.
+
+        A sensor the model follows to the noise counts fully. One that every candidate misses
+        by far more (a real house's surface the model sees through a simplified wall, a heavy
+        wall still carrying the start the model does not know) counts as a measurement whose
+        error is that misfit: its residual is what no candidate is about, and unweighted it
+        would choose, among the explanations of the air, the one that mends it best (on the
+        real Twin House, a west-sun gain in the living room whose validation error doubled).
+        A sensor that a candidate mends counts as its noise: a component's own surface, which
+        disagrees with the model as written because that component is wrong, is the evidence
+        that places the fault there, not a misfit to discount."""
+        out = []
+        for i, ids in enumerate(self.sensors):
+            k = self.ks[i]
             if not ids:
                 out.append(np.zeros(0))
                 continue
-            model = bases[i] or building
-            T = case.with_inputs(model).run(model)[:, np.asarray(ids) - 1]
-            misfit = np.nanmean(np.square(self.sensed[i][:self.ks[i]] - T[:self.ks[i]]), axis=0)
+            misfit = np.min([np.nanmean(np.square(self.sensed[i][:k] - run[i][:k]), axis=0) for run in runs], axis=0)
             out.append(POLICY.sensor_weight(sigma, np.maximum(misfit, np.finfo(float).tiny)))
         return out
 
-    def with_numerical(self, runs, building, bases, objective):
+    def own_columns(self, nodes):
+        """Per record, the columns of its other sensors (`sensors`) that are among `nodes` (ids):
+        a component's own sensors."""
+        return [[j for j, node in enumerate(ids) if node in nodes] for ids in self.sensors]
+
+    def own_J(self, sensed, columns):
+        """J (C2) of the other sensors' `columns` (`own_columns`) on every block, the records' in
+        order, unweighted, for the runs `sensed` (one (N_t, len(sensors)) per record); and the
+        readings they score."""
+        parts = [(self.sensed[i][:self.ks[i]] - sensed[i][:self.ks[i]])[m][:, columns[i]] for i, m in self.blocks]
+        return (np.array([float(np.nansum(np.square(r))) for r in parts]),
+                int(sum(np.isfinite(r).sum() for r in parts)))
+
+    def own_numerical(self, columns):
+        """The root mean square (C) of the file's own numerical error (`sensor_numerical`) at the
+        sensors' `columns` (one list per record), over the calibration window's scored readings."""
+        errors = [e[:k][:, c][np.isfinite(m[:k][:, c])] for e, k, m, c in
+                  zip(self.sensor_numerical or [], self.ks, self.sensed, columns)]
+        squares = np.concatenate(errors) ** 2 if errors else np.zeros(0)
+        return math.sqrt(float(squares.mean())) if squares.size else 0.0
+
+    def disagreeing(self, building, sensed, sigma):
+        """The components whose own sensors the model (its other sensed nodes `sensed`, one per
+        record) misses by more than the noise and the file's numerical error there could
+        (`Policy.at_noise` on their J over the blocks): a component the air may no longer point
+        at, whose own surface still says it is wrong."""
+        out = []
+        for c in building.components:
+            columns = self.own_columns(set(c.node_ids))
+            if not any(columns):
+                continue
+            J, n = self.own_J(sensed, columns)
+            if n and not POLICY.at_noise(float(J.sum()), n, math.hypot(sigma, self.own_numerical(columns))):
+                out.append(c.name)
+        return out
+
+    def with_numerical(self, runs, sensed, building, bases, objective):
         """The windows with the building file's own numerical error at the objective air (C, one
-        (N_t, zones) per record): the file's objective air as run (`runs`, under the record's
-        protocol's building in `bases`, else `building`) minus the file refined
-        (`model.numerical.reference`)."""
-        return replace(self, numerical=[run - reference(case, base or building, objective.air_nodes)
-                                        for run, case, base in zip(runs, self.cases, bases)])
+        (N_t, zones) per record) and at the other sensors (`sensor_numerical`, one (N_t,
+        len(sensors)) per record): the file as run (`runs` at the air, `sensed` at the sensors,
+        under the record's protocol's building in `bases`, else `building`) minus the file
+        refined (`model.numerical.reference`)."""
+        numerical, at_sensors = [], []
+        for run, at, case, base, ids in zip(runs, sensed, self.cases, bases, self.sensors):
+            fine = reference(case, base or building, list(objective.air_nodes) + list(ids))
+            numerical.append(run - fine[:, :len(objective.air_nodes)])
+            at_sensors.append(at - fine[:, len(objective.air_nodes):])
+        return replace(self, numerical=numerical, sensor_numerical=at_sensors)
 
     def numerical_rms(self):
         """The root mean square (C) of the file's numerical error over the residuals the blocks score."""
@@ -297,15 +355,12 @@ class Model:
                      [None if b is None else EFFECTS[effect].apply(b, target, values) for b in self.bases])
 
 
-def assess_all(model, pairs, windows, objective, folder, seed, workers, weights, number=1, on_top_of=(),
-               cluster=None):
+def assess_all(model, pairs, windows, objective, folder, seed, workers, cluster=None):
     """Each (effect, target) added to `model`, calibrated on every record's calibration window
     (t_0..t_k) with a fold per block, and run over each record, in parallel worker processes
     (which end with this process: nodeforce.lifetime), or on the workers of `cluster` (a
-    `nodeforce.cluster.Cluster`), each candidate's building file written in `folder`: the
-    candidates' `Fit`s, their `Model`s by label, and the simulations they took. `weights`: each
-    record's other sensors' weights in the choice (`Windows.sensor_weights`); `number`: the round;
-    `on_top_of`: the labels of the effects `model` holds."""
+    `nodeforce.cluster.Cluster`), each candidate's building file written in `folder`: their
+    `Assessed`, in the order of `pairs`."""
     shared = (model.building, model.bases, windows.calibrations, windows.cases, objective, windows.blocks,
               windows.sensors, windows.calibration_numerical(), seed)
     with tqdm(total=len(pairs), desc="calibrating candidate effects", unit="candidate",
@@ -324,24 +379,48 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers, weights,
                     bar.update()
     for (effect, target), a in zip(pairs, assessed):
         (folder / f"{effect}@{target}.json").write_text(json.dumps(a.building, indent=2) + "\n")
+    return list(assessed)
+
+
+def fits_of(model, pairs, assessed, windows, objective, sigma, number=1, on_top_of=()):
+    """The candidates' `Fit`s and their `Model`s by label, from their `Assessed`: what each
+    predicts of the air left out and of the other sensors over the blocks, each sensor weighted
+    by the least misfit the model or any of these candidates leaves there
+    (`Windows.sensor_weights`), and of its own component's sensors (`OwnSensors`); `sigma`: the
+    air sensors' noise (C); `number`: the round; `on_top_of`: the labels of the effects `model`
+    holds."""
     n = windows.scored()
     sensed = {i for ids in windows.sensors for i in ids}
-    results, models, simulations = [], {}, 0
+    base = windows.sensed_by(model)
+    weights = windows.sensor_weights([base] + [a.sensed for a in assessed], sigma)
+    results, models = [], {}
     for (effect, target), a in zip(pairs, assessed):
         metrics = windows.metrics(objective, a.runs)
         sensor_blocks, sensor_residuals, readings, counted = windows.sensor_scores(a.sensed, weights)
-        fit = Fit(effect, target, a.parameters, a.determined, POLICY.facts(model.building, effect, target, sensed),
+        physics = POLICY.facts(model.building, effect, target, sensed)
+        fit = Fit(effect, target, a.parameters, a.determined, physics,
                   CrossValidation([float(np.nansum(np.square(f["residuals"]))) for f in a.folds], n,
                                   [f["values"] for f in a.folds],
                                   # each block's left-out residuals, in one order for every candidate
                                   np.concatenate([f["residuals"][np.isfinite(f["residuals"])] for f in a.folds])),
                   # the other sensors over the blocks, which no fit read
-                  SensorEvidence([float(v) for v in sensor_blocks], readings, counted, sensor_residuals),
+                  SensorEvidence([float(v) for v in sensor_blocks], readings, counted, sensor_residuals,
+                                 own_sensors(model.building, target, windows, base, a.sensed)
+                                 if physics["sensed"] else None),
                   metrics, number, tuple(on_top_of))
         models[fit.label] = model.adding(effect, target, fit.values, a.runs, metrics)
         results.append(fit)
-        simulations += a.simulations
-    return results, models, simulations
+    return results, models
+
+
+def own_sensors(building, component, windows, base, sensed):
+    """`OwnSensors` of a candidate on `component`: its own sensors' J (C2) per block under the
+    model (its other sensed nodes `base`) and under the candidate (`sensed`), unweighted, and
+    the file's numerical error there (`Windows.own_numerical`)."""
+    columns = windows.own_columns(set(building.component(component).node_ids))
+    before, n = windows.own_J(base, columns)
+    after, _ = windows.own_J(sensed, columns)
+    return OwnSensors([float(v) for v in before], [float(v) for v in after], n, windows.own_numerical(columns))
 
 
 def diagnose(building, records, objective, workdir, *, source="measurements", fraction=0.6, calibration_end=None,
@@ -439,7 +518,7 @@ def prepare(building, records, objective, workdir, fmu_kind, noise):
         with FmuInstance(build_fmu(base or building, workdir / name, kind=fmu_kind)) as fmu:
             before_runs.append(simulate_fmu(fmu, case, output_ids=objective.air_nodes))
     model = Model(building, before_runs, windows.metrics(objective, before_runs), bases)
-    windows = windows.with_numerical(before_runs, building, bases, objective)
+    windows = windows.with_numerical(before_runs, windows.sensed_by(model), building, bases, objective)
     noise = Noise.of_records(windows.measured, noise).with_numerical(windows.numerical_rms())
     return Prepared(list(records), windows, bases, model, noise, windows.scored())
 
@@ -473,28 +552,29 @@ def rounds(prepared, localization, objective, workdir, seed, workers, cluster=No
     model, decisions, results, runs, sensitivities = prepared.model, [], [], {}, {}
     for number in range(POLICY.max_rounds):
         base_blocks = windows.block_J(model.runs)
-        if number and POLICY.at_noise(base_blocks.sum(), n, noise.floor_sd):
-            break  # the error left is the noise's
+        if number and POLICY.at_noise(base_blocks.sum(), n, noise.floor_sd) and \
+                not windows.disagreeing(model.building, windows.sensed_by(model), noise.sigma):
+            break  # the error left is the noise's, at the air and at every component's own sensors
         done = [d.chosen.label for d in decisions]  # every earlier round chose: a round without a choice ends them
         started = time.perf_counter()
         # a later round's candidates, on top of the earlier choices, are building files of their own
         into = folder / f"round{number + 1}" if number else folder
         into.mkdir(exist_ok=True)
-        weights = windows.sensor_weights(model.building, model.bases, noise.sigma)
         pairs = [p for p in physical(model.building, localization["components"], objective.zones,
                                      measured_ids, localization["best_nodes"]) if "@".join(p) not in done]
-        tried, models, simulations = assess_all(model, pairs, windows, objective, into, seed, workers, weights,
-                                                number + 1, done, cluster)
+        assessed = assess_all(model, pairs, windows, objective, into, seed, workers, cluster)
+        tried, models = fits_of(model, pairs, assessed, windows, objective, noise.sigma, number + 1, done)
         # shapes only where no physical candidate physics admits brings the error left to the
         # noise; the residual's statistics then choose which
         if not any(POLICY.at_noise(r.cv.J, n, noise.floor_sd) and not POLICY.objection_of(
                 r.effect, r.parameters, r.derived, r.physics) for r in tried):
-            pairs = [p for p in shapes(model.building, left_by(windows, model), objective.zones)
-                     if "@".join(p) not in done]
-            more, more_models, more_simulations = assess_all(model, pairs, windows, objective, into, seed, workers,
-                                                             weights, number + 1, done, cluster)
-            tried, simulations = tried + more, simulations + more_simulations
-            models.update(more_models)
+            more = [p for p in shapes(model.building, left_by(windows, model), objective.zones)
+                    if "@".join(p) not in done]
+            pairs, assessed = pairs + more, assessed + assess_all(model, more, windows, objective, into, seed,
+                                                                  workers, cluster)
+            # every sensor's weight from the least misfit any candidate of the round leaves
+            tried, models = fits_of(model, pairs, assessed, windows, objective, noise.sigma, number + 1, done)
+        simulations = sum(a.simulations for a in assessed)
         decision = decide(tried, base_blocks, noise.sigma, n, windows.groups(), noise.floor_sd)
         decision.cost = {"candidates": len(tried), "simulations": simulations,
                          "seconds": round(time.perf_counter() - started, 1)}

@@ -18,8 +18,9 @@ The choice of a round, in order (docs/method.md, "Choosing an effect"; `diagnosi
    before a shape (`shapes`), fewer parameters before more, a zone's effect before that of one
    component no sensor of which is measured; then the lower evidence.
 
-Rounds go on, `max_rounds` at most, while the error left is above the noise (`at_noise`) and a
-candidate passes. The yardsticks say their units: `noise_J` and `noise_change` are J (C2);
+Rounds go on, `max_rounds` at most, while the error left is above the noise (`at_noise`), at
+the objective air or at a component's own sensors (the noise and the file's numerical error
+there), and a candidate passes. The yardsticks say their units: `noise_J` and `noise_change` are J (C2);
 the sd they are computed from (`model.score.Noise.floor_sd`) is in C.
 """
 import math

@@ -49,15 +49,32 @@ class CrossValidation:
 
 
 @dataclass
+class OwnSensors:
+    """A component candidate's own sensors (the nodes of its component that are measured): their
+    J (C2) per block under the model it would be added to (`before`) and under the candidate
+    (`after`), unweighted, the readings (`n`), and the root mean square (C) of the file's own
+    numerical error there (`numerical`), which with the noise is what a right model leaves."""
+    before: list
+    after: list
+    n: int
+    numerical: float
+
+    def to_json(self):
+        return asdict(self)
+
+
+@dataclass
 class SensorEvidence:
     """What a candidate fitted to the air alone predicts of the other sensors (a wall's surface, a
     neighbouring zone's air) over the blocks: their weighted J (C2) per block, the readings (`n`),
-    what the noise counts of them (`n_weighted`, sum of the squared weights), and the weighted
-    residuals (C, None when read back from report.json)."""
+    what the noise counts of them (`n_weighted`, sum of the squared weights), the weighted
+    residuals (C, None when read back from report.json), and for a component's candidate, its
+    own sensors (`OwnSensors`, None for another)."""
     blocks: list = field(default_factory=list)
     n: int = 0
     n_weighted: float = 0.0
     residuals: np.ndarray = None
+    own: OwnSensors = None
 
     @property
     def J(self):
@@ -65,11 +82,12 @@ class SensorEvidence:
         return float(np.sum(self.blocks))
 
     def to_json(self):
-        return {"blocks": [float(b) for b in self.blocks], "J": self.J, "n": self.n, "n_weighted": self.n_weighted}
+        return {"blocks": [float(b) for b in self.blocks], "J": self.J, "n": self.n, "n_weighted": self.n_weighted,
+                **({"own": self.own.to_json()} if self.own else {})}
 
     @classmethod
     def of_json(cls, d):
-        return cls(d["blocks"], d["n"], d["n_weighted"])
+        return cls(d["blocks"], d["n"], d["n_weighted"], own=OwnSensors(**d["own"]) if d.get("own") else None)
 
 
 @dataclass
@@ -135,8 +153,8 @@ class Fit:
 class Verdict:
     """One candidate's test in a round (`diagnosis.selection.candidate_test`): its cross-validated
     fall of J (C2) and the fall's standard error, what it needs, what the days other than its best
-    gain, its evidence (C2), whether it passes, the records it harms and the objection of physics
-    (None if none)."""
+    gain, its evidence (C2), whether it passes, the records it harms, the objection of physics
+    (None if none), and its own sensors' test, whether it passes by them."""
     cv_fall: float
     cv_se: float
     needed: float
@@ -145,6 +163,8 @@ class Verdict:
     passes: bool
     harms: list
     objection: str = None
+    own: dict = None  # its own sensors' test (`selection.own_test`), None without
+    passes_by_own: bool = False  # it passes on them (the air no worse than the noise's margin)
 
     def to_json(self):
         return asdict(self)

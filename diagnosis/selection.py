@@ -50,8 +50,13 @@ to, block by block:
    differ by nearly the same small amount every day, so the blocks' scatter is tiny; yet another draw
    of the noise would move that difference by 2 sigma |r_a - r_b|, and reverse it where it is
    smaller. Components whose corrections cannot be told apart are named together in the reason.
-   Whether a candidate passes (1.) reads the air alone, the objective: the other sensors judge
-   between explanations of the air, never whether it needs one.
+   Whether a candidate passes (1.) reads the air, the objective: the other sensors judge
+   between explanations of the air, never whether it needs one; except a component's own
+   sensors (`own_test`): a component whose correction, fitted to the air, mends its own
+   surface beyond the noise and the file's numerical error there, and leaves the air no worse
+   than the noise's margin, passes too. The paper's method places a fault by forcing the
+   sub-model's measured nodes; a second fault the air no longer points at (the first effect
+   brought it to the noise) is still placed by the component's own sensor.
 
 The validation window plays no part. A model built by earlier rounds is the baseline a later
 round's candidate must pass against (its parameters held).
@@ -188,7 +193,7 @@ def decide(results, base, sigma, n, groups=(), floor_sd=None, distances=None):
     base = np.asarray(base, dtype=float)
     floor_sd = sigma if floor_sd is None else floor_sd
     margin = POLICY.least_fall(float(base.sum()), floor_sd, n)
-    verdicts = {r.label: candidate_test(r, base, margin, floor_sd, groups) for r in results}
+    verdicts = {r.label: candidate_test(r, base, margin, floor_sd, groups, sigma) for r in results}
     passing = [r for r in results if verdicts[r.label].passes]  # 1.
     admissible = [r for r in passing if not verdicts[r.label].objection]  # 2.
     suggestions = [{"candidate": r.label, "reason": verdicts[r.label].objection, "cv_rmse": r.cv.rmse}
@@ -210,7 +215,7 @@ def decide(results, base, sigma, n, groups=(), floor_sd=None, distances=None):
                      "n": n, "groups": list(groups), "distances": distances or {}})
 
 
-def candidate_test(result, base, margin, floor_sd, groups):
+def candidate_test(result, base, margin, floor_sd, groups, sigma):
     """One candidate's `Verdict` (steps 1 and 2): its cross-validated fall of J (C2) and the fall's
     standard error, what it needs (the noise's `margin`, C2, and `standard_errors` of its
     scatter), what the days other than its best gain, its evidence, whether it passes, the
@@ -220,6 +225,8 @@ def candidate_test(result, base, margin, floor_sd, groups):
     needed = max(margin, POLICY.standard_errors * se)
     # the other days than its best must gain too: one day alone is no evidence
     others = down - float(np.max(base - blocks))
+    own = own_test(result.sensors.own, sigma)
+    by_own = bool(own is not None and own["passes"] and down > -margin)
     harms = harmed(base, blocks, floor_sd, groups)
     said = POLICY.objection_of(result.effect, result.parameters, result.derived, result.physics)
     if harms:
@@ -227,8 +234,30 @@ def candidate_test(result, base, margin, floor_sd, groups):
             f"{h['record']} (its cross-validated J there rises by {-h['cv_fall']:.3g} C2, beyond the "
             f"{h['needed']:.3g} C2 the noise and the day-to-day scatter could make)" for h in harms)
             + ": a correction of the building must hold on every record of it"]))
-    return Verdict(down, se, needed, others, float(result.evidence().sum()), bool(down > needed and others > 0),
-                   harms, said)
+    return Verdict(down, se, needed, others, float(result.evidence().sum()),
+                   bool(down > needed and others > 0) or by_own, harms, said, own, by_own)
+
+
+def own_test(own, sigma):
+    """A component candidate's test on its own sensors (`result.OwnSensors`, None for another):
+    {"fall", "se", "needed", "passes"} (C2), the fall of their J over the blocks from the model to
+    the candidate, its standard error from the per-block falls, what it needs (the yardstick of
+    step 1 with the noise, sigma (C), and the file's numerical error there in quadrature, and
+    `standard_errors` of its scatter), and whether it beats that on more days than its best.
+
+    A component's own surface measures that sub-model directly, as the paper's forcing of it
+    does: where the air no longer points at it (another effect already brings the air to the
+    noise) but its own sensor still disagrees, and the component's correction, fitted to the
+    air, mends that sensor (which no fit read) without making the air worse beyond the noise's
+    margin, the data place a fault there (`candidate_test`)."""
+    if own is None or not own.n:
+        return None
+    before, after = np.asarray(own.before, dtype=float), np.asarray(own.after, dtype=float)
+    down, se = fall(before, after) if len(before) > 1 else (float((before - after).sum()), 0.0)
+    floor = math.hypot(sigma, own.numerical)
+    needed = max(POLICY.least_fall(float(before.sum()), floor, own.n), POLICY.standard_errors * se)
+    others = down - float(np.max(before - after))
+    return {"fall": down, "se": se, "needed": needed, "passes": bool(down > needed and others > 0)}
 
 
 def claim(result):
@@ -270,10 +299,19 @@ def _reason(chosen, alike, results, passing, base, n, verdicts, margin, componen
     what = (f"an unexplained heat source, acting {acting(chosen)} ({chosen.effect} on {chosen.target})"
             if POLICY.is_shape(chosen.effect) else f"{chosen.effect} on {chosen.target}")
     verdict = verdicts[chosen.label]
-    said = (f"{what[0].upper() + what[1:]} lowers the cross-validated J from {base.sum():.3g} to "
-            f"{chosen.cv.J:.3g} C2 ({rmse_before:.3f} -> {chosen.cv.rmse:.3f} C; each of {B} days "
-            f"predicted by a fit to the others), beyond the {verdict.needed:.3g} C2 that the noise, the file's "
-            f"numerical error and the day-to-day scatter could make; {len(passing)} of {len(results)} candidates pass")
+    if verdict.passes_by_own and not (verdict.cv_fall > verdict.needed and verdict.other_days > 0):
+        own = chosen.sensors.own
+        said = (f"{what[0].upper() + what[1:]} mends its own sensors, which no fit read: their J over the {B} days "
+                f"falls from {sum(own.before):.3g} to {sum(own.after):.3g} C2 ({own.n} readings), beyond the "
+                f"{verdict.own['needed']:.3g} C2 that the noise, the file's numerical error there and the "
+                f"day-to-day scatter could make, while the air left out stays within the noise ({base.sum():.3g} -> "
+                f"{chosen.cv.J:.3g} C2): the air alone no longer points at {chosen.target}, its own surface does; "
+                f"{len(passing)} of {len(results)} candidates pass")
+    else:
+        said = (f"{what[0].upper() + what[1:]} lowers the cross-validated J from {base.sum():.3g} to "
+                f"{chosen.cv.J:.3g} C2 ({rmse_before:.3f} -> {chosen.cv.rmse:.3f} C; each of {B} days "
+                f"predicted by a fit to the others), beyond the {verdict.needed:.3g} C2 that the noise, the file's "
+                f"numerical error and the day-to-day scatter could make; {len(passing)} of {len(results)} candidates pass")
     sensed = chosen.sensors.n
     if sensed and len(passing) > 1:
         said += (f"; among them it best predicts the air left out together with the other sensors over the "

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from nodeforce.diagnosis.policy import POLICY
-from nodeforce.diagnosis.result import CrossValidation, Fit, SensorEvidence
+from nodeforce.diagnosis.result import CrossValidation, Fit, OwnSensors, SensorEvidence
 from nodeforce.diagnosis.selection import blocks, decide
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.errors import InputError
@@ -372,4 +372,32 @@ def test_the_other_sensors_never_make_a_candidate_pass():
     surfaces = np.random.default_rng(2).normal(0.0, SIGMA, 4 * N)
     flat = with_sensors(door(BASE), surfaces)
     chosen, decision = choose([flat], BASE, SIGMA, N)
+    assert chosen is None and not decision.verdicts["conductivity@door"].passes
+
+
+def with_own(result, before, after, numerical=0.0):
+    """The candidate with its own component's sensors' J (C2) on the four days under the model
+    (`before`) and under it (`after`), 4 N readings, as diagnosis.loop.own_sensors records them."""
+    own = OwnSensors(list(before), list(after), 4 * N, numerical)
+    return replace(result, sensors=replace(result.sensors, own=own))
+
+
+def test_a_component_whose_own_sensor_it_mends_passes_though_the_air_is_at_the_noise():
+    # the air left out as the model's: another effect already brought it to the noise; the
+    # door's own surface was 0.5 C off on every reading (J = N 0.25 a day) and the door's
+    # correction, fitted to the air, brings it to the noise (N sigma^2): the data place a fault there
+    off, mended = [N * 0.25] * 4, [N * SIGMA ** 2] * 4
+    chosen, decision = choose([with_own(door(BASE), off, mended)], BASE, SIGMA, N)
+    assert chosen is not None and decision.verdicts["conductivity@door"].passes_by_own
+    assert "its own sensors" in decision.reason
+    # a fall of its own sensors' J that the noise could make does not pass ...
+    noise_only = [N * SIGMA ** 2 + 0.5 * 3 * SIGMA ** 2 * np.sqrt(2 * 4 * N) / 4] * 4
+    chosen, decision = choose([with_own(door(BASE), noise_only, [N * SIGMA ** 2] * 4)], BASE, SIGMA, N)
+    assert chosen is None
+    # ... nor one the file's own numerical error there (0.3 C) could
+    chosen, decision = choose([with_own(door(BASE), [N * 0.1] * 4, [N * 0.09] * 4, numerical=0.3)], BASE, SIGMA, N)
+    assert chosen is None
+    # nor a correction that makes the air worse by more than the noise's margin
+    worse = [b + 3.0 for b in BASE]
+    chosen, decision = choose([with_own(door(worse), off, mended)], BASE, SIGMA, N)
     assert chosen is None and not decision.verdicts["conductivity@door"].passes

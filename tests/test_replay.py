@@ -35,8 +35,10 @@ def test_the_demos_choice_is_recomputed_from_report_json_alone(tmp_path):
     read = check_replay(tmp_path / "report.json")
     # what the loop returned is what it wrote
     assert read.to_json() == json.loads(json.dumps(made.to_json()))
-    # a replay that could differ: with another noise the same records give another decision
-    noisier = replace(read, rounds=[replace(r, inputs={**r.inputs, "floor_sd": 10 * r.inputs["floor_sd"]})
+    # a replay that could differ: with thirty times the noise (3 C, more than the floor's own
+    # sensors miss the file by) the same records give another decision
+    noisier = replace(read, rounds=[replace(r, inputs={**r.inputs, "sigma": 30 * r.inputs["sigma"],
+                                                       "floor_sd": 30 * r.inputs["floor_sd"]})
                                     for r in read.rounds])
     assert noisier.replay()[0].chosen is None and read.rounds[0].chosen is not None
 
