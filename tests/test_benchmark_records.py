@@ -177,3 +177,20 @@ def test_look_alikes_of_a_mild_month_are_told_apart_by_the_other_sensors(name, t
     assert first and first[0] in r.spec.answers, diagnosis.rounds[0].reason
     assert diagnosis.after["validation"]["rmse"] < 1.5 * r.spec.noise
     check_replay(tmp_path / "report.json")  # the choice recomputed from report.json alone
+
+
+def test_two_faults_are_both_found_when_one_component_s_own_sensor_disagrees(tmp_path):
+    """The issue's case as a benchmark record: the door more conductive and the roof's
+    absorptance wrong, the paper's sensors (the door's inner surface among them), subtle
+    together. The roof's sun brings the air to the noise; the door's own surface still
+    disagrees, and the door's correction mends it: both are added, the door by its sensor."""
+    from nodeforce import api
+    r = record("mia-jun/door+roof-alpha-s", 0)
+    diagnosis = api.diagnose(r.building, r.case(), tmp_path, objective=api.objective(r.building, r.zones),
+                             workers=1, generations=30, noise=r.spec.noise, seed=0)
+    added = {(e.effect, e.target) for e in diagnosis.added}
+    for fault in r.spec.faults:
+        assert added & set(fault.answers), diagnosis.rounds[-1].reason
+    door = next(d for d in diagnosis.rounds if d.chosen and d.chosen.target == "door")
+    assert door.verdicts["conductivity@door"].passes_by_own
+    check_replay(tmp_path / "report.json")
