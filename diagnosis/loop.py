@@ -552,8 +552,8 @@ def rounds(prepared, localization, objective, workdir, seed, workers, cluster=No
     model, decisions, results, runs, sensitivities = prepared.model, [], [], {}, {}
     for number in range(POLICY.max_rounds):
         base_blocks = windows.block_J(model.runs)
-        if number and POLICY.at_noise(base_blocks.sum(), n, noise.floor_sd) and \
-                not windows.disagreeing(model.building, windows.sensed_by(model), noise.sigma):
+        air_at_noise = bool(number) and POLICY.at_noise(base_blocks.sum(), n, noise.floor_sd)
+        if air_at_noise and not windows.disagreeing(model.building, windows.sensed_by(model), noise.sigma):
             break  # the error left is the noise's, at the air and at every component's own sensors
         done = [d.chosen.label for d in decisions]  # every earlier round chose: a round without a choice ends them
         started = time.perf_counter()
@@ -575,7 +575,9 @@ def rounds(prepared, localization, objective, workdir, seed, workers, cluster=No
             # every sensor's weight from the least misfit any candidate of the round leaves
             tried, models = fits_of(model, pairs, assessed, windows, objective, noise.sigma, number + 1, done)
         simulations = sum(a.simulations for a in assessed)
-        decision = decide(tried, base_blocks, noise.sigma, n, windows.groups(), noise.floor_sd)
+        # a round run for a component's own sensors alone: only they can make a candidate pass
+        decision = decide(tried, base_blocks, noise.sigma, n, windows.groups(), noise.floor_sd,
+                          air_at_noise=air_at_noise)
         decision.cost = {"candidates": len(tried), "simulations": simulations,
                          "seconds": round(time.perf_counter() - started, 1)}
         decisions.append(decision)

@@ -363,7 +363,8 @@ class Diagnosis:
         for number, recorded in enumerate(self.rounds, start=1):
             given = recorded.inputs
             out.append(decide([c for c in self.candidates if c.round == number], given["blocks_before"],
-                              given["sigma"], given["n"], given["groups"], given["floor_sd"], given["distances"]))
+                              given["sigma"], given["n"], given["groups"], given["floor_sd"], given["distances"],
+                              given.get("air_at_noise", False)))
         return out
 
     @classmethod

@@ -170,7 +170,7 @@ def harmed(base, scores, floor_sd, groups):
     return out
 
 
-def decide(results, base, sigma, n, groups=(), floor_sd=None, distances=None):
+def decide(results, base, sigma, n, groups=(), floor_sd=None, distances=None, air_at_noise=False):
     """The `Decision` of one round (module docstring), its steps in order: 1. which candidates
     pass, 2. which of them physics refuses (suggestions), 3. the band of those the data cannot
     tell from the best, 4. the one of the band that claims least; with each candidate's `Verdict`
@@ -189,11 +189,14 @@ def decide(results, base, sigma, n, groups=(), floor_sd=None, distances=None):
         None
     distances : {label: {label: C}}, the `distance` of every two admissible candidates' residuals,
         as the decision keeps it (`inputs.distances`); computed from the residuals if None
+    air_at_noise : a later round run only because a component's own sensors disagree, the air's
+        error left being the noise's (`Policy.at_noise`): a fall of the air's J is then no
+        evidence of a fault, and a candidate passes on its own sensors alone
     """
     base = np.asarray(base, dtype=float)
     floor_sd = sigma if floor_sd is None else floor_sd
     margin = POLICY.least_fall(float(base.sum()), floor_sd, n)
-    verdicts = {r.label: candidate_test(r, base, margin, floor_sd, groups, sigma) for r in results}
+    verdicts = {r.label: candidate_test(r, base, margin, floor_sd, groups, sigma, air_at_noise) for r in results}
     passing = [r for r in results if verdicts[r.label].passes]  # 1.
     admissible = [r for r in passing if not verdicts[r.label].objection]  # 2.
     suggestions = [{"candidate": r.label, "reason": verdicts[r.label].objection, "cv_rmse": r.cv.rmse}
@@ -207,19 +210,20 @@ def decide(results, base, sigma, n, groups=(), floor_sd=None, distances=None):
         chosen = min(near, key=lambda r: (claim(r), r.evidence().sum()))  # 4.
         alike = [r for r in near if r is not chosen]
     # the candidates physics refused are in `suggestions`; the report says them grouped by reason
-    reason = _reason(chosen, alike, results, passing, base, n, verdicts, margin, components)
+    reason = _reason(chosen, alike, results, passing, base, n, verdicts, margin, components, air_at_noise)
     return Decision(chosen, reason, float(base.sum()), len(base), margin, POLICY.standard_errors, suggestions,
                     [r.label for r in alike], verdicts,
                     # what the steps read besides the candidates' fits: report.json can replay them
                     {"blocks_before": [float(b) for b in base], "sigma": sigma, "floor_sd": floor_sd,
-                     "n": n, "groups": list(groups), "distances": distances or {}})
+                     "n": n, "groups": list(groups), "distances": distances or {}, "air_at_noise": air_at_noise})
 
 
-def candidate_test(result, base, margin, floor_sd, groups, sigma):
+def candidate_test(result, base, margin, floor_sd, groups, sigma, air_at_noise=False):
     """One candidate's `Verdict` (steps 1 and 2): its cross-validated fall of J (C2) and the fall's
     standard error, what it needs (the noise's `margin`, C2, and `standard_errors` of its
-    scatter), what the days other than its best gain, its evidence, whether it passes, the
-    records it harms and the objection of physics, None if none."""
+    scatter), what the days other than its best gain, its evidence, whether it passes (on the
+    air unless `air_at_noise`, or on its own sensors), the records it harms and the objection of
+    physics, None if none."""
     blocks = np.asarray(result.cv.blocks)
     down, se = fall(base, blocks)
     needed = max(margin, POLICY.standard_errors * se)
@@ -234,8 +238,9 @@ def candidate_test(result, base, margin, floor_sd, groups, sigma):
             f"{h['record']} (its cross-validated J there rises by {-h['cv_fall']:.3g} C2, beyond the "
             f"{h['needed']:.3g} C2 the noise and the day-to-day scatter could make)" for h in harms)
             + ": a correction of the building must hold on every record of it"]))
-    return Verdict(down, se, needed, others, float(result.evidence().sum()),
-                   bool(down > needed and others > 0) or by_own, harms, said, own, by_own)
+    by_air = bool(down > needed and others > 0) and not air_at_noise
+    return Verdict(down, se, needed, others, float(result.evidence().sum()), by_air or by_own, harms, said, own,
+                   by_own)
 
 
 def own_test(own, sigma):
@@ -285,12 +290,18 @@ def band(admissible, base, sigma, floor_sd, n, distances):
     return [r for r in admissible if close(r)]
 
 
-def _reason(chosen, alike, results, passing, base, n, verdicts, margin, components):
+def _reason(chosen, alike, results, passing, base, n, verdicts, margin, components, air_at_noise=False):
     """The decision in words; `components` the building's component names."""
     B = len(base)
     rmse_before = math.sqrt(base.sum() / n)
     if not results:
         return "No candidate effect was tried, so the model is left as it is."
+    if not chosen and air_at_noise:
+        return (f"The air's error left is the noise's ({base.sum():.3g} C2 over {B} days); a component's own "
+                f"sensors still disagree with the model, but none of the {len(results)} candidates mends them beyond "
+                "what the noise and the file's numerical error there could, without making the air worse"
+                + (f" ({len(passing)} do, and physics or a record they harm refuses each)" if passing else "")
+                + ": no effect is added.")
     if not chosen:
         return (f"None of the {len(results)} candidates lowers the cross-validated J ({base.sum():.3g} C2 over "
                 f"{B} days) by more than the noise and the file's numerical error could ({margin:.3g} C2) and "

@@ -401,3 +401,15 @@ def test_a_component_whose_own_sensor_it_mends_passes_though_the_air_is_at_the_n
     worse = [b + 3.0 for b in BASE]
     chosen, decision = choose([with_own(door(worse), off, mended)], BASE, SIGMA, N)
     assert chosen is None and not decision.verdicts["conductivity@door"].passes
+
+
+def test_a_round_run_for_a_component_s_own_sensors_takes_no_effect_on_the_air_alone():
+    # the air's error left is the noise's and the round runs because the door's surface
+    # disagrees: a wall that lowers the air's J a little (noise it fits) is no evidence, the door
+    # that mends its own surface is
+    wall = candidate("conductivity", "west_wall", {"factor": parameter(2.0, 0.2)}, [b - 1.0 for b in BASE])
+    assert decide([wall], BASE, SIGMA, N).chosen is not None  # a first round would take it
+    decision = decide([wall], BASE, SIGMA, N, air_at_noise=True)
+    assert decision.chosen is None and "own sensors" in decision.reason
+    mends = with_own(door(BASE), [N * 0.25] * 4, [N * SIGMA ** 2] * 4)
+    assert decide([wall, mends], BASE, SIGMA, N, air_at_noise=True).chosen.target == "door"
