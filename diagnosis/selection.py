@@ -248,7 +248,11 @@ def own_test(own, sigma):
     {"fall", "se", "needed", "passes"} (C2), the fall of their J over the blocks from the model to
     the candidate, its standard error from the per-block falls, what it needs (the yardstick of
     step 1 with the noise, sigma (C), and the file's numerical error there in quadrature, and
-    `standard_errors` of its scatter), and whether it beats that on more days than its best.
+    `standard_errors` of its scatter), and whether it beats that on more days than its best and
+    leaves those sensors at the noise (`Policy.at_noise`, the test that found them disagreeing,
+    `loop.Windows.disagreeing`): a correction that moves a surface part of the way and leaves it
+    off by more than the noise has not explained it (a fault next to it has: the sun of an
+    opening, a neighbour's air), and does not place the fault there.
 
     A component's own surface measures that sub-model directly, as the paper's forcing of it
     does: where the air no longer points at it (another effect already brings the air to the
@@ -262,7 +266,8 @@ def own_test(own, sigma):
     floor = math.hypot(sigma, own.numerical)
     needed = max(POLICY.least_fall(float(before.sum()), floor, own.n), POLICY.standard_errors * se)
     others = down - float(np.max(before - after))
-    return {"fall": down, "se": se, "needed": needed, "passes": bool(down > needed and others > 0)}
+    mended = POLICY.at_noise(float(after.sum()), own.n, floor)
+    return {"fall": down, "se": se, "needed": needed, "passes": bool(down > needed and others > 0 and mended)}
 
 
 def claim(result):
@@ -310,7 +315,7 @@ def _reason(chosen, alike, results, passing, base, n, verdicts, margin, componen
     what = (f"an unexplained heat source, acting {acting(chosen)} ({chosen.effect} on {chosen.target})"
             if POLICY.is_shape(chosen.effect) else f"{chosen.effect} on {chosen.target}")
     verdict = verdicts[chosen.label]
-    if verdict.passes_by_own and not (verdict.cv_fall > verdict.needed and verdict.other_days > 0):
+    if verdict.passes_by_own and (air_at_noise or not (verdict.cv_fall > verdict.needed and verdict.other_days > 0)):
         own = chosen.sensors.own
         said = (f"{what[0].upper() + what[1:]} mends its own sensors, which no fit read: their J over the {B} days "
                 f"falls from {sum(own.before):.3g} to {sum(own.after):.3g} C2 ({own.n} readings), beyond the "

@@ -397,6 +397,11 @@ def test_a_component_whose_own_sensor_it_mends_passes_though_the_air_is_at_the_n
     # ... nor one the file's own numerical error there (0.3 C) could
     chosen, decision = choose([with_own(door(BASE), [N * 0.1] * 4, [N * 0.09] * 4, numerical=0.3)], BASE, SIGMA, N)
     assert chosen is None
+    # nor one that moves the surface much but leaves it off by more than the noise (0.3 C): a
+    # fault next to the door moved it, not one the door's correction explains
+    chosen, decision = choose([with_own(door(BASE), off, [N * 0.09] * 4)], BASE, SIGMA, N)
+    assert chosen is None and decision.verdicts["conductivity@door"].own["fall"] > decision.verdicts[
+        "conductivity@door"].own["needed"]
     # nor a correction that makes the air worse by more than the noise's margin
     worse = [b + 3.0 for b in BASE]
     chosen, decision = choose([with_own(door(worse), off, mended)], BASE, SIGMA, N)
