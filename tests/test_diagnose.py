@@ -103,9 +103,11 @@ def test_diagnose_finds_the_undeclared_effect(tmp_path, testcell_data, testcell,
     for name, p in report["effect"]["parameters"].items():
         assert declared_after[name] == pytest.approx(p["value"]), name
         assert declared_before[name] != pytest.approx(p["value"]), name
-    # every candidate exists as a building file declaring its calibrated effect
+    # every candidate exists as a building file declaring its calibrated effect (a later round's
+    # in candidates/round<n>/)
     for c in report["candidates"]:
-        declared = json.loads((tmp_path / "candidates" / f"{c['effect']}@{c['target']}.json").read_text())
+        folder = tmp_path / "candidates" / (f"round{c['round']}" if c["round"] > 1 else "")
+        declared = json.loads((folder / f"{c['effect']}@{c['target']}.json").read_text())
         values = EFFECTS[c["effect"]].read(parse_building(declared), c["target"])
         for name, p in c["parameters"].items():
             if not (c["effect"] == "ground_coupling" and values["U"] == 0.0):
