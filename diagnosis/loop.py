@@ -382,16 +382,15 @@ def assess_all(model, pairs, windows, objective, folder, seed, workers, cluster=
     return list(assessed)
 
 
-def fits_of(model, pairs, assessed, windows, objective, sigma, number=1, on_top_of=()):
+def fits_of(model, base, pairs, assessed, windows, objective, sigma, number=1, on_top_of=()):
     """The candidates' `Fit`s and their `Model`s by label, from their `Assessed`: what each
     predicts of the air left out and of the other sensors over the blocks, each sensor weighted
     by the least misfit the model or any of these candidates leaves there
-    (`Windows.sensor_weights`), and of its own component's sensors (`OwnSensors`); `sigma`: the
-    air sensors' noise (C); `number`: the round; `on_top_of`: the labels of the effects `model`
-    holds."""
+    (`Windows.sensor_weights`), and of its own component's sensors (`OwnSensors`); `base`: the
+    model's other sensed nodes (`Windows.sensed_by`); `sigma`: the air sensors' noise (C);
+    `number`: the round; `on_top_of`: the labels of the effects `model` holds."""
     n = windows.scored()
     sensed = {i for ids in windows.sensors for i in ids}
-    base = windows.sensed_by(model)
     weights = windows.sensor_weights([base] + [a.sensed for a in assessed], sigma)
     results, models = [], {}
     for (effect, target), a in zip(pairs, assessed):
@@ -553,7 +552,8 @@ def rounds(prepared, localization, objective, workdir, seed, workers, cluster=No
     for number in range(POLICY.max_rounds):
         base_blocks = windows.block_J(model.runs)
         air_at_noise = bool(number) and POLICY.at_noise(base_blocks.sum(), n, noise.floor_sd)
-        if air_at_noise and not windows.disagreeing(model.building, windows.sensed_by(model), noise.sigma):
+        base_sensed = windows.sensed_by(model)  # the round's model at the other sensors: one run per record
+        if air_at_noise and not windows.disagreeing(model.building, base_sensed, noise.sigma):
             break  # the error left is the noise's, at the air and at every component's own sensors
         done = [d.chosen.label for d in decisions]  # every earlier round chose: a round without a choice ends them
         started = time.perf_counter()
@@ -563,7 +563,7 @@ def rounds(prepared, localization, objective, workdir, seed, workers, cluster=No
         pairs = [p for p in physical(model.building, localization["components"], objective.zones,
                                      measured_ids, localization["best_nodes"]) if "@".join(p) not in done]
         assessed = assess_all(model, pairs, windows, objective, into, seed, workers, cluster)
-        tried, models = fits_of(model, pairs, assessed, windows, objective, noise.sigma, number + 1, done)
+        tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma, number + 1, done)
         # shapes only where no physical candidate physics admits brings the error left to the
         # noise; the residual's statistics then choose which
         if not any(POLICY.at_noise(r.cv.J, n, noise.floor_sd) and not POLICY.objection_of(
@@ -573,7 +573,7 @@ def rounds(prepared, localization, objective, workdir, seed, workers, cluster=No
             pairs, assessed = pairs + more, assessed + assess_all(model, more, windows, objective, into, seed,
                                                                   workers, cluster)
             # every sensor's weight from the least misfit any candidate of the round leaves
-            tried, models = fits_of(model, pairs, assessed, windows, objective, noise.sigma, number + 1, done)
+            tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma, number + 1, done)
         simulations = sum(a.simulations for a in assessed)
         # a round run for a component's own sensors alone: only they can make a candidate pass
         decision = decide(tried, base_blocks, noise.sigma, n, windows.groups(), noise.floor_sd,
