@@ -110,9 +110,9 @@ def block_J(residuals, masks):
 
 def fall(base, scores):
     """The fall of J from per-block J `base` to `scores` (C2) and its standard error from the
-    per-block falls (blocks as the unit)."""
+    per-block falls (blocks as the unit; 0 for one block, which has no scatter to measure)."""
     d = np.asarray(base, dtype=float) - np.asarray(scores, dtype=float)
-    return float(d.sum()), float(math.sqrt(len(d)) * d.std(ddof=1))
+    return float(d.sum()), float(math.sqrt(len(d)) * d.std(ddof=1)) if len(d) > 1 else 0.0
 
 
 def distance(a, b):
@@ -163,7 +163,7 @@ def harmed(base, scores, floor_sd, groups):
     out = []
     for group in groups:
         rows = np.asarray(group["blocks"], dtype=int)
-        down, se = fall(base[rows], scores[rows]) if len(rows) > 1 else (float((base[rows] - scores[rows]).sum()), 0.0)
+        down, se = fall(base[rows], scores[rows])
         needed = max(POLICY.least_fall(float(base[rows].sum()), floor_sd, group["n"]), POLICY.standard_errors * se)
         if down < -needed:
             out.append({"record": group["record"], "cv_fall": down, "needed": needed})
@@ -262,7 +262,7 @@ def own_test(own, sigma):
     if own is None or not own.n:
         return None
     before, after = np.asarray(own.before, dtype=float), np.asarray(own.after, dtype=float)
-    down, se = fall(before, after) if len(before) > 1 else (float((before - after).sum()), 0.0)
+    down, se = fall(before, after)
     floor = math.hypot(sigma, own.numerical)
     needed = max(POLICY.least_fall(float(before.sum()), floor, own.n), POLICY.standard_errors * se)
     others = down - float(np.max(before - after))
