@@ -15,6 +15,7 @@ A parameter is called identifiable from the data when that estimate is tight eno
 is held at its physical prior where it has one and the data allow it (`calibrate`).
 """
 import logging
+from dataclasses import dataclass
 from types import SimpleNamespace
 
 import numpy as np
@@ -90,7 +91,17 @@ class Candidate:
         return self._runs[key]
 
 
-def calibrate(candidate, cases, objective, blocks=(), numerical=None):
+@dataclass
+class Own:
+    """A component's own measured nodes, read by its candidate's fit beside the objective air:
+    per case their ids (besides the air's) and the file's numerical error there (C, (N_t,
+    len(ids)), or None), and the sd (C) of a reading's noise."""
+    ids: list
+    numerical: list
+    sd: float
+
+
+def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None):
     """Least-squares values of the candidate's parameters on the calibration windows of one or
     several records of the building (`cases`), on the residuals of every objective zone of every
     record together (the sum of each window's J), and the same fit with each block of steps left out.
@@ -117,33 +128,53 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None):
         cross-validation block (`diagnosis.selection`); a bare mask is a block of the first record
     numerical : per case, the file's numerical error at the objective air (C, (N_t, zones):
         `model.numerical.discretisation_error`), or None
+    own : the candidate's component's own measured nodes (`Own`), or None. The air alone fits a
+        component's value wrongly where another fault shares the air's error (a door's
+        conductivity taking part of a window's transmittance); its own surface says which value
+        is the component's. The fit to the air alone weighs each own node (`own_weights`), and
+        the fit is made again with them beside the air
 
     Returns
     -------
     dict {name: {"value", "std", "identifiable", "on_bound"}, and "prior": its source where held at
     its prior (std 0)}; the quantities the data determine
     even where the parameters are not (see `derived`); and per block the parameter values fitted
-    without it (`fold`) and the residuals (C, (N_t, zones) of its record, NaN off the block) they
-    leave on it
+    without it (`fold`), the residuals (C, (N_t, zones) of its record, NaN off the block) they
+    leave on it, and what they predict there of the own nodes ("own", C, (N_t, len(own ids)))
     """
     cases = as_cases(cases)
     blocks = [b if isinstance(b, tuple) else (0, b) for b in blocks]
-    measured = [objective.measured(case) for case in cases]
+    zones = len(objective.air_nodes)
+    extra = own.ids if own is not None else [[] for _ in cases]
+    ids = [list(objective.air_nodes) + list(e) for e in extra]
+    # the air's columns, then the component's own nodes'
+    measured = [np.hstack([objective.measured(case), case.scored([n - 1 for n in e])]) for case, e in zip(cases, extra)]
     have = [np.isfinite(m) for m in measured]
     lows, highs = np.array(candidate.bounds).T
     start = calibration_start(candidate.building, candidate.effect, candidate.target)
     x0 = np.array([start[p.name] for p in candidate.parameters])  # inside the bounds: `calibration_start`
 
-    numerical = numerical if numerical is not None else [np.zeros_like(m) for m in measured]
+    numerical = [np.hstack([air if air is not None else np.zeros((len(m), zones)),
+                            at if at is not None else np.zeros((len(m), len(e)))])
+                 for m, e, air, at in zip(measured, extra, numerical or [None] * len(cases),
+                                          (own.numerical if own is not None else None) or [None] * len(cases))]
     error = np.concatenate([e[h] for e, h in zip(numerical, have)])
 
     def raw(x):
-        return np.concatenate([m[h] - candidate.nodes(case, objective.air_nodes, x)[h]
-                               for case, m, h in zip(cases, measured, have)])
+        return np.concatenate([(m - candidate.nodes(case, i, x))[h] for case, i, m, h in zip(cases, ids, measured, have)])
 
-    def residuals(x, rows=None):
-        r = raw(x)
-        return r + share(r, error, rows) * error
+    def weighted(weights):
+        """The residuals with each own node's column times the square root of its weight (one
+        (len(ids),) per case; the air's columns weigh 1), less the share of the numerical error
+        found on the columns that count; and those columns' rows."""
+        scale = np.sqrt(np.concatenate([np.broadcast_to(np.r_[np.ones(zones), w], h.shape)[h]
+                                        for w, h in zip(weights, have)]))
+        counted = scale > 0
+
+        def residuals(x, rows=None):
+            r = raw(x)
+            return (r + share(r, error, counted if rows is None else counted & rows) * error) * scale
+        return residuals, counted
 
     # each record's steps numbered apart from the others' by more than the HAC's lags: residuals
     # of two records are not correlated
@@ -153,7 +184,14 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None):
         steps.append(np.nonzero(h)[0] + offset)
         offset += len(h) + lags + 1
     steps = np.concatenate(steps)
+    residuals, counted = weighted([np.zeros(len(e)) for e in extra])
     fit = solve(residuals, x0, lows, highs)
+    if any(extra):
+        weights = own_weights(candidate, cases, ids, measured, numerical, zones, fit.x, own.sd)
+        log.info("%s: its own nodes read beside the air, weighing %s", candidate.label,
+                 "; ".join(", ".join(f"{n}: {w:.2g}" for n, w in zip(e, ws)) for e, ws in zip(extra, weights)))
+        residuals, counted = weighted(weights)
+        fit = solve(residuals, fit.x, lows, highs)
     cov = parameter_covariance(fit.jac, fit.fun, steps, lags)
     priors = wanted_priors(candidate, cases, identified(candidate, fit, cov))
     if priors:
@@ -182,11 +220,33 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None):
         train = ~np.concatenate([rows[h] for rows, h in zip(on_block([h.shape for h in have], record, block), have)])
         x = fold(fit, train, lows, highs, lambda x: residuals(x, train))
         case, m, h = cases[record], measured[record], have[record]
-        s = share(raw(x), error, train)
-        left = np.where(h & block[:, None], m - candidate.nodes(case, objective.air_nodes, x) + s * numerical[record],
-                        np.nan)
-        folds.append({"values": [float(v) for v in x], "residuals": left})
+        s = share(raw(x), error, train & counted)
+        T = candidate.nodes(case, ids[record], x)
+        left = np.where(h & block[:, None], m - T + s * numerical[record], np.nan)
+        folds.append({"values": [float(v) for v in x], "residuals": left[:, :zones],
+                      "own": np.where(block[:, None], T[:, zones:], np.nan)})
     return result, derived(candidate, cases[0], fit.x, cov), folds
+
+
+def own_weights(candidate, cases, ids, measured, numerical, zones, x, sd):
+    """Per case, each own node's weight beside the air in a component candidate's fit
+    (`Policy.sensor_weight`): sd_j^2 over its mean squared residual at `x`, the fit to the air
+    alone, sd_j the noise `sd` (C) and the file's numerical error there; 0 where it has no reading.
+
+    A sensor is weighted as a measurement whose error is what the model leaves there: a surface
+    the component's correction brings to the noise counts as the air does, and fixes the
+    component's value where another fault shares the air's error; one the model cannot follow
+    whatever the value (a real wall behind a simplified one) counts as little as its misfit says,
+    and does not pull the fit of the air towards it."""
+    out = []
+    for case, i, m, e in zip(cases, ids, measured, numerical):
+        r, e = m[:, zones:] - candidate.nodes(case, i, x)[:, zones:], e[:, zones:]
+        finite = np.isfinite(r)
+        n = finite.sum(axis=0)
+        mean_square = np.where(finite, np.square(r), 0.0).sum(axis=0) / np.maximum(n, 1)
+        floor = np.hypot(sd, np.sqrt(np.where(finite, np.square(e), 0.0).sum(axis=0) / np.maximum(n, 1)))
+        out.append(np.where(n > 0, POLICY.sensor_weight(floor, np.maximum(mean_square, np.finfo(float).tiny)), 0.0))
+    return out
 
 
 def solve(residuals, x0, lows, highs, held=None):

@@ -50,7 +50,7 @@ from nodeforce import lifetime
 from nodeforce.cluster import Cluster
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
-from nodeforce.diagnosis.calibrate import Candidate, calibrate, sensitivity
+from nodeforce.diagnosis.calibrate import Candidate, Own, calibrate, sensitivity
 from nodeforce.diagnosis.candidates import physical, shaped_inputs, shapes
 from nodeforce.diagnosis.compare import compare
 from nodeforce.diagnosis.loss import heat_loss
@@ -116,17 +116,47 @@ class Assessed:
 def assess(shared, pair):
     """Calibrate one candidate effect, with its cross-validation folds, and run it: a task for a
     worker process or a Dask worker; its `Assessed`. `shared`: what every candidate of the round
-    reads (`assess_all`); `pair`: the (effect, target)."""
-    building, bases, calibrations, cases, objective, blocks, sensors, numerical, seed = shared
+    reads (`assess_all`); `pair`: the (effect, target).
+
+    A candidate on a component whose own nodes are measured is fitted to them beside the air
+    (`calibrate.Own`); its other sensed nodes on each block are then the fold's, fitted without
+    that block, so that what the choice reads of its own sensors is, as of the air, what no fit read."""
+    building, bases, calibrations, cases, objective, blocks, sensors, numerical, at_sensors, sigma, seed = shared
     effect, target = pair
     candidate = Candidate(building, effect, target, protocols(bases, calibrations, cases))
-    parameters, determined, folds = calibrate(candidate, calibrations, objective, blocks, numerical)
+    own = own_nodes(building, target, sensors, at_sensors, sigma)
+    parameters, determined, folds = calibrate(candidate, calibrations, objective, blocks, numerical, own)
     values = [parameters[p.name]["value"] for p in candidate.parameters]
     runs = [candidate.nodes(case, objective.air_nodes, values) for case in cases]
-    sensed = [candidate.nodes(case, ids, values) if ids else np.empty((len(case.times) - 1, 0))
+    sensed = [candidate.nodes(case, ids, values).copy() if ids else np.empty((len(case.times) - 1, 0))
               for case, ids in zip(cases, sensors)]
+    if own is not None:
+        for (record, block), f in zip(blocks, folds):
+            rows = np.nonzero(block)[0]
+            columns = [sensors[record].index(n) for n in own.ids[record]]
+            sensed[record][np.ix_(rows, columns)] = f["own"][rows]
     calibrated = EFFECTS[effect].apply(building, target, {name: p["value"] for name, p in parameters.items()})
     return Assessed(parameters, determined, runs, sensed, folds, candidate.simulations, calibrated.to_json())
+
+
+def own_nodes(building, target, sensors, numerical, sigma):
+    """The measured nodes of the component `target` among each record's other sensors
+    (`sensors`, ids), with the file's numerical error there (`numerical`, one (N_t,
+    len(sensors)) per record, or None) and the noise `sigma` (C): a `calibrate.Own`; None for a
+    target that is not a component or has no node measured."""
+    if target not in {c.name for c in building.components}:
+        return None
+    columns = columns_among(sensors, set(building.component(target).node_ids))
+    if not any(columns):
+        return None
+    return Own([[ids[j] for j in c] for ids, c in zip(sensors, columns)],
+               None if numerical is None else [e[:, c] for e, c in zip(numerical, columns)], sigma)
+
+
+def columns_among(sensors, nodes):
+    """Per record, the columns of its sensors (`sensors`, one list of node ids per record) that
+    are among `nodes` (ids)."""
+    return [[j for j, node in enumerate(ids) if node in nodes] for ids in sensors]
 
 
 def protocols(bases, *windows):
@@ -272,8 +302,8 @@ class Windows:
 
     def own_columns(self, nodes):
         """Per record, the columns of its other sensors (`sensors`) that are among `nodes` (ids):
-        a component's own sensors."""
-        return [[j for j, node in enumerate(ids) if node in nodes] for ids in self.sensors]
+        a component's own sensors (`columns_among`)."""
+        return columns_among(self.sensors, nodes)
 
     def own_J(self, sensed, columns):
         """J (C2) of the other sensors' `columns` (`own_columns`) on every block, the records' in
@@ -324,9 +354,11 @@ class Windows:
         squares = [np.square(e[:k])[np.isfinite(m[:k])] for e, k, m in zip(self.numerical, self.ks, self.measured)]
         return float(np.sqrt(np.concatenate(squares).mean()))
 
-    def calibration_numerical(self):
-        """The file's numerical error on each record's calibration window, None if not known."""
-        return None if self.numerical is None else [e[:k] for e, k in zip(self.numerical, self.ks)]
+    def calibration_numerical(self, sensors=False):
+        """The file's numerical error on each record's calibration window, at the objective air
+        (or at the other `sensors`), None if not known."""
+        errors = self.sensor_numerical if sensors else self.numerical
+        return None if errors is None else [e[:k] for e, k in zip(errors, self.ks)]
 
     def scored(self):
         """Residuals the blocks score, on every record."""
@@ -355,14 +387,16 @@ class Model:
                      [None if b is None else EFFECTS[effect].apply(b, target, values) for b in self.bases])
 
 
-def assess_all(model, pairs, windows, objective, folder, seed, workers, cluster=None):
+def assess_all(model, pairs, windows, objective, sigma, folder, seed, workers, cluster=None):
     """Each (effect, target) added to `model`, calibrated on every record's calibration window
     (t_0..t_k) with a fold per block, and run over each record, in parallel worker processes
     (which end with this process: nodeforce.lifetime), or on the workers of `cluster` (a
     `nodeforce.cluster.Cluster`), each candidate's building file written in `folder`: their
-    `Assessed`, in the order of `pairs`."""
+    `Assessed`, in the order of `pairs`. `sigma`: the sensors' noise (C), against which a
+    component's own nodes are weighed in its fit (`calibrate.own_weights`)."""
     shared = (model.building, model.bases, windows.calibrations, windows.cases, objective, windows.blocks,
-              windows.sensors, windows.calibration_numerical(), seed)
+              windows.sensors, windows.calibration_numerical(), windows.calibration_numerical(sensors=True), sigma,
+              seed)
     with tqdm(total=len(pairs), desc="calibrating candidate effects", unit="candidate",
               disable=not sys.stderr.isatty()) as bar:
         if cluster is not None:
@@ -562,7 +596,7 @@ def rounds(prepared, localization, objective, workdir, seed, workers, cluster=No
         into.mkdir(exist_ok=True)
         pairs = [p for p in physical(model.building, localization["components"], objective.zones,
                                      measured_ids, localization["best_nodes"]) if "@".join(p) not in done]
-        assessed = assess_all(model, pairs, windows, objective, into, seed, workers, cluster)
+        assessed = assess_all(model, pairs, windows, objective, noise.sigma, into, seed, workers, cluster)
         tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma, number + 1, done)
         # shapes only where no physical candidate physics admits brings the error left to the
         # noise; the residual's statistics then choose which
@@ -570,8 +604,8 @@ def rounds(prepared, localization, objective, workdir, seed, workers, cluster=No
                 r.effect, r.parameters, r.derived, r.physics) for r in tried):
             more = [p for p in shapes(model.building, left_by(windows, model), objective.zones)
                     if "@".join(p) not in done]
-            pairs, assessed = pairs + more, assessed + assess_all(model, more, windows, objective, into, seed,
-                                                                  workers, cluster)
+            pairs, assessed = pairs + more, assessed + assess_all(model, more, windows, objective, noise.sigma, into,
+                                                                  seed, workers, cluster)
             # every sensor's weight from the least misfit any candidate of the round leaves
             tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma, number + 1, done)
         simulations = sum(a.simulations for a in assessed)

@@ -214,3 +214,56 @@ def test_the_score_test_of_a_held_parameter_rejects_a_right_prior_at_its_level_a
             rejected[shift] += not POLICY.holds_prior(statistic, 1)
     assert abs(rejected[0.0] / draws - POLICY.prior_level) < 0.03
     assert rejected[3.0] / draws > 0.8
+
+
+def test_a_component_s_own_surface_read_beside_the_air_moves_its_value_to_the_truth_where_another_fault_shares_the_air(
+        testcell, weather):
+    """A door 1.5 times as conductive and a window that lets in a tenth less sun, the air and the
+    door's inside surface measured: the door's conductivity fitted to the air alone takes the
+    window's error for the door's; read beside its own surface, it lands at least three times
+    nearer the truth (the surface follows the air the window warms, so not on it). The surface
+    weighs the noise's square over its mean square misfit at the air-alone fit: 1.5 C off, it
+    weighs at most a hundredth, and pulls the fit less than the true surface does."""
+    from dataclasses import replace
+
+    from nodeforce.diagnosis.calibrate import Candidate, Own, calibrate, own_weights
+    from nodeforce.model.case import measured_case
+    from nodeforce.model.effects import EFFECTS
+    from nodeforce.model.score import Objective
+    from nodeforce.model.synth import pseudo_measurements
+
+    from .conftest import record_times
+    air, door = testcell.zones[0].air_node, testcell.component("door").node_ids[0]
+    case = measured_case(testcell, weather, pseudo_measurements(testcell, weather, record_times(6), [air, door]),
+                         burn_in_days=1)
+    B = case.burn_in_steps
+    truth = EFFECTS["conductivity"].apply(testcell, "door", {"factor": 1.5})
+    truth = EFFECTS["solar_transmittance"].apply(truth, "window",
+                                                 {"tau": 0.9 * testcell.component("window").solar_transmittance})
+    T = case.with_inputs(truth).run(truth)
+    measured = case.measured.copy()
+    measured[1 + B:, [air - 1, door - 1]] = T[B:, [air - 1, door - 1]]
+    objective = Objective.of(testcell)
+    candidate = Candidate(testcell, "conductivity", "door")
+
+    def with_offset(surface_offset):
+        m = measured.copy()
+        m[1 + B:, door - 1] += surface_offset
+        return replace(case, measured=m)
+
+    def fitted(surface_offset=0.0, own=True):
+        found, _, _ = calibrate(candidate, with_offset(surface_offset), objective,
+                                own=Own([[door]], None, 0.1) if own else None)
+        return found["factor"]["value"]
+
+    def weight(surface_offset):
+        c = with_offset(surface_offset)
+        at = np.hstack([objective.measured(c), c.scored([door - 1])])
+        return own_weights(candidate, [c], [[air, door]], [at], [np.zeros_like(at)], 1, [alone], 0.1)[0][0]
+
+    alone = fitted(own=False)
+    assert abs(alone - 1.5) > 0.3  # the air alone is fooled by the window
+    read = fitted()
+    assert abs(read - 1.5) < abs(alone - 1.5) / 3
+    assert weight(1.5) <= 0.01 < weight(0.0)
+    assert abs(fitted(1.5) - alone) < abs(read - alone)
