@@ -101,7 +101,8 @@ def split(case, source, fraction=None, end=None):
 class Assessed:
     """One candidate calibrated and run (`assess`): its parameters ({name: {"value", "std", ...}}),
     what the data determine besides, its objective air (N_t, zones) and other sensed nodes
-    (`Windows.sensors`) over each whole record, its cross-validation folds ({"values",
+    (`Windows.sensors`) over each whole record (its own component's, which its fit read, on
+    each block as the fold without that block predicts them: `assess`), its cross-validation folds ({"values",
     "residuals"} each), the simulations it took and its building file (JSON), declared at the
     calibrated values: the caller writes it, as a Dask worker may not share its file system."""
     parameters: dict
