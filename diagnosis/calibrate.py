@@ -95,10 +95,19 @@ class Candidate:
 class Own:
     """A component's own measured nodes, read by its candidate's fit beside the objective air:
     per case their ids (besides the air's) and the file's numerical error there (C, (N_t,
-    len(ids)), or None), and the sd (C) of a reading's noise."""
+    len(ids)), or None), the sd (C) of a reading's noise, and the component's memory of its
+    start (s: `Policy.start_memory` of its slowest time constant)."""
     ids: list
     numerical: list
     sd: float
+    memory: float
+
+    def measured(self, case, ids):
+        """(N_t, len(ids)) the readings of the nodes `ids` on `case` the fit reads: from `memory`
+        after the burn-in, NaN before."""
+        readings = case.scored([n - 1 for n in ids])
+        readings[:case.burn_in_steps + int(np.ceil(self.memory / case.dt))] = np.nan
+        return readings
 
 
 def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None):
@@ -132,7 +141,8 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None):
         component's value wrongly where another fault shares the air's error (a door's
         conductivity taking part of a window's transmittance); its own surface says which value
         is the component's. The fit to the air alone weighs each own node (`own_weights`), and
-        the fit is made again with them beside the air
+        the fit is made again with them beside the air, read once the component has forgotten
+        the start the burn-in could not set (`Own.measured`)
 
     Returns
     -------
@@ -148,7 +158,8 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None):
     extra = own.ids if own is not None else [[] for _ in cases]
     ids = [list(objective.air_nodes) + list(e) for e in extra]
     # the air's columns, then the component's own nodes'
-    measured = [np.hstack([objective.measured(case), case.scored([n - 1 for n in e])]) for case, e in zip(cases, extra)]
+    measured = [np.hstack([objective.measured(case), own.measured(case, e) if own is not None else case.scored([])])
+                for case, e in zip(cases, extra)]
     have = [np.isfinite(m) for m in measured]
     lows, highs = np.array(candidate.bounds).T
     start = calibration_start(candidate.building, candidate.effect, candidate.target)
@@ -186,7 +197,7 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None):
     steps = np.concatenate(steps)
     residuals, counted = weighted([np.zeros(len(e)) for e in extra])
     fit = solve(residuals, x0, lows, highs)
-    if any(extra):
+    if any(np.isfinite(m[:, zones:]).any() for m in measured):
         weights = own_weights(candidate, cases, ids, measured, numerical, zones, fit.x, own.sd)
         log.info("%s: its own nodes read beside the air, weighing %s", candidate.label,
                  "; ".join(", ".join(f"{n}: {w:.2g}" for n, w in zip(e, ws)) for e, ws in zip(extra, weights)))

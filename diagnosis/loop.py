@@ -68,6 +68,7 @@ from nodeforce.model.case import measured_case
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
+from nodeforce.model.network import assemble, slowest_time_constant
 from nodeforce.model.numerical import reference, share
 from nodeforce.model.score import Noise
 
@@ -143,15 +144,18 @@ def assess(shared, pair):
 def own_nodes(building, target, sensors, numerical, sigma):
     """The measured nodes of the component `target` among each record's other sensors
     (`sensors`, ids), with the file's numerical error there (`numerical`, one (N_t,
-    len(sensors)) per record, or None) and the noise `sigma` (C): a `calibrate.Own`; None for a
-    target that is not a component or has no node measured."""
+    len(sensors)) per record, or None), the noise `sigma` (C) and the component's memory of its
+    start as `building` describes it: a `calibrate.Own`; None for a target that is not a
+    component or has no node measured."""
     if target not in {c.name for c in building.components}:
         return None
-    columns = columns_among(sensors, set(building.component(target).node_ids))
+    nodes = building.component(target).node_ids
+    columns = columns_among(sensors, set(nodes))
     if not any(columns):
         return None
+    memory = POLICY.start_memory * slowest_time_constant(assemble(building), [i - 1 for i in nodes])
     return Own([[ids[j] for j in c] for ids, c in zip(sensors, columns)],
-               None if numerical is None else [e[:, c] for e, c in zip(numerical, columns)], sigma)
+               None if numerical is None else [e[:, c] for e, c in zip(numerical, columns)], sigma, memory)
 
 
 def columns_among(sensors, nodes):

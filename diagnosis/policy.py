@@ -119,6 +119,12 @@ class Policy:
     # sensor the model follows to the noise counts fully, one it misses by more, sd^2 over its
     # mean squared residual.
     sensor_weight_cap: float = 1.0
+    # The time constants of a component (its slowest, as the model describes it:
+    # `model.network.slowest_time_constant`) after the burn-in before its candidate's fit reads
+    # its own measured nodes (dimensionless): the burn-in sets the measured nodes, not those
+    # beside them (a heavy floor's deep layers), and whatever their start misses has fallen to
+    # e^-3 = 5 % of it by then.
+    start_memory: float = 3.0
 
     # -- rounds
     # Effects added at most, one a round (count): a record rarely supports three undeclared effects.

@@ -282,3 +282,19 @@ def face_heat_flux(building, network, T, U, component, face):
     net = T @ network.A[node] + network.sources(U)[:, node]
     within = sum(network.A[node, j] * (T[:, j] - T[:, node]) for j in own if j != node)
     return (net - within) / c.area
+
+
+def slowest_time_constant(network, nodes):
+    """The slowest time constant (s) of the nodes `nodes` (0-based; those with capacity) with every
+    other node and every input held: the time in which an error of their starting temperatures
+    falls by a factor e, whatever its shape through them (a heavy floor's deep nodes started
+    where the measurements do not say).
+
+    It is 1 / lambda_min of C^-1 K on those nodes, K = -A restricted to them (its diagonal holds
+    their conductances to the nodes held), computed as the symmetric C^-1/2 K C^-1/2."""
+    nodes = np.asarray([i for i in nodes if network.C[i] > 0.0])
+    if len(nodes) == 0:
+        return 0.0
+    root = np.sqrt(network.C[nodes])
+    K = -network.A[np.ix_(nodes, nodes)]
+    return float(1.0 / np.linalg.eigvalsh(K / np.outer(root, root)).min())

@@ -251,9 +251,9 @@ def test_a_component_s_own_surface_read_beside_the_air_moves_its_value_to_the_tr
         m[1 + B:, door - 1] += surface_offset
         return replace(case, measured=m)
 
-    def fitted(surface_offset=0.0, own=True):
+    def fitted(surface_offset=0.0, own=True, memory=0.0):
         found, _, _ = calibrate(candidate, with_offset(surface_offset), objective,
-                                own=Own([[door]], None, 0.1) if own else None)
+                                own=Own([[door]], None, 0.1, memory) if own else None)
         return found["factor"]["value"]
 
     def weight(surface_offset):
@@ -267,3 +267,6 @@ def test_a_component_s_own_surface_read_beside_the_air_moves_its_value_to_the_tr
     assert abs(read - 1.5) < abs(alone - 1.5) / 3
     assert weight(1.5) <= 0.01 < weight(0.0)
     assert abs(fitted(1.5) - alone) < abs(read - alone)
+    # a surface read only once the component has forgotten its start: a memory as long as the
+    # record leaves the air alone
+    assert fitted(memory=6 * 86400.0) == pytest.approx(alone)

@@ -302,3 +302,29 @@ def test_substeps_converge_to_the_exact_response_to_a_ramp_at_first_order():
     assert errors[2] / errors[1] == pytest.approx(1 / 4, rel=0.15)
     assert errors[3] / errors[2] == pytest.approx(1 / 4, rel=0.15)
     assert errors[3] < 0.005
+
+
+def test_a_component_s_slowest_time_constant_by_hand_and_from_its_free_decay():
+    """One node of capacity C tied to the nodes held by g: tau = C / g. A whole floor's
+    slowest time constant is the rate at which an error of its start dies away once every other
+    node is held, here from the matrix exponential of the free decay (non-symmetric, no
+    eigen-solver): after ten days the error's norm falls by exp(-day / tau) a day."""
+    from scipy.linalg import expm
+
+    from nodeforce.model.network import Network, slowest_time_constant
+    C, g = 2.0e5, 4.0
+    one = Network(C=np.array([C, 0.0]), A=np.array([[-g, g], [g, -g]]), B=np.zeros((2, 0)), q=np.zeros(2),
+                  input_names=())
+    assert slowest_time_constant(one, [0]) == pytest.approx(C / g, rel=1e-12)
+    assert slowest_time_constant(one, [1]) == 0.0  # a node without capacity forgets at once
+
+    building = parse_building(TESTCELL)
+    network = assemble(building)
+    floor = np.array(building.component("floor").node_ids) - 1
+    tau = slowest_time_constant(network, floor)
+    decay = network.A[np.ix_(floor, floor)] / network.C[floor][:, None]
+    day = 86400.0
+    error = expm(decay * 10 * day) @ np.linspace(1.0, -2.0, len(floor))
+    assert np.linalg.norm(expm(decay * day) @ error) / np.linalg.norm(error) == pytest.approx(np.exp(-day / tau),
+                                                                                            rel=1e-3)
+    assert tau > 2 * day  # a heavy floor: the reason its own nodes wait
