@@ -256,8 +256,9 @@ class Windows:
         return np.array(out)
 
     def sensor_scores(self, sensed, weights):
-        """What a candidate, fitted to the air alone, predicts of what the other sensors saw: their
-        J (C2) on every block, the records' in order, each sensor's squares times its weight
+        """What a candidate predicts of what the other sensors saw (its own component's, where its
+        fit read them, by the fold without each block: `assess`): their J (C2) on every block,
+        the records' in order, each sensor's squares times its weight
         (`sensor_weights`); the weighted residuals w r there (C, every block's in one order),
         from which the noise makes 2 sigma |w (r_a - r_b)| of a difference (`selection`); and
         the readings, and what the noise counts of them, sum w^2.

@@ -52,9 +52,10 @@ to, block by block:
    smaller. Components whose corrections cannot be told apart are named together in the reason.
    Whether a candidate passes (1.) reads the air, the objective: the other sensors judge
    between explanations of the air, never whether it needs one; except a component's own
-   sensors (`own_test`): a component whose correction, fitted to the air, brings its own
-   surface to the noise and the file's numerical error there, by a fall beyond what they could
-   make, and leaves the air no worse than the noise's margin, passes too. The paper's method
+   sensors (`own_test`): a component whose correction, its surface on each day predicted by
+   the fit without that day (`calibrate.Own`), brings that surface to the noise and the file's
+   numerical error there, by a fall beyond what they could make, and leaves the air no worse
+   than the noise's margin, passes too. The paper's method
    places a fault by forcing the sub-model's measured nodes; a second fault the air no longer
    points at (the first effect brought it to the noise) is still placed by the component's own
    sensor.
