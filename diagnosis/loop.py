@@ -103,9 +103,10 @@ class Assessed:
     """One candidate calibrated and run (`assess`): its parameters ({name: {"value", "std", ...}}),
     what the data determine besides, its objective air (N_t, zones) and other sensed nodes
     (`Windows.sensors`) over each whole record (its own component's, which its fit read, on
-    each block as the fold without that block predicts them: `assess`), its cross-validation folds ({"values",
-    "residuals"} each), the simulations it took and its building file (JSON), declared at the
-    calibrated values: the caller writes it, as a Dask worker may not share its file system."""
+    each block as the fold without that block predicts them: `assess`), its cross-validation
+    folds ({"values", "residuals"} each), the simulations it took and its building file (JSON),
+    declared at the calibrated values: the caller writes it, as a Dask worker may not share its
+    file system."""
     parameters: dict
     determined: dict
     runs: list
@@ -121,8 +122,8 @@ def assess(shared, pair):
     reads (`assess_all`); `pair`: the (effect, target).
 
     A candidate on a component whose own nodes are measured is fitted to them beside the air
-    (`calibrate.Own`); its other sensed nodes on each block are then the fold's, fitted without
-    that block, so that what the choice reads of its own sensors is, as of the air, what no fit read."""
+    (`calibrate.Own`); those nodes on each block are then the fold's, fitted without that block,
+    so that what the choice reads of its own sensors is, as of the air, what no fit read."""
     building, bases, calibrations, cases, objective, blocks, sensors, numerical, at_sensors, sigma, seed = shared
     effect, target = pair
     candidate = Candidate(building, effect, target, protocols(bases, calibrations, cases))

@@ -55,10 +55,9 @@ to, block by block:
    sensors (`own_test`): a component whose correction, its surface on each day predicted by
    the fit without that day (`calibrate.Own`), brings that surface to the noise and the file's
    numerical error there, by a fall beyond what they could make, and leaves the air no worse
-   than the noise's margin, passes too. The paper's method
-   places a fault by forcing the sub-model's measured nodes; a second fault the air no longer
-   points at (the first effect brought it to the noise) is still placed by the component's own
-   sensor.
+   than the noise's margin, passes too. The paper's method places a fault by forcing the
+   sub-model's measured nodes; a second fault the air no longer points at (the first effect
+   brought it to the noise) is still placed by the component's own sensor.
 
 The validation window plays no part. A model built by earlier rounds is the baseline a later
 round's candidate must pass against (its parameters held).
