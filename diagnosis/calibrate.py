@@ -197,7 +197,7 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None):
     steps = np.concatenate(steps)
     residuals, counted = weighted([np.zeros(len(e)) for e in extra])
     fit = solve(residuals, x0, lows, highs)
-    if any(np.isfinite(m[:, zones:]).any() for m in measured):
+    if any(h[:, zones:].any() for h in have):
         weights = own_weights(candidate, cases, ids, measured, numerical, zones, fit.x, own.sd)
         log.info("%s: its own nodes read beside the air, weighing %s", candidate.label,
                  "; ".join(", ".join(f"{n}: {w:.2g}" for n, w in zip(e, ws)) for e, ws in zip(extra, weights)))
