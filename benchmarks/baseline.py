@@ -42,7 +42,7 @@ def concerns(building, effect, target, zones):
 
 def air_run(building, case, air_nodes):
     """(N_t, zones) simulated air (C) of `building` on `case`, as the diagnosis runs it."""
-    return case.with_inputs(building).run(building)[:, np.array(air_nodes) - 1]
+    return case.with_inputs(building).run(building, np.array(air_nodes) - 1)
 
 
 def fit_one(building, case, effect, target, air_nodes, rows):

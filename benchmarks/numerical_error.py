@@ -28,7 +28,7 @@ CELLS = (2, 4)
 def air_on_calibration(building, r, air):
     """(n,) the air node's temperature (C) simulated from `building` on record `r`'s calibration window."""
     case = r.case(building=building)
-    T = case.run(building)[case.burn_in_steps:, air - 1]
+    T = case.run(building, [air - 1])[case.burn_in_steps:, 0]
     return T[:int(round(CALIBRATION_FRACTION * len(T)))]
 
 

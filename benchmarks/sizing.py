@@ -21,7 +21,7 @@ def before_error(building, weather, record, objective_node, burn_in=BURN_IN_DAYS
     start, on the record's last 40 %."""
     case = measured_case(building, weather, record, burn_in_days=burn_in).with_steady_start()
     h = case.history_steps
-    residual = (case.measured[1:, objective_node - 1] - case.run(building)[:, objective_node - 1])[h:]
+    residual = (case.measured[1:, objective_node - 1] - case.run(building, [objective_node - 1])[:, 0])[h:]
     k = int(round(CALIBRATION_FRACTION * len(residual)))
     return float(np.sqrt(np.nanmean(residual[k:] ** 2)))
 

@@ -265,9 +265,9 @@ def truth_record(truth, weather, times, nodes):
     empty = pd.DataFrame(index=weather.index)
     empty.attrs["source"] = "truth"
     case = prepare_case(truth, weather, empty)
-    T = simulate(truth, assemble(truth), case.U, case.dt, warmup_days=1, include_start=True, steady_start=True)
-    rows = weather.index.get_indexer(times)
-    return T[rows][:, np.array(nodes) - 1]
+    T = simulate(truth, assemble(truth), case.U, case.dt, warmup_days=1, include_start=True, steady_start=True,
+                 outputs=np.array(nodes) - 1)
+    return T[weather.index.get_indexer(times)]
 
 
 def frame(values, times, nodes, source):

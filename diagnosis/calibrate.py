@@ -84,10 +84,9 @@ class Candidate:
             _, inputs = self._inputs[id(case)]
             building = self.built(values, base)
             self.simulations += 1
-            T = inputs.run(building)
             if len(self._runs) >= KEPT_RUNS:
                 self._runs.pop(next(iter(self._runs)))
-            self._runs[key] = T[:, np.asarray(node_ids) - 1]
+            self._runs[key] = inputs.run(building, np.asarray(node_ids) - 1)
         return self._runs[key]
 
 

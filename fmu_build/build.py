@@ -35,7 +35,7 @@ VARIABLES = Path(__file__).with_name("variables.py")
 MODEL_DIR = Path(model.__file__).parent
 # The modules the FMU imports; weather and solar stay outside (their results are inputs).
 PHYSICS_MODULES = ("__init__", "errors", "building", "building_file", "discretise", "schedule", "effects", "network",
-                   "integrate")
+                   "modal", "integrate")
 SCHEMA = "data/nodal-building.schema.json"
 
 

@@ -159,5 +159,6 @@ class ModelEvaluator(_Evaluator):
         T = simulate(self.spec.building, self.network, case.U, case.dt, case.measured, force=force,
                      warmup_days=self.spec.warmup_days, burn_in_steps=case.burn_in_steps, stepper=self.stepper,
                      steady_start=case.steady_start, steady_stepper=self.steady, substeps=case.substeps,
-                     history_steps=case.history_steps, history_stepper=self.history)
-        return T[:, np.array(self.spec.objective.air_nodes) - 1]
+                     history_steps=case.history_steps, history_stepper=self.history,
+                     outputs=np.array(self.spec.objective.air_nodes) - 1)
+        return T

@@ -58,11 +58,21 @@ class Network:
     def sources(self, U):
         """B u + q + the products of inputs (W), for one input vector u (n_inputs,) or for rows
         of inputs U (n_rows, n_inputs), which give (n_rows, N)."""
+        terms, B, q = self.source_terms(U)
+        return terms @ B.T + q
+
+    def source_terms(self, U):
+        """The sources as terms linear in their coefficients: (terms, B', q) with
+        `sources(U) = terms B'^T + q`, the terms the inputs u then the products u_a u_b
+        (n_inputs + n_products of them, W per unit of each), B' (N, that many) their
+        coefficients."""
         U = np.asarray(U, dtype=float)
-        S = U @ self.B.T + self.q
-        for node, a, b, coefficient in self.products:
-            S[..., node] += coefficient * U[..., a] * U[..., b]
-        return S
+        if not self.products:
+            return U, self.B, self.q
+        nodes, a, b, coefficients = (np.array(x) for x in zip(*self.products))
+        products = np.zeros((self.n_nodes, len(self.products)))
+        products[nodes, np.arange(len(nodes))] = coefficients
+        return (np.concatenate([U, U[..., a] * U[..., b]], axis=-1), np.hstack([self.B, products]), self.q)
 
 
 def input_names(building):

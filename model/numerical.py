@@ -57,14 +57,14 @@ def reference(case, building, nodes):
     own nodes) at t_1..t_N, simulated as a diagnosis runs `case` (its history, burn-in and steady
     start)."""
     fine, on_fine = reference_case(case, building)
-    return on_fine.run(fine)[:, np.asarray(nodes) - 1]
+    return on_fine.run(fine, np.asarray(nodes) - 1)
 
 
 def discretisation_error(case, building, nodes):
     """(N_t, len(nodes)) the file's numerical error at `nodes` (ids), C, at t_1..t_N: the building
     as written minus the refined reference (`reference`), both simulated as a diagnosis runs
     `case`."""
-    return case.with_inputs(building).run(building)[:, np.asarray(nodes) - 1] - reference(case, building, nodes)
+    return case.with_inputs(building).run(building, np.asarray(nodes) - 1) - reference(case, building, nodes)
 
 
 def share(residual, error, rows=None):

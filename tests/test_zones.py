@@ -153,7 +153,8 @@ def test_an_irradiance_column_equals_the_same_values_given_as_I_component(tmp_pa
     own = weather_csv(tmp_path / "b.csv", lambda sun: {"I_wA": 0.8 * sun, "I_wB": 0.8 * sun})
     T_shared = simulate_case(building(True), shared)
     T_own = simulate_case(building(False), own)
-    assert np.array_equal(T_shared, T_own)
+    # the same sources summed in another order (one column for two faces, or one each): equal to rounding
+    assert np.abs(T_shared - T_own).max() < 1e-10
     # and the measured column is what the faces get, not the computed transposition
     T_computed = simulate_case(building(False), weather_csv(tmp_path / "c.csv", lambda sun: {}))
     assert np.abs(T_computed - T_own).max() > 0.01
