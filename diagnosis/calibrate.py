@@ -19,8 +19,6 @@ from dataclasses import dataclass
 from types import SimpleNamespace
 
 import numpy as np
-from SALib.analyze import morris as morris_analyze
-from SALib.sample import morris as morris_sample
 from scipy.optimize import least_squares
 
 from nodeforce.diagnosis.candidates import calibration_start
@@ -34,7 +32,6 @@ from nodeforce.model.numerical import share
 
 log = logging.getLogger("nodeforce.diagnosis")
 
-MORRIS_TRAJECTORIES = 4
 # The step of a derived quantity's differences (`gradient`), as a fraction of a parameter's range:
 # the HLC and a ground coupling's flux are smooth in every parameter (a conductance in series, a
 # linear network solved exactly), so a small step is exact to many digits.
@@ -461,22 +458,3 @@ def gradient(f, x, bounds):
         # a parameter f does not depend on (a capacity in the HLC, a gain) moves it by rounding only
         slope[j] = change / h if abs(change) > 1e-12 * max(abs(at), 1.0) else 0.0
     return at, slope
-
-
-def sensitivity(candidate, cases, objective, seed=0):
-    """Morris elementary effects of the parameters, over their bounds, on J of `cases` (a Case,
-    or several records' calibration windows, their J summed).
-
-    Returns {name: {"mu_star": C2, "sigma": C2}}: mu* ranks how much J moves with a parameter,
-    sigma how much that depends on the others (interaction or non-linearity).
-    """
-    cases = as_cases(cases)
-    measured = [objective.measured(case) for case in cases]
-    problem = {"num_vars": len(candidate.parameters), "names": [p.name for p in candidate.parameters],
-               "bounds": [list(b) for b in candidate.bounds]}
-    X = morris_sample.sample(problem, MORRIS_TRAJECTORIES, num_levels=4, seed=seed)
-    Y = np.array([sum(objective.J(m, candidate.nodes(case, objective.air_nodes, x)) for case, m in zip(cases, measured))
-                  for x in X])
-    analysis = morris_analyze.analyze(problem, X, Y, num_levels=4, seed=seed)
-    return {name: {"mu_star": float(m), "sigma": float(s)}
-            for name, m, s in zip(problem["names"], analysis["mu_star"], analysis["sigma"])}

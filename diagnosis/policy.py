@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 
 import numpy as np
-from scipy.stats import chi2
+from scipy.special import chdtrc
 
 from nodeforce.model.effects import EFFECTS, bridge_parts
 
@@ -162,7 +162,7 @@ class Policy:
         """Whether the data leave `held` parameters at their physical priors: the score
         statistic (`diagnosis.calibrate.score_statistic`, chi-square with `held` degrees of
         freedom) has a p-value of at least `prior_level`."""
-        return bool(chi2.sf(statistic, held) >= self.prior_level)
+        return bool(chdtrc(held, statistic) >= self.prior_level)  # the chi-square's survival function
 
     def sensor_weight(self, sd, mean_square):
         """Sensors' weights in the evidence: sd^2 (C2) over each one's mean squared residual (C2,

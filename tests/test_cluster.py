@@ -84,8 +84,8 @@ def test_a_diagnosis_on_a_two_worker_cluster_gives_the_local_answer(door, local,
 def kill_at_first_candidate(done, victim=None):
     """In a worker process: the first candidate any worker starts kills `victim` (default its own
     process) outright (SIGKILL, as a machine lost); the file `done` says it happened, so only once."""
-    from nodeforce.diagnosis import loop
-    assess = loop.assess
+    from nodeforce.diagnosis import assess as task
+    assess = task.assess
 
     def killing(shared, pair):
         try:
@@ -94,7 +94,7 @@ def kill_at_first_candidate(done, victim=None):
             return assess(shared, pair)
         os.kill(victim or os.getpid(), signal.SIGKILL)
 
-    loop.assess = killing
+    task.assess = killing
 
 
 def test_a_worker_killed_in_the_middle_of_a_round_costs_no_answer(door, local, tmp_path):
