@@ -322,10 +322,10 @@ class Model:
                      [None if b is None else EFFECTS[effect].apply(b, target, values) for b in self.bases])
 
 
-def assess_all(model, pairs, windows, objective, sigma, folder, seed, workers, cluster=None):
+def assess_all(model, pairs, windows, objective, sigma, folder, seed, pool=None, cluster=None):
     """Each (effect, target) added to `model`, calibrated on every record's calibration window
-    (t_0..t_k) with a fold per block, and run over each record, in parallel worker processes
-    (which end with this process: nodeforce.lifetime), or on the workers of `cluster` (a
+    (t_0..t_k) with a fold per block, and run over each record, in the worker processes of
+    `pool` (`lifetime.worker_pool`; None: in this process), or on the workers of `cluster` (a
     `nodeforce.cluster.Cluster`), each candidate's building file written in `folder`: their
     `Assessed`, in the order of `pairs`. `sigma`: the sensors' noise (C), against which a
     component's own nodes are weighed in its fit (`calibrate.own_weights`)."""
@@ -340,12 +340,10 @@ def assess_all(model, pairs, windows, objective, sigma, folder, seed, workers, c
                 if isinstance(outcome, BaseException):
                     raise outcome
         else:
-            n_workers = min(workers or os.cpu_count(), len(pairs))
-            with (lifetime.worker_pool(n_workers) if n_workers > 1 else nullcontext()) as pool:
-                assessed = []
-                for outcome in (pool.map if pool else map)(partial(assess, shared), pairs):
-                    assessed.append(outcome)
-                    bar.update()
+            assessed = []
+            for outcome in (pool.map if pool else map)(partial(assess, shared), pairs):
+                assessed.append(outcome)
+                bar.update()
     for (effect, target), a in zip(pairs, assessed):
         (folder / f"{effect}@{target}.json").write_text(json.dumps(a.building, indent=2) + "\n")
     return list(assessed)
@@ -512,58 +510,64 @@ def localise(building, prepared, objective, workdir, search):
 def rounds(prepared, localization, objective, workdir, seed, workers, cluster=None):
     """Stage 3: rounds of candidates, `POLICY.max_rounds` at most, each on top of the last,
     while the error left is above the noise and one is chosen (`selection.decide`); the
-    candidates in `workers` processes or on `cluster`'s workers (`assess_all`)."""
-    windows, n, noise = prepared.windows, prepared.n, prepared.noise
-    folder = workdir / "candidates"
-    folder.mkdir(exist_ok=True)
-    measured_ids = sorted({i for case in windows.cases for i in case.measured_ids})
-    model, decisions, results, runs, sensitivities = prepared.model, [], [], {}, {}
-    for number in range(POLICY.max_rounds):
-        base_blocks = windows.block_J(model.runs)
-        air_at_noise = bool(number) and POLICY.at_noise(base_blocks.sum(), n, noise.floor_sd)
-        base_sensed = windows.sensed_by(model)  # the round's model at the other sensors: one run per record
-        if air_at_noise and not windows.disagreeing(model.building, base_sensed, noise.sigma):
-            break  # the error left is the noise's, at the air and at every component's own sensors
-        done = [d.chosen.label for d in decisions]  # every earlier round chose: a round without a choice ends them
-        started = time.perf_counter()
-        # a later round's candidates, on top of the earlier choices, are building files of their own
-        into = folder / f"round{number + 1}" if number else folder
-        into.mkdir(exist_ok=True)
-        pairs = [p for p in physical(model.building, localization["components"], objective.zones,
-                                     measured_ids, localization["best_nodes"]) if "@".join(p) not in done]
-        assessed = assess_all(model, pairs, windows, objective, noise.sigma, into, seed, workers, cluster)
-        tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma, number + 1, done)
-        # shapes only where no physical candidate physics admits brings the error left to the
-        # noise; the residual's statistics then choose which
-        if not any(POLICY.at_noise(r.cv.J, n, noise.floor_sd) and not POLICY.objection_of(
-                r.effect, r.parameters, r.derived, r.physics) for r in tried):
-            more = [p for p in shapes(model.building, left_by(windows, model), objective.zones)
-                    if "@".join(p) not in done]
-            pairs, assessed = pairs + more, assessed + assess_all(model, more, windows, objective, noise.sigma, into,
-                                                                  seed, workers, cluster)
-            # every sensor's weight from the least misfit any candidate of the round leaves
-            tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma, number + 1, done)
-        simulations = sum(a.simulations for a in assessed)
-        # a round run for a component's own sensors alone: only they can make a candidate pass
-        decision = decide(tried, base_blocks, noise.sigma, n, windows.groups(), noise.floor_sd,
-                          air_at_noise=air_at_noise)
-        decision.cost = {"candidates": len(tried), "simulations": simulations,
-                         "seconds": round(time.perf_counter() - started, 1)}
-        decisions.append(decision)
-        # the residuals themselves go (the decision keeps what the choice read of them, the
-        # distances of every two admissible candidates'): a house's rounds would hold gigabytes
-        results += [replace(r, cv=replace(r.cv, left_out=None), sensors=replace(r.sensors, residuals=None))
-                    for r in tried]
-        runs.update({(key if not number else f"{key} (round {number + 1})"): m.runs for key, m in models.items()})
-        chosen = decision.chosen
-        if not chosen:
-            break
-        # the Morris screening of the chosen effect's parameters, on the model it is added to: a
-        # screening of every candidate would cost a quarter of a round's simulations
-        screened = Candidate(model.building, chosen.effect, chosen.target, protocols(model.bases, windows.calibrations))
-        sensitivities[chosen.label] = sensitivity(screened, windows.calibrations, objective, seed=seed)
-        model = models[chosen.label]
-    return Made(decisions, results, runs, sensitivities, model)
+    candidates in `workers` processes, one pool for every round (a worker's start, its imports,
+    paid once), or on `cluster`'s workers (`assess_all`)."""
+    n_workers = (workers or os.cpu_count()) if cluster is None else 1
+    with lifetime.worker_pool(n_workers) if n_workers > 1 else nullcontext() as pool:
+        windows, n, noise = prepared.windows, prepared.n, prepared.noise
+        folder = workdir / "candidates"
+        folder.mkdir(exist_ok=True)
+        measured_ids = sorted({i for case in windows.cases for i in case.measured_ids})
+        model, decisions, results, runs, sensitivities = prepared.model, [], [], {}, {}
+        for number in range(POLICY.max_rounds):
+            base_blocks = windows.block_J(model.runs)
+            air_at_noise = bool(number) and POLICY.at_noise(base_blocks.sum(), n, noise.floor_sd)
+            base_sensed = windows.sensed_by(model)  # the round's model at the other sensors: one run per record
+            if air_at_noise and not windows.disagreeing(model.building, base_sensed, noise.sigma):
+                break  # the error left is the noise's, at the air and at every component's own sensors
+            done = [d.chosen.label for d in decisions]  # every earlier round chose: a round without a choice ends them
+            started = time.perf_counter()
+            # a later round's candidates, on top of the earlier choices, are building files of their own
+            into = folder / f"round{number + 1}" if number else folder
+            into.mkdir(exist_ok=True)
+            pairs = [p for p in physical(model.building, localization["components"], objective.zones,
+                                         measured_ids, localization["best_nodes"]) if "@".join(p) not in done]
+            assessed = assess_all(model, pairs, windows, objective, noise.sigma, into, seed, pool, cluster)
+            tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma, number + 1,
+                                    done)
+            # shapes only where no physical candidate physics admits brings the error left to the
+            # noise; the residual's statistics then choose which
+            if not any(POLICY.at_noise(r.cv.J, n, noise.floor_sd) and not POLICY.objection_of(
+                    r.effect, r.parameters, r.derived, r.physics) for r in tried):
+                more = [p for p in shapes(model.building, left_by(windows, model), objective.zones)
+                        if "@".join(p) not in done]
+                pairs, assessed = pairs + more, assessed + assess_all(model, more, windows, objective, noise.sigma,
+                                                                      into, seed, pool, cluster)
+                # every sensor's weight from the least misfit any candidate of the round leaves
+                tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma,
+                                        number + 1, done)
+            simulations = sum(a.simulations for a in assessed)
+            # a round run for a component's own sensors alone: only they can make a candidate pass
+            decision = decide(tried, base_blocks, noise.sigma, n, windows.groups(), noise.floor_sd,
+                              air_at_noise=air_at_noise)
+            decision.cost = {"candidates": len(tried), "simulations": simulations,
+                             "seconds": round(time.perf_counter() - started, 1)}
+            decisions.append(decision)
+            # the residuals themselves go (the decision keeps what the choice read of them, the
+            # distances of every two admissible candidates'): a house's rounds would hold gigabytes
+            results += [replace(r, cv=replace(r.cv, left_out=None), sensors=replace(r.sensors, residuals=None))
+                        for r in tried]
+            runs.update({(key if not number else f"{key} (round {number + 1})"): m.runs for key, m in models.items()})
+            chosen = decision.chosen
+            if not chosen:
+                break
+            # the Morris screening of the chosen effect's parameters, on the model it is added to: a
+            # screening of every candidate would cost a quarter of a round's simulations
+            screened = Candidate(model.building, chosen.effect, chosen.target,
+                                 protocols(model.bases, windows.calibrations))
+            sensitivities[chosen.label] = sensitivity(screened, windows.calibrations, objective, seed=seed)
+            model = models[chosen.label]
+        return Made(decisions, results, runs, sensitivities, model)
 
 
 def left_by(windows, model):
