@@ -68,7 +68,8 @@ def code_digest():
     """A digest of the source files in `CODE` (their paths and contents)."""
     digest = hashlib.sha1()
     for path in sorted(p for folder in CODE for p in (ROOT / folder).rglob("*") if p.suffix in (".py", ".c", ".h", ".json")):
-        if path.name != "bench_diagnosis.py":  # its tables and options make no result
+        if not path.name.startswith("bench_"):  # the benchmarks' own scripts (this one's tables, the speed
+            # measurements) make no result
             digest.update(str(path.relative_to(ROOT)).encode() + path.read_bytes())
     return digest.hexdigest()
 
@@ -378,14 +379,14 @@ def summary(results, draws):
     return lines, numbers
 
 
-# What one diagnosis costs, measured in the run of 2026-11-27 (every record, 3 draws of the test
-# cell's): the whole run is sized from it.
-BUDGET = ("The budget, measured in the run of 2026-11-27 on 2 cores, the forcing search driving the "
-          "standalone FMU (the API's default since commit 7d6ad65, as the command line's; the Python FMU "
-          "made the search some 5 times slower): a test-cell diagnosis takes 11 to 32 s with the paper's "
-          "sensors or the air alone and 16 to 47 s with every node measured (gso-jan, 23 forcing genes), "
-          "the baseline about 15 s, a Twin House diagnosis 2 to 3 min (its baseline 2 min). Every record "
-          "under one draw is then about 35 min on 2 workers, the two draws more about an hour, the Twin "
+# What one diagnosis costs, measured in the run of 2026-11-29 (every record, 3 draws): the whole
+# run is sized from it.
+BUDGET = ("The budget, measured in the run of 2026-11-29 on 2 cores (5 to 95 % of the records' times), the "
+          "forcing search driving the standalone FMU (the API's default since commit 7d6ad65, as the command "
+          "line's): a test-cell diagnosis takes 4 to 11 s with the paper's sensors or the air alone and 16 to "
+          "47 s with every node measured (gso-jan and mia-dec, 23 forcing genes), its baseline 2 to 4 s, a "
+          "Twin House diagnosis about 2 min (its baseline 1 min), making a record's truth 4 to 27 s. Every "
+          "record under one draw is then about 20 min on 2 workers, the two draws more 40 min, the Twin "
           "House's among them. The GA and the calibrations keep the command line's defaults. Finished "
           "records are kept in out/bench_diagnosis/records, each with a digest of its spec and of the "
           "code (the package, the records, the baseline, the examples): a rerun skips what is unchanged, "
