@@ -7,8 +7,9 @@ the node's measured temperature: a Dirichlet condition. M is factorised once per
 the zones' nodes above). A record sampled every dt is integrated in `substeps(dt)` steps per
 sample, its inputs and imposed temperatures in between from `within_steps`.
 
-The FMU's `doStep` and the direct model's `simulate` both call `ImplicitEuler.step`: one
-arithmetic for every path through the code.
+The FMU's `doStep` calls `ImplicitEuler.step`; the direct model's `simulate` calls it too, or,
+over a long run of steps under one step matrix, solves the same steps in their modes (`modal`):
+the same temperatures to rounding.
 """
 import math
 from collections import OrderedDict
