@@ -40,9 +40,10 @@ STEADY_STEP = 1e10  # s
 # burn-in day, within 0.004 to 0.011 C of the truth alike; 3 h keeps the day's swing in the steps.
 HISTORY_STEP = 10800.0  # s
 # Steps per state node from which a run of steps under one step matrix is solved in its modes
-# (`modal`) rather than stepped: the eigen-decomposition costs about as much as this many steps
-# per node (on a 2-core Xeon: 20 ms for the Twin House's 260 state nodes, against 10 us a step;
-# 0.1 ms for the test cell's 22, against 3 us).
+# (`modal`) rather than stepped: a shorter run costs less stepped than decomposed. The test
+# cell's 22 state nodes decompose in 0.1 ms against 3 us a step (some 1.5 steps a node); a
+# decomposition grows as the cube of the nodes, a step as their square, so larger networks
+# break even later.
 MODAL_FROM = 8
 
 
