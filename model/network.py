@@ -14,6 +14,7 @@ the product of two inputs: `products` holds those terms, and `sources` adds them
 network stays linear in the temperatures and M is still factorised once per forcing mask.
 """
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -69,10 +70,17 @@ class Network:
         U = np.asarray(U, dtype=float)
         if not self.products:
             return U, self.B, self.q
+        a, b, B = self._product_terms
+        return np.concatenate([U, U[..., a] * U[..., b]], axis=-1), B, self.q
+
+    @cached_property
+    def _product_terms(self):
+        """The products' input indices a and b and B with their coefficients as columns, made
+        once: the Python FMU reads `sources` at every step."""
         nodes, a, b, coefficients = (np.array(x) for x in zip(*self.products))
         products = np.zeros((self.n_nodes, len(self.products)))
         products[nodes, np.arange(len(nodes))] = coefficients
-        return (np.concatenate([U, U[..., a] * U[..., b]], axis=-1), np.hstack([self.B, products]), self.q)
+        return a, b, np.hstack([self.B, products])
 
 
 def input_names(building):
