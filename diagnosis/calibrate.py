@@ -307,13 +307,30 @@ def score_statistic(held, indices, residuals, bounds, steps, lags):
     with as many degrees of freedom as parameters held where the priors are right. Read at the
     held fit, not the free one: along a valley the free fit's linearisation is no guide to how
     far its end is from the prior (T_ground +- 8600 K on a 50 K range). The held parameters'
-    Jacobian columns, which the held fit did not need, are differences of `STEP` of their ranges."""
+    Jacobian columns, which the held fit did not need, are differences of `STEP` of their ranges.
+
+    Those columns are taken where the held parameters act: a parameter the held fit left on a
+    bound is moved one such step into its range first. A bound can switch a held parameter off (a
+    ground coupling's U = 0 leaves no flux for T_ground to set): on it, the held column is the
+    simulation's rounding, and the statistic whatever that rounding makes of it; a step inside,
+    the column has the direction it takes as the bound is left, which is what the test asks
+    about (whether the data want the effect at another value than the prior). The statistic does
+    not depend on the parameters' scales, and is computed with every column scaled to unit
+    length, so that a short column (T_ground's, in proportion to U) is not lost below the
+    solvers' relative cutoffs."""
+    at = held.x.copy()
+    for j, (low, high) in enumerate(bounds):
+        if held.active_mask[j] != 0:
+            at[j] += step_inside(at[j], low, high)
+    base = residuals(at) if (at != held.x).any() else held.fun
     jac = held.jac.copy()
     for i in indices:
-        h = step_inside(held.x[i], *bounds[i])
-        moved = held.x.copy()
+        h = step_inside(at[i], *bounds[i])
+        moved = at.copy()
         moved[i] += h
-        jac[:, i] = (residuals(moved) - held.fun) / h
+        jac[:, i] = (residuals(moved) - base) / h
+    length = np.linalg.norm(jac, axis=0)
+    jac = jac / np.where(length > 0, length, 1.0)
     step = np.linalg.lstsq(jac, -held.fun, rcond=None)[0][indices]
     cov = parameter_covariance(jac, held.fun, steps, lags)[np.ix_(indices, indices)]
     return float(step @ np.linalg.pinv(cov) @ step)

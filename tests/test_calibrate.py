@@ -216,6 +216,36 @@ def test_the_score_test_of_a_held_parameter_rejects_a_right_prior_at_its_level_a
     assert rejected[3.0] / draws > 0.8
 
 
+def test_the_score_test_of_a_prior_sees_it_where_the_held_fit_switches_its_effect_off():
+    """A flux U (T - face(t)) with T held at a prior of 26 C above most of the face's swing: data
+    whose flux comes from a ground at 20 C make the held fit switch the coupling off (U = 0, on
+    its bound), where T acts not at all. The test reads T where the coupling is switched on, and
+    rejects the prior nearly always; with no flux in the data it rejects the prior in about
+    `prior_level` of the draws, as a regular chi-square with one degree of freedom."""
+    rng = np.random.default_rng(7)
+    n, prior = 400, 26.0
+    t = np.linspace(0.0, 1.0, n)
+    face = 25.0 + np.sin(2 * np.pi * 3 * t)
+    bounds = [(0.0, 20.0), (-10.0, 40.0)]
+    lows, highs = np.array(bounds).T
+    rejected = {0.0: 0, 0.5: 0}
+    draws = 400
+    for _ in range(draws):
+        noise = rng.normal(0.0, 0.1, n)
+        for U in rejected:
+            y = U * (20.0 - face) + noise
+
+            def residuals(x):
+                return y - x[0] * (x[1] - face)
+            held = solve(residuals, np.array([1.0, prior]), lows, highs, {1: prior})
+            statistic = score_statistic(held, [1], residuals, bounds, np.arange(n), 0)
+            rejected[U] += not POLICY.holds_prior(statistic, 1)
+            if U:
+                assert held.x[0] == pytest.approx(0.0, abs=1e-9)
+    assert abs(rejected[0.0] / draws - POLICY.prior_level) < 0.03
+    assert rejected[0.5] / draws > 0.95
+
+
 def test_a_component_s_own_surface_read_beside_the_air_moves_its_value_to_the_truth_where_another_fault_shares_the_air(
         testcell, weather):
     """A door 1.5 times as conductive and a window that lets in a tenth less sun, the air and the
