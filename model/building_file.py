@@ -13,7 +13,6 @@ Nodes are given explicitly (`"nodes": [{"id", "depth"}]`) or generated from the 
 (`"nodes": {"max_spacing": m}`), in which case the tool numbers every node: components in file
 order, each inside to outside, then each zone's air and radiant node.
 """
-import copy
 import functools
 import json
 import math
@@ -21,7 +20,8 @@ from dataclasses import replace
 from importlib.resources import files
 
 from .building import (DAY_TERMS, Adiabatic, AngularTransmittance, Boundary, Building, Component, Exterior, Gain,
-                       Inflow, Lumped, Material, Supply, Surface, Ventilation, Zone, boundary_columns)
+                       Inflow, Lumped, Material, Supply, Surface, Ventilation, Zone, boundary_columns,
+                       json_copy)
 from .discretise import generated_depths
 from .errors import InputError
 from .schedule import WEEKDAYS, Schedule
@@ -164,7 +164,7 @@ def parse_checked(data, source="<building>"):
                if name not in flux_sensors}
     return Building(name=str(data.get("name", "")), site=site, zones=zones, components=components,
                     sensors=sensors, flux_sensors=flux_sensors, boundary_factors=boundary_factors,
-                    schedules=schedules, source=source, data=copy.deepcopy(data),
+                    schedules=schedules, source=source, data=json_copy(data),
                     reader=parse_building)
 
 
