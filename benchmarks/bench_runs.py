@@ -1,13 +1,15 @@
-"""The cost of one simulation of a record as a diagnosis runs it (`model.case.Case.run`: the
-history, the burn-in, the sub-steps), on a few of the benchmark's records (docs/performance.md,
-"The diagnosis on one machine").
+"""The cost of one simulation of a record as a calibration runs it, on a few of the benchmark's
+records (docs/performance.md, "The diagnosis on one machine"): the effect's edit of the building
+file at the parameters' values (here a conductivity factor on the building's first component:
+the file copied, changed, checked and read again) and the run (`model.case.Case.run`: the
+history, the burn-in, the sub-steps).
 
     python benchmarks/bench_runs.py                 # the records below
     python benchmarks/bench_runs.py mia-jun/door-s  # others
 
 Each record's case and building as `benchmarks/records.py` makes them (draw 0); the median of
 `RUNS` runs in this process after one not counted, every node returned (the call every version
-of the code has). Run it in two checkouts to compare them.
+of the code has). Run it in two checkouts to compare them (this file copied into the older).
 """
 import statistics
 import sys
@@ -17,30 +19,38 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).parents[1]))
 
 from benchmarks.records import record  # noqa: E402
+from nodeforce.model.effects import EFFECTS  # noqa: E402
 
 RECORDS = ("mia-jun/door-s", "gso-apr/gain-L", "twin-gso-feb/W8-L")
 RUNS = 10
 
 
-def timed(name):
-    """(steps, median ms) of `Case.run` of the record's building on its case."""
-    r = record(name, 0)
-    case = r.case().with_inputs(r.building)
-    case.run(r.building)
+def median_ms(call):
+    """The median of `RUNS` calls (ms), after one not counted."""
+    call()
     seconds = []
     for _ in range(RUNS):
         started = time.perf_counter()
-        case.run(r.building)
+        call()
         seconds.append(time.perf_counter() - started)
-    return (len(case.U) - 1) * case.substeps, 1e3 * statistics.median(seconds)
+    return 1e3 * statistics.median(seconds)
+
+
+def timed(name):
+    """(steps, median ms of the edit, median ms of `Case.run`) of the record's building."""
+    r = record(name, 0)
+    case = r.case().with_inputs(r.building)
+    first = r.building.components[0].name
+    edit = median_ms(lambda: EFFECTS["conductivity"].apply(r.building, first, {"factor": 1.1}))
+    return (len(case.U) - 1) * case.substeps, edit, median_ms(lambda: case.run(r.building))
 
 
 def main(names):
-    print("| record | steps | Case.run (ms, median of %d) |" % RUNS)
-    print("|---|---|---|")
+    print("| record | steps | the edit (ms, median of %d) | Case.run (ms, median of %d) |" % (RUNS, RUNS))
+    print("|---|---|---|---|")
     for name in names or RECORDS:
-        steps, ms = timed(name)
-        print(f"| {name} | {steps:,} | {ms:.1f} |")
+        steps, edit, run = timed(name)
+        print(f"| {name} | {steps:,} | {edit:.2f} | {run:.1f} |")
     return 0
 
 
