@@ -5,7 +5,8 @@ on data the calibration did not see.
    record's first days are a burn-in (docs/model.md: every measured node forced, not scored), so
    the walls start from what the sensors saw rather than from the warm-up's replay of the first
    day, which a record with real history does not match; the calibration window's scored steps
-   are cut into blocks of whole days for the cross-validation (`diagnosis.selection`).
+   are cut into blocks of whole days for the cross-validation (`diagnosis.selection`); the
+   windows, and the scores read on them, are `diagnosis.windows`.
 2. Before: the building as described, simulated through its FMU; metrics on both windows, per
    objective zone and together.
 3. The forcing search (`ga.locate`) on the calibration window: which nodes it locates, and per
@@ -35,7 +36,6 @@ on data the calibration did not see.
    correction holds beyond the records it was fitted and chosen on.
 """
 import json
-import math
 import os
 import sys
 import time
@@ -50,7 +50,7 @@ from nodeforce import lifetime
 from nodeforce.cluster import Cluster
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
-from nodeforce.diagnosis.assess import assess, columns_among, protocols
+from nodeforce.diagnosis.assess import assess, protocols
 from nodeforce.diagnosis.calibrate import Candidate
 from nodeforce.diagnosis.candidates import physical, shaped_inputs, shapes
 from nodeforce.diagnosis.compare import compare
@@ -61,251 +61,17 @@ from nodeforce.diagnosis.residuals import diagnostics as residual_diagnostics
 from nodeforce.diagnosis.policy import POLICY
 from nodeforce.diagnosis.result import (CrossValidation, Diagnosis, Fit, LaterRecord, OwnSensors, RecordOutcome,
                                         SensorEvidence)
-from nodeforce.diagnosis.selection import block_J, blocks as blocks_of, decide, on_block
+from nodeforce.diagnosis.selection import decide
 from nodeforce.diagnosis.sensitivity import sensitivity
+from nodeforce.diagnosis.windows import Record, Windows, period
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.iotools.energyplus_corrections import idf_of, write_corrections
 from nodeforce.ga.locate import check_measured, evaluator_kind, locate
-from nodeforce.model.case import measured_case
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
-from nodeforce.model.integrate import steps_per_day
-from nodeforce.model.numerical import reference, share
 from nodeforce.model.score import Noise
 
 
-def split(case, source, fraction=None, end=None):
-    """Row index k of the last calibration time: t_0..t_k calibrate, t_k+1..t_N validate.
-
-    Parameters
-    ----------
-    case : Case (its burn-in must fit in the calibration window, with a day to score)
-    source : the measurement file, for errors
-    fraction : the part of the record, by time, that calibrates
-    end : pandas Timestamp, the last calibration time (the row at or before it)
-    """
-    n, h = len(case.times) - 1, case.history_steps
-    if end is not None:
-        k = int(case.times.searchsorted(end, side="right")) - 1
-        what = f"a calibration ending {end.isoformat()}"
-    else:  # of the measured record: the weather's history before it is no part of either window
-        k = h + int(round(fraction * (n - h)))
-        what = f"a split {fraction:.0%} / {1 - fraction:.0%}"
-    day = steps_per_day(case.dt)
-    if k < case.burn_in_steps + day or n - k < day:
-        raise InputError(source, "time", f"{n - h} steps of {case.dt:g} s from {case.start.isoformat()}: {what} "
-                                         f"leaves no calibration window of the burn-in plus a day, or no "
-                                         f"validation window of a day")
-    return k
-
-
-@dataclass
-class Record:
-    """One record of the building: its case (burn-in set), the measurement file it came from (for
-    errors), its name in the report, where its calibration window ends (`calibration_end`, a
-    pandas Timestamp, else the `fraction` of it by time), its phases (iotools.phases.Phase) and,
-    for a record run under another protocol than the building file's (other supply flows, other
-    blinds), the building as written for that protocol (`building`, the case's): the same house,
-    node for node, to which every correction is added as to the building file. `read_from`:
-    `measured_case`'s arguments but the building (the weather and measurements DataFrames, the
-    burn-in, ...) where it was read from files (`nodeforce.read_record`), from which a later
-    record's case is prepared for each building compared (`case_for`)."""
-    case: object
-    source: str = "measurements"
-    name: str = None
-    fraction: float = 0.6
-    calibration_end: object = None
-    phases: tuple = ()
-    building: object = None
-    read_from: dict = None
-
-    def case_for(self, building):
-        """The record's case as `nodeforce compare` prepares it for `building` (`measured_case`
-        of the files it was read from, its burn-in the same)."""
-        return measured_case(building, **self.read_from)
-
-
-@dataclass
-class Windows:
-    """The records as the loop reads them: each one's case (steady start), the row k of its last
-    calibration time, its calibration window, its measured objective air (N_t, zones), the
-    cross-validation blocks of all records in order, (record index, mask), and each one's other
-    sensed nodes (`sensors`: the measured nodes besides the objective air, a wall's surface, a
-    neighbouring zone's air) with their measurements (`sensed`, (N_t, len(sensors)), NaN where
-    not scored)."""
-    records: list
-    cases: list
-    ks: list
-    calibrations: list
-    measured: list
-    blocks: list
-    sensors: list
-    sensed: list
-    numerical: list = None
-    sensor_numerical: list = None
-
-    @classmethod
-    def of(cls, records, objective):
-        cases, ks, calibrations, measured, blocks, sensors, sensed = [], [], [], [], [], [], []
-        for i, record in enumerate(records):
-            # what no sensor sets (every wall of an air-only record) starts from the steady state of
-            # the first day, not at the air's temperature: a heavy component would carry that guess
-            # for weeks, and the candidates' slow parameters would fit it
-            case = record.case if record.case.steady_start else record.case.with_steady_start()
-            k = split(case, record.source, record.fraction, record.calibration_end)
-            cases.append(case)
-            ks.append(k)
-            calibrations.append(case.window(0, k))
-            measured.append(objective.measured(case))
-            blocks += [(i, m) for m in blocks_of(k, case.burn_in_steps, case.dt, record.source)]
-            sensors.append([node for node in case.measured_ids if node not in objective.air_nodes])
-            sensed.append(case.scored([node - 1 for node in sensors[-1]]))
-        return cls(list(records), cases, ks, calibrations, measured, blocks, sensors, sensed)
-
-    def metrics(self, objective, runs, record=None):
-        """{"calibration", "validation"}: the objective's metrics of `runs` (one (N_t, zones) per
-        record) on every record's window together, or on `record`'s (an index) alone."""
-        chosen = range(len(self.cases)) if record is None else [record]
-        return {window: objective.metrics(*(np.concatenate([part[i][rows(self.ks[i])] for i in chosen])
-                                            for part in (self.measured, runs)))
-                for window, rows in (("calibration", lambda k: slice(None, k)),
-                                     ("validation", lambda k: slice(k, None)))}
-
-    def block_J(self, runs):
-        """J (C2) of `runs` on every block, the records' in order, each less the share of the
-        file's numerical error (`model.numerical.share`) the other blocks hold, as a candidate's
-        left-out block is scored (`diagnosis.calibrate`)."""
-        residuals = [m[:k] - run[:k] for m, run, k in zip(self.measured, runs, self.ks)]
-        errors = self.calibration_numerical() or [np.zeros_like(r) for r in residuals]
-        r, e = (np.concatenate([a.ravel() for a in parts]) for parts in (residuals, errors))
-        out = []
-        for i, mask in self.blocks:
-            s = share(r, e, ~np.concatenate([rows.ravel() for rows in on_block([a.shape for a in residuals], i, mask)]))
-            out.append(block_J(residuals[i] + s * errors[i], [mask])[0])
-        return np.array(out)
-
-    def sensor_scores(self, sensed, weights):
-        """What a candidate predicts of what the other sensors saw (its own component's, where its
-        fit read them, by the fold without each block: `assess`): their J (C2) on every block,
-        the records' in order, each sensor's squares times its weight
-        (`sensor_weights`); the weighted residuals w r there (C, every block's in one order),
-        from which the noise makes 2 sigma |w (r_a - r_b)| of a difference (`selection`); and
-        the readings, and what the noise counts of them, sum w^2.
-
-        sensed : the other sensed nodes' runs, one (N_t, len(sensors)) per record
-        weights : one (len(sensors),) per record"""
-        parts = [((self.sensed[i][:self.ks[i]] - sensed[i][:self.ks[i]])[m], weights[i]) for i, m in self.blocks]
-        return (np.array([float(np.nansum(w * np.square(r))) for r, w in parts]),
-                np.concatenate([(w * r)[np.isfinite(r)] for r, w in parts]),
-                int(sum(np.isfinite(r).sum() for r, _ in parts)),
-                float(sum((np.isfinite(r) * w ** 2).sum() for r, w in parts)))
-
-    def sensed_by(self, model):
-        """Per record, `model`'s temperatures (C, (N_t, len(sensors))) at the other sensed nodes,
-        under the record's protocol's building (`Model.bases`)."""
-        out = []
-        for case, ids, base in zip(self.cases, self.sensors, model.bases):
-            building = base or model.building
-            out.append(case.with_inputs(building).run(building, np.asarray(ids, dtype=int) - 1) if ids
-                       else np.empty((len(case.times) - 1, 0)))
-        return out
-
-    def sensor_weights(self, runs, sigma):
-        """Per record, each other sensor's weight in the choice: sigma^2 over the least mean
-        squared residual (over the calibration window) that any of `runs` leaves there
-        (`Policy.sensor_weight`); `runs`: the model's and each candidate's other sensed nodes
-        (`sensed_by`, `Assessed.sensed`), one (N_t, len(sensors)) per record each.
-
-        A sensor the model follows to the noise counts fully. One that every candidate misses
-        by far more (a real house's surface the model sees through a simplified wall, a heavy
-        wall still carrying the start the model does not know) counts as a measurement whose
-        error is that misfit: its residual is what no candidate is about, and unweighted it
-        would choose, among the explanations of the air, the one that mends it best (on the
-        real Twin House, a west-sun gain in the living room whose validation error doubled).
-        A sensor that a candidate mends counts as its noise: a component's own surface, which
-        disagrees with the model as written because that component is wrong, is the evidence
-        that places the fault there, not a misfit to discount."""
-        out = []
-        for i, ids in enumerate(self.sensors):
-            k = self.ks[i]
-            if not ids:
-                out.append(np.zeros(0))
-                continue
-            misfit = np.min([np.nanmean(np.square(self.sensed[i][:k] - run[i][:k]), axis=0) for run in runs], axis=0)
-            out.append(POLICY.sensor_weight(sigma, np.maximum(misfit, np.finfo(float).tiny)))
-        return out
-
-    def own_columns(self, nodes):
-        """Per record, the columns of its other sensors (`sensors`) that are among `nodes` (ids):
-        a component's own sensors (`columns_among`)."""
-        return columns_among(self.sensors, nodes)
-
-    def own_J(self, sensed, columns):
-        """J (C2) of the other sensors' `columns` (`own_columns`) on every block, the records' in
-        order, unweighted, for the runs `sensed` (one (N_t, len(sensors)) per record); and the
-        readings they score."""
-        parts = [(self.sensed[i][:self.ks[i]] - sensed[i][:self.ks[i]])[m][:, columns[i]] for i, m in self.blocks]
-        return (np.array([float(np.nansum(np.square(r))) for r in parts]),
-                int(sum(np.isfinite(r).sum() for r in parts)))
-
-    def own_numerical(self, columns):
-        """The root mean square (C) of the file's own numerical error (`sensor_numerical`) at the
-        sensors' `columns` (one list per record), over the calibration window's scored readings."""
-        errors = [e[:k][:, c][np.isfinite(m[:k][:, c])] for e, k, m, c in
-                  zip(self.sensor_numerical or [], self.ks, self.sensed, columns)]
-        squares = np.concatenate(errors) ** 2 if errors else np.zeros(0)
-        return math.sqrt(float(squares.mean())) if squares.size else 0.0
-
-    def disagreeing(self, building, sensed, sigma):
-        """The components whose own sensors the model (its other sensed nodes `sensed`, one per
-        record) misses by more than the noise and the file's numerical error there could
-        (`Policy.at_noise` on their J over the blocks): a component the air may no longer point
-        at, whose own surface still says it is wrong."""
-        out = []
-        for c in building.components:
-            columns = self.own_columns(set(c.node_ids))
-            if not any(columns):
-                continue
-            J, n = self.own_J(sensed, columns)
-            if n and not POLICY.at_noise(float(J.sum()), n, math.hypot(sigma, self.own_numerical(columns))):
-                out.append(c.name)
-        return out
-
-    def with_numerical(self, runs, sensed, building, bases, objective):
-        """The windows with the building file's own numerical error at the objective air (C, one
-        (N_t, zones) per record) and at the other sensors (`sensor_numerical`, one (N_t,
-        len(sensors)) per record): the file as run (`runs` at the air, `sensed` at the sensors,
-        under the record's protocol's building in `bases`, else `building`) minus the file
-        refined (`model.numerical.reference`)."""
-        numerical, at_sensors = [], []
-        for run, at, case, base, ids in zip(runs, sensed, self.cases, bases, self.sensors):
-            fine = reference(case, base or building, list(objective.air_nodes) + list(ids))
-            numerical.append(run - fine[:, :len(objective.air_nodes)])
-            at_sensors.append(at - fine[:, len(objective.air_nodes):])
-        return replace(self, numerical=numerical, sensor_numerical=at_sensors)
-
-    def numerical_rms(self):
-        """The root mean square (C) of the file's numerical error over the residuals the blocks score."""
-        squares = [np.square(e[:k])[np.isfinite(m[:k])] for e, k, m in zip(self.numerical, self.ks, self.measured)]
-        return float(np.sqrt(np.concatenate(squares).mean()))
-
-    def calibration_numerical(self, sensors=False):
-        """The file's numerical error on each record's calibration window, at the objective air
-        (or at the other `sensors`), None if not known."""
-        errors = self.sensor_numerical if sensors else self.numerical
-        return None if errors is None else [e[:k] for e, k in zip(errors, self.ks)]
-
-    def scored(self):
-        """Residuals the blocks score, on every record."""
-        return sum(int(np.isfinite(m[:k]).sum()) for m, k in zip(self.measured, self.ks))
-
-    def groups(self):
-        """Per record, its name, the indices of its blocks and the residuals they score: what
-        `selection.decide` needs to see a candidate that harms one record; [] for one record."""
-        if len(self.records) < 2:
-            return []
-        return [{"record": r.name, "blocks": [b for b, (i, _) in enumerate(self.blocks) if i == j],
-                 "n": int(np.isfinite(self.measured[j][:self.ks[j]]).sum())} for j, r in enumerate(self.records)]
 @dataclass
 class Model:
     """A model of the loop: its building, its objective air simulated over each whole record
@@ -698,17 +464,3 @@ def protocol(building, record):
             raise InputError(other.source, what, f"record {record.name}'s building is not {building.source}'s house "
                                                  f"under another protocol: its {what} differ")
     return other
-
-
-def period(windows, i):
-    """The calibration and validation spans of record i, where its scoring starts and its blocks."""
-    times, k, case = windows.cases[i].times, windows.ks[i], windows.cases[i]
-    return {"calibration": [case.start.isoformat(), times[k].isoformat()],
-            "calibration_scored_from": times[case.burn_in_steps + 1].isoformat(),
-            "validation": [times[k + 1].isoformat(), times[-1].isoformat()],
-            "blocks": [[times[1:k + 1][m][0].isoformat(), times[1:k + 1][m][-1].isoformat()]
-                       for j, m in windows.blocks if j == i],
-            "roles": {"calibration": "the forcing search and the candidates' fits read it; each of its "
-                                     "blocks of whole days ('blocks') is left out of a fit in turn and "
-                                     "predicted, and the choice is made on those predictions",
-                      "validation": "reports before and after only; no part in any choice"}}

@@ -255,7 +255,7 @@ class Diagnosis:
     """A whole diagnosis (`nodeforce.diagnose`).
 
     objective : the objective's zone names
-    period : the first record's windows and blocks (`diagnosis.loop.period`)
+    period : the first record's windows and blocks (`diagnosis.windows.period`)
     before, after : the objective's metrics ({"calibration", "validation"}, each per zone too) of
         the building as described and as corrected, every record's windows together
     localization : the forcing search's result on every record's calibration window (locate.json)

@@ -251,7 +251,7 @@ def own_test(own, sigma):
     step 1 with the noise, sigma (C), and the file's numerical error there in quadrature, and
     `standard_errors` of its scatter), and whether it beats that on more days than its best and
     leaves those sensors at the noise (`Policy.at_noise`, the test that found them disagreeing,
-    `loop.Windows.disagreeing`): a correction that moves a surface part of the way and leaves it
+    `windows.Windows.disagreeing`): a correction that moves a surface part of the way and leaves it
     off by more than the noise has not explained it (a fault next to it has: the sun of an
     opening, a neighbour's air), and does not place the fault there.
 

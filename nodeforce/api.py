@@ -12,7 +12,7 @@ from pathlib import Path
 from nodeforce import tempdirs
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import input_table, simulate_fmu
-from nodeforce.diagnosis import compare as _compare, loop as _loop
+from nodeforce.diagnosis import compare as _compare, loop as _loop, windows as _windows
 from nodeforce.fmu_build.build import build_fmu, fmu_kind as _fmu_kind
 from nodeforce.ga import locate as _locate
 from nodeforce.iotools.fmu_inputs import write_fmu_inputs
@@ -32,8 +32,8 @@ __all__ = ["InputError", "read_building", "convert_idf", "read_weather", "read_m
            "score_forcing", "locate", "diagnose", "Record", "compare"]
 
 # One record of a building among several in one diagnosis, or a later one: case, source, name,
-# fraction, calibration_end, phases, building, read_from (diagnosis.loop.Record).
-Record = _loop.Record
+# fraction, calibration_end, phases, building, read_from (diagnosis.windows.Record).
+Record = _windows.Record
 
 # The API's cases carry no file name: errors about their measurements say "measurements".
 SOURCE = "measurements"

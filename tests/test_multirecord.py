@@ -5,7 +5,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from nodeforce.diagnosis.loop import Record, diagnose
+from nodeforce.diagnosis.loop import diagnose
+from nodeforce.diagnosis.windows import Record
 from nodeforce.diagnosis.selection import harmed
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import Case

@@ -102,7 +102,7 @@ def test_the_model_a_candidate_is_measured_against_scores_each_day_with_the_shar
     all the others, as a candidate's left-out day is: the odd day with s = 0.6 (seven days of
     -0.6 e), leaving (0.6 - 0.2)^2 E; every other day with s = (6 x 0.6 + 0.2) / 7, leaving
     (0.6 - s)^2 E. Without the error given, every day keeps its whole residual, 0.36 E."""
-    from nodeforce.diagnosis.loop import Windows
+    from nodeforce.diagnosis.windows import Windows
 
     day, days = 24, 4
     t = np.arange(day * days) / day

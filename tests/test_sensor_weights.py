@@ -1,9 +1,10 @@
 """The other sensors' weights in the choice among explanations of the air
-(`diagnosis.loop.Windows.sensor_weights`): sigma^2 over what the model already misses at each,
+(`diagnosis.windows.Windows.sensor_weights`): sigma^2 over what the model already misses at each,
 checked against a sensor offset by a known amount."""
 import numpy as np
 
-from nodeforce.diagnosis.loop import Model, Record, Windows
+from nodeforce.diagnosis.loop import Model
+from nodeforce.diagnosis.windows import Record, Windows
 from nodeforce.model.case import prepare_case
 from nodeforce.model.score import Objective
 from nodeforce.model.synth import pseudo_measurements
