@@ -11,13 +11,12 @@ Each record's case and building as `benchmarks/records.py` makes them (draw 0); 
 `RUNS` runs in this process after one not counted, every node returned (the call every version
 of the code has). Run it in two checkouts to compare them (this file copied into the older).
 """
-import statistics
 import sys
-import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parents[1]))
 
+from benchmarks.bench_search import median_time  # noqa: E402
 from benchmarks.records import record  # noqa: E402
 from nodeforce.model.effects import EFFECTS  # noqa: E402
 
@@ -25,24 +24,14 @@ RECORDS = ("mia-jun/door-s", "gso-apr/gain-L", "twin-gso-feb/W8-L")
 RUNS = 10
 
 
-def median_ms(call):
-    """The median of `RUNS` calls (ms), after one not counted."""
-    call()
-    seconds = []
-    for _ in range(RUNS):
-        started = time.perf_counter()
-        call()
-        seconds.append(time.perf_counter() - started)
-    return 1e3 * statistics.median(seconds)
-
-
 def timed(name):
     """(steps, median ms of the edit, median ms of `Case.run`) of the record's building."""
     r = record(name, 0)
     case = r.case().with_inputs(r.building)
     first = r.building.components[0].name
-    edit = median_ms(lambda: EFFECTS["conductivity"].apply(r.building, first, {"factor": 1.1}))
-    return (len(case.U) - 1) * case.substeps, edit, median_ms(lambda: case.run(r.building))
+    edit = median_time(lambda: EFFECTS["conductivity"].apply(r.building, first, {"factor": 1.1}), RUNS)
+    run = median_time(lambda: case.run(r.building), RUNS)
+    return (len(case.U) - 1) * case.substeps, 1e3 * edit, 1e3 * run
 
 
 def main(names):
