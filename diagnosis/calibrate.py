@@ -28,6 +28,7 @@ from nodeforce.model.case import as_cases
 from nodeforce.model.significance import bandwidth, parameter_covariance
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.hlc import heat_loss_coefficient
+from nodeforce.model.network import assemble
 from nodeforce.model.numerical import share
 
 log = logging.getLogger("nodeforce.diagnosis")
@@ -48,14 +49,24 @@ class Candidate:
 
     `protocols` ({id(case): Building}) gives, for a case of a record run under another protocol
     (its own supply flows, its own blinds), that record's building as the model stands; the effect
-    is added to it there. Other cases run `building`."""
+    is added to it there. Other cases run `building`.
+
+    An effect that acts on the model's inputs alone, affinely in its parameters
+    (`model.effects.Effect.on_inputs`: a gain, an absorptance, a transmittance, a split of the
+    heat input), leaves the step matrix as it was, and the temperatures are affine in its
+    parameters: T(x) = T(a) + sum_i (x_i - a_i) S_i, every term linear in the sources. Such a
+    candidate is simulated 1 + k times per case and nodes (at a, and at each parameter moved to
+    its far bound: `Superposition`), and every other value of its parameters, the least
+    squares' iterations, their differences and the folds, is that sum: the same temperatures to
+    rounding. Whether the matrix is indeed left as it was is checked on the buildings themselves
+    (a heat input's split changes the links of a heater node, where the zone has one)."""
 
     def __init__(self, building, effect, target, protocols=None):
         self.building, self.effect, self.target = building, effect, target
         self.protocols = protocols or {}
         self.parameters = EFFECTS[effect].parameters
         self.bounds = EFFECTS[effect].bounds(building, target)  # [(low, high)] a calibration explores
-        self._runs, self._inputs = {}, {}
+        self._runs, self._inputs, self._superposed = {}, {}, {}
         self.simulations = 0  # simulations run (kept ones not counted again): a round's cost
 
     @property
@@ -72,19 +83,71 @@ class Candidate:
         """Simulated temperatures (C) of nodes at t_1..t_N, (N_t, len(node_ids)), with the effect
         at `values` (sequence)."""
         key = (id(case), tuple(node_ids), tuple(float(v) for v in values))
-        if key not in self._runs:
+        if key in self._runs:
+            return self._runs[key]
+        superposed = self._superposition(case, key[1])
+        run = superposed(values) if superposed is not None else self._simulated(case, node_ids, values)
+        if len(self._runs) >= KEPT_RUNS:
+            self._runs.pop(next(iter(self._runs)))
+        self._runs[key] = run
+        return run
+
+    def _simulated(self, case, node_ids, values):
+        base = self.protocols.get(id(case), self.building)
+        if id(case) not in self._inputs:
+            # the effect may read inputs the building as declared does not (a daily gain, the clock)
+            declared = EFFECTS[self.effect].apply(base, self.target, {})
+            self._inputs[id(case)] = (case, case.with_inputs(declared))
+        _, inputs = self._inputs[id(case)]
+        self.simulations += 1
+        return inputs.run(self.built(values, base), np.asarray(node_ids) - 1)
+
+    def _superposition(self, case, node_ids):
+        """The `Superposition` of these nodes on `case`, or None where the effect is not on the
+        inputs alone or its building's matrices move with its parameters."""
+        if not EFFECTS[self.effect].on_inputs:
+            return None
+        key = (id(case), node_ids)
+        if key not in self._superposed:
             base = self.protocols.get(id(case), self.building)
-            if id(case) not in self._inputs:
-                # the effect may read inputs the building as declared does not (a daily gain, the clock)
-                declared = EFFECTS[self.effect].apply(base, self.target, {})
-                self._inputs[id(case)] = (case, case.with_inputs(declared))
-            _, inputs = self._inputs[id(case)]
-            building = self.built(values, base)
-            self.simulations += 1
-            if len(self._runs) >= KEPT_RUNS:
-                self._runs.pop(next(iter(self._runs)))
-            self._runs[key] = inputs.run(building, np.asarray(node_ids) - 1)
-        return self._runs[key]
+            reference, far = superposition_points(self.building, self.effect, self.target, self.bounds)
+            networks = [assemble(self.built(x, base)) for x in [reference, *far]]
+            kept = all(np.array_equal(n.C, networks[0].C) and np.array_equal(n.A, networks[0].A)
+                       and n.switched == networks[0].switched for n in networks[1:])
+            self._superposed[key] = Superposition(
+                reference, far, [self._simulated(case, node_ids, x) for x in [reference, *far]]) if kept else None
+        return self._superposed[key]
+
+
+def superposition_points(building, effect, target, bounds):
+    """Where a `Superposition` simulates an effect: its calibration's start a (strictly inside
+    the range), and a with each parameter in turn moved to the farther of its bounds, the
+    longest difference, whose rounding is the least."""
+    start = calibration_start(building, effect, target)
+    a = np.array([start[p.name] for p in EFFECTS[effect].parameters])
+    far = []
+    for i, (low, high) in enumerate(bounds):
+        x = a.copy()
+        x[i] = high if high - a[i] >= a[i] - low else low
+        far.append(x)
+    return a, far
+
+
+class Superposition:
+    """Temperatures affine in an effect's parameters, from runs at a point a and at a with each
+    parameter moved alone (`far`): T(x) = T(a) + sum_i (x_i - a_i) (T(far_i) - T(a)) /
+    (far_i - a_i)."""
+
+    def __init__(self, reference, far, runs):
+        self.reference = np.asarray(reference, dtype=float)
+        self.at = runs[0]
+        self.slopes = [(run - self.at) / (x[i] - self.reference[i]) for i, (x, run) in enumerate(zip(far, runs[1:]))]
+
+    def __call__(self, values):
+        out = self.at.copy()
+        for value, a, slope in zip(values, self.reference, self.slopes):
+            out += (float(value) - a) * slope
+        return out
 
 
 @dataclass

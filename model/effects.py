@@ -56,6 +56,10 @@ class Effect:
     # (building, target, outdoor air (C) over the weather read) -> {name: Prior}: what physics
     # expects of a parameter where the data fix a combination of the effect's parameters only
     priors: Callable | None = None
+    # whether the effect acts on the model's inputs alone (its sources B u + q), affinely in its
+    # parameters, the step matrix left as declared: the temperatures are then affine in them
+    # (`diagnosis.calibrate.Superposition`)
+    on_inputs: bool = False
 
     def applies(self, building, target):
         return target in self.targets(building)
@@ -355,11 +359,12 @@ EFFECTS = {e.id: e for e in (
            *_zone_field("air_change_rate", "n"), _no_node),
     Effect("internal_gain", "a constant heat gain to the air",
            (Parameter("Q", "W", -5000.0, 5000.0),), _zones,
-           *_zone_field("internal_gain", "Q"), _no_node),
+           *_zone_field("internal_gain", "Q"), _no_node, on_inputs=True),
     Effect("solar_absorptance", "a corrected outside solar absorptance",
            (Parameter("alpha", "-", 0.0, 1.0),),
            lambda b: [c.name for c in b.exterior_components],
-           lambda b, t: {"alpha": b.component(t).outside.solar_absorptance}, _absorptance_write, _own_nodes),
+           lambda b, t: {"alpha": b.component(t).outside.solar_absorptance}, _absorptance_write, _own_nodes,
+           on_inputs=True),
     Effect("conductivity", "a scale on a component's conductances",
            (Parameter("factor", "-", 0.05, 20.0),), lambda b: [c.name for c in b.components],
            lambda b, t: {"factor": b.component(t).conductivity_factor}, _conductivity_write, _own_nodes),
@@ -369,13 +374,14 @@ EFFECTS = {e.id: e for e in (
     Effect("solar_transmittance", "a corrected transmittance of a glazing",
            (Parameter("tau", "-", 0.0, 1.0),),
            lambda b: [c.name for c in b.components if c.solar_transmittance is not None],
-           lambda b, t: {"tau": b.component(t).solar_transmittance}, _transmittance_write, _receiver_nodes),
+           lambda b, t: {"tau": b.component(t).solar_transmittance}, _transmittance_write, _receiver_nodes,
+           on_inputs=True),
     Effect("thermal_bridge", "a conductance from a zone's air to the outdoor air or a boundary temperature",
            (Parameter("UA", "W/K", 0.0, 200.0),), _bridge_targets, _bridge_read, _bridge_write, _no_node),
     Effect("heat_input_split", "a corrected radiative fraction of a zone's measured heat input",
            (Parameter("f_r", "-", 0.0, 1.0),), lambda b: [z.name for z in b.zones if z.heat_input],
            *_zone_field("heat_input_radiative_fraction", "f_r"),
-           lambda b, t: b.facing(t)),
+           lambda b, t: b.facing(t), on_inputs=True),
     Effect("internal_mass", "the zone's furniture and undeclared internal mass: a node coupled to its air",
            (Parameter("C_m", "J/K", 0.0, 1e9), Parameter("H_m", "W/K", 0.01, 1e5)), _zones,
            *_lumped_field("internal_mass", "C_m", "H_m"), _no_node, _lumped_limits("C_m")),
@@ -391,14 +397,14 @@ EFFECTS = {e.id: e for e in (
     Effect("shading_transmittance", "the part of a glazing's sun that the zone's closed shading devices "
                                     "still let in (a screen's openness, the heat a blind absorbs and passes on)",
            (Parameter("f", "-", 0.0, 1.0),), _shading_targets,
-           *_zone_field("shading_transmittance", "f"), _shading_receivers),
+           *_zone_field("shading_transmittance", "f"), _shading_receivers, on_inputs=True),
     Effect("daily_gain", "a heat gain to the air with a daily profile: its mean and harmonics of the local time",
            (Parameter("mean", "W", -5000.0, 5000.0), *(Parameter(t, "W", -5000.0, 5000.0) for t in DAY_TERMS)),
-           _zones, _daily_read, _daily_write, _no_node),
+           _zones, _daily_read, _daily_write, _no_node, on_inputs=True),
     Effect("proportional_gain", "a heat gain to the air of k times an input column (W per unit of the column: "
                                 "dimensionless for a heat input, m2 for an irradiance)",
            (Parameter("k", "-", -10.0, 10.0),), _proportional_targets, _proportional_read, _proportional_write,
-           _no_node),
+           _no_node, on_inputs=True),
     Effect("boundary_conductance", "one factor on every conductance from the building to a boundary temperature "
                                    "column (attic, cellar, a neighbour): its components' layers and outside "
                                    "coefficients, and the zones' thermal bridges to it",
@@ -410,7 +416,7 @@ EFFECTS = {e.id: e for e in (
            (Parameter("V", "m3/h", 0.0, 3000.0),), _pair_targets, _pair_read, _pair_write, _no_node),
     Effect("heat_input_factor", "a factor on a zone's measured heat input: the heat its heater delivers per W read",
            (Parameter("factor", "-", 0.0, 5.0),), lambda b: [z.name for z in b.zones if z.heat_input],
-           *_zone_field("heat_input_factor", "factor"), _no_node),
+           *_zone_field("heat_input_factor", "factor"), _no_node, on_inputs=True),
 )}
 
 

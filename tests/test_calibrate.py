@@ -1,12 +1,21 @@
 """The cross-validation folds of a calibration (`diagnosis.calibrate.fold`): a fold is the fit
 without one day, one Gauss-Newton step from the whole window's optimum; checked against fits
-made afresh by scipy on the days it keeps; and the test that holds a parameter at its prior."""
+made afresh by scipy on the days it keeps; the test that holds a parameter at its prior; and a
+candidate on the inputs alone, superposed, against its model simulated afresh."""
+import copy
+
 import numpy as np
+import pandas as pd
 import pytest
 from scipy.optimize import least_squares
 
-from nodeforce.diagnosis.calibrate import fold, score_statistic, solve
+from nodeforce.diagnosis.calibrate import Candidate, fold, score_statistic, solve
 from nodeforce.diagnosis.policy import POLICY
+from nodeforce.model.building_file import parse_building
+from nodeforce.model.case import prepare_case
+from nodeforce.model.effects import EFFECTS
+from nodeforce.model.synth import pseudo_measurements
+from tests.conftest import SENSORS
 
 DAYS, PER_DAY = 4, 100
 
@@ -59,7 +68,6 @@ def test_a_component_s_loss_is_what_its_layers_add_to_the_heat_loss_coefficient(
     lower bound; it saturates behind the surface coefficients; its sd is the slope times the
     factor's sd (a central difference, apart from the forward one `derived` takes)."""
     from nodeforce.diagnosis.calibrate import Candidate, derived
-    from nodeforce.model.effects import EFFECTS
     from nodeforce.model.hlc import heat_loss_coefficient
 
     door = Candidate(testcell, "conductivity", "door")
@@ -92,7 +100,6 @@ def test_a_ground_flux_s_spread_moves_the_face_with_the_parameters(testcell, wea
     the face still, which reads it several times larger."""
     from nodeforce.diagnosis.calibrate import Candidate, derived, within_ranges
     from nodeforce.model.case import measured_case
-    from nodeforce.model.synth import pseudo_measurements
 
     from .conftest import SENSORS, record_times
     case = measured_case(testcell, weather, pseudo_measurements(testcell, weather, record_times(3), SENSORS),
@@ -153,10 +160,8 @@ def test_a_fit_that_carries_the_files_numerical_error_finds_the_walls_of_the_fil
     from nodeforce.diagnosis.calibrate import Candidate, calibrate
     from nodeforce.diagnosis.selection import blocks
     from nodeforce.model.case import measured_case
-    from nodeforce.model.effects import EFFECTS
     from nodeforce.model.numerical import discretisation_error, reference_case
     from nodeforce.model.score import Objective
-    from nodeforce.model.synth import pseudo_measurements
 
     from .conftest import record_times
     air = testcell.zones[0].air_node
@@ -258,9 +263,7 @@ def test_a_component_s_own_surface_read_beside_the_air_moves_its_value_to_the_tr
 
     from nodeforce.diagnosis.calibrate import Candidate, Own, calibrate, own_weights
     from nodeforce.model.case import measured_case
-    from nodeforce.model.effects import EFFECTS
     from nodeforce.model.score import Objective
-    from nodeforce.model.synth import pseudo_measurements
 
     from .conftest import record_times
     air, door = testcell.zones[0].air_node, testcell.component("door").node_ids[0]
@@ -301,3 +304,61 @@ def test_a_component_s_own_surface_read_beside_the_air_moves_its_value_to_the_tr
     # record leaves the air alone (to least squares' own tolerance: the run that carries the
     # door's column too rounds the air's otherwise)
     assert fitted(memory=6 * 86400.0) == pytest.approx(alone, rel=1e-3)
+
+
+# -- an effect on the inputs alone, superposed --------------------------------------------
+
+@pytest.fixture(scope="module")
+def equipped(testcell_data, weather):
+    """The test cell with a measured heater (`Q_heat`, on and off) and a blind on its window
+    (`blind`, drawn 9 to 17 h), so that every effect on the inputs has a target; its case, 3 days
+    at 15 min with the paper's sensors (forced over a burn-in day), and the same cell whose heater
+    has a node of its own (`heat_input_lag`)."""
+    data = copy.deepcopy(testcell_data)
+    data["zones"][0]["heat_input"] = "Q_heat"
+    next(c for c in data["components"] if "solar_transmittance" in c)["shading"] = "blind"
+    building = parse_building(data)
+    hour = weather.index.tz_convert("-05:00").hour
+    rng = np.random.default_rng(3)
+    w = weather.assign(blind=np.where((hour >= 9) & (hour < 17), 0.0, 1.0),
+                       Q_heat=500.0 * (np.cumsum(rng.random(len(weather)) < 0.2) % 2))
+    w.attrs = weather.attrs
+    times = pd.date_range("2001-06-10 00:00", periods=3 * 96 + 1, freq="15min", tz="-05:00", name="time")
+    case = prepare_case(building, w, pseudo_measurements(building, w, times, SENSORS, noise_sd=0.1, seed=1))
+    lagged = EFFECTS["heat_input_lag"].apply(building, "cell", {"C_h": 5e4, "H_h": 20.0})
+    return building, case.with_burn_in(1), lagged
+
+
+@pytest.mark.parametrize("effect", [e.id for e in EFFECTS.values() if e.on_inputs])
+def test_an_effect_on_the_inputs_alone_is_its_runs_superposed_to_rounding(effect, equipped):
+    """The temperatures of a candidate on the inputs alone, at random values of its parameters,
+    from its 1 + k runs superposed, against the model with the effect at those values simulated
+    afresh: equal to rounding, and the effect moves them by tenths of a degree at least."""
+    building, case, _ = equipped
+    target = EFFECTS[effect].targets(building)[0]
+    candidate = Candidate(building, effect, target)
+    ids = [23, 7, 9, 1]
+    rng = np.random.default_rng(11)
+    moved = 0.0
+    for _ in range(3):
+        x = [rng.uniform(low, high) for low, high in candidate.bounds]
+        built = candidate.built(x)
+        direct = case.with_inputs(built).run(built, np.array(ids) - 1)
+        superposed = candidate.nodes(case, ids, x)
+        assert np.abs(superposed - direct).max() < 1e-9
+        moved = max(moved, np.abs(direct - case.with_inputs(building).run(building, np.array(ids) - 1)).max())
+    assert candidate.simulations == 1 + len(candidate.parameters)  # the runs superposed, no more
+    assert moved > 0.1
+
+
+def test_a_split_of_the_heat_input_to_a_heater_node_is_simulated_not_superposed(equipped):
+    """Where the zone's heater has a node of its own, the split sets its links' conductances:
+    the step matrix moves with the parameter, and every value is a run of its own, as the model
+    with the effect simulated afresh."""
+    _, case, lagged = equipped
+    candidate = Candidate(lagged, "heat_input_split", "cell")
+    inputs = case.with_inputs(lagged)
+    for f_r in (0.1, 0.5, 0.9):
+        built = candidate.built([f_r])
+        assert np.abs(candidate.nodes(inputs, [23], [f_r]) - inputs.run(built, [22])).max() < 1e-12
+    assert candidate.simulations == 3
