@@ -9,7 +9,8 @@ import pandas as pd
 import pytest
 from scipy.optimize import least_squares
 
-from nodeforce.diagnosis.calibrate import Candidate, fold, score_statistic, solve
+from nodeforce.diagnosis.calibrate import (Candidate, Superposition, fold, score_statistic, solve,
+                                          superposition_points)
 from nodeforce.diagnosis.policy import POLICY
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import prepare_case
@@ -362,3 +363,30 @@ def test_a_split_of_the_heat_input_to_a_heater_node_is_simulated_not_superposed(
         built = candidate.built([f_r])
         assert np.abs(candidate.nodes(inputs, [23], [f_r]) - inputs.run(built, [22])).max() < 1e-12
     assert candidate.simulations == 3
+
+
+@pytest.mark.parametrize("effect", [e.id for e in EFFECTS.values() if e.on_inputs])
+def test_a_superposed_effect_s_slopes_are_the_model_s_derivatives(effect, equipped):
+    """The slopes a superposition reads (dT/dx_i, exact for a model affine in x), from its runs
+    at the candidate's points, against central differences of the model simulated afresh at a
+    point of their own: equal to 1e-6 of the slope's size."""
+    building, case, _ = equipped
+    target = EFFECTS[effect].targets(building)[0]
+    candidate = Candidate(building, effect, target)
+    ids = np.array([23, 9])
+
+    def run(x):
+        built = candidate.built(x)
+        return case.with_inputs(built).run(built, ids - 1)
+    reference, far = superposition_points(building, effect, target, candidate.bounds)
+    superposed = Superposition(reference, far, [run(x) for x in [reference, *far]])
+    x = np.array([low + 0.3 * (high - low) for low, high in candidate.bounds])
+    for i, (low, high) in enumerate(candidate.bounds):
+        h = 1e-3 * (high - low)
+        plus, minus = x.copy(), x.copy()
+        plus[i] += h
+        minus[i] -= h
+        central = (run(plus) - run(minus)) / (2 * h)
+        slope = superposed.slopes[i]
+        assert np.abs(slope).max() > 0.0
+        assert np.abs(slope - central).max() <= 1e-6 * np.abs(slope).max()
