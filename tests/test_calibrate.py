@@ -3,20 +3,25 @@ without one day, one Gauss-Newton step from the whole window's optimum; checked 
 made afresh by scipy on the days it keeps; the test that holds a parameter at its prior; and a
 candidate on the inputs alone, superposed, against its model simulated afresh."""
 import copy
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
 import pytest
 from scipy.optimize import least_squares
 
-from nodeforce.diagnosis.calibrate import (Candidate, Superposition, fold, score_statistic, solve,
-                                          superposition_points)
+from nodeforce.diagnosis.calibrate import (Candidate, Own, Superposition, calibrate, derived, fold, own_weights,
+                                          score_statistic, solve, superposition_points, within_ranges)
 from nodeforce.diagnosis.policy import POLICY
+from nodeforce.diagnosis.selection import blocks
 from nodeforce.model.building_file import parse_building
-from nodeforce.model.case import prepare_case
+from nodeforce.model.case import measured_case, prepare_case
 from nodeforce.model.effects import EFFECTS
+from nodeforce.model.hlc import heat_loss_coefficient
+from nodeforce.model.numerical import discretisation_error, reference_case
+from nodeforce.model.score import Objective
 from nodeforce.model.synth import pseudo_measurements
-from tests.conftest import SENSORS
+from tests.conftest import SENSORS, record_times
 
 DAYS, PER_DAY = 4, 100
 
@@ -68,9 +73,6 @@ def test_a_component_s_loss_is_what_its_layers_add_to_the_heat_loss_coefficient(
     coefficient computed apart: the HLC less that of the door with its layers at the factor's
     lower bound; it saturates behind the surface coefficients; its sd is the slope times the
     factor's sd (a central difference, apart from the forward one `derived` takes)."""
-    from nodeforce.diagnosis.calibrate import Candidate, derived
-    from nodeforce.model.hlc import heat_loss_coefficient
-
     door = Candidate(testcell, "conductivity", "door")
 
     def hlc(factor):
@@ -99,10 +101,6 @@ def test_a_ground_flux_s_spread_moves_the_face_with_the_parameters(testcell, wea
     `derived` reports it, is the gradient's with the face simulated again (central differences
     here, apart from the forward ones `derived` takes), not the (T_ground - T_face, U) that holds
     the face still, which reads it several times larger."""
-    from nodeforce.diagnosis.calibrate import Candidate, derived, within_ranges
-    from nodeforce.model.case import measured_case
-
-    from .conftest import SENSORS, record_times
     case = measured_case(testcell, weather, pseudo_measurements(testcell, weather, record_times(3), SENSORS),
                          burn_in_days=1)
     coupled = Candidate(testcell, "ground_coupling", "floor")
@@ -128,8 +126,6 @@ def test_a_flux_the_data_fix_keeps_its_spread_where_the_valley_along_it_is_unbou
     ranges' uniform precision P (`within_ranges`), the flux's variance is, by Sherman-Morrison,
     sigma_q^2 a / (sigma_q^2 + a) with a = g' P^-1 g: at most sigma_q^2, whatever the valley; the
     linearised covariance alone, read by a gradient off the valley by 1e-3, gives tens of sigma_q."""
-    from nodeforce.diagnosis.calibrate import within_ranges
-
     bounds = [(0.0, 20.0), (-10.0, 40.0)]
     U, T_ground, T_face, sigma_q = 0.13, 4.2, 25.0, 0.15
     g = np.array([T_ground - T_face, U])
@@ -156,15 +152,6 @@ def test_a_fit_that_carries_the_files_numerical_error_finds_the_walls_of_the_fil
     continuum's difference from the file; carrying that difference as a share in [0, 1]
     (`numerical`), the fit finds the continuum's wall as it finds the network's, and each day
     left out is predicted to the rounding."""
-    from dataclasses import replace
-
-    from nodeforce.diagnosis.calibrate import Candidate, calibrate
-    from nodeforce.diagnosis.selection import blocks
-    from nodeforce.model.case import measured_case
-    from nodeforce.model.numerical import discretisation_error, reference_case
-    from nodeforce.model.score import Objective
-
-    from .conftest import record_times
     air = testcell.zones[0].air_node
     case = measured_case(testcell, weather, pseudo_measurements(testcell, weather, record_times(6), [air]),
                          burn_in_days=1)
@@ -260,13 +247,6 @@ def test_a_component_s_own_surface_read_beside_the_air_moves_its_value_to_the_tr
     nearer the truth (the surface follows the air the window warms, so not on it). The surface
     weighs the noise's square over its mean square misfit at the air-alone fit: 1.5 C off, it
     weighs at most a hundredth, and pulls the fit less than the true surface does."""
-    from dataclasses import replace
-
-    from nodeforce.diagnosis.calibrate import Candidate, Own, calibrate, own_weights
-    from nodeforce.model.case import measured_case
-    from nodeforce.model.score import Objective
-
-    from .conftest import record_times
     air, door = testcell.zones[0].air_node, testcell.component("door").node_ids[0]
     case = measured_case(testcell, weather, pseudo_measurements(testcell, weather, record_times(6), [air, door]),
                          burn_in_days=1)
