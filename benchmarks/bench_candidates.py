@@ -20,7 +20,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parents[1]))
 
-from benchmarks.bench_search import median_time  # noqa: E402
+from benchmarks.bench_runs import run_time  # noqa: E402
 from benchmarks.records import record  # noqa: E402
 from nodeforce import api  # noqa: E402
 
@@ -33,7 +33,7 @@ def measured(name):
     seconds) of the record's draw 0."""
     r = record(name, 0)
     case = r.case()
-    one = median_time(lambda: case.with_inputs(r.building).run(r.building), 5)
+    one = run_time(case, r.building, 5)
     with tempfile.TemporaryDirectory() as out, contextlib.redirect_stdout(io.StringIO()):
         started = time.perf_counter()
         api.diagnose(r.building, case, Path(out), objective=api.objective(r.building, r.zones), workers=1,
