@@ -79,6 +79,11 @@ class Candidate:
         return EFFECTS[self.effect].apply(self.building if base is None else base, self.target,
                                           {p.name: float(v) for p, v in zip(self.parameters, values)})
 
+    def base(self, case):
+        """The building `case` runs before the effect is added (its record's protocol's, or
+        `building`)."""
+        return self.protocols.get(id(case), self.building)
+
     def nodes(self, case, node_ids, values):
         """Simulated temperatures (C) of nodes at t_1..t_N, (N_t, len(node_ids)), with the effect
         at `values` (sequence)."""
@@ -86,21 +91,22 @@ class Candidate:
         if key in self._runs:
             return self._runs[key]
         superposed = self._superposition(case, key[1])
-        run = superposed(values) if superposed is not None else self._simulated(case, node_ids, values)
+        run = superposed(values) if superposed is not None else \
+            self._simulated(case, node_ids, self.built(values, self.base(case)))
         if len(self._runs) >= KEPT_RUNS:
             self._runs.pop(next(iter(self._runs)))
         self._runs[key] = run
         return run
 
-    def _simulated(self, case, node_ids, values):
-        base = self.protocols.get(id(case), self.building)
+    def _simulated(self, case, node_ids, building):
+        """The nodes of `building`, the case's base with the effect at some values, simulated."""
         if id(case) not in self._inputs:
             # the effect may read inputs the building as declared does not (a daily gain, the clock)
-            declared = EFFECTS[self.effect].apply(base, self.target, {})
+            declared = EFFECTS[self.effect].apply(self.base(case), self.target, {})
             self._inputs[id(case)] = (case, case.with_inputs(declared))
         _, inputs = self._inputs[id(case)]
         self.simulations += 1
-        return inputs.run(self.built(values, base), np.asarray(node_ids) - 1)
+        return inputs.run(building, np.asarray(node_ids) - 1)
 
     def _superposition(self, case, node_ids):
         """The `Superposition` of these nodes on `case`, or None where the effect is not on the
@@ -109,13 +115,13 @@ class Candidate:
             return None
         key = (id(case), node_ids)
         if key not in self._superposed:
-            base = self.protocols.get(id(case), self.building)
             reference, far = superposition_points(self.building, self.effect, self.target, self.bounds)
-            networks = [assemble(self.built(x, base)) for x in [reference, *far]]
+            buildings = [self.built(x, self.base(case)) for x in [reference, *far]]
+            networks = [assemble(b) for b in buildings]
             kept = all(np.array_equal(n.C, networks[0].C) and np.array_equal(n.A, networks[0].A)
                        and n.switched == networks[0].switched for n in networks[1:])
             self._superposed[key] = Superposition(
-                reference, far, [self._simulated(case, node_ids, x) for x in [reference, *far]]) if kept else None
+                reference, far, [self._simulated(case, node_ids, b) for b in buildings]) if kept else None
         return self._superposed[key]
 
 
