@@ -7,7 +7,6 @@ import numpy as np
 
 from nodeforce.diagnosis.calibrate import Candidate, Own, calibrate
 from nodeforce.diagnosis.policy import POLICY
-from nodeforce.model.effects import EFFECTS
 from nodeforce.model.network import assemble, slowest_time_constant
 
 
@@ -19,7 +18,8 @@ class Assessed:
     each block as the fold without that block predicts them: `assess`), its cross-validation
     folds ({"values", "residuals"} each), the simulations it took and its building file (JSON),
     declared at the calibrated values: the caller writes it, as a Dask worker may not share its
-    file system."""
+    file system. `beside`: where the model's effects were refitted together with it, their
+    parameters so refitted, by label ({label: {name: {"value", "std", ...}}}); None otherwise."""
     parameters: dict
     determined: dict
     runs: list
@@ -27,22 +27,25 @@ class Assessed:
     folds: list
     simulations: int
     building: dict
+    beside: dict = None
 
 
 def assess(shared, pair):
     """Calibrate one candidate effect, with its cross-validation folds, and run it: a task for a
     worker process or a Dask worker; its `Assessed`. `shared`: what every candidate of the round
-    reads (`assess_all`); `pair`: the (effect, target).
+    reads (`assess_all`), the effects the model holds that are refitted together with it among
+    them (`Candidate`'s `beside` and `held`); `pair`: the (effect, target).
 
     A candidate on a component whose own nodes are measured is fitted to them beside the air
     (`calibrate.Own`); those nodes on each block are then the fold's, fitted without that block,
     so that what the choice reads of its own sensors is, as of the air, what no fit read."""
-    building, bases, calibrations, cases, objective, blocks, sensors, numerical, at_sensors, sigma, seed = shared
+    (building, bases, calibrations, cases, objective, blocks, sensors, numerical, at_sensors, sigma, seed,
+     beside, held) = shared
     effect, target = pair
-    candidate = Candidate(building, effect, target, protocols(bases, calibrations, cases))
-    own = own_nodes(building, target, sensors, at_sensors, sigma)
-    parameters, determined, folds = calibrate(candidate, calibrations, objective, blocks, numerical, own)
-    values = [parameters[p.name]["value"] for p in candidate.parameters]
+    candidate = Candidate(building, effect, target, protocols(bases, calibrations, cases), beside, held)
+    own = own_nodes(building, [target, *(t for _, t in beside)], sensors, at_sensors, sigma)
+    fitted, determined, folds = calibrate(candidate, calibrations, objective, blocks, numerical, own)
+    values = [fitted[name]["value"] for name in candidate.names]
     runs = [candidate.nodes(case, objective.air_nodes, values) for case in cases]
     sensed = [candidate.nodes(case, ids, values).copy() if ids else np.empty((len(case.times) - 1, 0))
               for case, ids in zip(cases, sensors)]
@@ -51,19 +54,26 @@ def assess(shared, pair):
             rows = np.nonzero(block)[0]
             columns = [sensors[record].index(n) for n in own.ids[record]]
             sensed[record][np.ix_(rows, columns)] = f["own"][rows]
-    calibrated = EFFECTS[effect].apply(building, target, {name: p["value"] for name, p in parameters.items()})
-    return Assessed(parameters, determined, runs, sensed, folds, candidate.simulations, calibrated.to_json())
+    parameters = {name: fitted[name] for name in candidate.names[:candidate.own]}
+    refitted = {}
+    for name in candidate.names[candidate.own:]:
+        label, parameter = name.split("/")
+        refitted.setdefault(label, {})[parameter] = fitted[name]
+    return Assessed(parameters, determined, runs, sensed, folds, candidate.simulations,
+                    candidate.built(values).to_json(), refitted or None)
 
 
-def own_nodes(building, target, sensors, numerical, sigma):
-    """The measured nodes of the component `target` among each record's other sensors
+def own_nodes(building, targets, sensors, numerical, sigma):
+    """The measured nodes of the components among `targets` among each record's other sensors
     (`sensors`, ids), with the file's numerical error there (`numerical`, one (N_t,
-    len(sensors)) per record, or None), the noise `sigma` (C) and the component's memory of its
-    start as `building` describes it: a `calibrate.Own`; None for a target that is not a
-    component or has no node measured."""
-    if target not in {c.name for c in building.components}:
+    len(sensors)) per record, or None), the noise `sigma` (C) and the components' memory of their
+    start as `building` describes them (the slowest's): a `calibrate.Own`; None where no target
+    is a component or none has a node measured. Effects refitted together read the own nodes of
+    each, as each one's own fit did."""
+    components = {c.name for c in building.components}
+    nodes = [i for target in targets if target in components for i in building.component(target).node_ids]
+    if not nodes:
         return None
-    nodes = building.component(target).node_ids
     columns = columns_among(sensors, set(nodes))
     if not any(columns):
         return None

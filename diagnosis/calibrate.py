@@ -59,13 +59,27 @@ class Candidate:
     its far bound: `Superposition`), and every other value of its parameters, the least
     squares' iterations, their differences and the folds, is that sum: the same temperatures to
     rounding. Whether the matrix is indeed left as it was is checked on the buildings themselves
-    (a heat input's split changes the links of a heater node, where the zone has one)."""
+    (a heat input's split changes the links of a heater node, where the zone has one).
 
-    def __init__(self, building, effect, target, protocols=None):
+    `beside`: effects the building already holds ((effect, target) pairs) refitted together with
+    the candidate, their parameters after its own (`names`: theirs as "effect@target/name"), each
+    starting from its value in `building`; those named in `held` ({label: names}) stay there
+    (a parameter their own round held at its physical prior). A model's effects refitted
+    together is the fair test of one of them against another (`diagnosis.loop.revisit`)."""
+
+    def __init__(self, building, effect, target, protocols=None, beside=(), held=None):
         self.building, self.effect, self.target = building, effect, target
         self.protocols = protocols or {}
-        self.parameters = EFFECTS[effect].parameters
-        self.bounds = EFFECTS[effect].bounds(building, target)  # [(low, high)] a calibration explores
+        self.parts = ((effect, target), *beside)
+        self.own = len(EFFECTS[effect].parameters)  # the candidate's own parameters come first
+        self.parameters = tuple(p for e, _ in self.parts for p in EFFECTS[e].parameters)
+        self.names = tuple(p.name if i == 0 else f"{e}@{t}/{p.name}"
+                           for i, (e, t) in enumerate(self.parts) for p in EFFECTS[e].parameters)
+        # [(low, high)] a calibration explores
+        self.bounds = [b for e, t in self.parts for b in EFFECTS[e].bounds(building, t)]
+        held = held or {}
+        self.held = tuple(i for i, name in enumerate(self.names)
+                          if "/" in name and name.split("/")[1] in held.get(name.split("/")[0], ()))
         self._runs, self._inputs, self._superposed = {}, {}, {}
         self.simulations = 0  # simulations run (kept ones not counted again): a round's cost
 
@@ -73,11 +87,25 @@ class Candidate:
     def label(self):
         return f"{self.effect}@{self.target}"
 
+    def start(self):
+        """Where its calibration starts (`calibration_start` of each part, in `parameters` order):
+        every value strictly inside its range."""
+        values = []
+        for effect, target in self.parts:
+            start = calibration_start(self.building, effect, target)
+            values += [start[p.name] for p in EFFECTS[effect].parameters]
+        return np.array(values)
+
     def built(self, values, base=None):
-        """The building (`base`, default the candidate's) with the effect at `values` (sequence, in
-        `parameters` order)."""
-        return EFFECTS[self.effect].apply(self.building if base is None else base, self.target,
-                                          {p.name: float(v) for p, v in zip(self.parameters, values)})
+        """The building (`base`, default the candidate's) with the effect, and those `beside` it, at
+        `values` (sequence, in `parameters` order)."""
+        building, values = self.building if base is None else base, list(values)
+        for effect, target in self.parts:
+            parameters = EFFECTS[effect].parameters
+            building = EFFECTS[effect].apply(building, target, {p.name: float(v) for p, v in
+                                                                zip(parameters, values[:len(parameters)])})
+            values = values[len(parameters):]
+        return building
 
     def base(self, case):
         """The building `case` runs before the effect is added (its record's protocol's, or
@@ -102,7 +130,9 @@ class Candidate:
         """The nodes of `building`, the case's base with the effect at some values, simulated."""
         if id(case) not in self._inputs:
             # the effect may read inputs the building as declared does not (a daily gain, the clock)
-            declared = EFFECTS[self.effect].apply(self.base(case), self.target, {})
+            declared = self.base(case)
+            for effect, target in self.parts:
+                declared = EFFECTS[effect].apply(declared, target, {})
             self._inputs[id(case)] = (case, case.with_inputs(declared))
         _, inputs = self._inputs[id(case)]
         self.simulations += 1
@@ -111,7 +141,7 @@ class Candidate:
     def _superposition(self, case, node_ids):
         """The `Superposition` of these nodes on `case`, or None where the effect is not on the
         inputs alone or its building's matrices move with its parameters."""
-        if not EFFECTS[self.effect].on_inputs:
+        if not EFFECTS[self.effect].on_inputs or len(self.parts) > 1:
             return None
         key = (id(case), node_ids)
         if key not in self._superposed:
@@ -227,8 +257,8 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None):
                 for case, e in zip(cases, extra)]
     have = [np.isfinite(m) for m in measured]
     lows, highs = np.array(candidate.bounds).T
-    start = calibration_start(candidate.building, candidate.effect, candidate.target)
-    x0 = np.array([start[p.name] for p in candidate.parameters])  # inside the bounds: `calibration_start`
+    x0 = candidate.start()  # inside the bounds: `calibration_start`
+    kept = {i: x0[i] for i in candidate.held}  # the effects beside it keep what their own round held
 
     numerical = [np.hstack([air if air is not None else np.zeros((len(m), zones)),
                             at if at is not None else np.zeros((len(m), len(e)))])
@@ -261,17 +291,17 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None):
         offset += len(h) + lags + 1
     steps = np.concatenate(steps)
     residuals, counted = weighted([np.zeros(len(e)) for e in extra])
-    fit = solve(residuals, x0, lows, highs)
+    fit = solve(residuals, x0, lows, highs, kept)
     if any(h[:, zones:].any() for h in have):
         weights = own_weights(candidate, cases, ids, measured, numerical, zones, fit.x, own.sd)
         log.info("%s: its own nodes read beside the air, weighing %s", candidate.label,
                  "; ".join(", ".join(f"{n}: {w:.2g}" for n, w in zip(e, ws)) for e, ws in zip(extra, weights)))
         residuals, counted = weighted(weights)
-        fit = solve(residuals, fit.x, lows, highs)
+        fit = solve(residuals, fit.x, lows, highs, kept)
     cov = parameter_covariance(fit.jac, fit.fun, steps, lags)
     priors = wanted_priors(candidate, cases, identified(candidate, fit, cov))
     if priors:
-        held = solve(residuals, x0, lows, highs, {i: prior.value for i, prior in priors.items()})
+        held = solve(residuals, x0, lows, highs, {**kept, **{i: prior.value for i, prior in priors.items()}})
         statistic = score_statistic(held, list(priors), residuals, candidate.bounds, steps, lags)
         if POLICY.holds_prior(statistic, len(priors)):
             fit, cov = held, parameter_covariance(held.jac, held.fun, steps, lags)
@@ -283,13 +313,13 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None):
             priors = {}
     std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     result = {}
-    for i, (p, value, sd, bound, fixed) in enumerate(zip(candidate.parameters, fit.x, std, fit.active_mask,
-                                                         identified(candidate, fit, cov))):
+    for i, (p, name, value, sd, bound, fixed) in enumerate(zip(candidate.parameters, candidate.names, fit.x, std,
+                                                               fit.active_mask, identified(candidate, fit, cov))):
         identifiable = bool(fixed and i not in priors)
         if not identifiable and i not in priors:
             log.info("%s: %s = %.4g +- %.2g %s is not identifiable from these data%s", candidate.label,
-                     p.name, value, sd, p.unit, " (it ended on a bound)" if bound else "")
-        result[p.name] = {"value": float(value), "std": float(sd), "identifiable": identifiable,
+                     name, value, sd, p.unit, " (it ended on a bound)" if bound else "")
+        result[name] = {"value": float(value), "std": float(sd), "identifiable": identifiable,
                           "on_bound": bool(bound != 0), **({"prior": priors[i].source} if i in priors else {})}
     folds = []
     for record, block in blocks:
@@ -361,11 +391,12 @@ def wanted_priors(candidate, cases, fixed):
     left: a ground coupling's T_ground, the flux fixed and U fitted to it. The prior reads the
     outdoor air of the weather the `cases` hold, their history included."""
     effect = EFFECTS[candidate.effect]
-    if effect.priors is None or len(candidate.parameters) < 2:
+    if effect.priors is None or candidate.own < 2:
         return {}
     outdoor = np.concatenate([case.U[:, case.input_names.index("T_out")] for case in cases])
     priors = effect.priors(candidate.building, candidate.target, outdoor)
-    return {i: priors[p.name] for i, (p, (low, high)) in enumerate(zip(candidate.parameters, candidate.bounds))
+    return {i: priors[p.name] for i, (p, (low, high)) in
+            enumerate(zip(candidate.parameters[:candidate.own], candidate.bounds))
             if p.name in priors and low <= priors[p.name].value <= high and not fixed[i]}
 
 
@@ -487,15 +518,15 @@ def derived(candidate, case, x, cov):
         face = candidate.building.component(candidate.target).node_ids[-1]
 
         def flux(values):
-            U, T_ground = values
+            U, T_ground = values[:2]
             return U * (T_ground - float(np.mean(candidate.nodes(case, [face], values))))
         out["ground_heat_flux"] = with_sd(*gradient(flux, x, candidate.bounds), "W/m2")
     if candidate.effect == "conductivity":
-        (low, _), = candidate.bounds
-        out["component_loss"] = with_sd(hlc - heat_loss_coefficient(candidate.built([low])), slope, "W/K")
+        low = candidate.bounds[0][0]
+        out["component_loss"] = with_sd(hlc - heat_loss_coefficient(candidate.built([low, *x[1:]])), slope, "W/K")
     if candidate.effect in TIME_CONSTANTS:
-        C, H = x
-        out[TIME_CONSTANTS[candidate.effect]] = with_sd(C / H, np.array([1.0 / H, -C / H ** 2]), "s")
+        C, H = x[:2]
+        out[TIME_CONSTANTS[candidate.effect]] = with_sd(C / H, np.r_[1.0 / H, -C / H ** 2, np.zeros(len(x) - 2)], "s")
     return out
 
 

@@ -21,12 +21,15 @@ on data the calibration did not see.
    (`diagnosis.selection.decide`: blocked cross-validation, the one-standard-error rule, the
    objections of physics), against the model the earlier rounds made. Rounds go on while the
    error left is above the noise, at the air or at a component's own sensors (a second fault
-   the air no longer points at), and a candidate passes. The validation window plays no part in
-   any choice: its before and after are an honest estimate. The decision of every round, its
-   margins, its cost and its reason go into report.json, which the report reads.
+   the air no longer points at), and a candidate passes. Once they end, each earlier choice is
+   chosen again, the model's other effects refitted together with every candidate (`revisit`):
+   another may take its place. The validation window plays no part in any choice: its before
+   and after are an honest estimate. The decision of every round, its margins, its cost and its
+   reason go into report.json, which the report reads.
 5. The chosen model is built as an FMU and written (`model_after.fmu`, `building_after.json`);
    every candidate's building file is written declaring its calibrated effect
-   (`candidates/<effect>@<target>.json`, a later round's in `candidates/round<n>/`).
+   (`candidates/<effect>@<target>.json`, a later round's in `candidates/round<n>/`, a revisit's in
+   `candidates/revisit<n>/`).
 6. The residual of the first objective zone on the validation window, before and after, is
    described (`diagnosis.residuals`): is it white, and which input or time of day does it follow.
 7. Given the experiment's phases, every model is scored on each (`diagnosis.phases`), and an
@@ -60,8 +63,8 @@ from nodeforce.diagnosis.phases import phase_errors, worsened
 from nodeforce.diagnosis.residuals import diagnostics as residual_diagnostics
 from nodeforce.diagnosis.policy import POLICY
 from nodeforce.diagnosis.result import (CrossValidation, Diagnosis, Fit, LaterRecord, OwnSensors, RecordOutcome,
-                                        SensorEvidence)
-from nodeforce.diagnosis.selection import decide
+                                        SensorEvidence, added_effects, last_change)
+from nodeforce.diagnosis.selection import decide, revisited
 from nodeforce.diagnosis.sensitivity import sensitivity
 from nodeforce.diagnosis.windows import Record, Windows, period
 from nodeforce.fmu_build.build import build_fmu
@@ -82,22 +85,43 @@ class Model:
     metrics: dict
     bases: list
 
-    def adding(self, effect, target, values, runs, metrics):
-        """The model with the effect at `values` added to its building and to every record's."""
-        return Model(EFFECTS[effect].apply(self.building, target, values), runs, metrics,
-                     [None if b is None else EFFECTS[effect].apply(b, target, values) for b in self.bases])
+    def adding(self, effect, target, values, runs, metrics, refitted=None):
+        """The model with the effect at `values` added to its building and to every record's, and
+        the effects it holds that were `refitted` with it ({label: {name: value}}) at their new values."""
+        changes = [(effect, target, values)] + [(*label.split("@", 1), v) for label, v in (refitted or {}).items()]
+
+        def changed(building):
+            for e, t, v in changes:
+                building = EFFECTS[e].apply(building, t, v)
+            return building
+        return Model(changed(self.building), runs, metrics, [None if b is None else changed(b) for b in self.bases])
+
+    def without(self, effect, target, declared, windows, objective):
+        """The model with `effect` on `target` back at the value of the building as `declared` (the
+        file's, before any round), the others as they are, run over each record."""
+        def reverted(building, original):
+            return EFFECTS[effect].apply(building, target, EFFECTS[effect].read(original, target))
+        bases = [None if b is None else reverted(b, declared.bases[i] or declared.building)
+                 for i, b in enumerate(self.bases)]
+        building = reverted(self.building, declared.building)
+        runs = [case.with_inputs(base or building).run(base or building, np.asarray(objective.air_nodes) - 1)
+                for case, base in zip(windows.cases, bases)]
+        return Model(building, runs, windows.metrics(objective, runs), bases)
 
 
-def assess_all(model, pairs, windows, objective, sigma, folder, seed, pool=None, cluster=None):
+def assess_all(model, pairs, windows, objective, sigma, folder, seed, pool=None, cluster=None, beside=(),
+               held=None):
     """Each (effect, target) added to `model`, calibrated on every record's calibration window
     (t_0..t_k) with a fold per block, and run over each record, in the worker processes of
     `pool` (`lifetime.worker_pool`; None: in this process), or on the workers of `cluster` (a
     `nodeforce.cluster.Cluster`), each candidate's building file written in `folder`: their
     `Assessed`, in the order of `pairs`. `sigma`: the sensors' noise (C), against which a
-    component's own nodes are weighed in its fit (`calibrate.own_weights`)."""
+    component's own nodes are weighed in its fit (`calibrate.own_weights`). `beside`: effects
+    `model` holds ((effect, target)) refitted together with each candidate, those of their
+    parameters `held` ({label: names}) kept as they are (`calibrate.Candidate`)."""
     shared = (model.building, model.bases, windows.calibrations, windows.cases, objective, windows.blocks,
               windows.sensors, windows.calibration_numerical(), windows.calibration_numerical(sensors=True), sigma,
-              seed)
+              seed, tuple(beside), held or {})
     with tqdm(total=len(pairs), desc="calibrating candidate effects", unit="candidate",
               disable=not sys.stderr.isatty()) as bar:
         if cluster is not None:
@@ -140,7 +164,9 @@ def fits_of(model, base, pairs, assessed, windows, objective, sigma, number=1, o
                                  own_sensors(model.building, target, windows, base, a.sensed)
                                  if physics["sensed"] else None),
                   metrics, number, tuple(on_top_of))
-        models[fit.label] = model.adding(effect, target, fit.values, a.runs, metrics)
+        models[fit.label] = model.adding(effect, target, fit.values, a.runs, metrics,
+                                         {label: {name: p["value"] for name, p in refitted.items()}
+                                          for label, refitted in (a.beside or {}).items()})
         results.append(fit)
     return results, models
 
@@ -234,8 +260,8 @@ class Made:
 
     @property
     def added(self):
-        """The effects added, in order (their `Fit`s)."""
-        return [d.chosen for d in self.decisions if d.chosen is not None]
+        """The effects added, in order (their `Fit`s; `result.added_effects`)."""
+        return added_effects(self.decisions)
 
 
 def prepare(building, records, objective, workdir, fmu_kind, noise):
@@ -333,7 +359,60 @@ def rounds(prepared, localization, objective, workdir, seed, workers, cluster=No
                                  protocols(model.bases, windows.calibrations))
             sensitivities[chosen.label] = sensitivity(screened, windows.calibrations, objective, seed=seed)
             model = models[chosen.label]
-        return Made(decisions, results, runs, sensitivities, model)
+        made = Made(decisions, results, runs, sensitivities, model)
+        for fit in made.added[:-1] if len(made.added) > 1 else ():
+            made = revisit(prepared, made, fit, objective, folder, seed, pool, cluster)
+        return made
+
+
+def revisit(prepared, made, fit, objective, folder, seed, pool, cluster):
+    """An effect an earlier round chose (`fit`), chosen again once the rounds end: the candidates
+    that passed in its round, each calibrated with the other effects the model holds refitted
+    together with it (their parameters held at a prior kept there), against the model without
+    it, by the rule of every round (`selection.decide`). Where another is chosen, it takes the
+    effect's place, the others at their values refitted with it; `made` with that decision.
+
+    Forward selection adds the effect that best explains what is left; with two faults, the one
+    that takes a share of both (a zone's envelope, which scales a faulty door too) wins the
+    first round, and the second round, its parameters held, adds the door on top of it. Once
+    the door is in the model, the first choice is no longer the one the data ask for: an air
+    change with the door refitted may explain them as well or better. Refitted alone, the other
+    effects would keep the share of the revisited one they took on top of it; refitted
+    together, each candidate is judged as the rounds judge, the model around it fitted anew.
+    The last round's choice is not revisited: the earlier ones were refitted with it."""
+    windows, n, noise = prepared.windows, prepared.n, prepared.noise
+    number = len(made.decisions) + 1
+    others = [a for a in made.added if a.label != fit.label]
+    model = made.model.without(fit.effect, fit.target, prepared.model, windows, objective)
+    chosen_in = next(d for d in made.decisions if d.chosen is not None and d.chosen.label == fit.label)
+    tried_in = {r.label: r for r in made.results if r.round == chosen_in.chosen.round}
+    pairs = [(tried_in[label].effect, tried_in[label].target) for label, v in chosen_in.verdicts.items()
+             if v.passes and not v.objection and label in tried_in and label not in {a.label for a in others}]
+    started = time.perf_counter()
+    into = folder / f"revisit{number}"
+    into.mkdir(exist_ok=True)
+    base_sensed = windows.sensed_by(model)
+    assessed = assess_all(model, pairs, windows, objective, noise.sigma, into, seed, pool, cluster,
+                          [(a.effect, a.target) for a in others],
+                          {a.label: [name for name, p in a.parameters.items() if p.get("prior")] for a in others})
+    tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma, number,
+                            [a.label for a in others])
+    decision = decide(tried, windows.block_J(model.runs), noise.sigma, n, windows.groups(), noise.floor_sd)
+    chosen = decision.chosen
+    decision = revisited(decision, fit.label, [a.label for a in others],
+                         chosen and assessed[[t.label for t in tried].index(chosen.label)].beside)
+    decision.cost = {"candidates": len(tried), "simulations": sum(a.simulations for a in assessed),
+                     "seconds": round(time.perf_counter() - started, 1)}
+    kept = chosen is None or chosen.label == fit.label
+    results = made.results + [replace(r, cv=replace(r.cv, left_out=None), sensors=replace(r.sensors, residuals=None))
+                              for r in tried]
+    runs = {**made.runs, **{f"{key} (revisit of {fit.label})": m.runs for key, m in models.items()}}
+    sensitivities = dict(made.sensitivities)
+    if not kept:
+        screened = Candidate(model.building, chosen.effect, chosen.target, protocols(model.bases, windows.calibrations))
+        sensitivities[chosen.label] = sensitivity(screened, windows.calibrations, objective, seed=seed)
+    return Made(made.decisions + [decision], results, runs, sensitivities,
+                made.model if kept else models[decision.chosen.label])
 
 
 def left_by(windows, model):
@@ -378,7 +457,8 @@ def write(building, prepared, located, made, objective, workdir, fmu_kind, refer
         objective=list(objective.zones), period=period(windows, 0), before=prepared.model.metrics,
         after=model.metrics, localization=located.localization, candidates=made.results, rounds=made.decisions,
         structure_left=left_by(windows, model)["sentence"],
-        heat_loss=heat_loss(building, model.building, added, made.results, prepared.noise.sigma),
+        heat_loss=heat_loss(building, model.building, added, made.results, prepared.noise.sigma,
+                            last_change(made.decisions)),
         residuals=validation_residuals(prepared, made), sensitivity=made.sensitivities, noise=prepared.noise,
         assumptions=list(dict.fromkeys(a for case in windows.cases for a in case.assumptions)),
         node_names={str(i): name for i, name in building.node_names().items()},

@@ -21,7 +21,7 @@ AGREE_Z = 2.0
 AGREE_RELATIVE = 0.05
 
 
-def heat_loss(before_building, after_building, added, results, sigma):
+def heat_loss(before_building, after_building, added, results, sigma, last=None):
     """report.json's `heat_loss_coefficient`: {"before", "after", "after_sd"} (W/K) and "split",
     a sentence where the data fix the HLC but not how it splits among effects (else None).
 
@@ -32,9 +32,11 @@ def heat_loss(before_building, after_building, added, results, sigma):
         the model with the effect and its sd from the calibration's covariance)
     results : every candidate's `Fit`, each with the `round` it was tried in
     sigma : the air sensors' noise sd (C), which sets the change of J no test can tell apart
+    last : the `Fit` whose model is `after_building` (`result.last_change`), default the last added
     """
+    last = last or (added[-1] if added else None)
     out = {"before": heat_loss_coefficient(before_building), "after": heat_loss_coefficient(after_building),
-           "after_sd": float(added[-1].derived[HLC]["std"]) if added else 0.0, "split": None}
+           "after_sd": float(last.derived[HLC]["std"]) if last else 0.0, "split": None}
     rounds = [[r for r in results if r.round == number] for number in range(1, len(added) + 1)]
     starts = [{"value": out["before"], "std": 0.0}] + [a.derived[HLC] for a in added]
     for chosen, start, tried in zip(added, starts, rounds):

@@ -10,7 +10,7 @@ choice read of them, the distances of every two admissible candidates'.
 from __future__ import annotations
 
 import json
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -177,7 +177,10 @@ class Decision:
     standard errors asked, the suggestions physics refused, the candidates the data cannot tell
     from the chosen (labels), every candidate's verdict by label, what the steps read besides the
     candidates (`inputs`: the model's per-block J, sigma, floor_sd, n, groups, distances), and
-    what the round cost."""
+    what the round cost. A decision made once the rounds end, on an effect an earlier round chose
+    (`diagnosis.loop.revisit`), names it (`replaces`), and where another takes its place, the
+    values the model's other effects take refitted with that one (`refitted`, {label: {name:
+    {"value", "std", ...}}})."""
     chosen: Fit
     reason: str
     cv_J_before: float
@@ -189,20 +192,44 @@ class Decision:
     verdicts: dict
     inputs: dict
     cost: dict = None
+    replaces: str = None
+    refitted: dict = None
 
     def to_json(self):
         return {"chosen": self.chosen.label if self.chosen else None, "reason": self.reason,
                 "cv_J_before": self.cv_J_before, "blocks": self.blocks, "noise_margin": self.noise_margin,
                 "standard_errors": self.standard_errors, "suggestions": self.suggestions,
                 "indistinct": self.indistinct, "candidates": {k: v.to_json() for k, v in self.verdicts.items()},
-                "inputs": self.inputs, **({"cost": self.cost} if self.cost is not None else {})}
+                "inputs": self.inputs, **({"cost": self.cost} if self.cost is not None else {}),
+                **({"replaces": self.replaces, "refitted": self.refitted} if self.replaces else {})}
 
     @classmethod
     def of_json(cls, d, chosen):
         """The decision report.json records, `chosen` its chosen candidate's `Fit` (None)."""
         return cls(chosen, d["reason"], d["cv_J_before"], d["blocks"], d["noise_margin"], d["standard_errors"],
                    d["suggestions"], d["indistinct"], {k: Verdict(**v) for k, v in d["candidates"].items()},
-                   d["inputs"], d.get("cost"))
+                   d["inputs"], d.get("cost"), d.get("replaces"), d.get("refitted"))
+
+
+def added_effects(decisions):
+    """The effects the `decisions` add, in order (their `Fit`s): each round's choice, where a
+    later decision (`Decision.replaces`) put another in its place, that one, and the others with
+    the values refitted with it."""
+    out = []
+    for d in decisions:
+        if d.replaces is None:
+            out += [d.chosen] if d.chosen is not None else []
+        elif d.chosen is not None and d.chosen.label != d.replaces:
+            out = [d.chosen if a.label == d.replaces else
+                   replace(a, parameters={**a.parameters, **d.refitted.get(a.label, {})}) for a in out]
+    return out
+
+
+def last_change(decisions):
+    """The `Fit` of the last of the `decisions` that changed the model (a round's choice, or one
+    that took another's place), whose `derived` are those of the model they leave; None."""
+    changed = [d.chosen for d in decisions if d.chosen is not None and d.chosen.label != d.replaces]
+    return changed[-1] if changed else None
 
 
 @dataclass
@@ -297,8 +324,8 @@ class Diagnosis:
 
     @property
     def added(self):
-        """The effects added, in order (their `Fit`s)."""
-        return [d.chosen for d in self.rounds if d.chosen is not None]
+        """The effects added, in order (their `Fit`s: `added_effects`)."""
+        return added_effects(self.rounds)
 
     @property
     def plots(self):
@@ -311,7 +338,8 @@ class Diagnosis:
         rounds = [d.to_json() for d in self.rounds]
         added = self.added
         out = {**rounds[0], "chosen": added[-1].label if added else None,
-               "reason": " ".join(f"Round {i + 1}: {d.reason}" if len(rounds) > 1 else d.reason
+               "reason": " ".join((f"Round {i + 1}: " if d.replaces is None else "Once the rounds end, ") + d.reason
+                                  if len(rounds) > 1 else d.reason
                                   for i, d in enumerate(self.rounds)),
                "rounds": rounds, "structure_left": self.structure_left}
         if self.worsened_phases is not None:
@@ -358,13 +386,15 @@ class Diagnosis:
         (`diagnosis.selection.decide`): the round's candidates' fits and what its decision read
         besides (`Decision.inputs`). On a diagnosis read from report.json it is the check that
         the report holds every input of the choice."""
-        from nodeforce.diagnosis.selection import decide  # the choice reads these records
+        from nodeforce.diagnosis.selection import decide, revisited  # the choice reads these records
         out = []
         for number, recorded in enumerate(self.rounds, start=1):
-            given = recorded.inputs
-            out.append(decide([c for c in self.candidates if c.round == number], given["blocks_before"],
-                              given["sigma"], given["n"], given["groups"], given["floor_sd"], given["distances"],
-                              given.get("air_at_noise", False)))
+            given, tried = recorded.inputs, [c for c in self.candidates if c.round == number]
+            decision = decide(tried, given["blocks_before"], given["sigma"], given["n"], given["groups"],
+                              given["floor_sd"], given["distances"], given.get("air_at_noise", False))
+            if recorded.replaces:  # a choice made again, the others refitted with each candidate
+                decision = revisited(decision, recorded.replaces, list(tried[0].on_top_of), recorded.refitted)
+            out.append(decision)
         return out
 
     @classmethod

@@ -219,6 +219,20 @@ def decide(results, base, sigma, n, groups=(), floor_sd=None, distances=None, ai
                      "n": n, "groups": list(groups), "distances": distances or {}, "air_at_noise": air_at_noise})
 
 
+def revisited(decision, replaces, others, refitted):
+    """The `decision` of a choice made again once the rounds end (`diagnosis.loop.revisit`): of
+    the effect `replaces` (its label), among candidates each fitted with the model's `others`
+    (labels) refitted together with it; `refitted` ({label: {name: {"value", ...}}}) their values
+    refitted with the one chosen, kept where it takes the place of `replaces`. The reason says it."""
+    kept = decision.chosen is None or decision.chosen.label == replaces
+    effect, target = replaces.split("@", 1)
+    decision.replaces, decision.refitted = replaces, {} if kept else refitted
+    decision.reason = (f"{effect} on {target} chosen again, the other effects refitted together with each candidate "
+                       f"({', '.join(others)}): {decision.reason[:-1]}; "
+                       + ("it stays." if kept else f"it takes the place of {effect} on {target}."))
+    return decision
+
+
 def candidate_test(result, base, margin, floor_sd, groups, sigma, air_at_noise=False):
     """One candidate's `Verdict` (steps 1 and 2): its cross-validated fall of J (C2) and the fall's
     standard error, what it needs (the noise's `margin`, C2, and `standard_errors` of its

@@ -287,6 +287,36 @@ def test_a_component_s_own_surface_read_beside_the_air_moves_its_value_to_the_tr
     assert fitted(memory=6 * 86400.0) == pytest.approx(alone, rel=1e-3)
 
 
+
+def test_effects_refitted_together_find_both_faults_where_one_held_at_an_earlier_round_s_value_does_not(
+        testcell, weather):
+    """An air change of 0.5 1/h and a door 2.5 times as conductive, the air measured: a model
+    that holds the door at 1.2 (an earlier round's value) and fits the air change alone gives it
+    the door's missing loss; fitted with the door refitted beside it (`Candidate`'s `beside`),
+    both come back to the truth, the door's value named as the model's effect; held at its
+    value (`held`), the door stays where it was, and the fit is the one alone."""
+    air = testcell.zones[0].air_node
+    case = measured_case(testcell, weather, pseudo_measurements(testcell, weather, record_times(4), [air]),
+                         burn_in_days=1)
+    truth = EFFECTS["conductivity"].apply(EFFECTS["infiltration"].apply(testcell, "cell", {"n": 0.5}), "door",
+                                          {"factor": 2.5})
+    measured = case.measured.copy()
+    measured[1 + case.burn_in_steps:, air - 1] = case.with_inputs(truth).run(truth)[case.burn_in_steps:, air - 1]
+    case = replace(case, measured=measured)
+    model = EFFECTS["conductivity"].apply(testcell, "door", {"factor": 1.2})
+    objective = Objective.of(testcell)
+
+    alone, _, _ = calibrate(Candidate(model, "infiltration", "cell"), case, objective)
+    together, _, _ = calibrate(Candidate(model, "infiltration", "cell", beside=[("conductivity", "door")]), case,
+                               objective)
+    held, _, _ = calibrate(Candidate(model, "infiltration", "cell", beside=[("conductivity", "door")],
+                                     held={"conductivity@door": ["factor"]}), case, objective)
+    assert alone["n"]["value"] - 0.5 > 0.05  # the door's share taken by the air change (0.57)
+    assert together["n"]["value"] == pytest.approx(0.5, rel=1e-3)
+    assert together["conductivity@door/factor"]["value"] == pytest.approx(2.5, rel=1e-3)
+    assert held["conductivity@door/factor"]["value"] == 1.2
+    assert held["n"]["value"] == pytest.approx(alone["n"]["value"], rel=1e-6)
+
 # -- an effect on the inputs alone, superposed --------------------------------------------
 
 @pytest.fixture(scope="module")

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from nodeforce.diagnosis.policy import POLICY
-from nodeforce.diagnosis.result import CrossValidation, Fit, OwnSensors, SensorEvidence
+from nodeforce.diagnosis.result import CrossValidation, Fit, OwnSensors, SensorEvidence, added_effects, last_change
 from nodeforce.diagnosis.selection import blocks, decide
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.errors import InputError
@@ -418,3 +418,27 @@ def test_a_round_run_for_a_component_s_own_sensors_takes_no_effect_on_the_air_al
     assert decision.chosen is None and "own sensors" in decision.reason
     mends = with_own(door(BASE), [N * 0.25] * 4, [N * SIGMA ** 2] * 4)
     assert decide([wall, mends], BASE, SIGMA, N, air_at_noise=True).chosen.target == "door"
+
+
+def test_a_choice_revisited_takes_the_place_of_the_one_it_replaces_and_the_others_their_refitted_values():
+    """The effects a diagnosis adds (`result.added_effects`): each round's choice in order; a
+    decision made once the rounds end that chooses another in place of an earlier one puts it
+    at that place, the other effects at the values refitted with it; one that chooses the same
+    effect again changes nothing."""
+    envelope = candidate("envelope_conductance", "cell", {"factor": parameter(1.2, 0.05)}, [3.0, 3.0])
+    first_door = replace(door([2.0, 2.0], factor=1.26), round=2)
+    air = replace(candidate("infiltration", "cell", {"n": parameter(0.45, 0.05)}, [1.9, 1.9]), round=3)
+
+    def decision(chosen, replaces=None, refitted=None):
+        made = decide([chosen], [4.0, 4.0], 0.1, N)
+        return replace(made, replaces=replaces, refitted=refitted)
+    rounds = [decision(envelope), decision(first_door)]
+    assert [a.label for a in added_effects(rounds)] == ["envelope_conductance@cell", "conductivity@door"]
+    stays = decision(replace(envelope, round=3), replaces="envelope_conductance@cell", refitted={})
+    assert added_effects(rounds + [stays]) == added_effects(rounds)
+    swapped = decision(air, replaces="envelope_conductance@cell",
+                       refitted={"conductivity@door": {"factor": parameter(1.58, 0.03)}})
+    after = added_effects(rounds + [swapped])
+    assert [a.label for a in after] == ["infiltration@cell", "conductivity@door"]
+    assert after[1].values == {"factor": 1.58} and first_door.values == {"factor": 1.26}
+    assert last_change(rounds + [stays]) is first_door and last_change(rounds + [swapped]) is air

@@ -18,12 +18,14 @@ def check_replay(path):
     """Every round of the diagnosis report.json at `path` holds recomputed from the report alone:
     the same choice, band, suggestions, verdicts and reason; returns the diagnosis read."""
     read = Diagnosis.read(path)
-    recorded = json.loads(path.read_text())["decision"]["rounds"]
+    report = json.loads(path.read_text())
+    recorded = report["decision"]["rounds"]
     replayed = read.replay()
     assert read.rounds and len(replayed) == len(read.rounds)
     for again, written in zip(replayed, recorded):
         assert again.to_json() == {k: v for k, v in written.items() if k != "cost"}
-    assert [a.label for a in read.added] == [r["chosen"] for r in recorded if r["chosen"]]
+    # the effects the decisions add (a round's choice, or one that took an earlier one's place)
+    assert [a.effect_json() for a in read.added] == report["effects"]
     return read
 
 

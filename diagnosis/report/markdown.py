@@ -33,7 +33,10 @@ def decision_lines(report):
     lines += refused + ([""] if refused else [])
     for number, r in enumerate(d.get("rounds") or [d], start=1):
         cost = r.get("cost") or {}
-        lines.append(f"- round {number}: cross-validated J of the model it starts from {fmt_sig(r.get('cv_J_before'))} C² "
+        which = (f"round {number}: cross-validated J of the model it starts from" if not r.get("replaces") else
+                 f"{r['replaces']} chosen again, the other effects refitted together with each candidate: "
+                 "cross-validated J of the model without it")
+        lines.append(f"- {which} {fmt_sig(r.get('cv_J_before'))} C² "
                      f"over {r.get('blocks', NA)} days left out in turn; a candidate must lower it by more than the "
                      f"sensor noise and the file's numerical error could ({fmt_sig(r.get('noise_margin'))} C²) and by more than "
                      f"{fmt_sig(r.get('standard_errors'), 3)} standard error of its fall from day to day, on more "
