@@ -366,11 +366,12 @@ def rounds(prepared, localization, objective, workdir, seed, workers, cluster=No
 
 
 def revisit(prepared, made, fit, objective, folder, seed, pool, cluster):
-    """An effect an earlier round chose (`fit`), chosen again once the rounds end: the candidates
-    that passed in its round, each calibrated with the other effects the model holds refitted
-    together with it (their parameters held at a prior kept there), against the model without
-    it, by the rule of every round (`selection.decide`). Where another is chosen, it takes the
-    effect's place, the others at their values refitted with it; `made` with that decision.
+    """An effect an earlier round chose (`fit`), chosen again once the rounds end: it and the
+    admissible candidates nearest it in its round (`Policy.revisited`), each calibrated with the
+    other effects the model holds refitted together with it (their parameters held at a prior
+    kept there), against the model without it, by the rule of every round (`selection.decide`).
+    Where another is chosen, it takes the effect's place, the others at their values refitted
+    with it; `made` with that decision.
 
     Forward selection adds the effect that best explains what is left; with two faults, the one
     that takes a share of both (a zone's envelope, which scales a faulty door too) wins the
@@ -386,8 +387,10 @@ def revisit(prepared, made, fit, objective, folder, seed, pool, cluster):
     model = made.model.without(fit.effect, fit.target, prepared.model, windows, objective)
     chosen_in = next(d for d in made.decisions if d.chosen is not None and d.chosen.label == fit.label)
     tried_in = {r.label: r for r in made.results if r.round == chosen_in.chosen.round}
-    pairs = [(tried_in[label].effect, tried_in[label].target) for label, v in chosen_in.verdicts.items()
-             if v.passes and not v.objection and label in tried_in and label not in {a.label for a in others}]
+    nearest = sorted((v.evidence, label) for label, v in chosen_in.verdicts.items()
+                     if v.passes and not v.objection and label in tried_in and label not in {a.label for a in others})
+    labels = [fit.label] + [label for _, label in nearest if label != fit.label][:POLICY.revisited - 1]
+    pairs = [(tried_in[label].effect, tried_in[label].target) for label in labels]
     started = time.perf_counter()
     into = folder / f"revisit{number}"
     into.mkdir(exist_ok=True)

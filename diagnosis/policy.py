@@ -129,6 +129,13 @@ class Policy:
     # -- rounds
     # Effects added at most, one a round (count): a record rarely supports three undeclared effects.
     max_rounds: int = 3
+    # The candidates of an earlier round's choice that a revisit calibrates again, the model's
+    # other effects refitted with each (`diagnosis.loop.revisit`): the admissible ones nearest it
+    # in its round by evidence, itself among them (count). What a later effect can give back is
+    # the share of its fault the first choice took; a candidate that explained the round's data
+    # far worse would need it to be most of the fault. With two faults, the effect that took a
+    # share of both and the one it displaced lead their round.
+    revisited: int = 5
 
     # ---- the yardsticks
     def noise_J(self, sd, n):
