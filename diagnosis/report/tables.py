@@ -238,7 +238,8 @@ def phases(report):
     labels = list(rows[0]["rmse"])
     if len(labels) > PHASE_COLUMNS:
         # a whole house tries a hundred candidates: the table keeps the chosen ones (report.json has all)
-        chosen = [r["chosen"] if i == 0 else f"{r['chosen']} (round {i + 1})"
+        chosen = [f"{r['chosen']} (revisit of {r['replaces']})" if r.get("replaces") else
+                  r["chosen"] if i == 0 else f"{r['chosen']} (round {i + 1})"
                   for i, r in enumerate((report.get("decision") or {}).get("rounds") or []) if r.get("chosen")]
         labels = [label for label in labels if label in ("before", "after") or label in chosen]
 
