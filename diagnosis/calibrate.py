@@ -320,7 +320,7 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None):
             log.info("%s: %s = %.4g +- %.2g %s is not identifiable from these data%s", candidate.label,
                      name, value, sd, p.unit, " (it ended on a bound)" if bound else "")
         result[name] = {"value": float(value), "std": float(sd), "identifiable": identifiable,
-                          "on_bound": bool(bound != 0), **({"prior": priors[i].source} if i in priors else {})}
+                        "on_bound": bool(bound != 0), **({"prior": priors[i].source} if i in priors else {})}
     folds = []
     for record, block in blocks:
         train = ~np.concatenate([rows[h] for rows, h in zip(on_block([h.shape for h in have], record, block), have)])
