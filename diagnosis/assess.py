@@ -54,11 +54,7 @@ def assess(shared, pair):
             rows = np.nonzero(block)[0]
             columns = [sensors[record].index(n) for n in own.ids[record]]
             sensed[record][np.ix_(rows, columns)] = f["own"][rows]
-    parameters = {name: fitted[name] for name in candidate.names[:candidate.own]}
-    refitted = {}
-    for name in candidate.names[candidate.own:]:
-        label, parameter = name.split("/")
-        refitted.setdefault(label, {})[parameter] = fitted[name]
+    parameters, refitted = candidate.by_effect(fitted)
     return Assessed(parameters, determined, runs, sensed, folds, candidate.simulations,
                     candidate.built(values).to_json(), refitted or None)
 

@@ -72,20 +72,29 @@ class Candidate:
         self.protocols = protocols or {}
         self.parts = ((effect, target), *beside)
         self.own = len(EFFECTS[effect].parameters)  # the candidate's own parameters come first
-        self.parameters = tuple(p for e, _ in self.parts for p in EFFECTS[e].parameters)
-        self.names = tuple(p.name if i == 0 else f"{e}@{t}/{p.name}"
-                           for i, (e, t) in enumerate(self.parts) for p in EFFECTS[e].parameters)
+        # (label of the effect beside it, or None for its own, parameter), in `parameters` order
+        entries = [(f"{e}@{t}" if j else None, p) for j, (e, t) in enumerate(self.parts) for p in EFFECTS[e].parameters]
+        self.parameters = tuple(p for _, p in entries)
+        self.names = tuple(p.name if label is None else f"{label}/{p.name}" for label, p in entries)
         # [(low, high)] a calibration explores
         self.bounds = [b for e, t in self.parts for b in EFFECTS[e].bounds(building, t)]
-        held = held or {}
-        self.held = tuple(i for i, name in enumerate(self.names)
-                          if "/" in name and name.split("/")[1] in held.get(name.split("/")[0], ()))
+        self.held = tuple(i for i, (label, p) in enumerate(entries)
+                          if label is not None and p.name in (held or {}).get(label, ()))
+        self._beside = [(label, p.name) for label, p in entries[self.own:]]
         self._runs, self._inputs, self._superposed = {}, {}, {}
         self.simulations = 0  # simulations run (kept ones not counted again): a round's cost
 
     @property
     def label(self):
         return f"{self.effect}@{self.target}"
+
+    def by_effect(self, fitted):
+        """A calibration's result ({name: ...}, `names`) split: the candidate's own parameters by
+        name, and those of the effects beside it by label ({label: {name: ...}})."""
+        beside = {}
+        for (label, name), key in zip(self._beside, self.names[self.own:]):
+            beside.setdefault(label, {})[name] = fitted[key]
+        return {name: fitted[name] for name in self.names[:self.own]}, beside
 
     def start(self):
         """Where its calibration starts (`calibration_start` of each part, in `parameters` order):

@@ -104,8 +104,7 @@ class Model:
         bases = [None if b is None else reverted(b, declared.bases[i] or declared.building)
                  for i, b in enumerate(self.bases)]
         building = reverted(self.building, declared.building)
-        runs = [case.with_inputs(base or building).run(base or building, np.asarray(objective.air_nodes) - 1)
-                for case, base in zip(windows.cases, bases)]
+        runs = windows.nodes(building, bases, [objective.air_nodes] * len(windows.cases))
         return Model(building, runs, windows.metrics(objective, runs), bases)
 
 
@@ -345,22 +344,15 @@ def rounds(prepared, localization, objective, workdir, seed, workers, cluster=No
             decision.cost = {"candidates": len(tried), "simulations": simulations,
                              "seconds": round(time.perf_counter() - started, 1)}
             decisions.append(decision)
-            # the residuals themselves go (the decision keeps what the choice read of them, the
-            # distances of every two admissible candidates'): a house's rounds would hold gigabytes
-            results += [replace(r, cv=replace(r.cv, left_out=None), sensors=replace(r.sensors, residuals=None))
-                        for r in tried]
+            results += [lean(r) for r in tried]
             runs.update({(key if not number else f"{key} (round {number + 1})"): m.runs for key, m in models.items()})
             chosen = decision.chosen
             if not chosen:
                 break
-            # the Morris screening of the chosen effect's parameters, on the model it is added to: a
-            # screening of every candidate would cost a quarter of a round's simulations
-            screened = Candidate(model.building, chosen.effect, chosen.target,
-                                 protocols(model.bases, windows.calibrations))
-            sensitivities[chosen.label] = sensitivity(screened, windows.calibrations, objective, seed=seed)
+            sensitivities[chosen.label] = screened(model, chosen, windows, objective, seed)
             model = models[chosen.label]
         made = Made(decisions, results, runs, sensitivities, model)
-        for fit in made.added[:-1] if len(made.added) > 1 else ():
+        for fit in made.added[:-1]:
             made = revisit(prepared, made, fit, objective, folder, seed, pool, cluster)
         return made
 
@@ -406,16 +398,27 @@ def revisit(prepared, made, fit, objective, folder, seed, pool, cluster):
                          chosen and assessed[[t.label for t in tried].index(chosen.label)].beside)
     decision.cost = {"candidates": len(tried), "simulations": sum(a.simulations for a in assessed),
                      "seconds": round(time.perf_counter() - started, 1)}
-    kept = chosen is None or chosen.label == fit.label
-    results = made.results + [replace(r, cv=replace(r.cv, left_out=None), sensors=replace(r.sensors, residuals=None))
-                              for r in tried]
     runs = {**made.runs, **{f"{key} (revisit of {fit.label})": m.runs for key, m in models.items()}}
-    sensitivities = dict(made.sensitivities)
-    if not kept:
-        screened = Candidate(model.building, chosen.effect, chosen.target, protocols(model.bases, windows.calibrations))
-        sensitivities[chosen.label] = sensitivity(screened, windows.calibrations, objective, seed=seed)
-    return Made(made.decisions + [decision], results, runs, sensitivities,
-                made.model if kept else models[decision.chosen.label])
+    if not decision.changes_model:
+        return Made(made.decisions + [decision], made.results + [lean(r) for r in tried], runs, made.sensitivities,
+                    made.model)
+    return Made(made.decisions + [decision], made.results + [lean(r) for r in tried], runs,
+                {**made.sensitivities, chosen.label: screened(model, chosen, windows, objective, seed)},
+                models[chosen.label])
+
+
+def lean(fit):
+    """The `Fit` as the diagnosis keeps it, without its residuals (the decision keeps what the
+    choice read of them, the distances of every two admissible candidates'): a house's rounds
+    would hold gigabytes."""
+    return replace(fit, cv=replace(fit.cv, left_out=None), sensors=replace(fit.sensors, residuals=None))
+
+
+def screened(model, chosen, windows, objective, seed):
+    """The Morris screening of the `chosen` effect's parameters on the `model` it is added to: a
+    screening of every candidate would cost a quarter of a round's simulations."""
+    candidate = Candidate(model.building, chosen.effect, chosen.target, protocols(model.bases, windows.calibrations))
+    return sensitivity(candidate, windows.calibrations, objective, seed=seed)
 
 
 def left_by(windows, model):

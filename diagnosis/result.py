@@ -195,6 +195,12 @@ class Decision:
     replaces: str = None
     refitted: dict = None
 
+    @property
+    def changes_model(self):
+        """Whether the decision changes the model: a round's choice, or a revisit's that takes
+        another's place."""
+        return self.chosen is not None and self.chosen.label != self.replaces
+
     def to_json(self):
         return {"chosen": self.chosen.label if self.chosen else None, "reason": self.reason,
                 "cv_J_before": self.cv_J_before, "blocks": self.blocks, "noise_margin": self.noise_margin,
@@ -218,8 +224,8 @@ def added_effects(decisions):
     out = []
     for d in decisions:
         if d.replaces is None:
-            out += [d.chosen] if d.chosen is not None else []
-        elif d.chosen is not None and d.chosen.label != d.replaces:
+            out += [d.chosen] if d.changes_model else []
+        elif d.changes_model:
             out = [d.chosen if a.label == d.replaces else
                    replace(a, parameters={**a.parameters, **d.refitted.get(a.label, {})}) for a in out]
     return out
@@ -228,7 +234,7 @@ def added_effects(decisions):
 def last_change(decisions):
     """The `Fit` of the last of the `decisions` that changed the model (a round's choice, or one
     that took another's place), whose `derived` are those of the model they leave; None."""
-    changed = [d.chosen for d in decisions if d.chosen is not None and d.chosen.label != d.replaces]
+    changed = [d.chosen for d in decisions if d.changes_model]
     return changed[-1] if changed else None
 
 

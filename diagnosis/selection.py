@@ -224,12 +224,12 @@ def revisited(decision, replaces, others, refitted):
     the effect `replaces` (its label), among candidates each fitted with the model's `others`
     (labels) refitted together with it; `refitted` ({label: {name: {"value", ...}}}) their values
     refitted with the one chosen, kept where it takes the place of `replaces`. The reason says it."""
-    kept = decision.chosen is None or decision.chosen.label == replaces
     effect, target = replaces.split("@", 1)
-    decision.replaces, decision.refitted = replaces, {} if kept else refitted
+    decision.replaces = replaces
+    decision.refitted = refitted if decision.changes_model else {}
     decision.reason = (f"{effect} on {target} chosen again, the other effects refitted together with each candidate "
                        f"({', '.join(others)}): {decision.reason[:-1]}; "
-                       + ("it stays." if kept else f"it takes the place of {effect} on {target}."))
+                       + (f"it takes the place of {effect} on {target}." if decision.changes_model else "it stays."))
     return decision
 
 

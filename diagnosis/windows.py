@@ -142,15 +142,20 @@ class Windows:
                 int(sum(np.isfinite(r).sum() for r, _ in parts)),
                 float(sum((np.isfinite(r) * w ** 2).sum() for r, w in parts)))
 
+    def nodes(self, building, bases, ids):
+        """Per record, the temperatures (C, (N_t, len(ids))) of its nodes `ids` (one sequence per
+        record) under its protocol's building (`bases`, None: `building`)."""
+        out = []
+        for case, nodes, base in zip(self.cases, ids, bases):
+            run = base or building
+            out.append(case.with_inputs(run).run(run, np.asarray(nodes, dtype=int) - 1) if len(nodes)
+                       else np.empty((len(case.times) - 1, 0)))
+        return out
+
     def sensed_by(self, model):
         """Per record, `model`'s temperatures (C, (N_t, len(sensors))) at the other sensed nodes,
         under the record's protocol's building (`Model.bases`)."""
-        out = []
-        for case, ids, base in zip(self.cases, self.sensors, model.bases):
-            building = base or model.building
-            out.append(case.with_inputs(building).run(building, np.asarray(ids, dtype=int) - 1) if ids
-                       else np.empty((len(case.times) - 1, 0)))
-        return out
+        return self.nodes(model.building, model.bases, self.sensors)
 
     def sensor_weights(self, runs, sigma):
         """Per record, each other sensor's weight in the choice: sigma^2 over the least mean

@@ -287,7 +287,6 @@ def test_a_component_s_own_surface_read_beside_the_air_moves_its_value_to_the_tr
     assert fitted(memory=6 * 86400.0) == pytest.approx(alone, rel=1e-3)
 
 
-
 def test_effects_refitted_together_find_both_faults_where_one_held_at_an_earlier_round_s_value_does_not(
         testcell, weather):
     """An air change of 0.5 1/h and a door 2.5 times as conductive, the air measured: a model
