@@ -118,14 +118,16 @@ class Case:
             raise InputError(building.source, absent[0], "an input column the case was not prepared with")
         return replace(self, input_names=names, U=np.column_stack([columns[n] for n in names]), building=building)
 
-    def run(self, building, nodes=None):
+    def run(self, building, nodes=None, network=None, derivatives=()):
         """The temperatures (C) at t_1..t_N of the `nodes` of `building` (indices, default every
         node) on this case, with the direct model, as a diagnosis runs it: its burn-in, its
         steady start and its sub-steps. The case must carry the inputs `building` reads
-        (`with_inputs`)."""
-        return simulate(building, assemble(building), self.U, self.dt, self.measured, burn_in_steps=self.burn_in_steps,
-                        steady_start=self.steady_start, substeps=self.substeps, history_steps=self.history_steps,
-                        outputs=nodes)
+        (`with_inputs`). `network`: the building's, where the caller has assembled it;
+        `derivatives`: its `network.Derivative` with respect to each of k parameters, whose
+        derivatives (N_t, len(nodes), k) are returned too (`integrate.simulate`)."""
+        return simulate(building, assemble(building) if network is None else network, self.U, self.dt, self.measured,
+                        burn_in_steps=self.burn_in_steps, steady_start=self.steady_start, substeps=self.substeps,
+                        history_steps=self.history_steps, outputs=nodes, derivatives=derivatives)
 
     def window(self, start, stop):
         """The sub-case on rows start..stop (inclusive), t_start becoming its t_0; the burn-in

@@ -427,8 +427,9 @@ def history_block(dt):
 
 def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2, T_default=20.0,
              include_start=False, burn_in_steps=0, stepper=None, steady_start=False, steady_stepper=None,
-             substeps=1, history_steps=0, history_stepper=None, outputs=None):
-    """Simulate the network over input samples t_0..t_N; return temperatures at t_1..t_N.
+             substeps=1, history_steps=0, history_stepper=None, outputs=None, derivatives=()):
+    """Simulate the network over input samples t_0..t_N; return temperatures at t_1..t_N, and with
+    `derivatives` their derivatives with respect to the network's parameters.
 
     Parameters
     ----------
@@ -457,11 +458,17 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     history_stepper : the network's `ImplicitEuler` for those steps, if one is kept between runs
     outputs : indices of the nodes returned (default every node): a run in modes (`modal`) forms
         only those
+    derivatives : the `network.Derivative` of the network with respect to each of k parameters:
+        the temperatures' derivatives are propagated beside them, through the same factors
+        (forward sensitivities, docs/model.md section 5.9; `sensitivity_steps`). The start is
+        the measurements' and a forced node's temperature is imposed: neither moves with a
+        parameter.
 
     Returns
     -------
     (N_t, N) node temperatures (C) at t_1..t_N, or (N_t+1, N) at t_0..t_N with `include_start`;
-    N the nodes of `outputs` where given
+    N the nodes of `outputs` where given. With `derivatives`, also their derivatives, (N_t, N, k)
+    or (N_t+1, N, k), C per unit of each parameter.
     """
     n_rows, n = U.shape[0], network.n_nodes
     if measured is None:
@@ -475,20 +482,31 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     H = history_steps
     stepper = ImplicitEuler(network, dt / substeps) if stepper is None else stepper
     T = initial_state(building, measured[0], T_default)
+    S = np.zeros((n, len(derivatives)))  # the temperatures' derivatives, none at the start
     if steady_start:
         u, held, values = steady_inputs(U, measured, forced, dt)
         steady_stepper = ImplicitEuler(network, STEADY_STEP) if steady_stepper is None else steady_stepper
-        T = steady_stepper.step(T, network.sources(u), held, values, network.switched_diagonal(u))
+        switched = network.switched_diagonal(u)
+        before, T = T, steady_stepper.step(T, network.sources(u), held, values, switched)
+        if derivatives:
+            _, S = sensitivity_steps(steady_stepper, network, derivatives, S, before[None], T[None], u[None], held,
+                                     switched, [], [])
     out = np.empty((n_rows, len(outputs)))
     out[0] = T[outputs]
+    d_out = np.empty((n_rows, len(outputs), len(derivatives)))
+    d_out[0] = S[outputs]
     if H:
         block = history_block(dt)
         history_stepper = ImplicitEuler(network, block * dt) if history_stepper is None else history_stepper
         free, nothing = np.zeros(n, dtype=bool), np.full(n, np.nan)
         means = history_inputs(U, H, dt)
+        path, start = np.empty((len(means), n)), T
         for b, (source, u) in enumerate(zip(network.sources(means), means)):
-            T = history_stepper.step(T, source, free, nothing, network.switched_diagonal(u))
-            out[b * block + 1:(b + 1) * block + 1] = T[outputs]
+            T = path[b] = history_stepper.step(T, source, free, nothing, network.switched_diagonal(u))
+        out[1:H + 1] = np.repeat(path[:, outputs], block, axis=0)
+        if derivatives:
+            d_path, S = history_sensitivities(history_stepper, network, derivatives, S, start, path, means)
+            d_out[1:H + 1] = np.repeat(d_path[:, outputs], block, axis=0)
     # the record's steps from t_H, the warm-up's replay standing in for a history the record
     # lacks: each step's input row (from t_H) and sub-step
     rows = warmup_rows(n_rows - H, dt, 0 if H else warmup_days)
@@ -498,16 +516,23 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     imposed = np.stack(within_steps(measured[H:], substeps), axis=1)[row_of, sub_of]
     # the rows from t_H on, each after its last sub-step
     ks = np.arange(max(start - 1, 0), len(rows))
-    out[H + ks - start + 1] = steps(stepper, network, T, inputs, forced[H:][row_of], imposed, (ks + 1) * substeps - 1,
-                                    outputs)
-    return out if include_start else out[1:]
+    stepped = steps(stepper, network, T, inputs, forced[H:][row_of], imposed, (ks + 1) * substeps - 1, outputs,
+                    derivatives, S)
+    first = 0 if include_start else 1
+    if not derivatives:
+        out[H + ks - start + 1] = stepped
+        return out[first:]
+    out[H + ks - start + 1], d_out[H + ks - start + 1] = stepped
+    return out[first:], d_out[first:]
 
 
-def steps(stepper, network, T, inputs, forced, imposed, kept, outputs):
+def steps(stepper, network, T, inputs, forced, imposed, kept, outputs, derivatives=(), S=None):
     """The temperatures of the `outputs` nodes (C) after the `kept` steps (increasing indices) of
     a sequence of steps from T: (len(kept), len(outputs)). Each run of steps under one step
     matrix (one forcing mask and switched conductances) long enough is solved in its modes
-    (`modal`, `MODAL_FROM`), any other stepped.
+    (`modal`, `MODAL_FROM`), any other stepped. With `derivatives` (`simulate`'s) and the
+    temperatures' derivatives S (N, k) before the first step, also theirs after the kept steps,
+    (len(kept), len(outputs), k): `sensitivity_steps` of each run.
 
     Parameters
     ----------
@@ -521,29 +546,113 @@ def steps(stepper, network, T, inputs, forced, imposed, kept, outputs):
     """
     terms, B, q = network.source_terms(inputs)
     switched = network.switched_diagonal(inputs)  # None where nothing switches
-    changes = np.any(forced[1:] != forced[:-1], axis=1)
-    if switched is not None:
-        changes |= np.any(switched[1:] != switched[:-1], axis=1)
-    bounds = np.concatenate([[0], np.flatnonzero(changes) + 1, [len(inputs)]])
+    bounds = runs(forced, switched)
     out = np.empty((len(kept), len(outputs)))
+    d_out = np.empty((len(kept), len(outputs), len(derivatives)))
+    reads = np.unique(np.concatenate([d.reads for d in derivatives])) if derivatives else None
     for a, b in zip(bounds[:-1], bounds[1:]):
         mask, g = forced[a], None if switched is None else switched[a]
         here = np.flatnonzero((kept >= a) & (kept < b))
         modes = stepper.modes(mask, g) if b - a >= MODAL_FROM * np.count_nonzero((network.C > 0) & ~mask) else None
+        before = T
         if modes is not None:
             solve, _ = stepper.solver(mask, g)
-            out[here], T = modal_run(solve.inverse, stepper.c_dt, mask, modes, T, terms[a:b], B, q, imposed[a:b],
-                                     kept[here] - a, outputs)
-            continue
-        sources = terms[a:b] @ B.T + q
-        at = iter(here)
-        i = next(at, None)
-        for k in range(a, b):
-            T = stepper.step(T, sources[k - a], mask, imposed[k], g)
-            if i is not None and kept[i] == k:
-                out[i] = T[outputs]
-                i = next(at, None)
-    return out
+            if derivatives:  # from the same scan, every step of the nodes the derivatives' sources read too
+                nodes = np.union1d(outputs, reads)
+                path = np.zeros((b - a, network.n_nodes))
+                path[:, nodes], T = modal_run(solve.inverse, stepper.c_dt, mask, modes, T, terms[a:b], B, q,
+                                              imposed[a:b], np.arange(b - a), nodes)
+                out[here] = path[kept[here] - a][:, outputs]
+            else:
+                out[here], T = modal_run(solve.inverse, stepper.c_dt, mask, modes, T, terms[a:b], B, q, imposed[a:b],
+                                         kept[here] - a, outputs)
+        else:
+            sources = terms[a:b] @ B.T + q
+            path = np.empty((b - a if derivatives else 0, network.n_nodes))
+            at = iter(here)
+            i = next(at, None)
+            for k in range(a, b):
+                T = stepper.step(T, sources[k - a], mask, imposed[k], g)
+                if derivatives:
+                    path[k - a] = T
+                if i is not None and kept[i] == k:
+                    out[i] = T[outputs]
+                    i = next(at, None)
+        if derivatives:
+            d_out[here], S = sensitivity_steps(stepper, network, derivatives, S, np.vstack([before[None], path[:-1]]),
+                                               path, inputs[a:b], mask, g, kept[here] - a, outputs, modes)
+    return (out, d_out) if derivatives else out
+
+
+def runs(forced, switched):
+    """The bounds [0, ..., L] of the runs of steps under one step matrix: the same forced nodes
+    ((L, N) bool) and switched conductances ((L, N), or None)."""
+    changes = np.any(forced[1:] != forced[:-1], axis=1)
+    if switched is not None:
+        changes |= np.any(switched[1:] != switched[:-1], axis=1)
+    return np.concatenate([[0], np.flatnonzero(changes) + 1, [len(forced)]])
+
+
+def history_sensitivities(stepper, network, derivatives, S, start, path, inputs):
+    """The derivatives (L, N, k) after each of a history's steps (nothing forced; `simulate`),
+    from S (N, k) at its `start` (N,), its temperatures after each step `path` (L, N) and each
+    step's inputs (L, n_inputs); and (N, k) after the last."""
+    n = network.n_nodes
+    forced = np.zeros((len(path), n), dtype=bool)
+    switched = network.switched_diagonal(inputs)
+    before = np.vstack([start[None], path[:-1]])
+    out = np.empty(path.shape + (len(derivatives),))
+    bounds = runs(forced, switched)
+    for a, b in zip(bounds[:-1], bounds[1:]):
+        out[a:b], S = sensitivity_steps(stepper, network, derivatives, S, before[a:b], path[a:b], inputs[a:b],
+                                        forced[a], None if switched is None else switched[a], np.arange(b - a),
+                                        np.arange(n))
+    return out, S
+
+
+def sensitivity_steps(stepper, network, derivatives, S, before, after, inputs, forced, switched, kept, outputs,
+                      modes=None):
+    """The temperatures' derivatives through a run of L steps under one step matrix (forward
+    sensitivities, docs/model.md section 5.9): for each parameter, its `network.Derivative`'s
+    source from the temperatures before and after each step (C, (L, N)) and the steps' inputs
+    (L, n_inputs), carried by the step itself with the forced nodes held at zero (a forced
+    temperature is the measurement's, which no parameter moves). The factors are the
+    temperatures' own (`stepper.solver`); where the run was solved in its `modes`, so are
+    the derivatives (`modal.run` with the source as its inputs).
+
+    Returns
+    -------
+    (len(kept), len(outputs), k) the derivatives of the `outputs` nodes after the `kept` steps
+    (C per unit of each parameter), and (N, k) every node's after the last step
+    """
+    terms, _, _ = network.source_terms(inputs)
+    source = np.stack([d.source(before, after, terms, inputs, stepper.dt) for d in derivatives], axis=-1)
+    solve, index = stepper.solver(forced, switched)
+    source[:, index] = 0.0
+    out = np.empty((len(kept), len(outputs), len(derivatives)))
+    if modes is not None:  # the source as inputs, on the rows where it may be other than zero
+        n = network.n_nodes
+        rows = np.unique(np.concatenate([d.rows for d in derivatives]))
+        last = np.empty_like(S)
+        for j in range(len(derivatives)):
+            out[..., j], last[:, j] = modal_run(solve.inverse, stepper.c_dt, forced, modes, S[:, j],
+                                                source[:, rows, j], np.eye(n)[:, rows], np.zeros(n),
+                                                np.zeros((len(source), n)), kept, outputs)
+        return out, last
+    # one parameter at a time: a matrix-vector product is several times faster than one with a
+    # matrix of two columns (BLAS's paths for each), and the parameters are few
+    c = np.where(forced, 0.0, stepper.c_dt)
+    S, source = S.T.copy(), np.ascontiguousarray(source.transpose(2, 0, 1))
+    at = iter(range(len(kept)))
+    i = next(at, None)
+    for k in range(source.shape[1]):
+        for j, s in enumerate(S):
+            S[j] = solve(c * s + source[j, k])
+        S[:, index] = 0.0
+        if i is not None and kept[i] == k:
+            out[i] = S[:, outputs].T
+            i = next(at, None)
+    return out, S.T
 
 
 def history_inputs(U, history_steps, dt):

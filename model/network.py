@@ -83,6 +83,96 @@ class Network:
         return a, b, np.hstack([self.B, products])
 
 
+class Coefficients:
+    """A matrix's nonzero rows and columns and the dense block they cross: products with it cost
+    what its nonzeros do (a parameter moves a few links of a network of hundreds of nodes)."""
+
+    def __init__(self, matrix):
+        self.shape = matrix.shape
+        self.rows = np.flatnonzero(np.any(matrix != 0.0, axis=1))
+        self.cols = np.flatnonzero(np.any(matrix != 0.0, axis=0))
+        self.block = matrix[np.ix_(self.rows, self.cols)]
+
+    def dense(self):
+        out = np.zeros(self.shape)
+        out[np.ix_(self.rows, self.cols)] = self.block
+        return out
+
+    def add_product(self, out, x):
+        """out[:, rows] += x[:, cols] block^T: out += x M^T for rows of vectors x (L, n)."""
+        if len(self.rows):
+            out[:, self.rows] += x[:, self.cols] @ self.block.T
+
+
+@dataclass(frozen=True)
+class Derivative:
+    """The derivative of a `Network`'s coefficients with respect to one parameter p (their units
+    per unit of p): the capacities C (J/K), the conductances A (W/K), the sources' coefficients
+    B' and q (W per unit of each source term, `Network.source_terms`) and the switched
+    conductances, as the matrix G (W/K per unit of each input) whose product with the inputs is
+    what they add to the diagonal of -A (`Network.switched_diagonal`)."""
+    C: np.ndarray  # (N,)
+    A: Coefficients
+    B: Coefficients
+    q: np.ndarray  # (N,)
+    G: Coefficients
+
+    @cached_property
+    def reads(self):
+        """The nodes whose temperatures `source` reads (indices)."""
+        return np.union1d(np.union1d(np.flatnonzero(self.C), self.A.cols), self.G.rows)
+
+    @cached_property
+    def rows(self):
+        """The nodes where `source` may be other than zero (indices)."""
+        return np.union1d(np.union1d(self.reads, self.A.rows), np.union1d(self.B.rows, np.flatnonzero(self.q)))
+
+    def close_to(self, other, rtol):
+        """Whether `other` is this derivative to `rtol` of the largest entry of each coefficient."""
+        def close(a, b):
+            return np.abs(a - b).max(initial=0.0) <= rtol * max(np.abs(a).max(initial=0.0), np.abs(b).max(initial=0.0))
+        return all(close(a, b) for a, b in ((self.C, other.C), (self.q, other.q), (self.A.dense(), other.A.dense()),
+                                            (self.B.dense(), other.B.dense()), (self.G.dense(), other.G.dense())))
+
+    def source(self, before, after, terms, inputs, dt):
+        """(L, N): what backward-Euler steps of dt (s) add to the right-hand side of the
+        temperatures' derivatives (W per unit of p), from each step's temperatures before and
+        after (C, (L, N): only those it `reads` matter), source terms (`Network.source_terms`) and
+        inputs: differentiating
+        M T^n+1 = (C/dt) T^n + s^n+1, M = C/dt - A + diag(G u), gives
+        M dT^n+1 = (C/dt) dT^n + (dC/dt) (T^n - T^n+1) + dA T^n+1 - (dG u) T^n+1 + dB' terms + dq
+        (docs/model.md section 5.9)."""
+        out = (before - after) * (self.C / dt) + self.q
+        self.A.add_product(out, after)
+        self.B.add_product(out, terms)
+        switched = np.zeros_like(out)
+        self.G.add_product(switched, inputs)
+        return out - switched * after
+
+
+def switched_matrix(network):
+    """(N, n_inputs) G: the switched conductances g u_j (W/K) as `G u`."""
+    G = np.zeros((network.n_nodes, len(network.input_names)))
+    for node, j, g in network.switched:
+        G[node, j] += g
+    return G
+
+
+def derivative(network, moved, h):
+    """The `Derivative` (moved - network) / h of two networks of one building at parameter values
+    h apart; None where they differ in shape (nodes, inputs, which inputs multiply, which
+    conductances switch), which no derivative spans."""
+    shape = (lambda n: (n.n_nodes, n.input_names, [(node, a, b) for node, a, b, _ in n.products],
+                        [(node, j) for node, j, _ in n.switched]))
+    if shape(network) != shape(moved):
+        return None
+    (_, B0, _), (_, B1, _) = network.source_terms(np.zeros((1, len(network.input_names)))), \
+        moved.source_terms(np.zeros((1, len(moved.input_names))))
+    return Derivative(C=(moved.C - network.C) / h, A=Coefficients((moved.A - network.A) / h),
+                      B=Coefficients((B1 - B0) / h), q=(moved.q - network.q) / h,
+                      G=Coefficients((switched_matrix(moved) - switched_matrix(network)) / h))
+
+
 def input_names(building):
     """The input vector's names, in the order of the columns of B."""
     irradiance = tuple(dict.fromkeys(c.irradiance_input for c in building.exterior_components))
