@@ -28,8 +28,8 @@ from nodeforce.model.case import as_cases
 from nodeforce.model.significance import bandwidth, parameter_covariance
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.hlc import heat_loss_coefficient
-from nodeforce.model.network import assemble
-from nodeforce.model.numerical import share
+from nodeforce.model.network import assemble, derivative
+from nodeforce.model.numerical import share, share_slope
 
 log = logging.getLogger("nodeforce.diagnosis")
 
@@ -42,6 +42,15 @@ STEP = 1e-6
 KEPT_RUNS = 64
 # Halvings of a fold's step before it falls back on the whole window's optimum (`fold`).
 FOLD_HALVINGS = 6
+# The network's derivative with respect to a parameter is the difference of two assemblies this
+# fraction of the parameter's range apart, divided by it: exact, whatever the fraction, for a
+# network affine in the parameter, which a third assembly a step further checks (`AFFINE`). A
+# large step keeps the difference's rounding far below the entries it measures.
+NETWORK_STEP = 1e-2
+# How far apart the two steps' differences may be, relative to the largest entry, for the network
+# to be affine in the parameter; a parameter it is not affine in keeps finite differences of its
+# runs (`Candidate.jacobian`).
+AFFINE = 1e-9
 
 
 class Candidate:
@@ -81,7 +90,8 @@ class Candidate:
         self.held = tuple(i for i, (label, p) in enumerate(entries)
                           if label is not None and p.name in (held or {}).get(label, ()))
         self._beside = [(label, p.name) for label, p in entries[self.own:]]
-        self._runs, self._inputs, self._superposed = {}, {}, {}
+        self._runs, self._inputs, self._superposed, self._jacobians = {}, {}, {}, {}
+        self._derivatives, self._affine = {}, {}
         self.simulations = 0  # simulations run (kept ones not counted again): a round's cost
 
     @property
@@ -130,22 +140,99 @@ class Candidate:
         superposed = self._superposition(case, key[1])
         run = superposed(values) if superposed is not None else \
             self._simulated(case, node_ids, self.built(values, self.base(case)))
+        self._kept(key, run)
+        return run
+
+    def jacobian(self, case, node_ids, values):
+        """(N_t, len(node_ids), k): the derivatives of `nodes` at `values` with respect to each
+        parameter (C per unit of it). A superposed candidate's are its slopes; any other's are
+        propagated through the run's own factors beside its temperatures (forward
+        sensitivities: `integrate.simulate`, docs/model.md section 5.9), from the network's
+        derivative with respect to each parameter (`_derivative`), at the cost of one run. A
+        parameter the network is not affine in has none: its column is a forward difference of
+        runs, least squares' own step (`step_forward`)."""
+        values = np.asarray(values, dtype=float)
+        key = (id(case), tuple(node_ids), tuple(values))
+        if key in self._jacobians:
+            return self._jacobians[key]
+        superposed = self._superposition(case, key[1])
+        if superposed is not None:
+            jacobian = np.stack(superposed.slopes, axis=-1)
+        else:
+            base = self.base(case)
+            building = self.built(values, base)
+            network = assemble(building)
+            derivatives = [self._derivative(base, network, values, i) for i in range(len(values))]
+            exact = [i for i, d in enumerate(derivatives) if d is not None]
+            self.simulations += 1
+            run = self._inputs_of(case).run(building, np.asarray(node_ids) - 1, network,
+                                            [derivatives[i] for i in exact])
+            run, moved = run if exact else (run, None)
+            self._kept(key, run)
+            jacobian = np.empty(run.shape + (len(values),))
+            if exact:
+                jacobian[..., exact] = moved
+            for i in sorted(set(range(len(values))) - set(exact)):
+                h = step_forward(values[i], *self.bounds[i])
+                stepped = values.copy()
+                stepped[i] += h
+                jacobian[..., i] = (self.nodes(case, node_ids, stepped) - run) / h
+        if len(self._jacobians) >= KEPT_RUNS:
+            self._jacobians.pop(next(iter(self._jacobians)))
+        self._jacobians[key] = jacobian
+        return jacobian
+
+    def _derivative(self, base, network, values, i):
+        """The `network.Derivative` of `network`, the candidate's on `base` at `values`, with
+        respect to parameter i: the difference of the assemblies at values and one step
+        (`NETWORK_STEP`) of i's range away, or None where the network is not affine in the
+        parameter (a difference one step further is not the same, to `AFFINE`, or the
+        network's shape moves with it). Kept for the values of the others: the network's
+        terms in one parameter may scale with another (a ground coupling's U T_ground)."""
+        key = (id(base), i, tuple(np.delete(values, i)))
+        if key in self._derivatives:
+            return self._derivatives[key]
+        low, high = self.bounds[i]
+        h = NETWORK_STEP * (high - low)
+        h = h if values[i] + 2 * h <= high else -h
+
+        def at(steps):
+            moved = values.copy()
+            moved[i] += steps * h
+            return assemble(self.built(moved, base))
+        one = at(1)
+        found = derivative(network, one, h)
+        if found is not None and (id(base), i) not in self._affine:
+            further = derivative(one, at(2), h)
+            self._affine[(id(base), i)] = further is not None and found.close_to(further, AFFINE)
+            if not self._affine[(id(base), i)]:
+                log.info("%s: the network is not affine in %s: its derivatives by differences of runs",
+                         self.label, self.names[i])
+        if not self._affine.get((id(base), i), False):
+            found = None
+        self._derivatives[key] = found
+        return found
+
+    def _kept(self, key, run):
+        """Keep a run by its (case, nodes, values), the oldest dropped past `KEPT_RUNS`."""
         if len(self._runs) >= KEPT_RUNS:
             self._runs.pop(next(iter(self._runs)))
         self._runs[key] = run
-        return run
 
-    def _simulated(self, case, node_ids, building):
-        """The nodes of `building`, the case's base with the effect at some values, simulated."""
+    def _inputs_of(self, case):
+        """The case with the inputs the candidate's buildings read: the effect may read inputs the
+        building as declared does not (a daily gain, the clock)."""
         if id(case) not in self._inputs:
-            # the effect may read inputs the building as declared does not (a daily gain, the clock)
             declared = self.base(case)
             for effect, target in self.parts:
                 declared = EFFECTS[effect].apply(declared, target, {})
             self._inputs[id(case)] = (case, case.with_inputs(declared))
-        _, inputs = self._inputs[id(case)]
+        return self._inputs[id(case)][1]
+
+    def _simulated(self, case, node_ids, building):
+        """The nodes of `building`, the case's base with the effect at some values, simulated."""
         self.simulations += 1
-        return inputs.run(building, np.asarray(node_ids) - 1)
+        return self._inputs_of(case).run(building, np.asarray(node_ids) - 1)
 
     def _superposition(self, case, node_ids):
         """The `Superposition` of these nodes on `case`, or None where the effect is not on the
@@ -214,6 +301,33 @@ class Own:
         return readings
 
 
+class Residuals:
+    """A fit's residuals at parameter values x, and their Jacobian: the measured less the
+    simulated (`raw`, and its derivatives `raw_jacobian`, (rows, k)), less the share of the file's
+    numerical error `error` found on the rows that count (`model.numerical.share`), each row times
+    its `scale` (the square root of its weight; a row of weight 0 does not count)."""
+
+    def __init__(self, raw, raw_jacobian, error, scale):
+        self.raw, self.raw_jacobian, self.error, self.scale = raw, raw_jacobian, error, scale
+        self.counted = scale > 0
+
+    def __call__(self, x, rows=None):
+        """The residuals at x, the share read on the `rows` (bool) that count, or all of them."""
+        r = self.raw(x)
+        return (r + share(r, self.error, self.counted if rows is None else self.counted & rows) * self.error) * self.scale
+
+    def fitting(self, x):
+        """The residuals at x with their Jacobian there worked out beside them (the candidate keeps
+        both): least squares asks for the Jacobian at every point it moves to, and a run that
+        carries the derivatives costs less than a run and then another for them."""
+        self.raw_jacobian(x)
+        return self(x)
+
+    def jacobian(self, x):
+        r, slopes = self.raw(x), self.raw_jacobian(x)
+        return (slopes + np.outer(self.error, share_slope(r, self.error, self.counted, slopes))) * self.scale[:, None]
+
+
 def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None):
     """Least-squares values of the candidate's parameters on the calibration windows of one or
     several records of the building (`cases`), on the residuals of every objective zone of every
@@ -278,18 +392,15 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None):
     def raw(x):
         return np.concatenate([(m - candidate.nodes(case, i, x))[h] for case, i, m, h in zip(cases, ids, measured, have)])
 
+    def raw_jacobian(x):
+        return -np.concatenate([candidate.jacobian(case, i, x)[h] for case, i, h in zip(cases, ids, have)])
+
     def weighted(weights):
-        """The residuals with each own node's column times the square root of its weight (one
-        (len(ids),) per case; the air's columns weigh 1), less the share of the numerical error
-        found on the columns that count; and those columns' rows."""
+        """The `Residuals` with each own node's column times the square root of its weight (one
+        (len(ids),) per case; the air's columns weigh 1)."""
         scale = np.sqrt(np.concatenate([np.broadcast_to(np.r_[np.ones(zones), w], h.shape)[h]
                                         for w, h in zip(weights, have)]))
-        counted = scale > 0
-
-        def residuals(x, rows=None):
-            r = raw(x)
-            return (r + share(r, error, counted if rows is None else counted & rows) * error) * scale
-        return residuals, counted
+        return Residuals(raw, raw_jacobian, error, scale)
 
     # each record's steps numbered apart from the others' by more than the HAC's lags: residuals
     # of two records are not correlated
@@ -299,13 +410,13 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None):
         steps.append(np.nonzero(h)[0] + offset)
         offset += len(h) + lags + 1
     steps = np.concatenate(steps)
-    residuals, counted = weighted([np.zeros(len(e)) for e in extra])
+    residuals = weighted([np.zeros(len(e)) for e in extra])
     fit = solve(residuals, x0, lows, highs, kept)
     if any(h[:, zones:].any() for h in have):
         weights = own_weights(candidate, cases, ids, measured, numerical, zones, fit.x, own.sd)
         log.info("%s: its own nodes read beside the air, weighing %s", candidate.label,
                  "; ".join(", ".join(f"{n}: {w:.2g}" for n, w in zip(e, ws)) for e, ws in zip(extra, weights)))
-        residuals, counted = weighted(weights)
+        residuals = weighted(weights)
         fit = solve(residuals, fit.x, lows, highs, kept)
     cov = parameter_covariance(fit.jac, fit.fun, steps, lags)
     priors = wanted_priors(candidate, cases, identified(candidate, fit, cov))
@@ -335,7 +446,7 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None):
         train = ~np.concatenate([rows[h] for rows, h in zip(on_block([h.shape for h in have], record, block), have)])
         x = fold(fit, train, lows, highs, lambda x: residuals(x, train))
         case, m, h = cases[record], measured[record], have[record]
-        s = share(raw(x), error, train & counted)
+        s = share(raw(x), error, train & residuals.counted)
         T = candidate.nodes(case, ids[record], x)
         left = np.where(h & block[:, None], m - T + s * numerical[record], np.nan)
         folds.append({"values": [float(v) for v in x], "residuals": left[:, :zones],
@@ -367,7 +478,9 @@ def own_weights(candidate, cases, ids, measured, numerical, zones, x, sd):
 def solve(residuals, x0, lows, highs, held=None):
     """Bounded least squares of `residuals(x)` from x0 over the parameters not `held` ({index:
     value}, those fixed at their value): its x, fun, jac and active_mask as scipy's, of every
-    parameter (a held one's Jacobian column zero, its active_mask 0)."""
+    parameter (a held one's Jacobian column zero, its active_mask 0). The Jacobian is
+    `residuals.jacobian(x)` where the residuals carry one (`Residuals`), else least squares'
+    differences."""
     held = held or {}
     free = np.array([i not in held for i in range(len(x0))])
     x = np.array(x0, dtype=float)
@@ -377,8 +490,10 @@ def solve(residuals, x0, lows, highs, held=None):
         out = x.copy()
         out[free] = z
         return out
-    fit = least_squares(lambda z: residuals(full(z)), x[free], bounds=(lows[free], highs[free]), x_scale="jac",
-                        method="trf")
+    exact = getattr(residuals, "jacobian", None)
+    fun = residuals if exact is None else residuals.fitting
+    fit = least_squares(lambda z: fun(full(z)), x[free], bounds=(lows[free], highs[free]), x_scale="jac",
+                        method="trf", jac="2-point" if exact is None else (lambda z: exact(full(z))[:, free]))
     jac = np.zeros((len(fit.fun), len(x)))
     jac[:, free] = fit.jac
     active = np.zeros(len(x), dtype=int)
@@ -562,6 +677,13 @@ def within_ranges(cov, bounds):
     values, vectors = np.linalg.eigh(cov / np.outer(scale, scale))
     values = np.clip(values, 0.0, None)
     return np.outer(scale, scale) * ((vectors * (values / (1.0 + values))) @ vectors.T)
+
+
+def step_forward(value, low, high):
+    """The forward difference step of least squares' own Jacobian (scipy's "2-point": sqrt of the
+    machine epsilon times max(1, |value|)), turned back where it would leave the range."""
+    h = np.sqrt(np.finfo(float).eps) * max(1.0, abs(value))
+    return h if value + h <= high else -h
 
 
 def step_inside(value, low, high):

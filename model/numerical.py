@@ -82,3 +82,17 @@ def share(residual, error, rows=None):
     e, r = error[keep], residual[keep]
     energy = float(e @ e)
     return float(np.clip(-(e @ r) / energy, 0.0, 1.0)) if energy > 0.0 else 0.0
+
+
+def share_slope(residual, error, rows, slopes):
+    """(k,) the derivatives of `share` with respect to k parameters the residual moves with, from
+    the residual's own derivatives `slopes` (C per unit of each, (residual.size, k) for the
+    residual flattened): -(e . dr) / (e . e) on the rows `share` reads, zero where the share is
+    held at 0 or 1."""
+    keep = (np.isfinite(residual) & np.isfinite(error) & (True if rows is None else rows)).ravel()
+    e, r = error.ravel()[keep], residual.ravel()[keep]
+    energy = float(e @ e)
+    if energy <= 0.0 or not 0.0 < -(e @ r) / energy < 1.0:
+        return np.zeros(slopes.shape[1])
+    return -(e @ slopes[keep]) / energy
+

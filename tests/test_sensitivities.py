@@ -1,0 +1,173 @@
+"""The temperatures' derivatives with respect to an effect's parameters (forward sensitivities,
+`integrate.simulate(derivatives=...)`, docs/model.md section 5.9) against central differences
+of runs, for every effect of the registry, on a network whose runs are solved in their modes
+(the test cell) and on one stepped (two zones, air carried one way, a switched ventilation);
+a parameter the network is not affine in keeps differences of runs; the derivative of the share
+of the numerical error."""
+import numpy as np
+import pandas as pd
+import pytest
+
+from nodeforce.diagnosis.calibrate import Candidate
+from nodeforce.diagnosis.candidates import calibration_start
+from nodeforce.model.building_file import load_building, parse_building
+from nodeforce.model.case import Case
+from nodeforce.model.effects import EFFECTS, Effect, Parameter
+from nodeforce.model.integrate import simulate
+from nodeforce.model.network import assemble, derivative
+from nodeforce.model.numerical import share, share_slope
+
+from .conftest import DATA
+from .test_house_effects import with_all
+from .test_zones import multizone_with_everything
+
+DT, DAYS, HISTORY = 900.0, 4, 24  # s, days of record, samples of history (two of its 3-h steps)
+# central differences of a relative step of 1e-4 are exact to some 1e-8 here (their truncation
+# and rounding); the derivatives must agree with them to
+RTOL = 1e-6
+
+
+def house():
+    """Two zones with every house effect's target, a ground face and a ventilation switched by a
+    schedule (its conductance follows the schedule: `Network.switched`)."""
+    data = with_all(multizone_with_everything()).to_json()
+    data["components"].append(
+        {"name": "slab", "area": 10.0, "tilt": 180.0, "azimuth": 0.0, "layers": [["board", 0.15]],
+         "nodes": {"max_spacing": 0.05}, "inside": {"zone": "B", "h_conv": 2.0, "h_rad": 5.0},
+         "outside": {"type": "adiabatic"}})
+    data["schedules"] = {"night": {"days": {"d": [[6, 1.0], [18, 0.25], [24, 1.0]]},
+                                   "periods": [{"through": "12-31", "week": ["d"] * 7}]}}
+    data["zones"][1]["ventilation"] = [{"name": "vent", "flow": 40.0, "schedule": "night"}]
+    return parse_building(data)
+
+
+def record(building, seed):
+    """A case as a diagnosis runs one: a history, a steady start, a burn-in forcing the measured
+    nodes, sub-steps; the weather and heat inputs made up, the air and a surface measured."""
+    rng = np.random.default_rng(seed)
+    n_rows = HISTORY + DAYS * 96 + 1
+    times = pd.date_range("2014-04-09", periods=n_rows, freq="15min", tz="+01:00", name="time")
+    hours = np.arange(n_rows) * 0.25
+    day = np.sin(2 * np.pi * hours / 24)
+    columns = {"T_out": 8 + 6 * day + rng.normal(0, 0.3, n_rows), "T_sky": -2 + 6 * day,
+               "heater": rng.choice([0.0, 900.0], n_rows), "duct": np.full(n_rows, -60.0),
+               "T_supply": 17 + 3 * np.cos(2 * np.pi * hours / 24),
+               "T_cellar": 13 + 0.5 * np.sin(2 * np.pi * hours / 72), "blind": (day > 0.5).astype(float)}
+    for c in building.exterior_components:
+        columns[c.irradiance_input] = np.clip(600 * day, 0, None)
+    measured = np.full((n_rows, building.n_nodes), np.nan)
+    for z in building.zones[:1]:
+        measured[HISTORY:, z.air_node - 1] = 21 + day[HISTORY:] + rng.normal(0, 0.1, n_rows - HISTORY)
+    face = building.components[0].node_ids[0] - 1
+    measured[HISTORY:, face] = 20 + 0.5 * day[HISTORY:]
+    case = Case(times, DT, tuple(columns), np.column_stack(list(columns.values())), measured,
+                burn_in_steps=HISTORY + 96, steady_start=True, substeps=3, history_steps=HISTORY, building=building)
+    return case.with_inputs(building)
+
+
+def buildings():
+    return {"test cell": load_building(DATA / "testcell_miami.json"), "house": house()}
+
+
+def effect_cases():
+    out = []
+    for label, building in buildings().items():
+        for effect, record_ in EFFECTS.items():
+            targets = record_.targets(building)
+            if targets:
+                out.append((label, effect, targets[0]))
+    return out
+
+
+CASES = effect_cases()
+
+
+def runs(building, effect, target, case, values, outputs, force=None, derivatives=()):
+    changed = EFFECTS[effect].apply(building, target, dict(zip([p.name for p in EFFECTS[effect].parameters], values)))
+    network = assemble(changed)
+    return simulate(changed, network, case.U, case.dt, case.measured, force=force, burn_in_steps=case.burn_in_steps,
+                    steady_start=case.steady_start, substeps=case.substeps, history_steps=case.history_steps,
+                    outputs=outputs, derivatives=derivatives), network
+
+
+@pytest.mark.parametrize("label, effect, target", CASES, ids=[f"{e}@{t} ({b})" for b, e, t in CASES])
+def test_the_derivatives_of_every_effect_equal_central_differences(label, effect, target):
+    building = buildings()[label]
+    record_ = EFFECTS[effect]
+    base = record_.apply(building, target, {})  # the building reading the inputs the effect reads
+    case = record(base, seed=1)
+    start = calibration_start(building, effect, target)
+    x = np.array([start[p.name] for p in record_.parameters], dtype=float)
+    bounds = record_.bounds(building, target)
+    outputs = np.arange(base.n_nodes)
+    # a node forced over part of the record too (the search's Dirichlet condition)
+    force = np.zeros(base.n_nodes, dtype=bool)
+    force[base.components[0].node_ids[0] - 1] = True
+    _, network = runs(building, effect, target, case, x, outputs)
+    derivatives = []
+    for i, (low, high) in enumerate(bounds):
+        moved = x.copy()
+        moved[i] += 0.01 * (high - low)
+        _, other = runs(building, effect, target, case, moved, outputs)
+        derivatives.append(derivative(network, other, moved[i] - x[i]))
+    for forcing in (None, force):
+        plain, _ = runs(building, effect, target, case, x, outputs, forcing)
+        (T, dT), _ = runs(building, effect, target, case, x, outputs, forcing, derivatives)
+        # the temperatures are the run's own (a run in modes forms more of them: to rounding)
+        assert np.abs(T - plain).max() <= 1e-12 * np.abs(plain).max()
+        for i, (low, high) in enumerate(bounds):
+            h = 1e-4 * max(abs(x[i]), 1e-3 * (high - low))
+            up, down = x.copy(), x.copy()
+            up[i] += h
+            down[i] -= h
+            central = (runs(building, effect, target, case, up, outputs, forcing)[0]
+                       - runs(building, effect, target, case, down, outputs, forcing)[0]) / (2 * h)
+            scale = np.abs(central).max()
+            assert scale > 0.0, "the parameter moves no temperature: nothing checked"
+            assert np.abs(dT[..., i] - central).max() <= RTOL * scale, (effect, record_.parameters[i].name)
+
+
+def test_a_parameter_the_network_is_not_affine_in_keeps_differences_of_runs(monkeypatch, testcell, caplog):
+    """An effect whose conductivity factor is the square of its parameter: the network's two
+    steps' differences disagree, the column is least squares' own forward difference of runs,
+    and the log says so; an affine one's column is the sensitivities' (they differ by that
+    difference's error)."""
+    square = Effect("squared_conductivity", "a conductivity factor p^2", (Parameter("p", "-", 0.5, 3.0),),
+                    lambda b: [c.name for c in b.components],
+                    lambda b, t: {"p": float(np.sqrt(b.component(t).conductivity_factor))},
+                    lambda data, t, v: next(c for c in data["components"] if c["name"] == t).update(
+                        conductivity_factor=float(v["p"]) ** 2),
+                    lambda b, t: b.component(t).node_ids)
+    monkeypatch.setitem(EFFECTS, square.id, square)
+    case = record(testcell, seed=2)
+    ids = [testcell.zones[0].air_node]
+    caplog.set_level("INFO", logger="nodeforce.diagnosis")
+    squared = Candidate(testcell, "squared_conductivity", "door")
+    J = squared.jacobian(case, ids, [1.3])
+    assert "not affine in p" in caplog.text
+    h = np.sqrt(np.finfo(float).eps) * 1.3
+    forward = (squared.nodes(case, ids, [1.3 + h]) - squared.nodes(case, ids, [1.3])) / h
+    assert np.array_equal(J[..., 0], forward)
+    # the same physics by the registry's affine factor f = p^2: dT/dp = 2 p dT/df, propagated exactly;
+    # the forward difference agrees to its own error (its step's rounding: 1e-5 of the largest here)
+    affine = Candidate(testcell, "conductivity", "door").jacobian(case, ids, [1.3 ** 2])[..., 0] * 2 * 1.3
+    assert np.abs(J[..., 0] - affine).max() <= 1e-4 * np.abs(affine).max()
+    assert not np.array_equal(J[..., 0], affine)
+
+
+def test_the_share_s_derivative_is_its_difference_quotient_inside_and_zero_where_clipped():
+    rng = np.random.default_rng(5)
+    error = rng.normal(0.0, 0.2, 300)
+    slopes = rng.normal(0.0, 1.0, (300, 2))
+
+    def residual(x):
+        return -0.4 * error + 0.05 * rng_free + slopes @ x
+    rng_free = np.random.default_rng(6).normal(0.0, 1.0, 300)
+    x, h = np.array([0.01, -0.02]), 1e-6
+    assert 0.0 < share(residual(x), error) < 1.0
+    numeric = [(share(residual(x + h * e), error) - share(residual(x - h * e), error)) / (2 * h) for e in np.eye(2)]
+    np.testing.assert_allclose(share_slope(residual(x), error, None, slopes), numeric, rtol=1e-6)
+    clipped = residual(x) + 5.0 * error  # the residual holds more than all of the error: s held at 0
+    assert share(clipped, error) == 0.0
+    assert not share_slope(clipped, error, None, slopes).any()
+
