@@ -46,9 +46,11 @@ def assess(shared, pair):
     own = own_nodes(building, [target, *(t for _, t in beside)], sensors, at_sensors, sigma)
     fitted, determined, folds = calibrate(candidate, calibrations, objective, blocks, numerical, own)
     values = [fitted[name]["value"] for name in candidate.names]
-    runs = [candidate.nodes(case, objective.air_nodes, values) for case in cases]
-    sensed = [candidate.nodes(case, ids, values).copy() if ids else np.empty((len(case.times) - 1, 0))
-              for case, ids in zip(cases, sensors)]
+    zones = len(objective.air_nodes)
+    # the objective air and the other sensors (never the objective air) in one run of each record
+    every = [candidate.nodes(case, [*objective.air_nodes, *ids], values) for case, ids in zip(cases, sensors)]
+    runs = [run[:, :zones].copy() for run in every]
+    sensed = [run[:, zones:].copy() for run in every]
     if own is not None:
         for (record, block), f in zip(blocks, folds):
             rows = np.nonzero(block)[0]
