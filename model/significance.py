@@ -36,11 +36,19 @@ def parameter_covariance(jacobian, residuals, steps, lags):
     """
     jacobian, residuals = np.asarray(jacobian, dtype=float), np.asarray(residuals, dtype=float)
     steps = np.asarray(steps)
+    # computed for the parameters in units that give every column unit length: the inverse's
+    # relative cutoff then drops a direction the data leave undetermined, never a parameter whose
+    # unit makes its column short (a capacity in J/K beside a conductance in W/K) or whose
+    # column is exact rounding (a mass of no capacity's conductance); a zero column (a parameter
+    # held) keeps its variance 0
+    length = np.linalg.norm(jacobian, axis=0)
+    unit = np.where(length > 0, length, 1.0)
+    jacobian = jacobian / unit
     scores = np.zeros((steps.max() - steps.min() + 1, jacobian.shape[1]))
     # the zones' scores of one step are one moment of that step: their correlation is kept
     np.add.at(scores, steps - steps.min(), jacobian * residuals[:, None])
     bread = np.linalg.pinv(jacobian.T @ jacobian)
-    return bread @ S_hac_simple(scores, nlags=lags) @ bread
+    return bread @ S_hac_simple(scores, nlags=lags) @ bread / np.outer(unit, unit)
 
 
 def change_of_J(before, after, lags):

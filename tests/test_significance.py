@@ -53,6 +53,23 @@ def test_with_white_residuals_it_is_the_textbook_uncertainty():
     assert np.median(ratios, axis=0) == pytest.approx([1.0, 1.0], abs=0.1)
 
 
+def test_a_parameter_s_unit_changes_its_variance_by_its_square_and_nothing_else():
+    """A capacity in J/K beside a conductance in W/K: columns 1e9 apart in length. The
+    covariance transforms as the units do, and a column of rounding (a parameter that acts on
+    nothing) is unknown, not known exactly."""
+    rng = np.random.default_rng(3)
+    n = 2000
+    J = np.column_stack([np.sin(np.arange(n) / 40.0), rng.normal(0.0, 1.0, n)])
+    r = rng.normal(0.0, 0.1, n)
+    cov = parameter_covariance(J, r, np.arange(n), 5)
+    units = np.array([1.0, 1e-9])
+    scaled = parameter_covariance(J * units, r, np.arange(n), 5)
+    np.testing.assert_allclose(scaled, cov / np.outer(units, units), rtol=1e-9)
+    rounding = np.column_stack([J[:, 0], rng.normal(0.0, 1e-17, n)])
+    sd = np.sqrt(np.diag(parameter_covariance(rounding, r, np.arange(n), 5)))
+    assert sd[1] > 1e12  # with the inverse's relative cutoff in the raw units, 0
+
+
 def test_zones_of_one_step_are_one_moment():
     # two zones with the same residual at every step: summing their scores per step doubles
     # the score, so the HAC variance of their common offset is that of one zone's
