@@ -6,7 +6,9 @@ the FMUs carry the same equations and are tested equal to it (tests/test_fmu3.py
 diagnosis calibrates tens of candidates, each once on the whole calibration window and once per
 cross-validation block left out (`diagnosis.selection`, each fold one Gauss-Newton step from the
 whole window's optimum), so a simulation without an FMU's per-step calls is what makes that
-affordable. The chosen effect's FMU is built and written all
+affordable. Least squares' Jacobian is exact: the temperatures' derivatives propagated with each
+run through its own factors (forward sensitivities, `Candidate.jacobian`), one run a point for
+every parameter, not a run a parameter. The chosen effect's FMU is built and written all
 the same (`diagnosis.loop`). The covariance of the estimate is the linearised sandwich of
 `model.significance`, which allows for the residual's correlation in time (the textbook
 s^2 (J^T J)^-1 assumes independent residuals and, on real records, is several times too tight).
