@@ -62,7 +62,7 @@ def localization_lines(report):
            *([f"- {loc['finding']}"] if loc.get("finding") else []),
            f"- ranked nodes (lowest J first): {loc.get('ranked_nodes', NA)}"
            + (f"; the noise cannot separate {', '.join(map(str, loc['tied_nodes']))}" if loc.get("tied_nodes") else ""),
-           *([f"- evidence per component (share of J above the noise its forcing removes): " + ", ".join(
+           *(["- evidence per component (share of J above the noise its forcing removes): " + ", ".join(
                f"{e['component']} {e['share']:.0%}" for e in loc["components"])] if loc.get("components") else [])]
     search = loc.get("search") or {}
     if search:
@@ -161,7 +161,7 @@ def write_markdown(out_dir, report, plots, notes):
     if by_phase:
         md += ["RMSE (C) of the objective's air in each phase of the record, over both windows (the "
                f"calibration fitted the first): ▲ marks a phase made worse than before by {WORSE:.0%} or more"
-               + (f"; the chosen candidates only, every candidate's in report.json" if len(
+               + ("; the chosen candidates only, every candidate's in report.json" if len(
                    report["phases"][0]["rmse"]) > tables.PHASE_COLUMNS else "") + ".", "",
                by_phase, ""]
         by_zone = tables.phase_zones(report)
