@@ -489,8 +489,8 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
         switched = network.switched_diagonal(u)
         before, T = T, steady_stepper.step(T, network.sources(u), held, values, switched)
         if derivatives:
-            _, S = sensitivity_steps(steady_stepper, network, derivatives, S, before[None], T[None], u[None], held,
-                                     switched, [], [])
+            _, S = sensitivity_steps(steady_stepper, network, derivatives, S, before[None], T[None], u[None],
+                                     network.source_terms(u[None])[0], held, switched, [], [])
     out = np.empty((n_rows, len(outputs)))
     out[0] = T[outputs]
     d_out = np.empty((n_rows, len(outputs), len(derivatives)))
@@ -580,7 +580,7 @@ def steps(stepper, network, T, inputs, forced, imposed, kept, outputs, derivativ
                     i = next(at, None)
         if derivatives:
             d_out[here], S = sensitivity_steps(stepper, network, derivatives, S, np.vstack([before[None], path[:-1]]),
-                                               path, inputs[a:b], mask, g, kept[here] - a, outputs, modes)
+                                               path, inputs[a:b], terms[a:b], mask, g, kept[here] - a, outputs, modes)
     return (out, d_out) if derivatives else out
 
 
@@ -600,22 +600,23 @@ def history_sensitivities(stepper, network, derivatives, S, start, path, inputs)
     n = network.n_nodes
     forced = np.zeros((len(path), n), dtype=bool)
     switched = network.switched_diagonal(inputs)
+    terms, _, _ = network.source_terms(inputs)
     before = np.vstack([start[None], path[:-1]])
     out = np.empty(path.shape + (len(derivatives),))
     bounds = runs(forced, switched)
     for a, b in zip(bounds[:-1], bounds[1:]):
         out[a:b], S = sensitivity_steps(stepper, network, derivatives, S, before[a:b], path[a:b], inputs[a:b],
-                                        forced[a], None if switched is None else switched[a], np.arange(b - a),
-                                        np.arange(n))
+                                        terms[a:b], forced[a], None if switched is None else switched[a],
+                                        np.arange(b - a), np.arange(n))
     return out, S
 
 
-def sensitivity_steps(stepper, network, derivatives, S, before, after, inputs, forced, switched, kept, outputs,
-                      modes=None):
+def sensitivity_steps(stepper, network, derivatives, S, before, after, inputs, terms, forced, switched, kept,
+                      outputs, modes=None):
     """The temperatures' derivatives through a run of L steps under one step matrix (forward
     sensitivities, docs/model.md section 5.9): for each parameter, its `network.Derivative`'s
-    source from the temperatures before and after each step (C, (L, N)) and the steps' inputs
-    (L, n_inputs), carried by the step itself with the forced nodes held at zero (a forced
+    source from the temperatures before and after each step (C, (L, N)), the steps' inputs
+    (L, n_inputs) and source terms (`Network.source_terms`), carried by the step itself with the forced nodes held at zero (a forced
     temperature is the measurement's, which no parameter moves). The factors are the
     temperatures' own (`stepper.solver`); where the run was solved in its `modes`, so are
     the derivatives (`modal.run` with the source as its inputs).
@@ -625,7 +626,6 @@ def sensitivity_steps(stepper, network, derivatives, S, before, after, inputs, f
     (len(kept), len(outputs), k) the derivatives of the `outputs` nodes after the `kept` steps
     (C per unit of each parameter), and (N, k) every node's after the last step
     """
-    terms, _, _ = network.source_terms(inputs)
     source = np.stack([d.source(before, after, terms, inputs, stepper.dt) for d in derivatives], axis=-1)
     solve, index = stepper.solver(forced, switched)
     source[:, index] = 0.0
@@ -633,11 +633,11 @@ def sensitivity_steps(stepper, network, derivatives, S, before, after, inputs, f
     if modes is not None:  # the source as inputs, on the rows where it may be other than zero
         n = network.n_nodes
         rows = np.unique(np.concatenate([d.rows for d in derivatives]))
+        B, q, imposed = np.eye(n)[:, rows], np.zeros(n), np.zeros((len(source), n))
         last = np.empty_like(S)
         for j in range(len(derivatives)):
             out[..., j], last[:, j] = modal_run(solve.inverse, stepper.c_dt, forced, modes, S[:, j],
-                                                source[:, rows, j], np.eye(n)[:, rows], np.zeros(n),
-                                                np.zeros((len(source), n)), kept, outputs)
+                                                source[:, rows, j], B, q, imposed, kept, outputs)
         return out, last
     # one parameter at a time: a matrix-vector product is several times faster than one with a
     # matrix of two columns (BLAS's paths for each), and the parameters are few

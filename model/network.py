@@ -73,6 +73,11 @@ class Network:
         a, b, B = self._product_terms
         return np.concatenate([U, U[..., a] * U[..., b]], axis=-1), B, self.q
 
+    @property
+    def source_coefficients(self):
+        """B' of `source_terms`: B, with the products' coefficients as columns after the inputs'."""
+        return self._product_terms[2] if self.products else self.B
+
     @cached_property
     def _product_terms(self):
         """The products' input indices a and b and B with their coefficients as columns, made
@@ -145,9 +150,11 @@ class Derivative:
         out = (before - after) * (self.C / dt) + self.q
         self.A.add_product(out, after)
         self.B.add_product(out, terms)
-        switched = np.zeros_like(out)
-        self.G.add_product(switched, inputs)
-        return out - switched * after
+        if len(self.G.rows):
+            switched = np.zeros_like(out)
+            self.G.add_product(switched, inputs)
+            out -= switched * after
+        return out
 
 
 def switched_matrix(network):
@@ -166,10 +173,9 @@ def derivative(network, moved, h):
                         [(node, j) for node, j, _ in n.switched]))
     if shape(network) != shape(moved):
         return None
-    (_, B0, _), (_, B1, _) = network.source_terms(np.zeros((1, len(network.input_names)))), \
-        moved.source_terms(np.zeros((1, len(moved.input_names))))
     return Derivative(C=(moved.C - network.C) / h, A=Coefficients((moved.A - network.A) / h),
-                      B=Coefficients((B1 - B0) / h), q=(moved.q - network.q) / h,
+                      B=Coefficients((moved.source_coefficients - network.source_coefficients) / h),
+                      q=(moved.q - network.q) / h,
                       G=Coefficients((switched_matrix(moved) - switched_matrix(network)) / h))
 
 

@@ -78,9 +78,7 @@ def share(residual, error, rows=None):
     residual plus s * error (measured minus the file's run moved s of the way to the continuum)
     is fitted to what the physics the file declares misses, not to what its discretisation makes
     (`diagnosis.calibrate`)."""
-    keep = np.isfinite(residual) & np.isfinite(error) & (True if rows is None else rows)
-    e, r = error[keep], residual[keep]
-    energy = float(e @ e)
+    _, e, r, energy = read_by_share(residual, error, rows)
     return float(np.clip(-(e @ r) / energy, 0.0, 1.0)) if energy > 0.0 else 0.0
 
 
@@ -89,10 +87,16 @@ def share_slope(residual, error, rows, slopes):
     the residual's own derivatives `slopes` (C per unit of each, (residual.size, k) for the
     residual flattened): -(e . dr) / (e . e) on the rows `share` reads, zero where the share is
     held at 0 or 1."""
-    keep = (np.isfinite(residual) & np.isfinite(error) & (True if rows is None else rows)).ravel()
-    e, r = error.ravel()[keep], residual.ravel()[keep]
-    energy = float(e @ e)
+    keep, e, r, energy = read_by_share(residual, error, rows)
     if energy <= 0.0 or not 0.0 < -(e @ r) / energy < 1.0:
         return np.zeros(slopes.shape[1])
     return -(e @ slopes[keep]) / energy
+
+
+def read_by_share(residual, error, rows):
+    """What `share` reads: the flattened rows it keeps (finite, among `rows` where given), the
+    error and the residual there, and the error's energy e . e (C2)."""
+    keep = (np.isfinite(residual) & np.isfinite(error) & (True if rows is None else rows)).ravel()
+    e = error.ravel()[keep]
+    return keep, e, residual.ravel()[keep], float(e @ e)
 
