@@ -142,7 +142,7 @@ class Candidate:
         superposed = self._superposition(case, key[1])
         run = superposed(values) if superposed is not None else \
             self._simulated(case, node_ids, self.built(values, self.base(case)))
-        self._kept(key, run)
+        keep_run(self._runs, key, run)
         return run
 
     def jacobian(self, case, node_ids, values):
@@ -170,7 +170,7 @@ class Candidate:
             run = self._inputs_of(case).run(building, np.asarray(node_ids) - 1, network,
                                             [derivatives[i] for i in exact])
             run, moved = run if exact else (run, None)
-            self._kept(key, run)
+            keep_run(self._runs, key, run)
             jacobian = np.empty(run.shape + (len(values),))
             if exact:
                 jacobian[..., exact] = moved
@@ -179,9 +179,7 @@ class Candidate:
                 stepped = values.copy()
                 stepped[i] += h
                 jacobian[..., i] = (self.nodes(case, node_ids, stepped) - run) / h
-        if len(self._jacobians) >= KEPT_RUNS:
-            self._jacobians.pop(next(iter(self._jacobians)))
-        self._jacobians[key] = jacobian
+        keep_run(self._jacobians, key, jacobian)
         return jacobian
 
     def _derivative(self, base, network, values, i):
@@ -215,12 +213,6 @@ class Candidate:
         self._derivatives[key] = found
         return found
 
-    def _kept(self, key, run):
-        """Keep a run by its (case, nodes, values), the oldest dropped past `KEPT_RUNS`."""
-        if len(self._runs) >= KEPT_RUNS:
-            self._runs.pop(next(iter(self._runs)))
-        self._runs[key] = run
-
     def _inputs_of(self, case):
         """The case with the inputs the candidate's buildings read: the effect may read inputs the
         building as declared does not (a daily gain, the clock)."""
@@ -251,6 +243,14 @@ class Candidate:
             self._superposed[key] = Superposition(
                 reference, far, [self._simulated(case, node_ids, b) for b in buildings]) if kept else None
         return self._superposed[key]
+
+
+def keep_run(store, key, value):
+    """Keep a run or its derivatives in `store` by its (case, nodes, values), the oldest dropped
+    past `KEPT_RUNS`."""
+    if len(store) >= KEPT_RUNS:
+        store.pop(next(iter(store)))
+    store[key] = value
 
 
 def superposition_points(building, effect, target, bounds):
