@@ -53,6 +53,14 @@ NETWORK_STEP = 1e-2
 # to be affine in the parameter; a parameter it is not affine in keeps finite differences of its
 # runs (`Candidate.jacobian`).
 AFFINE = 1e-9
+# Least squares stops once a step lowers its cost (half the sum of squared residuals) by less
+# than this fraction of it (scipy's ftol). At a fit near the noise the cost is n sigma^2 / 2 for n
+# residuals, so the fraction is n / 2e6 of one residual's variance: a thousandth of sigma^2 on
+# a record of 2,000 scored steps, a twentieth on one of 100,000, where the choice reads
+# differences of J of the order of its spread over the blocks, some sigma^2 sqrt(2 n). scipy's
+# default, 1e-8, walked a ground coupling's valley (the data fix U (T_ground - T_floor), not U
+# and T_ground apart) for 190 iterations and 0.03 % of J: most of a test-cell round's time.
+FIT_TOLERANCE = 1e-6
 
 
 class Candidate:
@@ -495,7 +503,8 @@ def solve(residuals, x0, lows, highs, held=None):
     exact = getattr(residuals, "jacobian", None)
     fun = residuals if exact is None else residuals.fitting
     fit = least_squares(lambda z: fun(full(z)), x[free], bounds=(lows[free], highs[free]), x_scale="jac",
-                        method="trf", jac="2-point" if exact is None else (lambda z: exact(full(z))[:, free]))
+                        method="trf", ftol=FIT_TOLERANCE,
+                        jac="2-point" if exact is None else (lambda z: exact(full(z))[:, free]))
     jac = np.zeros((len(fit.fun), len(x)))
     jac[:, free] = fit.jac
     active = np.zeros(len(x), dtype=int)
