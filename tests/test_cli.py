@@ -119,7 +119,7 @@ def test_bad_measurements_and_forcing(files, capsys):
 
 
 def test_a_user_mistake_never_shows_a_traceback():
-    result = subprocess.run([sys.executable, "-m", "nodeforce.cli", "simulate", "missing.json",
+    result = subprocess.run([sys.executable, "-m", "nodeforce", "simulate", "missing.json",
                              "--weather", "nowhere.csv"], capture_output=True, text=True)
     assert result.returncode == 2
     assert result.stderr.strip() == "nodeforce: missing.json: file: not found"

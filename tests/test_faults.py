@@ -73,7 +73,7 @@ def session(sid):
 
 def start(arguments):
     """`nodeforce ARGUMENTS` as a process of its own session."""
-    return subprocess.Popen([sys.executable, "-m", "nodeforce.cli", *arguments], cwd=ROOT, text=True,
+    return subprocess.Popen([sys.executable, "-m", "nodeforce", *arguments], cwd=ROOT, text=True,
                             start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
 
 

@@ -43,7 +43,7 @@ def test_locate_gives_the_same_answer_through_either_fmu(files, tmp_path, capsys
 @pytest.mark.slow  # processes, a cluster or a whole diagnosis: not in `make check`
 def test_locate_with_two_workers_ends_cleanly_ten_times(files, tmp_path):
     for run in range(10):
-        done = subprocess.run([sys.executable, "-m", "nodeforce.cli", *files, "-o", str(tmp_path / str(run)),
+        done = subprocess.run([sys.executable, "-m", "nodeforce", *files, "-o", str(tmp_path / str(run)),
                                "--workers", "2"], capture_output=True, text=True, timeout=300)
         assert done.returncode == 0, done.stderr
         assert "corrupted" not in done.stderr and "free()" not in done.stderr, f"run {run}:\n{done.stderr}"

@@ -168,7 +168,7 @@ def test_small_office_two_faults_located(office, tmp_path):
     out, building = office
     sensors = (out / "sensors.txt").read_text().strip()
     measured = tmp_path / "measured.csv"
-    run = [sys.executable, "-m", "nodeforce.cli"]
+    run = [sys.executable, "-m", "nodeforce"]
     subprocess.run(run + ["synth", str(out / "building.json"), "--weather", str(out / "weather.csv"),
                           "--start", "2001-01-15T00:00-05:00", "--days", "3", "--sensors", sensors,
                           "--noise", "0.05", "--seed", "3", "--history-days", "0",
