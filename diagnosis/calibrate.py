@@ -324,7 +324,8 @@ class Residuals:
     def __call__(self, x, rows=None):
         """The residuals at x, the share read on the `rows` (bool) that count, or all of them."""
         r = self.raw(x)
-        return (r + share(r, self.error, self.counted if rows is None else self.counted & rows) * self.error) * self.scale
+        counted = self.counted if rows is None else self.counted & rows
+        return (r + share(r, self.error, counted) * self.error) * self.scale
 
     def fitting(self, x):
         """The residuals at x with their Jacobian there worked out beside them (the candidate keeps

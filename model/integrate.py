@@ -616,10 +616,10 @@ def sensitivity_steps(stepper, network, derivatives, S, before, after, inputs, t
     """The temperatures' derivatives through a run of L steps under one step matrix (forward
     sensitivities, docs/model.md section 5.9): for each parameter, its `network.Derivative`'s
     source from the temperatures before and after each step (C, (L, N)), the steps' inputs
-    (L, n_inputs) and source terms (`Network.source_terms`), carried by the step itself with the forced nodes held at zero (a forced
-    temperature is the measurement's, which no parameter moves). The factors are the
-    temperatures' own (`stepper.solver`); where the run was solved in its `modes`, so are
-    the derivatives (`modal.run` with the source as its inputs).
+    (L, n_inputs) and source terms (`Network.source_terms`), carried by the step itself with the
+    forced nodes held at zero (a forced temperature is the measurement's, which no parameter
+    moves). The factors are the temperatures' own (`stepper.solver`); where the run was solved
+    in its `modes`, so are the derivatives (`modal.run` with the source as its inputs).
 
     Returns
     -------

@@ -99,4 +99,3 @@ def read_by_share(residual, error, rows):
     keep = (np.isfinite(residual) & np.isfinite(error) & (True if rows is None else rows)).ravel()
     e = error.ravel()[keep]
     return keep, e, residual.ravel()[keep], float(e @ e)
-
