@@ -26,7 +26,7 @@ from nodeforce.model.effects import EFFECTS, fmu_parameters
 from nodeforce.model.network import input_names
 
 from . import description
-from .compiler import C_DIR, compile_library
+from .compiler import C_DIR, library
 from .guard import PLATFORM, guard_binary, guarded
 from .variables import Layout
 
@@ -167,10 +167,7 @@ def _build_standalone(building, destination, effect, fmi):
 
     files, identifier, source_files = standalone_files(building, effect, model_interface(building, effect))
     if fmi == 3:
-        with tempdirs.folder("fmu") as tmp:
-            library = Path(tmp) / f"{identifier}.so"
-            compile_library(FMI3_BUILD[0], library, libraries=FMI3_BUILD[1], defines=FMI3_BUILD[2])
-            binary = library.read_bytes()
+        binary = library(FMI3_BUILD[0], libraries=FMI3_BUILD[1], defines=FMI3_BUILD[2])
         files = _as_fmi3(files, identifier, model_interface(building, effect), binary)
         files.update({f"sources/{name}": (C_DIR / name).read_bytes() for name in FMI3_SOURCES})
         files["sources/buildDescription.xml"] = description.build_description(identifier, *FMI3_BUILD)

@@ -1,9 +1,15 @@
 """Compiling the FMUs' C code (c/) at export: the standalone FMU's binary and the guard in front
-of the Python FMU's. The importing machine needs no compiler; the exporting one does for these."""
+of the Python FMU's. The importing machine needs no compiler; the exporting one does for these.
+
+No library depends on the building (a building is its FMU's data, in resources/): each is
+compiled at a process's first export that needs it, and every later export copies its bytes."""
+import functools
 import os
 import shutil
 import subprocess
 from pathlib import Path
+
+from nodeforce import tempdirs
 
 C_DIR = Path(__file__).with_name("c")
 
@@ -21,9 +27,10 @@ def find_compiler():
 RPATH = ("-Wl,--disable-new-dtags", "-Wl,-rpath,$ORIGIN")
 
 
-def compile_library(source, output, libraries=(), link_options=(), defines=()):
-    """Compile c/<source> (a file name, or several) with the headers beside it into the shared
-    library `output`.
+@functools.lru_cache(maxsize=None)
+def library(source, libraries=(), link_options=(), defines=()):
+    """The shared library (bytes) of c/<source> (a file name, or a tuple of several) with the
+    headers beside it, compiled once per process.
 
     Compiled in c/ by relative name, without debug information: the bytes do not depend on
     where nodeforce is installed, so the same model gives the same FMU.
@@ -36,9 +43,12 @@ def compile_library(source, output, libraries=(), link_options=(), defines=()):
     compiler = find_compiler()
     if compiler is None:
         raise RuntimeError("no C compiler found (cc, gcc or $CC): install one (e.g. apt-get install gcc)")
-    command = [*compiler, "-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden", *(f"-D{d}" for d in defines),
-               "-o", str(output), *([source] if isinstance(source, str) else source), *RPATH, *link_options,
-               *(f"-l{name}" for name in libraries)]
-    done = subprocess.run(command, cwd=C_DIR, capture_output=True, text=True)
-    if done.returncode:
-        raise RuntimeError(f"compiling {source!r} failed: {' '.join(command)}\n{done.stderr}")
+    with tempdirs.folder("c") as tmp:
+        output = Path(tmp) / "library.so"
+        command = [*compiler, "-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden",
+                   *(f"-D{d}" for d in defines), "-o", str(output), *([source] if isinstance(source, str) else source),
+                   *RPATH, *link_options, *(f"-l{name}" for name in libraries)]
+        done = subprocess.run(command, cwd=C_DIR, capture_output=True, text=True)
+        if done.returncode:
+            raise RuntimeError(f"compiling {source!r} failed: {' '.join(command)}\n{done.stderr}")
+        return output.read_bytes()

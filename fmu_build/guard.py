@@ -15,8 +15,7 @@ import sys
 import sysconfig
 from pathlib import Path
 
-from nodeforce import tempdirs
-from .compiler import compile_library, find_compiler
+from .compiler import find_compiler, library
 
 PLATFORM = "linux64"  # the guard's platform; pythonfmu's other binaries (win64) stay unguarded
 GUARD_FILE = "resources/guard.txt"
@@ -37,13 +36,10 @@ def guard_binary(fmi=2):
               "guard, so forbidden calls get fmi2Discard or fmi2Fatal instead of fmi2Error and a C host "
               "must preload libpython", file=sys.stderr)
         return None
-    with tempdirs.folder("guard") as tmp:
-        library = Path(tmp) / "guard.so"
-        # libdl.so.2 by name and kept: where glibc is older than 2.34 the dl* functions the guard
-        # asks for (c/guard.c) are there; since, it is an empty compatibility library
-        compile_library(("guard.c", "fmi3.c") if fmi == 3 else "guard.c", library, libraries=(":libdl.so.2",),
-                        link_options=("-Wl,--no-as-needed",), defines=("NODEFORCE_FMI3",) if fmi == 3 else ())
-        return library.read_bytes()
+    # libdl.so.2 by name and kept: where glibc is older than 2.34 the dl* functions the guard
+    # asks for (c/guard.c) are there; since, it is an empty compatibility library
+    return library(("guard.c", "fmi3.c") if fmi == 3 else "guard.c", libraries=(":libdl.so.2",),
+                   link_options=("-Wl,--no-as-needed",), defines=("NODEFORCE_FMI3",) if fmi == 3 else ())
 
 
 def libpython():

@@ -20,16 +20,14 @@ reach, not with N^2 per parameter. The export checks that form against a direct 
 every parameter moved at once, and refuses a network that does not fit it.
 """
 import itertools
-from pathlib import Path
 
 import numpy as np
 
-from nodeforce import tempdirs
 from nodeforce.model.effects import fmu_parameters, properties, with_fmu_parameters
 from nodeforce.model.integrate import MAX_STEP
 from nodeforce.model.network import assemble
 
-from .compiler import C_DIR, compile_library
+from .compiler import C_DIR, library
 
 SOURCES = ("nodeforce_fmu.c", "fmi2.h", "variables.h", "resources.h")
 IDENTIFIER = "nodeforce_standalone"
@@ -199,10 +197,8 @@ def standalone_files(building, effect, layout):
     files = {f"sources/{name}": (C_DIR / name).read_bytes() for name in SOURCES}
     files["resources/network.txt"] = network_text(building, effect).encode()
     files["resources/names.txt"] = layout.names_file().encode()
-    with tempdirs.folder("fmu") as tmp:
-        try:
-            compile_library("nodeforce_fmu.c", Path(tmp) / f"{IDENTIFIER}.so", libraries=("m",))
-        except RuntimeError as e:
-            raise RuntimeError(f"the standalone FMU's linux64 binary is compiled at export: {e}") from None
-        files[f"binaries/linux64/{IDENTIFIER}.so"] = (Path(tmp) / f"{IDENTIFIER}.so").read_bytes()
+    try:
+        files[f"binaries/linux64/{IDENTIFIER}.so"] = library("nodeforce_fmu.c", libraries=("m",))
+    except RuntimeError as e:
+        raise RuntimeError(f"the standalone FMU's linux64 binary is compiled at export: {e}") from None
     return files, IDENTIFIER, ("nodeforce_fmu.c",)

@@ -19,6 +19,7 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 
 from nodeforce.cosim.fmi import content_id
+from nodeforce.fmu_build import compiler
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.effects import EFFECTS
@@ -213,6 +214,23 @@ def test_the_standalone_binary_needs_no_python(fmus, tmp_path):
         assert "sources/nodeforce_fmu.c" in fmu.namelist()
     needed = subprocess.run(["ldd", str(library)], capture_output=True, text=True).stdout
     assert "python" not in needed and "stdc++" not in needed
+
+
+@pytest.mark.parametrize("kind", ["standalone", "standalone-fmi3", "python"])
+def test_an_export_compiles_its_c_library_once_per_process(testcell_data, tmp_path, monkeypatch, kind):
+    # the building is the FMU's data: another building's FMU carries the same binary, copied
+    first = build_fmu(parse_building(testcell_data), tmp_path / "first.fmu", kind=kind)
+    other = copy.deepcopy(testcell_data)
+    other["zones"][0]["internal_gain"] = 10.0
+
+    def no_compiler(command, **_):
+        raise AssertionError(f"compiled again: {command}")
+    monkeypatch.setattr(compiler.subprocess, "run", no_compiler)
+    second = build_fmu(parse_building(other), tmp_path / "second.fmu", kind=kind)
+    with zipfile.ZipFile(first) as a, zipfile.ZipFile(second) as b:
+        binaries = [name for name in a.namelist() if name.startswith("binaries/") and name.endswith(".so")]
+        assert binaries and all(a.read(name) == b.read(name) for name in binaries)
+        assert a.read("modelDescription.xml") != b.read("modelDescription.xml")
 
 
 @pytest.mark.parametrize("kind", KINDS)
