@@ -132,7 +132,9 @@ class NodalBuilding(Fmi2Slave):
             raise ValueError(index)
         values = np.asarray(values, dtype=float)
         if real and not np.isfinite(values).all():  # a NaN is refused but in a measurement (layout)
-            for vr, value in zip(index.tolist(), values.tolist()):
+            # `_index` allowed every reference: only a value that is not finite may be refused
+            bad = ~np.isfinite(values) & ~self.layout.takes_nan(index)
+            for vr, value in zip(index[bad].tolist(), values[bad].tolist()):
                 reason = self.layout.refusal(vr, real, True, self._state, value, self._time)
                 if reason:
                     raise ValueError(reason)

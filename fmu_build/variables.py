@@ -71,6 +71,11 @@ class Layout:
         """A parameter: settable only before initialisation ends."""
         return vr < self.T_start.stop or self.parameters.start <= vr < self.max_step
 
+    def takes_nan(self, vr):
+        """Whether a Real set to NaN is allowed: on T_forced, a measurement's gap (vr: a value
+        reference or an array of them)."""
+        return (self.T_forced.start <= vr) & (vr < self.T_forced.stop)
+
     def derivative_of(self, vr):
         """The value reference whose time derivative `vr` holds (`derivatives`), or None."""
         if self.derivatives.start <= vr < self.derivatives.stop:
@@ -105,6 +110,6 @@ class Layout:
             reason = "is a fixed parameter, which cannot change after initialisation"
         elif state == TERMINATED:
             reason = "cannot be set: the slave is terminated"
-        elif real and value - value != 0.0 and not (self.T_forced.start <= vr < self.T_forced.stop):
+        elif real and value - value != 0.0 and not self.takes_nan(vr):
             reason = f"set to {value} at t = {time:.17g} s: it must be finite (NaN means \"not measured\" on T_forced only)"
         return reason and f"value reference {vr} ({self.names()[vr]}) {reason}"
