@@ -495,18 +495,15 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     out[0] = T[outputs]
     d_out = np.empty((n_rows, len(outputs), len(derivatives)))
     d_out[0] = S[outputs]
-    if H:
+    if H:  # nothing forced: a run of steps under one matrix, in its modes where it has them
         block = history_block(dt)
         history_stepper = ImplicitEuler(network, block * dt) if history_stepper is None else history_stepper
-        free, nothing = np.zeros(n, dtype=bool), np.full(n, np.nan)
         means = history_inputs(U, H, dt)
-        path, start = np.empty((len(means), n)), T
-        for b, (source, u) in enumerate(zip(network.sources(means), means)):
-            T = path[b] = history_stepper.step(T, source, free, nothing, network.switched_diagonal(u))
-        out[1:H + 1] = np.repeat(path[:, outputs], block, axis=0)
-        if derivatives:
-            d_path, S = history_sensitivities(history_stepper, network, derivatives, S, start, path, means)
-            d_out[1:H + 1] = np.repeat(d_path[:, outputs], block, axis=0)
+        L = len(means)
+        path, d_path, T, S = steps(history_stepper, network, T, means, np.zeros((L, n), dtype=bool),
+                                   np.full((L, n), np.nan), np.arange(L), outputs, derivatives, S)
+        out[1:H + 1] = np.repeat(path, block, axis=0)
+        d_out[1:H + 1] = np.repeat(d_path, block, axis=0)
     # the record's steps from t_H, the warm-up's replay standing in for a history the record
     # lacks: each step's input row (from t_H) and sub-step
     rows = warmup_rows(n_rows - H, dt, 0 if H else warmup_days)
@@ -516,23 +513,20 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     imposed = np.stack(within_steps(measured[H:], substeps), axis=1)[row_of, sub_of]
     # the rows from t_H on, each after its last sub-step
     ks = np.arange(max(start - 1, 0), len(rows))
-    stepped = steps(stepper, network, T, inputs, forced[H:][row_of], imposed, (ks + 1) * substeps - 1, outputs,
-                    derivatives, S)
+    out[H + ks - start + 1], d_out[H + ks - start + 1], _, _ = steps(
+        stepper, network, T, inputs, forced[H:][row_of], imposed, (ks + 1) * substeps - 1, outputs, derivatives, S)
     first = 0 if include_start else 1
-    if not derivatives:
-        out[H + ks - start + 1] = stepped
-        return out[first:]
-    out[H + ks - start + 1], d_out[H + ks - start + 1] = stepped
-    return out[first:], d_out[first:]
+    return (out[first:], d_out[first:]) if derivatives else out[first:]
 
 
-def steps(stepper, network, T, inputs, forced, imposed, kept, outputs, derivatives=(), S=None):
+def steps(stepper, network, T, inputs, forced, imposed, kept, outputs, derivatives, S):
     """The temperatures of the `outputs` nodes (C) after the `kept` steps (increasing indices) of
-    a sequence of steps from T: (len(kept), len(outputs)). Each run of steps under one step
-    matrix (one forcing mask and switched conductances) long enough is solved in its modes
-    (`modal`, `MODAL_FROM`), any other stepped. With `derivatives` (`simulate`'s) and the
-    temperatures' derivatives S (N, k) before the first step, also theirs after the kept steps,
-    (len(kept), len(outputs), k): `sensitivity_steps` of each run.
+    a sequence of steps from T, (len(kept), len(outputs)); the derivatives of `derivatives`
+    (`simulate`'s: k of them) from theirs S (N, k) before the first step, after the same steps
+    (len(kept), len(outputs), k: `sensitivity_steps` of each run); and every node's temperature
+    (N,) and derivatives (N, k) after the last step. Each run of steps under one step matrix (one
+    forcing mask and switched conductances) long enough is solved in its modes (`modal`,
+    `MODAL_FROM`), any other stepped.
 
     Parameters
     ----------
@@ -581,7 +575,7 @@ def steps(stepper, network, T, inputs, forced, imposed, kept, outputs, derivativ
         if derivatives:
             d_out[here], S = sensitivity_steps(stepper, network, derivatives, S, np.vstack([before[None], path[:-1]]),
                                                path, inputs[a:b], terms[a:b], mask, g, kept[here] - a, outputs, modes)
-    return (out, d_out) if derivatives else out
+    return out, d_out, T, S
 
 
 def runs(forced, switched):
@@ -591,24 +585,6 @@ def runs(forced, switched):
     if switched is not None:
         changes |= np.any(switched[1:] != switched[:-1], axis=1)
     return np.concatenate([[0], np.flatnonzero(changes) + 1, [len(forced)]])
-
-
-def history_sensitivities(stepper, network, derivatives, S, start, path, inputs):
-    """The derivatives (L, N, k) after each of a history's steps (nothing forced; `simulate`),
-    from S (N, k) at its `start` (N,), its temperatures after each step `path` (L, N) and each
-    step's inputs (L, n_inputs); and (N, k) after the last."""
-    n = network.n_nodes
-    forced = np.zeros((len(path), n), dtype=bool)
-    switched = network.switched_diagonal(inputs)
-    terms, _, _ = network.source_terms(inputs)
-    before = np.vstack([start[None], path[:-1]])
-    out = np.empty(path.shape + (len(derivatives),))
-    bounds = runs(forced, switched)
-    for a, b in zip(bounds[:-1], bounds[1:]):
-        out[a:b], S = sensitivity_steps(stepper, network, derivatives, S, before[a:b], path[a:b], inputs[a:b],
-                                        terms[a:b], forced[a], None if switched is None else switched[a],
-                                        np.arange(b - a), np.arange(n))
-    return out, S
 
 
 def sensitivity_steps(stepper, network, derivatives, S, before, after, inputs, terms, forced, switched, kept,
