@@ -197,13 +197,14 @@ class NodalBuilding(Fmi2Slave):
         if stepper is None:
             stepper = self._steppers[tau] = _physics["integrate"].ImplicitEuler(self.network, tau)
         T = values[layout.T]
-        varying = du.any()
-        source = None if varying else self.network.sources(u)
-        for j in range(1, k + 1):
-            s = j * tau
-            u_s = u + du * s if varying else u
-            T = stepper.step(T, self.network.sources(u_s) if varying else source, forced,
-                             T_forced + dT_forced * s, self.network.switched_diagonal(u_s))
+        # each sub-step's inputs and imposed temperatures at its end, their sources at once
+        s = tau * np.arange(1, k + 1)[:, None]
+        u_s = u + du * s if du.any() else u[None]
+        sources, switched = self.network.sources(u_s), self.network.switched_diagonal(u_s)
+        T_s = T_forced + dT_forced * s
+        for j in range(k):
+            i = min(j, len(u_s) - 1)
+            T = stepper.step(T, sources[i], forced, T_s[j], None if switched is None else switched[i])
         values[layout.T] = T
         values[layout.derivatives] = 0.0  # the next step's are set before it, or it holds its inputs
         self._time = current_time + step_size
