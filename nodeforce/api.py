@@ -12,7 +12,7 @@ from pathlib import Path
 from nodeforce import tempdirs
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import input_table, simulate_fmu
-from nodeforce.diagnosis import compare as _compare, loop as _loop, windows as _windows
+from nodeforce.diagnosis import windows as _windows
 from nodeforce.fmu_build.build import build_fmu, fmu_kind as _fmu_kind
 from nodeforce.ga import locate as _locate
 from nodeforce.iotools.fmu_inputs import write_fmu_inputs
@@ -444,12 +444,13 @@ def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibrati
     -------
     Diagnosis
     """
+    from nodeforce.diagnosis import loop  # here: the report's plotting and statistics load with it
     with _folder(workdir) as folder:
-        return _loop.diagnose(building, case, objective or Objective.of(building), folder, source=SOURCE,
-                              fraction=fraction, calibration_end=calibration_end, phases=phases, seed=seed,
-                              workers=workers, scheduler=scheduler, fmu_kind=fmu_kind, noise=noise,
-                              reference=reference, population=population, generations=generations,
-                              later=list(later))
+        return loop.diagnose(building, case, objective or Objective.of(building), folder, source=SOURCE,
+                             fraction=fraction, calibration_end=calibration_end, phases=phases, seed=seed,
+                             workers=workers, scheduler=scheduler, fmu_kind=fmu_kind, noise=noise,
+                             reference=reference, population=population, generations=generations,
+                             later=list(later))
 
 
 def compare(models, workdir=None, phases=(), fmu_kind="python"):
@@ -473,10 +474,11 @@ def compare(models, workdir=None, phases=(), fmu_kind="python"):
         compare.json's content: per model its heat loss coefficient (W/K) and the RMSE, mean and
         sd (C) of each objective zone's air residual, overall and per phase.
     """
-    result, series = _compare.compare(models, phases, fmu_kind=fmu_kind)
+    from nodeforce.diagnosis.compare import compare as scored, write_compare  # as `diagnose`'s loop
+    result, series = scored(models, phases, fmu_kind=fmu_kind)
     if workdir is not None:
         Path(workdir).mkdir(parents=True, exist_ok=True)
-        _compare.write_compare(Path(workdir), result, series)
+        write_compare(Path(workdir), result, series)
     return result
 
 
