@@ -197,13 +197,15 @@ class NodalBuilding(Fmi2Slave):
         if stepper is None:
             stepper = self._steppers[tau] = _physics["integrate"].ImplicitEuler(self.network, tau)
         T = values[layout.T]
-        # each sub-step's inputs and imposed temperatures at its end, their sources at once
+        # each sub-step's inputs and imposed temperatures at its end, their sources at once; inputs
+        # held over the step give one row for every sub-step
         s = tau * np.arange(1, k + 1)[:, None]
-        u_s = u + du * s if du.any() else u[None]
+        held = not du.any()
+        u_s = u[None] if held else u + du * s
         sources, switched = self.network.sources(u_s), self.network.switched_diagonal(u_s)
         T_s = T_forced + dT_forced * s
         for j in range(k):
-            i = min(j, len(u_s) - 1)
+            i = 0 if held else j
             T = stepper.step(T, sources[i], forced, T_s[j], None if switched is None else switched[i])
         values[layout.T] = T
         values[layout.derivatives] = 0.0  # the next step's are set before it, or it holds its inputs
