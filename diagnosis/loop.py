@@ -181,8 +181,8 @@ def own_sensors(building, component, windows, base, sensed):
 
 
 def diagnose(building, records, objective, workdir, *, source="measurements", fraction=0.6, calibration_end=None,
-             seed=0, workers=None, scheduler=None, population=30, generations=400, fmu_kind="auto", reference=None,
-             noise=None, phases=None, later=()):
+             seed=0, workers=None, scheduler=None, population=30, generations=400, fmu_kind="python",
+             search_fmu="auto", reference=None, noise=None, phases=None, later=()):
     """Run the whole loop, its stages in order (`prepare`, `localise`, `rounds`, `write`); write the
     artifacts in `workdir`; return the `Diagnosis` (report.json is its `to_json()`).
 
@@ -193,10 +193,12 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
     search reads every record's calibration window together, then, reported, each one's alone.
     `reference` ({"label", "rmse": {phase: K}}), another model's error, is reported for scale;
     `noise` (C) is the air sensors' noise sd if the user knows it, else it is estimated from
-    every record's air. `fmu_kind`: the FMUs built, run and written (`ga.locate.locate`; "auto": the
-    standalone FMU where a C compiler is at hand). `scheduler` ("tcp://host:port"): the forcing
-    search and every round's candidates run on that Dask cluster's workers (`nodeforce.cluster`)
-    instead of `workers` processes; an unreachable one is an InputError before any work.
+    every record's air. `fmu_kind`: the FMUs of the model before and after, run and written
+    (`fmu_build.build.build_fmu`'s kinds, or "auto", `ga.locate.evaluator_kind`); `search_fmu`:
+    the FMUs the forcing search drives (`ga.locate.locate`'s `fmu_kind`; "auto": the standalone
+    where it can run the building). `scheduler` ("tcp://host:port"): the forcing search and every
+    round's candidates run on that Dask cluster's workers (`nodeforce.cluster`) instead of
+    `workers` processes; an unreachable one is an InputError before any work.
     `later`: `Record`s of the same building under the building file's protocol, read from their
     files (`nodeforce.read_record`), which nothing but the final comparison reads (`scored_later`):
     no fit, no choice, no cross-validation."""
@@ -211,11 +213,11 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
         if r.read_from is None or protocol(building, r) is not None:
             raise InputError(r.source, "later", f"record {r.name}: a later record is read from its files "
                                                 f"(read_record) for the building diagnosed, {building.source}")
-    fmu_kind = evaluator_kind(building) if fmu_kind == "auto" else fmu_kind
+    fmu_kind = evaluator_kind(fmu_kind, [building, *filter(None, (protocol(building, r) for r in records))])
     with Cluster(scheduler) if scheduler is not None else nullcontext() as cluster:
         prepared = prepare(building, records, objective, workdir, fmu_kind, noise)
         search = dict(seed=seed, workers=workers, scheduler=scheduler, population=population,
-                      generations=generations, fmu_kind=fmu_kind,
+                      generations=generations, fmu_kind=search_fmu,
                       noise=prepared.noise.sigma if prepared.noise.given else None)
         located = localise(building, prepared, objective, workdir, search)
         made = rounds(prepared, located.localization, objective, workdir, seed, workers, cluster)

@@ -23,16 +23,19 @@ from nodeforce.model.network import assemble
 from nodeforce.model.score import Noise, removed
 
 
-def evaluator_kind(building=None):
-    """The FMU kind the search drives for `fmu_kind="auto"`: the standalone FMU where a C compiler
-    is at hand (it is compiled at export), else the Python FMU. Measured (benchmarks/bench_scale.py,
+def evaluator_kind(kind, buildings):
+    """`kind` as `build_fmu` takes it: "auto" (or "auto-fmi3") is the standalone FMU where a C
+    compiler is at hand (it is compiled at export) and every one of `buildings` has a constant
+    network, else the Python FMU; any other kind is itself. Measured (benchmarks/bench_scale.py,
     docs/performance.md): a simulation of a new mask costs at least 1.7 times less through the
     standalone FMU than through the Python FMU, from the test cell's 23 nodes to 2,922. A building
     with a scheduled air flow runs the Python FMU: the standalone steps one constant matrix."""
-    if building is not None and any(v.schedule is not None and not building.schedules[v.schedule].is_constant
-                                    for z in building.zones for v in z.ventilation):
-        return "python"
-    return "standalone" if find_compiler() else "python"
+    base, _, version = kind.partition("-fmi")
+    if base != "auto":
+        return kind
+    scheduled = any(v.schedule is not None and not b.schedules[v.schedule].is_constant
+                    for b in buildings for z in b.zones for v in z.ventilation)
+    return ("python" if scheduled or not find_compiler() else "standalone") + (f"-fmi{version}" if version else "")
 
 
 def check_measured(objective, case, source):
@@ -95,13 +98,13 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
     sensors' noise sd (C) if the user knows it, else it is estimated (`model.score.Noise`) from
     every record's air. patience and seeded
     choose the search (ga.search: the defaults stop at convergence; ga.search.PAPER's values
-    give the paper's search). fmu_kind: "python", "standalone" (or their "-fmi3" kinds) or "auto"
-    (`evaluator_kind`, FMI 2.0: the command line's default and this one's).
+    give the paper's search). fmu_kind: "python", "standalone", or "auto" (`evaluator_kind`: the
+    command line's default and this one's), each with "-fmi3" for FMI 3.0.
     """
     cases = as_cases(case)
     protocols = list(protocols) if protocols is not None else [None] * len(cases)
     candidates = chromosome_nodes(building, cases, objective, source, nodes, include_algebraic)
-    kind = evaluator_kind(building) if fmu_kind == "auto" else fmu_kind
+    kind = evaluator_kind(fmu_kind, [building, *filter(None, protocols)])
     # one FMU per building a record runs under: `building`'s only where a record runs it
     names = ["model.fmu" if own is None else f"model_{k + 1}.fmu" for k, own in enumerate(protocols)]
     built = {}

@@ -390,8 +390,8 @@ def locate(building, case, objective=None, workdir=None, source=SOURCE, **search
 
 
 def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibration_end=None, phases=(), seed=0,
-             workers=None, scheduler=None, fmu_kind="python", noise=None, reference=None, population=30,
-             generations=400, later=()):
+             workers=None, scheduler=None, fmu_kind="python", search_fmu="auto", noise=None, reference=None,
+             population=30, generations=400, later=()):
     """The whole loop of `nodeforce diagnose`; writes its files in `workdir` (docs/guide.md, Output
     files) and returns the `Diagnosis`: `summary()` the first screen, `to_json()` report.json's
     content, `added` the effects added, `rounds` each round's decision, `candidates` every fit.
@@ -422,12 +422,18 @@ def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibrati
         answer is the same; a worker lost midway costs none; a lost scheduler raises
         `nodeforce.lifetime.RunStopped`, an unreachable one `InputError`.
     fmu_kind : str
-        The FMUs built, run and written: "python" (the default, as on the command line),
-        "standalone" (or their "-fmi3" forms), or "auto", the standalone where a C compiler is at
-        hand. The candidates are fitted on the direct model, and the model they are measured
-        against runs through this FMU: the Python FMU repeats the direct model's arithmetic (to
-        1e-14 C), the C FMU differs by rounding (1e-12 C), which a candidate the data do not
-        determine can turn into another of its many equally good fits.
+        The FMUs of the model before and after, run and written (`model_before.fmu`,
+        `model_after.fmu`): "python" (the default, as on the command line), "standalone", or
+        "auto", the standalone where a C compiler is at hand and it can run the building; each
+        with "-fmi3" for FMI 3.0. The candidates are fitted on the direct model, and the model
+        they are measured against runs through this FMU: the Python FMU repeats the direct
+        model's arithmetic (to 1e-14 C), the C FMU differs by rounding (1e-12 C), which a
+        candidate the data do not determine can turn into another of its many equally good fits.
+    search_fmu : str
+        The FMUs the forcing search drives (`model.fmu`), of the same kinds; default "auto", as
+        `locate`'s: the standalone, 4 to 6 times faster a simulation on the test cell
+        (docs/performance.md). Its J differs from the Python FMU's by rounding, far below the
+        noise its choice of nodes reads.
     noise : float, optional
         The air sensors' noise sd (C) where the user knows it; default estimated from the air.
     reference : dict, optional
@@ -448,8 +454,8 @@ def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibrati
     with _folder(workdir) as folder:
         return loop.diagnose(building, case, objective or Objective.of(building), folder, source=SOURCE,
                              fraction=fraction, calibration_end=calibration_end, phases=phases, seed=seed,
-                             workers=workers, scheduler=scheduler, fmu_kind=fmu_kind, noise=noise,
-                             reference=reference, population=population, generations=generations,
+                             workers=workers, scheduler=scheduler, fmu_kind=fmu_kind, search_fmu=search_fmu,
+                             noise=noise, reference=reference, population=population, generations=generations,
                              later=list(later))
 
 

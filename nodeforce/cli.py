@@ -226,7 +226,8 @@ def run_diagnosis(building, records, objective, out, args, later=()):
     `later`: the records read for the final comparison alone."""
     check_workers(args)
     diagnosis = api.diagnose(building, records, out, objective, seed=args.seed, workers=args.workers,
-                             scheduler=args.scheduler, fmu_kind=kind_of(args), noise=noise(args),
+                             scheduler=args.scheduler, fmu_kind=kind_of(args),
+                             search_fmu=kind_of(args, "search_fmu"), noise=noise(args),
                              reference=read_reference(args.reference) if args.reference else None, later=later)
     print(diagnosis.summary())
     print(f"wrote {out / 'report.json'}, {out / 'report.md'}, {out / 'building_after.json'}, {out / 'model_after.fmu'}")
@@ -399,12 +400,11 @@ def fmi_argument(s):
     s.add_argument("--fmi", type=int, choices=(2, 3), default=2, help="the FMI version of the FMU (default 2)")
 
 
-def kind_of(args):
-    """The FMU kind of --fmu at --fmi (fmu_build.build.fmu_kind); "auto" is the search's own
-    choice (ga.locate.evaluator_kind)."""
+def kind_of(args, option="fmu"):
+    """The FMU kind of --fmu (or another `option`) at --fmi (fmu_build.build.fmu_kind); "auto" is
+    resolved where the buildings are known (ga.locate.evaluator_kind)."""
     from nodeforce.fmu_build.build import fmu_kind
-    from nodeforce.ga.locate import evaluator_kind
-    return fmu_kind(evaluator_kind() if args.fmu == "auto" else args.fmu, args.fmi)
+    return fmu_kind(getattr(args, option), args.fmi)
 
 
 def diagnosis_arguments(s):
@@ -412,7 +412,11 @@ def diagnosis_arguments(s):
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--workers", type=int, help="processes (default: all cores)")
     scheduler_argument(s)
-    s.add_argument("--fmu", choices=("python", "standalone"), default="python", help="the FMU kind to run")
+    s.add_argument("--fmu", choices=("python", "standalone"), default="python",
+                   help="the FMU kind of the model before and after (model_before.fmu, model_after.fmu)")
+    s.add_argument("--search-fmu", choices=("auto", "python", "standalone"), default="auto",
+                   help="the FMU kind the forcing search drives (auto: standalone if a C compiler is found "
+                        "and it can run the building, else python; the standalone is the faster)")
     s.add_argument("--calibration-fraction", type=float, default=0.6,
                    help="the first part of the record, by time, that calibrates; the rest validates")
     s.add_argument("--calibration-end",

@@ -330,8 +330,14 @@ def test_standalone_fmu_refuses_a_switched_conductance():
     b = b.edited(lambda d: d["zones"][0].update(ventilation=[{"name": "v", "flow": 10.0, "schedule": "s"}]))
     with pytest.raises(InputError, match="follows a schedule"):
         network_terms(b, None)
+    from nodeforce.fmu_build.compiler import find_compiler
     from nodeforce.ga.locate import evaluator_kind
-    assert evaluator_kind(b) == "python"  # "auto" never picks the FMU that cannot run it
+    # "auto" never picks the FMU that cannot run it, for the building or another record's protocol
+    plain = "standalone" if find_compiler() else "python"
+    assert evaluator_kind("auto", [minimal_building()]) == plain
+    assert evaluator_kind("auto-fmi3", [minimal_building()]) == plain + "-fmi3"
+    assert evaluator_kind("auto", [minimal_building(), b]) == "python"
+    assert evaluator_kind("auto-fmi3", [b]) == "python-fmi3"
 
 
 def test_650ff_converts_its_night_ventilation(tmp_path):
