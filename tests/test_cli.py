@@ -3,6 +3,7 @@ import json
 import re
 import subprocess
 import sys
+import zipfile
 
 import numpy as np
 import pandas as pd
@@ -225,6 +226,12 @@ def test_demo_finds_the_ground_coupling_and_python_writes_the_same_report(tmp_pa
     assert report["after"]["validation"]["rmse"] < 0.5 * report["before"]["validation"]["rmse"]
     for name in ("report.md", "building_after.json", "model_after.fmu", "air_temperature.png"):
         assert (tmp_path / name).stat().st_size > 0
+    # the search drives the standalone FMU where it can (--search-fmu auto); the model before and
+    # after, which the candidates are measured against and the user takes away, the Python FMU
+    from nodeforce.fmu_build.compiler import find_compiler
+    standalone = {name: "resources/network.txt" in zipfile.ZipFile(tmp_path / name).namelist()
+                  for name in ("model.fmu", "model_before.fmu", "model_after.fmu")}
+    assert standalone == {"model.fmu": bool(find_compiler()), "model_before.fmu": False, "model_after.fmu": False}
     # the same inputs through Python: the same report.json, byte for byte, timings and folders aside
     import nodeforce
     building = nodeforce.read_building(DATA / "testcell_miami.json")
