@@ -2,8 +2,12 @@
 
 Pure functions on numpy arrays and pandas indexes, no I/O. The sun position is computed once for
 a time grid (`solar_position`) and reused for every surface (`incident_irradiance`), because it is
-by far the most expensive part and does not depend on the surface.
+by far the most expensive part and does not depend on the surface; the last few grids' positions
+are kept, since a record is prepared for several buildings of one site.
 """
+
+import threading
+from collections import OrderedDict
 
 import numpy as np
 import pandas as pd
@@ -85,10 +89,32 @@ def solar_position(times, latitude, longitude, altitude):
     Returns
     -------
     pandas.DataFrame
-        pvlib's `get_solarposition(times, latitude, longitude, altitude)`; the columns used here
-        are `apparent_zenith` and `azimuth`, degrees (azimuth clockwise from north).
+        pvlib's `get_solarposition(times, latitude, longitude, altitude)`, indexed by `times`; the
+        columns used here are `apparent_zenith` and `azimuth`, degrees (azimuth clockwise from
+        north). A copy: the caller may change it.
     """
-    return pvlib.solarposition.get_solarposition(times, latitude, longitude, altitude)
+    # pvlib's SPA costs some 10 us a time: a record prepared for the building as written and as
+    # corrected, or a synthetic truth run at several fault sizes, asks for the same grid again
+    key = (times.asi8.tobytes(), str(times.tz), float(latitude), float(longitude), float(altitude))
+    with _KEPT_LOCK:  # a Dask worker runs tasks in threads
+        position = _POSITIONS.get(key)
+        if position is not None:
+            _POSITIONS.move_to_end(key)
+    if position is None:
+        position = pvlib.solarposition.get_solarposition(times, latitude, longitude, altitude)
+        with _KEPT_LOCK:
+            _POSITIONS[key] = position
+            while len(_POSITIONS) > POSITIONS_KEPT:
+                _POSITIONS.popitem(last=False)
+    position = position.copy()
+    position.index = times
+    return position
+
+
+#: How many time grids' sun positions `solar_position` keeps (the least recently asked dropped).
+POSITIONS_KEPT = 4
+_POSITIONS = OrderedDict()
+_KEPT_LOCK = threading.Lock()
 
 
 def incident_irradiance(position, ghi, dni, dhi, tilt, azimuth, albedo):

@@ -86,3 +86,17 @@ def test_transmitted_sun_by_hand():
                                  azimuth=180.0, albedo=0.2, angles=[0, 40, 60, 80], factors=[1, 0.98, 0.8, 0.3],
                                  diffuse=0.85)
     assert sun == pytest.approx([0.8 * 1000 * 0.5 + 0.85 * 100, 0.85 * 50], rel=1e-9)
+
+
+def test_a_grid_asked_again_gets_pvlibs_positions_as_its_own_copy():
+    times = pd.date_range("2001-06-21", periods=96, freq="15min", tz="Etc/GMT+5")
+    first = solar_position(times, 25.8, -80.3, 2.0)
+    first["azimuth"] = 0.0  # the caller's to change
+    again = solar_position(times.rename("time"), 25.8, -80.3, 2.0)
+    direct = pvlib.solarposition.get_solarposition(times, 25.8, -80.3, 2.0)
+    assert np.array_equal(again.to_numpy(), direct.to_numpy()) and list(again.columns) == list(direct.columns)
+    assert again.index.equals(times) and again.index.name == "time"
+    south = solar_position(times, -25.8, -80.3, 2.0)  # another site, the same times
+    assert np.abs(south["apparent_zenith"] - direct["apparent_zenith"]).max() > 10.0
+    later = solar_position(times + pd.Timedelta(hours=6), 25.8, -80.3, 2.0)
+    assert np.array_equal(later["azimuth"].to_numpy()[:72], direct["azimuth"].to_numpy()[24:])
