@@ -29,7 +29,7 @@ PYTEST := $(BIN)/python -m pytest -q -n 2 --dist loadfile
 test: venv system-deps
 	$(PYTEST)
 
-# The edit-test loop: everything but the searches, diagnoses and importer runs (under a minute).
+# The edit-test loop: everything but the searches, diagnoses and importer runs (about 2 min on 2 cores).
 check: venv
 	$(PYTEST) -m "not slow"
 
