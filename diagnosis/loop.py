@@ -213,9 +213,10 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
         if r.read_from is None or protocol(building, r) is not None:
             raise InputError(r.source, "later", f"record {r.name}: a later record is read from its files "
                                                 f"(read_record) for the building diagnosed, {building.source}")
-    fmu_kind = evaluator_kind(fmu_kind, [building, *filter(None, (protocol(building, r) for r in records))])
+    bases = [protocol(building, r) for r in records]
+    fmu_kind = evaluator_kind(fmu_kind, [building, *filter(None, bases)])
     with Cluster(scheduler) if scheduler is not None else nullcontext() as cluster:
-        prepared = prepare(building, records, objective, workdir, fmu_kind, noise)
+        prepared = prepare(building, records, bases, objective, workdir, fmu_kind, noise)
         search = dict(seed=seed, workers=workers, scheduler=scheduler, population=population,
                       generations=generations, fmu_kind=search_fmu,
                       noise=prepared.noise.sigma if prepared.noise.given else None)
@@ -265,12 +266,12 @@ class Made:
         return added_effects(self.decisions)
 
 
-def prepare(building, records, objective, workdir, fmu_kind, noise):
-    """Stage 1: the records' windows; the building as described (each record's protocol's)
-    built as an FMU and run over each record (`model_before.fmu`); the file's own numerical error
-    beside it; the noise (C), `noise` if the user gave it."""
+def prepare(building, records, bases, objective, workdir, fmu_kind, noise):
+    """Stage 1: the records' windows; the building as described (each record's protocol's,
+    `bases`: `protocol` of each record) built as an FMU and run over each record
+    (`model_before.fmu`); the file's own numerical error beside it; the noise (C), `noise` if the
+    user gave it."""
     windows = Windows.of(records, objective)
-    bases = [protocol(building, r) for r in records]
     before_runs = []
     for i, (case, base) in enumerate(zip(windows.cases, bases)):
         name = "model_before.fmu" if base is None else f"model_before_{i + 1}.fmu"
