@@ -15,11 +15,12 @@ def layer_bounds(thicknesses):
     return np.concatenate(([0.0], np.cumsum(thicknesses)))
 
 
-def _integral(bounds, density, a, b):
-    """Integral over [a, b] (m) of a piecewise-constant profile `density` given per layer."""
-    lo = np.clip(bounds[:-1], a, b)
-    hi = np.clip(bounds[1:], a, b)
-    return float(np.sum(density * (hi - lo)))
+def _integrals(bounds, density, a, b):
+    """Integrals over each [a_k, b_k] (m) of a piecewise-constant profile `density` given per layer."""
+    a, b = np.asarray(a, dtype=float)[:, None], np.asarray(b, dtype=float)[:, None]
+    lo = np.clip(bounds[None, :-1], a, b)
+    hi = np.clip(bounds[None, 1:], a, b)
+    return np.sum(density * (hi - lo), axis=1)
 
 
 def conductances(layers, depths):
@@ -36,7 +37,8 @@ def conductances(layers, depths):
     """
     bounds = layer_bounds([t for _, t in layers])
     resistivity = np.array([1.0 / m.conductivity for m, _ in layers])
-    return np.array([1.0 / _integral(bounds, resistivity, a, b) for a, b in zip(depths, depths[1:])])
+    x = np.asarray(depths, dtype=float)
+    return 1.0 / _integrals(bounds, resistivity, x[:-1], x[1:])
 
 
 def capacities(layers, depths):
@@ -48,7 +50,7 @@ def capacities(layers, depths):
     mid = (x[:-1] + x[1:]) / 2
     lo = np.concatenate(([x[0]], mid))
     hi = np.concatenate((mid, [x[-1]]))
-    return np.array([_integral(bounds, rho_c, a, b) for a, b in zip(lo, hi)])
+    return _integrals(bounds, rho_c, lo, hi)
 
 
 def generated_depths(thicknesses, max_spacing, layer_boundaries=True, extra=(), merge=1e-3):
