@@ -28,7 +28,7 @@ RPATH = ("-Wl,--disable-new-dtags", "-Wl,-rpath,$ORIGIN")
 
 
 @functools.lru_cache(maxsize=None)
-def library(source, libraries=(), link_options=(), defines=()):
+def library(source, libraries=(), link_options=(), defines=(), options=("-O2",)):
     """The shared library (bytes) of c/<source> (a file name, or a tuple of several) with the
     headers beside it, compiled once per process.
 
@@ -36,7 +36,7 @@ def library(source, libraries=(), link_options=(), defines=()):
     where nodeforce is installed, so the same model gives the same FMU.
 
     libraries : names given to -l; link_options : options for the linker (-Wl,...), before them;
-    defines : preprocessor names given to -D
+    defines : preprocessor names given to -D; options : the compiler's (optimisation)
 
     Raises RuntimeError without a C compiler or when compiling fails.
     """
@@ -45,7 +45,7 @@ def library(source, libraries=(), link_options=(), defines=()):
         raise RuntimeError("no C compiler found (cc, gcc or $CC): install one (e.g. apt-get install gcc)")
     with tempdirs.folder("c") as tmp:
         output = Path(tmp) / "library.so"
-        command = [*compiler, "-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden",
+        command = [*compiler, "-std=c99", *options, "-fPIC", "-shared", "-fvisibility=hidden",
                    *(f"-D{d}" for d in defines), "-o", str(output), *([source] if isinstance(source, str) else source),
                    *RPATH, *link_options, *(f"-l{name}" for name in libraries)]
         done = subprocess.run(command, cwd=C_DIR, capture_output=True, text=True)

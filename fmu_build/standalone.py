@@ -29,7 +29,7 @@ from nodeforce.model.network import assemble
 
 from .compiler import C_DIR, library
 
-SOURCES = ("nodeforce_fmu.c", "fmi2.h", "variables.h", "resources.h")
+SOURCES = ("nodeforce_fmu.c", "profile.h", "fmi2.h", "variables.h", "resources.h")
 IDENTIFIER = "nodeforce_standalone"
 
 

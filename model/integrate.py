@@ -205,6 +205,7 @@ class ImplicitEuler:
         self._partition = None
         self._solvers = OrderedDict()
         self._modes = {}
+        self._pattern = None
 
     def solver(self, forced, switched=None):
         """The solve of M with the rows of the `forced` nodes (bool mask) replaced by unit rows
@@ -237,6 +238,48 @@ class ImplicitEuler:
             self._modes[key] = (Modes.of(solve.inverse, self.c_dt, forced) if isinstance(solve, DenseSolve)
                                 else None)
         return self._modes[key]
+
+    def matrix(self, forced, switched=None):
+        """M's nonzeros ((rows, cols) int32, values) with the switched conductances `switched`
+        (N,) added to its diagonal and the rows of the `forced` nodes unit rows."""
+        if self._pattern is None:  # M's pattern, the diagonal included: every mask's
+            rows, cols = np.nonzero((self._M != 0) | np.eye(len(self._M), dtype=bool))
+            self._pattern = (rows.astype(np.int32), cols.astype(np.int32)), self._M[rows, cols]
+        (rows, cols), values = self._pattern
+        values, diagonal = values.copy(), rows == cols
+        if switched is not None:
+            values[diagonal] += switched[rows[diagonal]]
+        at = forced[rows]
+        values[at] = diagonal[at]
+        return (rows, cols), values
+
+    def run(self, T, sources, forced, imposed=None, switched=None, rows=None):
+        """The temperatures of the nodes `rows` (indices, default every node) after each of L steps
+        under one mask and switched conductances, (L, len(rows)), and every node's after the last
+        (N,): compiled (`model.compiled`) where a C compiler is found, else step by step (`step`).
+
+        Parameters
+        ----------
+        T : (N,) C before the first step
+        sources : (L, N) each step's `B u + q` (W)
+        forced : (N,) bool, the nodes imposed at every step
+        imposed : (L, N) each step's imposed temperatures (C), read where forced; None: zero (the
+            temperatures' derivatives, which no parameter moves at a forced node)
+        switched : (N,) the steps' switched conductances (`Network.switched_diagonal`), or None
+        """
+        from . import compiled  # not in the Python FMU, which steps one doStep at a time
+        rows = np.arange(len(T)) if rows is None else np.asarray(rows, dtype=int)
+        index = np.flatnonzero(forced)
+        if compiled.available():
+            v = np.array(sources, dtype=float)
+            v[:, index] = 0.0 if imposed is None else imposed[:, index]
+            return compiled.steps(*self.matrix(forced, switched), np.where(forced, 0.0, self.c_dt), v, T, rows)
+        zero = np.zeros(len(T))
+        out = np.empty((len(sources), len(rows)))
+        for k, source in enumerate(sources):
+            T = self.step(T, source, forced, zero if imposed is None else imposed[k], switched)
+            out[k] = T[rows]
+        return out, T
 
     def step(self, T, source, forced, T_forced, switched=None):
         """Temperatures (C) at t_n+1 from T at t_n.
@@ -560,18 +603,9 @@ def steps(stepper, network, T, inputs, forced, imposed, kept, outputs, derivativ
             else:
                 out[here], T = modal_run(solve.inverse, stepper.c_dt, mask, modes, T, terms[a:b], B, q, imposed[a:b],
                                          kept[here] - a, outputs)
-        else:
-            sources = terms[a:b] @ B.T + q
-            path = np.empty((b - a if derivatives else 0, network.n_nodes))
-            at = iter(here)
-            i = next(at, None)
-            for k in range(a, b):
-                T = stepper.step(T, sources[k - a], mask, imposed[k], g)
-                if derivatives:
-                    path[k - a] = T
-                if i is not None and kept[i] == k:
-                    out[i] = T[outputs]
-                    i = next(at, None)
+        else:  # every node's path where the derivatives' sources read it
+            path, T = stepper.run(T, terms[a:b] @ B.T + q, mask, imposed[a:b], g, None if derivatives else outputs)
+            out[here] = path[kept[here] - a][:, outputs] if derivatives else path[kept[here] - a]
         if derivatives:
             d_out[here], S = sensitivity_steps(stepper, network, derivatives, S, np.vstack([before[None], path[:-1]]),
                                                path, inputs[a:b], terms[a:b], mask, g, kept[here] - a, outputs, modes)
@@ -603,10 +637,10 @@ def sensitivity_steps(stepper, network, derivatives, S, before, after, inputs, t
     (C per unit of each parameter), and (N, k) every node's after the last step
     """
     source = np.stack([d.source(before, after, terms, inputs, stepper.dt) for d in derivatives], axis=-1)
-    solve, index = stepper.solver(forced, switched)
-    source[:, index] = 0.0
+    source[:, forced] = 0.0
     out = np.empty((len(kept), len(outputs), len(derivatives)))
     if modes is not None:  # the source as inputs, on the rows where it may be other than zero
+        solve, _ = stepper.solver(forced, switched)
         n = network.n_nodes
         rows = np.unique(np.concatenate([d.rows for d in derivatives]))
         B, q, imposed = np.eye(n)[:, rows], np.zeros(n), np.zeros((len(source), n))
@@ -615,20 +649,12 @@ def sensitivity_steps(stepper, network, derivatives, S, before, after, inputs, t
             out[..., j], last[:, j] = modal_run(solve.inverse, stepper.c_dt, forced, modes, S[:, j],
                                                 source[:, rows, j], B, q, imposed, kept, outputs)
         return out, last
-    # one parameter at a time: a matrix-vector product is several times faster than one with a
-    # matrix of two columns (BLAS's paths for each), and the parameters are few
-    c = np.where(forced, 0.0, stepper.c_dt)
-    S, source = S.T.copy(), np.ascontiguousarray(source.transpose(2, 0, 1))
-    at = iter(range(len(kept)))
-    i = next(at, None)
-    for k in range(source.shape[1]):
-        for j, s in enumerate(S):
-            S[j] = solve(c * s + source[j, k])
-        S[:, index] = 0.0
-        if i is not None and kept[i] == k:
-            out[i] = S[:, outputs].T
-            i = next(at, None)
-    return out, S.T
+    # one parameter at a time, each a run of the step with its source
+    last = np.empty_like(S)
+    for j in range(len(derivatives)):
+        path, last[:, j] = stepper.run(S[:, j], source[..., j], forced, None, switched, outputs)
+        out[..., j] = path[kept]
+    return out, last
 
 
 def history_inputs(U, history_steps, dt):

@@ -9,7 +9,7 @@
        (C/dt - A) T+ = (C/dt) T + B u + q + s(u),   s_i(u) = sum over products k on i of P_k u_a u_b,
    the rows of forced nodes (force[i] and T_forced[i] not NaN) replaced by T+_i = T_forced[i],
    with M factorised once per pattern of imposed nodes and step size: LU within the profile of
-   M reordered by reverse Cuthill-McKee (Profile below), O(N) per step on a building's network.
+   M reordered by reverse Cuthill-McKee (profile.h), O(N) per step on a building's network.
    The state at the start is T_start. The inputs set before doStep(t, h) are those at t, their
    first derivatives (fmi2SetRealInputDerivatives; zero where none is set for this step) make
    them linear over the step: doStep takes k = ceil(h / max_step) steps of h / k, each with the
@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include "fmi2.h"
+#include "profile.h"
 #include "resources.h"
 #include "variables.h"
 
@@ -33,20 +34,9 @@
 typedef struct {
     double dt;
     unsigned char *imposed; /* N */
-    double *lower, *upper;  /* the profile: row i of L and column i of U, from column first[i] */
-    double *diagonal;       /* N: U's */
+    Lu lu;
     int used;
 } Factors;
-
-/* M in the reverse Cuthill-McKee order of the network's links, and its profile (envelope):
-   row and column i of the reordered M hold nonzeros from first[i] on only, so its LU factors
-   (without pivoting: M is an M-matrix, forced rows unit rows) fill nothing outside it. A zone's
-   chains of wall nodes keep the profile narrow: O(N) per step, not O(N^2). */
-typedef struct {
-    int *order;  /* N: old node at new position i */
-    int *first;  /* N: first column of row i (new numbering) */
-    long *start; /* N + 1: where row i begins in lower/upper */
-} Profile;
 
 typedef struct {
     int n, n_in, n_par, n_terms, n_products;
@@ -206,22 +196,13 @@ static void network_at_parameters(Model *m) {
     m->b_start[net->n] = k;
 }
 
-/* The profile of M's links in any term of the network (so in M at any parameter values):
-   reverse Cuthill-McKee from a node of least degree in each connected part. */
+/* The profile of M's links in any term of the network (so in M at any parameter values). */
 static int order_network(Model *m) {
     const Network *net = &m->net;
-    int n = net->n, i, j, head = 0, tail = 0, placed = 0;
-    long k, e, pairs = 0, nonzeros = net->term_start[net->n_terms];
-    int *degree = calloc((size_t)n + 1, sizeof(int)), *seen = calloc((size_t)n + 1, sizeof(int));
-    int *position = calloc((size_t)n + 1, sizeof(int)), *queue = calloc((size_t)n + 1, sizeof(int));
-    long *at = calloc((size_t)n + 1, sizeof(long));
+    int n = net->n, ok;
+    long k, pairs = 0, nonzeros = net->term_start[net->n_terms];
     int *a = calloc((size_t)2 * nonzeros + 1, sizeof(int)), *b = calloc((size_t)2 * nonzeros + 1, sizeof(int));
-    int *neighbour = NULL;
-    Profile *p = &m->profile;
-    p->order = calloc((size_t)n + 1, sizeof(int));
-    p->first = calloc((size_t)n + 1, sizeof(int));
-    p->start = calloc((size_t)n + 1, sizeof(long));
-    if (!degree || !seen || !position || !queue || !at || !a || !b || !p->order || !p->first || !p->start) goto fail;
+    if (!a || !b) { free(a); free(b); return 0; }
     /* the links: A's off-diagonal nonzeros in any term, both ways */
     for (k = 0; k < nonzeros; k++) {
         long offset = net->index[k] - n;
@@ -229,88 +210,9 @@ static int order_network(Model *m) {
         a[pairs] = (int)(offset / n); b[pairs++] = (int)(offset % n);
         a[pairs] = (int)(offset % n); b[pairs++] = (int)(offset / n);
     }
-    for (e = 0; e < pairs; e++) degree[a[e]]++;
-    for (i = 0; i < n; i++) at[i + 1] = at[i] + degree[i];
-    neighbour = calloc((size_t)at[n] + 1, sizeof(int));
-    if (!neighbour) goto fail;
-    memset(degree, 0, (size_t)n * sizeof(int));
-    for (e = 0; e < pairs; e++) { /* each neighbour once (a node has few) */
-        long q;
-        for (q = at[a[e]]; q < at[a[e]] + degree[a[e]] && neighbour[q] != b[e]; q++) {}
-        if (q == at[a[e]] + degree[a[e]]) neighbour[at[a[e]] + degree[a[e]]++] = b[e];
-    }
-    while (placed < n) {
-        int root = -1;
-        for (i = 0; i < n; i++)
-            if (!seen[i] && (root < 0 || degree[i] < degree[root])) root = i;
-        seen[root] = 1;
-        queue[tail++] = root;
-        while (head < tail) {
-            int node = queue[head++], from = tail;
-            long k;
-            for (k = at[node]; k < at[node] + degree[node]; k++)
-                if (!seen[neighbour[k]]) { seen[neighbour[k]] = 1; queue[tail++] = neighbour[k]; }
-            for (i = from + 1; i < tail; i++) /* the new neighbours by increasing degree */
-                for (j = i; j > from && degree[queue[j]] < degree[queue[j - 1]]; j--) {
-                    int swap = queue[j]; queue[j] = queue[j - 1]; queue[j - 1] = swap;
-                }
-        }
-        placed = tail;
-    }
-    for (i = 0; i < n; i++) { p->order[i] = queue[n - 1 - i]; position[queue[n - 1 - i]] = i; }
-    for (i = 0; i < n; i++) {
-        int node = p->order[i];
-        long k;
-        p->first[i] = i;
-        for (k = at[node]; k < at[node] + degree[node]; k++)
-            if (position[neighbour[k]] < p->first[i]) p->first[i] = position[neighbour[k]];
-        p->start[i + 1] = p->start[i] + (i - p->first[i]);
-    }
-    free(degree); free(seen); free(position); free(queue); free(at); free(neighbour); free(a); free(b);
-    return 1;
-fail:
-    free(degree); free(seen); free(position); free(queue); free(at); free(neighbour); free(a); free(b);
-    return 0;
-}
-
-/* LU of the reordered M within its profile (Doolittle, L unit lower); 0 if a pivot is zero. */
-static int profile_factor(Factors *f, const Profile *p, int n) {
-    int i, j, k;
-    for (i = 0; i < n; i++) {
-        double *L_i = f->lower + p->start[i] - p->first[i], *U_i = f->upper + p->start[i] - p->first[i];
-        double d = f->diagonal[i];
-        for (j = p->first[i]; j < i; j++) {
-            const double *L_j = f->lower + p->start[j] - p->first[j], *U_j = f->upper + p->start[j] - p->first[j];
-            double l = L_i[j], u = U_i[j];
-            for (k = p->first[i] > p->first[j] ? p->first[i] : p->first[j]; k < j; k++) {
-                l -= L_i[k] * U_j[k];
-                u -= L_j[k] * U_i[k];
-            }
-            U_i[j] = u;
-            L_i[j] = l / f->diagonal[j];
-            d -= L_i[j] * U_i[j];
-        }
-        if (d == 0.0 || !isfinite(d)) return 0;
-        f->diagonal[i] = d;
-    }
-    return 1;
-}
-
-/* Solve M x = b in place, b in the original numbering; y is scratch (N). */
-static void profile_solve(const Factors *f, const Profile *p, double *b, double *y, int n) {
-    int i, k;
-    for (i = 0; i < n; i++) {
-        const double *L_i = f->lower + p->start[i] - p->first[i];
-        double s = b[p->order[i]];
-        for (k = p->first[i]; k < i; k++) s -= L_i[k] * y[k];
-        y[i] = s;
-    }
-    for (i = n - 1; i >= 0; i--) {
-        const double *U_i = f->upper + p->start[i] - p->first[i];
-        double x = y[i] /= f->diagonal[i];
-        for (k = p->first[i]; k < i; k++) y[k] -= U_i[k] * x;
-    }
-    for (i = 0; i < n; i++) b[p->order[i]] = y[i];
+    ok = profile_order(&m->profile, n, a, b, pairs);
+    free(a); free(b);
+    return ok;
 }
 
 /* M_rc: the step matrix, a forced row the unit row. */
@@ -327,33 +229,30 @@ static Factors *factors(Model *m, double dt) {
     Factors *f;
     for (i = 0; i < CACHED_PATTERNS; i++) {
         f = &m->cache[i];
-        if (f->lower && f->dt == dt && memcmp(f->imposed, m->imposed, (size_t)n) == 0) {
+        if (f->lu.lower && f->dt == dt && memcmp(f->imposed, m->imposed, (size_t)n) == 0) {
             f->used = ++m->clock;
             return f;
         }
         if (f->used < m->cache[slot].used) slot = i; /* the least recently used (unused: 0) */
     }
     f = &m->cache[slot];
-    if (!f->lower) {
-        f->lower = malloc(((size_t)p->start[n] + 1) * sizeof(double));
-        f->upper = malloc(((size_t)p->start[n] + 1) * sizeof(double));
-        f->diagonal = malloc((size_t)n * sizeof(double));
+    if (!f->lu.lower) {
         f->imposed = malloc((size_t)n);
-        if (!f->lower || !f->upper || !f->diagonal || !f->imposed) return NULL;
+        if (!lu_alloc(&f->lu, p, n) || !f->imposed) return NULL;
     }
     for (i = 0; i < n; i++) {
         int r = p->order[i];
-        double *L_i = f->lower + p->start[i] - p->first[i], *U_i = f->upper + p->start[i] - p->first[i];
+        double *L_i = lu_row(f->lu.lower, p, i), *U_i = lu_row(f->lu.upper, p, i);
         for (j = p->first[i]; j < i; j++) {
             L_i[j] = step_matrix(m, dt, r, p->order[j]);
             U_i[j] = step_matrix(m, dt, p->order[j], r);
         }
-        f->diagonal[i] = step_matrix(m, dt, r, r);
+        f->lu.diagonal[i] = step_matrix(m, dt, r, r);
     }
     f->dt = dt;
     memcpy(f->imposed, m->imposed, (size_t)n);
     f->used = ++m->clock;
-    if (!profile_factor(f, p, n)) {
+    if (!profile_factor(&f->lu, p, n)) {
         f->dt = -1.0; /* never matches again */
         f->used = 0;
         return NULL;
@@ -406,7 +305,7 @@ static fmi2Status step(Model *m, double h) {
         }
         for (i = 0; i < n; i++)
             m->v[i] = m->imposed[i] ? T_forced[i] + dT_forced[i] * s : m->C[i] / dt * T[i] + m->v[i];
-        profile_solve(f, &m->profile, m->v, m->work, n);
+        profile_solve(&f->lu, &m->profile, m->v, m->work, n);
         for (i = 0; i < n; i++) T[i] = m->imposed[i] ? T_forced[i] + dT_forced[i] * s : m->v[i];
     }
     /* the next step's derivatives are set before it, or it holds its inputs */
@@ -427,12 +326,12 @@ static void free_model(Model *m) {
     int i;
     if (!m) return;
     for (i = 0; i < CACHED_PATTERNS; i++) {
-        free(m->cache[i].lower); free(m->cache[i].upper); free(m->cache[i].diagonal); free(m->cache[i].imposed);
+        lu_free(&m->cache[i].lu); free(m->cache[i].imposed);
     }
     free_network(&m->net);
     free_names(&m->layout);
     free(m->name); free(m->values); free(m->start_values); free(m->derivatives); free(m->u); free(m->C); free(m->v); free(m->work);
-    free(m->imposed); free(m->profile.order); free(m->profile.first); free(m->profile.start);
+    free(m->imposed); profile_free(&m->profile);
     free(m->b_start); free(m->b_column); free(m->b_value);
     free(m);
 }

@@ -1,0 +1,76 @@
+"""The direct model's runs of steps compiled (fmu_build/c/steps.c), where a C compiler is found.
+
+A run of backward-Euler steps under one step matrix (`integrate.ImplicitEuler.run`) is, in
+numpy, one product with the dense inverse of M a step: O(N^2), some 15 us on the Twin House's
+267 nodes, and as much again in Python's own work per step. In C, M factorised within its
+profile (the standalone FMU's LU, fmu_build/c/profile.h) makes a step two triangular solves of
+O(N). The library is compiled once per process at its first run, for this machine's processor
+(it is never shipped), and loaded from a temporary folder removed at once; without a C
+compiler `steps` says so (None) and the caller steps in numpy: the same arithmetic, rounded
+otherwise (tests/test_compiled.py).
+
+Only the direct model loads it: the Python FMU steps in numpy alone (`fmu_build.slave`).
+"""
+import ctypes
+import functools
+import threading
+from pathlib import Path
+
+import numpy as np
+
+from nodeforce import tempdirs
+
+_LOCK = threading.Lock()
+_DOUBLE, _INT = np.ctypeslib.ndpointer(np.float64, flags="C"), np.ctypeslib.ndpointer(np.int32, flags="C")
+
+
+@functools.lru_cache(maxsize=None)
+def _library():
+    """The loaded library, or None where it cannot be compiled (no C compiler)."""
+    from nodeforce.fmu_build.compiler import find_compiler, library
+    if find_compiler() is None:
+        return None
+    with tempdirs.folder("steps") as tmp:
+        path = Path(tmp) / "steps.so"
+        path.write_bytes(library("steps.c", options=("-O3", "-march=native")))
+        loaded = ctypes.CDLL(str(path))
+    function = loaded.nodeforce_steps
+    function.restype = ctypes.c_int
+    function.argtypes = [ctypes.c_int, ctypes.c_long, _INT, _INT, _DOUBLE, _DOUBLE, ctypes.c_long, _DOUBLE,
+                         _DOUBLE, ctypes.c_int, _INT, _DOUBLE]
+    return function
+
+
+def available():
+    """Whether the compiled steps load here (a C compiler is found)."""
+    with _LOCK:
+        return _library() is not None
+
+
+def steps(pattern, values, c, v, T, rows):
+    """The temperatures after each of L steps M T^k+1 = c T^k + v^k, or None where the library
+    cannot be compiled.
+
+    Parameters
+    ----------
+    pattern : (rows, cols) int32 arrays of M's nonzeros; values : their values (W/K), the forced
+        nodes' rows unit rows
+    c : (N,) C/dt, zero at the forced nodes (W/K)
+    v : (L, N) each step's sources (W), the forced nodes' imposed temperatures (C) in their place
+    T : (N,) C before the first step
+    rows : indices of the nodes returned
+
+    Returns
+    -------
+    (L, len(rows)) C after each step, and (N,) C after the last; ValueError where M is singular
+    """
+    if not available():
+        return None
+    T = np.array(T, dtype=float)
+    v = np.ascontiguousarray(v, dtype=float)
+    rows = np.ascontiguousarray(rows, dtype=np.int32)
+    path = np.empty((len(v), len(rows)))
+    if not _library()(len(T), len(values), pattern[0], pattern[1], np.ascontiguousarray(values, dtype=float),
+                      np.ascontiguousarray(c, dtype=float), len(v), v, T, len(rows), rows, path):
+        raise ValueError("the step matrix is singular")
+    return path, T
