@@ -47,7 +47,8 @@ EXPORT int nodeforce_steps(int n, long nonzeros, const int *row, const int *col,
     for (s = 0; s < L; s++) {
         const double *v_s = v + s * n;
         double *out = path + s * n_rows;
-        for (i = 0; i < n; i++) x[i] = c[i] * T[i] + v_s[i];
+        /* a forced node's (c = 0) is its imposed temperature whatever T held before */
+        for (i = 0; i < n; i++) x[i] = c[i] != 0.0 ? c[i] * T[i] + v_s[i] : v_s[i];
         profile_solve(&f, &p, x, y, n);
         memcpy(T, x, (size_t)n * sizeof(double));
         for (i = 0; i < n_rows; i++) out[i] = T[rows[i]];
