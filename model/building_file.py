@@ -83,26 +83,35 @@ ITEMS = {"zones": "zone", "components": "component"}
 
 
 def _schema_error(data, before):
-    """(path prefix, jsonschema's best error or None) of `data`, or of the items of ITEMS it
-    changed from `before` where nothing else differs: the top level of the schema asks nothing
-    of an item but its own definition."""
+    """(path prefix, jsonschema's best error or None) of `data`, or, of an edit of `before` that
+    removed no field, of the top-level fields it added or changed, and within those of ITEMS of
+    the same length, of the items it changed: the top level of the schema asks nothing of a
+    field but its own schema (its properties, none required but those `before` has, no other)."""
     import jsonschema  # here: an FMU at its declared parameters runs this module without it
     best = jsonschema.exceptions.best_match
-    if (not isinstance(data, dict) or not isinstance(before, dict) or data.keys() != before.keys()
-            or any(data[k] != before[k] for k in data if k not in ITEMS)
-            or any(not isinstance(data[k], list) or len(data[k]) != len(before[k]) for k in ITEMS if k in data)):
+    if (not isinstance(data, dict) or not isinstance(before, dict) or not before.keys() <= data.keys()
+            or not data.keys() <= SCHEMA["properties"].keys()):
         return (), best(_validator(None).iter_errors(data))
-    for key, definition in ITEMS.items():
-        for i, (new, old) in enumerate(zip(data.get(key, ()), before.get(key, ()))):
-            error = best(_validator(definition).iter_errors(new)) if new != old else None
-            if error is not None:
-                return (key, i), error
+    for key, value in data.items():
+        if key in before and value == before[key]:
+            continue
+        old = before.get(key)
+        if key in ITEMS and isinstance(value, list) and isinstance(old, list) and len(value) == len(old):
+            for i, (new, was) in enumerate(zip(value, old)):
+                error = best(_validator(ITEMS[key]).iter_errors(new)) if new != was else None
+                if error is not None:
+                    return (key, i), error
+            continue
+        error = best(_validator(("properties", key)).iter_errors(value))
+        if error is not None:
+            return (key,), error
     return (), None
 
 
 @functools.lru_cache(maxsize=None)
 def _validator(definition):
-    """The format's JSON Schema validator, of a whole file or of one of its `$defs`. Python's json
+    """The format's JSON Schema validator, of a whole file, of one of its `$defs` (a name) or of
+    a top-level field (("properties", name)). Python's json
     reads NaN and Infinity, which JSON has no number for, and an id 1.0 is a float the parser
     cannot index by: a "number" is a finite one and an "integer" an int here."""
     import jsonschema
@@ -110,7 +119,12 @@ def _validator(definition):
     types = base.TYPE_CHECKER.redefine_many({
         "number": lambda _, v: isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v),
         "integer": lambda _, v: isinstance(v, int) and not isinstance(v, bool)})
-    schema = SCHEMA if definition is None else {"$defs": SCHEMA["$defs"], "$ref": f"#/$defs/{definition}"}
+    if definition is None:
+        schema = SCHEMA
+    elif isinstance(definition, tuple):  # a top-level field's own schema
+        schema = {"$defs": SCHEMA["$defs"], **SCHEMA["properties"][definition[1]]}
+    else:
+        schema = {"$defs": SCHEMA["$defs"], "$ref": f"#/$defs/{definition}"}
     return jsonschema.validators.extend(base, type_checker=types)(schema)
 
 

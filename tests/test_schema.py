@@ -188,6 +188,14 @@ def _wrong_format(d):
     d["format"] = "nodal-building/2"
 
 
+def _negative_boundary_factor(d):  # a field the file had not: the boundary_conductance effect's
+    d["boundary_conductance_factors"] = {"T_cellar": -0.5}
+
+
+def _unknown_field(d):
+    d["boundary_factors"] = {"T_cellar": 0.5}
+
+
 @pytest.mark.parametrize("mutate", [
     _unknown_outside_type, _negative_area, _tilt_200, _missing_layers, _absorptance_1_5,
     _zero_conductivity, _boundary_without_h, _exterior_without_absorptance,
@@ -279,7 +287,7 @@ def test_a_node_id_is_a_json_integer(validator):
 @pytest.mark.parametrize("mutate", [
     _unknown_outside_type, _negative_area, _missing_layers, _absorptance_1_5, _zero_conductivity,
     _negative_air_change_rate, _latitude_100, _glazing_without_target, _wrong_format,
-    *(change for change, _, _ in SCHEMA_RULES.values()),
+    _negative_boundary_factor, _unknown_field, *(change for change, _, _ in SCHEMA_RULES.values()),
 ], ids=lambda f: getattr(f, "__name__", "rule").strip("_"))
 def test_an_edit_is_refused_as_the_file_it_makes_would_be(mutate):
     """An edit (an effect's, at each step of a calibration) is checked against the schema where it
