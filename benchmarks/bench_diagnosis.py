@@ -379,18 +379,18 @@ def summary(results, draws):
     return lines, numbers
 
 
-# What one diagnosis costs, measured in the run of 2026-11-29 (every record, 3 draws): the whole
-# run is sized from it.
-BUDGET = ("The budget, measured in the run of 2026-11-29 on 2 cores (5 to 95 % of the records' times), the "
-          "forcing search driving the standalone FMU (the API's default since commit 7d6ad65, as the command "
-          "line's): a test-cell diagnosis takes 4 to 11 s with the paper's sensors or the air alone and 16 to "
-          "47 s with every node measured (gso-jan and mia-dec, 23 forcing genes), its baseline 2 to 4 s, a "
-          "Twin House diagnosis about 2 min (its baseline 1 min), making a record's truth 4 to 27 s. Every "
-          "record under one draw is then about 20 min on 2 workers, the two draws more 40 min, the Twin "
-          "House's among them. The GA and the calibrations keep the command line's defaults. Finished "
-          "records are kept in out/bench_diagnosis/records, each with a digest of its spec and of the "
-          "code (the package, the records, the baseline, the examples): a rerun skips what is unchanged, "
-          "a changed loop runs everything again.")
+# What one diagnosis costs, measured in the draw 0 of commit d9c343e: the whole run is sized from it.
+BUDGET = ("The budget, measured in the draw 0 of commit d9c343e on 2 cores, two diagnoses at a time (5 to 95 % of "
+          "the records' times), the forcing search driving the standalone FMU (`search_fmu=\"auto\"`, the API's "
+          "default as the command line's) and the runs of steps compiled where a C compiler is found: a test-cell "
+          "diagnosis takes 8 to 15 s with the paper's sensors or the air alone and 12 to 23 s with every node "
+          "measured (gso-jan and mia-dec, 23 forcing genes), its baseline 4 to 8 s, a Twin House diagnosis 68 to "
+          "84 s (its baseline 44 to 78 s), making a record's truth 5 to 10 s on the test cell and 20 to 26 s for "
+          "the Twin House. Every record under one draw is then about 20 min on 2 workers. The GA and the "
+          "calibrations keep the command line's defaults. Finished records are kept in "
+          "out/bench_diagnosis/records, each with a digest of its spec and of the code (the package, the "
+          "records, the baseline, the examples): a rerun skips what is unchanged, a changed loop runs "
+          "everything again.")
 
 
 def scenarios_table():
