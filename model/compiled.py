@@ -6,13 +6,14 @@ numpy, one product with the dense inverse of M a step: O(N^2), some 15 us on the
 profile (the standalone FMU's LU, fmu_build/c/profile.h) makes a step two triangular solves of
 O(N). The library is compiled once per process at its first run, for this machine's processor
 (it is never shipped), and loaded from a temporary folder removed at once; without a C
-compiler `steps` says so (None) and the caller steps in numpy: the same arithmetic, rounded
-otherwise (tests/test_compiled.py).
+compiler, or with one that fails on it, `steps` says so (None) and the caller steps in numpy:
+the same arithmetic, rounded otherwise (tests/test_compiled.py).
 
 Only the direct model loads it: the Python FMU steps in numpy alone (`fmu_build.slave`).
 """
 import ctypes
 import functools
+import logging
 import threading
 from pathlib import Path
 
@@ -20,19 +21,26 @@ import numpy as np
 
 from nodeforce import tempdirs
 
+log = logging.getLogger("nodeforce.model")
 _LOCK = threading.Lock()
 _DOUBLE, _INT = np.ctypeslib.ndpointer(np.float64, flags="C"), np.ctypeslib.ndpointer(np.int32, flags="C")
 
 
 @functools.lru_cache(maxsize=None)
 def _library():
-    """The loaded library, or None where it cannot be compiled (no C compiler)."""
+    """The loaded library, or None where it cannot be compiled (no C compiler, or one that fails
+    on it: said once in the log)."""
     from nodeforce.fmu_build.compiler import find_compiler, library
     if find_compiler() is None:
         return None
+    try:
+        data = library("steps.c", options=("-O3", "-march=native"))
+    except RuntimeError as error:
+        log.warning("the runs of steps are stepped in numpy: %s", str(error).splitlines()[0])
+        return None
     with tempdirs.folder("steps") as tmp:
         path = Path(tmp) / "steps.so"
-        path.write_bytes(library("steps.c", options=("-O3", "-march=native")))
+        path.write_bytes(data)
         loaded = ctypes.CDLL(str(path))
     function = loaded.nodeforce_steps
     function.restype = ctypes.c_int

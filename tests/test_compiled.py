@@ -84,3 +84,18 @@ def test_a_singular_step_matrix_is_refused():
     pattern = (np.array([0, 1], dtype=np.int32), np.array([0, 1], dtype=np.int32))
     with pytest.raises(ValueError, match="singular"):
         compiled.steps(pattern, np.array([2.0, 0.0]), np.array([1.0, 0.0]), np.ones((3, 2)), np.zeros(2), [0])
+
+
+def test_a_compiler_that_fails_leaves_the_steps_to_numpy(monkeypatch, caplog):
+    from nodeforce.fmu_build import compiler
+
+    def fails(*args, **kwargs):
+        raise RuntimeError("compiling 'steps.c' failed: cc: error: unrecognized option")
+    monkeypatch.setattr(compiler, "library", fails)
+    compiled._library.cache_clear()
+    try:
+        with caplog.at_level("WARNING", logger="nodeforce.model"):
+            assert not compiled.available()
+        assert "stepped in numpy: compiling 'steps.c' failed" in caplog.text
+    finally:
+        compiled._library.cache_clear()  # compiled again by the next test that runs steps
