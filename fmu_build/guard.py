@@ -15,7 +15,9 @@ import sys
 import sysconfig
 from pathlib import Path
 
-from .compiler import find_compiler, library
+from nodeforce.model.compiled import find_compiler
+
+from .compiler import library
 
 PLATFORM = "linux64"  # the guard's platform; pythonfmu's other binaries (win64) stay unguarded
 GUARD_FILE = "resources/guard.txt"

@@ -27,9 +27,10 @@ from nodeforce.model.effects import fmu_parameters, properties, with_fmu_paramet
 from nodeforce.model.integrate import MAX_STEP
 from nodeforce.model.network import assemble
 
-from .compiler import C_DIR, library
+from .compiler import C_DIR, MODEL_C_DIR, library
 
-SOURCES = ("nodeforce_fmu.c", "profile.h", "fmi2.h", "variables.h", "resources.h")
+SOURCES = (C_DIR / "nodeforce_fmu.c", MODEL_C_DIR / "profile.h", C_DIR / "fmi2.h", C_DIR / "variables.h",
+           C_DIR / "resources.h")
 IDENTIFIER = "nodeforce_standalone"
 
 
@@ -194,7 +195,7 @@ def network_text(building, effect):
 
 def standalone_files(building, effect, layout):
     """({archive name: bytes}, model identifier, source file names) of the standalone FMU."""
-    files = {f"sources/{name}": (C_DIR / name).read_bytes() for name in SOURCES}
+    files = {f"sources/{path.name}": path.read_bytes() for path in SOURCES}
     files["resources/network.txt"] = network_text(building, effect).encode()
     files["resources/names.txt"] = layout.names_file().encode()
     try:

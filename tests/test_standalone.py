@@ -19,7 +19,6 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 
 from nodeforce.cosim.fmi import content_id
-from nodeforce.fmu_build import compiler
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.effects import EFFECTS
@@ -225,7 +224,7 @@ def test_an_export_compiles_its_c_library_once_per_process(testcell_data, tmp_pa
 
     def no_compiler(command, **_):
         raise AssertionError(f"compiled again: {command}")
-    monkeypatch.setattr(compiler.subprocess, "run", no_compiler)
+    monkeypatch.setattr(subprocess, "run", no_compiler)
     second = build_fmu(parse_building(other), tmp_path / "second.fmu", kind=kind)
     with zipfile.ZipFile(first) as a, zipfile.ZipFile(second) as b:
         binaries = [name for name in a.namelist() if name.startswith("binaries/") and name.endswith(".so")]
