@@ -30,7 +30,7 @@ from nodeforce.model.case import as_cases
 from nodeforce.model.significance import bandwidth, parameter_covariance
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.hlc import heat_loss_coefficient
-from nodeforce.model.network import assemble, derivative
+from nodeforce.model.network import assemble, derivative, moved
 from nodeforce.model.numerical import share, share_slope
 
 log = logging.getLogger("nodeforce.diagnosis")
@@ -101,7 +101,7 @@ class Candidate:
                           if label is not None and p.name in (held or {}).get(label, ()))
         self._beside = [(label, p.name) for label, p in entries[self.own:]]
         self._runs, self._inputs, self._superposed, self._jacobians = {}, {}, {}, {}
-        self._derivatives, self._affine = {}, {}
+        self._derivatives, self._affine_alone, self._affines = {}, {}, {}
         self.simulations = 0  # simulations run (kept ones not counted again): a round's cost
 
     @property
@@ -149,7 +149,7 @@ class Candidate:
             return self._runs[key]
         superposed = self._superposition(case, key[1])
         run = superposed(values) if superposed is not None else \
-            self._simulated(case, node_ids, self.built(values, self.base(case)))
+            self._simulated(case, node_ids, *self._network(self.base(case), values))
         keep_run(self._runs, key, run)
         return run
 
@@ -170,9 +170,10 @@ class Candidate:
             jacobian = np.stack(superposed.slopes, axis=-1)
         else:
             base = self.base(case)
-            building = self.built(values, base)
-            network = assemble(building)
-            derivatives = [self._derivative(base, network, values, i) for i in range(len(values))]
+            building, network = self._network(base, values)
+            affine = self.affine(base)
+            derivatives = affine.derivatives if affine is not None else \
+                [self._derivative(base, network, values, i) for i in range(len(values))]
             exact = [i for i, d in enumerate(derivatives) if d is not None]
             self.simulations += 1
             run = self._inputs_of(case).run(building, np.asarray(node_ids) - 1, network,
@@ -210,13 +211,13 @@ class Candidate:
             return assemble(self.built(moved, base))
         one = at(1)
         found = derivative(network, one, h)
-        if found is not None and (id(base), i) not in self._affine:
+        if found is not None and (id(base), i) not in self._affine_alone:
             further = derivative(one, at(2), h)
-            self._affine[(id(base), i)] = further is not None and found.close_to(further, AFFINE)
-            if not self._affine[(id(base), i)]:
+            self._affine_alone[(id(base), i)] = further is not None and found.close_to(further, AFFINE)
+            if not self._affine_alone[(id(base), i)]:
                 log.info("%s: the network is not affine in %s: its derivatives by differences of runs",
                          self.label, self.names[i])
-        if not self._affine.get((id(base), i), False):
+        if not self._affine_alone.get((id(base), i), False):
             found = None
         self._derivatives[key] = found
         return found
@@ -231,10 +232,47 @@ class Candidate:
             self._inputs[id(case)] = (case, case.with_inputs(declared))
         return self._inputs[id(case)][1]
 
-    def _simulated(self, case, node_ids, building):
-        """The nodes of `building`, the case's base with the effect at some values, simulated."""
+    def _simulated(self, case, node_ids, building, network=None):
+        """The nodes of `building`, the case's base with the effect at some values, simulated
+        (`network`: its network, where the caller has it)."""
         self.simulations += 1
-        return self._inputs_of(case).run(building, np.asarray(node_ids) - 1)
+        return self._inputs_of(case).run(building, np.asarray(node_ids) - 1, network)
+
+    def _network(self, base, values):
+        """The building and the network of the candidate on `base` at `values`: where the network
+        is affine in the parameters together (`affine`), the one assembled at the start moved
+        along its derivatives (the building's layout, which is all a run reads of it besides its
+        network, does not move with them); else the building edited and assembled."""
+        affine = self.affine(base)
+        if affine is None:
+            building = self.built(values, base)
+            return building, assemble(building)
+        return affine.building, affine.network_at(values)
+
+    def affine(self, base):
+        """The candidate's `Affine` network on `base`, or None where the network is not affine in
+        its parameters together: each affine alone (`_derivative`), and at the far corner of
+        their ranges, every parameter moved to the farther of its bounds, the network moved
+        along the derivatives from the start is the one assembled there to `AFFINE` of the
+        move (a ground coupling's U T_ground is affine in each alone, not in both)."""
+        if id(base) in self._affines:
+            return self._affines[id(base)]
+        start = self.start()
+        building = self.built(start, base)
+        network = assemble(building)
+        derivatives = [self._derivative(base, network, start, i) for i in range(len(start))]
+        affine = None
+        if all(d is not None for d in derivatives):
+            far = np.array([high if high - x >= x - low else low for x, (low, high) in zip(start, self.bounds)])
+            assembled = derivative(network, assemble(self.built(far, base)), 1.0)
+            predicted = derivative(network, moved(network, derivatives, far - start), 1.0)
+            if assembled is not None and predicted.close_to(assembled, AFFINE):
+                affine = Affine(start, building, network, derivatives)
+            else:
+                log.info("%s: the network is not affine in its parameters together: assembled at each of "
+                         "their values", self.label)
+        self._affines[id(base)] = affine
+        return affine
 
     def _superposition(self, case, node_ids):
         """The `Superposition` of these nodes on `case`, or None where the effect is not on the
@@ -251,6 +289,22 @@ class Candidate:
             self._superposed[key] = Superposition(
                 reference, far, [self._simulated(case, node_ids, b) for b in buildings]) if kept else None
         return self._superposed[key]
+
+
+@dataclass
+class Affine:
+    """A candidate's network on one base where it is affine in the parameters together: the
+    building and its network assembled at the values `at`, and the network's `Derivative` with
+    respect to each parameter."""
+    at: np.ndarray
+    building: object
+    network: object
+    derivatives: list
+
+    def network_at(self, values):
+        """The network at `values`: the one assembled moved along its derivatives
+        (`network.moved`), exactly it at `at`."""
+        return moved(self.network, self.derivatives, np.asarray(values, dtype=float) - self.at)
 
 
 def keep_run(store, key, value):

@@ -103,6 +103,10 @@ class Coefficients:
         out[np.ix_(self.rows, self.cols)] = self.block
         return out
 
+    def add_to(self, out, scale):
+        """out += scale M, `out` of the matrix's shape."""
+        out[np.ix_(self.rows, self.cols)] += scale * self.block
+
     def add_product(self, out, x):
         """out[:, rows] += x[:, cols] block^T: out += x M^T for rows of vectors x (L, n)."""
         if len(self.rows):
@@ -177,6 +181,33 @@ def derivative(network, moved, h):
                       B=Coefficients((moved.source_coefficients - network.source_coefficients) / h),
                       q=(moved.q - network.q) / h,
                       G=Coefficients((switched_matrix(moved) - switched_matrix(network)) / h))
+
+
+def moved(network, derivatives, steps):
+    """The `Network` whose coefficients are `network`'s plus sum_i steps_i derivatives_i (each a
+    `Derivative` with respect to one parameter, moved by steps_i in its units): for a network
+    affine in its parameters, the network at other values without editing and assembling the
+    building again. A step of 0 leaves the coefficients exactly as they were."""
+    C, q, A = network.C.copy(), network.q.copy(), network.A.copy()
+    B = network.source_coefficients.copy()
+    G = np.zeros((network.n_nodes, len(network.input_names)))
+    for d, s in zip(derivatives, steps):
+        if s == 0.0:
+            continue
+        C += s * d.C
+        q += s * d.q
+        d.A.add_to(A, s)
+        d.B.add_to(B, s)
+        d.G.add_to(G, s)
+    n = len(network.input_names)
+    products = tuple((node, a, b, B[node, n + p]) for p, (node, a, b, _) in enumerate(network.products))
+    # G sums the switched conductances of a node and input: its move goes to the first of them
+    switched, seen = [], set()
+    for node, j, g in network.switched:
+        switched.append((node, j, g if (node, j) in seen else g + G[node, j]))
+        seen.add((node, j))
+    return Network(C=C, A=A, B=B[:, :n], q=q, input_names=network.input_names, products=products,
+                   switched=tuple(switched))
 
 
 def input_names(building):

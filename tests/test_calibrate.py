@@ -364,13 +364,14 @@ def test_an_effect_on_the_inputs_alone_is_its_runs_superposed_to_rounding(effect
 def test_a_split_of_the_heat_input_to_a_heater_node_is_simulated_not_superposed(equipped):
     """Where the zone's heater has a node of its own, the split sets its links' conductances:
     the step matrix moves with the parameter, and every value is a run of its own, as the model
-    with the effect simulated afresh."""
+    with the effect simulated afresh (its network moved along its derivative from the start's:
+    the same to rounding)."""
     _, case, lagged = equipped
     candidate = Candidate(lagged, "heat_input_split", "cell")
     inputs = case.with_inputs(lagged)
     for f_r in (0.1, 0.5, 0.9):
         built = candidate.built([f_r])
-        assert np.abs(candidate.nodes(inputs, [23], [f_r]) - inputs.run(built, [22])).max() < 1e-12
+        assert np.abs(candidate.nodes(inputs, [23], [f_r]) - inputs.run(built, [22])).max() < 1e-9
     assert candidate.simulations == 3
 
 

@@ -14,7 +14,7 @@ from nodeforce.model.building_file import load_building, parse_building
 from nodeforce.model.case import Case
 from nodeforce.model.effects import EFFECTS, Effect, Parameter
 from nodeforce.model.integrate import simulate
-from nodeforce.model.network import assemble, derivative
+from nodeforce.model.network import assemble, derivative, switched_matrix
 from nodeforce.model.numerical import share, share_slope
 
 from .conftest import DATA
@@ -125,6 +125,35 @@ def test_the_derivatives_of_every_effect_equal_central_differences(label, effect
             scale = np.abs(central).max()
             assert scale > 0.0, "the parameter moves no temperature: nothing checked"
             assert np.abs(dT[..., i] - central).max() <= RTOL * scale, (effect, record_.parameters[i].name)
+
+
+@pytest.mark.parametrize("label, effect, target", CASES, ids=[f"{e}@{t} ({b})" for b, e, t in CASES])
+def test_a_candidate_s_network_moved_along_its_derivatives_is_the_one_assembled(label, effect, target):
+    """A candidate's network at values across its ranges, moved from the start's along its
+    derivatives, against the building edited and assembled there: every coefficient the same to
+    1e-9 of what the move changed, and the same links, products and switched conductances. The
+    ground coupling's q holds U T_ground, affine in each parameter alone but not in both: it has
+    no affine network, and is assembled at each value."""
+    building = buildings()[label]
+    candidate = Candidate(building, effect, target)
+    affine = candidate.affine(building)
+    if effect == "ground_coupling":
+        assert affine is None
+        return
+    assert affine is not None
+    start = assemble(candidate.built(affine.at))
+    rng = np.random.default_rng(3)
+    for _ in range(3):
+        x = np.array([rng.uniform(low, high) for low, high in candidate.bounds])
+        assembled, got = assemble(candidate.built(x)), affine.network_at(x)
+        assert [p[:3] for p in got.products] == [p[:3] for p in assembled.products]
+        assert [s[:2] for s in got.switched] == [s[:2] for s in assembled.switched]
+        for coefficients in (lambda n: n.C, lambda n: n.A, lambda n: n.B, lambda n: n.q,
+                             lambda n: n.source_coefficients, switched_matrix):
+            change = np.abs(coefficients(assembled) - coefficients(start)).max(initial=0.0)
+            assert np.abs(coefficients(got) - coefficients(assembled)).max(initial=0.0) <= 1e-9 * change
+        moved = np.abs(assembled.A - start.A).max() + np.abs(assembled.source_coefficients - start.source_coefficients).max()
+        assert moved + np.abs(assembled.C - start.C).max() + np.abs(assembled.q - start.q).max() > 0.0
 
 
 def test_a_parameter_the_network_is_not_affine_in_keeps_differences_of_runs(monkeypatch, testcell, caplog):
