@@ -206,6 +206,7 @@ class ImplicitEuler:
         self._solvers = OrderedDict()
         self._modes = {}
         self._pattern = None
+        self._one_way = None
 
     def solver(self, forced, switched=None):
         """The solve of M with the rows of the `forced` nodes (bool mask) replaced by unit rows
@@ -231,7 +232,15 @@ class ImplicitEuler:
     def modes(self, forced, switched=None):
         """The `modal.Modes` of the step with this mask and switched conductances (kept with its
         factors), None where M is solved by blocks (`CondensedSolve`: its inverse is never formed)
-        or the modes are not well enough conditioned for a run."""
+        or the modes are not well enough conditioned for a run. Air carried one way between two
+        free nodes (a supply from one zone to the next) makes the step non-symmetric, which
+        `Modes.of` would find only after M's inverse is formed: such a mask has None at once."""
+        if self._one_way is None:  # M's non-symmetric pairs, the same for every mask
+            asymmetric = np.abs(self._M - self._M.T) > 1e-12 * np.abs(self._M).max(initial=0.0)
+            self._one_way = np.nonzero(asymmetric)
+        rows, cols = self._one_way
+        if np.any(~forced[rows] & ~forced[cols]):
+            return None
         solve, _ = self.solver(forced, switched)
         key = forced.tobytes() + (b"" if switched is None else switched.tobytes())
         if key not in self._modes:
