@@ -3,14 +3,18 @@ project's C compiler itself, which the FMUs' export uses too (`fmu_build.compile
 
 A run of backward-Euler steps under one step matrix (`integrate.ImplicitEuler.run`) is, in
 numpy, one product with the dense inverse of M a step: O(N^2), some 15 us on the Twin House's
-267 nodes, and as much again in Python's own work per step. In C, M factorised within its
-profile (c/profile.h, the standalone FMU's LU too) makes a step two triangular solves of
-O(N). The library is compiled once per process at its first run, for this machine's processor
-(it is never shipped), and loaded from a temporary folder removed at once; without a C
-compiler, or with one that fails on it, `steps` says so (None) and the caller steps in numpy:
-the same arithmetic, rounded otherwise (tests/test_compiled.py).
+267 nodes, and as much again in Python's own work per step. In C, with M factorised once by
+SuperLU (`factorise`: scipy's, in a minimum-degree order of M + M^T, pivots on the diagonal),
+a step is two sparse triangular solves: a building's walls are chains of nodes hung on a few
+air and radiant nodes, which that order eliminates last, so L and U hold about as many entries
+as M (459 each off the diagonal on the Twin House, whose M has 974). The library is compiled
+once per process at its first run, for this machine's processor (it is never shipped), and
+loaded from a temporary folder removed at once; without a C compiler, or with one that fails
+on it, `steps` says so (None) and the caller steps in numpy: the same arithmetic, rounded
+otherwise (tests/test_compiled.py).
 
-Only the direct model loads it: the Python FMU steps in numpy alone (`fmu_build.slave`).
+Only the direct model loads it: the Python FMU steps in numpy alone (`fmu_build.slave`), and
+the standalone FMU factorises within M's profile in its own C (model/c/profile.h).
 """
 import ctypes
 import functools
@@ -22,6 +26,8 @@ import threading
 from pathlib import Path
 
 import numpy as np
+from scipy import sparse
+from scipy.sparse.linalg import splu
 
 from nodeforce import tempdirs
 
@@ -85,8 +91,8 @@ def _library():
         loaded = ctypes.CDLL(str(path))
     function = loaded.nodeforce_steps
     function.restype = ctypes.c_int
-    function.argtypes = [ctypes.c_int, ctypes.c_long, _INT, _INT, _DOUBLE, _DOUBLE, ctypes.c_long, _DOUBLE,
-                         _DOUBLE, ctypes.c_int, _INT, _DOUBLE]
+    function.argtypes = [ctypes.c_int, _INT, _INT, _INT, _INT, _DOUBLE, _INT, _INT, _DOUBLE, _DOUBLE,
+                         ctypes.c_long, _DOUBLE, _DOUBLE, ctypes.c_int, _INT, _DOUBLE]
     return function
 
 
@@ -96,14 +102,39 @@ def available():
         return _library() is not None
 
 
-def steps(pattern, values, c, v, T, rows):
+class Factors:
+    """M = P_r^T L U P_c^T factorised by SuperLU in a minimum-degree order of M + M^T with its
+    pivots on the diagonal (M is diagonally dominant: a node's capacity over the step and its
+    conductances against those to its neighbours; a forced node's row a unit row), L and U by
+    columns as SuperLU gives them, which the kernel reads.
+
+    Parameters
+    ----------
+    pattern : (rows, cols) int32 arrays of M's nonzeros; values : their values (W/K)
+    n : M's order
+
+    ValueError where M is singular."""
+
+    def __init__(self, pattern, values, n):
+        M = sparse.csc_matrix((np.asarray(values, dtype=float), pattern), shape=(n, n))
+        try:
+            lu = splu(M, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+        except RuntimeError as error:  # SuperLU's "Factor is exactly singular"
+            raise ValueError(f"the step matrix is singular: {error}") from None
+        L, U = lu.L, lu.U
+        self.arrays = tuple(np.ascontiguousarray(a, dtype=t) for a, t in (
+            (lu.perm_r, np.int32), (lu.perm_c, np.int32), (L.indptr, np.int32), (L.indices, np.int32),
+            (L.data, float), (U.indptr, np.int32), (U.indices, np.int32), (U.data, float)))
+        self.n = n
+
+
+def steps(factors, c, v, T, rows):
     """The temperatures after each of L steps M T^k+1 = c T^k + v^k, or None where the library
     cannot be compiled.
 
     Parameters
     ----------
-    pattern : (rows, cols) int32 arrays of M's nonzeros; values : their values (W/K), the forced
-        nodes' rows unit rows
+    factors : M's `Factors`, the forced nodes' rows unit rows
     c : (N,) C/dt, zero at the forced nodes (W/K)
     v : (L, N) each step's sources (W), the forced nodes' imposed temperatures (C) in their place
     T : (N,) C before the first step
@@ -111,7 +142,7 @@ def steps(pattern, values, c, v, T, rows):
 
     Returns
     -------
-    (L, len(rows)) C after each step, and (N,) C after the last; ValueError where M is singular
+    (L, len(rows)) C after each step, and (N,) C after the last
     """
     if not available():
         return None
@@ -119,7 +150,7 @@ def steps(pattern, values, c, v, T, rows):
     v = np.ascontiguousarray(v, dtype=float)
     rows = np.ascontiguousarray(rows, dtype=np.int32)
     path = np.empty((len(v), len(rows)))
-    if not _library()(len(T), len(values), pattern[0], pattern[1], np.ascontiguousarray(values, dtype=float),
-                      np.ascontiguousarray(c, dtype=float), len(v), v, T, len(rows), rows, path):
-        raise ValueError("the step matrix is singular")
+    if not _library()(factors.n, *factors.arrays, np.ascontiguousarray(c, dtype=float), len(v), v, T, len(rows),
+                      rows, path):
+        raise ValueError("the step matrix is singular, or the compiled steps ran out of memory")
     return path, T

@@ -207,6 +207,7 @@ class ImplicitEuler:
         self._modes = {}
         self._pattern = None
         self._one_way = None
+        self._factors = OrderedDict()  # the compiled runs' `compiled.Factors`, by mask as `_solvers`
 
     def solver(self, forced, switched=None):
         """The solve of M with the rows of the `forced` nodes (bool mask) replaced by unit rows
@@ -282,7 +283,15 @@ class ImplicitEuler:
         if compiled.available():
             v = np.array(sources, dtype=float)
             v[:, index] = 0.0 if imposed is None else imposed[:, index]
-            return compiled.steps(*self.matrix(forced, switched), np.where(forced, 0.0, self.c_dt), v, T, rows)
+            key = forced.tobytes() + (b"" if switched is None else switched.tobytes())
+            factors = self._factors.get(key)
+            if factors is None:
+                factors = self._factors[key] = compiled.Factors(*self.matrix(forced, switched), len(T))
+                if len(self._factors) > self.CACHED_MASKS:
+                    self._factors.popitem(last=False)
+            else:
+                self._factors.move_to_end(key)
+            return compiled.steps(factors, np.where(forced, 0.0, self.c_dt), v, T, rows)
         zero = np.zeros(len(T))
         out = np.empty((len(sources), len(rows)))
         for k, source in enumerate(sources):
@@ -539,7 +548,7 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
         u, held, values = steady_inputs(U, measured, forced, dt)
         steady_stepper = ImplicitEuler(network, STEADY_STEP) if steady_stepper is None else steady_stepper
         switched = network.switched_diagonal(u)
-        before, T = T, steady_stepper.step(T, network.sources(u), held, values, switched)
+        before, (_, T) = T, steady_stepper.run(T, network.sources(u)[None], held, values[None], switched)
         if derivatives:
             _, S = sensitivity_steps(steady_stepper, network, derivatives, S, before[None], T[None], u[None],
                                      network.source_terms(u[None])[0], held, switched, [], [])
