@@ -149,7 +149,7 @@ class Candidate:
             return self._runs[key]
         superposed = self._superposition(case, key[1])
         run = superposed(values) if superposed is not None else \
-            self._simulated(case, node_ids, *self._network(self.base(case), values))
+            self._simulated(case, node_ids, *self.network(values, self.base(case)))
         keep_run(self._runs, key, run)
         return run
 
@@ -170,7 +170,7 @@ class Candidate:
             jacobian = np.stack(superposed.slopes, axis=-1)
         else:
             base = self.base(case)
-            building, network = self._network(base, values)
+            building, network = self.network(values, base)
             affine = self.affine(base)
             derivatives = affine.derivatives if affine is not None else \
                 [self._derivative(base, network, values, i) for i in range(len(values))]
@@ -201,18 +201,10 @@ class Candidate:
         key = (id(base), i, tuple(np.delete(values, i)))
         if key in self._derivatives:
             return self._derivatives[key]
-        low, high = self.bounds[i]
-        h = NETWORK_STEP * (high - low)
-        h = h if values[i] + 2 * h <= high else -h
-
-        def at(steps):
-            moved = values.copy()
-            moved[i] += steps * h
-            return assemble(self.built(moved, base))
-        one = at(1)
+        one, h = self._stepped(base, values, i, 1)
         found = derivative(network, one, h)
         if found is not None and (id(base), i) not in self._affine_alone:
-            further = derivative(one, at(2), h)
+            further = derivative(one, self._stepped(base, values, i, 2)[0], h)
             self._affine_alone[(id(base), i)] = further is not None and found.close_to(further, AFFINE)
             if not self._affine_alone[(id(base), i)]:
                 log.info("%s: the network is not affine in %s: its derivatives by differences of runs",
@@ -221,6 +213,17 @@ class Candidate:
             found = None
         self._derivatives[key] = found
         return found
+
+    def _stepped(self, base, values, i, steps):
+        """The network of the candidate on `base` at `values` with parameter i moved `steps` steps
+        of `NETWORK_STEP` of its range (towards the side with room for two), assembled; and the
+        step (the parameter's unit)."""
+        low, high = self.bounds[i]
+        h = NETWORK_STEP * (high - low)
+        h = h if values[i] + 2 * h <= high else -h
+        moved = values.copy()
+        moved[i] += steps * h
+        return assemble(self.built(moved, base)), h
 
     def _inputs_of(self, case):
         """The case with the inputs the candidate's buildings read: the effect may read inputs the
@@ -238,11 +241,13 @@ class Candidate:
         self.simulations += 1
         return self._inputs_of(case).run(building, np.asarray(node_ids) - 1, network)
 
-    def _network(self, base, values):
-        """The building and the network of the candidate on `base` at `values`: where the network
-        is affine in the parameters together (`affine`), the one assembled at the start moved
-        along its derivatives (the building's layout, which is all a run reads of it besides its
-        network, does not move with them); else the building edited and assembled."""
+    def network(self, values, base=None):
+        """The building and the network of the candidate on `base` (default its building) at
+        `values`: where the network is affine in the parameters together (`affine`), the one
+        assembled at the start moved along its derivatives, and the building at the start (its
+        layout, which is all a run or the HLC reads of it besides the network, does not move
+        with them); else the building edited and assembled."""
+        base = self.building if base is None else base
         affine = self.affine(base)
         if affine is None:
             building = self.built(values, base)
@@ -251,16 +256,18 @@ class Candidate:
 
     def affine(self, base):
         """The candidate's `Affine` network on `base`, or None where the network is not affine in
-        its parameters together: each affine alone (`_derivative`), and at the far corner of
-        their ranges, every parameter moved to the farther of its bounds, the network moved
-        along the derivatives from the start is the one assembled there to `AFFINE` of the
-        move (a ground coupling's U T_ground is affine in each alone, not in both)."""
+        its parameters together. Its derivatives are differences of one step (`NETWORK_STEP`)
+        of each parameter's range from the start; at the far corner of the ranges, every
+        parameter moved to the farther of its bounds, the network moved along them from the
+        start must be the one assembled there to `AFFINE` of the move: a network curved in a
+        parameter over its range fails it, as one whose terms in a parameter scale with another
+        does (a ground coupling's U T_ground, affine in each alone)."""
         if id(base) in self._affines:
             return self._affines[id(base)]
         start = self.start()
         building = self.built(start, base)
         network = assemble(building)
-        derivatives = [self._derivative(base, network, start, i) for i in range(len(start))]
+        derivatives = [derivative(network, *self._stepped(base, start, i, 1)) for i in range(len(start))]
         affine = None
         if all(d is not None for d in derivatives):
             far = np.array([high if high - x >= x - low else low for x, (low, high) in zip(start, self.bounds)])
@@ -702,7 +709,7 @@ def derived(candidate, case, x, cov):
     def with_sd(value, gradient, unit, cov=within):
         return {"value": float(value), "std": float(np.sqrt(max(gradient @ cov @ gradient, 0.0))), "unit": unit}
 
-    hlc, slope = gradient(lambda values: heat_loss_coefficient(candidate.built(values)), x, candidate.bounds)
+    hlc, slope = gradient(lambda values: heat_loss_coefficient(*candidate.network(values)), x, candidate.bounds)
     out = {"heat_loss_coefficient": with_sd(hlc, slope, "W/K", cov)}
     if candidate.effect == "ground_coupling":
         face = candidate.building.component(candidate.target).node_ids[-1]
@@ -713,7 +720,7 @@ def derived(candidate, case, x, cov):
         out["ground_heat_flux"] = with_sd(*gradient(flux, x, candidate.bounds), "W/m2")
     if candidate.effect == "conductivity":
         low = candidate.bounds[0][0]
-        out["component_loss"] = with_sd(hlc - heat_loss_coefficient(candidate.built([low, *x[1:]])), slope, "W/K")
+        out["component_loss"] = with_sd(hlc - heat_loss_coefficient(*candidate.network([low, *x[1:]])), slope, "W/K")
     if candidate.effect in TIME_CONSTANTS:
         C, H = x[:2]
         out[TIME_CONSTANTS[candidate.effect]] = with_sd(C / H, np.r_[1.0 / H, -C / H ** 2, np.zeros(len(x) - 2)], "s")
