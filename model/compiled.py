@@ -3,18 +3,19 @@ project's C compiler itself, which the FMUs' export uses too (`fmu_build.compile
 
 A run of backward-Euler steps under one step matrix (`integrate.ImplicitEuler.run`) is, in
 numpy, one product with the dense inverse of M a step: O(N^2), some 15 us on the Twin House's
-267 nodes, and as much again in Python's own work per step. In C, with M factorised once by
-SuperLU (`factorise`: scipy's, in a minimum-degree order of M + M^T, pivots on the diagonal),
-a step is two sparse triangular solves: a building's walls are chains of nodes hung on a few
-air and radiant nodes, which that order eliminates last, so L and U hold about as many entries
-as M (459 each off the diagonal on the Twin House, whose M has 974). The library is compiled
-once per process at its first run, for this machine's processor (it is never shipped), and
-loaded from a temporary folder removed at once; without a C compiler, or with one that fails
-on it, `steps` says so (None) and the caller steps in numpy: the same arithmetic, rounded
-otherwise (tests/test_compiled.py).
+267 nodes, and as much again in Python's own work per step. In C, M is factorised once per run,
+without pivoting, on the pattern its links fill in a minimum-degree order (`Pattern`, made once
+per pattern: SuperLU's order, scipy's), and a step is two sparse triangular solves. A
+building's walls are chains of nodes hung on a few air and radiant nodes, which that order
+eliminates last, so L and U hold about as many entries as M (459 each off the diagonal on the
+Twin House, whose M has 974 nonzeros; its profile in reverse Cuthill-McKee order, within which
+the standalone FMU factorises, model/c/profile.h, holds 5,257). The library is compiled once per
+process at its first run, for this machine's processor (it is never shipped), and loaded from a
+temporary folder removed at once; without a C compiler, or with one that fails on it, `steps`
+says so (None) and the caller steps in numpy: the same arithmetic, rounded otherwise
+(tests/test_compiled.py).
 
-Only the direct model loads it: the Python FMU steps in numpy alone (`fmu_build.slave`), and
-the standalone FMU factorises within M's profile in its own C (model/c/profile.h).
+Only the direct model loads it: the Python FMU steps in numpy alone (`fmu_build.slave`).
 """
 import ctypes
 import functools
@@ -91,7 +92,7 @@ def _library():
         loaded = ctypes.CDLL(str(path))
     function = loaded.nodeforce_steps
     function.restype = ctypes.c_int
-    function.argtypes = [ctypes.c_int, _INT, _INT, _INT, _INT, _DOUBLE, _INT, _INT, _DOUBLE, _DOUBLE,
+    function.argtypes = [ctypes.c_int, _INT, _INT, _INT, _INT, _INT, ctypes.c_long, _INT, _DOUBLE, _DOUBLE,
                          ctypes.c_long, _DOUBLE, _DOUBLE, ctypes.c_int, _INT, _DOUBLE]
     return function
 
@@ -102,39 +103,70 @@ def available():
         return _library() is not None
 
 
-class Factors:
-    """M = P_r^T L U P_c^T factorised by SuperLU in a minimum-degree order of M + M^T with its
-    pivots on the diagonal (M is diagonally dominant: a node's capacity over the step and its
-    conductances against those to its neighbours; a forced node's row a unit row), L and U by
-    columns as SuperLU gives them, which the kernel reads.
+class Pattern:
+    """M's pattern of links eliminated in a minimum-degree order (SuperLU's, scipy's, on M + M^T):
+    the order, the pattern L and U fill in (the elimination of each node makes its later
+    neighbours a clique), and where each of M's nonzeros goes in the factors' storage
+    ([diagonal | L | U], as c/steps.c reads it). Made once per pattern (`pattern`): every mask
+    and switched conductance of a network, and every value of an effect's parameters, share it.
 
     Parameters
     ----------
-    pattern : (rows, cols) int32 arrays of M's nonzeros; values : their values (W/K)
+    starts, rows : int32 arrays of M's nonzeros column after column
+        (`integrate.ImplicitEuler.matrix`), the diagonal among them
     n : M's order
+    """
 
-    ValueError where M is singular."""
-
-    def __init__(self, pattern, values, n):
-        M = sparse.csc_matrix((np.asarray(values, dtype=float), pattern), shape=(n, n))
-        try:
-            lu = splu(M, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
-        except RuntimeError as error:  # SuperLU's "Factor is exactly singular"
-            raise ValueError(f"the step matrix is singular: {error}") from None
-        L, U = lu.L, lu.U
-        self.arrays = tuple(np.ascontiguousarray(a, dtype=t) for a, t in (
-            (lu.perm_r, np.int32), (lu.perm_c, np.int32), (L.indptr, np.int32), (L.indices, np.int32),
-            (L.data, float), (U.indptr, np.int32), (U.indices, np.int32), (U.data, float)))
+    def __init__(self, starts, rows, n):
+        cols = np.repeat(np.arange(n), np.diff(starts))
+        diagonal = rows == cols
+        # the order reads the pattern alone: ones on it, made dominant on the diagonal
+        ones = sparse.csc_matrix((np.where(diagonal, float(n), -1.0 / n), rows, starts), shape=(n, n))
+        position = splu(ones, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                        options={"SymmetricMode": True}).perm_c
+        neighbours = [set() for _ in range(n)]
+        for i, j in zip(position[rows[~diagonal]], position[cols[~diagonal]]):
+            neighbours[i].add(j)
+            neighbours[j].add(i)
+        for i in range(n):
+            later = [j for j in neighbours[i] if j > i]
+            for j in later:
+                neighbours[j].update(later)
+                neighbours[j].discard(j)
+        lower = [sorted(j for j in neighbours[i] if j < i) for i in range(n)]
+        upper = [sorted(j for j in neighbours[i] if j > i) for i in range(n)]
+        self.order = np.argsort(position).astype(np.int32)
+        self.lower_ptr, self.lower_col = _rows(lower)
+        self.upper_ptr, self.upper_col = _rows(upper)
+        at = {}
+        for i in range(n):
+            at[(i, i)] = i
+            at.update(((i, j), n + self.lower_ptr[i] + k) for k, j in enumerate(lower[i]))
+            at.update(((i, j), n + self.lower_ptr[n] + self.upper_ptr[i] + k) for k, j in enumerate(upper[i]))
+        self.slot = np.array([at[(i, j)] for i, j in zip(position[rows], position[cols])], dtype=np.int32)
         self.n = n
 
 
-def steps(factors, c, v, T, rows):
+def _rows(columns):
+    """(row starts, columns) int32 of rows of column indices."""
+    starts = np.concatenate([[0], np.cumsum([len(c) for c in columns])]).astype(np.int32)
+    return starts, np.array([j for c in columns for j in c], dtype=np.int32)
+
+
+@functools.lru_cache(maxsize=32)
+def pattern(n, starts, rows):
+    """The `Pattern` of M's nonzeros (`starts`, `rows`: the bytes of their int32 arrays)."""
+    return Pattern(np.frombuffer(starts, dtype=np.int32), np.frombuffer(rows, dtype=np.int32), n)
+
+
+def steps(matrix, c, v, T, rows):
     """The temperatures after each of L steps M T^k+1 = c T^k + v^k, or None where the library
     cannot be compiled.
 
     Parameters
     ----------
-    factors : M's `Factors`, the forced nodes' rows unit rows
+    matrix : M's nonzeros column after column, ((column starts, rows) int32, values (W/K)), the
+        forced nodes' rows unit rows (`integrate.ImplicitEuler.matrix`)
     c : (N,) C/dt, zero at the forced nodes (W/K)
     v : (L, N) each step's sources (W), the forced nodes' imposed temperatures (C) in their place
     T : (N,) C before the first step
@@ -142,15 +174,18 @@ def steps(factors, c, v, T, rows):
 
     Returns
     -------
-    (L, len(rows)) C after each step, and (N,) C after the last
+    (L, len(rows)) C after each step, and (N,) C after the last; ValueError where M is singular
     """
     if not available():
         return None
+    (starts, nonzero_rows), values = matrix
     T = np.array(T, dtype=float)
+    p = pattern(len(T), np.require(starts, np.int32).tobytes(), np.require(nonzero_rows, np.int32).tobytes())
     v = np.ascontiguousarray(v, dtype=float)
     rows = np.ascontiguousarray(rows, dtype=np.int32)
     path = np.empty((len(v), len(rows)))
-    if not _library()(factors.n, *factors.arrays, np.ascontiguousarray(c, dtype=float), len(v), v, T, len(rows),
-                      rows, path):
-        raise ValueError("the step matrix is singular, or the compiled steps ran out of memory")
+    if not _library()(p.n, p.order, p.lower_ptr, p.lower_col, p.upper_ptr, p.upper_col, len(p.slot), p.slot,
+                      np.ascontiguousarray(values, dtype=float), np.ascontiguousarray(c, dtype=float), len(v), v,
+                      T, len(rows), rows, path):
+        raise ValueError("the step matrix is singular")
     return path, T

@@ -207,7 +207,6 @@ class ImplicitEuler:
         self._modes = {}
         self._pattern = None
         self._one_way = None
-        self._factors = OrderedDict()  # the compiled runs' `compiled.Factors`, by mask as `_solvers`
 
     def solver(self, forced, switched=None):
         """The solve of M with the rows of the `forced` nodes (bool mask) replaced by unit rows
@@ -250,18 +249,20 @@ class ImplicitEuler:
         return self._modes[key]
 
     def matrix(self, forced, switched=None):
-        """M's nonzeros ((rows, cols) int32, values) with the switched conductances `switched`
-        (N,) added to its diagonal and the rows of the `forced` nodes unit rows."""
+        """M with the switched conductances `switched` (N,) added to its diagonal and the rows of
+        the `forced` nodes unit rows, by columns: ((column starts (N + 1,), rows) int32, values)
+        of its nonzeros, column after column."""
         if self._pattern is None:  # M's pattern, the diagonal included: every mask's
-            rows, cols = np.nonzero((self._M != 0) | np.eye(len(self._M), dtype=bool))
-            self._pattern = (rows.astype(np.int32), cols.astype(np.int32)), self._M[rows, cols]
-        (rows, cols), values = self._pattern
+            cols, rows = np.nonzero(((self._M != 0) | np.eye(len(self._M), dtype=bool)).T)
+            starts = np.concatenate([[0], np.cumsum(np.bincount(cols, minlength=len(self._M)))])
+            self._pattern = (starts.astype(np.int32), rows.astype(np.int32)), cols, self._M[rows, cols]
+        (starts, rows), cols, values = self._pattern
         values, diagonal = values.copy(), rows == cols
         if switched is not None:
             values[diagonal] += switched[rows[diagonal]]
         at = forced[rows]
         values[at] = diagonal[at]
-        return (rows, cols), values
+        return (starts, rows), values
 
     def run(self, T, sources, forced, imposed=None, switched=None, rows=None):
         """The temperatures of the nodes `rows` (indices, default every node) after each of L steps
@@ -283,15 +284,7 @@ class ImplicitEuler:
         if compiled.available():
             v = np.array(sources, dtype=float)
             v[:, index] = 0.0 if imposed is None else imposed[:, index]
-            key = forced.tobytes() + (b"" if switched is None else switched.tobytes())
-            factors = self._factors.get(key)
-            if factors is None:
-                factors = self._factors[key] = compiled.Factors(*self.matrix(forced, switched), len(T))
-                if len(self._factors) > self.CACHED_MASKS:
-                    self._factors.popitem(last=False)
-            else:
-                self._factors.move_to_end(key)
-            return compiled.steps(factors, np.where(forced, 0.0, self.c_dt), v, T, rows)
+            return compiled.steps(self.matrix(forced, switched), np.where(forced, 0.0, self.c_dt), v, T, rows)
         zero = np.zeros(len(T))
         out = np.empty((len(sources), len(rows)))
         for k, source in enumerate(sources):
@@ -571,7 +564,10 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     start = len(rows) - (n_rows - 1 - H)  # the step that reaches t_H+1
     row_of, sub_of = np.repeat(rows, substeps), np.tile(np.arange(substeps), len(rows))
     inputs = np.stack(within_steps(U[H:], substeps, held_inputs(building, network.input_names)), axis=1)[row_of, sub_of]
-    imposed = np.stack(within_steps(measured[H:], substeps), axis=1)[row_of, sub_of]
+    # imposed where measured: within_steps is column by column, and a column never measured is NaN
+    read = np.flatnonzero(np.isfinite(measured[H:]).any(axis=0))
+    imposed = np.full((len(row_of), n), np.nan)
+    imposed[:, read] = np.stack(within_steps(measured[H:, read], substeps), axis=1)[row_of, sub_of]
     # the rows from t_H on, each after its last sub-step
     ks = np.arange(max(start - 1, 0), len(rows))
     out[H + ks - start + 1], d_out[H + ks - start + 1], _, _ = steps(

@@ -20,9 +20,8 @@ pytestmark = pytest.mark.skipif(not compiled.available(), reason="no C compiler:
 def test_one_node_s_steps_are_the_recurrence_solved_by_hand():
     # C/dt = c, one conductance G to a node held at 0: (c + G) T^k+1 = c T^k + v^k, v constant
     c, G, v, T0 = 4.0, 1.0, 3.0, 10.0
-    pattern = (np.array([0], dtype=np.int32), np.array([0], dtype=np.int32))
-    factors = compiled.Factors(pattern, np.array([c + G]), 1)
-    path, last = compiled.steps(factors, np.array([c]), np.full((50, 1), v), np.array([T0]), [0])
+    pattern = (np.array([0, 1], dtype=np.int32), np.array([0], dtype=np.int32))
+    path, last = compiled.steps((pattern, np.array([c + G])), np.array([c]), np.full((50, 1), v), np.array([T0]), [0])
     k = np.arange(1, 51)
     lam = c / (c + G)
     expected = lam ** k * T0 + v / (c + G) * (1 - lam ** k) / (1 - lam)
@@ -74,8 +73,7 @@ def test_without_a_compiler_the_run_steps_in_numpy(monkeypatch):
     forced = np.zeros(network.n_nodes, dtype=bool)
     T0 = np.full(network.n_nodes, 15.0)
     monkeypatch.setattr(compiled, "available", lambda: False)
-    assert compiled.steps(compiled.Factors(*stepper.matrix(forced), network.n_nodes), stepper.c_dt, sources, T0,
-                          [0]) is None
+    assert compiled.steps(stepper.matrix(forced), stepper.c_dt, sources, T0, [0]) is None
     path, last = stepper.run(T0, sources, forced, None, None, [0, 1])
     reference = stepped(stepper, T0, sources, forced, np.zeros_like(sources), None)
     assert np.array_equal(path, reference[:, :2]) and np.array_equal(last, reference[-1])
@@ -83,9 +81,9 @@ def test_without_a_compiler_the_run_steps_in_numpy(monkeypatch):
 
 def test_a_singular_step_matrix_is_refused():
     # a node with no capacity and no link: its row of M is zero
-    pattern = (np.array([0, 1], dtype=np.int32), np.array([0, 1], dtype=np.int32))
+    pattern = (np.array([0, 1, 2], dtype=np.int32), np.array([0, 1], dtype=np.int32))
     with pytest.raises(ValueError, match="singular"):
-        compiled.Factors(pattern, np.array([2.0, 0.0]), 2)
+        compiled.steps((pattern, np.array([2.0, 0.0])), np.array([1.0, 0.0]), np.ones((3, 2)), np.zeros(2), [0])
 
 
 def test_a_compiler_that_fails_leaves_the_steps_to_numpy(monkeypatch, caplog):

@@ -5,54 +5,75 @@
 
    M (N x N) the step matrix C/dt - A with the forced nodes' rows unit rows, c (N) C/dt with the
    forced nodes' zeroed, v^k (L x N) each step's sources with the forced nodes' imposed
-   temperatures in their place. M comes factorised, P_r M P_c = L U in a fill-reducing order
-   (model/compiled.py: a building's walls are chains hung on a few air and radiant nodes, which
-   eliminated last leave L and U about as sparse as M), and each step is two sparse triangular
-   solves: O(nonzeros of M) where the dense inverse's product is O(N^2). */
+   temperatures in their place. M is factorised M = L U in a minimum-degree order of its nodes,
+   on the pattern that order fills in (model/compiled.py: `Pattern`, made once per pattern of
+   links): a building's walls are chains hung on a few air and radiant nodes, which that order
+   eliminates last, so L and U hold about as many entries as M. No pivoting: M is an M-matrix
+   (its diagonal the node's capacity over the step and conductances, at least the sum of its
+   row's links), and a forced row a unit row. Each step is then two sparse triangular solves,
+   O(entries), where a product with the dense inverse is O(N^2). */
 #include <stdlib.h>
-#include <string.h>
 
 #define EXPORT __attribute__((visibility("default")))
 
-/* perm_r, perm_c (N): b goes to y[perm_r[i]] = b[i], the solution is x[i] = y[perm_c[i]]; L
-   (unit diagonal) and U by columns as SuperLU gives them (ptr N + 1, row, val; each column's
-   diagonal among its entries). T (N): the temperatures before the first step, after the last on
-   return; path (L x R): the temperatures of the nodes rows (R) after each step. Returns 1, or 0
-   where memory runs out or U has a zero on its diagonal. */
-EXPORT int nodeforce_steps(int n, const int *perm_r, const int *perm_c, const int *l_ptr, const int *l_row,
-                           const double *l_val, const int *u_ptr, const int *u_row, const double *u_val,
-                           const double *c, long L, const double *v, double *T, int n_rows, const int *rows,
-                           double *path) {
-    double *y = malloc(((size_t)n + 1) * sizeof(double)), *inverse = malloc(((size_t)n + 1) * sizeof(double));
-    long s;
-    int i, j, k, ok = 0;
-    if (!y || !inverse) goto done;
-    for (j = 0; j < n; j++) {
-        inverse[j] = 0.0;
-        for (k = u_ptr[j]; k < u_ptr[j + 1]; k++)
-            if (u_row[k] == j) inverse[j] = 1.0 / u_val[k];
-        if (inverse[j] == 0.0) goto done;
+/* order (N): the node of each position of the elimination order; lower_ptr/lower_col (N + 1,
+   and columns): each row's entries of L left of the diagonal, in increasing column;
+   upper_ptr/upper_col: each row's entries of U right of it, in increasing column. M's
+   nonzeros (value) are added into the factors' storage at slot: [diagonal (N) | L's | U's].
+   T (N): the temperatures before the first step, after the last on return; path (L x R): the
+   temperatures of the nodes rows (R) after each step. Returns 1, or 0 where a pivot is zero
+   (M singular) or memory runs out. */
+EXPORT int nodeforce_steps(int n, const int *order, const int *lower_ptr, const int *lower_col,
+                           const int *upper_ptr, const int *upper_col, long nonzeros, const int *slot,
+                           const double *value, const double *c, long L, const double *v, double *T, int n_rows,
+                           const int *rows, double *path) {
+    long entries = (long)n + lower_ptr[n] + upper_ptr[n], s, e;
+    double *f = calloc((size_t)entries + 1, sizeof(double)), *w = calloc((size_t)n + 1, sizeof(double));
+    double *y = malloc(((size_t)n + 1) * sizeof(double));
+    double *diagonal = f, *lower = f + n, *upper = f + n + lower_ptr[n];
+    int i, p, q, ok = 0;
+    if (!f || !w || !y) goto done;
+    for (e = 0; e < nonzeros; e++) f[slot[e]] += value[e];
+    /* row by row (Doolittle): row i less its multiples of the rows above it that L says */
+    for (i = 0; i < n; i++) {
+        for (p = lower_ptr[i]; p < lower_ptr[i + 1]; p++) w[lower_col[p]] = lower[p];
+        for (p = upper_ptr[i]; p < upper_ptr[i + 1]; p++) w[upper_col[p]] = upper[p];
+        w[i] = diagonal[i];
+        for (p = lower_ptr[i]; p < lower_ptr[i + 1]; p++) {
+            const int j = lower_col[p];
+            const double l = w[j] /= diagonal[j];
+            for (q = upper_ptr[j]; q < upper_ptr[j + 1]; q++) w[upper_col[q]] -= l * upper[q];
+        }
+        for (p = lower_ptr[i]; p < lower_ptr[i + 1]; p++) { lower[p] = w[lower_col[p]]; w[lower_col[p]] = 0.0; }
+        for (p = upper_ptr[i]; p < upper_ptr[i + 1]; p++) { upper[p] = w[upper_col[p]]; w[upper_col[p]] = 0.0; }
+        diagonal[i] = w[i];
+        w[i] = 0.0;
+        if (diagonal[i] == 0.0) goto done;
     }
+    for (i = 0; i < n; i++) w[i] = 1.0 / diagonal[i];
     for (s = 0; s < L; s++) {
         const double *v_s = v + s * n;
         double *out = path + s * n_rows;
         /* a forced node's (c = 0) is its imposed temperature whatever T held before */
-        for (i = 0; i < n; i++) y[perm_r[i]] = c[i] != 0.0 ? c[i] * T[i] + v_s[i] : v_s[i];
-        for (j = 0; j < n; j++) {
-            const double y_j = y[j];
-            for (k = l_ptr[j]; k < l_ptr[j + 1]; k++)
-                if (l_row[k] > j) y[l_row[k]] -= l_val[k] * y_j;
+        for (i = 0; i < n; i++) {
+            const int node = order[i];
+            y[i] = c[node] != 0.0 ? c[node] * T[node] + v_s[node] : v_s[node];
         }
-        for (j = n - 1; j >= 0; j--) {
-            const double y_j = y[j] *= inverse[j];
-            for (k = u_ptr[j]; k < u_ptr[j + 1]; k++)
-                if (u_row[k] < j) y[u_row[k]] -= u_val[k] * y_j;
+        for (i = 0; i < n; i++) {
+            double sum = y[i];
+            for (p = lower_ptr[i]; p < lower_ptr[i + 1]; p++) sum -= lower[p] * y[lower_col[p]];
+            y[i] = sum;
         }
-        for (i = 0; i < n; i++) T[i] = y[perm_c[i]];
+        for (i = n - 1; i >= 0; i--) {
+            double sum = y[i];
+            for (p = upper_ptr[i]; p < upper_ptr[i + 1]; p++) sum -= upper[p] * y[upper_col[p]];
+            y[i] = sum * w[i];
+        }
+        for (i = 0; i < n; i++) T[order[i]] = y[i];
         for (i = 0; i < n_rows; i++) out[i] = T[rows[i]];
     }
     ok = 1;
 done:
-    free(y); free(inverse);
+    free(f); free(w); free(y);
     return ok;
 }
