@@ -40,10 +40,12 @@ STEADY_STEP = 1e10  # s
 # burn-in day, within 0.004 to 0.011 C of the truth alike; 3 h keeps the day's swing in the steps.
 HISTORY_STEP = 10800.0  # s
 # Steps per state node from which a run of steps under one step matrix is solved in its modes
-# (`modal`) rather than stepped: a shorter run costs less stepped than decomposed. The test
-# cell's 22 state nodes decompose in 0.1 ms against 3 us a step (some 1.5 steps a node); a
+# (`modal`) rather than stepped in numpy: a shorter run costs less stepped than decomposed. The
+# test cell's 22 state nodes decompose in 0.1 ms against 3 us a step (some 1.5 steps a node); a
 # decomposition grows as the cube of the nodes, a step as their square, so larger networks
-# break even later.
+# break even later. Where the steps are compiled (`model.compiled`) every run is stepped: a
+# compiled step costs a fraction of a microsecond on the test cell, and a run of the test
+# cell's record in C a half to two thirds of one in its modes, its derivatives a fifth.
 MODAL_FROM = 8
 
 
@@ -582,8 +584,8 @@ def steps(stepper, network, T, inputs, forced, imposed, kept, outputs, derivativ
     (`simulate`'s: k of them) from theirs S (N, k) before the first step, after the same steps
     (len(kept), len(outputs), k: `sensitivity_steps` of each run); and every node's temperature
     (N,) and derivatives (N, k) after the last step. Each run of steps under one step matrix (one
-    forcing mask and switched conductances) long enough is solved in its modes (`modal`,
-    `MODAL_FROM`), any other stepped.
+    forcing mask and switched conductances) is stepped in C where the steps are compiled;
+    else, long enough, solved in its modes (`modal`, `MODAL_FROM`), or stepped in numpy.
 
     Parameters
     ----------
@@ -595,6 +597,8 @@ def steps(stepper, network, T, inputs, forced, imposed, kept, outputs, derivativ
     imposed : (L, N) C, each step's imposed temperatures (read where forced)
     kept, outputs : indices of the steps and the nodes returned
     """
+    from . import compiled  # not in the Python FMU, which steps one doStep at a time
+    modal = not compiled.available()
     terms, B, q = network.source_terms(inputs)
     switched = network.switched_diagonal(inputs)  # None where nothing switches
     bounds = runs(forced, switched)
@@ -604,7 +608,8 @@ def steps(stepper, network, T, inputs, forced, imposed, kept, outputs, derivativ
     for a, b in zip(bounds[:-1], bounds[1:]):
         mask, g = forced[a], None if switched is None else switched[a]
         here = np.flatnonzero((kept >= a) & (kept < b))
-        modes = stepper.modes(mask, g) if b - a >= MODAL_FROM * np.count_nonzero((network.C > 0) & ~mask) else None
+        modes = (stepper.modes(mask, g) if modal and b - a >= MODAL_FROM * np.count_nonzero((network.C > 0) & ~mask)
+                 else None)
         before = T
         if modes is not None:
             solve, _ = stepper.solver(mask, g)
