@@ -30,7 +30,9 @@ to 4e-12 of the steps', with complex modes, and its runs in no less time than it
 s against 0.16 s for a record of the living room). `Modes.of` says so (None), and the caller
 steps such a run one step at a time.
 
-numpy alone, as `integrate` (whose FMU must not load scipy).
+The direct model solves runs in their modes only where its steps are not compiled
+(`integrate.MODAL_FROM`): a compiled step of a building's sparse network costs less than the
+modes' projections. numpy alone, as `integrate` (whose FMU must not load scipy).
 """
 from dataclasses import dataclass
 
