@@ -270,7 +270,7 @@ class Candidate:
         derivatives = [derivative(network, *self._stepped(base, start, i, 1)) for i in range(len(start))]
         affine = None
         if all(d is not None for d in derivatives):
-            far = np.array([high if high - x >= x - low else low for x, (low, high) in zip(start, self.bounds)])
+            far = farther_bounds(start, self.bounds)
             assembled = derivative(network, assemble(self.built(far, base)), 1.0)
             predicted = derivative(network, moved(network, derivatives, far - start), 1.0)
             if assembled is not None and predicted.close_to(assembled, AFFINE):
@@ -328,12 +328,18 @@ def superposition_points(building, effect, target, bounds):
     longest difference, whose rounding is the least."""
     start = calibration_start(building, effect, target)
     a = np.array([start[p.name] for p in EFFECTS[effect].parameters])
+    corner = farther_bounds(a, bounds)
     far = []
-    for i, (low, high) in enumerate(bounds):
+    for i in range(len(bounds)):
         x = a.copy()
-        x[i] = high if high - a[i] >= a[i] - low else low
+        x[i] = corner[i]
         far.append(x)
     return a, far
+
+
+def farther_bounds(values, bounds):
+    """(k,) each parameter's bound the farther from its value: the longest move within its range."""
+    return np.array([high if high - x >= x - low else low for x, (low, high) in zip(values, bounds)])
 
 
 class Superposition:
