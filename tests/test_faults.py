@@ -250,7 +250,10 @@ def arm_after(generation, armed):
 @contextmanager
 def dask_cluster(folder, n_workers, threads=1):
     """`dask scheduler` on 127.0.0.1 (a port the system picks) and `dask worker`s (with their
-    nannies, which restart a killed worker); yields (address, scheduler process)."""
+    nannies, which restart a killed worker); yields (address, scheduler process). The cluster is
+    killed outright at the end: a worker caught holding a temporary folder (compiling the steps
+    at its first run) cannot remove it, and the folders of its dead processes are swept, as the
+    next nodeforce command would (`tempdirs.sweep`)."""
     from distributed import Client
     file = folder / "scheduler.json"
     env = {**os.environ, "PYTHONPATH": str(ROOT)}  # the workers unpickle this module's evaluators
@@ -274,6 +277,7 @@ def dask_cluster(folder, n_workers, threads=1):
             except ProcessLookupError:
                 pass
             process.wait()
+        tempdirs.sweep()
 
 
 BUDGET = dict(population=20, generations=15)
