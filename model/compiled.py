@@ -9,7 +9,9 @@ per pattern: SuperLU's order, scipy's), and a step is two sparse triangular solv
 building's walls are chains of nodes hung on a few air and radiant nodes, which that order
 eliminates last, so L and U hold about as many entries as M (459 each off the diagonal on the
 Twin House, whose M has 974 nonzeros; its profile in reverse Cuthill-McKee order, within which
-the standalone FMU factorises, model/c/profile.h, holds 5,257). The library is compiled once per
+the standalone FMU factorises, model/c/profile.h, holds 5,257). Each step's sources are formed
+there too, from the inputs and B's few nonzeros (100 of the Twin House's 267 x 20): formed in
+numpy, an (L, N) array of them cost a run as much as its steps. The library is compiled once per
 process at its first run, for this machine's processor (it is never shipped), and loaded from a
 temporary folder removed at once; without a C compiler, or with one that fails on it, `steps`
 says so (None) and the caller steps in numpy: the same arithmetic, rounded otherwise
@@ -93,7 +95,8 @@ def _library():
     function = loaded.nodeforce_steps
     function.restype = ctypes.c_int
     function.argtypes = [ctypes.c_int, _INT, _INT, _INT, _INT, _INT, ctypes.c_long, _INT, _DOUBLE, _DOUBLE,
-                         ctypes.c_long, _DOUBLE, _DOUBLE, ctypes.c_int, _INT, _DOUBLE]
+                         ctypes.c_long, ctypes.c_int, _DOUBLE, _INT, _INT, _DOUBLE, _DOUBLE, ctypes.c_int, _INT, _DOUBLE,
+                         _DOUBLE, ctypes.c_int, _INT, _DOUBLE]
     return function
 
 
@@ -159,16 +162,19 @@ def pattern(n, starts, rows):
     return Pattern(np.frombuffer(starts, dtype=np.int32), np.frombuffer(rows, dtype=np.int32), n)
 
 
-def steps(matrix, c, v, T, rows):
-    """The temperatures after each of L steps M T^k+1 = c T^k + v^k, or None where the library
-    cannot be compiled.
+def steps(matrix, c, sources, forced, imposed, T, rows):
+    """The temperatures after each of L steps M T^k+1 = c T^k + B t^k + q, the forced nodes' at
+    their imposed temperatures, or None where the library cannot be compiled.
 
     Parameters
     ----------
     matrix : M's nonzeros column after column, ((column starts, rows) int32, values (W/K)), the
         forced nodes' rows unit rows (`integrate.ImplicitEuler.matrix`)
-    c : (N,) C/dt, zero at the forced nodes (W/K)
-    v : (L, N) each step's sources (W), the forced nodes' imposed temperatures (C) in their place
+    c : (N,) C/dt (W/K)
+    sources : `integrate.Sources`, each step's terms t^k (L, m) and their coefficients B (N, m),
+        q (N,) (W): each step's sources are formed from B's nonzeros
+    forced : indices of the nodes imposed at every step
+    imposed : (L, len(forced)) their temperatures (C), or None: zero
     T : (N,) C before the first step
     rows : indices of the nodes returned
 
@@ -181,11 +187,19 @@ def steps(matrix, c, v, T, rows):
     (starts, nonzero_rows), values = matrix
     T = np.array(T, dtype=float)
     p = pattern(len(T), np.require(starts, np.int32).tobytes(), np.require(nonzero_rows, np.int32).tobytes())
-    v = np.ascontiguousarray(v, dtype=float)
+    terms = np.ascontiguousarray(sources.terms, dtype=float)
+    nodes, columns = np.nonzero(sources.B)  # row after row: each node's terms together
+    source_ptr = np.concatenate([[0], np.cumsum(np.bincount(nodes, minlength=len(T)))]).astype(np.int32)
+    forced = np.ascontiguousarray(forced, dtype=np.int32)
+    imposed = (np.zeros((len(terms), len(forced))) if imposed is None
+               else np.ascontiguousarray(imposed, dtype=float).reshape(len(terms), len(forced)))
     rows = np.ascontiguousarray(rows, dtype=np.int32)
-    path = np.empty((len(v), len(rows)))
+    path = np.empty((len(terms), len(rows)))
     if not _library()(p.n, p.order, p.lower_ptr, p.lower_col, p.upper_ptr, p.upper_col, len(p.slot), p.slot,
-                      np.ascontiguousarray(values, dtype=float), np.ascontiguousarray(c, dtype=float), len(v), v,
-                      T, len(rows), rows, path):
+                      np.ascontiguousarray(values, dtype=float), np.ascontiguousarray(c, dtype=float), len(terms),
+                      terms.shape[1], terms, source_ptr, columns.astype(np.int32),
+                      np.ascontiguousarray(sources.B[nodes, columns], dtype=float),
+                      np.ascontiguousarray(sources.q, dtype=float), len(forced), forced, imposed, T, len(rows), rows,
+                      path):
         raise ValueError("the step matrix is singular")
     return path, T

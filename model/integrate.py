@@ -183,6 +183,31 @@ def sparse(matrix):
     return r, c, matrix[r, c]
 
 
+class Sources:
+    """Each step's sources B t^k + q (W) of a run of L steps, as their terms t^k (L, m: the inputs
+    and their products, `Network.source_terms`), coefficients B (N, m) and constant q (N,): the
+    compiled steps form each step's from B's few nonzeros, never the (L, N) array."""
+
+    def __init__(self, terms, B, q):
+        self.terms, self.B, self.q = terms, B, q
+
+    @classmethod
+    def on(cls, values, nodes, n):
+        """The sources (L, len(nodes)) `values` on the `nodes` of a network of n nodes, zero on
+        the others."""
+        return cls(values, np.eye(n)[:, nodes], np.zeros(n))
+
+    def __len__(self):
+        return len(self.terms)
+
+    def __getitem__(self, steps):
+        return Sources(self.terms[steps], self.B, self.q)
+
+    def dense(self):
+        """(L, N) W."""
+        return self.terms @ self.B.T + self.q
+
+
 class ImplicitEuler:
     """The step of a `Network` for a step size dt (s), with the step matrix kept per forcing mask.
 
@@ -274,7 +299,7 @@ class ImplicitEuler:
         Parameters
         ----------
         T : (N,) C before the first step
-        sources : (L, N) each step's `B u + q` (W)
+        sources : `Sources` of the L steps
         forced : (N,) bool, the nodes imposed at every step
         imposed : (L, N) each step's imposed temperatures (C), read where forced; None: zero (the
             temperatures' derivatives, which no parameter moves at a forced node)
@@ -284,12 +309,11 @@ class ImplicitEuler:
         rows = np.arange(len(T)) if rows is None else np.asarray(rows, dtype=int)
         index = np.flatnonzero(forced)
         if compiled.available():
-            v = np.array(sources, dtype=float)
-            v[:, index] = 0.0 if imposed is None else imposed[:, index]
-            return compiled.steps(self.matrix(forced, switched), np.where(forced, 0.0, self.c_dt), v, T, rows)
+            return compiled.steps(self.matrix(forced, switched), self.c_dt, sources, index,
+                                  None if imposed is None else imposed[:, index], T, rows)
         zero = np.zeros(len(T))
         out = np.empty((len(sources), len(rows)))
-        for k, source in enumerate(sources):
+        for k, source in enumerate(sources.dense()):
             T = self.step(T, source, forced, zero if imposed is None else imposed[k], switched)
             out[k] = T[rows]
         return out, T
@@ -526,56 +550,85 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     N the nodes of `outputs` where given. With `derivatives`, also their derivatives, (N_t, N, k)
     or (N_t+1, N, k), C per unit of each parameter.
     """
-    n_rows, n = U.shape[0], network.n_nodes
-    if measured is None:
-        measured = np.full((n_rows, n), np.nan)
-    elif measured.shape[1] < n:  # a case of the building as declared: the nodes its effects add are never measured
-        measured = np.hstack([measured, np.full((n_rows, n - measured.shape[1]), np.nan)])
-    if force is None:
-        force = np.zeros(n, dtype=bool)
-    forced = forcing_schedule(force, measured, burn_in_steps)
-    outputs = np.arange(n) if outputs is None else np.asarray(outputs, dtype=int)
-    H = history_steps
-    stepper = ImplicitEuler(network, dt / substeps) if stepper is None else stepper
-    T = initial_state(building, measured[0], T_default)
-    S = np.zeros((n, len(derivatives)))  # the temperatures' derivatives, none at the start
-    if steady_start:
-        u, held, values = steady_inputs(U, measured, forced, dt)
-        steady_stepper = ImplicitEuler(network, STEADY_STEP) if steady_stepper is None else steady_stepper
-        switched = network.switched_diagonal(u)
-        before, (_, T) = T, steady_stepper.run(T, network.sources(u)[None], held, values[None], switched)
-        if derivatives:
-            _, S = sensitivity_steps(steady_stepper, network, derivatives, S, before[None], T[None], u[None],
-                                     network.source_terms(u[None])[0], held, switched, [], [])
-    out = np.empty((n_rows, len(outputs)))
-    out[0] = T[outputs]
-    d_out = np.empty((n_rows, len(outputs), len(derivatives)))
-    d_out[0] = S[outputs]
-    if H:  # nothing forced: a run of steps under one matrix, in its modes where it has them
-        block = history_block(dt)
-        history_stepper = ImplicitEuler(network, block * dt) if history_stepper is None else history_stepper
-        means = history_inputs(U, H, dt)
-        L = len(means)
-        path, d_path, T, S = steps(history_stepper, network, T, means, np.zeros((L, n), dtype=bool),
-                                   np.full((L, n), np.nan), np.arange(L), outputs, derivatives, S)
-        out[1:H + 1] = np.repeat(path, block, axis=0)
-        d_out[1:H + 1] = np.repeat(d_path, block, axis=0)
-    # the record's steps from t_H, the warm-up's replay standing in for a history the record
-    # lacks: each step's input row (from t_H) and sub-step
-    rows = warmup_rows(n_rows - H, dt, 0 if H else warmup_days)
-    start = len(rows) - (n_rows - 1 - H)  # the step that reaches t_H+1
-    row_of, sub_of = np.repeat(rows, substeps), np.tile(np.arange(substeps), len(rows))
-    inputs = np.stack(within_steps(U[H:], substeps, held_inputs(building, network.input_names)), axis=1)[row_of, sub_of]
-    # imposed where measured: within_steps is column by column, and a column never measured is NaN
-    read = np.flatnonzero(np.isfinite(measured[H:]).any(axis=0))
-    imposed = np.full((len(row_of), n), np.nan)
-    imposed[:, read] = np.stack(within_steps(measured[H:, read], substeps), axis=1)[row_of, sub_of]
-    # the rows from t_H on, each after its last sub-step
-    ks = np.arange(max(start - 1, 0), len(rows))
-    out[H + ks - start + 1], d_out[H + ks - start + 1], _, _ = steps(
-        stepper, network, T, inputs, forced[H:][row_of], imposed, (ks + 1) * substeps - 1, outputs, derivatives, S)
-    first = 0 if include_start else 1
-    return (out[first:], d_out[first:]) if derivatives else out[first:]
+    plan = Plan(building, network, U, dt, measured, force, warmup_days, T_default, burn_in_steps, steady_start,
+                substeps, history_steps)
+    return plan.run(network, outputs, derivatives, include_start, stepper, steady_stepper, history_stepper)
+
+
+class Plan:
+    """What a run reads of its record whatever the values of its network (`simulate`'s arguments
+    but the network's values): each node's start, the steady start's mean inputs and held nodes,
+    the history's inputs, each step's input row, inputs, forced nodes and imposed temperatures.
+    A calibration runs the same record hundreds of times at other values of its parameters:
+    `model.case.Case.run` keeps the plan of each building layout it runs."""
+
+    def __init__(self, building, network, U, dt, measured=None, force=None, warmup_days=2, T_default=20.0,
+                 burn_in_steps=0, steady_start=False, substeps=1, history_steps=0):
+        n_rows, n = U.shape[0], network.n_nodes
+        self.layout = (n, tuple(network.input_names))
+        if measured is None:
+            measured = np.full((n_rows, n), np.nan)
+        elif measured.shape[1] < n:  # a case of the building as declared: the nodes its effects add are never measured
+            measured = np.hstack([measured, np.full((n_rows, n - measured.shape[1]), np.nan)])
+        if force is None:
+            force = np.zeros(n, dtype=bool)
+        forced = forcing_schedule(force, measured, burn_in_steps)
+        self.n_rows, self.dt, self.substeps, H = n_rows, dt, substeps, history_steps
+        self.history_steps = H
+        self.start_state = initial_state(building, measured[0], T_default)
+        self.steady = steady_inputs(U, measured, forced, dt) if steady_start else None
+        self.history = history_inputs(U, H, dt) if H else None
+        # the record's steps from t_H, the warm-up's replay standing in for a history the record
+        # lacks: each step's input row (from t_H) and sub-step
+        rows = warmup_rows(n_rows - H, dt, 0 if H else warmup_days)
+        start = len(rows) - (n_rows - 1 - H)  # the step that reaches t_H+1
+        row_of, sub_of = np.repeat(rows, substeps), np.tile(np.arange(substeps), len(rows))
+        self.inputs = np.stack(within_steps(U[H:], substeps, held_inputs(building, network.input_names)),
+                               axis=1)[row_of, sub_of]
+        self.forced = forced[H:][row_of]
+        # imposed where measured: within_steps is column by column, and a column never measured is NaN
+        read = np.flatnonzero(np.isfinite(measured[H:]).any(axis=0))
+        self.imposed = np.full((len(row_of), n), np.nan)
+        self.imposed[:, read] = np.stack(within_steps(measured[H:, read], substeps), axis=1)[row_of, sub_of]
+        # the rows from t_H on, each after its last sub-step
+        ks = np.arange(max(start - 1, 0), len(rows))
+        self.rows, self.kept = H + ks - start + 1, (ks + 1) * substeps - 1
+
+    def run(self, network, outputs=None, derivatives=(), include_start=False, stepper=None, steady_stepper=None,
+            history_stepper=None):
+        """`simulate` of `network`, of the layout the plan was made for (its nodes and inputs)."""
+        if (network.n_nodes, tuple(network.input_names)) != self.layout:
+            raise ValueError("a network of another layout than its plan's")
+        n, dt, H = network.n_nodes, self.dt, self.history_steps
+        outputs = np.arange(n) if outputs is None else np.asarray(outputs, dtype=int)
+        stepper = ImplicitEuler(network, dt / self.substeps) if stepper is None else stepper
+        T = self.start_state.copy()
+        S = np.zeros((n, len(derivatives)))  # the temperatures' derivatives, none at the start
+        if self.steady is not None:
+            u, held, values = self.steady
+            steady_stepper = ImplicitEuler(network, STEADY_STEP) if steady_stepper is None else steady_stepper
+            switched = network.switched_diagonal(u)
+            before, (_, T) = T, steady_stepper.run(T, Sources(*network.source_terms(u[None])), held, values[None],
+                                                    switched)
+            if derivatives:
+                _, S = sensitivity_steps(steady_stepper, network, derivatives, S, before[None], T[None], u[None],
+                                         network.source_terms(u[None])[0], held, switched, [], [])
+        out = np.empty((self.n_rows, len(outputs)))
+        out[0] = T[outputs]
+        d_out = np.empty((self.n_rows, len(outputs), len(derivatives)))
+        d_out[0] = S[outputs]
+        if H:  # nothing forced: a run of steps under one matrix, in its modes where it has them
+            block = history_block(dt)
+            history_stepper = ImplicitEuler(network, block * dt) if history_stepper is None else history_stepper
+            L = len(self.history)
+            path, d_path, T, S = steps(history_stepper, network, T, self.history, np.zeros((L, n), dtype=bool),
+                                       np.full((L, n), np.nan), np.arange(L), outputs, derivatives, S)
+            out[1:H + 1] = np.repeat(path, block, axis=0)
+            d_out[1:H + 1] = np.repeat(d_path, block, axis=0)
+        out[self.rows], d_out[self.rows], _, _ = steps(stepper, network, T, self.inputs, self.forced, self.imposed,
+                                                       self.kept, outputs, derivatives, S)
+        first = 0 if include_start else 1
+        return (out[first:], d_out[first:]) if derivatives else out[first:]
 
 
 def steps(stepper, network, T, inputs, forced, imposed, kept, outputs, derivatives, S):
@@ -623,7 +676,8 @@ def steps(stepper, network, T, inputs, forced, imposed, kept, outputs, derivativ
                 out[here], T = modal_run(solve.inverse, stepper.c_dt, mask, modes, T, terms[a:b], B, q, imposed[a:b],
                                          kept[here] - a, outputs)
         else:  # every node's path where the derivatives' sources read it
-            path, T = stepper.run(T, terms[a:b] @ B.T + q, mask, imposed[a:b], g, None if derivatives else outputs)
+            path, T = stepper.run(T, Sources(terms[a:b], B, q), mask, imposed[a:b], g,
+                                  None if derivatives else outputs)
             out[here] = path[kept[here] - a][:, outputs] if derivatives else path[kept[here] - a]
         if derivatives:
             d_out[here], S = sensitivity_steps(stepper, network, derivatives, S, np.vstack([before[None], path[:-1]]),
@@ -657,22 +711,18 @@ def sensitivity_steps(stepper, network, derivatives, S, before, after, inputs, t
     """
     source = np.stack([d.source(before, after, terms, inputs, stepper.dt) for d in derivatives], axis=-1)
     source[:, forced] = 0.0
+    rows = np.unique(np.concatenate([d.rows for d in derivatives]))  # where the source may be other than zero
     out = np.empty((len(kept), len(outputs), len(derivatives)))
-    if modes is not None:  # the source as inputs, on the rows where it may be other than zero
-        solve, _ = stepper.solver(forced, switched)
-        n = network.n_nodes
-        rows = np.unique(np.concatenate([d.rows for d in derivatives]))
-        B, q, imposed = np.eye(n)[:, rows], np.zeros(n), np.zeros((len(source), n))
-        last = np.empty_like(S)
-        for j in range(len(derivatives)):
-            out[..., j], last[:, j] = modal_run(solve.inverse, stepper.c_dt, forced, modes, S[:, j],
-                                                source[:, rows, j], B, q, imposed, kept, outputs)
-        return out, last
-    # one parameter at a time, each a run of the step with its source
     last = np.empty_like(S)
-    for j in range(len(derivatives)):
-        path, last[:, j] = stepper.run(S[:, j], source[..., j], forced, None, switched, outputs)
-        out[..., j] = path[kept]
+    for j in range(len(derivatives)):  # one parameter at a time, each a run of the step with its source
+        on = Sources.on(source[:, rows, j], rows, network.n_nodes)
+        if modes is not None:  # the source as inputs
+            inverse = stepper.solver(forced, switched)[0].inverse
+            out[..., j], last[:, j] = modal_run(inverse, stepper.c_dt, forced, modes, S[:, j], on.terms, on.B, on.q,
+                                                np.zeros((len(source), network.n_nodes)), kept, outputs)
+        else:
+            path, last[:, j] = stepper.run(S[:, j], on, forced, None, switched, outputs)
+            out[..., j] = path[kept]
     return out, last
 
 

@@ -1,11 +1,12 @@
 /* The direct model's runs of backward-Euler steps under one step matrix (model/integrate.py,
    `ImplicitEuler.run`), compiled where a C compiler is found (model/compiled.py):
 
-       M T^k+1 = c T^k + v^k,   k = 0 .. L-1,
+       M T^k+1 = c T^k + B t^k + q,   k = 0 .. L-1,
 
-   M (N x N) the step matrix C/dt - A with the forced nodes' rows unit rows, c (N) C/dt with the
-   forced nodes' zeroed, v^k (L x N) each step's sources with the forced nodes' imposed
-   temperatures in their place. M is factorised M = L U in a minimum-degree order of its nodes,
+   M (N x N) the step matrix C/dt - A with the forced nodes' rows unit rows, c (N) C/dt, and each
+   step's sources formed here from their terms t^k (L x m: the inputs and their products) and the
+   few nonzeros of B (N x m), never as an L x N array; a forced node's right-hand side is its
+   imposed temperature instead. M is factorised M = L U in a minimum-degree order of its nodes,
    on the pattern that order fills in (model/compiled.py: `Pattern`, made once per pattern of
    links): a building's walls are chains hung on a few air and radiant nodes, which that order
    eliminates last, so L and U hold about as many entries as M. No pivoting: M is an M-matrix
@@ -20,19 +21,24 @@
    and columns): each row's entries of L left of the diagonal, in increasing column;
    upper_ptr/upper_col: each row's entries of U right of it, in increasing column. M's
    nonzeros (value) are added into the factors' storage at slot: [diagonal (N) | L's | U's].
-   T (N): the temperatures before the first step, after the last on return; path (L x R): the
-   temperatures of the nodes rows (R) after each step. Returns 1, or 0 where a pivot is zero
-   (M singular) or memory runs out. */
+   terms (L x m), source_ptr/source_col/source_value (N + 1, and entries): each node's nonzeros
+   of B, by term; q (N). forced (n_forced): the nodes imposed at every step, imposed (L x
+   n_forced) their temperatures. T (N): the temperatures before the first step, after the last
+   on return; path (L x R): the temperatures of the nodes rows (R) after each step. Returns 1, or
+   0 where a pivot is zero (M singular) or memory runs out. */
 EXPORT int nodeforce_steps(int n, const int *order, const int *lower_ptr, const int *lower_col,
                            const int *upper_ptr, const int *upper_col, long nonzeros, const int *slot,
-                           const double *value, const double *c, long L, const double *v, double *T, int n_rows,
-                           const int *rows, double *path) {
+                           const double *value, const double *c, long L, int m, const double *terms,
+                           const int *source_ptr, const int *source_col, const double *source_value,
+                           const double *q, int n_forced, const int *forced, const double *imposed, double *T,
+                           int n_rows, const int *rows, double *path) {
     long entries = (long)n + lower_ptr[n] + upper_ptr[n], s, e;
     double *f = calloc((size_t)entries + 1, sizeof(double)), *w = calloc((size_t)n + 1, sizeof(double));
     double *y = malloc(((size_t)n + 1) * sizeof(double));
+    int *position = malloc(((size_t)n + 1) * sizeof(int));
     double *diagonal = f, *lower = f + n, *upper = f + n + lower_ptr[n];
-    int i, p, q, ok = 0;
-    if (!f || !w || !y) goto done;
+    int i, p, k, ok = 0;
+    if (!f || !w || !y || !position) goto done;
     for (e = 0; e < nonzeros; e++) f[slot[e]] += value[e];
     /* row by row (Doolittle): row i less its multiples of the rows above it that L says */
     for (i = 0; i < n; i++) {
@@ -42,7 +48,7 @@ EXPORT int nodeforce_steps(int n, const int *order, const int *lower_ptr, const 
         for (p = lower_ptr[i]; p < lower_ptr[i + 1]; p++) {
             const int j = lower_col[p];
             const double l = w[j] /= diagonal[j];
-            for (q = upper_ptr[j]; q < upper_ptr[j + 1]; q++) w[upper_col[q]] -= l * upper[q];
+            for (k = upper_ptr[j]; k < upper_ptr[j + 1]; k++) w[upper_col[k]] -= l * upper[k];
         }
         for (p = lower_ptr[i]; p < lower_ptr[i + 1]; p++) { lower[p] = w[lower_col[p]]; w[lower_col[p]] = 0.0; }
         for (p = upper_ptr[i]; p < upper_ptr[i + 1]; p++) { upper[p] = w[upper_col[p]]; w[upper_col[p]] = 0.0; }
@@ -50,15 +56,18 @@ EXPORT int nodeforce_steps(int n, const int *order, const int *lower_ptr, const 
         w[i] = 0.0;
         if (diagonal[i] == 0.0) goto done;
     }
-    for (i = 0; i < n; i++) w[i] = 1.0 / diagonal[i];
+    for (i = 0; i < n; i++) { w[i] = 1.0 / diagonal[i]; position[order[i]] = i; }
     for (s = 0; s < L; s++) {
-        const double *v_s = v + s * n;
+        const double *t_s = terms + s * m;
         double *out = path + s * n_rows;
-        /* a forced node's (c = 0) is its imposed temperature whatever T held before */
         for (i = 0; i < n; i++) {
             const int node = order[i];
-            y[i] = c[node] != 0.0 ? c[node] * T[node] + v_s[node] : v_s[node];
+            double sum = q[node];
+            for (p = source_ptr[node]; p < source_ptr[node + 1]; p++) sum += source_value[p] * t_s[source_col[p]];
+            /* a node without capacity (c = 0) has no past to carry, whatever T held */
+            y[i] = c[node] != 0.0 ? c[node] * T[node] + sum : sum;
         }
+        for (k = 0; k < n_forced; k++) y[position[forced[k]]] = imposed[s * n_forced + k];
         for (i = 0; i < n; i++) {
             double sum = y[i];
             for (p = lower_ptr[i]; p < lower_ptr[i + 1]; p++) sum -= lower[p] * y[lower_col[p]];
@@ -74,6 +83,6 @@ EXPORT int nodeforce_steps(int n, const int *order, const int *lower_ptr, const 
     }
     ok = 1;
 done:
-    free(f); free(w); free(y);
+    free(f); free(w); free(y); free(position);
     return ok;
 }
