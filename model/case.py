@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 from .errors import InputError
-from .integrate import Plan, history_block, initial_state, simulate, steps_per_day, substeps
+from .integrate import Plan, held_inputs, history_block, initial_state, simulate, steps_per_day, substeps
 from .building import DAY_TERMS
 from .network import assemble, clock_input_names, day_input, input_names
 from .units import check_celsius
@@ -55,7 +55,7 @@ class Case:
     building: object = None  # the Building whose nodes `measured` holds (its state at t_0: `start_state`)
     substeps: int = 1  # integration steps per sample (`integrate.substeps`: of at most MAX_STEP)
     history_steps: int = 0  # H: t_1..t_H the weather before the first measurement (t_H), part of the burn-in
-    # the `integrate.Plan` of the last building layouts run (`run`): (building, plan) by (id, network layout)
+    # the `integrate.Plan` of the last layouts run (`run`), by layout
     _plans: dict = field(default_factory=dict, init=False, repr=False, compare=False)
     PLANS = 4
 
@@ -137,18 +137,19 @@ class Case:
         `derivatives`: its `network.Derivative` with respect to each of k parameters, whose
         derivatives (N_t, len(nodes), k) are returned too (`integrate.simulate`).
 
-        The run's `integrate.Plan` is kept for the building (the same object) and its network's
-        layout: a calibration runs one building's network at hundreds of values."""
+        The run's `integrate.Plan` is kept for its layout (its nodes, its inputs and which are
+        held): a calibration runs one building's network at hundreds of values."""
         network = assemble(building) if network is None else network
-        key = (id(building), network.n_nodes, tuple(network.input_names))
-        kept = self._plans.get(key)  # which holds the building: its id is no other's while kept
-        if kept is None:
-            kept = self._plans[key] = (building, Plan(building, network, self.U, self.dt, self.measured,
-                                                      burn_in_steps=self.burn_in_steps, steady_start=self.steady_start,
-                                                      substeps=self.substeps, history_steps=self.history_steps))
+        held = held_inputs(building, network.input_names)
+        key = (network.n_nodes, tuple(network.input_names), held.tobytes())
+        plan = self._plans.get(key)
+        if plan is None:
+            plan = self._plans[key] = Plan(network, held, self.U, self.dt, self.measured,
+                                           burn_in_steps=self.burn_in_steps, steady_start=self.steady_start,
+                                           substeps=self.substeps, history_steps=self.history_steps)
             while len(self._plans) > self.PLANS:
                 self._plans.pop(next(iter(self._plans)))
-        return kept[1].run(network, nodes, derivatives)
+        return plan.run(building, network, nodes, derivatives)
 
     def window(self, start, stop):
         """The sub-case on rows start..stop (inclusive), t_start becoming its t_0; the burn-in

@@ -550,19 +550,20 @@ def simulate(building, network, U, dt, measured=None, force=None, warmup_days=2,
     N the nodes of `outputs` where given. With `derivatives`, also their derivatives, (N_t, N, k)
     or (N_t+1, N, k), C per unit of each parameter.
     """
-    plan = Plan(building, network, U, dt, measured, force, warmup_days, T_default, burn_in_steps, steady_start,
-                substeps, history_steps)
-    return plan.run(network, outputs, derivatives, include_start, stepper, steady_stepper, history_stepper)
+    plan = Plan(network, held_inputs(building, network.input_names), U, dt, measured, force, warmup_days, T_default,
+                burn_in_steps, steady_start, substeps, history_steps)
+    return plan.run(building, network, outputs, derivatives, include_start, stepper, steady_stepper, history_stepper)
 
 
 class Plan:
     """What a run reads of its record whatever the values of its network (`simulate`'s arguments
-    but the network's values): each node's start, the steady start's mean inputs and held nodes,
-    the history's inputs, each step's input row, inputs, forced nodes and imposed temperatures.
-    A calibration runs the same record hundreds of times at other values of its parameters:
-    `model.case.Case.run` keeps the plan of each building layout it runs."""
+    but the building and the network, of which it reads their layout: the nodes, the inputs and
+    which are `held`): the measurements at the start, the steady start's mean inputs and held
+    nodes, the history's inputs, each step's input row, inputs, forced nodes and imposed
+    temperatures. A calibration runs the same record hundreds of times at other values of its
+    parameters: `model.case.Case.run` keeps the plan of each layout it runs."""
 
-    def __init__(self, building, network, U, dt, measured=None, force=None, warmup_days=2, T_default=20.0,
+    def __init__(self, network, held, U, dt, measured=None, force=None, warmup_days=2, T_default=20.0,
                  burn_in_steps=0, steady_start=False, substeps=1, history_steps=0):
         n_rows, n = U.shape[0], network.n_nodes
         self.layout = (n, tuple(network.input_names))
@@ -575,7 +576,7 @@ class Plan:
         forced = forcing_schedule(force, measured, burn_in_steps)
         self.n_rows, self.dt, self.substeps, H = n_rows, dt, substeps, history_steps
         self.history_steps = H
-        self.start_state = initial_state(building, measured[0], T_default)
+        self.measured0, self.T_default = measured[0], T_default
         self.steady = steady_inputs(U, measured, forced, dt) if steady_start else None
         self.history = history_inputs(U, H, dt) if H else None
         # the record's steps from t_H, the warm-up's replay standing in for a history the record
@@ -583,8 +584,7 @@ class Plan:
         rows = warmup_rows(n_rows - H, dt, 0 if H else warmup_days)
         start = len(rows) - (n_rows - 1 - H)  # the step that reaches t_H+1
         row_of, sub_of = np.repeat(rows, substeps), np.tile(np.arange(substeps), len(rows))
-        self.inputs = np.stack(within_steps(U[H:], substeps, held_inputs(building, network.input_names)),
-                               axis=1)[row_of, sub_of]
+        self.inputs = np.stack(within_steps(U[H:], substeps, held), axis=1)[row_of, sub_of]
         self.forced = forced[H:][row_of]
         # imposed where measured: within_steps is column by column, and a column never measured is NaN
         read = np.flatnonzero(np.isfinite(measured[H:]).any(axis=0))
@@ -594,15 +594,16 @@ class Plan:
         ks = np.arange(max(start - 1, 0), len(rows))
         self.rows, self.kept = H + ks - start + 1, (ks + 1) * substeps - 1
 
-    def run(self, network, outputs=None, derivatives=(), include_start=False, stepper=None, steady_stepper=None,
-            history_stepper=None):
-        """`simulate` of `network`, of the layout the plan was made for (its nodes and inputs)."""
+    def run(self, building, network, outputs=None, derivatives=(), include_start=False, stepper=None,
+            steady_stepper=None, history_stepper=None):
+        """`simulate` of `building`'s `network`, of the layout the plan was made for (its nodes and
+        inputs)."""
         if (network.n_nodes, tuple(network.input_names)) != self.layout:
             raise ValueError("a network of another layout than its plan's")
         n, dt, H = network.n_nodes, self.dt, self.history_steps
         outputs = np.arange(n) if outputs is None else np.asarray(outputs, dtype=int)
         stepper = ImplicitEuler(network, dt / self.substeps) if stepper is None else stepper
-        T = self.start_state.copy()
+        T = initial_state(building, self.measured0, self.T_default)
         S = np.zeros((n, len(derivatives)))  # the temperatures' derivatives, none at the start
         if self.steady is not None:
             u, held, values = self.steady
