@@ -55,11 +55,13 @@ def fit_one(building, case, effect, target, air_nodes, rows):
     start = np.where(start <= low, low + 1e-3 * (high - low), np.where(start >= high, high - 1e-3 * (high - low), start))
     scale = np.maximum(np.abs(start), 1e-2 * (high - low))
     measured = case.measured[1:, np.array(air_nodes) - 1][rows]
+    # the inputs the effect reads, at any of its values: one case, whose runs share their plan
+    inputs = case.with_inputs(record.apply(building, target, {}))
 
     def residual(x):
         try:
             fitted = record.apply(building, target, dict(zip(names, x)))
-            r = (measured - air_run(fitted, case, air_nodes)[rows]).ravel()
+            r = (measured - inputs.run(fitted, np.array(air_nodes) - 1)[rows]).ravel()
         except ValueError:  # a value the building refuses (the InputError of an impossible field)
             return np.full(measured.size, 1e3)
         return r if np.all(np.isfinite(r)) else np.full(r.size, 1e3)
