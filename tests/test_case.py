@@ -60,3 +60,27 @@ def test_the_plain_api_simulates_every_node_with_forcing(testcell, weather):
     assert np.array_equal(forced["T9"].to_numpy(), measured["T9"].to_numpy()[1:])
     # without measurements the weather's own hourly grid is used
     assert len(free) == len(weather) - 1 and free.index[0] == weather.index[1]
+
+
+def test_a_case_s_kept_plan_runs_every_building_of_its_layout_as_a_fresh_simulation(real_case):
+    # Case.run keeps a run's plan by layout: a building with another conductivity (the same layout)
+    # must run on it as simulate runs it afresh, and one with a node more (an internal mass) on
+    # its own; the plans are never pickled with the case
+    import pickle
+    from dataclasses import replace
+    from nodeforce.model.effects import EFFECTS
+    from nodeforce.model.integrate import simulate
+    from nodeforce.model.network import assemble
+    case = replace(real_case.with_steady_start(), burn_in_steps=24)
+    size = len(pickle.dumps(case))
+    cell = real_case.building
+    zone = cell.zones[0].name
+    door = EFFECTS["conductivity"].apply(cell, "door", {"factor": 2.0})
+    massive = EFFECTS["internal_mass"].apply(cell, zone, {"C_m": 2e6, "H_m": 150.0})
+    for building in (cell, door, massive, door, massive):
+        fresh = simulate(building, assemble(building), case.U, case.dt, case.measured, burn_in_steps=case.burn_in_steps,
+                         steady_start=True, substeps=case.substeps, history_steps=case.history_steps)
+        assert np.array_equal(case.run(building), fresh)
+    assert case.run(massive).shape[1] == case.run(cell).shape[1] + 1
+    assert not np.array_equal(case.run(door), case.run(cell))
+    assert len(pickle.dumps(case)) == size
