@@ -32,12 +32,14 @@ scheduler) raises `RunStopped` and exits with 75 (EX_TEMPFAIL of sysexits.h: try
 import ctypes
 import multiprocessing
 import os
+import pickle
 import signal
 import sys
 import threading
 import time
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
+from pathlib import Path
 
 from threadpoolctl import threadpool_limits
 
@@ -155,10 +157,47 @@ def _worker_start(parent, workers, initializer, initargs):
         initializer(*initargs)
 
 
+# What a pipe holds before its writer waits (Linux's default, 64 KiB, less a margin)
+PIPE_BYTES = 60_000
+
+
+class _Pool(ProcessPoolExecutor):
+    """A ProcessPoolExecutor that removes, once shut down, the folder its initializer's arguments
+    were written to (`new_pool`)."""
+    folder = None
+
+    def shutdown(self, wait=True, *, cancel_futures=False):
+        super().shutdown(wait=wait, cancel_futures=cancel_futures)
+        if self.folder is not None:
+            tempdirs.remove(self.folder)
+
+
+def _initialized_from(path):
+    initializer, initargs = pickle.loads(Path(path).read_bytes())
+    initializer(*initargs)
+
+
 def new_pool(workers: int, initializer=None, initargs=()) -> ProcessPoolExecutor:
-    """A pool of `workers` spawned processes that end when this process ends (module docstring)."""
-    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
-                               initializer=_worker_start, initargs=(os.getpid(), workers, initializer, initargs))
+    """A pool of `workers` spawned processes that end when this process ends (module docstring).
+
+    A spawned worker is handed its arguments through a pipe its parent writes whole before
+    starting the next: arguments larger than the pipe (a search's FMU and records) would keep the
+    parent waiting while each worker imports what they need, one worker after the other (3.5 s
+    each for the Twin House's search). Such arguments are written to a file of the pool's, which
+    every worker reads as it starts, all at once."""
+    arguments = (initializer, initargs)
+    folder = None
+    if initializer is not None:
+        payload = pickle.dumps(arguments, pickle.HIGHEST_PROTOCOL)
+        if len(payload) > PIPE_BYTES:
+            folder = tempdirs.make("pool")
+            path = Path(folder) / "initializer.pickle"
+            path.write_bytes(payload)
+            arguments = (_initialized_from, (str(path),))
+    pool = _Pool(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
+                 initializer=_worker_start, initargs=(os.getpid(), workers, *arguments))
+    pool.folder = folder
+    return pool
 
 
 def stop_pool(pool: ProcessPoolExecutor) -> None:
