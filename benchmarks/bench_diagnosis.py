@@ -395,15 +395,15 @@ def summary(results, draws):
     return lines, numbers
 
 
-# What one diagnosis costs, measured in the draw 0 of commit d9c343e: the whole run is sized from it.
-BUDGET = ("The budget, measured in the draw 0 of commit d9c343e on 2 cores, two diagnoses at a time (5 to 95 % of "
-          "the records' times), the forcing search driving the standalone FMU (`search_fmu=\"auto\"`, the API's "
-          "default as the command line's) and the runs of steps compiled where a C compiler is found: a test-cell "
-          "diagnosis takes 8 to 15 s with the paper's sensors or the air alone and 12 to 23 s with every node "
-          "measured (gso-jan and mia-dec, 23 forcing genes), its baseline 4 to 8 s, a Twin House diagnosis 68 to "
-          "84 s (its baseline 44 to 78 s), making a record's truth 5 to 10 s on the test cell and 20 to 26 s for "
-          "the Twin House. Every record under one draw is then about 20 min on 2 workers. The GA and the "
-          "calibrations keep the command line's defaults. Finished records are kept in "
+# What one diagnosis costs, measured in the draw 0 of commit ca616bd: the whole run is sized from it.
+BUDGET = ("The budget, measured in the draw 0 of commit ca616bd on 2 cores, two diagnoses at a time (5 to 95 % "
+          "of the records' times), the forcing search driving the standalone FMU (`search_fmu=\"auto\"`, the "
+          "API's default as the command line's) and the runs of steps compiled where a C compiler is found: a "
+          "test-cell diagnosis takes 5 to 10 s with the paper's sensors or the air alone and 10 to 19 s with "
+          "every node measured (gso-jan and mia-dec, 23 forcing genes), its baseline 3 to 5 s, a Twin House "
+          "diagnosis 41 to 56 s (its baseline 22 to 32 s), making a record's truth 1 to 5 s on the test cell "
+          "and 12 to 19 s for the Twin House. Every record under one draw is then about 12 min on 2 workers. "
+          "The GA and the calibrations keep the command line's defaults. Finished records are kept in "
           "out/bench_diagnosis/records, each with a digest of its spec and of the code (the package, the "
           "records, the baseline, the examples): a rerun skips what is unchanged, a changed loop runs "
           "everything again.")
