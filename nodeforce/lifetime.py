@@ -173,6 +173,7 @@ class _Pool(ProcessPoolExecutor):
 
 
 def _initialized_from(path):
+    tempdirs.hold(Path(path).parent)  # a parent killed outright leaves it to its workers
     initializer, initargs = pickle.loads(Path(path).read_bytes())
     initializer(*initargs)
 

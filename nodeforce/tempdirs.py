@@ -64,6 +64,13 @@ def folder(kind: str):
         remove(path)
 
 
+def hold(path) -> None:
+    """Count a folder another process made among this process's own, removed with them if it is
+    stopped (`remove_held`): a pool's, which its workers read beside the parent that made it,
+    and remove when that parent is killed outright."""
+    _held.add(str(path))
+
+
 def remove_held() -> None:
     """Remove every folder this process made and has not removed yet (a worker's last act)."""
     for path in list(_held):
