@@ -191,12 +191,6 @@ class Sources:
     def __init__(self, terms, B, q):
         self.terms, self.B, self.q = terms, B, q
 
-    @classmethod
-    def on(cls, values, nodes, n):
-        """The sources (L, len(nodes)) `values` on the `nodes` of a network of n nodes, zero on
-        the others."""
-        return cls(values, np.eye(n)[:, nodes], np.zeros(n))
-
     def __len__(self):
         return len(self.terms)
 
@@ -608,12 +602,11 @@ class Plan:
         if self.steady is not None:
             u, held, values = self.steady
             steady_stepper = ImplicitEuler(network, STEADY_STEP) if steady_stepper is None else steady_stepper
-            switched = network.switched_diagonal(u)
-            before, (_, T) = T, steady_stepper.run(T, Sources(*network.source_terms(u[None])), held, values[None],
-                                                    switched)
+            switched, sources = network.switched_diagonal(u), Sources(*network.source_terms(u[None]))
+            before, (_, T) = T, steady_stepper.run(T, sources, held, values[None], switched)
             if derivatives:
                 _, S = sensitivity_steps(steady_stepper, network, derivatives, S, before[None], T[None], u[None],
-                                         network.source_terms(u[None])[0], held, switched, [], [])
+                                         sources.terms, held, switched, [], [])
         out = np.empty((self.n_rows, len(outputs)))
         out[0] = T[outputs]
         d_out = np.empty((self.n_rows, len(outputs), len(derivatives)))
@@ -712,15 +705,19 @@ def sensitivity_steps(stepper, network, derivatives, S, before, after, inputs, t
     """
     source = np.stack([d.source(before, after, terms, inputs, stepper.dt) for d in derivatives], axis=-1)
     source[:, forced] = 0.0
-    rows = np.unique(np.concatenate([d.rows for d in derivatives]))  # where the source may be other than zero
+    # the source on the nodes where it may be other than zero, as inputs to them
+    n = network.n_nodes
+    rows = np.unique(np.concatenate([d.rows for d in derivatives]))
+    B, q = np.eye(n)[:, rows], np.zeros(n)
+    if modes is not None:
+        inverse, imposed = stepper.solver(forced, switched)[0].inverse, np.zeros((len(source), n))
     out = np.empty((len(kept), len(outputs), len(derivatives)))
     last = np.empty_like(S)
     for j in range(len(derivatives)):  # one parameter at a time, each a run of the step with its source
-        on = Sources.on(source[:, rows, j], rows, network.n_nodes)
-        if modes is not None:  # the source as inputs
-            inverse = stepper.solver(forced, switched)[0].inverse
-            out[..., j], last[:, j] = modal_run(inverse, stepper.c_dt, forced, modes, S[:, j], on.terms, on.B, on.q,
-                                                np.zeros((len(source), network.n_nodes)), kept, outputs)
+        on = Sources(source[:, rows, j], B, q)
+        if modes is not None:
+            out[..., j], last[:, j] = modal_run(inverse, stepper.c_dt, forced, modes, S[:, j], on.terms, B, q,
+                                                imposed, kept, outputs)
         else:
             path, last[:, j] = stepper.run(S[:, j], on, forced, None, switched, outputs)
             out[..., j] = path[kept]

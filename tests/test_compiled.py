@@ -85,7 +85,7 @@ def test_a_singular_step_matrix_is_refused():
     # a node with no capacity and no link: its row of M is zero
     pattern = (np.array([0, 1, 2], dtype=np.int32), np.array([0, 1], dtype=np.int32))
     with pytest.raises(ValueError, match="singular"):
-        compiled.steps((pattern, np.array([2.0, 0.0])), np.array([1.0, 0.0]), Sources.on(np.ones((3, 2)), [0, 1], 2),
+        compiled.steps((pattern, np.array([2.0, 0.0])), np.array([1.0, 0.0]), Sources(np.ones((3, 2)), np.eye(2), np.zeros(2)),
                        [], None, np.zeros(2), [0])
 
 
