@@ -2,8 +2,9 @@
 
 An `FmuInstance` extracts and instantiates an FMU once; each `run` resets it, so a search can
 simulate thousands of forcing masks without unzipping or instantiating again. The step loop
-writes the inputs into preallocated ctypes arrays through numpy views and calls FMPy's
-low-level set, doStep and get functions, so a step allocates nothing in Python.
+writes the inputs into preallocated ctypes arrays through numpy views and calls the FMU's set,
+doStep and get functions as FMPy bound them from its library, checking their status as FMPy
+does, so a step allocates nothing in Python.
 
 The calls follow the model description's fmiVersion, as FMPy's own `simulate_fmu` does: one class
 per version (`Fmi2`, `Fmi3`) sets, steps and gets, and both speak in scalar names (`force[i]`,
@@ -19,12 +20,26 @@ from ctypes import byref
 
 import numpy as np
 from fmpy import extract, read_model_description
-from fmpy.fmi2 import FMU2Slave, fmi2Boolean, fmi2Integer, fmi2Real, fmi2True, fmi2ValueReference
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import FMU2Slave, fmi2Boolean, fmi2Integer, fmi2Real, fmi2True, fmi2ValueReference, fmi2Warning
 from fmpy.fmi3 import FMU3Slave, fmi3Boolean, fmi3Float64, fmi3ValueReference
 
 from nodeforce import tempdirs
 
 _OPEN = weakref.WeakSet()
+
+
+def raw(fmu, name):
+    """The FMI function `name` of `fmu`'s library as FMPy declared it (its argument and result
+    types), called in the step loop without FMPy's per-call wrapper (its call logger, unused
+    here: a tenth of a standalone FMU's run); its status is checked with `check`."""
+    return getattr(fmu.dll, name)
+
+
+def check(status, name):
+    """FMPy's FMICallException where an FMI call's status is above warning, as FMPy raises it."""
+    if status > fmi2Warning:
+        raise FMICallException(function=name, status=status)
 
 
 class Fmi2:
@@ -76,29 +91,28 @@ class Fmi2:
         d_orders = (fmi2Integer * n_slopes)(*([1] * n_slopes))
         d_values = (fmi2Real * n_slopes)()
         d_view = np.ctypeslib.as_array(d_values) if n_slopes else None
-        if self.derivatives_as_values:
-            set_derivatives = lambda c, r, n, _, v: fmu.fmi2SetReal(c, r, n, v)  # noqa: E731
-        else:
-            set_derivatives = fmu.fmi2SetRealInputDerivatives
+        d_name = "fmi2SetReal" if self.derivatives_as_values else "fmi2SetRealInputDerivatives"
+        d_set = raw(fmu, d_name)
+        d_args = (d_refs, n_slopes, d_values) if self.derivatives_as_values else (d_refs, n_slopes, d_orders, d_values)
         in_refs = (fmi2ValueReference * n_in)(*self.refs(input_names))
         in_values = (fmi2Real * n_in)()
         in_view = np.ctypeslib.as_array(in_values) if n_in else None
         out_refs = (fmi2ValueReference * n_out)(*self.refs(output_names))
         out_values = (fmi2Real * n_out)()
         out_view = np.ctypeslib.as_array(out_values) if n_out else None
-        component = fmu.component
-        set_real, do_step, get_real = fmu.fmi2SetReal, fmu.fmi2DoStep, fmu.fmi2GetReal
+        component, no_rollback = fmu.component, fmi2Boolean(fmi2True)
+        set_real, do_step, get_real = (raw(fmu, name) for name in ("fmi2SetReal", "fmi2DoStep", "fmi2GetReal"))
 
         def step(time, dt, row, out, slopes=None):
             if n_in:
                 in_view[:] = row
-                set_real(component, in_refs, n_in, in_values)
+                check(set_real(component, in_refs, n_in, in_values), "fmi2SetReal")
             if n_slopes:
                 d_view[:] = slopes
-                set_derivatives(component, d_refs, n_slopes, d_orders, d_values)
-            do_step(component, time, dt, fmi2Boolean(fmi2True))
+                check(d_set(component, *d_args), d_name)
+            check(do_step(component, time, dt, no_rollback), "fmi2DoStep")
             if out is not None:
-                get_real(component, out_refs, n_out, out_values)
+                check(get_real(component, out_refs, n_out, out_values), "fmi2GetReal")
                 out[:] = out_view
         return step
 
@@ -179,20 +193,20 @@ class Fmi3(Fmi2):
         out_values = (fmi3Float64 * n_out)()
         out_view = np.ctypeslib.as_array(out_values) if n_out else None
         component = fmu.component
-        set_float, do_step, get_float = fmu.fmi3SetFloat64, fmu.fmi3DoStep, fmu.fmi3GetFloat64
+        set_float, do_step, get_float = (raw(fmu, name) for name in ("fmi3SetFloat64", "fmi3DoStep", "fmi3GetFloat64"))
         event, terminate, early, last = fmi3Boolean(), fmi3Boolean(), fmi3Boolean(), fmi3Float64()
+        flags = fmi3Boolean(True), byref(event), byref(terminate), byref(early), byref(last)
 
         def step(time, dt, row, out, slopes=None):
             if n_in:
                 in_view[in_positions] = row
-                set_float(component, in_refs, len(in_refs), in_values, n_in)
+                check(set_float(component, in_refs, len(in_refs), in_values, n_in), "fmi3SetFloat64")
             if n_slopes:
                 d_view[d_positions] = slopes
-                set_float(component, d_refs, len(d_refs), d_values, len(d_view))
-            do_step(component, time, dt, fmi3Boolean(True), byref(event), byref(terminate), byref(early),
-                    byref(last))
+                check(set_float(component, d_refs, len(d_refs), d_values, len(d_view)), "fmi3SetFloat64")
+            check(do_step(component, time, dt, *flags), "fmi3DoStep")
             if out is not None:
-                get_float(component, out_refs, len(out_refs), out_values, n_out)
+                check(get_float(component, out_refs, len(out_refs), out_values, n_out), "fmi3GetFloat64")
                 out[:] = out_view[out_positions]
         return step
 

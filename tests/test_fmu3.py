@@ -92,6 +92,25 @@ def test_fmi3_equals_fmi2_and_the_direct_model_with_forcing_and_effect(fmus, tes
     assert np.abs(direct - uncoupled).max() > 0.1  # the effect's parameters reached the model
 
 
+@pytest.mark.parametrize("kind", KINDS)
+@pytest.mark.parametrize("fmi", (2, 3))
+def test_a_value_the_fmu_refuses_mid_run_stops_the_run_naming_the_call(fmus, real_case, kind, fmi):
+    """The step loop calls the FMI functions without FMPy's wrapper: a refusal (a NaN outdoor
+    temperature at the sixth step, fmi2Error/fmi3Error) still raises FMPy's exception, the call
+    named, and the next run of the instance is whole."""
+    from fmpy.fmi1 import FMICallException
+    with FmuInstance(fmus[(kind, fmi)]) as instance:
+        names = ["T_out"]
+        rows = np.full((10, 1), 20.0)
+        rows[5, 0] = np.nan
+        with pytest.raises(FMICallException) as refused:
+            instance.run(600.0, {}, {}, names, rows, ["T[1]"])
+        assert refused.value.status == 3
+        assert str(refused.value).startswith("fmi2SetReal" if fmi == 2 else "fmi3SetFloat64")
+        rows[5, 0] = 20.0
+        assert np.isfinite(instance.run(600.0, {}, {}, names, rows, ["T[1]"])).all()
+
+
 @pytest.mark.slow  # a search through four FMUs
 def test_a_search_through_fmi3_gives_the_fmi2_answer(files, tmp_path):  # noqa: F811
     results = {}
