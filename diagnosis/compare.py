@@ -27,11 +27,11 @@ from nodeforce.model.network import assemble, face_heat_flux
 from nodeforce.model.score import metrics
 
 
-def run_model(building, case, output_ids, fmu_kind="python"):
-    """The nodes `output_ids` (C) at t_1..t_N of `building` simulated on `case` through its FMU,
-    built and removed in a temporary folder."""
+def run_model(building, case, output_ids, fmu_kind="python", fmu=None):
+    """The nodes `output_ids` (C) at t_1..t_N of `building` simulated on `case` through its FMU:
+    `fmu`, the building's own already built, or one built and removed in a temporary folder."""
     with tempdirs.folder("compare") as tmp:
-        with FmuInstance(build_fmu(building, Path(tmp) / "model.fmu", kind=fmu_kind)) as instance:
+        with FmuInstance(fmu or build_fmu(building, Path(tmp) / "model.fmu", kind=fmu_kind)) as instance:
             return simulate_fmu(instance, case, output_ids=output_ids)
 
 
@@ -57,7 +57,7 @@ def surface_fluxes(building, case, T):
     return out
 
 
-def compare(models, phases=(), fmu_kind="python"):
+def compare(models, phases=(), fmu_kind="python", fmus=None):
     """Score each model on its record; return the content of compare.json and the series to plot.
 
     Parameters
@@ -66,6 +66,7 @@ def compare(models, phases=(), fmu_kind="python"):
         (its burn-in set) and its objective; the records must share their times and the
         objectives their zone names
     phases : iotools.phases.Phase records, each model scored on each
+    fmus : each model's FMU of `fmu_kind` where one is built already, else None (built here)
     """
     path0, _, case0, objective0 = models[0]
     for path, _, case, objective in models:
@@ -82,13 +83,13 @@ def compare(models, phases=(), fmu_kind="python"):
     # plotted from the first measurement: the weather's history before it is not the record
     h = case0.history_steps
     series = {"times": times[h:], "scored_from": case0.times[case0.burn_in_steps + 1], "measured": None, "runs": []}
-    for path, building, case, objective in models:
+    for (path, building, case, objective), fmu in zip(models, fmus or [None] * len(models)):
         measured = objective.measured(case)
         if case.fluxes:
-            T = run_model(building, case, range(1, building.n_nodes + 1), fmu_kind)
+            T = run_model(building, case, range(1, building.n_nodes + 1), fmu_kind, fmu)
             simulated = T[:, [i - 1 for i in objective.air_nodes]]
         else:
-            simulated = run_model(building, case, objective.air_nodes, fmu_kind)
+            simulated = run_model(building, case, objective.air_nodes, fmu_kind, fmu)
         by_phase = {}
         for phase in phases:
             inside = np.asarray(phase.mask(times))

@@ -45,6 +45,7 @@ import time
 from contextlib import nullcontext
 from dataclasses import dataclass, replace
 from functools import partial
+from pathlib import Path
 
 import numpy as np
 from tqdm import tqdm
@@ -229,14 +230,15 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
 class Prepared:
     """What every stage reads (`prepare`): the records, their windows (with the file's numerical
     error), each record's protocol's building (`bases`, None: the building's), the model as
-    described (its runs over each record and its metrics), the noise, and the residuals the
-    blocks score (`n`)."""
+    described (its runs over each record and its metrics), the noise, the residuals the
+    blocks score (`n`) and the building's FMU."""
     records: list
     windows: Windows
     bases: list
     model: Model
     noise: Noise
     n: int
+    fmu: Path | None = None  # the building's own FMU (model_before.fmu), where a record is under its protocol
 
 
 @dataclass
@@ -272,15 +274,17 @@ def prepare(building, records, bases, objective, workdir, fmu_kind, noise):
     (`model_before.fmu`); the file's own numerical error beside it; the noise (C), `noise` if the
     user gave it."""
     windows = Windows.of(records, objective)
-    before_runs = []
+    before_runs, fmus = [], {}
     for i, (case, base) in enumerate(zip(windows.cases, bases)):
         name = "model_before.fmu" if base is None else f"model_before_{i + 1}.fmu"
-        with FmuInstance(build_fmu(base or building, workdir / name, kind=fmu_kind)) as fmu:
+        if name not in fmus:
+            fmus[name] = build_fmu(base or building, workdir / name, kind=fmu_kind)
+        with FmuInstance(fmus[name]) as fmu:
             before_runs.append(simulate_fmu(fmu, case, output_ids=objective.air_nodes))
     model = Model(building, before_runs, windows.metrics(objective, before_runs), bases)
     windows = windows.with_numerical(before_runs, windows.sensed_by(model), building, bases, objective)
     noise = Noise.of_records(windows.measured, noise).with_numerical(windows.numerical_rms())
-    return Prepared(list(records), windows, bases, model, noise, windows.scored())
+    return Prepared(list(records), windows, bases, model, noise, windows.scored(), fmus.get("model_before.fmu"))
 
 
 def localise(building, prepared, objective, workdir, search):
@@ -454,9 +458,10 @@ def write(building, prepared, located, made, objective, workdir, fmu_kind, refer
     windows, records, model, added = prepared.windows, prepared.records, made.model, made.added
     (workdir / "building_after.json").write_text(json.dumps(priors_stated(model.building, added).to_json(), indent=2)
                                                  + "\n")
-    later = [scored_later(record, (building.source, building), (workdir / "building_after.json", model.building),
-                          objective, fmu_kind) for record in later]
     fmu_after = build_fmu(model.building, workdir / "model_after.fmu", kind=fmu_kind)
+    later = [scored_later(record, (building.source, building, prepared.fmu),
+                          (workdir / "building_after.json", model.building, fmu_after), objective, fmu_kind)
+             for record in later]
     # a record under another protocol: its own building as corrected, for `nodeforce compare`
     protocols_after = {i: workdir / f"building_after_record{i + 1}.json" for i, b in enumerate(model.bases) if b is not None}
     for i, path in protocols_after.items():
@@ -493,10 +498,10 @@ def write(building, prepared, located, made, objective, workdir, fmu_kind, refer
 
 def scored_later(record, written, corrected, objective, fmu_kind):
     """The later `record` scored as `nodeforce compare` scores it (`diagnosis.compare`): the
-    building as written and as corrected, each (path, Building), run through its FMU on the
-    record's case prepared for it; their `LaterRecord`."""
-    result, _ = compare([(path, b, record.case_for(b), objective) for path, b in (written, corrected)],
-                        fmu_kind=fmu_kind)
+    building as written and as corrected, each (path, Building, its FMU or None: built), run
+    through its FMU on the record's case prepared for it; their `LaterRecord`."""
+    result, _ = compare([(path, b, record.case_for(b), objective) for path, b, _ in (written, corrected)],
+                        fmu_kind=fmu_kind, fmus=[fmu for _, _, fmu in (written, corrected)])
     before, after = (m["metrics"] for m in result["models"])
     return LaterRecord(record.name, str(record.source), result["record"], result["scored_from"], before, after)
 
