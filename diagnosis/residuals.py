@@ -22,6 +22,7 @@ consecutive steps where the residual and every input are finite, and the result 
 """
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 
@@ -60,17 +61,25 @@ def step_hours(times):
 
 
 def _ar_filter(x, max_order):
-    """The AR polynomial [1, -phi_1, ..., -phi_p] of x, order p <= max_order by AIC (p may be 0)."""
+    """The AR polynomial [1, -phi_1, ..., -phi_p] of x, order p <= max_order by AIC (p may be 0).
+    An input's filter is the same for every residual diagnosed beside it (the model before and
+    after, each round's): kept for the series (`_ar_filter_of`)."""
+    return _ar_filter_of(np.ascontiguousarray(x, dtype=float).tobytes(), max_order)
+
+
+@functools.lru_cache(maxsize=64)
+def _ar_filter_of(data, max_order):
+    x = np.frombuffer(data).copy()
     with warnings.catch_warnings():
         # A piecewise-constant input (heater pulses) is predicted almost exactly by its last
         # value: statsmodels warns of a near-singular fit, yet the filter it gives is right
         # (differencing: the innovations are the switches).
         warnings.simplefilter("ignore", (SingularMatrixWarning, RuntimeWarning))
         lags = ar_select_order(x, maxlag=max_order, ic="aic", trend="c").ar_lags
-        if not lags:
-            return np.ones(1)
-        phi = AutoReg(x, lags=max(lags), trend="c").fit().params[1:]
-    return np.concatenate(([1.0], -phi))
+        phi = AutoReg(x, lags=max(lags), trend="c").fit().params[1:] if lags else []
+    a = np.concatenate(([1.0], -np.asarray(phi)))
+    a.setflags(write=False)  # shared by every caller
+    return a
 
 
 def prewhitened_ccf(residual, x, max_lag, max_order):
