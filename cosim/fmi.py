@@ -37,7 +37,8 @@ def raw(fmu, name):
 
 
 def check(status, name):
-    """FMPy's FMICallException where an FMI call's status is above warning, as FMPy raises it."""
+    """FMPy's FMICallException where an FMI call's status is above warning (1 in FMI 2.0 and
+    3.0 alike), as FMPy raises it."""
     if status > fmi2Warning:
         raise FMICallException(function=name, status=status)
 

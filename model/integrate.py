@@ -703,18 +703,18 @@ def sensitivity_steps(stepper, network, derivatives, S, before, after, inputs, t
     (len(kept), len(outputs), k) the derivatives of the `outputs` nodes after the `kept` steps
     (C per unit of each parameter), and (N, k) every node's after the last step
     """
-    source = np.stack([d.source(before, after, terms, inputs, stepper.dt) for d in derivatives], axis=-1)
-    source[:, forced] = 0.0
     # the source on the nodes where it may be other than zero, as inputs to them
     n = network.n_nodes
     rows = np.unique(np.concatenate([d.rows for d in derivatives]))
+    source = np.stack([d.source(before, after, terms, inputs, stepper.dt, rows) for d in derivatives], axis=-1)
+    source[:, forced[rows]] = 0.0
     B, q = np.eye(n)[:, rows], np.zeros(n)
     if modes is not None:
         inverse, imposed = stepper.solver(forced, switched)[0].inverse, np.zeros((len(source), n))
     out = np.empty((len(kept), len(outputs), len(derivatives)))
     last = np.empty_like(S)
     for j in range(len(derivatives)):  # one parameter at a time, each a run of the step with its source
-        on = Sources(source[:, rows, j], B, q)
+        on = Sources(source[:, :, j], B, q)
         if modes is not None:
             out[..., j], last[:, j] = modal_run(inverse, stepper.c_dt, forced, modes, S[:, j], on.terms, B, q,
                                                 imposed, kept, outputs)
