@@ -107,11 +107,11 @@ class Coefficients:
         """out += scale M, `out` of the matrix's shape."""
         out[np.ix_(self.rows, self.cols)] += scale * self.block
 
-    def add_product(self, out, x, at=None):
-        """out[:, rows] += x[:, cols] block^T: out += x M^T for rows of vectors x (L, n); `at`:
-        the columns of `out` that hold the rows, where it holds some nodes only."""
+    def add_product(self, out, x, nodes):
+        """out += x M^T on `nodes` for rows of vectors x (L, n): `out` (L, len(nodes)) holds the
+        columns of `nodes` (sorted indices holding the rows), to which x[:, cols] block^T adds."""
         if len(self.rows):
-            out[:, self.rows if at is None else at] += x[:, self.cols] @ self.block.T
+            out[:, np.searchsorted(nodes, self.rows)] += x[:, self.cols] @ self.block.T
 
 
 @dataclass(frozen=True)
@@ -144,20 +144,18 @@ class Derivative:
         return all(close(a, b) for a, b in ((self.C, other.C), (self.q, other.q), (self.A.dense(), other.A.dense()),
                                             (self.B.dense(), other.B.dense()), (self.G.dense(), other.G.dense())))
 
-    def source(self, before, after, terms, inputs, dt, nodes=None):
+    def source(self, before, after, terms, inputs, dt, nodes):
         """(L, len(nodes)): what backward-Euler steps of dt (s) add to the right-hand side of the
-        temperatures' derivatives (W per unit of p) on `nodes` (sorted indices holding `rows`,
-        default every node), from each step's temperatures before and after (C, (L, N): only
-        those it `reads` matter), source terms (`Network.source_terms`) and inputs:
-        differentiating
+        temperatures' derivatives (W per unit of p) on `nodes` (sorted indices holding `rows`),
+        from each step's temperatures before and after (C, (L, N): only those it `reads`
+        matter), source terms (`Network.source_terms`) and inputs: differentiating
         M T^n+1 = (C/dt) T^n + s^n+1, M = C/dt - A + diag(G u), gives
         M dT^n+1 = (C/dt) dT^n + (dC/dt) (T^n - T^n+1) + dA T^n+1 - (dG u) T^n+1 + dB' terms + dq
         (docs/model.md section 5.9). On the nodes the source can reach alone, a run of a house's
         steps forms a few columns of L x N rather than all."""
-        nodes = np.arange(len(self.C)) if nodes is None else nodes
         out = (before[:, nodes] - after[:, nodes]) * (self.C[nodes] / dt) + self.q[nodes]
-        self.A.add_product(out, after, np.searchsorted(nodes, self.A.rows))
-        self.B.add_product(out, terms, np.searchsorted(nodes, self.B.rows))
+        self.A.add_product(out, after, nodes)
+        self.B.add_product(out, terms, nodes)
         if len(self.G.rows):
             switched = inputs[:, self.G.cols] @ self.G.block.T
             out[:, np.searchsorted(nodes, self.G.rows)] -= switched * after[:, self.G.rows]
