@@ -30,9 +30,12 @@ from nodeforce.model.score import metrics
 def run_model(building, case, output_ids, fmu_kind="python", fmu=None):
     """The nodes `output_ids` (C) at t_1..t_N of `building` simulated on `case` through its FMU:
     `fmu`, the building's own already built, or one built and removed in a temporary folder."""
-    with tempdirs.folder("compare") as tmp:
-        with FmuInstance(fmu or build_fmu(building, Path(tmp) / "model.fmu", kind=fmu_kind)) as instance:
-            return simulate_fmu(instance, case, output_ids=output_ids)
+    if fmu is None:
+        with tempdirs.folder("compare") as tmp:
+            fmu = build_fmu(building, Path(tmp) / "model.fmu", kind=fmu_kind)
+            return run_model(building, case, output_ids, fmu=fmu)
+    with FmuInstance(fmu) as instance:
+        return simulate_fmu(instance, case, output_ids=output_ids)
 
 
 def surface_fluxes(building, case, T):

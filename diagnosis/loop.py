@@ -274,17 +274,18 @@ def prepare(building, records, bases, objective, workdir, fmu_kind, noise):
     (`model_before.fmu`); the file's own numerical error beside it; the noise (C), `noise` if the
     user gave it."""
     windows = Windows.of(records, objective)
-    before_runs, fmus = [], {}
+    before_runs, fmus = [], {}  # {the record's protocol's index, None for the building's own: its FMU}
     for i, (case, base) in enumerate(zip(windows.cases, bases)):
-        name = "model_before.fmu" if base is None else f"model_before_{i + 1}.fmu"
-        if name not in fmus:
-            fmus[name] = build_fmu(base or building, workdir / name, kind=fmu_kind)
-        with FmuInstance(fmus[name]) as fmu:
+        key = None if base is None else i
+        if key not in fmus:
+            name = "model_before.fmu" if base is None else f"model_before_{i + 1}.fmu"
+            fmus[key] = build_fmu(base or building, workdir / name, kind=fmu_kind)
+        with FmuInstance(fmus[key]) as fmu:
             before_runs.append(simulate_fmu(fmu, case, output_ids=objective.air_nodes))
     model = Model(building, before_runs, windows.metrics(objective, before_runs), bases)
     windows = windows.with_numerical(before_runs, windows.sensed_by(model), building, bases, objective)
     noise = Noise.of_records(windows.measured, noise).with_numerical(windows.numerical_rms())
-    return Prepared(list(records), windows, bases, model, noise, windows.scored(), fmus.get("model_before.fmu"))
+    return Prepared(list(records), windows, bases, model, noise, windows.scored(), fmus.get(None))
 
 
 def localise(building, prepared, objective, workdir, search):
