@@ -299,3 +299,51 @@ def test_an_edit_is_refused_as_the_file_it_makes_would_be(mutate):
     with pytest.raises(InputError) as edit:
         parse_building(TESTCELL, source="cell.json").edited(mutate)
     assert str(edit.value) == str(whole.value)
+
+
+def test_the_checks_references_inlined_find_the_errors_of_the_schema_as_written():
+    """The parser's validators have the schema's references inlined (a reference is resolved at
+    every visit): on random changes of a file, of each field and of each item an edit checks
+    alone, they find the error the schema as written finds, at the same field, in the same words,
+    of the same rule."""
+    import random
+
+    from nodeforce.model.building_file import ITEMS, _validator
+
+    def as_written(definition):
+        schema = SCHEMA if definition is None else {"$defs": SCHEMA["$defs"], "$ref": f"#/$defs/{definition}"}
+        types = _validator(None).TYPE_CHECKER  # the parser's finite numbers and int ids
+        return jsonschema.validators.extend(jsonschema.Draft202012Validator, type_checker=types)(schema)
+
+    def best(validator, instance):
+        e = jsonschema.exceptions.best_match(validator.iter_errors(instance))
+        return e and (list(e.absolute_path), e.message, e.validator, e.schema.get("description"))
+
+    def places(node, path=()):
+        yield path
+        children = node.items() if isinstance(node, dict) else enumerate(node) if isinstance(node, list) else ()
+        for key, child in children:
+            yield from places(child, (*path, key))
+
+    rng = random.Random(45)
+    values = [None, "x", "", -1, 0, 2, 1.5, -1e-3, 1e9, True, [], {}, [1], {"a": 1}, "outdoor", [0.0, 1.0]]
+    checks = [(None, HEATED)] + [(ITEMS[key], item) for key in ITEMS for item in HEATED[key]]
+    found = 0
+    for definition, instance in checks:
+        inlined, written = _validator(definition), as_written(definition)
+        assert best(inlined, instance) is None and best(written, instance) is None
+        where = [p for p in places(instance) if p]
+        for _ in range(80):
+            changed = copy.deepcopy(instance)
+            *parent_path, key = rng.choice(where)
+            parent = changed
+            for k in parent_path:
+                parent = parent[k]
+            if rng.random() < 0.7:
+                parent[key] = copy.deepcopy(rng.choice(values))
+            else:
+                del parent[key]
+            error = best(written, changed)
+            found += error is not None
+            assert best(inlined, changed) == error
+    assert found > 40 * len(checks)  # most changes break a rule: the comparison is of errors, not of silence
