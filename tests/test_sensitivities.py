@@ -205,3 +205,31 @@ def test_the_share_s_derivative_is_its_difference_quotient_inside_and_zero_where
     assert share(clipped, error) == 0.0
     assert not share_slope(clipped, error, None, slopes).any()
 
+
+
+def test_a_derivative_s_source_on_some_nodes_is_the_dense_formula_s_there():
+    """`Derivative.source` forms the right-hand side of the derivatives' steps on the nodes it is
+    given from the blocks its coefficients move: on random coefficients, every term nonzero
+    (switched conductances too, which no effect of the registry moves yet), it is the dense
+    (C/dt)(T^n - T^n+1) + q + A T^n+1 + B' terms - (G u) T^n+1 on those columns."""
+    from nodeforce.model.network import Coefficients, Derivative
+
+    rng = np.random.default_rng(5)
+    n, k, m, steps, dt = 9, 4, 3, 6, 600.0
+
+    def sparse(shape, rows, cols):
+        M = np.zeros(shape)
+        M[np.ix_(rows, cols)] = rng.normal(size=(len(rows), len(cols)))
+        return M
+
+    C, q = np.zeros(n), np.zeros(n)
+    C[[1, 6]], q[[2]] = rng.normal(size=2), rng.normal()
+    A, B, G = sparse((n, n), [1, 2], [1, 2, 7]), sparse((n, k), [6], [0, 3]), sparse((n, m), [2, 8], [1])
+    d = Derivative(C=C, A=Coefficients(A), B=Coefficients(B), q=q, G=Coefficients(G))
+    before, after = rng.normal(size=(steps, n)), rng.normal(size=(steps, n))
+    terms, inputs = rng.normal(size=(steps, k)), rng.normal(size=(steps, m))
+    dense = (before - after) * (C / dt) + q + after @ A.T + terms @ B.T - (inputs @ G.T) * after
+    nodes = np.array([1, 2, 4, 6, 7, 8])  # the rows the source may be nonzero on, and one beside them
+    assert set(d.rows) <= set(nodes)
+    np.testing.assert_allclose(d.source(before, after, terms, inputs, dt, nodes), dense[:, nodes],
+                               rtol=1e-12, atol=1e-12)
