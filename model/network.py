@@ -157,8 +157,9 @@ class Derivative:
         self.A.add_product(out, after, nodes)
         self.B.add_product(out, terms, nodes)
         if len(self.G.rows):
-            switched = inputs[:, self.G.cols] @ self.G.block.T
-            out[:, np.searchsorted(nodes, self.G.rows)] -= switched * after[:, self.G.rows]
+            switched = np.zeros_like(out)
+            self.G.add_product(switched, inputs, nodes)
+            out -= switched * after[:, nodes]
         return out
 
 
