@@ -41,10 +41,10 @@ RAISES_AND_RECOVERS = textwrap.dedent("""
 
     def run(U):
         calls.initialise(slave, 0.0, {}, {"ground_coupling.U": U})
-        step, T = calls.stepper(slave, [], ["T[23]"]), np.empty(1)
-        for k in range(4):
-            step(900.0 * k, 900.0, np.empty(0), T)
-        return T[0]
+        T = np.empty((4, 1))
+        calls.steps(slave, [], ["T[23]"]).run(900.0 * np.arange(4), np.full(4, 900.0), np.empty((4, 0)),
+                                               np.empty((4, 0)), T, 0)
+        return T[-1, 0]
 
     answers = []
     for attempt in range(12):
