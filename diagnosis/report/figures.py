@@ -305,53 +305,54 @@ PLOTTED_CANDIDATES = 24
 def plot_candidates(path, report):
     """Validation RMSE of the candidates against the baseline's, coloured by the loop's verdict:
     every chosen one and the others of lowest cross-validated error, PLOTTED_CANDIDATES in all
-    (a round calibrates tens)."""
+    (a round calibrates tens), one bar a row in the order they were tried, each named by its
+    effect and target (and round, where there are several)."""
     tried = report.get("candidates") or []
     kept = sorted(tried, key=lambda c: (not content.is_chosen(report, c),
                                         num((c.get("cv") or {}).get("J")) if num((c.get("cv") or {}).get("J"))
                                         is not None else np.inf))[:PLOTTED_CANDIDATES]
     candidates = [c for c in tried if any(c is k for k in kept)]
+    rounds = len({c.get("round") for c in tried}) > 1
     base = num(metrics(report, "before", "validation").get("rmse"))
-    fig = _new_figure(max(7.0, 1.1 * len(candidates) + 3), 5.0)
+    fig = _new_figure(10.0, 1.8 + 0.32 * len(candidates))
     ax = fig.add_subplot()
-    x = np.arange(len(candidates))
+    y = np.arange(len(candidates))[::-1]
     used = set()
-    for xi, c in zip(x, candidates):
+    for yi, c in zip(y, candidates):
         v = num(metrics(report, c, "validation").get("rmse"))
         if v is None:
-            ax.text(xi, 0.02, "failed", transform=ax.get_xaxis_transform(), ha="center", va="bottom",
-                    fontsize=8, color="tab:red")
+            ax.text(0.01, yi, "failed", transform=ax.get_yaxis_transform(), va="center", fontsize=8, color="tab:red")
             continue
-        verdict = content.verdict(report, c)
-        key = verdict_key(verdict)
+        key = verdict_key(content.verdict(report, c))
         style = dict(facecolor="tab:blue") if content.is_chosen(report, c) else VERDICT_STYLES[key][0]
         used.add("chosen" if content.is_chosen(report, c) else key)
-        ax.bar(xi, v, edgecolor="0.2", lw=0.5, **style)
+        ax.barh(yi, v, height=0.7, edgecolor="0.2", lw=0.5, **style)
         cv = num((c.get("cv") or {}).get("rmse"))
-        ax.annotate(fmt_temp(v) + (f"\nCV {fmt_temp(cv)}" if cv is not None else ""), (xi, v), xytext=(0, 3), textcoords="offset points", ha="center",
-                    va="bottom", fontsize=8, bbox=dict(facecolor="white", edgecolor="none", alpha=0.8, pad=0.5))
+        ax.annotate(fmt_temp(v) + (f" (CV {fmt_temp(cv)})" if cv is not None else ""), (v, yi), xytext=(3, 0),
+                    textcoords="offset points", va="center", fontsize=8)
     if base is not None:
-        ax.axhline(base, color=COLOR["before"], ls="--", lw=1.2, label=f"baseline (no effect) = {fmt_temp(base)} C")
+        ax.axvline(base, color=COLOR["before"], ls="--", lw=1.2, label=f"baseline (no effect) = {fmt_temp(base)} C")
     ref = content.reference(report)
     ref_rmse = num(ref[1].get("validation")) if ref else None
     if ref_rmse is not None:
-        ax.axhline(ref_rmse, color="tab:green", ls=":", lw=1.2, label=f"{ref[0]} = {fmt_temp(ref_rmse)} C")
+        ax.axvline(ref_rmse, color="tab:green", ls=":", lw=1.2, label=f"{ref[0]} = {fmt_temp(ref_rmse)} C")
     handles, _ = ax.get_legend_handles_labels()
     if "chosen" in used:
         handles.append(Patch(facecolor="tab:blue", edgecolor="0.2", label="chosen"))
     handles += [Patch(edgecolor="0.2", label=label, **style) for key, (style, label) in VERDICT_STYLES.items()
                 if key in used]
-    ax.set_xticks(x, [f"{c.get('effect')}\n{c.get('target') or ''}" for c in candidates], fontsize=8)
-    ax.set_xlabel("candidate effect / target")
-    ax.set_ylabel("validation RMSE of the air residual (C)")
+    ax.set_yticks(y, [f"{c.get('effect')} / {c.get('target') or ''}" + (f", round {c.get('round')}" if rounds else "")
+                      for c in candidates], fontsize=8)
+    ax.set_ylim(-0.7, len(candidates) - 0.3)
+    ax.set_xlabel("validation RMSE of the air residual (C)")
     tops = [v for v in [base, ref_rmse] + [num(metrics(report, c, "validation").get("rmse")) for c in candidates]
             if v is not None]
     if tops:
-        ax.set_ylim(0, 1.18 * max(tops))
+        ax.set_xlim(0, 1.3 * max(tops))  # room for the values written after the bars
     ax.set_title("Candidate effects: validation RMSE after calibration"
-                 + (f" (the {len(candidates)} of {len(tried)} of lowest cross-validated error)"
+                 + (f"\n(the {len(candidates)} of {len(tried)} of lowest cross-validated error)"
                     if len(candidates) < len(tried) else ""))
-    ax.grid(axis="y", alpha=0.3)
+    ax.grid(axis="x", alpha=0.3)
     fig.legend(handles=handles, loc="outside lower center", ncols=2, fontsize=9, frameon=False)
     return _save(fig, path)
 
