@@ -54,7 +54,7 @@ from nodeforce import lifetime
 from nodeforce.cluster import Cluster
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
-from nodeforce.diagnosis.assess import assess, protocols
+from nodeforce.diagnosis.assess import assess, assess_shared, protocols
 from nodeforce.diagnosis.calibrate import Candidate
 from nodeforce.diagnosis.candidates import physical, shaped_inputs, shapes
 from nodeforce.diagnosis.compare import compare
@@ -131,9 +131,11 @@ def assess_all(model, pairs, windows, objective, sigma, folder, seed, pool=None,
                     raise outcome
         else:
             assessed = []
-            for outcome in (pool.map if pool else map)(partial(assess, shared), pairs):
-                assessed.append(outcome)
-                bar.update()
+            with lifetime.shared(shared) if pool else nullcontext() as path:
+                task = partial(assess_shared, path) if pool else partial(assess, shared)
+                for outcome in (pool.map if pool else map)(task, pairs):
+                    assessed.append(outcome)
+                    bar.update()
     for (effect, target), a in zip(pairs, assessed):
         (folder / f"{effect}@{target}.json").write_text(json.dumps(a.building, indent=2) + "\n")
     return list(assessed)

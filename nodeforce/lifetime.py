@@ -30,6 +30,7 @@ SIGTERM. A run stopped by a cause outside its inputs that a rerun may not meet (
 scheduler) raises `RunStopped` and exits with 75 (EX_TEMPFAIL of sysexits.h: try again).
 """
 import ctypes
+import functools
 import multiprocessing
 import os
 import pickle
@@ -221,6 +222,28 @@ def stop_pool(pool: ProcessPoolExecutor) -> None:
             killed = True
     if killed:
         tempdirs.sweep()
+
+
+@contextmanager
+def shared(value):
+    """The path of `value` pickled once to a folder of its own, for the tasks of a pool to read
+    where they run (`read_shared`: once a worker) instead of each carrying it through the pipe
+    (a round of the Twin House's candidates shares some 30 MB: 37 ms to pickle in the parent and
+    13 ms to read, for every one of its 180 tasks). The folder goes at the block's end."""
+    folder = tempdirs.make("shared")
+    try:
+        path = Path(folder) / "shared.pickle"
+        path.write_bytes(pickle.dumps(value, pickle.HIGHEST_PROTOCOL))
+        yield str(path)
+    finally:
+        tempdirs.remove(folder)
+
+
+@functools.lru_cache(maxsize=1)
+def read_shared(path):
+    """What `shared` wrote to `path`, read once in this process (the last one read is kept)."""
+    tempdirs.hold(Path(path).parent)  # a parent killed outright leaves it to its workers
+    return pickle.loads(Path(path).read_bytes())
 
 
 @contextmanager
