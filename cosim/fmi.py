@@ -16,7 +16,6 @@ when the interpreter exits: instances still open then are freed first, while Pyt
 (a library's own exit handlers must not meet live instances after the interpreter has gone).
 """
 import atexit
-import ctypes
 import functools
 import logging
 import weakref
@@ -31,7 +30,7 @@ from fmpy.fmi2 import FMU2Slave, fmi2Boolean, fmi2Integer, fmi2True, fmi2Warning
 from fmpy.fmi3 import FMU3Slave, fmi3Boolean, fmi3Float64
 
 from nodeforce import tempdirs
-from nodeforce.model.compiled import compile_library, find_compiler
+from nodeforce.model.compiled import compiled_function
 
 log = logging.getLogger("nodeforce.cosim")
 
@@ -57,17 +56,10 @@ def _master():
     """The step loop compiled (c/master.c), loaded once per process; None where it cannot be
     compiled (no C compiler, or one that fails on it: said once in the log): the loop runs in
     Python."""
-    if find_compiler() is None:
+    function = compiled_function(Path(__file__).with_name("c"), "master.c", "nodeforce_master_steps",
+                                 "the FMUs' steps are looped in Python", log)
+    if function is None:
         return None
-    try:
-        data = compile_library(Path(__file__).with_name("c"), "master.c")
-    except RuntimeError as error:
-        log.warning("the FMUs' steps are looped in Python: %s", str(error).splitlines()[0])
-        return None
-    with tempdirs.folder("master") as tmp:
-        path = Path(tmp) / "master.so"
-        path.write_bytes(data)
-        function = ctypes.CDLL(str(path)).nodeforce_master_steps
     double = np.ctypeslib.ndpointer(np.float64, flags="C")
     function.restype = c_int64
     function.argtypes = [c_int, c_void_p, c_void_p, c_int, c_void_p, c_int, c_void_p, c_void_p,

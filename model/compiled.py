@@ -77,22 +77,34 @@ def compile_library(directory, source, libraries=(), link_options=(), defines=()
         return output.read_bytes()
 
 
+def compiled_function(directory, source, symbol, fallback, logger, options=("-O2",)):
+    """The function `symbol` of `directory`/`source` compiled here (`compile_library`) and loaded
+    from a temporary folder removed at once; None where it cannot be compiled (no C compiler, or
+    one that fails on it: `fallback`, what is done instead, said in `logger`'s log with the
+    compiler's first line). The caller declares its argument and result types."""
+    if find_compiler() is None:
+        return None
+    try:
+        data = compile_library(directory, source, options=options)
+    except RuntimeError as error:
+        logger.warning("%s: %s", fallback, str(error).splitlines()[0])
+        return None
+    stem = Path(source).stem
+    with tempdirs.folder(stem) as tmp:
+        path = Path(tmp) / f"{stem}.so"
+        path.write_bytes(data)
+        return getattr(ctypes.CDLL(str(path)), symbol)
+
+
 @functools.lru_cache(maxsize=None)
 def _library():
     """The loaded library, or None where it cannot be compiled (no C compiler, or one that fails
     on it: said once in the log)."""
-    if find_compiler() is None:
+    # for this machine's processor: the library is never shipped
+    function = compiled_function(C_DIR, "steps.c", "nodeforce_steps", "the runs of steps are stepped in numpy", log,
+                                 options=("-O3", "-march=native"))
+    if function is None:
         return None
-    try:  # for this machine's processor: the library is never shipped
-        data = compile_library(C_DIR, "steps.c", options=("-O3", "-march=native"))
-    except RuntimeError as error:
-        log.warning("the runs of steps are stepped in numpy: %s", str(error).splitlines()[0])
-        return None
-    with tempdirs.folder("steps") as tmp:
-        path = Path(tmp) / "steps.so"
-        path.write_bytes(data)
-        loaded = ctypes.CDLL(str(path))
-    function = loaded.nodeforce_steps
     function.restype = ctypes.c_int
     function.argtypes = [ctypes.c_int, _INT, _INT, _INT, _INT, _INT, ctypes.c_long, _INT, _DOUBLE, _DOUBLE,
                          ctypes.c_long, ctypes.c_int, _DOUBLE, _INT, _INT, _DOUBLE, _DOUBLE, ctypes.c_int, _INT, _DOUBLE,
