@@ -5,7 +5,7 @@ simulate thousands of forcing masks without unzipping or instantiating again. A 
 (`Steps`) call the FMU's set, doStep and get functions as FMPy bound them from its library,
 checking their status as FMPy does: in a loop compiled once per process (c/master.c), where a
 C compiler is found, else in Python, the same calls with the same values. A step of the test
-cell's standalone FMU costs some 5 us in C, 16 us in Python (benchmarks/bench_fmu_calls.py).
+cell's standalone FMU costs some 5 us in C, 16 us in Python (docs/performance.md).
 
 The calls follow the model description's fmiVersion, as FMPy's own `simulate_fmu` does: one class
 per version (`Fmi2`, `Fmi3`) sets, steps and gets, and both speak in scalar names (`force[i]`,
@@ -100,10 +100,10 @@ SET_REAL2, SET_DERIVATIVES2, SET_FLOAT3 = 0, 1, 2
 
 
 class Steps:
-    """A run's calls at every step, bound to an instance: set the inputs (`inputs`, set by the
-    FMI function `input_call` of form `input_form`), set their slopes (`slopes`, `slope_call`,
-    `slope_form`), `step_call`, get the outputs (`outputs`, `output_call`); `bound` holds, for the
-    loop in Python, each of them as a function of what changes between steps."""
+    """A run's calls at every step, bound to an instance: set the inputs (the `Transfer`
+    `inputs`), set their slopes (`slopes`), step, get the outputs (`outputs`). `calls` names the
+    four FMI functions, `forms` says how c/master.c calls the two sets (SET_REAL2, ...), and
+    `bound` holds, for the loop in Python, each call as a function of what changes between steps."""
 
     def __init__(self, version, fmu, inputs, slopes, outputs, calls, forms, bound):
         self.version, self.fmu = version, fmu
@@ -116,7 +116,8 @@ class Steps:
         loop compiles, else in Python: the same calls with the same values."""
         master = _master()
         if master is None:
-            return self._run_in_python(times, steps, inputs, slopes, outputs, skip)
+            self._run_in_python(times, steps, inputs, slopes, outputs, skip)
+            return
         orders = np.ones(max(self.slopes.n, 1), dtype=np.intc)
         status = c_int()
         address = lambda name: cast(raw(self.fmu, name), c_void_p).value
