@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
-from fmpy.fmi2 import FMU2Slave, fmi2Boolean, fmi2Integer, fmi2True, fmi2Warning
+from fmpy.fmi2 import FMU2Slave, fmi2Boolean, fmi2True, fmi2Warning
 from fmpy.fmi3 import FMU3Slave, fmi3Boolean, fmi3Float64
 
 from nodeforce import tempdirs
@@ -99,16 +99,27 @@ class _TransferStruct(Structure):
 SET_REAL2, SET_DERIVATIVES2, SET_FLOAT3 = 0, 1, 2
 
 
+def _bound(form, function, component, t, orders):
+    """The set (or get) of transfer `t` by FMI function `function` as c/master.c calls it in
+    `form`, with nothing left to give: a get has the arguments of the set of its version."""
+    tail = {SET_REAL2: (t.values_pointer,), SET_DERIVATIVES2: (orders, t.values_pointer),
+            SET_FLOAT3: (t.values_pointer, len(t.values))}[form]
+    return partial(function, component, t.refs_pointer, len(t.refs), *tail)
+
+
 class Steps:
     """A run's calls at every step, bound to an instance: set the inputs (the `Transfer`
-    `inputs`), set their slopes (`slopes`), step, get the outputs (`outputs`). `calls` names the
-    four FMI functions, `forms` says how c/master.c calls the two sets (SET_REAL2, ...), and
-    `bound` holds, for the loop in Python, each call as a function of what changes between steps."""
+    `inputs`), set their slopes (`slopes`), step, get the outputs (`outputs`), through the FMI
+    functions `calls` names; `forms` says how the two sets are called (SET_REAL2, ...). The loop
+    in C (c/master.c) and the one in Python read these alike."""
 
-    def __init__(self, version, fmu, inputs, slopes, outputs, calls, forms, bound):
-        self.version, self.fmu = version, fmu
+    def __init__(self, version, fmu, inputs, slopes, outputs, calls, forms):
+        self.version, self.component = version, fmu.component
         self.inputs, self.slopes, self.outputs = inputs, slopes, outputs
-        self.calls, self.forms, self.bound = calls, forms, bound
+        self.calls, self.forms = calls, forms
+        self.orders = np.ones(max(slopes.n, 1), dtype=np.intc)
+        self.functions = [raw(fmu, name) for name in calls]
+        self.addresses = [cast(f, c_void_p).value for f in self.functions]
 
     def run(self, times, steps, inputs, slopes, outputs, skip):
         """Step k from times[k] by steps[k] with row k of `inputs` and of `slopes` set before it,
@@ -118,18 +129,26 @@ class Steps:
         if master is None:
             self._run_in_python(times, steps, inputs, slopes, outputs, skip)
             return
-        orders = np.ones(max(self.slopes.n, 1), dtype=np.intc)
         status = c_int()
-        address = lambda name: cast(raw(self.fmu, name), c_void_p).value
-        failed = master(self.version, self.fmu.component, address(self.calls[0]), self.forms[0],
-                        address(self.calls[1]), self.forms[1], address(self.calls[2]), address(self.calls[3]),
-                        byref(self.inputs.struct), byref(self.slopes.struct), byref(self.outputs.struct),
-                        len(times), times, steps, inputs, slopes, outputs, skip, orders, byref(status))
+        set_inputs, set_slopes, do_step, get_outputs = self.addresses
+        failed = master(self.version, self.component, set_inputs, self.forms[0], set_slopes, self.forms[1], do_step,
+                        get_outputs, byref(self.inputs.struct), byref(self.slopes.struct), byref(self.outputs.struct),
+                        len(times), times, steps, inputs, slopes, outputs, skip, self.orders, byref(status))
         if failed >= 0:
             check(status.value, self.calls[failed % 4])
 
     def _run_in_python(self, times, steps, inputs, slopes, outputs, skip):
-        set_inputs, set_slopes, do_step, get_outputs = self.bound
+        orders = self.orders.ctypes.data_as(POINTER(c_int))
+        set_inputs, set_slopes = (_bound(form, f, self.component, t, orders) for form, f, t in
+                                  zip(self.forms, self.functions, (self.inputs, self.slopes)))
+        get_outputs = _bound(SET_REAL2 if self.version == 2 else SET_FLOAT3, self.functions[3], self.component,
+                             self.outputs, orders)
+        if self.version == 2:
+            flags = (fmi2Boolean(fmi2True),)
+        else:
+            event, terminate, early, last = fmi3Boolean(), fmi3Boolean(), fmi3Boolean(), fmi3Float64()
+            flags = fmi3Boolean(True), byref(event), byref(terminate), byref(early), byref(last)
+        do_step = self.functions[2]
         for k in range(len(times)):
             if self.inputs.n:
                 self.inputs.values[self.inputs.positions] = inputs[k]
@@ -137,7 +156,7 @@ class Steps:
             if self.slopes.n:
                 self.slopes.values[self.slopes.positions] = slopes[k]
                 check(set_slopes(), self.calls[1])
-            check(do_step(times[k], steps[k]), self.calls[2])
+            check(do_step(self.component, times[k], steps[k], *flags), self.calls[2])
             if k >= skip:
                 check(get_outputs(), self.calls[3])
                 outputs[k - skip] = self.outputs.values[self.outputs.positions]
@@ -190,16 +209,8 @@ class Fmi2:
         outputs = Transfer.scalars(self.refs(output_names))
         slope_call, slope_form = (("fmi2SetReal", SET_REAL2) if self.derivatives_as_values
                                   else ("fmi2SetRealInputDerivatives", SET_DERIVATIVES2))
-        orders = () if self.derivatives_as_values else ((fmi2Integer * n_slopes)(*([1] * n_slopes)),)
-        component, no_rollback = fmu.component, fmi2Boolean(fmi2True)
-        set_real, set_slopes, do_step, get_real = (raw(fmu, name) for name in
-                                                   ("fmi2SetReal", slope_call, "fmi2DoStep", "fmi2GetReal"))
-        bound = (partial(set_real, component, inputs.refs_pointer, inputs.n, inputs.values_pointer),
-                 partial(set_slopes, component, slopes.refs_pointer, slopes.n, *orders, slopes.values_pointer),
-                 lambda time, dt: do_step(component, time, dt, no_rollback),
-                 partial(get_real, component, outputs.refs_pointer, outputs.n, outputs.values_pointer))
         return Steps(2, fmu, inputs, slopes, outputs, ("fmi2SetReal", slope_call, "fmi2DoStep", "fmi2GetReal"),
-                     (SET_REAL2, slope_form), bound)
+                     (SET_REAL2, slope_form))
 
 
 class Fmi3(Fmi2):
@@ -267,17 +278,8 @@ class Fmi3(Fmi2):
         inputs, slopes, outputs = (Transfer(*self.layout(names)) for names in
                                    (input_names, [self.derivative_name(n) for n in input_names[:n_slopes]],
                                     output_names))
-        component = fmu.component
-        set_float, do_step, get_float = (raw(fmu, name) for name in ("fmi3SetFloat64", "fmi3DoStep", "fmi3GetFloat64"))
-        event, terminate, early, last = fmi3Boolean(), fmi3Boolean(), fmi3Boolean(), fmi3Float64()
-        flags = fmi3Boolean(True), byref(event), byref(terminate), byref(early), byref(last)
-        bound = tuple(partial(set_float, component, t.refs_pointer, len(t.refs), t.values_pointer, len(t.values))
-                      for t in (inputs, slopes))
-        bound += (lambda time, dt: do_step(component, time, dt, *flags),
-                  partial(get_float, component, outputs.refs_pointer, len(outputs.refs), outputs.values_pointer,
-                          len(outputs.values)))
         return Steps(3, fmu, inputs, slopes, outputs, ("fmi3SetFloat64", "fmi3SetFloat64", "fmi3DoStep", "fmi3GetFloat64"),
-                     (SET_FLOAT3, SET_FLOAT3), bound)
+                     (SET_FLOAT3, SET_FLOAT3))
 
 
 VERSIONS = {"2.0": Fmi2, "3.0": Fmi3}
