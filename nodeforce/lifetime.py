@@ -173,9 +173,22 @@ class _Pool(ProcessPoolExecutor):
             tempdirs.remove(self.folder)
 
 
-def _initialized_from(path):
+def _written(payload, kind):
+    """The path of `payload` (a pickle's bytes) written to a new folder of `kind`
+    (`tempdirs.make`), which the caller removes, for worker processes to read (`_unpickled`)."""
+    path = Path(tempdirs.make(kind)) / f"{kind}.pickle"
+    path.write_bytes(payload)
+    return str(path)
+
+
+def _unpickled(path):
+    """What `_written` wrote to `path`, read in a worker, which counts its folder among its own."""
     tempdirs.hold(Path(path).parent)  # a parent killed outright leaves it to its workers
-    initializer, initargs = pickle.loads(Path(path).read_bytes())
+    return pickle.loads(Path(path).read_bytes())
+
+
+def _initialized_from(path):
+    initializer, initargs = _unpickled(path)
     initializer(*initargs)
 
 
@@ -192,10 +205,9 @@ def new_pool(workers: int, initializer=None, initargs=()) -> ProcessPoolExecutor
     if initializer is not None:
         payload = pickle.dumps(arguments, pickle.HIGHEST_PROTOCOL)
         if len(payload) > PIPE_BYTES:
-            folder = tempdirs.make("pool")
-            path = Path(folder) / "initializer.pickle"
-            path.write_bytes(payload)
-            arguments = (_initialized_from, (str(path),))
+            path = _written(payload, "pool")
+            folder = str(Path(path).parent)
+            arguments = (_initialized_from, (path,))
     pool = _Pool(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
                  initializer=_worker_start, initargs=(os.getpid(), workers, *arguments))
     pool.folder = folder
@@ -230,20 +242,17 @@ def shared(value):
     where they run (`read_shared`: once a worker) instead of each carrying it through the pipe
     (a round of the Twin House's candidates shares some 30 MB: 37 ms to pickle in the parent and
     13 ms to read, for every one of its 180 tasks). The folder goes at the block's end."""
-    folder = tempdirs.make("shared")
+    path = _written(pickle.dumps(value, pickle.HIGHEST_PROTOCOL), "shared")
     try:
-        path = Path(folder) / "shared.pickle"
-        path.write_bytes(pickle.dumps(value, pickle.HIGHEST_PROTOCOL))
-        yield str(path)
+        yield path
     finally:
-        tempdirs.remove(folder)
+        tempdirs.remove(Path(path).parent)
 
 
 @functools.lru_cache(maxsize=1)
 def read_shared(path):
     """What `shared` wrote to `path`, read once in this process (the last one read is kept)."""
-    tempdirs.hold(Path(path).parent)  # a parent killed outright leaves it to its workers
-    return pickle.loads(Path(path).read_bytes())
+    return _unpickled(path)
 
 
 @contextmanager
