@@ -13,8 +13,8 @@ on data the calibration did not see.
    component the share of J above the noise its forcing removes (the evidence).
 4. Rounds. Each calibrates every physical candidate (`diagnosis.candidates.physical`: every zone
    effect of the objective zones, the component effects of the components the evidence ranks
-   highest and of those no sensor sits in) on the direct model, the candidates in parallel
-   worker processes or on a Dask cluster's workers (`scheduler`, as the forcing search), once
+   highest and of those no sensor sits in) on the direct model, the candidates in the worker
+   processes that ran the forcing search or on a Dask cluster's workers (`scheduler`), once
    on the whole calibration window and once per block left out
    (`diagnosis.calibrate`); where none brings the error to the noise, the shapes the residual's
    statistics point at too (`diagnosis.candidates.shapes`). One rule chooses
@@ -113,9 +113,9 @@ def assess_all(model, pairs, windows, objective, sigma, folder, seed, pool=None,
                held=None):
     """Each (effect, target) added to `model`, calibrated on every record's calibration window
     (t_0..t_k) with a fold per block, and run over each record, in the worker processes of
-    `pool` (`lifetime.worker_pool`; None: in this process), or on the workers of `cluster` (a
-    `nodeforce.cluster.Cluster`), each candidate's building file written in `folder`: their
-    `Assessed`, in the order of `pairs`. `sigma`: the sensors' noise (C), against which a
+    `pool` (the command's `lifetime.Workers`; None: in this process), or on the workers of
+    `cluster` (a `nodeforce.cluster.Cluster`), each candidate's building file written in
+    `folder`: their `Assessed`, in the order of `pairs`. `sigma`: the sensors' noise (C), against which a
     component's own nodes are weighed in its fit (`calibrate.own_weights`). `beside`: effects
     `model` holds ((effect, target)) refitted together with each candidate, those of their
     parameters `held` ({label: names}) kept as they are (`calibrate.Candidate`)."""
@@ -218,13 +218,16 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
                                                 f"(read_record) for the building diagnosed, {building.source}")
     bases = [protocol(building, r) for r in records]
     fmu_kind = evaluator_kind(fmu_kind, [building, *filter(None, bases)])
-    with Cluster(scheduler) if scheduler is not None else nullcontext() as cluster:
+    # one pool of workers for the search and the rounds, started first: their imports overlap `prepare`
+    count = (workers or os.cpu_count()) if scheduler is None else 1
+    with Cluster(scheduler) if scheduler is not None else nullcontext() as cluster, \
+            lifetime.worker_pool(count) if count > 1 else nullcontext() as pool:
         prepared = prepare(building, records, bases, objective, workdir, fmu_kind, noise)
-        search = dict(seed=seed, workers=workers, scheduler=scheduler, population=population,
+        search = dict(seed=seed, workers=pool or 1, scheduler=scheduler, population=population,
                       generations=generations, fmu_kind=search_fmu,
                       noise=prepared.noise.sigma if prepared.noise.given else None)
         located = localise(building, prepared, objective, workdir, search)
-        made = rounds(prepared, located.localization, objective, workdir, seed, workers, cluster)
+        made = rounds(prepared, located.localization, objective, workdir, seed, pool, cluster)
     return write(building, prepared, located, made, objective, workdir, fmu_kind, reference, later)
 
 
@@ -308,63 +311,61 @@ def localise(building, prepared, objective, workdir, search):
     return Located(localization, alone, convergence)
 
 
-def rounds(prepared, localization, objective, workdir, seed, workers, cluster=None):
+def rounds(prepared, localization, objective, workdir, seed, pool=None, cluster=None):
     """Stage 3: rounds of candidates, `POLICY.max_rounds` at most, each on top of the last,
     while the error left is above the noise and one is chosen (`selection.decide`); the
-    candidates in `workers` processes, one pool for every round (a worker's start, its imports,
-    paid once), or on `cluster`'s workers (`assess_all`)."""
-    n_workers = (workers or os.cpu_count()) if cluster is None else 1
-    with lifetime.worker_pool(n_workers) if n_workers > 1 else nullcontext() as pool:
-        windows, n, noise = prepared.windows, prepared.n, prepared.noise
-        folder = workdir / "candidates"
-        folder.mkdir(exist_ok=True)
-        measured_ids = sorted({i for case in windows.cases for i in case.measured_ids})
-        model, decisions, results, runs, sensitivities = prepared.model, [], [], {}, {}
-        for number in range(POLICY.max_rounds):
-            base_blocks = windows.block_J(model.runs)
-            air_at_noise = bool(number) and POLICY.at_noise(base_blocks.sum(), n, noise.floor_sd)
-            base_sensed = windows.sensed_by(model)  # the round's model at the other sensors: one run per record
-            if air_at_noise and not windows.disagreeing(model.building, base_sensed, noise.sigma):
-                break  # the error left is the noise's, at the air and at every component's own sensors
-            done = [d.chosen.label for d in decisions]  # every earlier round chose: a round without a choice ends them
-            started = time.perf_counter()
-            # a later round's candidates, on top of the earlier choices, are building files of their own
-            into = folder / f"round{number + 1}" if number else folder
-            into.mkdir(exist_ok=True)
-            pairs = [p for p in physical(model.building, localization["components"], objective.zones,
-                                         measured_ids, localization["best_nodes"]) if "@".join(p) not in done]
-            assessed = assess_all(model, pairs, windows, objective, noise.sigma, into, seed, pool, cluster)
-            tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma, number + 1,
-                                    done)
-            # shapes only where no physical candidate physics admits brings the error left to the
-            # noise; the residual's statistics then choose which
-            if not any(POLICY.at_noise(r.cv.J, n, noise.floor_sd) and not POLICY.objection_of(
-                    r.effect, r.parameters, r.derived, r.physics) for r in tried):
-                more = [p for p in shapes(model.building, left_by(windows, model), objective.zones)
-                        if "@".join(p) not in done]
-                pairs, assessed = pairs + more, assessed + assess_all(model, more, windows, objective, noise.sigma,
-                                                                      into, seed, pool, cluster)
-                # every sensor's weight from the least misfit any candidate of the round leaves
-                tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma,
-                                        number + 1, done)
-            simulations = sum(a.simulations for a in assessed)
-            # a round run for a component's own sensors alone: only they can make a candidate pass
-            decision = decide(tried, base_blocks, noise.sigma, n, windows.groups(), noise.floor_sd,
-                              air_at_noise=air_at_noise)
-            decision.cost = {"candidates": len(tried), "simulations": simulations,
-                             "seconds": round(time.perf_counter() - started, 1)}
-            decisions.append(decision)
-            results += [lean(r) for r in tried]
-            runs.update({(key if not number else f"{key} (round {number + 1})"): m.runs for key, m in models.items()})
-            chosen = decision.chosen
-            if not chosen:
-                break
-            sensitivities[chosen.label] = screened(model, chosen, windows, objective, seed)
-            model = models[chosen.label]
-        made = Made(decisions, results, runs, sensitivities, model)
-        for fit in made.added[:-1]:
-            made = revisit(prepared, made, fit, objective, folder, seed, pool, cluster)
-        return made
+    candidates in the worker processes of `pool` (the command's `lifetime.Workers`, which ran
+    its forcing search; None: in this process) or on `cluster`'s workers (`assess_all`)."""
+    windows, n, noise = prepared.windows, prepared.n, prepared.noise
+    folder = workdir / "candidates"
+    folder.mkdir(exist_ok=True)
+    measured_ids = sorted({i for case in windows.cases for i in case.measured_ids})
+    model, decisions, results, runs, sensitivities = prepared.model, [], [], {}, {}
+    for number in range(POLICY.max_rounds):
+        base_blocks = windows.block_J(model.runs)
+        air_at_noise = bool(number) and POLICY.at_noise(base_blocks.sum(), n, noise.floor_sd)
+        base_sensed = windows.sensed_by(model)  # the round's model at the other sensors: one run per record
+        if air_at_noise and not windows.disagreeing(model.building, base_sensed, noise.sigma):
+            break  # the error left is the noise's, at the air and at every component's own sensors
+        done = [d.chosen.label for d in decisions]  # every earlier round chose: a round without a choice ends them
+        started = time.perf_counter()
+        # a later round's candidates, on top of the earlier choices, are building files of their own
+        into = folder / f"round{number + 1}" if number else folder
+        into.mkdir(exist_ok=True)
+        pairs = [p for p in physical(model.building, localization["components"], objective.zones,
+                                     measured_ids, localization["best_nodes"]) if "@".join(p) not in done]
+        assessed = assess_all(model, pairs, windows, objective, noise.sigma, into, seed, pool, cluster)
+        tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma, number + 1,
+                                done)
+        # shapes only where no physical candidate physics admits brings the error left to the
+        # noise; the residual's statistics then choose which
+        if not any(POLICY.at_noise(r.cv.J, n, noise.floor_sd) and not POLICY.objection_of(
+                r.effect, r.parameters, r.derived, r.physics) for r in tried):
+            more = [p for p in shapes(model.building, left_by(windows, model), objective.zones)
+                    if "@".join(p) not in done]
+            pairs, assessed = pairs + more, assessed + assess_all(model, more, windows, objective, noise.sigma,
+                                                                  into, seed, pool, cluster)
+            # every sensor's weight from the least misfit any candidate of the round leaves
+            tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma,
+                                    number + 1, done)
+        simulations = sum(a.simulations for a in assessed)
+        # a round run for a component's own sensors alone: only they can make a candidate pass
+        decision = decide(tried, base_blocks, noise.sigma, n, windows.groups(), noise.floor_sd,
+                          air_at_noise=air_at_noise)
+        decision.cost = {"candidates": len(tried), "simulations": simulations,
+                         "seconds": round(time.perf_counter() - started, 1)}
+        decisions.append(decision)
+        results += [lean(r) for r in tried]
+        runs.update({(key if not number else f"{key} (round {number + 1})"): m.runs for key, m in models.items()})
+        chosen = decision.chosen
+        if not chosen:
+            break
+        sensitivities[chosen.label] = screened(model, chosen, windows, objective, seed)
+        model = models[chosen.label]
+    made = Made(decisions, results, runs, sensitivities, model)
+    for fit in made.added[:-1]:
+        made = revisit(prepared, made, fit, objective, folder, seed, pool, cluster)
+    return made
 
 
 def revisit(prepared, made, fit, objective, folder, seed, pool, cluster):

@@ -25,6 +25,7 @@ import math
 import multiprocessing.util
 import pickle
 import threading
+from contextlib import ExitStack
 from functools import partial
 from typing import Iterable, Sequence
 
@@ -104,46 +105,42 @@ class InProcessBackend(_Backend):
         close_evaluator(self._evaluator)
 
 
-# Per worker process: the evaluator built once by the pool initializer.
+# Per worker process: the search in progress's (path of its factory, evaluator, finaliser that
+# closes it), the evaluator built on the search's first task there from the factory it shares
+# (`lifetime.shared`). A later search in the same processes (a command's `lifetime.Workers`)
+# closes it.
 _process_evaluator = None
-_process_setup_error: "str | None" = None
 
 
-def _pool_initializer(factory):
-    # An initializer that raises would break the pool and look like a crash; keep the error
-    # and report it from the tasks instead, so it stops the search as a setup error.
-    global _process_evaluator, _process_setup_error
-    try:
-        _process_evaluator = _build(factory)
-    except EvaluatorSetupError as exc:
-        _process_setup_error = str(exc)
-        return
-    # Closed when the worker exits, which the pool's shutdown makes it do (multiprocessing runs
-    # its finalisers at a worker's normal exit, fork or spawn alike).
-    multiprocessing.util.Finalize(_process_evaluator, close_evaluator, args=(_process_evaluator,),
-                                  exitpriority=10)
-
-
-def _pool_task(masks):
-    if _process_evaluator is None:
-        raise EvaluatorSetupError(_process_setup_error)
-    return evaluate_masks(_process_evaluator, masks)
+def _pool_task(path, masks):
+    global _process_evaluator
+    if _process_evaluator is None or _process_evaluator[0] != path:
+        if _process_evaluator is not None:
+            _process_evaluator[2]()
+            _process_evaluator = None
+        evaluator = _build(lifetime.read_shared(path))
+        # closed at the latest when the worker exits, which the pool's shutdown makes it do
+        # (multiprocessing runs its finalisers at a worker's normal exit)
+        _process_evaluator = (path, evaluator, multiprocessing.util.Finalize(
+            evaluator, close_evaluator, args=(evaluator,), exitpriority=10))
+    return evaluate_masks(_process_evaluator[1], masks)
 
 
 class ProcessBackend(_Backend):
-    """A pool of `workers` processes, each holding its own evaluator; they end with this process
-    (nodeforce.lifetime)."""
+    """Worker processes, each building its own evaluator from the factory on its first chunk:
+    `workers`, a command's `lifetime.Workers` that other stages use after the search, or a count
+    of processes started for the search alone; they end with this process (nodeforce.lifetime).
+    A worker that dies (a crash in a C library) breaks the pool: the processes are started anew."""
 
-    def __init__(self, factory, workers: int):
-        self._factory = factory
-        self.slots = workers
-        self._pool = self._new_pool()
-
-    def _new_pool(self):
-        return lifetime.new_pool(self.slots, _pool_initializer, (self._factory,))
+    def __init__(self, factory, workers: "int | lifetime.Workers"):
+        self._own = not isinstance(workers, lifetime.Workers)
+        self._workers = lifetime.Workers(workers) if self._own else workers
+        self.slots = self._workers.count
+        self._shared = ExitStack()
+        self._task = partial(_pool_task, self._shared.enter_context(lifetime.shared(factory)))
 
     def run(self, chunks):
-        futures = [self._pool.submit(_pool_task, chunk) for chunk in chunks]
+        futures = [self._workers.submit(self._task, chunk) for chunk in chunks]
         results, broken = [], False
         for future in futures:
             try:
@@ -154,15 +151,17 @@ class ProcessBackend(_Backend):
                 results.append(exc)
                 broken = True
         if broken:
-            self._pool.shutdown(wait=False, cancel_futures=True)
-            self._pool = self._new_pool()
+            self._workers.renew()
         return results
 
     def close(self, abort=False):
-        if abort:
-            lifetime.stop_pool(self._pool)
-        else:
-            self._pool.shutdown(wait=True, cancel_futures=True)
+        try:
+            if self._own and abort:
+                lifetime.stop_pool(self._workers.pool)
+            elif self._own:
+                self._workers.pool.shutdown(wait=True, cancel_futures=True)
+        finally:
+            self._shared.close()
 
 
 # Per Dask worker process: evaluators keyed by (factory token, thread), built on first use.
@@ -217,8 +216,9 @@ class DaskBackend(_Backend):
             self._cluster.close()
 
 
-def open_backend(factory, workers: "int | None", scheduler: "str | None"):
-    """The backend the caller asked for: Dask if a scheduler address is given, else processes."""
+def open_backend(factory, workers: "int | lifetime.Workers", scheduler: "str | None"):
+    """The backend the caller asked for: Dask if a scheduler address is given, else processes
+    (`workers`: a count, 1 for this process, or a command's `lifetime.Workers`)."""
     if scheduler is not None:
         return DaskBackend(factory, scheduler)
     if workers == 1:

@@ -1,9 +1,9 @@
 """How a run ends when it is stopped: worker processes that end with their parent, SIGINT and
 SIGTERM turned into a clean stop, and a distinct exit status for each way of stopping.
 
-Worker pools (`new_pool`, `worker_pool`) start their processes with "spawn" (evaluators hold FMU
-and C-library state that must not be inherited through fork) and, in each worker, before the
-caller's initializer:
+Worker pools (`new_pool`, `worker_pool`'s `Workers`) start their processes with "spawn"
+(evaluators hold FMU and C-library state that must not be inherited through fork) and, in each
+worker, before any task:
 
 - on Linux, the parent-death signal (prctl PR_SET_PDEATHSIG) is SIGTERM, then the parent's pid
   is checked once more: a parent that died before the prctl would never send it. The kernel
@@ -144,7 +144,7 @@ def share_cores(workers):
     threadpool_limits(threads)
 
 
-def _worker_start(parent, workers, initializer, initargs):
+def _worker_start(parent, workers):
     share_cores(workers)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, _worker_exit)
@@ -154,64 +154,16 @@ def _worker_start(parent, workers, initializer, initargs):
             _worker_exit(signal.SIGTERM, None)
     else:
         threading.Thread(target=_watch_parent, args=(parent,), daemon=True).start()
-    if initializer is not None:
-        initializer(*initargs)
 
 
-# What a pipe holds before its writer waits (Linux's default, 64 KiB, less a margin)
-PIPE_BYTES = 60_000
-
-
-class _Pool(ProcessPoolExecutor):
-    """A ProcessPoolExecutor that removes, once shut down, the folder its initializer's arguments
-    were written to (`new_pool`)."""
-    folder = None
-
-    def shutdown(self, wait=True, *, cancel_futures=False):
-        super().shutdown(wait=wait, cancel_futures=cancel_futures)
-        if self.folder is not None:
-            tempdirs.remove(self.folder)
-
-
-def _written(payload, kind):
-    """The path of `payload` (a pickle's bytes) written to a new folder of `kind`
-    (`tempdirs.make`), which the caller removes, for worker processes to read (`_unpickled`)."""
-    path = Path(tempdirs.make(kind)) / f"{kind}.pickle"
-    path.write_bytes(payload)
-    return str(path)
-
-
-def _unpickled(path):
-    """What `_written` wrote to `path`, read in a worker, which counts its folder among its own."""
-    tempdirs.hold(Path(path).parent)  # a parent killed outright leaves it to its workers
-    return pickle.loads(Path(path).read_bytes())
-
-
-def _initialized_from(path):
-    initializer, initargs = _unpickled(path)
-    initializer(*initargs)
-
-
-def new_pool(workers: int, initializer=None, initargs=()) -> ProcessPoolExecutor:
+def new_pool(workers: int) -> ProcessPoolExecutor:
     """A pool of `workers` spawned processes that end when this process ends (module docstring).
-
-    A spawned worker is handed its arguments through a pipe its parent writes whole before
-    starting the next: arguments larger than the pipe (a search's FMU and records) would keep the
-    parent waiting while each worker imports what they need, one worker after the other (3.5 s
-    each for the Twin House's search). Such arguments are written to a file of the pool's, which
-    every worker reads as it starts, all at once."""
-    arguments = (initializer, initargs)
-    folder = None
-    if initializer is not None:
-        payload = pickle.dumps(arguments, pickle.HIGHEST_PROTOCOL)
-        if len(payload) > PIPE_BYTES:
-            path = _written(payload, "pool")
-            folder = str(Path(path).parent)
-            arguments = (_initialized_from, (path,))
-    pool = _Pool(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
-                 initializer=_worker_start, initargs=(os.getpid(), workers, *arguments))
-    pool.folder = folder
-    return pool
+    What its tasks all read (a search's FMU and records, a round's model) reaches them through a
+    file (`shared`), read once a worker: an initializer's arguments go through a pipe the parent
+    writes whole before it starts the next worker, which kept it waiting while each worker
+    imported what they need (3.5 s each for the Twin House's search)."""
+    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
+                               initializer=_worker_start, initargs=(os.getpid(), workers))
 
 
 def stop_pool(pool: ProcessPoolExecutor) -> None:
@@ -242,7 +194,9 @@ def shared(value):
     where they run (`read_shared`: once a worker) instead of each carrying it through the pipe
     (a round of the Twin House's candidates shares some 30 MB: 37 ms to pickle in the parent and
     13 ms to read, for every one of its 180 tasks). The folder goes at the block's end."""
-    path = _written(pickle.dumps(value, pickle.HIGHEST_PROTOCOL), "shared")
+    path = Path(tempdirs.make("shared")) / "shared.pickle"
+    path.write_bytes(pickle.dumps(value, pickle.HIGHEST_PROTOCOL))
+    path = str(path)
     try:
         yield path
     finally:
@@ -251,18 +205,42 @@ def shared(value):
 
 @functools.lru_cache(maxsize=1)
 def read_shared(path):
-    """What `shared` wrote to `path`, read once in this process (the last one read is kept)."""
-    return _unpickled(path)
+    """What `shared` wrote to `path`, read once in this process (the last one read is kept). The
+    worker counts the folder among its own: a parent killed outright leaves it to its workers."""
+    tempdirs.hold(Path(path).parent)
+    return pickle.loads(Path(path).read_bytes())
+
+
+class Workers:
+    """The worker processes of a command (`worker_pool`), which its stages share: the forcing
+    search's evaluations and the rounds' candidates run in the same processes, whose start and
+    imports (some 2 s each) are paid once. A stage that finds one of them dead (a crash in a C
+    library: the pool is broken) starts them anew (`renew`), for itself and the stages after it."""
+
+    def __init__(self, count: int):
+        self.count = count
+        self.pool = new_pool(count)
+
+    def submit(self, fn, *args, **kwargs):
+        return self.pool.submit(fn, *args, **kwargs)
+
+    def map(self, fn, *iterables):
+        return self.pool.map(fn, *iterables)
+
+    def renew(self):
+        """New processes in place of a broken pool (its work lost, its workers gone)."""
+        self.pool.shutdown(wait=False, cancel_futures=True)
+        self.pool = new_pool(self.count)
 
 
 @contextmanager
-def worker_pool(workers: int, initializer=None, initargs=()):
-    """new_pool for a `with` block: shut down normally at its end, stopped (stop_pool) when the
+def worker_pool(workers: int):
+    """`Workers` for a `with` block: shut down normally at its end, stopped (stop_pool) when the
     block raises, so an error or a signal does not wait for the work in progress."""
-    pool = new_pool(workers, initializer, initargs)
+    processes = Workers(workers)
     try:
-        yield pool
+        yield processes
     except BaseException:
-        stop_pool(pool)
+        stop_pool(processes.pool)
         raise
-    pool.shutdown(wait=True)
+    processes.pool.shutdown(wait=True)

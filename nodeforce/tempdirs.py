@@ -8,8 +8,9 @@ remove its folders; `sweep` (run by every `nodeforce` command as it starts) remo
 owner no longer runs, and never touches the folder of a live process (on a system without /proc
 it removes nothing).
 
-The folders a process holds are also listed here, so a worker told to stop by a signal
-removes its own before it exits (`remove_held`, nodeforce.lifetime).
+The folders a process made and those of its parent it reads are also listed here, so a worker
+told to stop by a signal removes its own, and its parent's if that parent is gone, before it
+exits (`remove_held`, nodeforce.lifetime).
 """
 import os
 import re
@@ -20,7 +21,8 @@ from pathlib import Path
 
 PREFIX = "nodeforce_"
 _OWNED = re.compile(r"nodeforce_[a-z]+_(\d+)-(\d+)_")
-_held: set = set()
+_made: set = set()  # this process's folders, not removed yet
+_held: set = set()  # other processes' folders this process reads (`hold`)
 
 
 def start_time(pid: int) -> "int | None":
@@ -45,12 +47,13 @@ def make(kind: str) -> str:
     """A new folder `nodeforce_<kind>_<pid>-<start>_*` in the temp directory; the caller removes
     it (`remove`), else the next run's `sweep` does once this process has ended."""
     path = tempfile.mkdtemp(prefix=f"{PREFIX}{kind}_{owner_tag()}_")
-    _held.add(path)
+    _made.add(path)
     return path
 
 
 def remove(path) -> None:
     shutil.rmtree(path, ignore_errors=True)
+    _made.discard(str(path))
     _held.discard(str(path))
 
 
@@ -66,15 +69,20 @@ def folder(kind: str):
 
 def hold(path) -> None:
     """Count a folder another process made among this process's own, removed with them if it is
-    stopped (`remove_held`): a pool's, which its workers read beside the parent that made it,
-    and remove when that parent is killed outright."""
+    stopped (`remove_held`) once that process is gone: a pool's, which its workers read beside
+    the parent that made it and remove when that parent is killed outright, but leave to a
+    parent that stops them (a broken pool renewed, a run stopped) and removes it itself."""
     _held.add(str(path))
 
 
 def remove_held() -> None:
-    """Remove every folder this process made and has not removed yet (a worker's last act)."""
-    for path in list(_held):
+    """Remove every folder this process made and has not removed yet, and those it holds whose
+    owner no longer runs (a worker's last act)."""
+    for path in list(_made):
         remove(path)
+    for path in list(_held):
+        if not owner_alive(Path(path).name):
+            remove(path)
 
 
 def owner_alive(name: str) -> bool:

@@ -30,33 +30,6 @@ def test_a_thread_count_the_user_set_is_kept(monkeypatch):
         assert pool.submit(blas_threads).result() == [1]
 
 
-_KEPT = None
-
-
-def _keep(values, label):
-    global _KEPT
-    _KEPT = (label, float(values.sum()), len(values))
-
-
-def _kept():
-    return _KEPT
-
-
-def test_an_initializer_s_arguments_larger_than_a_pipe_reach_every_worker_and_leave_nothing(private_tmp):
-    import numpy as np
-    values = np.arange(50_000, dtype=float)  # 400 kB, beyond PIPE_BYTES: through the pool's file
-    pool = lifetime.new_pool(2, _keep, (values, "big"))
-    assert list(private_tmp.glob("nodeforce_pool_*"))
-    try:
-        assert [f.result() for f in [pool.submit(_kept) for _ in range(4)]] == [("big", values.sum(), 50_000)] * 4
-    finally:
-        pool.shutdown()
-    assert not list(private_tmp.glob("nodeforce_pool_*"))
-    with lifetime.worker_pool(1, _keep, (values[:10], "small")) as small:  # through the pipe
-        assert not list(private_tmp.glob("nodeforce_pool_*"))
-        assert small.submit(_kept).result() == ("small", values[:10].sum(), 10)
-
-
 def _shared_sum(path, task):
     """(the shared values' sum, how many times this worker has read a shared file)."""
     return float(lifetime.read_shared(path).sum()), lifetime.read_shared.cache_info().misses

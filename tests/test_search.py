@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from nodeforce import lifetime
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga import parsimony
 from nodeforce.model.score import Objective
@@ -61,6 +62,11 @@ class SyntheticEvaluator:
         return (spec.base + sum(w for w, b in zip(spec.weights, mask) if b)
                 + sum(w for i, j, w in spec.pairs if mask[i] and mask[j]))
 
+    def close(self):
+        if self.spec.log_dir:
+            with open(Path(self.spec.log_dir) / f"evaluators-{os.getpid()}.txt", "a") as f:
+                f.write("closed\n")
+
 
 def linear(k, gains, penalty=2.0, **kw):
     """Nodes in `gains` lower J by their gain when forced; every other node raises it."""
@@ -79,7 +85,12 @@ def seen_masks(log_dir):
 
 def evaluators_built(log_dir):
     """Per process that built evaluators: how many it built."""
-    return [len(f.read_text().split()) for f in Path(log_dir).glob("evaluators-*.txt")]
+    return [f.read_text().split().count("built") for f in Path(log_dir).glob("evaluators-*.txt")]
+
+
+def evaluator_logs(log_dir):
+    """{pid: what its evaluators said, "built" and "closed", in order}."""
+    return {int(f.stem.split("-")[1]): f.read_text().split() for f in Path(log_dir).glob("evaluators-*.txt")}
 
 
 def without_time(result):
@@ -256,6 +267,30 @@ def test_two_worker_processes_give_the_same_result(tmp_path):
     parallel = search(spec, NODES12, workers=2, **GA_BUDGET)
     assert without_time(parallel) == without_time(serial)
     assert evaluators_built(tmp_path) == [1, 1]  # one evaluator per worker process
+
+
+@pytest.mark.slow  # processes, a cluster or a whole diagnosis: not in `make check`
+def test_searches_in_a_command_s_workers_run_in_its_processes_and_close_what_they_leave(tmp_path):
+    # a diagnosis's searches (on the records together, then on each) and its rounds share its workers
+    serial = search(TWELVE, NODES12, workers=1, **GA_BUDGET)
+    logs = [tmp_path / "first", tmp_path / "second"]
+    with lifetime.worker_pool(2) as workers:
+        results = []
+        for log in logs:
+            log.mkdir()
+            results.append(search(linear(12, {1: 40.0, 6: 25.0, 9: 15.0}, log_dir=str(log)), NODES12,
+                                  workers=workers, **GA_BUDGET))
+        processes = set(workers.pool._processes)
+        first, second = (evaluator_logs(log) for log in logs)
+        # every evaluator in the pool's two processes, the second search's in those of the first
+        assert len(processes) == 2 and first and second and set(first) | set(second) <= processes
+        # the second search's evaluator closed the first's in every process it came to; the
+        # processes stay for the stages after it
+        assert all(first[pid] == ["built", "closed"] for pid in second if pid in first)
+        assert all(said == ["built"] for said in second.values())
+    assert all(without_time(r) == without_time(serial) for r in results)
+    # the pool's end closes what the last search left
+    assert all(said == ["built", "closed"] for said in evaluator_logs(logs[1]).values())
 
 
 @pytest.mark.slow  # processes, a cluster or a whole diagnosis: not in `make check`
