@@ -81,49 +81,70 @@ def simulate_fmu(instance, case, force=None, warmup_days=2, output_ids=None, T_d
     -------
     (N_t, len(output_ids)) ndarray
     """
-    measured = case.measured
-    n_rows, n = measured.shape
-    # The FMU forces node i where force[i] is set and T_forced[i] is a number: the schedule's
-    # nodes get force[i], and T_forced[i] is NaN at the steps the schedule leaves them computed.
-    schedule = forcing_schedule(np.zeros(n, dtype=bool) if force is None else force, measured,
-                                case.burn_in_steps)
-    forced_ids = [i + 1 for i in np.flatnonzero(schedule[1:].any(axis=0))]
-    output_ids = list(range(1, n + 1)) if output_ids is None else list(output_ids)
-    # the state at t_0 is the FMU's T_start: the measured nodes at their value, the others by the
-    # rule of the direct model (model.integrate.initial_state)
-    start = case.start_state(T_default)
-    parameters = {**dict(zip(node_names("T_start", range(1, len(start) + 1)), start.tolist())),
-                  **{name: True for name in node_names("force", forced_ids)}, **(parameters or {})}
-    H = case.history_steps  # a history stands in for the warm-up, in steps of its own (integrate.simulate)
-    rows = H + warmup_rows(n_rows - H, case.dt, 0 if H else warmup_days)
-    columns = np.array(forced_ids, dtype=int) - 1
-    # the step to each row r starts from step_start's row r with the slope to row r (the direct
-    # model's within_steps); T_forced NaN (slope 0) where the schedule leaves a node computed there
-    held = held_inputs(case.building, case.input_names)
-    u_start, m_start = step_start(case.U, held), step_start(measured[:, columns])
-    imposed = schedule[:, columns]
-    m_start = np.where(imposed, m_start, np.nan)
-    m_slope = np.where(imposed, measured[:, columns] - m_start, 0.0)
-    k = case.substeps
-    inputs = np.hstack([u_start[rows], m_start[rows], np.full((len(rows), 1), case.dt / k)])
-    slopes = np.hstack([case.U[rows] - u_start[rows], m_slope[rows]]) / case.dt
-    steps = np.full(len(inputs), case.dt)
-    block = history_block(case.dt)
-    if H:
-        coarse = history_inputs(case.U, H, case.dt)
-        inputs = np.vstack([np.hstack([coarse, np.full((len(coarse), len(columns)), np.nan),
-                                       np.full((len(coarse), 1), block * case.dt)]), inputs])
-        slopes = np.vstack([np.zeros((len(coarse), slopes.shape[1])), slopes])
-        steps = np.concatenate([np.full(len(coarse), block * case.dt), steps])
-    if case.steady_start:
-        u, held_nodes, values = steady_inputs(case.U, measured, schedule, case.dt)
-        inputs = np.vstack([np.concatenate([u, np.where(held_nodes[columns], values[columns], np.nan), [STEADY_STEP]]),
-                            inputs])
-        slopes = np.vstack([np.zeros((1, slopes.shape[1])), slopes])
-        steps = np.concatenate([[STEADY_STEP], steps])
-    history = H // block
-    names = list(case.input_names) + node_names("T_forced", forced_ids)
-    out = instance.run(steps, parameters, {}, names + ["max_step"], inputs, node_names("T", output_ids),
-                       skip=len(inputs) - (n_rows - 1 - H) - history, slopes=np.nan_to_num(slopes, nan=0.0))
-    # a history's rows hold each of its steps' end state, as the direct model's do
-    return np.vstack([np.repeat(out[:history], block, axis=0), out[history:]])
+    return CaseRuns(case, warmup_days, T_default).simulate(instance, force, output_ids, parameters)
+
+
+class CaseRuns:
+    """What every run of a case through an FMU sets whatever it forces (`simulate_fmu`): the
+    start state, the input row of every step (warm-up, history), the inputs' starts and slopes,
+    the measured nodes' starts; made once where a case is run under many forcings (the search's
+    evaluator)."""
+
+    def __init__(self, case, warmup_days=2, T_default=20.0):
+        self.case = case
+        n_rows = len(case.measured)
+        # the state at t_0 is the FMU's T_start: the measured nodes at their value, the others by
+        # the rule of the direct model (model.integrate.initial_state)
+        self.start = case.start_state(T_default)
+        H = case.history_steps  # a history stands in for the warm-up, in steps of its own (integrate.simulate)
+        self.rows = H + warmup_rows(n_rows - H, case.dt, 0 if H else warmup_days)
+        # the step to each row r starts from step_start's row r with the slope to row r (the
+        # direct model's within_steps)
+        u_start = step_start(case.U, held_inputs(case.building, case.input_names))
+        self.u_inputs, self.u_slopes = u_start[self.rows], (case.U[self.rows] - u_start[self.rows]) / case.dt
+        self.m_start = step_start(case.measured)
+        self.sub_step = np.full((len(self.rows), 1), case.dt / case.substeps)
+        self.block = history_block(case.dt)
+        self.coarse = history_inputs(case.U, H, case.dt) if H else None
+        self.returned = n_rows - 1 - H  # the steps after the history and the warm-up: their outputs are read
+
+    def simulate(self, instance, force=None, output_ids=None, parameters=None):
+        """`simulate_fmu` of the case with `force`, `output_ids` and `parameters`."""
+        case, rows = self.case, self.rows
+        measured = case.measured
+        n = measured.shape[1]
+        # The FMU forces node i where force[i] is set and T_forced[i] is a number: the schedule's
+        # nodes get force[i], and T_forced[i] is NaN at the steps the schedule leaves them computed.
+        schedule = forcing_schedule(np.zeros(n, dtype=bool) if force is None else force, measured,
+                                    case.burn_in_steps)
+        forced_ids = [i + 1 for i in np.flatnonzero(schedule[1:].any(axis=0))]
+        output_ids = list(range(1, n + 1)) if output_ids is None else list(output_ids)
+        parameters = {**dict(zip(node_names("T_start", range(1, len(self.start) + 1)), self.start.tolist())),
+                      **{name: True for name in node_names("force", forced_ids)}, **(parameters or {})}
+        columns = np.array(forced_ids, dtype=int) - 1
+        # T_forced NaN (slope 0) where the schedule leaves a node computed
+        imposed = schedule[:, columns]
+        m_start = np.where(imposed, self.m_start[:, columns], np.nan)
+        m_slope = np.where(imposed, measured[:, columns] - m_start, 0.0)
+        inputs = np.hstack([self.u_inputs, m_start[rows], self.sub_step])
+        slopes = np.hstack([self.u_slopes, m_slope[rows] / case.dt])
+        steps = np.full(len(inputs), case.dt)
+        if self.coarse is not None:
+            coarse = self.coarse
+            inputs = np.vstack([np.hstack([coarse, np.full((len(coarse), len(columns)), np.nan),
+                                           np.full((len(coarse), 1), self.block * case.dt)]), inputs])
+            slopes = np.vstack([np.zeros((len(coarse), slopes.shape[1])), slopes])
+            steps = np.concatenate([np.full(len(coarse), self.block * case.dt), steps])
+        if case.steady_start:
+            u, held_nodes, values = steady_inputs(case.U, measured, schedule, case.dt)
+            inputs = np.vstack([np.concatenate([u, np.where(held_nodes[columns], values[columns], np.nan),
+                                                [STEADY_STEP]]), inputs])
+            slopes = np.vstack([np.zeros((1, slopes.shape[1])), slopes])
+            steps = np.concatenate([[STEADY_STEP], steps])
+        history = case.history_steps // self.block
+        names = list(case.input_names) + node_names("T_forced", forced_ids)
+        out = instance.run(steps, parameters, {}, names + ["max_step"], inputs, node_names("T", output_ids),
+                           skip=len(inputs) - self.returned - history,
+                           slopes=np.nan_to_num(slopes, nan=0.0))
+        # a history's rows hold each of its steps' end state, as the direct model's do
+        return np.vstack([np.repeat(out[:history], self.block, axis=0), out[history:]])

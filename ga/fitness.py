@@ -11,7 +11,7 @@ the paper-mode comparisons (benchmarks/bench_search.py, tests).
 import numpy as np
 
 from nodeforce.cosim.fmi import FmuInstance, content_id
-from nodeforce.cosim.run import simulate_fmu
+from nodeforce.cosim.run import CaseRuns
 from nodeforce.model.integrate import STEADY_STEP, ImplicitEuler, history_block, simulate
 from nodeforce.model.network import assemble
 
@@ -133,11 +133,11 @@ class FmuEvaluator(_Evaluator):
     def __init__(self, spec):
         super().__init__(spec)
         self.instance = FmuInstance(spec.fmu_path)
+        self.runs = CaseRuns(spec.case, spec.warmup_days)  # what every forcing's run sets alike
 
     def air(self, force):
         """Objective air temperatures (C) at t_1..t_N with the `force` (N,) bool nodes forced."""
-        return simulate_fmu(self.instance, self.spec.case, force, self.spec.warmup_days,
-                            output_ids=self.spec.objective.air_nodes)
+        return self.runs.simulate(self.instance, force, output_ids=self.spec.objective.air_nodes)
 
     def close(self):
         """Free the FMU instance and remove its extracted files."""
