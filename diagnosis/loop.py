@@ -115,10 +115,10 @@ def assess_all(model, pairs, windows, objective, sigma, folder, seed, pool=None,
     (t_0..t_k) with a fold per block, and run over each record, in the worker processes of
     `pool` (the command's `lifetime.Workers`; None: in this process), or on the workers of
     `cluster` (a `nodeforce.cluster.Cluster`), each candidate's building file written in
-    `folder`: their `Assessed`, in the order of `pairs`. `sigma`: the sensors' noise (C), against which a
-    component's own nodes are weighed in its fit (`calibrate.own_weights`). `beside`: effects
-    `model` holds ((effect, target)) refitted together with each candidate, those of their
-    parameters `held` ({label: names}) kept as they are (`calibrate.Candidate`)."""
+    `folder`: their `Assessed`, in the order of `pairs`. `sigma`: the sensors' noise (C),
+    against which a component's own nodes are weighed in its fit (`calibrate.own_weights`).
+    `beside`: effects `model` holds ((effect, target)) refitted together with each candidate,
+    those of their parameters `held` ({label: names}) kept as they are (`calibrate.Candidate`)."""
     shared = (model.building, model.bases, windows.calibrations, windows.cases, objective, windows.blocks,
               windows.sensors, windows.calibration_numerical(), windows.calibration_numerical(sensors=True), sigma,
               seed, tuple(beside), held or {})
