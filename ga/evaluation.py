@@ -156,10 +156,8 @@ class ProcessBackend(_Backend):
 
     def close(self, abort=False):
         try:
-            if self._own and abort:
-                lifetime.stop_pool(self._workers.pool)
-            elif self._own:
-                self._workers.pool.shutdown(wait=True, cancel_futures=True)
+            if self._own:
+                self._workers.close(abort)
         finally:
             self._shared.close()
 

@@ -232,15 +232,22 @@ class Workers:
         self.pool.shutdown(wait=False, cancel_futures=True)
         self.pool = new_pool(self.count)
 
+    def close(self, abort=False):
+        """Shut the processes down once their work is done, or, `abort`, stop them now
+        (`stop_pool`): an error or a signal does not wait for the work in progress."""
+        if abort:
+            stop_pool(self.pool)
+        else:
+            self.pool.shutdown(wait=True)
+
 
 @contextmanager
 def worker_pool(workers: int):
-    """`Workers` for a `with` block: shut down normally at its end, stopped (stop_pool) when the
-    block raises, so an error or a signal does not wait for the work in progress."""
+    """`Workers` for a `with` block: closed at its end, stopped when the block raises."""
     processes = Workers(workers)
     try:
         yield processes
     except BaseException:
-        stop_pool(processes.pool)
+        processes.close(abort=True)
         raise
-    processes.pool.shutdown(wait=True)
+    processes.close()
