@@ -5,7 +5,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from nodeforce import lifetime
 from nodeforce.diagnosis.calibrate import Candidate, Own, calibrate
 from nodeforce.diagnosis.policy import POLICY
 from nodeforce.model.network import assemble, slowest_time_constant
@@ -29,12 +28,6 @@ class Assessed:
     simulations: int
     building: dict
     beside: dict = None
-
-
-def assess_shared(path, pair):
-    """`assess` in a pool's worker, with the round's `shared` read from `path`
-    (`lifetime.shared`), once a worker."""
-    return assess(lifetime.read_shared(path), pair)
 
 
 def assess(shared, pair):

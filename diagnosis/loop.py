@@ -44,7 +44,6 @@ import sys
 import time
 from contextlib import nullcontext
 from dataclasses import dataclass, replace
-from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -54,7 +53,7 @@ from nodeforce import lifetime
 from nodeforce.cluster import Cluster
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
-from nodeforce.diagnosis.assess import assess, assess_shared, protocols
+from nodeforce.diagnosis.assess import assess, protocols
 from nodeforce.diagnosis.calibrate import Candidate
 from nodeforce.diagnosis.candidates import physical, shaped_inputs, shapes
 from nodeforce.diagnosis.compare import compare
@@ -109,12 +108,11 @@ class Model:
         return Model(building, runs, windows.metrics(objective, runs), bases)
 
 
-def assess_all(model, pairs, windows, objective, sigma, folder, seed, pool=None, cluster=None, beside=(),
-               held=None):
+def assess_all(model, pairs, windows, objective, sigma, folder, seed, runner, beside=(), held=None):
     """Each (effect, target) added to `model`, calibrated on every record's calibration window
-    (t_0..t_k) with a fold per block, and run over each record, in the worker processes of
-    `pool` (the command's `lifetime.Workers`; None: in this process), or on the workers of
-    `cluster` (a `nodeforce.cluster.Cluster`), each candidate's building file written in
+    (t_0..t_k) with a fold per block, and run over each record, where `runner` runs tasks (this
+    process, `lifetime.InProcess`; the command's `lifetime.Workers`; a Dask
+    `nodeforce.cluster.Cluster`'s workers), each candidate's building file written in
     `folder`: their `Assessed`, in the order of `pairs`. `sigma`: the sensors' noise (C),
     against which a component's own nodes are weighed in its fit (`calibrate.own_weights`).
     `beside`: effects `model` holds ((effect, target)) refitted together with each candidate,
@@ -124,18 +122,7 @@ def assess_all(model, pairs, windows, objective, sigma, folder, seed, pool=None,
               seed, tuple(beside), held or {})
     with tqdm(total=len(pairs), desc="calibrating candidate effects", unit="candidate",
               disable=not sys.stderr.isatty()) as bar:
-        if cluster is not None:
-            assessed = cluster.map(assess, pairs, cluster.share(shared), done=lambda *_: bar.update())
-            for outcome in assessed:
-                if isinstance(outcome, BaseException):
-                    raise outcome
-        else:
-            assessed = []
-            with lifetime.shared(shared) if pool else nullcontext() as path:
-                task = partial(assess_shared, path) if pool else partial(assess, shared)
-                for outcome in (pool.map if pool else map)(task, pairs):
-                    assessed.append(outcome)
-                    bar.update()
+        assessed = runner.map_shared(assess, shared, pairs, done=bar.update)
     for (effect, target), a in zip(pairs, assessed):
         (folder / f"{effect}@{target}.json").write_text(json.dumps(a.building, indent=2) + "\n")
     return list(assessed)
@@ -218,16 +205,15 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
                                                 f"(read_record) for the building diagnosed, {building.source}")
     bases = [protocol(building, r) for r in records]
     fmu_kind = evaluator_kind(fmu_kind, [building, *filter(None, bases)])
-    # one pool of workers for the search and the rounds, started first: their imports overlap `prepare`
-    count = (workers or os.cpu_count()) if scheduler is None else 1
-    with Cluster(scheduler) if scheduler is not None else nullcontext() as cluster, \
-            lifetime.worker_pool(count) if count > 1 else nullcontext() as pool:
+    # one set of workers for the search and the rounds, started first: their imports overlap `prepare`
+    count = workers or os.cpu_count()
+    with Cluster(scheduler) if scheduler is not None else \
+            lifetime.worker_pool(count) if count > 1 else nullcontext(lifetime.InProcess()) as runner:
         prepared = prepare(building, records, bases, objective, workdir, fmu_kind, noise)
-        search = dict(seed=seed, workers=pool or 1, scheduler=scheduler, population=population,
-                      generations=generations, fmu_kind=search_fmu,
-                      noise=prepared.noise.sigma if prepared.noise.given else None)
+        search = dict(seed=seed, workers=runner, population=population, generations=generations,
+                      fmu_kind=search_fmu, noise=prepared.noise.sigma if prepared.noise.given else None)
         located = localise(building, prepared, objective, workdir, search)
-        made = rounds(prepared, located.localization, objective, workdir, seed, pool, cluster)
+        made = rounds(prepared, located.localization, objective, workdir, seed, runner)
     return write(building, prepared, located, made, objective, workdir, fmu_kind, reference, later)
 
 
@@ -311,11 +297,10 @@ def localise(building, prepared, objective, workdir, search):
     return Located(localization, alone, convergence)
 
 
-def rounds(prepared, localization, objective, workdir, seed, pool=None, cluster=None):
+def rounds(prepared, localization, objective, workdir, seed, runner=lifetime.InProcess()):
     """Stage 3: rounds of candidates, `POLICY.max_rounds` at most, each on top of the last,
     while the error left is above the noise and one is chosen (`selection.decide`); the
-    candidates in the worker processes of `pool` (the command's `lifetime.Workers`, which ran
-    its forcing search; None: in this process) or on `cluster`'s workers (`assess_all`)."""
+    candidates where `runner` runs tasks, which ran the forcing search (`assess_all`)."""
     windows, n, noise = prepared.windows, prepared.n, prepared.noise
     folder = workdir / "candidates"
     folder.mkdir(exist_ok=True)
@@ -334,7 +319,7 @@ def rounds(prepared, localization, objective, workdir, seed, pool=None, cluster=
         into.mkdir(exist_ok=True)
         pairs = [p for p in physical(model.building, localization["components"], objective.zones,
                                      measured_ids, localization["best_nodes"]) if "@".join(p) not in done]
-        assessed = assess_all(model, pairs, windows, objective, noise.sigma, into, seed, pool, cluster)
+        assessed = assess_all(model, pairs, windows, objective, noise.sigma, into, seed, runner)
         tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma, number + 1,
                                 done)
         # shapes only where no physical candidate physics admits brings the error left to the
@@ -344,7 +329,7 @@ def rounds(prepared, localization, objective, workdir, seed, pool=None, cluster=
             more = [p for p in shapes(model.building, left_by(windows, model), objective.zones)
                     if "@".join(p) not in done]
             pairs, assessed = pairs + more, assessed + assess_all(model, more, windows, objective, noise.sigma,
-                                                                  into, seed, pool, cluster)
+                                                                  into, seed, runner)
             # every sensor's weight from the least misfit any candidate of the round leaves
             tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma,
                                     number + 1, done)
@@ -364,11 +349,11 @@ def rounds(prepared, localization, objective, workdir, seed, pool=None, cluster=
         model = models[chosen.label]
     made = Made(decisions, results, runs, sensitivities, model)
     for fit in made.added[:-1]:
-        made = revisit(prepared, made, fit, objective, folder, seed, pool, cluster)
+        made = revisit(prepared, made, fit, objective, folder, seed, runner)
     return made
 
 
-def revisit(prepared, made, fit, objective, folder, seed, pool, cluster):
+def revisit(prepared, made, fit, objective, folder, seed, runner):
     """An effect an earlier round chose (`fit`), chosen again once the rounds end: it and the
     admissible candidates nearest it in its round (`Policy.revisited`), each calibrated with the
     other effects the model holds refitted together with it (their parameters held at a prior
@@ -398,7 +383,7 @@ def revisit(prepared, made, fit, objective, folder, seed, pool, cluster):
     into = folder / f"revisit{number}"
     into.mkdir(exist_ok=True)
     base_sensed = windows.sensed_by(model)
-    assessed = assess_all(model, pairs, windows, objective, noise.sigma, into, seed, pool, cluster,
+    assessed = assess_all(model, pairs, windows, objective, noise.sigma, into, seed, runner,
                           [(a.effect, a.target) for a in others],
                           {a.label: [name for name, p in a.parameters.items() if p.get("prior")] for a in others})
     tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma, number,

@@ -181,16 +181,18 @@ def _dask_close(token: str) -> None:
 
 
 class DaskBackend(_Backend):
-    """Chunks mapped over the workers of a dask.distributed scheduler at `address`
-    ("tcp://host:port") through `nodeforce.cluster`, the factory shipped once to every worker.
+    """Chunks mapped over the workers of a dask.distributed scheduler through `nodeforce.cluster`
+    (`cluster`: its address, "tcp://host:port", or a command's `Cluster`, which it leaves
+    open), the factory shipped once to every worker.
 
     A worker lost mid-task costs nothing (its tasks rerun, the factory is shipped again if it was
     lost with it); a lost scheduler stops the search (lifetime.RunStopped); its checkpoint
     resumes it.
     """
 
-    def __init__(self, factory, address: str):
-        self._cluster = Cluster(address)
+    def __init__(self, factory, cluster: "str | Cluster"):
+        self._own = not isinstance(cluster, Cluster)
+        self._cluster = Cluster(cluster) if self._own else cluster
         self._token = factory_token(factory)
         self._task = partial(_dask_task, self._token)
         self._factory = self._cluster.share(factory)
@@ -211,15 +213,17 @@ class DaskBackend(_Backend):
             if not abort:  # the workers keep the evaluators of a stopped search, for its rerun
                 self._cluster.run(_dask_close, self._token)
         finally:
-            self._cluster.close()
+            if self._own:
+                self._cluster.close()
 
 
-def open_backend(factory, workers: "int | lifetime.Workers", scheduler: "str | None"):
-    """The backend the caller asked for: Dask if a scheduler address is given, else processes
-    (`workers`: a count, 1 for this process, or a command's `lifetime.Workers`)."""
-    if scheduler is not None:
-        return DaskBackend(factory, scheduler)
-    if workers == 1:
+def open_backend(factory, workers: "int | lifetime.InProcess | lifetime.Workers | Cluster", scheduler: "str | None"):
+    """The backend the caller asked for: Dask if a scheduler address is given, else where
+    `workers` runs tasks: a count of processes (1: this process), or a command's own
+    (`lifetime.InProcess`, `lifetime.Workers`, a `Cluster`), which its later stages use too."""
+    if scheduler is not None or isinstance(workers, Cluster):
+        return DaskBackend(factory, scheduler if scheduler is not None else workers)
+    if workers == 1 or isinstance(workers, lifetime.InProcess):
         return InProcessBackend(factory)
     return ProcessBackend(factory, workers)
 

@@ -111,6 +111,16 @@ class Cluster:
                 shared.ship()
         return results
 
+    def map_shared(self, function, value, items, done=None) -> list:
+        """function(value, item) for each item on the workers, `value` shipped once to every
+        worker (`share`); the results in the order of `items`, `done()` as each ends; a task's
+        error raised once every task has ended (`lifetime.Workers.map_shared` on a cluster)."""
+        results = self.map(function, items, self.share(value), done=None if done is None else lambda *_: done())
+        for result in results:
+            if isinstance(result, BaseException):
+                raise result
+        return results
+
     def run(self, function, *args):
         """function(*args) once in every worker process (not as a task)."""
         return self.client.run(function, *args)

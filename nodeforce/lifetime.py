@@ -211,6 +211,33 @@ def read_shared(path):
     return pickle.loads(Path(path).read_bytes())
 
 
+def collected(results, done=None) -> list:
+    """The results of an iterable in a list, `done()` called after each arrives (a progress
+    bar's update)."""
+    kept = []
+    for result in results:
+        kept.append(result)
+        if done is not None:
+            done()
+    return kept
+
+
+def _shared_task(function, path, item):
+    """function(the value `shared` wrote to `path`, item): a task of `Workers.map_shared`."""
+    return function(read_shared(path), item)
+
+
+class InProcess:
+    """A command's tasks run in this process, one after another (one worker asked for): what
+    `Workers` and a Dask `nodeforce.cluster.Cluster` are for work spread over processes."""
+
+    count = 1
+
+    def map_shared(self, function, value, items, done=None) -> list:
+        """function(value, item) for each item, in order; `done()` after each."""
+        return collected((function(value, item) for item in items), done)
+
+
 class Workers:
     """The worker processes of a command (`worker_pool`), which its stages share: the forcing
     search's evaluations and the rounds' candidates run in the same processes, whose start and
@@ -226,6 +253,13 @@ class Workers:
 
     def map(self, fn, *iterables):
         return self.pool.map(fn, *iterables)
+
+    def map_shared(self, function, value, items, done=None) -> list:
+        """function(value, item) for each item in the workers (`function` a module's, to be
+        pickled), `value` written once to a file each worker reads once (`shared`); the results
+        in the order of `items`, `done()` after each; a task's error raised."""
+        with shared(value) as path:
+            return collected(self.pool.map(functools.partial(_shared_task, function, path), items), done)
 
     def renew(self):
         """New processes in place of a broken pool (its work lost, its workers gone)."""
