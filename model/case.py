@@ -19,7 +19,7 @@ import pandas as pd
 from .errors import InputError
 from .integrate import Plan, held_inputs, history_block, initial_state, simulate, steps_per_day, substeps
 from .building import DAY_TERMS
-from .network import assemble, clock_input_names, day_input, input_names
+from .network import assemble, clock_input_names, day_input, input_names, slowest_time_constant
 from .units import check_celsius
 from .solar import (DECOMPOSITIONS, complete_irradiance, incident_irradiance, measured_irradiance, sky_temperature,
                     solar_position, transmitted_irradiance)
@@ -106,7 +106,8 @@ class Case:
         mean conditions (`integrate.steady_inputs`), stated among its assumptions."""
         if self.steady_start:
             return self
-        return replace(self, steady_start=True, assumptions=self.assumptions + (STEADY_START,))
+        said = STEADY_START if self.building is None else f"{STEADY_START}; {start_memory(self.building)}"
+        return replace(self, steady_start=True, assumptions=self.assumptions + (said,))
 
     def scored(self, columns):
         """(N_t, k) measurements of the node indices `columns` at t_1..t_N, NaN where missing and
@@ -377,13 +378,22 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
         assumptions.append(f"The {before * dt / 86400:.3g} days of weather before the first measurement "
                            f"({times[0].isoformat()} to {times[before].isoformat()}) are simulated before it from "
                            "the steady state of their mean conditions, nothing measured or scored: the walls "
-                           "start from the weather's past.")
+                           f"start from the weather's past; {start_memory(building, before * dt)}.")
     measured = (measured_matrix(building, measurements, times) if measurements is not None
                 else np.full((len(times), building.n_nodes), np.nan))
     fluxes = measured_fluxes(building, measurements, times) if measurements is not None else {}
     return Case(times=times, dt=dt, input_names=names, U=U, measured=measured, assumptions=tuple(assumptions),
                 fluxes=fluxes, building=building, substeps=substeps(dt), burn_in_steps=before, history_steps=before,
                 steady_start=bool(before))
+
+
+def start_memory(building, seconds=None):
+    """What a run's start carries into the record, said: the building's slowest time constant
+    (`network.slowest_time_constant`, every node free), in which what the start got wrong falls
+    by a factor e, and the share of it left `seconds` (s) after the start, where given."""
+    tau = slowest_time_constant(assemble(building))
+    said = f"what that start gets wrong falls by a factor e in {tau / 86400:.3g} days (the building's slowest time constant)"
+    return said if seconds is None else f"{said}: {np.exp(-seconds / tau):.0%} of it is left at the first measurement"
 
 
 def check_warmup(case, source):

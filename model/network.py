@@ -431,17 +431,26 @@ def face_heat_flux(building, network, T, U, component, face):
     return (net - within) / c.area
 
 
-def slowest_time_constant(network, nodes):
-    """The slowest time constant (s) of the nodes `nodes` (0-based; those with capacity) with every
+def slowest_time_constant(network, nodes=None):
+    """The slowest time constant (s) of the nodes `nodes` (0-based; default every node) with every
     other node and every input held: the time in which an error of their starting temperatures
     falls by a factor e, whatever its shape through them (a heavy floor's deep nodes started
-    where the measurements do not say).
+    where the measurements do not say; a whole building started where its weather's past does
+    not say). Those of them without capacity follow the others at once.
 
-    It is 1 / lambda_min of C^-1 K on those nodes, K = -A restricted to them (its diagonal holds
-    their conductances to the nodes held), computed as the symmetric C^-1/2 K C^-1/2."""
-    nodes = np.asarray([i for i in nodes if network.C[i] > 0.0])
-    if len(nodes) == 0:
+    It is 1 / lambda_min of C^-1 K on the nodes with capacity, K = -A restricted to `nodes` (its
+    diagonal holds their conductances to the nodes held) with those without capacity
+    eliminated, K_cc - K_ca K_aa^-1 K_ac; computed as the symmetric C^-1/2 K C^-1/2 where K is
+    symmetric (conduction; an air flow from zone to zone is not)."""
+    nodes = np.arange(network.n_nodes) if nodes is None else np.asarray(nodes, dtype=int)
+    has = network.C[nodes] > 0.0
+    c, a = nodes[has], nodes[~has]
+    if len(c) == 0:
         return 0.0
-    root = np.sqrt(network.C[nodes])
-    K = -network.A[np.ix_(nodes, nodes)]
-    return float(1.0 / np.linalg.eigvalsh(K / np.outer(root, root)).min())
+    K = -network.A[np.ix_(c, c)]
+    if len(a):
+        K = K + network.A[np.ix_(c, a)] @ np.linalg.solve(network.A[np.ix_(a, a)], network.A[np.ix_(a, c)])
+    root = np.sqrt(network.C[c])
+    scaled = K / np.outer(root, root)
+    rates = np.linalg.eigvalsh(scaled) if np.allclose(scaled, scaled.T) else np.linalg.eigvals(scaled).real
+    return float(1.0 / rates.min())

@@ -51,6 +51,23 @@ def test_the_case_reaches_back_over_the_weather_before_the_first_measurement(tes
     assert measured_case(testcell, short, measured).history_steps * case.dt == HISTORY_STEP * (61.75 * 3600 // HISTORY_STEP)
 
 
+def test_the_case_says_how_much_of_its_start_the_record_still_carries(testcell, weather):
+    """The share of the start's error left at the first measurement falls with the history as
+    exp(-days / tau), tau the test cell's slowest mode (some two weeks: the floor above its
+    adiabatic face); without a history the steady start's sentence gives tau alone."""
+    import re
+    measured = air_record(testcell, weather)
+    said = {}
+    for days in (5, 60):
+        case = measured_case(testcell, cut(weather, measured.index[0] - pd.Timedelta(days=days)), measured)
+        said[days] = float(re.search(r"(\d+)% of it is left at the first measurement", case.assumptions[-1]).group(1))
+    tau = 5.0 / -np.log(said[5] / 100)
+    assert 10.0 < tau < 20.0  # days
+    assert said[60] == pytest.approx(100 * np.exp(-60.0 / tau), abs=1.0) and said[60] < 5 < 50 < said[5]
+    steady = measured_case(testcell, weather, measured, history_days=0).with_steady_start()
+    assert re.search(r"falls by a factor e in 1\d\.?\d* days", steady.assumptions[-1])
+
+
 def test_the_history_stops_where_an_input_is_missing_and_nothing_is_filled_in(testcell, weather):
     measured = air_record(testcell, weather)
     holed = weather.copy()

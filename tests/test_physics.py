@@ -328,3 +328,24 @@ def test_a_component_s_slowest_time_constant_by_hand_and_from_its_free_decay():
     assert np.linalg.norm(expm(decay * day) @ error) / np.linalg.norm(error) == pytest.approx(np.exp(-day / tau),
                                                                                             rel=1e-3)
     assert tau > 2 * day  # a heavy floor: the reason its own nodes wait
+
+
+def test_a_whole_building_s_slowest_time_constant_from_its_free_decay_through_the_integrator():
+    """Every node free, the radiant node, without capacity, following the others at once: the
+    difference of two runs that start apart under the same inputs, stepped by the model's own
+    implicit Euler (no eigen-solver, the algebraic node solved with the others at each step),
+    falls by exp(-day / tau) a day once the faster modes have died away."""
+    from nodeforce.model.integrate import ImplicitEuler, Sources
+    from nodeforce.model.network import slowest_time_constant
+    network = assemble(parse_building(TESTCELL))
+    n, dt, day = network.n_nodes, 600.0, 86400.0
+    assert (network.C == 0.0).any()
+    tau = slowest_time_constant(network)
+    sources = Sources(*network.source_terms(np.zeros((int(60 * day / dt), len(network.input_names)))))
+    stepper, free = ImplicitEuler(network, dt), np.zeros(n, dtype=bool)
+    apart = np.linalg.norm(stepper.run(np.full(n, 20.0), sources, free)[0]
+                           - stepper.run(np.linspace(10.0, 30.0, n), sources, free)[0], axis=1)
+    assert apart[-1] / apart[-1 - int(day / dt)] == pytest.approx(np.exp(-day / tau), rel=1e-3)
+    # slower than the floor alone, its neighbours held: free, they follow it
+    floor = np.array(parse_building(TESTCELL).component("floor").node_ids) - 1
+    assert tau >= slowest_time_constant(network, floor)
