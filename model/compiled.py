@@ -26,6 +26,7 @@ import os
 import shutil
 import subprocess
 import threading
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -50,9 +51,11 @@ def find_compiler():
     return command.split()
 
 
-def compile_library(directory, source, libraries=(), link_options=(), defines=(), options=("-O2",), includes=()):
-    """The shared library (bytes) of `directory`/<source> (a file name, or a tuple of several)
-    with the headers beside it and in `includes` (folders).
+@contextmanager
+def built_library(directory, source, libraries=(), link_options=(), defines=(), options=("-O2",), includes=()):
+    """The path of the shared library of `directory`/<source> (a file name, or a tuple of several)
+    with the headers beside it and in `includes` (folders), in a temporary folder removed at the
+    block's end.
 
     Compiled in `directory` by relative name, without debug information: the bytes do not depend
     on where nodeforce is installed, so the same model gives the same FMU.
@@ -74,26 +77,28 @@ def compile_library(directory, source, libraries=(), link_options=(), defines=()
         done = subprocess.run(command, cwd=directory, capture_output=True, text=True)
         if done.returncode:
             raise RuntimeError(f"compiling {source!r} failed: {' '.join(command)}\n{done.stderr}")
-        return output.read_bytes()
+        yield output
+
+
+def compile_library(directory, source, **options):
+    """The shared library (bytes) `built_library` compiles, for an FMU's binaries."""
+    with built_library(directory, source, **options) as path:
+        return path.read_bytes()
 
 
 def compiled_function(directory, source, symbol, fallback, logger, options=("-O2",)):
-    """The function `symbol` of `directory`/`source` compiled here (`compile_library`) and loaded
-    from a temporary folder removed at once; None where it cannot be compiled (no C compiler, or
-    one that fails on it: `fallback`, what is done instead, said in `logger`'s log with the
+    """The function `symbol` of `directory`/`source` compiled here (`built_library`) and loaded
+    from its temporary folder, removed at once; None where it cannot be compiled (no C compiler,
+    or one that fails on it: `fallback`, what is done instead, said in `logger`'s log with the
     compiler's first line). The caller declares its argument and result types."""
     if find_compiler() is None:
         return None
     try:
-        data = compile_library(directory, source, options=options)
+        with built_library(directory, source, options=options) as path:
+            return getattr(ctypes.CDLL(str(path)), symbol)
     except RuntimeError as error:
         logger.warning("%s: %s", fallback, str(error).splitlines()[0])
         return None
-    stem = Path(source).stem
-    with tempdirs.folder(stem) as tmp:
-        path = Path(tmp) / f"{stem}.so"
-        path.write_bytes(data)
-        return getattr(ctypes.CDLL(str(path)), symbol)
 
 
 @functools.lru_cache(maxsize=None)

@@ -92,7 +92,7 @@ def test_a_singular_step_matrix_is_refused():
 def test_a_compiler_that_fails_leaves_the_steps_to_numpy(monkeypatch, caplog):
     def fails(*args, **kwargs):
         raise RuntimeError("compiling 'steps.c' failed: cc: error: unrecognized option")
-    monkeypatch.setattr(compiled, "compile_library", fails)
+    monkeypatch.setattr(compiled, "built_library", fails)
     compiled._library.cache_clear()
     try:
         with caplog.at_level("WARNING", logger="nodeforce.model"):

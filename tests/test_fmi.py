@@ -11,9 +11,8 @@ from nodeforce.cosim.run import simulate_fmu
 from nodeforce.fmu_build.build import build_fmu, fmu_kind
 from nodeforce.model.building_file import parse_building
 from nodeforce.model import compiled as compiled_library
-from nodeforce.model.compiled import find_compiler
 
-pytestmark = pytest.mark.skipif(find_compiler() is None, reason="no C compiler: the steps are looped in Python")
+pytestmark = pytest.mark.skipif(compiled_library.find_compiler() is None, reason="no C compiler: the steps are looped in Python")
 
 KINDS = [("python", 2), ("standalone", 2), ("python", 3), ("standalone", 3)]
 
@@ -78,7 +77,7 @@ def test_a_compiler_that_fails_leaves_the_loop_to_python(fmus, real_case, monkey
 
         def fails(*args, **kwargs):
             raise RuntimeError("compiling 'master.c' failed: cc: error: unrecognized option")
-        monkeypatch.setattr(compiled_library, "compile_library", fails)
+        monkeypatch.setattr(compiled_library, "built_library", fails)
         fmi._master.cache_clear()
         try:
             with caplog.at_level("WARNING", logger="nodeforce.cosim"):
