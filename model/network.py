@@ -432,11 +432,12 @@ def face_heat_flux(building, network, T, U, component, face):
 
 
 def slowest_time_constant(network, nodes=None):
-    """The slowest time constant (s) of the nodes `nodes` (0-based; default every node) with every
-    other node and every input held: the time in which an error of their starting temperatures
-    falls by a factor e, whatever its shape through them (a heavy floor's deep nodes started
-    where the measurements do not say; a whole building started where its weather's past does
-    not say). Those of them without capacity follow the others at once.
+    """The slowest time constant (s) of the nodes `nodes` (0-based, each once however often it is
+    listed; default every node) with every other node and every input held: the time in which an
+    error of their starting temperatures falls by a factor e, whatever its shape through them (a
+    heavy floor's deep nodes started where the measurements do not say; a whole building started
+    where its weather's past does not say). Those of them without capacity follow the others at
+    once.
 
     It is 1 / lambda_min of the pencil K x = lambda C x on `nodes`, K = -A restricted to them (its
     diagonal holds their conductances to the nodes held; an air flow from zone to zone makes it
@@ -447,7 +448,7 @@ def slowest_time_constant(network, nodes=None):
     nodes, too small for it, by the dense pencil."""
     from scipy import linalg, sparse  # here: the FMU's host ships this module and needs numpy only
     from scipy.sparse.linalg import eigs
-    nodes = np.arange(network.n_nodes) if nodes is None else np.asarray(nodes, dtype=int)
+    nodes = np.arange(network.n_nodes) if nodes is None else np.asarray(list(dict.fromkeys(nodes)), dtype=int)
     C = network.C[nodes]
     if not (C > 0.0).any():
         return 0.0

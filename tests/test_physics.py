@@ -328,6 +328,7 @@ def test_a_component_s_slowest_time_constant_by_hand_and_from_its_free_decay():
     assert np.linalg.norm(expm(decay * day) @ error) / np.linalg.norm(error) == pytest.approx(np.exp(-day / tau),
                                                                                             rel=1e-3)
     assert tau > 2 * day  # a heavy floor: the reason its own nodes wait
+    assert slowest_time_constant(network, np.r_[floor, floor]) == tau  # a node listed twice counts once
 
 
 def test_a_whole_building_s_slowest_time_constant_from_its_free_decay_through_the_integrator():
