@@ -439,24 +439,19 @@ def slowest_time_constant(network, nodes=None):
     where its weather's past does not say). Those of them without capacity follow the others at
     once.
 
-    It is 1 / lambda_min of the pencil K x = lambda C x on `nodes`, K = -A restricted to them (its
-    diagonal holds their conductances to the nodes held; an air flow from zone to zone makes it
-    unsymmetric), whose nodes without capacity give infinite eigenvalues: as eliminating them,
-    K_cc - K_ca K_aa^-1 K_ac, would. Found by ARPACK in shift-invert about 0, which reaches the
-    smallest finite one without factorising more than the sparse K (milliseconds for the
-    1,730-node office, where a dense eigen-solution takes seconds); a set of fewer than three
-    nodes, too small for it, by the dense pencil."""
-    from scipy import linalg, sparse  # here: the FMU's host ships this module and needs numpy only
-    from scipy.sparse.linalg import eigs
+    It is 1 / lambda_min of C^-1 K on the nodes with capacity, K = -A restricted to `nodes` (its
+    diagonal holds their conductances to the nodes held) with those without capacity
+    eliminated, K_cc - K_ca K_aa^-1 K_ac; computed as the symmetric C^-1/2 K C^-1/2 where K is
+    symmetric (conduction; an air flow from zone to zone is not)."""
     nodes = np.arange(network.n_nodes) if nodes is None else np.asarray(list(dict.fromkeys(nodes)), dtype=int)
-    C = network.C[nodes]
-    if not (C > 0.0).any():
+    has = network.C[nodes] > 0.0
+    c, a = nodes[has], nodes[~has]
+    if len(c) == 0:
         return 0.0
-    K = -network.A[np.ix_(nodes, nodes)]
-    if len(nodes) < 3:
-        rates = linalg.eig(K, np.diag(C), right=False)
-        rates = rates[np.isfinite(rates)]
-    else:
-        rates = eigs(sparse.csc_matrix(K), k=1, M=sparse.diags(C, format="csc"), sigma=0.0, which="LM",
-                     return_eigenvectors=False)
-    return float(1.0 / rates.real.min())
+    K = -network.A[np.ix_(c, c)]
+    if len(a):
+        K = K + network.A[np.ix_(c, a)] @ np.linalg.solve(network.A[np.ix_(a, a)], network.A[np.ix_(a, c)])
+    root = np.sqrt(network.C[c])
+    scaled = K / np.outer(root, root)
+    rates = np.linalg.eigvalsh(scaled) if np.allclose(scaled, scaled.T) else np.linalg.eigvals(scaled).real
+    return float(1.0 / rates.min())
