@@ -69,9 +69,7 @@ def own_nodes(building, targets, sensors, numerical, sigma):
     is a component or none has a node measured. Effects refitted together read the own nodes of
     each, as each one's own fit did."""
     components = {c.name for c in building.components}
-    # a component two of the effects act on counts once (a revisit refits one beside another on it)
-    nodes = list(dict.fromkeys(i for target in targets if target in components
-                               for i in building.component(target).node_ids))
+    nodes = [i for target in targets if target in components for i in building.component(target).node_ids]
     if not nodes:
         return None
     columns = columns_among(sensors, set(nodes))

@@ -231,8 +231,6 @@ class InProcess:
     """A command's tasks run in this process, one after another (one worker asked for): what
     `Workers` and a Dask `nodeforce.cluster.Cluster` are for work spread over processes."""
 
-    count = 1
-
     def map_shared(self, function, value, items, done=None) -> list:
         """function(value, item) for each item, in order; `done()` after each."""
         return collected((function(value, item) for item in items), done)
@@ -250,9 +248,6 @@ class Workers:
 
     def submit(self, fn, *args, **kwargs):
         return self.pool.submit(fn, *args, **kwargs)
-
-    def map(self, fn, *iterables):
-        return self.pool.map(fn, *iterables)
 
     def map_shared(self, function, value, items, done=None) -> list:
         """function(value, item) for each item in the workers (`function` a module's, to be

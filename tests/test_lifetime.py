@@ -30,21 +30,18 @@ def test_a_thread_count_the_user_set_is_kept(monkeypatch):
         assert pool.submit(blas_threads).result() == [1]
 
 
-def _shared_sum(path, task):
+def _shared_sum(values, task):
     """(the shared values' sum, how many times this worker has read a shared file)."""
-    return float(lifetime.read_shared(path).sum()), lifetime.read_shared.cache_info().misses
+    return float(values.sum()), lifetime.read_shared.cache_info().misses
 
 
 def test_a_value_shared_with_a_pool_s_tasks_is_read_once_a_worker_and_removed_after(private_tmp):
     import numpy as np
-    from functools import partial
     values = np.arange(50_000, dtype=float)
     with lifetime.worker_pool(2) as pool:
-        with lifetime.shared(values) as path:
-            answers = list(pool.map(partial(_shared_sum, path), range(12)))
+        answers = pool.map_shared(_shared_sum, values, range(12))
         assert not list(private_tmp.glob("nodeforce_shared_*"))
-        with lifetime.shared(values[:10]) as second:  # another round: read again
-            again = list(pool.map(partial(_shared_sum, second), range(12)))
+        again = pool.map_shared(_shared_sum, values[:10], range(12))  # another round: read again
     assert {total for total, _ in answers} == {values.sum()} and {total for total, _ in again} == {values[:10].sum()}
     # read once a worker a round: the first round's by each worker that ran a task, the second's once more
     assert {reads for _, reads in answers} == {1} and {reads for _, reads in again} <= {1, 2}
