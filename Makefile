@@ -35,8 +35,8 @@ check: venv
 
 # ASHRAE 140 free-float cases (examples/bestest/README.md, docs/model.md section 10): nodeforce's
 # own case 600 IDF edited as the standard defines each case, converted by `nodeforce convert`,
-# simulated over the standard's Denver year, which the user supplies
-# (make bestest WEATHER=path/to/725650TYCST.epw); the table beside the reference range,
+# simulated over the standard's Denver year (examples/bestest/data/725650TYCST.epw; another with
+# make bestest WEATHER=path/to/file.epw); the table beside the reference range,
 # out/bestest/results.csv and out/bestest/bestest.png
 bestest: venv
 	@$(BIN)/python examples/bestest/run.py out/bestest "$(WEATHER)"

@@ -1,6 +1,7 @@
 """Weather files: the weather CSV of docs/model.md section 4 or an EPW file, read and checked.
 
-Hourly sources (EPW) have their rows at the middle of the hour (`nodeforce.iotools.hourly`).
+Hourly sources (EPW) have their rows at the middle of the hour (`nodeforce.iotools.hourly`). An EPW
+is read as EnergyPlus reads it: its months, days and hours in one calendar year.
 """
 
 from pathlib import Path
@@ -13,13 +14,18 @@ from .hourly import read_epw, to_mid_hour
 from nodeforce.model.units import check_celsius
 from .timetable import read_time_table
 
+#: The calendar year an EPW typical year is read in when none is given: the one on which
+#: `nodeforce convert` reads an IDF's schedules (its 1 January a Sunday, EnergyPlus's default
+#: start of a run period).
+TYPICAL_YEAR = 2017
+
 #: Irradiances (W/m2) below this are refused. Pyranometers read a few W/m2 below zero at night
 #: (thermal offset); those pass unchanged and the model clips incident solar at 0. A value far below
 #: is a sign error or a missing-value code (-999, -9999) that must not be read as data.
 IRRADIANCE_FLOOR = -50.0
 
 
-def read_weather(path):
+def read_weather(path, year=None, times=None):
     """Read and check a weather file: the CSV of docs/model.md section 4, or an EPW file (by extension).
 
     Parameters
@@ -30,6 +36,16 @@ def read_weather(path):
         `I_<component>` (W/m2) and any column a building file refers to by name (heat inputs,
         boundary and supply temperatures, irradiance, shading). Which columns a building may use
         is checked where the building is known (`nodeforce.model.weather.check_columns`).
+    year : int, optional
+        The calendar year an EPW is read in, as EnergyPlus reads any EPW: its months, days and
+        hours, whatever years its rows carry. None: the file's own year where its rows run in
+        time order (a record of actual weather), else (a typical year, whose months come from
+        different years) the year of the first of `times`, or `TYPICAL_YEAR` without them. In a
+        leap year, 29 February has no row: a gap, as any missing weather. Only for an EPW: a
+        CSV's times are its own.
+    times : pandas.DatetimeIndex, optional
+        The record's times (its measurements'), whose year an EPW typical year is read in when
+        `year` is not given.
 
     Returns
     -------
@@ -38,19 +54,24 @@ def read_weather(path):
         units; missing values are NaN. `attrs["source"]` is the path. An EPW file gives
         `T_out`, `ghi`, `dni`, `dhi`, `ir_h` at the middle of each hour (`iotools.hourly`); its
         missing-value codes (99.9 C, 9999 W/m2) become NaN and the first row's `T_out`, which
-        would need the reading before the file starts, is NaN.
+        would need the reading before the file starts, is NaN; that of a year read in another
+        (a typical year, or `year` given) is the mean of its first and last readings, the year
+        taken as cyclic, as `nodeforce.iotools.typical_year.convert_typical_year` writes it.
+        `attrs["typical_year"]` says whether the EPW's own rows mixed years.
 
     Raises
     ------
     InputError
         Naming the file and the column: the checks of `read_time_table`, no `T_out`, kelvin-looking
         `T_out` or `T_sky`, irradiance below `IRRADIANCE_FLOOR`, negative
-        `ir_h`, an EPW typical year (years mixed; convert it with
-        `nodeforce.iotools.typical_year.convert_typical_year`).
+        `ir_h`, `year` given for a CSV.
     """
     source = str(path)
     if Path(source).suffix.lower() == ".epw":
-        weather = _read_epw_weather(source)
+        weather = _read_epw_weather(source, year, None if times is None or not len(times) else times[0].year)
+    elif year is not None:
+        raise InputError(source, "year", f"{year}: a year is given to an EPW, whose rows EnergyPlus reads in "
+                                         "any calendar year; a weather CSV's times are its own")
     else:
         weather = read_time_table(path)
     for name in REQUIRED_COLUMNS:
@@ -66,17 +87,17 @@ def read_weather(path):
     return weather
 
 
-def _read_epw_weather(source):
+def _read_epw_weather(source, year, record_year):
     end_of_hour, columns, _ = read_epw(source)
-    steps = np.diff(utc_microseconds(end_of_hour))
-    if (steps <= 0).any():
-        raise InputError(
-            source, "time",
-            "the EPW mixes years (a typical year): convert it to one year with "
-            f"'python -m nodeforce.iotools.typical_year convert {source} OUT.csv --year YYYY'",
-        )
-    weather = to_mid_hour(end_of_hour, columns, cyclic=False)
-    weather.attrs["source"] = source
+    typical = bool((np.diff(utc_microseconds(end_of_hour)) <= 0).any())
+    if typical or year is not None:
+        year = year if year is not None else record_year or TYPICAL_YEAR
+        end_of_hour, columns, _ = read_epw(source, coerce_year=year)
+        # a year put in one calendar, as EnergyPlus runs it, is cyclic: its first hour follows its last
+        weather = to_mid_hour(end_of_hour, columns, cyclic=True)
+    else:
+        weather = to_mid_hour(end_of_hour, columns, cyclic=False)
+    weather.attrs.update(source=source, typical_year=typical)
     return weather
 
 

@@ -9,6 +9,8 @@ command line prints.
 from contextlib import contextmanager
 from pathlib import Path
 
+import pandas as pd
+
 from nodeforce import tempdirs
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import input_table, simulate_fmu
@@ -118,8 +120,8 @@ def read_case(building, weather, measurements=None, *, burn_in_days=0, decomposi
     Parameters
     ----------
     building : str or Path, or a Building already read
-    weather : str or Path
-        The weather CSV or EPW (`read_weather`).
+    weather : str or Path, or a DataFrame already read
+        The weather CSV or EPW (`read_weather`; an EPW typical year in the measurements' year).
     measurements : str or Path, optional
         The measurements CSV (`read_measurements`); None: a simulation without them.
     burn_in_days, decomposition, history_days
@@ -139,8 +141,10 @@ def _read(building, weather, measurements, burn_in_days, decomposition, history_
     """The building (read, unless given read) and the other arguments of `measured_case`, its
     files read: what `read_case` makes a case of, and what a `Record` keeps (`read_from`)."""
     building = building if isinstance(building, Building) else load_building(building)
-    return building, {"weather": read_weather(weather),
-                      "measurements": read_measurements(measurements) if measurements else None,
+    measurements = read_measurements(measurements) if measurements else None
+    if not isinstance(weather, pd.DataFrame):
+        weather = read_weather(weather, times=None if measurements is None else measurements.index)
+    return building, {"weather": weather, "measurements": measurements,
                       "burn_in_days": burn_in_days, "decomposition": decomposition, "history_days": history_days}
 
 
@@ -154,7 +158,8 @@ def read_record(building, weather, measurements, *, name=None, fraction=0.6, cal
         The building as written for this record's protocol (its own supply flows, blinds): the
         house the diagnosis corrects, or the same house node for node.
     weather, measurements : str or Path
-        The record's files; errors about the measurements name their file.
+        The record's files (the weather may be a DataFrame already read, `read_case`); errors
+        about the measurements name their file.
     name : str, optional
         The record's name in the report; default the measurement file's name before its first dot.
     fraction, calibration_end

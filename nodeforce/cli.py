@@ -15,6 +15,7 @@ from nodeforce.ga.search import PAPER, PATIENCE
 from nodeforce.model.case import HISTORY_DAYS
 from nodeforce.model.errors import InputError
 from nodeforce.iotools.timetable import instant
+from nodeforce.iotools.weather import TYPICAL_YEAR
 
 DATA = Path(str(files("nodeforce.model") / "data"))
 
@@ -38,11 +39,17 @@ def node_list(option, text):
 def load_inputs(args):
     """The building, the case of its weather and measurements with its burn-in (`api.read_case`),
     and the objective of --objective; what was assumed printed."""
-    building, case = api.read_case(args.building, args.weather, getattr(args, "measurements", None),
+    building, case = api.read_case(args.building, weather_of(args.weather, args), getattr(args, "measurements", None),
                                    burn_in_days=args.burn_in_days, decomposition=args.decomposition,
                                    history_days=history(args))
     said_assumed(case.assumptions)
     return building, case, objective_of(building, args)
+
+
+def weather_of(path, args):
+    """The weather file to read, or, with --year, the EPW read in that year (`api.read_weather`)."""
+    year = getattr(args, "year", None)  # `demo` reads its own CSV
+    return path if year is None else api.read_weather(path, year=year)
 
 
 def said_assumed(assumptions):
@@ -104,8 +111,11 @@ def cmd_simulate(args):
 def cmd_inputs(args):
     if args.force and not args.measurements:
         raise InputError("--force", args.force, "forcing needs --measurements to force nodes to")
-    table, start = api.fmu_inputs(api.read_building(args.building), api.read_weather(args.weather),
-                                  api.read_measurements(args.measurements) if args.measurements else None,
+    measurements = api.read_measurements(args.measurements) if args.measurements else None
+    table, start = api.fmu_inputs(api.read_building(args.building),
+                                  api.read_weather(args.weather, year=args.year,
+                                                   times=None if measurements is None else measurements.index),
+                                  measurements,
                                   node_list("--force", args.force) if args.force else (), args.burn_in_days,
                                   args.decomposition)
     start_path = api.write_fmu_inputs(args.output, table, start)
@@ -212,7 +222,7 @@ def cmd_synth(args):
     start = instant("--start", args.start)
     times = pd.date_range(start, periods=int(args.days * 86400 / args.step) + 1,
                           freq=pd.Timedelta(seconds=args.step), name="time")
-    frame = api.synthesize(building, api.read_weather(args.weather), times, node_list("--sensors", args.sensors),
+    frame = api.synthesize(building, api.read_weather(args.weather, year=args.year, times=times), times, node_list("--sensors", args.sensors),
                            effects=effects, noise_sd=args.noise, seed=args.seed, history_days=args.history_days,
                            decomposition=args.decomposition, source="--effect")
     Path(args.output).parent.mkdir(parents=True, exist_ok=True)
@@ -291,7 +301,7 @@ def records_of(building, args):
 def later_of(building, args):
     """The later records of --later (`api.read_record` under the building diagnosed, with the
     diagnosis's burn-in), read before any work so that a bad one stops the run at once."""
-    later = [api.read_record(building, fields["weather"], fields["measurements"], name=fields.get("name"),
+    later = [api.read_record(building, weather_of(fields["weather"], args), fields["measurements"], name=fields.get("name"),
                              burn_in_days=args.burn_in_days, decomposition=args.decomposition,
                              history_days=history(args))
              for fields in (record_fields(text, "--later", LATER_FIELDS) for text in args.later or ())]
@@ -311,7 +321,7 @@ def read_record(building, fields, options, args):
                                                      f"in {text!r}") from None
     end = fields.get("calibration-end", args.calibration_end)
     # a record run under another protocol (other flows, other blinds) reads the house as written for it
-    return api.read_record(fields.get("building", building), fields["weather"], fields["measurements"],
+    return api.read_record(fields.get("building", building), weather_of(fields["weather"], args), fields["measurements"],
                            name=fields.get("name"), fraction=check_fraction(options[0], fraction),
                            calibration_end=instant(options[1], end) if end else None,
                            phases=fields.get("phases", args.phases), burn_in_days=burn_in,
@@ -339,7 +349,8 @@ def cmd_diagnose(args):
 
 
 def cmd_compare(args):
-    weather, measurements = api.read_weather(args.weather), api.read_measurements(args.measurements)
+    measurements = api.read_measurements(args.measurements)
+    weather = api.read_weather(args.weather, year=args.year, times=measurements.index)
     models = []
     for path in args.buildings:
         building = api.read_building(path)
@@ -384,9 +395,16 @@ def case_arguments(s, measurements_required, output_help, output_default=None):
     """The building, weather and measurements every simulating command reads, and its output."""
     s.add_argument("building")
     s.add_argument("--weather", required=True)
+    year_argument(s)
     s.add_argument("--measurements", required=measurements_required)
     s.add_argument("-o", "--output", required=output_default is None, default=output_default, help=output_help)
     decomposition_argument(s)
+
+
+def year_argument(s):
+    s.add_argument("--year", type=int, help="the calendar year an EPW is read in, as EnergyPlus reads any EPW "
+                                            "(default: an actual year's own; a typical year's, the measurements' "
+                                            f"year, else {TYPICAL_YEAR})")
 
 
 def decomposition_argument(s):
@@ -530,6 +548,7 @@ def parser():
     s = sub.add_parser("diagnose", help="localise, add the missing effect, calibrate, report before/after")
     s.add_argument("building")
     s.add_argument("--weather")
+    year_argument(s)
     s.add_argument("--measurements")
     s.add_argument("--record", action="append",
                    help="one record of the building, instead of --weather and --measurements; repeat it for "
@@ -550,6 +569,7 @@ def parser():
                                        "per phase, heat loss coefficient")
     s.add_argument("buildings", metavar="BUILDING", nargs="+")
     s.add_argument("--weather", required=True)
+    year_argument(s)
     s.add_argument("--measurements", required=True)
     s.add_argument("-o", "--output", required=True, help="folder for compare.json, compare.md and the plot")
     s.add_argument("--phases", help="CSV time,phase: every model is scored on each phase")
@@ -562,6 +582,7 @@ def parser():
     s = sub.add_parser("synth", help="measurements of a building, optionally with an effect its file does not declare")
     s.add_argument("building")
     s.add_argument("--weather", required=True)
+    year_argument(s)
     s.add_argument("-o", "--output", required=True, help="the measurements CSV to write")
     s.add_argument("--start", required=True, help="first time, ISO 8601 with UTC offset")
     s.add_argument("--days", type=float, default=14.0)

@@ -314,3 +314,37 @@ def test_two_records_on_the_command_line_find_the_demos_ground_coupling(tmp_path
     for r in report["records"]:
         assert r["after"]["validation"]["rmse"] < 0.6 * r["before"]["validation"]["rmse"]
     assert "The 2 records apart" in (out / "report.md").read_text()
+
+
+def test_every_command_reads_a_typical_year_epw_as_energyplus_does(tmp_path, capsys):
+    """ASHRAE 140's Denver typical year, whose months come from different years: simulate reads it
+    in 2017 (no measurements) as its conversion to one year does, and synth, inputs, compare and
+    diagnose in the year of their record, 2013."""
+    bestest = DATA.parents[1] / "examples" / "bestest"
+    building, epw = str(bestest / "case600.json"), str(bestest / "data" / "725650TYCST.epw")
+    assert main(["simulate", building, "--weather", epw, "-o", str(tmp_path / "epw.csv")]) == 0
+    from nodeforce.iotools.typical_year import convert_typical_year
+    convert_typical_year(epw, tmp_path / "denver.csv", year=2017)
+    assert main(["simulate", building, "--weather", str(tmp_path / "denver.csv"), "-o", str(tmp_path / "csv.csv")]) == 0
+    from_epw, from_csv = (pd.read_csv(tmp_path / name, index_col=0) for name in ("epw.csv", "csv.csv"))
+    assert from_epw.index.equals(from_csv.index) and from_epw.index[0].startswith("2017-01-01")
+    assert np.allclose(from_epw.to_numpy(), from_csv.to_numpy(), atol=1e-3)  # the CSV's 6 digits
+
+    air = str(parse_building(json.loads((bestest / "case600.json").read_text())).zones[0].air_node)
+    measured = str(tmp_path / "m.csv")
+    assert main(["synth", building, "--weather", epw, "-o", measured, "--start", "2013-07-01T00:00-07:00",
+                 "--days", "6", "--step", "900", "--sensors", air, "--noise", "0.1", "--history-days", "5"]) == 0
+    assert read_measurements(measured).index[0] == pd.Timestamp("2013-07-01T00:00-07:00")
+    assert main(["inputs", building, "--weather", epw, "--measurements", measured, "-o", str(tmp_path / "in.csv")]) == 0
+    assert main(["compare", building, "--weather", epw, "--measurements", measured, "-o", str(tmp_path / "cmp")]) == 0
+    [model] = json.loads((tmp_path / "cmp" / "compare.json").read_text())["models"]
+    # the file's own weather, read in the record's year: the RMSE is the sensors' noise
+    assert 0.07 < next(iter(model["metrics"]["zones"].values()))["rmse"] < 0.13
+    assert main(["diagnose", building, "--weather", epw, "--measurements", measured, "-o", str(tmp_path / "dg"),
+                 "--workers", "1"]) == 0
+    assert json.loads((tmp_path / "dg" / "report.json").read_text())["effects"] == []  # nothing to add
+    # a year given reads the EPW in it: a record of 2013 is then not covered
+    capsys.readouterr()
+    assert main(["compare", building, "--weather", epw, "--year", "2015", "--measurements", measured,
+                 "-o", str(tmp_path / "cmp15")]) == 2
+    assert "does not cover" in capsys.readouterr().err

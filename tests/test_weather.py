@@ -11,7 +11,7 @@ import pytest
 from nodeforce.model.errors import InputError
 from nodeforce.model.solar import solar_position
 from nodeforce.iotools.typical_year import convert_typical_year, main, relocate
-from nodeforce.iotools.weather import read_weather
+from nodeforce.iotools.weather import TYPICAL_YEAR, read_weather
 from nodeforce.model.weather import weather_on_grid
 
 PVLIB_DATA = Path(pvlib.__file__).parent / "data"
@@ -170,11 +170,40 @@ def test_epw_rows_sit_at_mid_hour_with_codes_as_missing(tmp_path):
     assert np.isnan(w["T_out"].iloc[39]) and np.isnan(w["T_out"].iloc[40])  # 99.9 is missing
 
 
-def test_typical_year_epw_is_refused_with_the_way_out(tmp_path):
+def test_typical_year_epw_is_read_in_one_calendar_year_as_energyplus_reads_it(tmp_path):
+    # two days whose rows say 2011 and 1997: EnergyPlus reads their months, days and hours
     path = epw(tmp_path, [2011, 1997])
-    with pytest.raises(InputError, match="iotools.typical_year convert") as caught:
-        read_weather(path)
-    assert caught.value.field == "time"
+    w = read_weather(path)
+    assert w.attrs["typical_year"]
+    assert w.index[0] == pd.Timestamp(f"{TYPICAL_YEAR}-01-01T00:30+10:00") and len(w) == 48
+    assert w.index.is_monotonic_increasing and (w.index.year == TYPICAL_YEAR).all()
+    assert w["T_out"].iloc[0] == (48.0 + 1.0) / 2  # the year wraps around: its first hour follows its last
+    assert w["T_out"].iloc[1] == 1.5 and w["ghi"].iloc[0] == 101
+    given = read_weather(path, year=2013)
+    assert given.index[0] == pd.Timestamp("2013-01-01T00:30+10:00")
+    assert np.array_equal(given.to_numpy(), w.to_numpy(), equal_nan=True)
+
+
+def test_an_epw_read_in_a_year_equals_the_typical_year_converted_to_a_csv(tmp_path):
+    path = epw(tmp_path, [2011, 1997])
+    convert_typical_year(path, tmp_path / "w.csv", year=2003)
+    converted = read_weather(tmp_path / "w.csv")
+    read = read_weather(path, year=2003)
+    assert read.index.equals(converted.index)
+    assert np.allclose(read[converted.columns].to_numpy(), converted.to_numpy(), rtol=1e-5, equal_nan=True)
+
+
+def test_an_actual_year_epw_keeps_its_year_unless_one_is_given(tmp_path):
+    path = epw(tmp_path, [2019, 2019])
+    assert read_weather(path).index[0].year == 2019 and not read_weather(path).attrs["typical_year"]
+    assert read_weather(path, year=2021).index[0] == pd.Timestamp("2021-01-01T00:30+10:00")
+
+
+def test_a_year_given_to_a_weather_csv_is_refused(tmp_path):
+    path = hourly(tmp_path, [1.0, 2.0, 3.0])
+    with pytest.raises(InputError, match="EPW") as caught:
+        read_weather(path, year=2017)
+    assert (caught.value.source, caught.value.field) == (str(path), "year")
 
 
 def test_typical_year_epw_converts_with_infrared(tmp_path):

@@ -2,10 +2,11 @@
 `nodeforce simulate` over the standard's Denver year, their hourly zone air's minimum, maximum
 and mean beside the reference programs' range (ASHRAE 140-2020, Tables B8-5a, b, c).
 
-    python examples/bestest/run.py OUT WEATHER    writes OUT/results.csv, OUT/bestest.png
+    python examples/bestest/run.py OUT [WEATHER]    writes OUT/results.csv, OUT/bestest.png
 
-WEATHER is the standard's Denver weather, 725650TYCST.epw, distributed with ASHRAE 140; the
-repository does not carry it, the user supplies it.
+WEATHER is the standard's Denver weather, by default the copy the repository carries
+(examples/bestest/data/725650TYCST.epw, NREL's, with its README and licence), read as EnergyPlus
+reads a typical year: its months in one calendar year, 2017 (`--year`).
 """
 import subprocess
 import sys
@@ -21,6 +22,8 @@ sys.path.insert(0, str(Path(__file__).parent))
 import cases  # noqa: E402
 
 BIN = Path(sys.executable).parent
+WEATHER = Path(__file__).parent / "data" / "725650TYCST.epw"
+YEAR = 2017
 # ASHRAE 140-2020 Tables B8-5a, b, c: the range of the six reference programs, C
 REFERENCE = {
     "600FF": {"min": (-13.8, -9.9), "max": (62.4, 68.4), "mean": (24.3, 26.1)},
@@ -44,17 +47,14 @@ def zone_air(sim):
     return pd.read_csv(sim, index_col=0, parse_dates=True)[column]
 
 
-def main(out, epw):
+def main(out, weather=WEATHER):
     out = Path(out)
     cases.main(out)
-    weather = out / "weather.csv"
-    subprocess.run([sys.executable, "-m", "nodeforce.iotools.typical_year", "convert",
-                    epw, weather, "--year", "2017"], check=True, stdout=subprocess.DEVNULL)
     air, rows = {}, []
     for k, name in enumerate(cases.CASES, start=1):
         print(f"[{k}/{len(cases.CASES)}] {name}: nodeforce convert, nodeforce simulate over the year", flush=True)
         run("convert", out / f"{name}.idf", "-o", out / f"{name}.json")
-        run("simulate", out / f"{name}.json", "--weather", weather, "-o", out / f"{name}_sim.csv")
+        run("simulate", out / f"{name}.json", "--weather", weather, "--year", YEAR, "-o", out / f"{name}_sim.csv")
         air[name] = zone_air(out / f"{name}_sim.csv")
         rows.append({"case": name, "min": air[name].min(), "max": air[name].max(), "mean": air[name].mean()})
     results = pd.DataFrame(rows)
@@ -92,9 +92,9 @@ def plot(air, path):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 3 or not sys.argv[2]:
-        sys.exit(print("make bestest needs ASHRAE 140's Denver weather (725650TYCST.epw, distributed with the "
-                       "standard): make bestest WEATHER=path/to/725650TYCST.epw", file=sys.stderr) or 2)
-    if not Path(sys.argv[2]).is_file():
-        sys.exit(print(f"{sys.argv[2]}: no such weather file (ASHRAE 140's 725650TYCST.epw)", file=sys.stderr) or 2)
-    main(sys.argv[1], sys.argv[2])
+    if len(sys.argv) not in (2, 3):
+        sys.exit(print("usage: python examples/bestest/run.py OUT [WEATHER]", file=sys.stderr) or 2)
+    weather = Path(sys.argv[2]) if len(sys.argv) == 3 and sys.argv[2] else WEATHER
+    if not weather.is_file():
+        sys.exit(print(f"{weather}: file: no such weather file (ASHRAE 140's 725650TYCST.epw)", file=sys.stderr) or 2)
+    main(sys.argv[1], weather)

@@ -1,0 +1,52 @@
+"""ASHRAE 140's free-float cases (examples/bestest, `make bestest`) through `nodeforce convert`
+and the direct model over the Denver year the repository carries, against the reference
+programs' range (ASHRAE 140-2020, Tables B8-5a, b, c). docs/model.md section 10 gives the table."""
+import sys
+from pathlib import Path
+
+import idfkit
+import pytest
+
+from nodeforce.api import convert_idf
+from nodeforce.iotools.weather import read_weather
+from nodeforce.model.case import simulate_building
+
+BESTEST = Path(__file__).resolve().parents[1] / "examples" / "bestest"
+sys.path.insert(0, str(BESTEST))
+import cases  # noqa: E402
+from run import REFERENCE, WEATHER, YEAR  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def denver():
+    return read_weather(WEATHER, year=YEAR)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", ["600FF", "650FF", "900FF", "950FF", "680FF", "980FF"])
+def test_free_float_case_against_ashrae_140(case, denver, tmp_path):
+    path = tmp_path / f"{case}.idf"
+    idfkit.save_idf(cases.CASES[case](), str(path))
+    building = convert_idf(path)
+    T = simulate_building(building, denver)[f"T{building.zones[0].air_node}"]
+    figures = {"min": T.min(), "max": T.max(), "mean": T.mean()}
+    for key, value in figures.items():
+        low, high = REFERENCE[case][key]
+        assert low <= value <= high, f"{case} {key} {value:.2f} outside {low}..{high}"
+
+
+def test_the_carried_weather_is_the_standards_denver_year():
+    weather = read_weather(WEATHER)
+    assert weather.attrs["typical_year"] and len(weather) == 8760
+    assert weather.index[0].utcoffset().total_seconds() == -7 * 3600  # Mountain standard time
+    # Denver's typical year: an annual mean air near 10 C and a few hundred W/m2 of noon sun
+    assert 8.0 < weather["T_out"].mean() < 12.0 and 800 < weather["ghi"].max() < 1200
+
+
+def test_the_carried_case_600_building_file_is_what_convert_makes_of_its_idf():
+    """examples/bestest/case600.json, which the docs simulate, stays `nodeforce convert`'s."""
+    import json
+    made, carried = convert_idf(BESTEST / "case600.idf").data, json.loads((BESTEST / "case600.json").read_text())
+    # the file names its IDF from its own folder
+    assert (BESTEST / carried.pop("energyplus")["idf"]).resolve() == Path(made.pop("energyplus")["idf"]).resolve()
+    assert json.loads(json.dumps(made)) == carried  # as written: tuples are lists
