@@ -1,4 +1,4 @@
-"""Does the diagnosis name the effect a record carries? A benchmark of many records (issue 27).
+"""Does the diagnosis name the effect a record carries? A benchmark of many records.
 
 The records (`benchmarks/records.py`; their catalogue `benchmarks/catalogue.py`): the test cell under three typical years (pvlib's Miami,
 Greensboro and Sand Point files), 5 to 21 days at 10 to 60 min, 0.05 to 0.3 C of noise, read by
@@ -12,8 +12,10 @@ Each record, under `--draws` noise draws, is diagnosed by the loop through the p
 (`nodeforce.api.diagnose`, the command line's settings: GA population 30, 400 generations at
 most, seed 0; one worker per diagnosis, the sensors' noise given as the user would state it), and
 by the plain baseline (`benchmarks/baseline.py`). The results go, record by record, to
-`out/bench_diagnosis/records/` (a rerun skips the finished ones); the tables and the issue's
-criteria are printed and written to docs/benchmark_diagnosis.md and out/bench_diagnosis/results.json.
+`out/bench_diagnosis/records/` (a rerun skips the finished ones); the tables and the criteria
+are printed. A run of the whole benchmark is kept in benchmarks/results/diagnosis-DATE.json
+(`benchmarks.results`), from which docs/benchmark_diagnosis.md is made (`page`); a subset's
+tables go to out/bench_diagnosis/summary.md.
 
 Run:
 
@@ -22,6 +24,7 @@ Run:
     python benchmarks/bench_diagnosis.py --quick        # 8 records, one draw
     python benchmarks/bench_diagnosis.py --only 'gso-jan/*' --draws 1
     python benchmarks/bench_diagnosis.py --report       # the tables from the records already run
+    python benchmarks/pages.py                          # the docs again from the latest results
     python benchmarks/bench_diagnosis.py --scheduler tcp://10.0.0.1:8786   # on a Dask cluster's workers,
         # started with this checkout on their PYTHONPATH (they import benchmarks.records)
 """
@@ -47,6 +50,7 @@ from tqdm import tqdm  # noqa: E402
 from benchmarks.baseline import baseline  # noqa: E402
 from benchmarks.catalogue import PLAN, SCENARIOS, SPECS, SPECS_BY_NAME, quick_specs  # noqa: E402
 from benchmarks.records import later_record, later_spec, record  # noqa: E402
+from benchmarks import results as kept_results  # noqa: E402
 from nodeforce.model.case import HISTORY_DAYS  # noqa: E402
 
 OUT = ROOT / "out" / "bench_diagnosis"
@@ -291,6 +295,35 @@ def share(flags):
     return (sum(flags) / len(flags)) if flags else float("nan")
 
 
+def per_draw(texts):
+    """One text where every draw gives the same, else the draws' texts separated by " / "."""
+    return texts[0] if len(set(texts)) == 1 else " / ".join(texts)
+
+
+def record_row(draws):
+    """A record's row of the table "Every record": its diagnoses under each noise draw."""
+    r = draws[0]
+
+    def added(d):
+        effects = ", ".join(f"{e}@{t}" for e, t in d["loop"]["effects"]) or "none"
+        return (effects + ("" if right(d, "loop") else " (wrong)")
+                + (" (a fault missed)" if len(d["faults"]) > 1 and not all_found(d) else ""))
+
+    def base(d):
+        b = d["baseline"]
+        return f"{b['effect']}{'@' + b['target'] if b['target'] else ''}{'' if right(d, 'baseline') else ' (wrong)'}"
+
+    def later(d):
+        return (f"{d['later']['written'] / d['noise']:.2f}, {d['later']['corrected'] / d['noise']:.2f}"
+                + ("" if held(d) else " (worse)"))
+
+    after = per_draw([f"{d['loop']['hlc_after']:.1f}" if d["loop"]["hlc_after"] else "-" for d in draws])
+    return (f"| {r['name']} | {r['before_ratio_noiseless']:.2f} | {per_draw([added(d) for d in draws])} | "
+            f"{per_draw([format(d['loop']['after'] / d['noise'], '.2f') for d in draws])} | "
+            f"{per_draw([later(d) for d in draws])} | {per_draw([base(d) for d in draws])} | "
+            f"{r['hlc_truth']:.1f}, {after} | {per_draw([format(d['loop']['seconds'], '.0f') for d in draws])} |")
+
+
 def summary(results, draws):
     """The tables and the criteria, as markdown lines; and the numbers."""
     ok = [r for r in results if "error" not in r]
@@ -376,37 +409,15 @@ def summary(results, draws):
         f"(the file as given: {pct(numbers['hlc_error_file_median'])})",
         f"- time per diagnosis: mean {numbers['seconds_mean']:.1f} s, max {numbers['seconds_max']:.1f} s; "
         f"the baseline {numbers['baseline_seconds_mean']:.1f} s",
-        "", "## Every diagnosis", "",
-        "| record | draw | before/noise (noiseless) | loop: effects added | after/noise | later: written, corrected /noise "
+        "", "## Every record", "",
+        "Each figure is given per noise draw (draw 0 first), once where every draw gives the same.", "",
+        "| record | before/noise (noiseless) | loop: effects added | after/noise | later: written, corrected /noise "
         "| baseline | HLC truth, after (W/K) | s |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|",
     ]
-    for r in sorted(ok, key=lambda r: (r["name"], r["draw"])):
-        added = ", ".join(f"{e}@{t}" for e, t in r["loop"]["effects"]) or "none"
-        b = r["baseline"]
-        after = r["loop"]["hlc_after"]
-        lines.append(f"| {r['name']} | {r['draw']} | {r['before_ratio_noiseless']:.2f} | {added}"
-                     f"{'' if right(r, 'loop') else ' (wrong)'}{' (a fault missed)' if len(r['faults']) > 1 and not all_found(r) else ''} | "
-                     f"{r['loop']['after'] / r['noise']:.2f} | "
-                     f"{r['later']['written'] / r['noise']:.2f}, {r['later']['corrected'] / r['noise']:.2f}"
-                     f"{'' if held(r) else ' (worse)'} | "
-                     f"{b['effect']}{'@' + b['target'] if b['target'] else ''}{'' if right(r, 'baseline') else ' (wrong)'} | "
-                     f"{r['hlc_truth']:.1f}, {after if after is None else f'{after:.1f}'} | {r['loop']['seconds']:.0f} |")
+    for name in sorted({r["name"] for r in ok}):
+        lines.append(record_row(sorted((r for r in ok if r["name"] == name), key=lambda r: r["draw"])))
     return lines, numbers
-
-
-# What one diagnosis costs, measured in the draw 0 of commit ca616bd: the whole run is sized from it.
-BUDGET = ("The budget, measured in the draw 0 of commit ca616bd on 2 cores, two diagnoses at a time (5 to 95 % "
-          "of the records' times), the forcing search driving the standalone FMU (`search_fmu=\"auto\"`, the "
-          "API's default as the command line's) and the runs of steps compiled where a C compiler is found: a "
-          "test-cell diagnosis takes 5 to 10 s with the paper's sensors or the air alone and 10 to 19 s with "
-          "every node measured (gso-jan and mia-dec, 23 forcing genes), its baseline 3 to 5 s, a Twin House "
-          "diagnosis 41 to 56 s (its baseline 22 to 32 s), making a record's truth 1 to 5 s on the test cell "
-          "and 12 to 19 s for the Twin House. Every record under one draw is then about 12 min on 2 workers. "
-          "The GA and the calibrations keep the command line's defaults. Finished records are kept in "
-          "out/bench_diagnosis/records, each with a digest of its spec and of the code (the package, the "
-          "records, the baseline, the examples): a rerun skips what is unchanged, a changed loop runs "
-          "everything again.")
 
 
 def scenarios_table():
@@ -422,58 +433,79 @@ def scenarios_table():
     return "\n".join(lines)
 
 
-def write_docs(path, lines, args, elapsed):
-    subset = args.quick or args.only
-    # the command that made the results: --report and --docs only write them again
-    argv, skip = [], False
-    for a in sys.argv[1:]:
-        if skip or a in ("--report", "--docs") or a.startswith("--docs="):
-            skip = a == "--docs"
-            continue
-        argv.append(a)
-    command = COMMAND if not subset else f"python benchmarks/bench_diagnosis.py {' '.join(argv)}"
-    timing = ("" if args.report else f": {elapsed / 60:.0f} min for the diagnoses run this time")
-    header = [
-        "# The diagnosis on many records (issue 27)", "",
-        *(["A subset of the records; `make benchmark` writes the whole benchmark's tables here.", ""] if subset else []),
-        "Made by", "", f"    {command}", "",
-        f"on {'a Dask cluster' if args.scheduler else f'{os.cpu_count()} cores, {args.workers} workers'}{timing}. The loop runs through the public API (`nodeforce.api.diagnose`) with the command line's "
-        f"settings: GA population {args.population}, at most {args.generations} generations (stopped at "
-        "convergence), its own calibrations, seed 0, one worker per diagnosis, the sensors' noise given as "
-        "a user states it.", "",
-        BUDGET, "",
+def compact(result):
+    """A diagnosis's result as a run keeps it (what `summary` reads): the loop's rounds reduced to
+    the candidates each names as not told apart from its choice."""
+    if "error" in result:
+        return result
+    loop = {k: v for k, v in result["loop"].items() if k not in ("reason", "rounds")}
+    loop["rounds"] = [{"indistinct": d.get("indistinct", [])} for d in result["loop"].get("rounds", [])]
+    return {**{k: v for k, v in result.items() if k not in ("spec", "values", "generation_seconds", "loop")},
+            "loop": loop, "baseline": {k: result["baseline"][k] for k in ("effect", "target", "seconds")}}
+
+
+def cost_line(results):
+    """What a diagnosis took in the run, by building: the median and the range of its seconds."""
+    ok = [r for r in results if "error" not in r]
+    parts = []
+    for building in sorted({SPECS_BY_NAME[r["name"]].building for r in ok if r["name"] in SPECS_BY_NAME}):
+        seconds = sorted(r["loop"]["seconds"] for r in ok if SPECS_BY_NAME.get(r["name"]) and
+                         SPECS_BY_NAME[r["name"]].building == building)
+        base = sorted(r["baseline"]["seconds"] for r in ok if SPECS_BY_NAME.get(r["name"]) and
+                      SPECS_BY_NAME[r["name"]].building == building)
+        parts.append(f"{building}: {statistics.median(seconds):.0f} s a diagnosis ({seconds[0]:.0f} to "
+                     f"{seconds[-1]:.0f} s), its baseline {statistics.median(base):.0f} s")
+    return "; ".join(parts)
+
+
+def page(run, subset=False):
+    """docs/benchmark_diagnosis.md of a run as `benchmarks.results` keeps it."""
+    lines, _ = summary(run["diagnoses"], run["draws"])
+    return "\n".join([
+        "# The diagnosis on many records", "",
+        "Does the diagnosis name the effect a record carries, and does its correction hold on data no "
+        "choice read? Each record is the benchmark's building with a fault its file does not declare "
+        "(or none); the diagnosis runs on the file as written and is judged by the first effect it adds, "
+        "the error left on the days it held out, and the corrected file on a later record.", "",
+        *(["A subset of the records; `make benchmark` writes the whole benchmark's tables to "
+           "docs/benchmark_diagnosis.md.", ""] if subset else []),
+        "Made by", "", f"    {run['command']}", "",
+        kept_results.run_line(run), "",
+        f"{run['workers']} diagnoses at a time, {run['minutes']:.0f} min for the {len(run['diagnoses'])} "
+        "diagnoses. The loop runs through the public API (`nodeforce.api.diagnose`) with the command line's "
+        f"settings: GA population {run['population']}, at most {run['generations']} generations (stopped at "
+        "convergence), its own calibrations, seed 0, one worker per diagnosis, the sensors' noise given as a "
+        f"user states it. Time: {cost_line(run['diagnoses'])}. Finished records are kept in "
+        "out/bench_diagnosis/records, each with a digest of its spec and of the code (the package, the records, "
+        "the baseline, the examples): a rerun skips what is unchanged, a changed loop runs everything again.", "",
         "## The records", "",
-        "Made by `benchmarks/records.py` (read its docstring for why each choice): the truth is the "
-        "building file discretised finer (every stretch between two of its nodes or layer boundaries cut "
-        "in two) and simulated at 1 min from 90 days of history (the typical year read as cyclic), sampled at "
-        "the record's step, its inputs the same piecewise-linear weather and held heater powers the file's "
-        "model reads; the diagnosis reads the weather from some days before the record ('weather before' "
-        "below: its history, docs/model.md 5.7), never the truth's whole past; the fault is an "
-        "effect the file does not declare, applied with the registry's own `apply`, or a gain on a "
-        "schedule (150 W from 08:00 to 18:00 at scale 1), or a south opening (0.6 m2 of glazing at scale "
-        "1, its sun to the floor), or the envelope's materials and outside film coefficients both twice the "
-        "file's at scale 1 ('envelope-films'; 'envelope' is the registry's factor on the materials alone); a few records carry two faults together ('door+roof-alpha': a component whose inner surface a sensor reads and an effect no sensor reads), both moved by one common scale; its size is tuned by simulating so that the file's validation RMSE is "
-        "2.2 x the noise (subtle, accepted 1.5 to 3) or 6 x (strong, 4 to 9); Gaussian noise, seeded by "
-        "the record's name and draw. A fault is never scaled beyond its physical limits (a factor on a "
-        "conductance within 0.1 to 10, a room's mean convective coefficient within 0.5 to 20 W/m2/K): where that limit comes before the "
-        "size asked for, the record is as large as physics lets it be, its 'before/noise' below. Even "
-        "without a fault the file is not the truth: its coarser walls and the part of the truth's past "
-        "the weather does not reach leave it 0.03 to 0.09 C (it integrates every record in steps of at "
-        "most 5 min, docs/model.md 5.1; at the record's own step, the error grew with the step, to 0.3 C "
-        "at 60 min).", "",
+        "Made by `benchmarks/records.py` (its docstring says why each choice). The truth is the building "
+        "file discretised finer (every stretch between two of its nodes or layer boundaries cut in two) and "
+        "simulated at 1 min from 90 days of history (the typical year read as cyclic), sampled at the "
+        "record's step; the diagnosis reads the weather from some days before the record ('weather before' "
+        "below: its history, docs/model.md 5.7), never the truth's whole past. The fault is an effect the "
+        "file does not declare, applied with the registry's own `apply`; or a gain on a schedule (150 W from "
+        "08:00 to 18:00 at scale 1); or a south opening (0.6 m2 of glazing at scale 1, its sun to the floor); "
+        "or the envelope's materials and outside film coefficients both twice the file's ('envelope-films'; "
+        "'envelope' is the registry's factor on the materials alone). A few records carry two faults, moved "
+        "by one common scale. A fault's size is tuned by simulating, so that the file's validation RMSE is "
+        "2.2 x the noise (subtle, accepted 1.5 to 3) or 6 x (strong, 4 to 9), never beyond its physical "
+        "limits (a factor on a conductance within 0.1 to 10, a room's mean convective coefficient within 0.5 "
+        "to 20 W/m2/K): where the limit comes first, the record is as large as physics lets it be. Gaussian "
+        "noise is seeded by the record's name and draw. Without a fault the file is still not the truth: "
+        "its coarser walls and the part of the truth's past the weather does not reach leave it 0.03 to "
+        "0.09 C.", "",
         scenarios_table(), "",
-        "A first effect is right when it is the record's fault with its target; an air change and a "
-        "bridge to the outdoor air are one equation and count as one; a schedule is right as a daily "
-        "gain; the south opening as a gain proportional to the south wall's sun or as the south "
-        "window's transmittance; the envelope's materials and films as the zone's envelope factor or its "
-        "conductance to the outdoor air (an air change, a bridge: with the films scaled as the layers, the "
-        "share of the sun the envelope passes on is as declared, and only the sun tells them apart); on a "
-        "record without a fault, adding nothing is right. On a record with two faults the first effect is right when it names either, and both are found when each is named among the effects added. The baseline "
-        "(`benchmarks/baseline.py`) fits each catalogue effect alone by least squares to the objective "
-        "air on the calibration window and keeps the best by BIC if it falls by more than 10.", "",
-    ]
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text("\n".join(header + lines) + "\n")
+        "A first effect is right when it is the record's fault with its target. An air change and a bridge "
+        "to the outdoor air are one equation and count as one; a schedule is right as a daily gain; the south "
+        "opening as a gain following the south wall's sun or as the south window's transmittance; the "
+        "envelope's materials and films as the zone's envelope factor or its conductance to the outdoor air. "
+        "On a record without a fault, adding nothing is right. On a record with two faults the first effect "
+        "is right when it names either, and both are found when each is among the effects added. The "
+        "baseline (`benchmarks/baseline.py`) fits each catalogue effect alone by least squares on the "
+        "calibration window and keeps the best by BIC if it falls by more than 10.", "",
+        *lines,
+    ]) + "\n"
 
 
 def main(argv=None):
@@ -521,10 +553,23 @@ def main(argv=None):
     print("\n".join(lines))
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "results.json").write_text(json.dumps({"numbers": numbers, "results": results}, indent=1) + "\n")
-    # a subset's tables stay under out/: the docs hold the whole benchmark's
-    docs = args.docs or (DOCS if not (args.quick or args.only) else args.out / "summary.md")
-    write_docs(docs, lines, args, elapsed)
-    print(f"written: {docs}, {args.out / 'results.json'}")
+    figures = {"draws": draws, "workers": "a Dask cluster's" if args.scheduler else args.workers,
+               "population": args.population, "generations": args.generations, "minutes": elapsed / 60,
+               "numbers": numbers, "diagnoses": [compact(r) for r in results]}
+    given = [a for a in (sys.argv[1:] if argv is None else argv) if a != "--fresh"]
+    if "--docs" in given:  # where the tables go, not how they were made
+        del given[given.index("--docs"):given.index("--docs") + 2]
+    command = f"python benchmarks/bench_diagnosis.py {' '.join(given)}" if given else COMMAND
+    if args.quick or args.only or args.report or draws != 3 or args.history_days != HISTORY_DAYS:
+        # a subset, a rerun of the tables, one draw or another history: under out/, never the docs
+        written = args.docs or args.out / "summary.md"
+        written.write_text(page(kept_results.stamped("diagnosis", figures, command), subset=True))
+    else:
+        saved = kept_results.save("diagnosis", figures, command)
+        written = args.docs or DOCS
+        written.write_text(page(kept_results.latest("diagnosis")))
+        print(f"kept: {saved}")
+    print(f"written: {written}, {args.out / 'results.json'}")
     return 0
 
 

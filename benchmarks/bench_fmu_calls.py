@@ -41,8 +41,11 @@ def stepping(fmu, folder, one_by_one, repeats=3):
     return statistics.median(times), len(outputs), round(stop / step)
 
 
-def main():
-    print(f"{'building':14} {'FMU':10} {'N':>4} {'one call':>10} {'N calls':>10} {'per extra call':>15}")
+def measure():
+    """Each building's FMUs in the C host: {"tables": Markdown lines, "per_call_us": {building: {kind: us}}}."""
+    tables = ["| building | FMU | outputs N | a step loop, one call for all | N calls | a call more |",
+              "|---|---|---|---|---|---|"]
+    figures = {}
     with tempfile.TemporaryDirectory(prefix="nodeforce_bench_") as tmp:
         for label, path in BUILDINGS.items():
             building = load_building(path)
@@ -53,8 +56,13 @@ def main():
                 together, n, n_steps = stepping(fmu, folder, one_by_one=False)
                 apart, _, _ = stepping(fmu, folder, one_by_one=True)
                 per_call = (apart - together) / (n_steps * (n - 1))
-                print(f"{label:14} {kind:10} {n:4d} {together:9.3f}s {apart:9.3f}s {per_call * 1e6:12.2f} us",
-                      flush=True)
+                figures.setdefault(label, {})[kind] = per_call * 1e6
+                tables.append(f"| {label} | {kind} | {n} | {together:.3f} s | {apart:.3f} s | {per_call * 1e6:.2f} us |")
+    return {"tables": tables, "per_call_us": figures}
+
+
+def main():
+    print("\n".join(measure()["tables"]))
 
 
 if __name__ == "__main__":

@@ -63,6 +63,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # the verification cases are the tests'
 from tests.conftest import record_times  # noqa: E402
 from tests.test_locate import EXPECTED, disturbed  # noqa: E402
+from benchmarks.results import cpu_model  # noqa: E402
 
 DATA = ROOT / "model" / "data"
 DAYS, WARMUP_DAYS = 5, 2
@@ -70,18 +71,6 @@ OVERHEAD_TARGET_US = 10.0  # FMI overhead per step, the issue's target
 PAPER_BUDGET = 30 * 400  # evaluations the paper's GA asks for
 UNIQUE_TARGET = PAPER_BUDGET // 10  # the default search's simulations, at most
 MODES = {"paper": PAPER, "default": {}}
-
-
-def machine():
-    cpu = platform.processor()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return cpu or platform.machine()
 
 
 def median_time(fn, repeats, warmup=1):
@@ -215,15 +204,21 @@ def main(argv=None):
     parser.add_argument("--cases", action="store_true", help="item 6 only: paper vs default on every case")
     parser.add_argument("--repeats", type=int, default=20, help="timed runs of items 1 and 2")
     args = parser.parse_args(argv)
-    workers = os.cpu_count()
-
     print("nodeforce search benchmark")
-    print(f"machine : {workers} CPUs (os.cpu_count()), {machine()}")
+    print(f"machine : {os.cpu_count()} CPUs (os.cpu_count()), {cpu_model()}")
     print(f"python  : {platform.python_version()} ({platform.python_implementation()}), numpy {np.__version__}")
     if args.cases:
         print("paper vs default search on every verification case (direct model, one process):", flush=True)
         all_cases()
         return 0
+    print("\n".join(measure(args.quick, args.repeats)["tables"]))
+    return 0
+
+
+def measure(quick=True, repeats=20):
+    """Items 1 to 5 (the paper's search in item 5 unless `quick`): {"tables": Markdown lines, and
+    the figures}."""
+    workers = os.cpu_count()
     print("preparing the case (pseudo-measurements, one year of spin-up) ...", flush=True)
 
     data, building, case = the_case()
@@ -237,7 +232,7 @@ def main(argv=None):
     forced_ids = sorted(n for n, bit in zip(nodes, mask) if bit)
     force = np.zeros(building.n_nodes, dtype=bool)
     force[np.array(forced_ids) - 1] = True
-    modes = ["default"] if args.quick else ["default", "paper"]
+    modes = ["default"] if quick else ["default", "paper"]
 
     with tempfile.TemporaryDirectory(prefix="nodeforce_bench_") as tmp:
         tmp = Path(tmp)
@@ -247,14 +242,14 @@ def main(argv=None):
         T_direct = simulate(building, network, case.U, case.dt, case.measured, force=force, warmup_days=WARMUP_DAYS,
                             substeps=case.substeps)
         t_direct = median_time(lambda: simulate(building, network, case.U, case.dt, case.measured, force=force,
-                                                warmup_days=WARMUP_DAYS, substeps=case.substeps), args.repeats)
+                                                warmup_days=WARMUP_DAYS, substeps=case.substeps), repeats)
 
         # 2. one FMU evaluation through the driver, evaluator built once
         (tmp / "fmu").mkdir()
         fmu = build_fmu(building, tmp / "fmu" / "model.fmu")
         evaluator = FmuFitness(fmu, case, nodes, objective, WARMUP_DAYS)()
         J_fmu = evaluator.J(mask)
-        t_fmu = median_time(lambda: evaluator.J(mask), args.repeats)
+        t_fmu = median_time(lambda: evaluator.J(mask), repeats)
         evaluator.close()
         J_direct = ModelFitness(building, case, nodes, objective, WARMUP_DAYS)().J(mask)
 
@@ -262,7 +257,7 @@ def main(argv=None):
         setup = bare_loop_setup(building, case, force)
         T_bare = bare_loop(*setup)[steps - (n_rows - 1):]
         bare_error = float(np.max(np.abs(T_bare - T_direct)))
-        t_bare = median_time(lambda: bare_loop(*setup), max(5 * args.repeats, 100))
+        t_bare = median_time(lambda: bare_loop(*setup), max(5 * repeats, 100))
 
         # 5. the searches
         searches = {}
@@ -277,8 +272,8 @@ def main(argv=None):
     ms = lambda t: f"{t * 1e3:10.2f} ms"  # noqa: E731
 
     rows = [
-        ("1. direct simulation (model.integrate.simulate)", ms(t_direct), f"median of {args.repeats}"),
-        ("2. FMU evaluation (FmuFitness evaluator J)", ms(t_fmu), f"median of {args.repeats}"),
+        ("1. direct simulation (model.integrate.simulate)", ms(t_direct), f"median of {repeats}"),
+        ("2. FMU evaluation (FmuFitness evaluator J)", ms(t_fmu), f"median of {repeats}"),
         ("   J through FMU / direct", f"{J_fmu:.6g} / {J_direct:.6g}", f"difference {abs(J_fmu - J_direct):.1e}"),
         ("3. FMU / direct", f"{t_fmu / t_direct:10.1f} x", ""),
         ("   FMI overhead per step", f"{overhead_us:10.1f} us", f"target <= {OVERHEAD_TARGET_US:g} us/step"),
@@ -292,19 +287,24 @@ def main(argv=None):
                      "target < 1" if mode == "default" else ""))
         rows.append((f"   {mode}: unique simulations", f"{s['unique_evaluations']:10d}",
                      f"target <= {UNIQUE_TARGET:,}" if mode == "default" else ""))
-    width = max(len(r[0]) for r in rows)
-    value_width = max(len(r[1]) for r in rows)
-    print()
-    print(f"case    : {DAYS} days at {case.dt / 60:g} min = {n_rows - 1} steps + {WARMUP_DAYS}-day warm-up "
-          f"= {steps} steps; {building.n_nodes} nodes, {len(nodes)} in the chromosome; door disturbed")
-    print(f"mask    : items 1, 2 and 4 force nodes {','.join(map(str, forced_ids))}")
-    print()
-    for label, value, note in rows:
-        print(f"{label:<{width}}  {value:>{value_width}}  {note}".rstrip())
-    print()
-    print(f"5. the search over {len(nodes)} nodes, locate() incl. the FMU build, {workers} workers, seed 0:")
-    table([row("door, exact", mode, *searches[mode]) for mode in modes])
-    return 0
+    tables = [f"The case: {DAYS} days at {case.dt / 60:g} min = {n_rows - 1} steps + {WARMUP_DAYS}-day warm-up "
+              f"= {steps} steps; {building.n_nodes} nodes, {len(nodes)} in the chromosome; the door disturbed; "
+              f"items 1, 2 and 4 force nodes {','.join(map(str, forced_ids))}.", "",
+              "| what | figure | note |", "|---|---|---|",
+              *(f"| {label.strip()} | {value.strip()} | {note} |" for label, value, note in rows), "",
+              f"Item 5, the search over {len(nodes)} nodes (`locate()`, its FMU's build included, {workers} workers, "
+              "seed 0):", "",
+              "| mode | evaluations | unique | stopped | at generation | seconds | best nodes |",
+              "|---|---|---|---|---|---|---|"]
+    for mode in modes:
+        result, seconds, _ = searches[mode]
+        s = result["search"]
+        tables.append(f"| {mode} | {s['evaluations']} | {s['unique_evaluations']} | {s['stopped']} | "
+                      f"{s['stopped_at']} | {seconds:.1f} | {result['best_nodes']} |")
+    return {"tables": tables, "direct_ms": t_direct * 1e3, "fmu_ms": t_fmu * 1e3, "overhead_us_per_step": overhead_us,
+            "bare_loop_ms": t_bare * 1e3,
+            "searches": {mode: {"seconds": searches[mode][1], **searches[mode][0]["search"],
+                                "best_nodes": searches[mode][0]["best_nodes"]} for mode in modes}}
 
 
 if __name__ == "__main__":

@@ -57,12 +57,21 @@ def timed_stages(name):
     return seconds, whole
 
 
-def main(names):
-    print("| record | " + " | ".join(f"{stage} (s)" for stage in STAGES) + " | diagnosis (s) |")
-    print("|---|" + "---|" * (len(STAGES) + 1))
-    for name in names or RECORDS:
+def measure(names=RECORDS):
+    """Each record's stages: {"tables": Markdown lines, "seconds": {record: {stage: s, "diagnosis": s}}}."""
+    tables = ["| record | " + " | ".join(f"{stage} (s)" for stage in STAGES) + " | diagnosis (s) |",
+              "|---|" + "---|" * (len(STAGES) + 1)]
+    figures = {}
+    for name in names:
         seconds, whole = timed_stages(name)
-        print(f"| {name} | " + " | ".join(f"{seconds.get(stage, 0.0):.1f}" for stage in STAGES) + f" | {whole:.1f} |")
+        figures[name] = {**seconds, "diagnosis": whole}
+        tables.append(f"| {name} | " + " | ".join(f"{seconds.get(stage, 0.0):.1f}" for stage in STAGES)
+                      + f" | {whole:.1f} |")
+    return {"tables": tables, "seconds": figures}
+
+
+def main(names):
+    print("\n".join(measure(names or RECORDS)["tables"]))
     return 0
 
 

@@ -1,0 +1,67 @@
+"""Benchmark results: each run's figures in a dated JSON file under benchmarks/results/, from
+which the docs' tables are made (`benchmarks/pages.py`).
+
+A result is `{"benchmark", "command", "commit", "date", "machine", "python", ...figures}`: the
+figures are the benchmark's own, with the Markdown tables the docs show under "tables".
+"""
+import datetime
+import json
+import os
+import platform
+import subprocess
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+RESULTS = ROOT / "benchmarks" / "results"
+
+
+def cpu_model():
+    """The processor's model name (Linux), else what `platform` knows."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
+
+
+def commit():
+    """HEAD's short hash, "+changes" after it where tracked files differ from it; "unknown" outside git."""
+    def git(*args):
+        return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True, check=True).stdout.strip()
+    try:
+        head = git("rev-parse", "--short=7", "HEAD")
+        return head + ("+changes" if git("status", "--porcelain", "--untracked-files=no") else "")
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+def stamped(name, figures, command):
+    """`figures` with what says where they come from: the benchmark, its command, the commit, the
+    date and the machine."""
+    return {"benchmark": name, "command": command, "commit": commit(), "date": datetime.date.today().isoformat(),
+            "machine": f"{os.cpu_count()} cores, {cpu_model()}, {platform.system()}",
+            "python": platform.python_version(), **figures}
+
+
+def save(name, figures, command, folder=RESULTS):
+    """Write `figures`, `stamped`, as `folder/NAME-YYYY-MM-DD.json` (a run of the same day replaces
+    it); return the path."""
+    result = stamped(name, figures, command)
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"{name}-{result['date']}.json"
+    path.write_text(json.dumps(result, indent=1) + "\n")
+    return path
+
+
+def latest(name, folder=RESULTS):
+    """The newest result of benchmark `name` (by the date in its file name), or None."""
+    paths = sorted(folder.glob(f"{name}-????-??-??.json"))
+    return json.loads(paths[-1].read_text()) if paths else None
+
+
+def run_line(result):
+    """The one line a page gives its run: command, commit, date and machine."""
+    return (f"Run: `{result['command']}` on commit {result['commit']}, {result['date']}, "
+            f"{result['machine']}, Python {result['python']}.")
