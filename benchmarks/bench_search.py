@@ -278,7 +278,7 @@ def measure(quick=True, repeats=20):
         ("3. FMU / direct", f"{t_fmu / t_direct:10.1f} x", ""),
         ("   FMI overhead per step", f"{overhead_us:10.1f} us", f"target <= {OVERHEAD_TARGET_US:g} us/step"),
         ("4. bare loop (Minv @ v, numpy), one run", ms(t_bare), f"{t_bare / steps * 1e6:.2f} us/step; "
-                                                               f"max |T - direct| {bare_error:.1e} C"),
+                                                               f"max abs(T - direct) {bare_error:.1e} C"),
         ("   12,000 runs of the bare loop", f"{t_budget:10.2f} s", "the paper's 30 x 400"),
     ]
     for mode, (result, seconds, _) in searches.items():

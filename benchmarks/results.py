@@ -13,6 +13,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "benchmarks" / "results"
+# The folders whose files make a benchmark's figures: a change there is a change of what was run.
+CODE = ("nodeforce", "model", "fmu_build", "cosim", "ga", "diagnosis", "iotools", "benchmarks", "examples", "tests")
 
 
 def cpu_model():
@@ -27,12 +29,13 @@ def cpu_model():
 
 
 def commit():
-    """HEAD's short hash, "+changes" after it where tracked files differ from it; "unknown" outside git."""
+    """HEAD's short hash, "+changes" after it where tracked files of the `CODE` folders differ from
+    it; "unknown" outside git."""
     def git(*args):
         return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True, check=True).stdout.strip()
     try:
         head = git("rev-parse", "--short=7", "HEAD")
-        return head + ("+changes" if git("status", "--porcelain", "--untracked-files=no") else "")
+        return head + ("+changes" if git("status", "--porcelain", "--untracked-files=no", "--", *CODE) else "")
     except (OSError, subprocess.CalledProcessError):
         return "unknown"
 
