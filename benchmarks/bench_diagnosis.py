@@ -543,6 +543,11 @@ def main(argv=None):
     todo = [t for t in tasks if args.fresh or not finished(t[2], t[0])] if not args.report else []
     print(f"{len(specs)} records x {draws} draws: {len(tasks) - len(todo)} done before, {len(todo)} to run "
           f"on {args.scheduler or f'{args.workers} workers'}", flush=True)
+    given = [a for a in (sys.argv[1:] if argv is None else argv) if a != "--fresh"]
+    if "--docs" in given:  # where the tables go, not how they were made
+        del given[given.index("--docs"):given.index("--docs") + 2]
+    stamped = kept_results.stamp("diagnosis", f"python benchmarks/bench_diagnosis.py {' '.join(given)}"
+                                 if given else COMMAND)
     started = time.time()
     fresh = {(r["name"], r["draw"]): r for r in run(longest_first(todo), args.workers, args.scheduler)}
     elapsed = time.time() - started
@@ -556,16 +561,12 @@ def main(argv=None):
     figures = {"draws": draws, "workers": "a Dask cluster's" if args.scheduler else args.workers,
                "population": args.population, "generations": args.generations, "minutes": elapsed / 60,
                "numbers": numbers, "diagnoses": [compact(r) for r in results]}
-    given = [a for a in (sys.argv[1:] if argv is None else argv) if a != "--fresh"]
-    if "--docs" in given:  # where the tables go, not how they were made
-        del given[given.index("--docs"):given.index("--docs") + 2]
-    command = f"python benchmarks/bench_diagnosis.py {' '.join(given)}" if given else COMMAND
     if args.quick or args.only or args.report or draws != 3 or args.history_days != HISTORY_DAYS:
         # a subset, a rerun of the tables, one draw or another history: under out/, never the docs
         written = args.docs or args.out / "summary.md"
-        written.write_text(page(kept_results.stamped("diagnosis", figures, command), subset=True))
+        written.write_text(page({**stamped, **figures}, subset=True))
     else:
-        saved = kept_results.save("diagnosis", figures, command)
+        saved = kept_results.save(stamped, figures)
         written = args.docs or DOCS
         written.write_text(page(kept_results.latest("diagnosis")))
         print(f"kept: {saved}")

@@ -45,13 +45,13 @@ def main(argv=None):
     parts = {"search": bench_search.measure, "stages": bench_stages.measure, "fmu_calls": bench_fmu_calls.measure}
     if args.scale:
         parts["scale"] = scale
+    started = results.stamp("speed", "python benchmarks/bench_speed.py" + (" --scale" if args.scale else ""))
     figures = {}
     for name, measure in parts.items():
         print(f"{name} ...", flush=True)
         figures[name] = measure()
         print("\n".join(figures[name]["tables"]), flush=True)
-    command = "python benchmarks/bench_speed.py" + (" --scale" if args.scale else "")
-    print(f"kept: {results.save('speed', figures, command)}")
+    print(f"kept: {results.save(started, figures)}")
     return 0
 
 

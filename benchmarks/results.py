@@ -40,18 +40,20 @@ def commit():
         return "unknown"
 
 
-def stamped(name, figures, command):
-    """`figures` with what says where they come from: the benchmark, its command, the commit, the
-    date and the machine."""
+def stamp(name, command):
+    """What says where a run's figures come from, taken as it starts: the benchmark, its command,
+    the commit, the date and the machine (its load: the processes ready to run, averaged over the
+    minute before, on a machine of `os.cpu_count()` cores)."""
     return {"benchmark": name, "command": command, "commit": commit(), "date": datetime.date.today().isoformat(),
-            "machine": f"{os.cpu_count()} cores, {cpu_model()}, {platform.system()}",
-            "python": platform.python_version(), **figures}
+            "machine": f"{os.cpu_count()} cores, {cpu_model()}, {platform.system()}, load {os.getloadavg()[0]:.1f}",
+            "python": platform.python_version()}
 
 
-def save(name, figures, command, folder=RESULTS):
-    """Write `figures`, `stamped`, as `folder/NAME-YYYY-MM-DD.json` (a run of the same day replaces
-    it); return the path."""
-    result = stamped(name, figures, command)
+def save(stamped, figures, folder=RESULTS):
+    """Write a run's figures with its `stamp` as `folder/NAME-YYYY-MM-DD.json` (a run of the same
+    day replaces it); return the path."""
+    result = {**stamped, **figures}
+    name = result["benchmark"]
     folder.mkdir(parents=True, exist_ok=True)
     path = folder / f"{name}-{result['date']}.json"
     path.write_text(json.dumps(result, indent=1) + "\n")
