@@ -398,7 +398,7 @@ def summary(results, draws):
         + (f"; {numbers['failed']} failed: " + "; ".join(f"{r['name']} draw {r['draw']}: {r['error']}" for r in failed)
            if failed else ""),
         "",
-        "## The issue's criteria", "", *criteria, "",
+        "## The criteria", "", *criteria, "",
         "## First effect added by the loop, every record", "", confusion(ok), "",
         "### Subtle (validation RMSE before 1.5 to 3 x the noise)", "", confusion(subtle), "",
         "### Strong", "", confusion(strong), "",
