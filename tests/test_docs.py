@@ -17,7 +17,7 @@ import pytest
 from nodeforce.cli import main
 
 ROOT = Path(__file__).parents[1]
-PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+PAGES = [ROOT / "README.md", ROOT / "CHANGELOG.md", ROOT / "CONTRIBUTING.md", *sorted((ROOT / "docs").glob("*.md"))]
 EXAMPLE_PAGES = sorted((ROOT / "examples").glob("*/README.md"))
 
 FENCE = re.compile(r"^\s*(```|~~~)")
@@ -253,3 +253,46 @@ def test_no_page_or_file_points_outside_the_repository():
         text = path.read_text(encoding="utf-8", errors="replace")
         found += [f"{name}: {w}" for w in words if w in text]
     assert not found, found
+
+
+# A commit's short hash, as `git log --oneline` prints it.
+HASH = re.compile(r"\b[0-9a-f]{7}\b")
+RESULT_PAGES = ("performance.md", "benchmark_diagnosis.md")
+
+
+@pytest.mark.parametrize("name", RESULT_PAGES)
+def test_a_benchmark_page_is_a_reference_of_one_run(name):
+    """At most 300 lines, and no commit but its run's, in its one run line."""
+    lines = (ROOT / "docs" / name).read_text().splitlines()
+    assert len(lines) <= 300
+    hashes = [line for line in lines if HASH.search(line)]
+    assert len(hashes) == 1 and hashes[0].startswith("Run: "), hashes
+
+
+def test_the_readme_names_no_commit():
+    assert not HASH.search((ROOT / "README.md").read_text())
+
+
+def test_the_benchmark_pages_are_made_from_the_latest_results():
+    """docs/performance.md's tables and docs/benchmark_diagnosis.md are what `benchmarks/pages.py`
+    makes of the latest runs in benchmarks/results/."""
+    import sys
+    sys.path.insert(0, str(ROOT))
+    from benchmarks.pages import pages
+    for path, text in pages().items():
+        assert path.read_text() == text, f"{path.name}: run python benchmarks/pages.py"
+
+
+def test_the_pages_take_each_block_from_the_run_it_names(tmp_path):
+    """A results block of a page is filled from the newest file of its benchmark, by date."""
+    import json
+    import sys
+    sys.path.insert(0, str(ROOT))
+    from benchmarks.pages import filled
+    stamp = {"benchmark": "speed", "command": "c", "commit": "0000000", "machine": "m", "python": "3"}
+    for date, figure in (("2026-01-02", "new"), ("2025-12-31", "old")):
+        (tmp_path / f"speed-{date}.json").write_text(json.dumps({**stamp, "date": date, "search": {"tables": [figure]}}))
+    text = "a\n<!-- results speed search -->\nstale\n<!-- /results -->\n<!-- results speed run -->\n<!-- /results -->\n"
+    assert filled(text, tmp_path) == ("a\n<!-- results speed search -->\nnew\n<!-- /results -->\n"
+                                      "<!-- results speed run -->\nRun: `c` on commit 0000000, 2026-01-02, m, Python 3."
+                                      "\n<!-- /results -->\n")
