@@ -10,6 +10,8 @@ the field and the problem. The physics of the mapping (geometry, glazing) is `mo
 `model.glazing`; the coefficients EnergyPlus computes each step and the nodal model holds
 constant are `FILMS`.
 """
+import difflib
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -81,6 +83,11 @@ SUBSURFACES = ("FenestrationSurface:Detailed", "Window", "Door", "GlazedDoor", "
                "Door:Interzone", "GlazedDoor:Interzone")
 GAINS = ("People", "Lights", "ElectricEquipment", "GasEquipment", "HotWaterEquipment", "SteamEquipment",
          "OtherEquipment")
+# A gain's design level by its calculation method: the field each method reads (as 8.9's IDD names it)
+GAIN_FIELDS = {kind: {"equipmentlevel": "design_level", "watts/area": "power_per_zone_floor_area"}
+               for kind in ("GasEquipment", "HotWaterEquipment", "SteamEquipment", "OtherEquipment")}
+GAIN_FIELDS["ElectricEquipment"] = {"equipmentlevel": "design_level", "watts/area": "watts_per_zone_floor_area"}
+GAIN_FIELDS["Lights"] = {"lightinglevel": "lighting_level", "watts/area": "watts_per_zone_floor_area"}
 FLOWS = ("ZoneInfiltration:DesignFlowRate", "ZoneVentilation:DesignFlowRate")
 SCHEDULES = ("Schedule:Compact", "Schedule:Constant", "Schedule:Year", "Schedule:Week:Daily",
              "Schedule:Week:Compact", "Schedule:Day:Interval", "Schedule:Day:Hourly", "Schedule:Day:List",
@@ -119,22 +126,72 @@ def load_idf(path):
         raise InputError(path, "(file)", f"not a readable IDF: {message}") from None
 
 
-# Fields EnergyPlus renamed when it added spaces (9.6 on): the name read first, then its later one
-RENAMED = {"zone_or_zonelist_name": "zone_or_zonelist_or_space_or_spacelist_name",
-           "watts_per_zone_floor_area": "watts_per_floor_area",
-           "power_per_zone_floor_area": "power_per_floor_area",
-           "flow_per_zone_floor_area": "flow_rate_per_floor_area",
-           "people_per_zone_floor_area": "people_per_floor_area",
-           "zone_floor_area_per_person": "floor_area_per_person"}
+# The version whose IDD names the fields this module asks for; a file of another version has its
+# fields found by aligning that version's IDD field list with this one's (`_field_names`)
+REFERENCE_SCHEMA = (8, 9, 0)
+
+
+def _idd_fields(obj_type, version):
+    """The IDD's fields of an object type in an EnergyPlus version, in order ([] for an unknown type)."""
+    import idfkit.schema
+    schema = idfkit.schema.get_schema(tuple(version))
+    obj = schema.get_object_schema(obj_type) if obj_type in schema else None
+    return list(obj["legacy_idd"]["fields"]) if obj else []
+
+
+def _words(name):
+    return set(name.split("_"))
+
+
+@functools.lru_cache(maxsize=None)
+def _field_names(obj_type, version):
+    """{reference name: name in `version`} of an object type's fields, found through the two
+    versions' IDDs (idfkit's schemas), not a table of renames: their field lists aligned (difflib),
+    a field kept where it was, a renamed one the field at its place (a run of renamed fields of
+    equal length, field by field; else the field sharing most words with it, as `Zone Name` ->
+    `Zone or ZoneList Name` beside an inserted `Space or SpaceList Name`)."""
+    ref, own = _idd_fields(obj_type, REFERENCE_SCHEMA), _idd_fields(obj_type, version)
+    out = {n: n for n in own}
+    matcher = difflib.SequenceMatcher(None, ref, own, autojunk=False)
+    for tag, i1, i2, j1, j2 in matcher.get_opcodes():
+        if tag != "replace":
+            continue
+        if i2 - i1 == j2 - j1:
+            out.update({ref[i]: own[j1 + i - i1] for i in range(i1, i2) if ref[i] not in out})
+            continue
+        for i in range(i1, i2):
+            best = max(own[j1:j2], key=lambda n: len(_words(n) & _words(ref[i])) / len(_words(n) | _words(ref[i])))
+            if _words(best) & _words(ref[i]) - {"name"} and ref[i] not in out:
+                out[ref[i]] = best
+    return out
+
+
+def _version_of(obj):
+    doc = getattr(obj, "theidf", None)
+    version = getattr(doc, "version", None)
+    return tuple(version) if version else REFERENCE_SCHEMA
+
+
+def _own_name(obj, field):
+    """A field's name in the IDD of the object's own version."""
+    return _field_names(obj.obj_type, _version_of(obj)).get(field, field)
 
 
 def _field(obj, field):
-    """A field's value (by its name in the IDF's version), None where the object's type has no such
-    field (idfkit refuses the name)."""
-    fields = obj.to_dict()
-    if field not in fields and field in RENAMED:
-        return fields.get(RENAMED[field])
-    return fields.get(field)
+    """A field's value, the field named as the reference version's IDD names it and found in the
+    object's own version's (`_field_names`); None where the object's type has no such field."""
+    return obj.to_dict().get(_own_name(obj, field))
+
+
+def _field_label(obj, field):
+    """A field's name as the IDD of the object's own version writes it (`Watts per Floor Area`)."""
+    import idfkit.schema
+    own = _own_name(obj, field)
+    try:
+        info = idfkit.schema.get_schema(_version_of(obj)).get_object_schema(obj.obj_type)["legacy_idd"]["field_info"]
+        return info[own]["field_name"]
+    except (KeyError, TypeError):
+        return _label(field)
 
 
 def _blank(value):
@@ -168,20 +225,20 @@ class _Reader:
         value = _field(obj, field)
         if _blank(value):
             if default is None:
-                self.fail(obj, _label(field), "missing: a number is needed")
+                self.fail(obj, _field_label(obj, field), "missing: a number is needed")
             return float(default)
         if isinstance(value, str):
             if value.strip().lower() in ("autocalculate", "autosize"):
-                self.fail(obj, _label(field), f"{value}: the converter needs the number")
+                self.fail(obj, _field_label(obj, field), f"{value}: the converter needs the number")
             try:
                 value = float(value)
             except ValueError:
-                self.fail(obj, _label(field), f"{value!r} is not a number")
+                self.fail(obj, _field_label(obj, field), f"{value!r} is not a number")
         value = float(value)
         if low is not None and (value <= low if low_open else value < low):
-            self.fail(obj, _label(field), f"{value:g} must be {'>' if low_open else '>='} {low:g}")
+            self.fail(obj, _field_label(obj, field), f"{value:g} must be {'>' if low_open else '>='} {low:g}")
         if high is not None and value > high:
-            self.fail(obj, _label(field), f"{value:g} must be <= {high:g}")
+            self.fail(obj, _field_label(obj, field), f"{value:g} must be <= {high:g}")
         return value
 
     def text(self, obj, field, default=""):
@@ -201,9 +258,77 @@ def convert(path):
     return _Converter(_Reader(doc, str(path))).building()
 
 
+class _DaySchedules:
+    """A schedule's values over the year `YEAR` on a time step, as idfkit evaluates them, but day by
+    day: the document's holidays and special days found once (idfkit's `values` finds them again at
+    every time step, some 40 s a schedule of a DOE reference building), and each day profile
+    evaluated once, the days that share it copied."""
+
+    def __init__(self, doc):
+        from idfkit.schedules.holidays import get_holidays, get_special_days_by_type
+        self.doc = doc
+        self.special = (get_holidays(doc, YEAR), get_special_days_by_type(doc, YEAR, "CustomDay1"),
+                        get_special_days_by_type(doc, YEAR, "CustomDay2"))
+        self.profiles = {}
+
+    def dates(self):
+        import datetime
+        first = datetime.date(YEAR, 1, 1)
+        return [first + datetime.timedelta(days=k) for k in range((datetime.date(YEAR + 1, 1, 1) - first).days)]
+
+    def times(self, ts):
+        import datetime
+        return [datetime.time(h, m * 60 // ts) for h in range(24) for m in range(ts)]
+
+    def of(self, obj, ts):
+        """(days, 24 ts) values of a Schedule:Compact, Schedule:Constant or Schedule:Week:Daily/Compact."""
+        from idfkit.schedules import compact, day_types, week
+        from idfkit.schedules.time_utils import evaluate_time_values
+        from idfkit.schedules.types import DayType
+        kind = obj.obj_type.upper()
+        if kind == "SCHEDULE:CONSTANT":
+            value = self.day_values(obj, ts)[0]
+            return np.full((len(self.dates()), 24 * ts), value)
+        rows = []
+        if kind == "SCHEDULE:COMPACT":
+            periods, interpolation = compact.parse_compact(obj)
+            for d in self.dates():
+                period = compact._find_period_for_date(periods, d) if periods else None
+                rule = None if period is None else compact._find_matching_rule(
+                    period.day_rules, day_types.get_applicable_day_types(d, DayType.NORMAL, *self.special))
+                key = ("rule", id(rule), ts)
+                if key not in self.profiles:
+                    self.profiles[key] = (np.zeros(24 * ts) if rule is None else np.array(
+                        [evaluate_time_values(rule.time_values, t, interpolation) for t in self.times(ts)]), rule)
+                rows.append(self.profiles[key][0])
+            return np.array(rows, dtype=float)
+        for d in self.dates():
+            if kind == "SCHEDULE:WEEK:DAILY":
+                day_name = week._get_day_schedule_name_for_date(obj, d, DayType.NORMAL, *self.special)
+            else:
+                day_name = week._find_matching_day_in_week_compact(
+                    obj, day_types.get_applicable_day_types(d, DayType.NORMAL, *self.special))
+            if day_name is None:
+                rows.append(np.zeros(24 * ts))
+                continue
+            day = week._find_day_schedule(self.doc, day_name)
+            if day is None:
+                raise ValueError(f"Day schedule not found: {day_name!r}")
+            rows.append(self.day_values(day, ts))
+        return np.array(rows, dtype=float)
+
+    def day_values(self, day, ts):
+        from idfkit.schedules.day import get_day_values
+        key = ("day", day.obj_type.upper(), str(day.name).upper(), ts)
+        if key not in self.profiles:
+            self.profiles[key] = (np.asarray(get_day_values(day, ts), dtype=float), day)
+        return self.profiles[key][0]
+
+
 class _Converter:
     def __init__(self, reader):
         self.r = reader
+        self._days = _DaySchedules(reader.doc)
         self.materials = {}
         self.schedules = {}
         self.not_modelled = []
@@ -282,14 +407,13 @@ class _Converter:
         the IDF's time step, as day profiles by date and day of the week)."""
         if name in self.schedules:
             return name
-        import idfkit.schedules as S
         obj = self.r.get(("Schedule:Compact", "Schedule:Constant", "Schedule:Year"), name, referrer, field)
         ts = self.timesteps
         try:
             if obj.obj_type.upper() == "SCHEDULE:YEAR":
                 values = self._year_values(obj, ts)
             else:
-                values = np.asarray(S.values(obj, year=YEAR, timestep=ts, document=self.r.doc), dtype=float)
+                values = self._days.of(obj, ts).ravel()
         except InputError:
             raise
         except Exception as e:
@@ -300,8 +424,6 @@ class _Converter:
     def _year_values(self, obj, ts):
         """A Schedule:Year's values: each week schedule over its dates (idfkit reads the weeks)."""
         import datetime
-
-        import idfkit.schedules as S
         days = (datetime.date(YEAR + 1, 1, 1) - datetime.date(YEAR, 1, 1)).days
         out = np.full((days, 24 * ts), np.nan)
         fields = obj.to_dict()
@@ -320,7 +442,7 @@ class _Converter:
                 end = datetime.date(YEAR, int(float(w["end_month"])), int(float(w["end_day"])))
             except (TypeError, ValueError) as e:
                 self.r.fail(obj, f"Start Month {k}", f"not a date ({e})")
-            values = np.asarray(S.values(week, year=YEAR, timestep=ts, document=self.r.doc), dtype=float)
+            values = self._days.of(week, ts)
             first, last = (start - datetime.date(YEAR, 1, 1)).days, (end - datetime.date(YEAR, 1, 1)).days
             out[first:last + 1] = values.reshape(-1, 24 * ts)[first:last + 1]
         if np.isnan(out).any():
@@ -598,7 +720,7 @@ class _Converter:
         name = self.r.text(obj, field)
         zone = self.zone_objs.get(name.upper())
         if zone is None:
-            self.r.fail(obj, _label(field), f"names no Zone ({name!r})")
+            self.r.fail(obj, _field_label(obj, field), f"names no Zone ({name!r})")
         return zone
 
     def vertices(self, s, zone):
@@ -662,7 +784,7 @@ class _Converter:
             return [self.zone_objs[name.upper()].name]
         zl = self.r.by_name.get("ZONELIST", {}).get(name.upper())
         if zl is None:
-            self.r.fail(obj, _label(field), f"names no Zone or ZoneList ({name!r})")
+            self.r.fail(obj, _field_label(obj, field), f"names no Zone or ZoneList ({name!r})")
         fields = zl.to_dict()
         if isinstance(fields.get("zones"), list):
             return [d["zone_name"] for d in fields["zones"]]
@@ -679,7 +801,8 @@ class _Converter:
                     continue
                 method = self.r.text(o, "design_flow_rate_calculation_method", "Flow/Zone").lower()
                 per = {"flow/zone": ("design_flow_rate", 3600.0),
-                       "flow/area": ("flow_per_zone_floor_area", 3600.0 * floor),
+                       "flow/area": ("flow_per_zone_floor_area" if kind == FLOWS[0] else "flow_rate_per_zone_floor_area",
+                                     3600.0 * floor),
                        "flow/exteriorarea": ("flow_per_exterior_surface_area", 3600.0 * exterior),
                        "flow/exteriorwallarea": ("flow_per_exterior_surface_area", 3600.0 * walls),
                        "airchanges/hour": ("air_changes_per_hour", volume),
@@ -698,10 +821,10 @@ class _Converter:
                     self.not_modelled.append(f"{kind} {o.name}: {', '.join(dropped)} not held (the building file's "
                                              f"air flows do not vary with temperature or wind); its constant term kept")
                 if kind == "ZoneVentilation:DesignFlowRate":
-                    limits = [_label(f) for f in ("minimum_indoor_temperature", "maximum_indoor_temperature",
-                                                  "delta_temperature", "minimum_outdoor_temperature",
-                                                  "maximum_outdoor_temperature", "maximum_wind_speed")
-                              if not _blank(o.get(f)) and f in o.to_dict()]
+                    limits = [_field_label(o, f) for f in ("minimum_indoor_temperature", "maximum_indoor_temperature",
+                                                           "delta_temperature", "minimum_outdoor_temperature",
+                                                           "maximum_outdoor_temperature", "maximum_wind_speed")
+                              if not _blank(_field(o, f))]
                     if limits:
                         self.not_modelled.append(f"{kind} {o.name}: its controls ({', '.join(limits)}) not held; "
                                                  "the flow runs as scheduled")
@@ -725,12 +848,7 @@ class _Converter:
                 if kind == "People":
                     out.append(self.people(o, floor))
                     continue
-                if kind == "Lights":
-                    method_field, fields = "design_level_calculation_method", {
-                        "lightinglevel": "lighting_level", "watts/area": "watts_per_zone_floor_area"}
-                else:
-                    method_field, fields = "design_level_calculation_method", {
-                        "equipmentlevel": "design_level", "watts/area": "power_per_zone_floor_area"}
+                method_field, fields = "design_level_calculation_method", GAIN_FIELDS[kind]
                 method = self.r.text(o, method_field).lower()
                 if method not in fields:
                     self.r.fail(o, _label(method_field), f"{method!r} is not read ({', '.join(fields)} are)")
@@ -768,9 +886,9 @@ class _Converter:
         if method == "people":
             n = self.r.number(o, "number_of_people", low=0)
         elif method == "people/area":
-            n = self.r.number(o, "people_per_floor_area", low=0) * floor
+            n = self.r.number(o, "people_per_zone_floor_area", low=0) * floor
         elif method == "area/person":
-            n = floor / self.r.number(o, "floor_area_per_person", low=0, low_open=True)
+            n = floor / self.r.number(o, "zone_floor_area_per_person", low=0, low_open=True)
         else:
             self.r.fail(o, "Number of People Calculation Method", f"{method!r} is not read")
         activity = self.constant_schedule_value(self.r.text(o, "activity_level_schedule_name"), o,
@@ -865,7 +983,7 @@ class _Converter:
 
     def internal_masses(self, components):
         for o in self.r.all("InternalMass"):
-            zone = self.zone_of(o, "zone_or_zonelist_name" if "zone_or_zonelist_name" in o.to_dict() else "zone_name")
+            zone = self.zone_of(o, "zone_name")
             layers, _, inner, _ = self.layers(self.r.text(o, "construction_name"), o, "Construction Name")
             # EnergyPlus's internal mass sees the zone on one face, the other adiabatic
             s = {"tilt": 90.0, "azimuth": 0.0, "zone": zone.name, "type": "internalmass"}
