@@ -96,7 +96,9 @@ READ = set(("Version", "Site:Location", "GlobalGeometryRules", "Building", "Zone
             "Material", "Material:NoMass", "Material:AirGap", "WindowMaterial:Glazing", "WindowMaterial:Gas",
             "WindowMaterial:SimpleGlazingSystem", "Site:GroundTemperature:BuildingSurface",
             "Site:GroundTemperature:Deep", "Timestep",
-            "InternalMass", "SurfaceConvectionAlgorithm:Inside", "SurfaceConvectionAlgorithm:Outside") + SURFACES + tuple(SIMPLE_SURFACES) + SUBSURFACES + GAINS + FLOWS + SCHEDULES)
+            "InternalMass", "Construction:FfactorGroundFloor", "Construction:CfactorUndergroundWall",
+            "Site:GroundTemperature:FCfactorMethod", "SurfaceProperty:OtherSideCoefficients",
+            "SurfaceProperty:OtherSideConditionsModel", "WindowMaterial:GasMixture", "SurfaceConvectionAlgorithm:Inside", "SurfaceConvectionAlgorithm:Outside") + SURFACES + tuple(SIMPLE_SURFACES) + SUBSURFACES + GAINS + FLOWS + SCHEDULES)
 # Objects about the run and its reports, not the building
 NOT_PHYSICS = ("Output", "OutputControl", "LifeCycleCost", "Meter", "RunPeriod", "SimulationControl", "Sizing:Parameters",
                "UtilityCost", "ComponentCost", "CurrencyType")
@@ -256,6 +258,43 @@ def convert(path):
     the conversion cannot read (docs/guide.md lists each refusal)."""
     doc = load_idf(path)
     return _Converter(_Reader(doc, str(path))).building()
+
+
+# EnergyPlus's equivalent construction of an F- or C-factor (Engineering Reference, "Ground Heat
+# Transfer Calculations using C and F Factor Constructions"; HeatBalanceManager's
+# CreateFCfactorConstructions): 6 in of heavy concrete behind a fictitious massless layer
+FC_CONCRETE = "~FC_Concrete"
+FC_CONCRETE_PROPERTIES = (0.15, 1.95, 2240.0, 900.0)  # m, W/m/K, kg/m3, J/kg/K
+FC_FILM_INSIDE, FC_FILM_OUTSIDE = 0.135, 0.03  # m2K/W, the films an F-factor includes
+FC_MIN_RESISTANCE = 0.001  # m2K/W, the least fictitious layer EnergyPlus accepts
+FC_NO_PERIMETER = 1000.0  # m2K/W, a floor with no exposed perimeter loses nothing to the ground's edge
+
+
+def ffactor_fictitious_resistance(F, area, perimeter):
+    """The fictitious layer (m2K/W) of an F-factor floor: its effective resistance A / (P F), F in
+    W/m/K, A in m2, P the exposed perimeter in m, less the concrete and the two films it includes."""
+    if perimeter <= 0:
+        return FC_NO_PERIMETER
+    R_eff = area / (perimeter * F)
+    R_concrete = FC_CONCRETE_PROPERTIES[0] / FC_CONCRETE_PROPERTIES[1]
+    return max(FC_MIN_RESISTANCE, R_eff - R_concrete - FC_FILM_INSIDE - FC_FILM_OUTSIDE)
+
+
+def cfactor_fictitious_resistance(C, height):
+    """The fictitious layer (m2K/W) of a C-factor underground wall of `height` m: 1/C (W/m2/K,
+    films excluded) plus the soil's equivalent resistance 0.0607 + 0.3479 H (Engineering Reference,
+    eq. 3.195), less the concrete."""
+    R_eff = 1.0 / C + 0.0607 + 0.3479 * height
+    return max(FC_MIN_RESISTANCE, R_eff - FC_CONCRETE_PROPERTIES[0] / FC_CONCRETE_PROPERTIES[1])
+
+
+# Constructions the building file cannot hold, with why
+UNREAD_CONSTRUCTIONS = {
+    "Construction:WindowDataFile": "a window from a WINDOW data file is not read (give its layers)",
+    "Construction:WindowEquivalentLayer": "an equivalent-layer window is not read (give its layers)",
+    "Construction:ComplexFenestrationState": "a BSDF window is not read (give its layers)",
+    "Construction:AirBoundary": "an air boundary between zones is not held by the building file",
+}
 
 
 class _DaySchedules:
@@ -454,6 +493,14 @@ class _Converter:
         s = self.schedules[self.schedule(name, referrer, field)]
         return s["constant"] if "constant" in s else None
 
+    def monthly_schedule(self, name, kind, default):
+        """A schedule of an object's twelve monthly temperatures (C), once."""
+        if name not in self.schedules:
+            obj = self.r.all(kind)[0]
+            temps = [self.r.number(obj, f"{m}_ground_temperature", default=default) for m in MONTHS]
+            self.schedules[name] = monthly(temps)
+        return name
+
     def ground_schedule(self):
         if "ground temperature" in self.schedules:
             return "ground temperature"
@@ -464,22 +511,30 @@ class _Converter:
             temps = [DEFAULT_GROUND] * 12
             self.notes.append(f"no Site:GroundTemperature:BuildingSurface: the ground is at EnergyPlus's default "
                               f"{DEFAULT_GROUND:g} C all year")
-        ends = ("01-31", "02-28", "03-31", "04-30", "05-31", "06-30", "07-31", "08-31", "09-30", "10-31",
-                "11-30", "12-31")
-        if len(set(temps)) == 1:
-            self.schedules["ground temperature"] = {"constant": temps[0]}
-        else:
-            self.schedules["ground temperature"] = {
-                "days": {m: [[24, t]] for m, t in zip(MONTHS, temps)},
-                "periods": [{"through": e, "week": [m] * 7} for m, e in zip(MONTHS, ends)]}
+        self.schedules["ground temperature"] = monthly(temps)
         return "ground temperature"
 
     # ---- constructions -----------------------------------------------------------------
     def layers(self, construction_name, referrer, field, height=None):
         """(layers outside first as [[material, thickness]], outer Layer info, inner Layer info,
         glazing or None) of a Construction."""
-        c = self.r.get("Construction", construction_name, referrer, field)
+        for kind, equivalent in (("Construction:FfactorGroundFloor", self.ffactor_layers),
+                                 ("Construction:CfactorUndergroundWall", self.cfactor_layers)):
+            c = self.r.by_name.get(kind.upper(), {}).get(str(construction_name).upper())
+            if c is not None:
+                return equivalent(c)
+        for kind in UNREAD_CONSTRUCTIONS:
+            c = self.r.by_name.get(kind.upper(), {}).get(str(construction_name).upper())
+            if c is not None:
+                self.r.fail(referrer, field, f"{construction_name!r} is a {kind}: {UNREAD_CONSTRUCTIONS[kind]}")
+        c = self.r.get(("Construction", "Construction:InternalSource"), construction_name, referrer, field)
         names = [v for v in c.to_dict().values()][1:]
+        if c.obj_type.upper() == "CONSTRUCTION:INTERNALSOURCE":
+            fields = c.to_dict()
+            names = [fields.get("outside_layer")] + [fields.get(f"layer_{k}") for k in range(2, 11)]
+            line = f"Construction:InternalSource {c.name}: its layers read, its heat source not held"
+            if line not in self.not_modelled:
+                self.not_modelled.append(line)
         names = [n for n in names if not _blank(n)]
         if not names:
             self.r.fail(c, "Outside Layer", "missing: a construction needs a layer")
@@ -502,6 +557,30 @@ class _Converter:
             return self.glazing_layers(c, objs, height)
         layers = [[self.opaque_material(o), self._thickness(o)] for o in objs]
         return layers, self._faces(objs[0]), self._faces(objs[-1]), None
+
+    def _fc_concrete(self):
+        self.materials.setdefault(FC_CONCRETE, {"conductivity": FC_CONCRETE_PROPERTIES[1], "density": FC_CONCRETE_PROPERTIES[2],
+                                                "specific_heat": FC_CONCRETE_PROPERTIES[3]})
+        return [FC_CONCRETE, FC_CONCRETE_PROPERTIES[0]]
+
+    def _fc_layers(self, c, R_fic):
+        """EnergyPlus's equivalent construction: a fictitious massless layer of R_fic outside 0.15 m
+        of heavy concrete (HeatBalanceManager, CreateFCfactorConstructions)."""
+        name = f"{c.name} (fictitious R {R_fic:.4g})"
+        self.materials[name] = {"conductivity": MASSLESS_THICKNESS / R_fic, "density": 0.0, "specific_heat": 0.0}
+        faces = {"emissivity": 0.9, "solar": 0.7, "roughness": convection.ROUGHNESS["mediumrough"]}
+        return [[name, MASSLESS_THICKNESS], self._fc_concrete()], faces, faces, None
+
+    def ffactor_layers(self, c):
+        F = self.r.number(c, "f_factor", low=0, low_open=True)
+        area = self.r.number(c, "area", low=0, low_open=True)
+        perimeter = self.r.number(c, "perimeterexposed", low=0)
+        return self._fc_layers(c, ffactor_fictitious_resistance(F, area, perimeter))
+
+    def cfactor_layers(self, c):
+        C = self.r.number(c, "c_factor", low=0, low_open=True)
+        height = self.r.number(c, "height", low=0)
+        return self._fc_layers(c, cfactor_fictitious_resistance(C, height))
 
     def _thickness(self, o):
         if o.obj_type.upper() == "MATERIAL":
@@ -747,9 +826,12 @@ class _Converter:
         own = [s for s in surfaces.values() if s["zone"].upper() == z.name.upper()]
         if not own:
             self.r.fail(z, "Name", "no surface belongs to this zone")
-        multiplier = self.r.number(z, "multiplier", default=1.0)
+        multiplier = self.r.number(z, "multiplier", default=1.0, low=1)
         if multiplier != 1:
-            self.r.fail(z, "Multiplier", f"{multiplier:g}: a zone multiplier is not held by the building file")
+            # its copies are identical zones: free-floating, each has the one zone's temperature;
+            # what a copy exchanges with another zone is counted once
+            self.not_modelled.append(f"Zone {z.name}: multiplier {multiplier:g} not held; the zone is modelled once "
+                                     "(each copy's air as its own; its partitions with other zones counted once)")
         volume_field = _field(z, "volume")
         if _blank(volume_field) or str(volume_field).lower() == "autocalculate":
             polygons = [s["vertices"] for s in own if s["vertices"] is not None]
@@ -811,7 +893,7 @@ class _Converter:
                     self.r.fail(o, "Design Flow Rate Calculation Method", f"{method!r} is not read (Flow/Zone, Flow/Area, "
                                 "Flow/ExteriorArea, Flow/ExteriorWallArea, AirChanges/Hour are)")
                 field, scale = per[method]
-                flow = self.r.number(o, field, low=0) * scale
+                flow = self.design_value(o, field) * scale
                 A = self.r.number(o, "constant_term_coefficient", default=1.0)
                 dropped = [(label, self.r.number(o, f, default=0.0)) for label, f in (
                     ("temperature term", "temperature_term_coefficient"), ("velocity term", "velocity_term_coefficient"),
@@ -852,7 +934,7 @@ class _Converter:
                 method = self.r.text(o, method_field).lower()
                 if method not in fields:
                     self.r.fail(o, _label(method_field), f"{method!r} is not read ({', '.join(fields)} are)")
-                power = self.r.number(o, fields[method]) * (floor if method == "watts/area" else 1.0)
+                power = self.design_value(o, fields[method]) * (floor if method == "watts/area" else 1.0)
                 if kind == "Lights":
                     radiant = self.r.number(o, "fraction_radiant", default=0.0) + self.r.number(o, "fraction_visible", default=0.0)
                     returned = self.r.number(o, "return_air_fraction", default=0.0)
@@ -881,14 +963,23 @@ class _Converter:
         else:
             gain["power"] *= value
 
+    def design_value(self, o, field):
+        """The number a gain's or flow's calculation method reads; blank is 0, as EnergyPlus reads
+        a blank number (its other methods' fields are never required)."""
+        if _blank(_field(o, field)):
+            self.note(f"a blank design level of a {o.obj_type} read as 0, as EnergyPlus reads it")
+            return 0.0
+        return self.r.number(o, field, low=0)
+
     def people(self, o, floor):
         method = self.r.text(o, "number_of_people_calculation_method", "People").lower()
         if method == "people":
-            n = self.r.number(o, "number_of_people", low=0)
+            n = self.design_value(o, "number_of_people")
         elif method == "people/area":
-            n = self.r.number(o, "people_per_zone_floor_area", low=0) * floor
+            n = self.design_value(o, "people_per_zone_floor_area") * floor
         elif method == "area/person":
-            n = floor / self.r.number(o, "zone_floor_area_per_person", low=0, low_open=True)
+            per = self.design_value(o, "zone_floor_area_per_person")
+            n = floor / per if per > 0 else 0.0
         else:
             self.r.fail(o, "Number of People Calculation Method", f"{method!r} is not read")
         activity = self.constant_schedule_value(self.r.text(o, "activity_level_schedule_name"), o,
@@ -896,7 +987,7 @@ class _Converter:
         if activity is None:
             self.r.fail(o, "Activity Level Schedule Name", "varies in time: a gain has one schedule; give a constant activity")
         sensible = _field(o, "sensible_heat_fraction")
-        if _blank(sensible) or str(sensible).lower() == "autocalculate":
+        if _blank(sensible) or str(sensible).lower() in ("autocalculate", "autosize"):
             # EnergyPlus's polynomial in the activity and the zone's air, at the converter's air temperature
             heat = people_sensible_heat(activity)
             self.note(f"a person's sensible heat EnergyPlus's polynomial at {PEOPLE_T:g} C")
@@ -907,9 +998,22 @@ class _Converter:
         self._gain_schedule(gain, o, "number_of_people_schedule_name")
         return gain
 
+    def pair_owner(self, s, surfaces):
+        """Of two surfaces naming each other, the one that becomes the partition (its inside the
+        first's zone): the one whose zone comes first in the file's zones, then by name, so that the
+        order of the two objects does not change the building."""
+        other = surfaces.get(s["other"].upper())
+        if other is None or other["other"].upper() != s["obj"].name.upper() or other is s:
+            return s
+        order = {name: k for k, name in enumerate(self.zone_objs)}
+        key = lambda t: (order[t["zone"].upper()], t["obj"].name.upper())  # noqa: E731
+        return min((s, other), key=key)
+
     def components(self, surfaces):
         comps, done = [], set()
         for key, s in surfaces.items():
+            if s["boundary"].lower() == "surface" and self.pair_owner(s, surfaces) is not s:
+                continue  # its partner, which comes first, is the partition
             if key in done:
                 continue
             done.add(key)
@@ -921,12 +1025,12 @@ class _Converter:
             if net <= 1e-9:
                 self.r.fail(obj, "Vertex 1 X-coordinate", f"its windows and doors ({s['area'] - net:.3f} m2) fill all "
                                                           f"of its {s['area']:.3f} m2")
-            comps.append(self.component(obj.name, net, s, layers, inner, outside))
+            comps.append(self.component(obj.name, net, s, layers, inner, outside, outer))
             for w in s["subsurfaces"]:
                 height = w["height"]
                 layers, outer, inner, glass = self.layers(w["construction"], w["obj"], "Construction Name", height)
                 w_outside = self.outside(s, boundary, outer, surfaces, done, subsurface=w)
-                c = self.component(w["obj"].name, w["area"], s, layers, inner, w_outside)
+                c = self.component(w["obj"].name, w["area"], s, layers, inner, w_outside, outer)
                 if glass is not None:
                     c["solar_transmittance"] = round(glass["tau"], 6)
                     c["transmitted_solar_to"] = None  # set once every component is known (`receivers`)
@@ -939,9 +1043,15 @@ class _Converter:
                 comps.append(c)
         return comps
 
-    def component(self, name, area, s, layers, inner, outside):
+    def component(self, name, area, s, layers, inner, outside, outer=None):
+        # each face the zones' sun can land on: (zone, its type seen from that zone, solar absorptance);
+        # a partition's outer face is in the other zone (a ceiling there is its floor)
+        faces = [(s["zone"], s["type"].lower(), inner["solar"])]
+        if outside["type"] == "zone" and outer is not None:
+            flip = {"ceiling": "floor", "floor": "ceiling", "roof": "floor"}
+            faces.append((outside["zone"], flip.get(s["type"].lower(), s["type"].lower()), outer["solar"]))
         # EnergyPlus lists a construction's layers outside first; the building file inside first
-        return {"name": name, "area": round(area, 6), "tilt": round(s["tilt"], 6), "azimuth": round(s["azimuth"] % 360, 6),
+        return {"_faces": faces, "name": name, "area": round(area, 6), "tilt": round(s["tilt"], 6), "azimuth": round(s["azimuth"] % 360, 6),
                 "layers": [[m, t] for m, t in reversed(layers)], "nodes": {"max_spacing": MAX_SPACING},
                 "inside": {"zone": s["zone"], "h_conv": FILMS.inside_convection(s["tilt"], self.inside_algorithm(s["zone"])),
                            "h_rad": round(FILMS.radiative(inner["emissivity"], FILMS.T_inside), 4)},
@@ -968,27 +1078,110 @@ class _Converter:
                 other_zone = zone.name
             else:
                 other = surfaces.get(other_name.upper())
-                if other is None:
-                    self.r.fail(obj, "Outside Boundary Condition Object", f"names no surface ({other_name!r})")
-                if other["other"].upper() != obj.name.upper():
-                    self.r.fail(obj, "Outside Boundary Condition Object",
-                                f"{other_name!r} names {other['other']!r} back, not this surface")
-                done.add(other_name.upper())  # one partition for the pair
-                other_zone = other["zone"]
+                if other is None and other_name.upper() in self.zone_objs:
+                    # a Wall:Interzone (or Ceiling/Floor) may name the zone on its other side
+                    other_zone = self.zone_objs[other_name.upper()].name
+                elif other is None:
+                    self.r.fail(obj, "Outside Boundary Condition Object", f"names no surface or zone ({other_name!r})")
+                elif other is s:
+                    # its own other side: EnergyPlus sets its outer face to its inner face's temperature,
+                    # no heat crossing its middle; the nearest the file holds is an adiabatic outer face
+                    self.approximated(s, "its other side is itself: read with an adiabatic outer face (the zone "
+                                         "sees its inner face alone, as EnergyPlus has it)")
+                    return {"type": "adiabatic"}
+                elif other["other"].upper() != obj.name.upper():
+                    # not a pair: this face sees the other surface's zone, the other is its own component
+                    self.approximated(s, f"names {other_name!r}, which names {other['other']!r} back: read as "
+                                         f"facing the air of {other['zone']!r}")
+                    other_zone = other["zone"]
+                else:
+                    done.add(other_name.upper())  # one partition for the pair
+                    other_zone = other["zone"]
             h_c = FILMS.inside_convection(180.0 - s["tilt"], self.inside_algorithm(other_zone))
             return {"type": "zone", "zone": other_zone, "h_conv": h_c,
                     "h_rad": round(FILMS.radiative(outer["emissivity"], FILMS.T_inside), 4)}
+        reader = NEAREST_BOUNDARY.get(boundary)
+        if reader is not None:
+            return reader(self, s)
         self.r.fail(obj, "Outside Boundary Condition", f"{s['boundary']!r} is not read (Outdoors, Ground, Adiabatic, "
-                                                       "Surface, Zone are)")
+                                                       "Surface, Zone and the approximated "
+                                                       f"{', '.join(sorted(NEAREST_LABELS))} are)")
+
+    # ---- boundaries the building file holds only approximately: the nearest it holds, listed ----
+    def approximated(self, s, text):
+        line = f"{s['obj'].obj_type} {s['obj'].name}: {text}"
+        if line not in self.not_modelled:
+            self.not_modelled.append(line)
+
+    def fc_ground(self, s):
+        """GroundFCfactorMethod: the face at Site:GroundTemperature:FCfactorMethod's months (EnergyPlus
+        takes the weather file's 0.5 m ground temperatures where the IDF has none: the converter does
+        not read the weather, and holds the building surface's ground temperature instead, said so)."""
+        if self.r.all("Site:GroundTemperature:FCfactorMethod"):
+            return {"type": "boundary", "temperature": self.monthly_schedule(
+                "FC-factor ground temperature", "Site:GroundTemperature:FCfactorMethod", DEFAULT_GROUND), "h": FILMS.ground}
+        self.note("no Site:GroundTemperature:FCfactorMethod: the F- and C-factor surfaces' ground is the building "
+                  "surfaces' ground temperature (EnergyPlus takes the weather file's 0.5 m ground temperatures)")
+        return {"type": "boundary", "temperature": self.ground_schedule(), "h": FILMS.ground}
+
+    def preprocessed_ground(self, s):
+        self.approximated(s, f"outside boundary {s['boundary']} read as Ground (the ground temperature schedule), "
+                             "the preprocessor's temperatures not held")
+        return {"type": "boundary", "temperature": self.ground_schedule(), "h": FILMS.ground}
+
+    def foundation(self, s):
+        """Foundation (Kiva's 2-D ground): the face held at the ground temperature, as Ground, through the
+        construction as written; Kiva's soil, insulation and footing are not held."""
+        self.approximated(s, "outside boundary Foundation (Kiva) read as Ground: the face held at the ground "
+                             "temperature schedule, Kiva's soil and foundation insulation not held")
+        return {"type": "boundary", "temperature": self.ground_schedule(), "h": FILMS.ground}
+
+    def other_side_model(self, s):
+        """OtherSideConditionsModel: a ground-coupled one as Ground, a ventilated cavity
+        (GapConvectionRadiation) as outdoor air shading the face from the sun, with natural convection."""
+        model = self.r.get("SurfaceProperty:OtherSideConditionsModel", s["other"], s["obj"],
+                           "Outside Boundary Condition Object")
+        kind = self.r.text(model, "type_of_modeling", "GapConvectionRadiation").lower()
+        if kind in ("groundcoupledsurface", "undergroundpipingsystemsurface"):
+            self.approximated(s, f"outside boundary OtherSideConditionsModel ({kind}) read as Ground")
+            return {"type": "boundary", "temperature": self.ground_schedule(), "h": FILMS.ground}
+        self.approximated(s, f"outside boundary OtherSideConditionsModel ({kind}) read as outdoor air behind a "
+                             "shading cavity: no sun, natural convection, the cavity's own balance not held")
+        return self._sheltered(s)
+
+    def _sheltered(self, s):
+        emissivity = 0.9
+        return {"type": "exterior", "h_conv": round(float(convection.natural_convection(s["tilt"], FILMS.delta_T)), 4),
+                "h_rad": round(FILMS.radiative(emissivity, FILMS.T_outside), 4), "solar_absorptance": 0.0,
+                "sky_view_factor": 0.0}
+
+    def other_side_coefficients(self, s):
+        """OtherSideCoefficients: T = C2 T_const + C3 T_out + ... with film C1: a constant temperature
+        alone is a boundary at it (through C1, or the face held at it); any other term is read as
+        outdoor air without sun, said so."""
+        o = self.r.get("SurfaceProperty:OtherSideCoefficients", s["other"], s["obj"], "Outside Boundary Condition Object")
+        h = self.r.number(o, "combined_convective_radiative_film_coefficient", default=0.0, low=0)
+        T = self.r.number(o, "constant_temperature", default=0.0)
+        c_const = self.r.number(o, "constant_temperature_coefficient", default=1.0)
+        others = [f for f in ("external_dry_bulb_temperature_coefficient", "ground_temperature_coefficient",
+                              "wind_speed_coefficient", "zone_air_temperature_coefficient")
+                  if self.r.number(o, f, default=0.0) != 0]
+        if not others and _blank(_field(o, "constant_temperature_schedule_name")):
+            return {"type": "boundary", "temperature": round(c_const * T, 6), "h": h if h > 0 else FILMS.ground}
+        self.approximated(s, "outside boundary OtherSideCoefficients read as outdoor air without sun "
+                             f"(its {', '.join(_label(f) for f in others) or 'scheduled temperature'} not held)")
+        return self._sheltered(s)
 
     def internal_masses(self, components):
         for o in self.r.all("InternalMass"):
-            zone = self.zone_of(o, "zone_name")
+            zones = self._targets(o, "zone_name")  # a ZoneList gives each of its zones the whole area
             layers, _, inner, _ = self.layers(self.r.text(o, "construction_name"), o, "Construction Name")
-            # EnergyPlus's internal mass sees the zone on one face, the other adiabatic
-            s = {"tilt": 90.0, "azimuth": 0.0, "zone": zone.name, "type": "internalmass"}
-            components.append(self.component(o.name, self.r.number(o, "surface_area", low=0, low_open=True), s,
-                                             layers[::-1], inner, {"type": "adiabatic"}))
+            area = self.r.number(o, "surface_area", low=0, low_open=True)
+            for zone in zones:
+                # EnergyPlus's internal mass sees the zone on one face, the other adiabatic
+                s = {"tilt": 90.0, "azimuth": 0.0, "zone": self.zone_objs[zone.upper()].name, "type": "internalmass"}
+                name = o.name if len(zones) == 1 else f"{o.name} {s['zone']}"
+                components.append(self.component(name, area, s, layers[::-1], inner, {"type": "adiabatic"}))
 
     def receivers(self, components):
         """Where the sun a zone's windows let in lands, as EnergyPlus's FullInteriorAndExterior
@@ -998,21 +1191,25 @@ class _Converter:
         proportion to its area times its absorptance, A_i alpha_i / sum_j A_j alpha_j, the
         glazings' share leaving the zone. Applied to the diffuse sun too (the building file has
         one transmitted input per glazing)."""
+        faces = {}  # zone: [(component, type, absorptance, glazing?)] of every face in it
+        for k in components:
+            for zone, kind, alpha in k["_faces"]:
+                faces.setdefault(zone, []).append((k, kind, alpha, "solar_transmittance" in k))
         for c in components:
             if "transmitted_solar_to" not in c:
                 continue
-            own = [k for k in components if k["_zone"] == c["_zone"] and k["inside"]["zone"] == c["_zone"]]
-            opaque = [k for k in own if "solar_transmittance" not in k]
-            floors = [k for k in opaque if k["_type"] == "floor"] or opaque
-            floor = max(floors, key=lambda k: k["area"])
-            c["transmitted_solar_to"] = floor["name"]
-            total = sum(k["area"] * k["_absorbs"] for k in own)
-            reflected = 1 - floor["_absorbs"]
-            shares = {k["name"]: reflected * k["area"] * k["_absorbs"] / total for k in opaque if k["_absorbs"] > 0}
-            shares[floor["name"]] = shares.get(floor["name"], 0.0) + floor["_absorbs"]
+            own = faces[c["_zone"]]
+            opaque = [f for f in own if not f[3]]
+            floors = [f for f in opaque if f[1] == "floor"] or opaque
+            floor = max(floors, key=lambda f: f[0]["area"])
+            c["transmitted_solar_to"] = floor[0]["name"]
+            total = sum(k["area"] * alpha for k, _, alpha, _ in own)
+            reflected = 1 - floor[2]
+            shares = {k["name"]: reflected * k["area"] * alpha / total for k, _, alpha, _ in opaque if alpha > 0}
+            shares[floor[0]["name"]] = shares.get(floor[0]["name"], 0.0) + floor[2]
             c["solar_distribution"] = {name: round(f, 6) for name, f in shares.items()}
         for c in components:
-            c.pop("_zone"), c.pop("_type"), c.pop("_absorbs")
+            c.pop("_zone"), c.pop("_type"), c.pop("_absorbs"), c.pop("_faces")
 
     def list_not_modelled(self):
         for obj in self.r.doc.all_objects:
@@ -1023,6 +1220,28 @@ class _Converter:
             name = next((str(v) for v in obj.to_dict().values() if not _blank(v)), "")
             self.not_modelled.append(f"{kind} {name}: not held by the building file")
 
+
+def monthly(temps):
+    """A building file's schedule of twelve monthly values."""
+    ends = ("01-31", "02-28", "03-31", "04-30", "05-31", "06-30", "07-31", "08-31", "09-30", "10-31",
+            "11-30", "12-31")
+    if len(set(temps)) == 1:
+        return {"constant": temps[0]}
+    return {"days": {m: [[24, t]] for m, t in zip(MONTHS, temps)},
+            "periods": [{"through": e, "week": [m] * 7} for m, e in zip(MONTHS, ends)]}
+
+
+# The outside boundaries the building file holds only approximately, each read as the nearest it holds
+NEAREST_BOUNDARY = {
+    "groundfcfactormethod": _Converter.fc_ground, "foundation": _Converter.foundation,
+    "othersideconditionsmodel": _Converter.other_side_model, "othersidecoefficients": _Converter.other_side_coefficients,
+    **{b: _Converter.preprocessed_ground for b in ("groundslabpreprocessoraverage", "groundslabpreprocessorcore",
+                                                   "groundslabpreprocessorperimeter", "groundbasementpreprocessoraveragewall",
+                                                   "groundbasementpreprocessoraveragefloor",
+                                                   "groundbasementpreprocessorupperwall",
+                                                   "groundbasementpreprocessorlowerwall")}}
+NEAREST_LABELS = ("GroundFCfactorMethod", "Foundation", "OtherSideConditionsModel", "OtherSideCoefficients",
+                  "GroundSlabPreprocessor*", "GroundBasementPreprocessor*")
 
 YEAR = 2017  # the calendar on which the schedules' weekdays are read (its 1 January is a Sunday)
 
