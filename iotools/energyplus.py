@@ -57,6 +57,8 @@ class Films:
 
 
 FILMS = Films()
+# A surface's vertices off its plane: listed beyond 2 cm, refused beyond a tenth of its size
+PLANAR_LISTED, PLANAR_REFUSED = 0.02, 0.1  # m, fraction of sqrt(area)
 # Glass, where EnergyPlus gives a pane no density or specific heat (it neglects a pane's capacity)
 GLASS_DENSITY, GLASS_SPECIFIC_HEAT = 2500.0, 840.0  # kg/m3, J/kg/K
 # A massless layer (Material:NoMass, Material:AirGap) is written as a layer this thick with its
@@ -104,17 +106,48 @@ NOT_PHYSICS = ("Output", "OutputControl", "LifeCycleCost", "Meter", "RunPeriod",
                "UtilityCost", "ComponentCost", "CurrencyType")
 
 
+def unterminated_object(text):
+    """The first line of the object an IDF text leaves open (its last object without the ';' that
+    ends it, as a truncated file does), None if every object is closed. Read before idfkit parses
+    the file: its object pattern backtracks exponentially on an open tail (20, 25, 30 characters:
+    0.03, 1.1, 40 s), where this reads the text once."""
+    code = [line.split("!", 1)[0] for line in text.splitlines()]
+    tail = "\n".join(code).rsplit(";", 1)[-1]
+    if tail.strip() == "":
+        return None
+    return next(line.strip() for line in tail.splitlines() if line.strip())
+
+
+def newest_schema():
+    """The newest EnergyPlus version whose IDD idfkit holds, (major, minor, patch)."""
+    import idfkit.schema
+    return max(idfkit.schema.get_schema_manager().get_available_versions())
+
+
 def load_idf(path):
     """The idfkit document of an IDF; InputError naming the file for one that cannot be read."""
     import idfkit
     try:
-        version = idfkit.get_idf_version(str(path))
+        text = open(path, encoding="utf-8", errors="replace").read()
     except FileNotFoundError:
         raise InputError(path, "file", "not found") from None
+    except OSError as e:
+        raise InputError(path, "file", f"cannot be read ({e.strerror})") from None
+    open_object = unterminated_object(text)
+    if open_object is not None:
+        kind = open_object.split(",")[0].strip()
+        raise InputError(path, kind or "(file)", f"the object {open_object[:40]!r} has no closing ';': the file is "
+                                                 "truncated or its last object unterminated")
+    try:
+        version = idfkit.get_idf_version(str(path))
     except Exception as e:
         raise InputError(path, "Version", f"no EnergyPlus version could be read ({e})") from None
     if version is None:
         raise InputError(path, "Version", "the file has no Version object")
+    newest = newest_schema()
+    if tuple(version[:2]) > tuple(newest[:2]):
+        raise InputError(path, "Version", f"EnergyPlus {'.'.join(map(str, version[:2]))} is newer than any IDD the "
+                                          f"converter holds (idfkit's newest: {'.'.join(map(str, newest[:2]))})")
     override = None
     if tuple(version[:2]) < SCHEMA_MIN[:2]:
         if tuple(version[:2]) < MIN_VERSION:
@@ -819,8 +852,23 @@ class _Converter:
             self.r.fail(s, "Number of Vertices", f"{len(v)} vertices: a surface needs at least 3")
         if geometry.area(v) <= 1e-9:
             self.r.fail(s, "Vertex 1 X-coordinate", "the vertices enclose no area")
+        self.check_planar(s, v)
         origin, turn = self.zone_transform(zone)
         return geometry.rotate_z(v + origin, turn)
+
+    def check_planar(self, s, v):
+        """A polygon's vertices off its plane (Newell's normal through their centroid): beyond
+        PLANAR_LISTED listed (its area and orientation are its plane's), beyond PLANAR_REFUSED of
+        its size refused (no plane stands for it)."""
+        n = geometry.outward_normal(v)
+        off = np.abs((v - v.mean(axis=0)) @ n)
+        k = int(np.argmax(off))
+        if off[k] > PLANAR_REFUSED * np.sqrt(geometry.area(v)):
+            self.r.fail(s, f"Vertex {k + 1} X-coordinate", f"{off[k]:.3f} m off the surface's plane: not a planar "
+                                                           "surface")
+        if off[k] > PLANAR_LISTED:
+            self.approximated({"obj": s}, f"not planar (vertex {k + 1} {off[k]:.3f} m off its plane): its area and "
+                                          "orientation those of its best plane")
 
     def zone(self, z, surfaces):
         own = [s for s in surfaces.values() if s["zone"].upper() == z.name.upper()]
