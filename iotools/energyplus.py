@@ -229,6 +229,25 @@ def _field_label(obj, field):
         return _label(field)
 
 
+def _autocalculated(value):
+    """A field EnergyPlus computes: blank, Autocalculate (or Autosize), or 0 (which it reads so for
+    a zone's volume, floor area and ceiling height)."""
+    if _blank(value) or str(value).strip().lower() in ("autocalculate", "autosize"):
+        return True
+    try:
+        return float(value) == 0.0
+    except (TypeError, ValueError):
+        return False
+
+
+def geometry_closed(polygons, counterclockwise=True, tolerance=0.01):
+    """Whether polygons close a volume: their area-weighted outward normals sum to less than
+    `tolerance` of their total area (a closed polyhedron's sum to zero)."""
+    total = sum(geometry.area(p) for p in polygons)
+    flux = sum(geometry.area(p) * geometry.outward_normal(p, counterclockwise) for p in polygons)
+    return total > 0 and float(np.linalg.norm(flux)) < tolerance * total
+
+
 def _blank(value):
     return value is None or (isinstance(value, str) and value.strip() == "")
 
@@ -572,6 +591,7 @@ class _Converter:
         if not names:
             self.r.fail(c, "Outside Layer", "missing: a construction needs a layer")
         kinds = ("Material", "Material:NoMass", "Material:AirGap", "WindowMaterial:Glazing", "WindowMaterial:Gas",
+                 "WindowMaterial:GasMixture",
                  "WindowMaterial:SimpleGlazingSystem")
         objs = []
         for k, n in enumerate(names):
@@ -673,8 +693,8 @@ class _Converter:
         panes, layers = [], []
         for k, o in enumerate(objs):
             kind = o.obj_type.upper()
-            expected = "WINDOWMATERIAL:GLAZING" if k % 2 == 0 else "WINDOWMATERIAL:GAS"
-            if kind != expected:
+            expected = ("WINDOWMATERIAL:GLAZING",) if k % 2 == 0 else ("WINDOWMATERIAL:GAS", "WINDOWMATERIAL:GASMIXTURE")
+            if kind not in expected:
                 self.r.fail(c, f"Layer {k + 1}", f"{o.name!r}: panes and gas gaps must alternate, a pane outermost "
                                                  "and innermost")
             if kind == "WINDOWMATERIAL:GLAZING":
@@ -690,13 +710,11 @@ class _Converter:
                                                  "density": GLASS_DENSITY, "specific_heat": GLASS_SPECIFIC_HEAT})
                 layers.append([name, thickness])
             else:
-                if self.r.text(o, "gas_type", "Air").lower() != "air":
-                    self.r.fail(o, "Gas Type", f"{self.r.text(o, 'gas_type')}: only air gaps are read")
                 layers.append([o, self.r.number(o, "thickness", low=0, low_open=True)])
         # a gap's conductance depends on the emissivities facing it and the pane's height
         for k in range(1, len(layers), 2):
             gap, d = layers[k]
-            h = glazing.gap_conductance(d, height or 1.5, panes[k // 2][3], panes[k // 2 + 1][2])
+            h = glazing.gap_conductance(d, height or 1.5, panes[k // 2][3], panes[k // 2 + 1][2], gas=self.gas(gap))
             name = f"{gap.name} in {c.name}"
             self.materials[name] = {"conductivity": h * d, "density": AIR_DENSITY, "specific_heat": AIR_SPECIFIC_HEAT}
             layers[k] = [name, d]
@@ -715,6 +733,29 @@ class _Converter:
         inner = {"emissivity": panes[-1][3], "solar": 1 - glazing.stack_reflectance(pairs[::-1])}
         return layers, outer, inner, {"tau": tau, "inner_alpha": inner_alpha, "angular": {"angles": list(glazing.ANGLES), "factors": factors,
                                                               "diffuse": diffuse}}
+
+    def gas(self, o):
+        """A gap's gas as `model.glazing.gas_properties` reads it: a name, a Custom gas's own
+        coefficients, or a WindowMaterial:GasMixture's gases and fractions."""
+        if o.obj_type.upper() == "WINDOWMATERIAL:GASMIXTURE":
+            n = int(self.r.number(o, "number_of_gases_in_mixture", low=1, high=4))
+            mixture = []
+            for i in range(1, n + 1):
+                name = self.r.text(o, f"gas_{i}_type").lower()
+                if name not in glazing.GASES:
+                    self.r.fail(o, f"Gas {i} Type", f"{name!r} is none of {', '.join(glazing.GASES)}")
+                mixture.append((name, self.r.number(o, f"gas_{i}_fraction", low=0, low_open=True, high=1)))
+            self.note("a gas mixture's properties the mole-fraction-weighted means of its gases' (EnergyPlus mixes "
+                      "by ISO 15099's rules)")
+            return mixture
+        name = self.r.text(o, "gas_type", "Air").lower()
+        if name == "custom":
+            coefficients = [tuple(self.r.number(o, f"{p}_coefficient_{c}", default=0.0) for c in "abc")
+                            for p in ("conductivity", "viscosity", "specific_heat")]
+            return (*coefficients, self.r.number(o, "molecular_weight", low=0, low_open=True))
+        if name not in glazing.GASES:
+            self.r.fail(o, "Gas Type", f"{name!r} is none of Air, Argon, Krypton, Xenon, Custom")
+        return name
 
     # ---- zones, surfaces ----------------------------------------------------------------
     def building(self):
@@ -783,6 +824,8 @@ class _Converter:
                                            construction=self.r.text(s, "construction_name"), vertices=None,
                                            area=length * other, azimuth=azimuth, tilt=tilt,
                                            height=self._rect_height(s, zone, stype, other, tilt))
+                z0 = out[s.name.upper()]["height"] - 0.5 * other * np.sin(np.radians(tilt))
+                out[s.name.upper()]["z_range"] = tuple(sorted((z0, z0 + other * np.sin(np.radians(tilt)))))
         if not out:
             self.r.fail(None, "BuildingSurface:Detailed", "missing: the model has no heat transfer surface")
         for s in out.values():
@@ -791,6 +834,7 @@ class _Converter:
                 s["azimuth"], s["tilt"] = geometry.azimuth_tilt(normal)
                 s["area"] = geometry.area(s["vertices"])
                 s["height"] = float(np.mean(s["vertices"][:, 2]))
+                s["z_range"] = (float(s["vertices"][:, 2].min()), float(s["vertices"][:, 2].max()))
             s["subsurfaces"] = []
         for kind in SUBSURFACES:
             for w in self.r.all(kind):
@@ -856,6 +900,28 @@ class _Converter:
         origin, turn = self.zone_transform(zone)
         return geometry.rotate_z(v + origin, turn)
 
+    def zone_volume(self, z, own, floor):
+        """An autocalculated zone volume (m3), as EnergyPlus's CalculateZoneVolume: a zone its
+        surfaces close (their area-weighted outward normals sum to nothing) by the divergence
+        theorem, sum over faces of A (x . n) / 3; any other its floor area times its ceiling height
+        (the field's, else the height its surfaces span), exact for a prism."""
+        polygons = [s["vertices"] for s in own if s["vertices"] is not None]
+        if len(polygons) == len(own) and geometry_closed(polygons, self.ccw):
+            volume = geometry.enclosed_volume(polygons, self.ccw)
+            if volume > 0:
+                return volume
+        height = _field(z, "ceiling_height")
+        if _autocalculated(height):
+            height = max(s["z_range"][1] for s in own) - min(s["z_range"][0] for s in own)
+        else:
+            height = self.r.number(z, "ceiling_height", low=0, low_open=True)
+        if floor * height <= 0:
+            self.r.fail(z, "Volume", "autocalculated for a zone whose surfaces enclose no volume and that has no floor "
+                                     "area or height: give the volume")
+        self.note("a zone whose surfaces do not close it takes its floor area times its height as volume, as "
+                  "EnergyPlus does")
+        return floor * height
+
     def check_planar(self, s, v):
         """A polygon's vertices off its plane (Newell's normal through their centroid): beyond
         PLANAR_LISTED listed (its area and orientation are its plane's), beyond PLANAR_REFUSED of
@@ -880,20 +946,13 @@ class _Converter:
             # what a copy exchanges with another zone is counted once
             self.not_modelled.append(f"Zone {z.name}: multiplier {multiplier:g} not held; the zone is modelled once "
                                      "(each copy's air as its own; its partitions with other zones counted once)")
-        volume_field = _field(z, "volume")
-        if _blank(volume_field) or str(volume_field).lower() == "autocalculate":
-            polygons = [s["vertices"] for s in own if s["vertices"] is not None]
-            if len(polygons) != len(own):
-                self.r.fail(z, "Volume", "autocalculated for a zone with rectangular surfaces: give the volume")
-            volume = geometry.enclosed_volume(polygons, self.ccw)
-            if volume <= 0:
-                self.r.fail(z, "Volume", "autocalculated from surfaces that enclose no volume: give the volume")
+        floor = sum(s["area"] for s in own if s["type"].lower() == "floor")
+        if not _autocalculated(_field(z, "floor_area")):
+            floor = self.r.number(z, "floor_area", low=0, low_open=True)
+        if _autocalculated(_field(z, "volume")):
+            volume = self.zone_volume(z, own, floor)
         else:
             volume = self.r.number(z, "volume", low=0, low_open=True)
-        floor = sum(s["area"] for s in own if s["type"].lower() == "floor")
-        floor_field = _field(z, "floor_area")
-        if not _blank(floor_field) and str(floor_field).lower() != "autocalculate":
-            floor = self.r.number(z, "floor_area", low=0, low_open=True)
         data = {"name": z.name, "volume": round(volume, 6), "_floor_area": floor}
         exterior = sum(s["area"] for s in own if s["boundary"].lower() == "outdoors")
         walls = sum(s["area"] for s in own if s["boundary"].lower() == "outdoors" and s["type"].lower() == "wall")

@@ -105,14 +105,39 @@ GAP_T_MEAN = 283.15  # K
 GAP_DELTA_T = 15.0  # K
 
 
-def gap_conductance(thickness, height, emissivity_1, emissivity_2, T_mean=GAP_T_MEAN, delta_T=GAP_DELTA_T):
-    """Conductance (W/m2/K) of an air gap of `thickness` m between two panes `height` m high:
-    conduction and convection, Nu k / d with ISO 15099's Nusselt number of a vertical cavity at
-    the Rayleigh number of (T_mean K, delta_T K), plus the radiative exchange of its two faces."""
-    k = AIR_CONDUCTIVITY[0] + AIR_CONDUCTIVITY[1] * T_mean
-    mu = 3.723e-6 + 4.94e-8 * T_mean  # Pa s
-    rho = 101325 * 0.02897 / (8.314462 * T_mean)  # kg/m3
-    cp = 1002.737 + 1.2324e-2 * T_mean  # J/kg/K
+# EnergyPlus's fill gases (its Material module's table, the IDD's defaults, ISO 15099): the
+# coefficients (a, b, c) of conductivity (W/m/K), viscosity (kg/m/s) and specific heat (J/kg/K),
+# each a + b T + c T^2 at T in K, and the molecular weight (g/mol)
+GASES = {
+    "air": ((2.873e-3, 7.760e-5, 0.0), (3.723e-6, 4.940e-8, 0.0), (1002.737, 1.2324e-2, 0.0), 28.97),
+    "argon": ((2.285e-3, 5.149e-5, 0.0), (3.379e-6, 6.451e-8, 0.0), (521.929, 0.0, 0.0), 39.948),
+    "krypton": ((9.443e-4, 2.826e-5, 0.0), (2.213e-6, 7.777e-8, 0.0), (248.091, 0.0, 0.0), 83.8),
+    "xenon": ((4.538e-4, 1.723e-5, 0.0), (1.069e-6, 7.414e-8, 0.0), (158.340, 0.0, 0.0), 131.3),
+}
+
+
+def gas_properties(gas, T):
+    """(conductivity W/m/K, viscosity kg/m/s, specific heat J/kg/K, molecular weight g/mol) at T (K)
+    of a gas: a name of `GASES`, a tuple of its own coefficients as GASES holds them, or a mixture
+    [(gas, mole fraction), ...], whose properties are the mole-fraction-weighted means (EnergyPlus
+    mixes by ISO 15099's rules; for argon or krypton in air the two differ by a few per cent in k)."""
+    if isinstance(gas, list):
+        parts = [(gas_properties(g, T), x) for g, x in gas]
+        total = sum(x for _, x in parts)
+        return tuple(sum(p[i] * x for p, x in parts) / total for i in range(4))
+    k, mu, cp, M = GASES[gas] if isinstance(gas, str) else gas
+    value = lambda c: c[0] + c[1] * T + c[2] * T * T  # noqa: E731
+    return value(k), value(mu), value(cp), M
+
+
+def gap_conductance(thickness, height, emissivity_1, emissivity_2, T_mean=GAP_T_MEAN, delta_T=GAP_DELTA_T,
+                    gas="air"):
+    """Conductance (W/m2/K) of a gas gap (`gas` as `gas_properties` reads it, air unless given) of
+    `thickness` m between two panes `height` m high: conduction and convection, Nu k / d with ISO
+    15099's Nusselt number of a vertical cavity at the Rayleigh number of (T_mean K, delta_T K),
+    plus the radiative exchange of its two faces."""
+    k, mu, cp, M = gas_properties(gas, T_mean)  # W/m/K, Pa s, J/kg/K, g/mol
+    rho = 101325 * M / 1000 / (8.314462 * T_mean)  # kg/m3
     ra = rho ** 2 * thickness ** 3 * 9.81 * cp * delta_T / (mu * k * T_mean)
     aspect = height / thickness
     if ra > 5e4:
