@@ -100,7 +100,7 @@ READ = set(("Version", "Site:Location", "GlobalGeometryRules", "Building", "Zone
             "Site:GroundTemperature:Deep", "Timestep",
             "InternalMass", "Construction:FfactorGroundFloor", "Construction:CfactorUndergroundWall",
             "Site:GroundTemperature:FCfactorMethod", "SurfaceProperty:OtherSideCoefficients",
-            "SurfaceProperty:OtherSideConditionsModel", "WindowMaterial:GasMixture", "SurfaceConvectionAlgorithm:Inside", "SurfaceConvectionAlgorithm:Outside") + SURFACES + tuple(SIMPLE_SURFACES) + SUBSURFACES + GAINS + FLOWS + SCHEDULES)
+            "SurfaceProperty:OtherSideConditionsModel", "WindowMaterial:GasMixture", "MaterialProperty:GlazingSpectralData", "SurfaceConvectionAlgorithm:Inside", "SurfaceConvectionAlgorithm:Outside") + SURFACES + tuple(SIMPLE_SURFACES) + SUBSURFACES + GAINS + FLOWS + SCHEDULES)
 # Objects about the run and its reports, not the building
 NOT_PHYSICS = ("Output", "OutputControl", "LifeCycleCost", "Meter", "RunPeriod", "SimulationControl", "Sizing:Parameters",
                "UtilityCost", "ComponentCost", "CurrencyType")
@@ -698,10 +698,15 @@ class _Converter:
                 self.r.fail(c, f"Layer {k + 1}", f"{o.name!r}: panes and gas gaps must alternate, a pane outermost "
                                                  "and innermost")
             if kind == "WINDOWMATERIAL:GLAZING":
-                if self.r.text(o, "optical_data_type", "SpectralAverage").lower() != "spectralaverage":
-                    self.r.fail(o, "Optical Data Type", "only SpectralAverage pane data are read")
-                T0 = self.r.number(o, "solar_transmittance_at_normal_incidence", low=0, low_open=True, high=1)
-                Rf = self.r.number(o, "front_side_solar_reflectance_at_normal_incidence", low=0, high=1)
+                optical = self.r.text(o, "optical_data_type", "SpectralAverage").lower()
+                if optical == "spectral":
+                    T0, Rf = self.spectral_pane(o)
+                elif optical == "spectralaverage":
+                    T0 = self.r.number(o, "solar_transmittance_at_normal_incidence", low=0, low_open=True, high=1)
+                    Rf = self.r.number(o, "front_side_solar_reflectance_at_normal_incidence", low=0, high=1)
+                else:
+                    self.r.fail(o, "Optical Data Type", f"{optical!r}: SpectralAverage and Spectral pane data are read "
+                                                        "(a BSDF pane is not)")
                 thickness = self.r.number(o, "thickness", low=0, low_open=True)
                 panes.append((T0, Rf, self.r.number(o, "front_side_infrared_hemispherical_emissivity", default=0.84),
                               self.r.number(o, "back_side_infrared_hemispherical_emissivity", default=0.84)))
@@ -733,6 +738,29 @@ class _Converter:
         inner = {"emissivity": panes[-1][3], "solar": 1 - glazing.stack_reflectance(pairs[::-1])}
         return layers, outer, inner, {"tau": tau, "inner_alpha": inner_alpha, "angular": {"angles": list(glazing.ANGLES), "factors": factors,
                                                               "diffuse": diffuse}}
+
+    def spectral_pane(self, o):
+        """(T, R_front) at normal incidence of a pane given by wavelength
+        (MaterialProperty:GlazingSpectralData): each averaged over the solar spectrum EnergyPlus
+        weighs with (`model.glazing.solar_average`)."""
+        data = self.r.get("MaterialProperty:GlazingSpectralData", self.r.text(o, "window_glass_spectral_data_set_name"),
+                          o, "Window Glass Spectral Data Set Name")
+        fields = data.to_dict()
+        rows = fields.get("extensions") or []
+        k = 1
+        while f"wavelength_{k}" in fields:  # the fields as numbered in the IDD
+            rows.append({f: fields.get(f"{f}_{k}") for f in ("wavelength", "transmittance", "front_reflectance")})
+            k += 1
+        if len(rows) < 2:
+            self.r.fail(data, "Wavelength 1", "a spectrum needs at least two wavelengths")
+        try:
+            table = np.array([[float(r["wavelength"]), float(r["transmittance"]), float(r["front_reflectance"])]
+                              for r in rows])
+        except (KeyError, TypeError, ValueError):
+            self.r.fail(data, "Wavelength 1", "a wavelength, transmittance or reflectance is not a number")
+        self.note("a pane's spectral data averaged over EnergyPlus's solar spectrum pane by pane (EnergyPlus "
+                  "integrates the whole glazing wavelength by wavelength)")
+        return (glazing.solar_average(table[:, 0], table[:, 1]), glazing.solar_average(table[:, 0], table[:, 2]))
 
     def gas(self, o):
         """A gap's gas as `model.glazing.gas_properties` reads it: a name, a Custom gas's own

@@ -116,6 +116,33 @@ GASES = {
 }
 
 
+def solar_spectrum():
+    """(wavelengths um, irradiance W/m2/um) of the solar spectrum EnergyPlus and WINDOW weigh pane
+    data with: ASTM E891-87 Table 1, direct normal at AM1.5 (ISO 9845-1), as LBNL's pywincalc ships it."""
+    import os
+
+    import pywincalc
+    path = os.path.join(pywincalc.standard_path, "ASTM E891 Table 1 Direct AM1_5.ssp")
+    rows = [line.split() for line in open(path)]
+    table = np.array([[float(a), float(b)] for a, b, *_ in (r for r in rows if len(r) >= 2 and r[0][0].isdigit())])
+    return table[:, 0], table[:, 1]
+
+
+_trapezoid = getattr(np, "trapezoid", None) or np.trapz  # numpy 2 renamed it
+
+
+def solar_average(wavelengths, values):
+    """A spectral property (at `wavelengths` um) averaged over the solar spectrum: the integral of
+    value x irradiance over that of irradiance, both by the trapezoid rule on the spectrum's
+    wavelengths within the data's range (the value interpolated linearly)."""
+    lam, E = solar_spectrum()
+    inside = (lam >= np.min(wavelengths)) & (lam <= np.max(wavelengths))
+    lam, E = lam[inside], E[inside]
+    order = np.argsort(wavelengths)
+    v = np.interp(lam, np.asarray(wavelengths)[order], np.asarray(values)[order])
+    return float(_trapezoid(v * E, lam) / _trapezoid(E, lam))
+
+
 def gas_properties(gas, T):
     """(conductivity W/m/K, viscosity kg/m/s, specific heat J/kg/K, molecular weight g/mol) at T (K)
     of a gas: a name of `GASES`, a tuple of its own coefficients as GASES holds them, or a mixture

@@ -355,3 +355,31 @@ def test_wall_interzone_may_name_the_zone_beyond(tmp_path):
             + "Wall:Interzone,\n  TO B,\n  LIGHT WALL,\n  A,\n  B,\n  90,\n  90,\n  4,\n  0,\n  0,\n  3,\n  2;\n")
     p = convert_idf(write(tmp_path, text)).component("TO B")
     assert (p.inside.zone, p.outside.zone, p.area) == ("A", "B", 6.0)
+
+
+# ---- spectral pane data -------------------------------------------------------------------
+def test_solar_average_of_spectral_data():
+    """A flat spectrum averages to itself; a pane clear below 0.7 um and opaque above lets through
+    the share of the solar spectrum's energy below 0.7 um (ASTM E891's direct AM1.5, read here by
+    the trapezoid rule on its own table)."""
+    assert glazing.solar_average([0.3, 2.5], [0.8, 0.8]) == pytest.approx(0.8)
+    lam, E = glazing.solar_spectrum()
+    assert lam[0] == 0.3 and E[1] == 3.4  # the standard's first rows
+    k = int(np.searchsorted(lam, 0.7))  # clear up to the standard's wavelength k, opaque from k + 1
+    full = lam <= 2.5
+    share = (np.trapezoid(E[:k + 1], lam[:k + 1]) + 0.5 * (lam[k + 1] - lam[k]) * E[k]) / np.trapezoid(E[full], lam[full])
+    step = glazing.solar_average([0.3, lam[k], lam[k + 1], 2.5], [1.0, 1.0, 0.0, 0.0])
+    assert step == pytest.approx(share, rel=1e-9)
+    assert 0.3 < share < 0.5  # about 40 % of the sun's energy is below 0.7 um
+
+
+def test_a_flat_spectral_pane_is_its_spectral_average(tmp_path):
+    """Case 600's pane given as spectral data flat at its averages converts to the same window."""
+    spectral = TEXT.replace("  SpectralAverage,              !- Optical Data Type\n  ,",
+                            "  Spectral,                     !- Optical Data Type\n  FLAT,")
+    assert spectral != TEXT
+    spectral += ("MaterialProperty:GlazingSpectralData,\n  FLAT,\n"
+                 + ",\n".join(f"  {lam}, 0.86156, 0.07846, 0.07846" for lam in (0.3, 0.8, 1.5, 2.5)) + ";\n")
+    w, w0 = (convert_idf(p).component("SOUTH WINDOW WEST") for p in (write(tmp_path, spectral), CASE600))
+    assert w.solar_transmittance == pytest.approx(w0.solar_transmittance, abs=1e-6)
+    assert w.outside.solar_absorptance == pytest.approx(w0.outside.solar_absorptance, abs=1e-6)
