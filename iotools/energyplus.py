@@ -230,12 +230,12 @@ def _field_label(obj, field):
 
 
 def _autocalculated(value):
-    """A field EnergyPlus computes: blank, Autocalculate (or Autosize), or 0 (which it reads so for
-    a zone's volume, floor area and ceiling height)."""
+    """A field EnergyPlus computes: blank, Autocalculate (or Autosize), or 0 or less (which it reads
+    so for a zone's volume, floor area and ceiling height)."""
     if _blank(value) or str(value).strip().lower() in ("autocalculate", "autosize"):
         return True
     try:
-        return float(value) == 0.0
+        return float(value) <= 0.0  # and a negative one, as -9999 in some reference buildings
     except (TypeError, ValueError):
         return False
 
@@ -974,11 +974,17 @@ class _Converter:
             # what a copy exchanges with another zone is counted once
             self.not_modelled.append(f"Zone {z.name}: multiplier {multiplier:g} not held; the zone is modelled once "
                                      "(each copy's air as its own; its partitions with other zones counted once)")
-        floor = sum(s["area"] for s in own if s["type"].lower() == "floor")
+        # faces of other zones' surfaces whose outside names this zone (a plenum's floor is often only
+        # the ceilings below naming it): part of its enclosure, seen from it reversed
+        beyond = [dict(s, vertices=None if s["vertices"] is None else s["vertices"][::-1],
+                       type={"ceiling": "floor", "floor": "ceiling", "roof": "floor"}.get(s["type"].lower(), s["type"]))
+                  for s in surfaces.values() if s["zone"].upper() != z.name.upper()
+                  and s["boundary"].lower() in ("zone", "surface") and s["other"].upper() == z.name.upper()]
+        floor = sum(s["area"] for s in own + beyond if s["type"].lower() == "floor")
         if not _autocalculated(_field(z, "floor_area")):
             floor = self.r.number(z, "floor_area", low=0, low_open=True)
         if _autocalculated(_field(z, "volume")):
-            volume = self.zone_volume(z, own, floor)
+            volume = self.zone_volume(z, own + beyond, floor)
         else:
             volume = self.r.number(z, "volume", low=0, low_open=True)
         data = {"name": z.name, "volume": round(volume, 6), "_floor_area": floor}
