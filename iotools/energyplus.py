@@ -100,8 +100,10 @@ READ = set(("Version", "Site:Location", "GlobalGeometryRules", "Building", "Zone
             "Site:GroundTemperature:Deep", "Timestep",
             "InternalMass", "Construction:FfactorGroundFloor", "Construction:CfactorUndergroundWall",
             "Site:GroundTemperature:FCfactorMethod", "SurfaceProperty:OtherSideCoefficients",
-            "SurfaceProperty:OtherSideConditionsModel", "WindowMaterial:GasMixture", "MaterialProperty:GlazingSpectralData", "SurfaceConvectionAlgorithm:Inside", "SurfaceConvectionAlgorithm:Outside") + SURFACES + tuple(SIMPLE_SURFACES) + SUBSURFACES + GAINS + FLOWS + SCHEDULES)
+            "SurfaceProperty:OtherSideConditionsModel", "WindowMaterial:GasMixture", "MaterialProperty:GlazingSpectralData", "RunPeriodControl:SpecialDays", "SurfaceConvectionAlgorithm:Inside", "SurfaceConvectionAlgorithm:Outside") + SURFACES + tuple(SIMPLE_SURFACES) + SUBSURFACES + GAINS + FLOWS + SCHEDULES)
 # Objects about the run and its reports, not the building
+# ... but these run objects change what the building sees, and are listed
+LISTED_RUN = ("RunPeriodControl:DaylightSavingTime",)
 NOT_PHYSICS = ("Output", "OutputControl", "LifeCycleCost", "Meter", "RunPeriod", "SimulationControl", "Sizing:Parameters",
                "UtilityCost", "ComponentCost", "CurrencyType")
 
@@ -803,6 +805,9 @@ class _Converter:
         self.internal_masses(components)
         self.receivers(components)
         self.list_not_modelled()
+        if any(w["type"].lower() in ("window", "glassdoor") for s in surfaces.values() for w in s["subsurfaces"]):
+            self.note("no surface of the building shades its windows or walls (EnergyPlus's shadow calculation is "
+                      "not held)")
         names = [b.name for b in self.r.all("Building")]
         description = (f"Converted by nodeforce convert from {self.r.source} (EnergyPlus "
                        f"{'.'.join(map(str, self.r.doc.version[:2]))}). Surface coefficients are the converter's "
@@ -1355,7 +1360,10 @@ class _Converter:
     def list_not_modelled(self):
         for obj in self.r.doc.all_objects:
             kind = obj.obj_type
-            if kind.upper() in {k.upper() for k in READ} or kind.startswith(NOT_PHYSICS):
+            if kind.upper() in {k.upper() for k in READ} or (kind.startswith(NOT_PHYSICS) and kind not in LISTED_RUN):
+                continue
+            if kind == "RunPeriodControl:DaylightSavingTime":
+                self.not_modelled.append(f"{kind}: not applied; the schedules run on standard time all year")
                 continue
             # an object without a name (ZoneHVAC:EquipmentConnections) is known by its first field
             name = next((str(v) for v in obj.to_dict().values() if not _blank(v)), "")

@@ -383,3 +383,11 @@ def test_a_flat_spectral_pane_is_its_spectral_average(tmp_path):
     w, w0 = (convert_idf(p).component("SOUTH WINDOW WEST") for p in (write(tmp_path, spectral), CASE600))
     assert w.solar_transmittance == pytest.approx(w0.solar_transmittance, abs=1e-6)
     assert w.outside.solar_absorptance == pytest.approx(w0.outside.solar_absorptance, abs=1e-6)
+
+
+def test_daylight_saving_and_self_shading_are_said(tmp_path):
+    text = TEXT + "RunPeriodControl:DaylightSavingTime,\n  2nd Sunday in March,\n  1st Sunday in November;\n"
+    b = convert_idf(write(tmp_path, text))
+    assert "RunPeriodControl:DaylightSavingTime: not applied; the schedules run on standard time all year" in \
+        b.data["not_modelled"]
+    assert "no surface of the building shades its windows" in b.data["description"]
