@@ -57,6 +57,10 @@ class Films:
 
 
 FILMS = Films()
+# An air flow's temperature term is taken at this indoor-outdoor difference, its wind terms at the
+# zone's wind (FILMS.wind at the station, at the height of the zone's surfaces' centroids)
+AIRFLOW_DELTA_T = 10.0  # K
+FLOW_WIND_HEIGHT = 1.5  # m, a zone's height where its surfaces give none
 # A surface's vertices off its plane: listed beyond 2 cm, refused beyond a tenth of its size
 PLANAR_LISTED, PLANAR_REFUSED = 0.02, 0.1  # m, fraction of sqrt(area)
 # Glass, where EnergyPlus gives a pane no density or specific heat (it neglects a pane's capacity)
@@ -995,7 +999,9 @@ class _Converter:
         data = {"name": z.name, "volume": round(volume, 6), "_floor_area": floor}
         exterior = sum(s["area"] for s in own if s["boundary"].lower() == "outdoors")
         walls = sum(s["area"] for s in own if s["boundary"].lower() == "outdoors" and s["type"].lower() == "wall")
-        flow, scheduled = self.air_flows(z, volume, floor, exterior, walls)
+        heights = [s["height"] for s in own if s.get("height") is not None]
+        flow, scheduled = self.air_flows(z, volume, floor, exterior, walls,
+                                         float(np.mean(heights)) if heights else FLOW_WIND_HEIGHT)
         if flow:
             data["air_change_rate"] = flow / volume
         if scheduled:
@@ -1018,7 +1024,7 @@ class _Converter:
             return [d["zone_name"] for d in fields["zones"]]
         return [v for k, v in fields.items() if k != "name" and not _blank(v)]
 
-    def air_flows(self, z, volume, floor, exterior, walls):
+    def air_flows(self, z, volume, floor, exterior, walls, wind_height=FLOW_WIND_HEIGHT):
         """The zone's constant outdoor air flow (m3/h) from its design flow rate objects, and its
         scheduled ones (the building file's `ventilation`)."""
         total, scheduled = 0.0, []
@@ -1040,14 +1046,20 @@ class _Converter:
                                 "Flow/ExteriorArea, Flow/ExteriorWallArea, AirChanges/Hour are)")
                 field, scale = per[method]
                 flow = self.design_value(o, field) * scale
+                # EnergyPlus's flow is the design flow times A + B |dT| + C v + D v^2; the building
+                # file's flows do not vary with either, so the terms are taken at a stated |dT| and
+                # the zone's wind
                 A = self.r.number(o, "constant_term_coefficient", default=1.0)
-                dropped = [(label, self.r.number(o, f, default=0.0)) for label, f in (
-                    ("temperature term", "temperature_term_coefficient"), ("velocity term", "velocity_term_coefficient"),
-                    ("velocity squared term", "velocity_squared_term_coefficient"))]
-                dropped = [f"{label} {v:g}" for label, v in dropped if v != 0]
-                if dropped:
-                    self.not_modelled.append(f"{kind} {o.name}: {', '.join(dropped)} not held (the building file's "
-                                             f"air flows do not vary with temperature or wind); its constant term kept")
+                B, C, D = (self.r.number(o, f, default=0.0) for f in (
+                    "temperature_term_coefficient", "velocity_term_coefficient", "velocity_squared_term_coefficient"))
+                if B or C or D:
+                    v = float(convection.wind_at_height(FILMS.wind, wind_height, self.terrain))
+                    A = A + B * AIRFLOW_DELTA_T + C * v + D * v * v
+                    self.not_modelled.append(
+                        f"{kind} {o.name}: its temperature and wind terms (B {B:g}, C {C:g}, D {D:g}) taken at "
+                        f"|dT| {AIRFLOW_DELTA_T:g} K and the zone's wind {v:.2f} m/s ({FILMS.wind:g} m/s at the "
+                        f"station): A + B |dT| + C v + D v^2 = {A:.4g}, the building file's air flows do not vary "
+                        "with temperature or wind")
                 if kind == "ZoneVentilation:DesignFlowRate":
                     limits = [_field_label(o, f) for f in ("minimum_indoor_temperature", "maximum_indoor_temperature",
                                                            "delta_temperature", "minimum_outdoor_temperature",

@@ -391,3 +391,19 @@ def test_daylight_saving_and_self_shading_are_said(tmp_path):
     assert "RunPeriodControl:DaylightSavingTime: not applied; the schedules run on standard time all year" in \
         b.data["not_modelled"]
     assert "no surface of the building shades its windows" in b.data["description"]
+
+
+def test_an_infiltrations_wind_and_temperature_terms_are_taken_at_stated_conditions(tmp_path):
+    """0.5 air changes times 0.1 + 0.01 |dT| + 0.224 v: |dT| 10 K and the wind at the zone's
+    surfaces' mean height (1.35 m in case 600's Country terrain) from the 4 m/s station wind,
+    the 2019 prototypes' form (their constant term is 0: the converter kept only it before)."""
+    from nodeforce.model import convection
+    text = TEXT.replace("  1,                            !- Constant Term Coefficient\n"
+                        "  0,                            !- Temperature Term Coefficient\n"
+                        "  0,                            !- Velocity Term Coefficient",
+                        "  0.1,\n  0.01,\n  0.224,")
+    assert text != TEXT
+    b = convert_idf(write(tmp_path, text))
+    v = convection.wind_at_height(4.0, 1.35, "country")
+    assert b.zones[0].air_change_rate == pytest.approx(0.5 * (0.1 + 0.01 * 10 + 0.224 * v), rel=1e-9)
+    assert any("taken at |dT| 10 K" in line for line in b.data["not_modelled"])
