@@ -1097,9 +1097,11 @@ class _Converter:
                     radiant = self.r.number(o, "fraction_radiant", default=0.0) + self.r.number(o, "fraction_visible", default=0.0)
                     returned = self.r.number(o, "return_air_fraction", default=0.0)
                     if returned:
-                        self.not_modelled.append(f"Lights {o.name}: return air fraction {returned:g} given to the zone's "
-                                                 "air (no return air plenum in a free-floating model)")
-                    sensible = 1.0
+                        # EnergyPlus puts it in the return air; without an air system (free-floating) no
+                        # zone gets it: 28.4 C in the 2004 medium office's mid core, 30.1 C given to the zone
+                        self.not_modelled.append(f"Lights {o.name}: return air fraction {returned:g} leaves with the "
+                                                 "return air, as in EnergyPlus without an air system (no zone gets it)")
+                    sensible = 1.0 - returned
                 else:
                     radiant = self.r.number(o, "fraction_radiant", default=0.0)
                     sensible = 1.0 - self.r.number(o, "fraction_latent", default=0.0) - self.r.number(o, "fraction_lost", default=0.0)

@@ -407,3 +407,13 @@ def test_an_infiltrations_wind_and_temperature_terms_are_taken_at_stated_conditi
     v = convection.wind_at_height(4.0, 1.35, "country")
     assert b.zones[0].air_change_rate == pytest.approx(0.5 * (0.1 + 0.01 * 10 + 0.224 * v), rel=1e-9)
     assert any("taken at |dT| 10 K" in line for line in b.data["not_modelled"])
+
+
+def test_a_lights_return_air_fraction_leaves_with_the_return_air(tmp_path):
+    """480 W of lights, 0.4 to the return air, 0.4 radiant and 0.2 visible: the zone gets 0.6 of
+    it, (0.4 + 0.2) / 0.6 of that radiant; EnergyPlus free-floating gives the return air's share
+    to no zone (its 2004 medium office's mid core: 28.4 C, and 30.1 C with the fraction 0)."""
+    text = (HEADER + zone("Z") + box("Z", "Z")
+            + "Lights,\n  L,\n  Z,\n  CONTINUOUS,\n  LightingLevel,\n  480,\n  ,\n  ,\n  0.4,\n  0.4,\n  0.2,\n  1;\n")
+    (g,) = convert_idf(write(tmp_path, text)).zone("Z").gains
+    assert (g.power, g.radiant_fraction) == pytest.approx((0.6 * 480, 1.0))
