@@ -263,6 +263,14 @@ def test_ffactor_floor_is_energyplus_equivalent_construction(tmp_path):
                                                      np.array([1.0]))[0] == 15.0
 
 
+def test_ffactor_layer_is_energyplus_own():
+    """EnergyPlus 25.2's eplusout.eio (Output:Constructions) for the 2019 small office prototype:
+    the fictitious layer of F = 0.90012 W/m/K, A = 113.45 m2, P = 27.69 m is 4.31 m2K/W, and of
+    A = 67.3 m2, P = 18.46 m 3.808 m2K/W."""
+    assert E.ffactor_fictitious_resistance(0.90012, 113.45, 27.69) == pytest.approx(4.31, abs=5e-3)
+    assert E.ffactor_fictitious_resistance(0.90012, 67.3, 18.46) == pytest.approx(3.808, abs=5e-4)
+
+
 def test_cfactor_wall_is_energyplus_equivalent_construction():
     """C = 0.5 W/m2/K, 2 m deep: R_eff = 1/C + 0.0607 + 0.3479 x 2 (Engineering Reference's
     soil), the fictitious layer that less the concrete."""
