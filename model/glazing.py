@@ -202,6 +202,22 @@ def simple_glazing_films(U):
     return float(h_in), 0.025342 * U + 29.163853
 
 
+def simple_glazing_absorptance(U, shgc):
+    """Solar absorptance of EnergyPlus's simple glazing system's equivalent layer (Engineering
+    Reference, "Simple Window Model", step 4): (SHGC - T) / Fr_in, the inward-flowing fraction
+    Fr_in = (R_o,s + R_l / 2) / (R_o,s + R_l + R_i,s) of what the layer absorbs at its middle, R_l the
+    layer's resistance left by U and step 2's films, R_o,s and R_i,s the films of the solar
+    (summer) condition as functions of SHGC - T."""
+    tau = simple_glazing_transmittance(U, shgc)
+    x = max(shgc - tau, 0.0)
+    h_in, h_out = simple_glazing_films(U)
+    R_l = 1 / U - 1 / h_in - 1 / h_out
+    R_is = 1 / (29.436546 * x ** 3 - 21.943415 * x ** 2 + 9.945872 * x + 7.426151)
+    R_os = 1 / (2.225824 * x + 20.57708)
+    inward = (R_os + 0.5 * R_l) / (R_os + R_l + R_is)
+    return min(1.0 - tau, x / inward)
+
+
 def pane_absorptances(panes):
     """Solar absorptance of each pane of a stack (outside first) at normal incidence, each
     (T0, R0) the same on both faces, of the sun falling on the outermost pane: with f_k and b_k
