@@ -10,6 +10,8 @@ the field and the problem. The physics of the mapping (geometry, glazing) is `mo
 `model.glazing`; the coefficients EnergyPlus computes each step and the nodal model holds
 constant are `FILMS`.
 """
+import difflib
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -55,6 +57,12 @@ class Films:
 
 
 FILMS = Films()
+# An air flow's temperature term is taken at this indoor-outdoor difference, its wind terms at the
+# zone's wind (FILMS.wind at the station, at the height of the zone's surfaces' centroids)
+AIRFLOW_DELTA_T = 10.0  # K
+FLOW_WIND_HEIGHT = 1.5  # m, a zone's height where its surfaces give none
+# A surface's vertices off its plane: listed beyond 2 cm, refused beyond a tenth of its size
+PLANAR_LISTED, PLANAR_REFUSED = 0.02, 0.1  # m, fraction of sqrt(area)
 # Glass, where EnergyPlus gives a pane no density or specific heat (it neglects a pane's capacity)
 GLASS_DENSITY, GLASS_SPECIFIC_HEAT = 2500.0, 840.0  # kg/m3, J/kg/K
 # A massless layer (Material:NoMass, Material:AirGap) is written as a layer this thick with its
@@ -81,6 +89,11 @@ SUBSURFACES = ("FenestrationSurface:Detailed", "Window", "Door", "GlazedDoor", "
                "Door:Interzone", "GlazedDoor:Interzone")
 GAINS = ("People", "Lights", "ElectricEquipment", "GasEquipment", "HotWaterEquipment", "SteamEquipment",
          "OtherEquipment")
+# A gain's design level by its calculation method: the field each method reads (as 8.9's IDD names it)
+GAIN_FIELDS = {kind: {"equipmentlevel": "design_level", "watts/area": "power_per_zone_floor_area"}
+               for kind in ("GasEquipment", "HotWaterEquipment", "SteamEquipment", "OtherEquipment")}
+GAIN_FIELDS["ElectricEquipment"] = {"equipmentlevel": "design_level", "watts/area": "watts_per_zone_floor_area"}
+GAIN_FIELDS["Lights"] = {"lightinglevel": "lighting_level", "watts/area": "watts_per_zone_floor_area"}
 FLOWS = ("ZoneInfiltration:DesignFlowRate", "ZoneVentilation:DesignFlowRate")
 SCHEDULES = ("Schedule:Compact", "Schedule:Constant", "Schedule:Year", "Schedule:Week:Daily",
              "Schedule:Week:Compact", "Schedule:Day:Interval", "Schedule:Day:Hourly", "Schedule:Day:List",
@@ -89,23 +102,58 @@ READ = set(("Version", "Site:Location", "GlobalGeometryRules", "Building", "Zone
             "Material", "Material:NoMass", "Material:AirGap", "WindowMaterial:Glazing", "WindowMaterial:Gas",
             "WindowMaterial:SimpleGlazingSystem", "Site:GroundTemperature:BuildingSurface",
             "Site:GroundTemperature:Deep", "Timestep",
-            "InternalMass", "SurfaceConvectionAlgorithm:Inside", "SurfaceConvectionAlgorithm:Outside") + SURFACES + tuple(SIMPLE_SURFACES) + SUBSURFACES + GAINS + FLOWS + SCHEDULES)
+            "InternalMass", "Construction:FfactorGroundFloor", "Construction:CfactorUndergroundWall",
+            "Site:GroundTemperature:FCfactorMethod", "SurfaceProperty:OtherSideCoefficients",
+            "SurfaceProperty:OtherSideConditionsModel", "WindowMaterial:GasMixture", "MaterialProperty:GlazingSpectralData", "RunPeriodControl:SpecialDays", "SurfaceConvectionAlgorithm:Inside", "SurfaceConvectionAlgorithm:Outside") + SURFACES + tuple(SIMPLE_SURFACES) + SUBSURFACES + GAINS + FLOWS + SCHEDULES)
 # Objects about the run and its reports, not the building
+# ... but these run objects change what the building sees, and are listed
+LISTED_RUN = ("RunPeriodControl:DaylightSavingTime",)
 NOT_PHYSICS = ("Output", "OutputControl", "LifeCycleCost", "Meter", "RunPeriod", "SimulationControl", "Sizing:Parameters",
                "UtilityCost", "ComponentCost", "CurrencyType")
+
+
+def unterminated_object(text):
+    """The first line of the object an IDF text leaves open (its last object without the ';' that
+    ends it, as a truncated file does), None if every object is closed. Read before idfkit parses
+    the file: its object pattern backtracks exponentially on an open tail (20, 25, 30 characters:
+    0.03, 1.1, 40 s), where this reads the text once."""
+    code = [line.split("!", 1)[0] for line in text.splitlines()]
+    tail = "\n".join(code).rsplit(";", 1)[-1]
+    if tail.strip() == "":
+        return None
+    return next(line.strip() for line in tail.splitlines() if line.strip())
+
+
+def newest_schema():
+    """The newest EnergyPlus version whose IDD idfkit holds, (major, minor, patch)."""
+    import idfkit.schema
+    return max(idfkit.schema.get_schema_manager().get_available_versions())
 
 
 def load_idf(path):
     """The idfkit document of an IDF; InputError naming the file for one that cannot be read."""
     import idfkit
     try:
-        version = idfkit.get_idf_version(str(path))
+        text = open(path, encoding="utf-8", errors="replace").read()
     except FileNotFoundError:
         raise InputError(path, "file", "not found") from None
+    except OSError as e:
+        raise InputError(path, "file", f"cannot be read ({e.strerror})") from None
+    open_object = unterminated_object(text)
+    if open_object is not None:
+        kind = open_object.split(",")[0].strip()
+        raise InputError(path, kind or "(file)", f"the object {open_object[:40]!r} has no closing ';': the file is "
+                                                 "truncated or its last object unterminated")
+    try:
+        version = idfkit.get_idf_version(str(path))
     except Exception as e:
         raise InputError(path, "Version", f"no EnergyPlus version could be read ({e})") from None
     if version is None:
         raise InputError(path, "Version", "the file has no Version object")
+    newest = newest_schema()
+    if tuple(version[:2]) > tuple(newest[:2]):
+        raise InputError(path, "Version", f"EnergyPlus {'.'.join(map(str, version[:2]))} is newer than any IDD the "
+                                          f"converter holds (idfkit's newest: {'.'.join(map(str, newest[:2]))})")
     override = None
     if tuple(version[:2]) < SCHEMA_MIN[:2]:
         if tuple(version[:2]) < MIN_VERSION:
@@ -119,22 +167,91 @@ def load_idf(path):
         raise InputError(path, "(file)", f"not a readable IDF: {message}") from None
 
 
-# Fields EnergyPlus renamed when it added spaces (9.6 on): the name read first, then its later one
-RENAMED = {"zone_or_zonelist_name": "zone_or_zonelist_or_space_or_spacelist_name",
-           "watts_per_zone_floor_area": "watts_per_floor_area",
-           "power_per_zone_floor_area": "power_per_floor_area",
-           "flow_per_zone_floor_area": "flow_rate_per_floor_area",
-           "people_per_zone_floor_area": "people_per_floor_area",
-           "zone_floor_area_per_person": "floor_area_per_person"}
+# The version whose IDD names the fields this module asks for; a file of another version has its
+# fields found by aligning that version's IDD field list with this one's (`_field_names`)
+REFERENCE_SCHEMA = (8, 9, 0)
+
+
+def _idd_fields(obj_type, version):
+    """The IDD's fields of an object type in an EnergyPlus version, in order ([] for an unknown type)."""
+    import idfkit.schema
+    schema = idfkit.schema.get_schema(tuple(version))
+    obj = schema.get_object_schema(obj_type) if obj_type in schema else None
+    return list(obj["legacy_idd"]["fields"]) if obj else []
+
+
+def _words(name):
+    return set(name.split("_"))
+
+
+@functools.lru_cache(maxsize=None)
+def _field_names(obj_type, version):
+    """{reference name: name in `version`} of an object type's fields, found through the two
+    versions' IDDs (idfkit's schemas), not a table of renames: their field lists aligned (difflib),
+    a field kept where it was, a renamed one the field at its place (a run of renamed fields of
+    equal length, field by field; else the field sharing most words with it, as `Zone Name` ->
+    `Zone or ZoneList Name` beside an inserted `Space or SpaceList Name`)."""
+    ref, own = _idd_fields(obj_type, REFERENCE_SCHEMA), _idd_fields(obj_type, version)
+    out = {n: n for n in own}
+    matcher = difflib.SequenceMatcher(None, ref, own, autojunk=False)
+    for tag, i1, i2, j1, j2 in matcher.get_opcodes():
+        if tag != "replace":
+            continue
+        if i2 - i1 == j2 - j1:
+            out.update({ref[i]: own[j1 + i - i1] for i in range(i1, i2) if ref[i] not in out})
+            continue
+        for i in range(i1, i2):
+            best = max(own[j1:j2], key=lambda n: len(_words(n) & _words(ref[i])) / len(_words(n) | _words(ref[i])))
+            if _words(best) & _words(ref[i]) - {"name"} and ref[i] not in out:
+                out[ref[i]] = best
+    return out
+
+
+def _version_of(obj):
+    doc = getattr(obj, "theidf", None)
+    version = getattr(doc, "version", None)
+    return tuple(version) if version else REFERENCE_SCHEMA
+
+
+def _own_name(obj, field):
+    """A field's name in the IDD of the object's own version."""
+    return _field_names(obj.obj_type, _version_of(obj)).get(field, field)
 
 
 def _field(obj, field):
-    """A field's value (by its name in the IDF's version), None where the object's type has no such
-    field (idfkit refuses the name)."""
-    fields = obj.to_dict()
-    if field not in fields and field in RENAMED:
-        return fields.get(RENAMED[field])
-    return fields.get(field)
+    """A field's value, the field named as the reference version's IDD names it and found in the
+    object's own version's (`_field_names`); None where the object's type has no such field."""
+    return obj.to_dict().get(_own_name(obj, field))
+
+
+def _field_label(obj, field):
+    """A field's name as the IDD of the object's own version writes it (`Watts per Floor Area`)."""
+    import idfkit.schema
+    own = _own_name(obj, field)
+    try:
+        info = idfkit.schema.get_schema(_version_of(obj)).get_object_schema(obj.obj_type)["legacy_idd"]["field_info"]
+        return info[own]["field_name"]
+    except (KeyError, TypeError):
+        return _label(field)
+
+
+def _autocalculated(value):
+    """A field EnergyPlus computes: blank, Autocalculate (or Autosize), or 0 or less (which it reads
+    so for a zone's volume, floor area and ceiling height)."""
+    if _blank(value) or str(value).strip().lower() in ("autocalculate", "autosize"):
+        return True
+    try:
+        return float(value) <= 0.0  # and a negative one, as -9999 in some reference buildings
+    except (TypeError, ValueError):
+        return False
+
+
+def geometry_closed(polygons, counterclockwise=True, tolerance=0.01):
+    """Whether polygons close a volume: their area-weighted outward normals sum to less than
+    `tolerance` of their total area (a closed polyhedron's sum to zero)."""
+    total = sum(geometry.area(p) for p in polygons)
+    flux = sum(geometry.area(p) * geometry.outward_normal(p, counterclockwise) for p in polygons)
+    return total > 0 and float(np.linalg.norm(flux)) < tolerance * total
 
 
 def _blank(value):
@@ -168,20 +285,20 @@ class _Reader:
         value = _field(obj, field)
         if _blank(value):
             if default is None:
-                self.fail(obj, _label(field), "missing: a number is needed")
+                self.fail(obj, _field_label(obj, field), "missing: a number is needed")
             return float(default)
         if isinstance(value, str):
             if value.strip().lower() in ("autocalculate", "autosize"):
-                self.fail(obj, _label(field), f"{value}: the converter needs the number")
+                self.fail(obj, _field_label(obj, field), f"{value}: the converter needs the number")
             try:
                 value = float(value)
             except ValueError:
-                self.fail(obj, _label(field), f"{value!r} is not a number")
+                self.fail(obj, _field_label(obj, field), f"{value!r} is not a number")
         value = float(value)
         if low is not None and (value <= low if low_open else value < low):
-            self.fail(obj, _label(field), f"{value:g} must be {'>' if low_open else '>='} {low:g}")
+            self.fail(obj, _field_label(obj, field), f"{value:g} must be {'>' if low_open else '>='} {low:g}")
         if high is not None and value > high:
-            self.fail(obj, _label(field), f"{value:g} must be <= {high:g}")
+            self.fail(obj, _field_label(obj, field), f"{value:g} must be <= {high:g}")
         return value
 
     def text(self, obj, field, default=""):
@@ -201,9 +318,114 @@ def convert(path):
     return _Converter(_Reader(doc, str(path))).building()
 
 
+# EnergyPlus's equivalent construction of an F- or C-factor (Engineering Reference, "Ground Heat
+# Transfer Calculations using C and F Factor Constructions"; HeatBalanceManager's
+# CreateFCfactorConstructions): 6 in of heavy concrete behind a fictitious massless layer
+FC_CONCRETE = "~FC_Concrete"
+FC_CONCRETE_PROPERTIES = (0.15, 1.95, 2240.0, 900.0)  # m, W/m/K, kg/m3, J/kg/K
+FC_FILM_INSIDE, FC_FILM_OUTSIDE = 0.135, 0.03  # m2K/W, the films an F-factor includes
+FC_MIN_RESISTANCE = 0.001  # m2K/W, the least fictitious layer EnergyPlus accepts
+FC_NO_PERIMETER = 1000.0  # m2K/W, a floor with no exposed perimeter loses nothing to the ground's edge
+
+
+def ffactor_fictitious_resistance(F, area, perimeter):
+    """The fictitious layer (m2K/W) of an F-factor floor: its effective resistance A / (P F), F in
+    W/m/K, A in m2, P the exposed perimeter in m, less the concrete and the two films it includes."""
+    if perimeter <= 0:
+        return FC_NO_PERIMETER
+    R_eff = area / (perimeter * F)
+    R_concrete = FC_CONCRETE_PROPERTIES[0] / FC_CONCRETE_PROPERTIES[1]
+    return max(FC_MIN_RESISTANCE, R_eff - R_concrete - FC_FILM_INSIDE - FC_FILM_OUTSIDE)
+
+
+def cfactor_fictitious_resistance(C, height):
+    """The fictitious layer (m2K/W) of a C-factor underground wall of `height` m: 1/C (W/m2/K,
+    films excluded) plus the soil's equivalent resistance 0.0607 + 0.3479 H (Engineering Reference,
+    eq. 3.195), less the concrete."""
+    R_eff = 1.0 / C + 0.0607 + 0.3479 * height
+    return max(FC_MIN_RESISTANCE, R_eff - FC_CONCRETE_PROPERTIES[0] / FC_CONCRETE_PROPERTIES[1])
+
+
+# Constructions the building file cannot hold, with why
+UNREAD_CONSTRUCTIONS = {
+    "Construction:WindowDataFile": "a window from a WINDOW data file is not read (give its layers)",
+    "Construction:WindowEquivalentLayer": "an equivalent-layer window is not read (give its layers)",
+    "Construction:ComplexFenestrationState": "a BSDF window is not read (give its layers)",
+    "Construction:AirBoundary": "an air boundary between zones is not held by the building file",
+}
+
+
+class _DaySchedules:
+    """A schedule's values over the year `YEAR` on a time step, as idfkit evaluates them, but day by
+    day: the document's holidays and special days found once (idfkit's `values` finds them again at
+    every time step, some 40 s a schedule of a DOE reference building), and each day profile
+    evaluated once, the days that share it copied."""
+
+    def __init__(self, doc):
+        from idfkit.schedules.holidays import get_holidays, get_special_days_by_type
+        self.doc = doc
+        self.special = (get_holidays(doc, YEAR), get_special_days_by_type(doc, YEAR, "CustomDay1"),
+                        get_special_days_by_type(doc, YEAR, "CustomDay2"))
+        self.profiles = {}
+
+    def dates(self):
+        import datetime
+        first = datetime.date(YEAR, 1, 1)
+        return [first + datetime.timedelta(days=k) for k in range((datetime.date(YEAR + 1, 1, 1) - first).days)]
+
+    def times(self, ts):
+        import datetime
+        return [datetime.time(h, m * 60 // ts) for h in range(24) for m in range(ts)]
+
+    def of(self, obj, ts):
+        """(days, 24 ts) values of a Schedule:Compact, Schedule:Constant or Schedule:Week:Daily/Compact."""
+        from idfkit.schedules import compact, day_types, week
+        from idfkit.schedules.time_utils import evaluate_time_values
+        from idfkit.schedules.types import DayType
+        kind = obj.obj_type.upper()
+        if kind == "SCHEDULE:CONSTANT":
+            value = self.day_values(obj, ts)[0]
+            return np.full((len(self.dates()), 24 * ts), value)
+        rows = []
+        if kind == "SCHEDULE:COMPACT":
+            periods, interpolation = compact.parse_compact(obj)
+            for d in self.dates():
+                period = compact._find_period_for_date(periods, d) if periods else None
+                rule = None if period is None else compact._find_matching_rule(
+                    period.day_rules, day_types.get_applicable_day_types(d, DayType.NORMAL, *self.special))
+                key = ("rule", id(rule), ts)
+                if key not in self.profiles:
+                    self.profiles[key] = (np.zeros(24 * ts) if rule is None else np.array(
+                        [evaluate_time_values(rule.time_values, t, interpolation) for t in self.times(ts)]), rule)
+                rows.append(self.profiles[key][0])
+            return np.array(rows, dtype=float)
+        for d in self.dates():
+            if kind == "SCHEDULE:WEEK:DAILY":
+                day_name = week._get_day_schedule_name_for_date(obj, d, DayType.NORMAL, *self.special)
+            else:
+                day_name = week._find_matching_day_in_week_compact(
+                    obj, day_types.get_applicable_day_types(d, DayType.NORMAL, *self.special))
+            if day_name is None:
+                rows.append(np.zeros(24 * ts))
+                continue
+            day = week._find_day_schedule(self.doc, day_name)
+            if day is None:
+                raise ValueError(f"Day schedule not found: {day_name!r}")
+            rows.append(self.day_values(day, ts))
+        return np.array(rows, dtype=float)
+
+    def day_values(self, day, ts):
+        from idfkit.schedules.day import get_day_values
+        key = ("day", day.obj_type.upper(), str(day.name).upper(), ts)
+        if key not in self.profiles:
+            self.profiles[key] = (np.asarray(get_day_values(day, ts), dtype=float), day)
+        return self.profiles[key][0]
+
+
 class _Converter:
     def __init__(self, reader):
         self.r = reader
+        self._days = _DaySchedules(reader.doc)
         self.materials = {}
         self.schedules = {}
         self.not_modelled = []
@@ -282,14 +504,13 @@ class _Converter:
         the IDF's time step, as day profiles by date and day of the week)."""
         if name in self.schedules:
             return name
-        import idfkit.schedules as S
         obj = self.r.get(("Schedule:Compact", "Schedule:Constant", "Schedule:Year"), name, referrer, field)
         ts = self.timesteps
         try:
             if obj.obj_type.upper() == "SCHEDULE:YEAR":
                 values = self._year_values(obj, ts)
             else:
-                values = np.asarray(S.values(obj, year=YEAR, timestep=ts, document=self.r.doc), dtype=float)
+                values = self._days.of(obj, ts).ravel()
         except InputError:
             raise
         except Exception as e:
@@ -300,8 +521,6 @@ class _Converter:
     def _year_values(self, obj, ts):
         """A Schedule:Year's values: each week schedule over its dates (idfkit reads the weeks)."""
         import datetime
-
-        import idfkit.schedules as S
         days = (datetime.date(YEAR + 1, 1, 1) - datetime.date(YEAR, 1, 1)).days
         out = np.full((days, 24 * ts), np.nan)
         fields = obj.to_dict()
@@ -320,7 +539,7 @@ class _Converter:
                 end = datetime.date(YEAR, int(float(w["end_month"])), int(float(w["end_day"])))
             except (TypeError, ValueError) as e:
                 self.r.fail(obj, f"Start Month {k}", f"not a date ({e})")
-            values = np.asarray(S.values(week, year=YEAR, timestep=ts, document=self.r.doc), dtype=float)
+            values = self._days.of(week, ts)
             first, last = (start - datetime.date(YEAR, 1, 1)).days, (end - datetime.date(YEAR, 1, 1)).days
             out[first:last + 1] = values.reshape(-1, 24 * ts)[first:last + 1]
         if np.isnan(out).any():
@@ -332,6 +551,14 @@ class _Converter:
         s = self.schedules[self.schedule(name, referrer, field)]
         return s["constant"] if "constant" in s else None
 
+    def monthly_schedule(self, name, kind, default):
+        """A schedule of an object's twelve monthly temperatures (C), once."""
+        if name not in self.schedules:
+            obj = self.r.all(kind)[0]
+            temps = [self.r.number(obj, f"{m}_ground_temperature", default=default) for m in MONTHS]
+            self.schedules[name] = monthly(temps)
+        return name
+
     def ground_schedule(self):
         if "ground temperature" in self.schedules:
             return "ground temperature"
@@ -342,26 +569,35 @@ class _Converter:
             temps = [DEFAULT_GROUND] * 12
             self.notes.append(f"no Site:GroundTemperature:BuildingSurface: the ground is at EnergyPlus's default "
                               f"{DEFAULT_GROUND:g} C all year")
-        ends = ("01-31", "02-28", "03-31", "04-30", "05-31", "06-30", "07-31", "08-31", "09-30", "10-31",
-                "11-30", "12-31")
-        if len(set(temps)) == 1:
-            self.schedules["ground temperature"] = {"constant": temps[0]}
-        else:
-            self.schedules["ground temperature"] = {
-                "days": {m: [[24, t]] for m, t in zip(MONTHS, temps)},
-                "periods": [{"through": e, "week": [m] * 7} for m, e in zip(MONTHS, ends)]}
+        self.schedules["ground temperature"] = monthly(temps)
         return "ground temperature"
 
     # ---- constructions -----------------------------------------------------------------
     def layers(self, construction_name, referrer, field, height=None):
         """(layers outside first as [[material, thickness]], outer Layer info, inner Layer info,
         glazing or None) of a Construction."""
-        c = self.r.get("Construction", construction_name, referrer, field)
+        for kind, equivalent in (("Construction:FfactorGroundFloor", self.ffactor_layers),
+                                 ("Construction:CfactorUndergroundWall", self.cfactor_layers)):
+            c = self.r.by_name.get(kind.upper(), {}).get(str(construction_name).upper())
+            if c is not None:
+                return equivalent(c)
+        for kind in UNREAD_CONSTRUCTIONS:
+            c = self.r.by_name.get(kind.upper(), {}).get(str(construction_name).upper())
+            if c is not None:
+                self.r.fail(referrer, field, f"{construction_name!r} is a {kind}: {UNREAD_CONSTRUCTIONS[kind]}")
+        c = self.r.get(("Construction", "Construction:InternalSource"), construction_name, referrer, field)
         names = [v for v in c.to_dict().values()][1:]
+        if c.obj_type.upper() == "CONSTRUCTION:INTERNALSOURCE":
+            fields = c.to_dict()
+            names = [fields.get("outside_layer")] + [fields.get(f"layer_{k}") for k in range(2, 11)]
+            line = f"Construction:InternalSource {c.name}: its layers read, its heat source not held"
+            if line not in self.not_modelled:
+                self.not_modelled.append(line)
         names = [n for n in names if not _blank(n)]
         if not names:
             self.r.fail(c, "Outside Layer", "missing: a construction needs a layer")
         kinds = ("Material", "Material:NoMass", "Material:AirGap", "WindowMaterial:Glazing", "WindowMaterial:Gas",
+                 "WindowMaterial:GasMixture",
                  "WindowMaterial:SimpleGlazingSystem")
         objs = []
         for k, n in enumerate(names):
@@ -380,6 +616,30 @@ class _Converter:
             return self.glazing_layers(c, objs, height)
         layers = [[self.opaque_material(o), self._thickness(o)] for o in objs]
         return layers, self._faces(objs[0]), self._faces(objs[-1]), None
+
+    def _fc_concrete(self):
+        self.materials.setdefault(FC_CONCRETE, {"conductivity": FC_CONCRETE_PROPERTIES[1], "density": FC_CONCRETE_PROPERTIES[2],
+                                                "specific_heat": FC_CONCRETE_PROPERTIES[3]})
+        return [FC_CONCRETE, FC_CONCRETE_PROPERTIES[0]]
+
+    def _fc_layers(self, c, R_fic):
+        """EnergyPlus's equivalent construction: a fictitious massless layer of R_fic outside 0.15 m
+        of heavy concrete (HeatBalanceManager, CreateFCfactorConstructions)."""
+        name = f"{c.name} (fictitious R {R_fic:.4g})"
+        self.materials[name] = {"conductivity": MASSLESS_THICKNESS / R_fic, "density": 0.0, "specific_heat": 0.0}
+        faces = {"emissivity": 0.9, "solar": 0.7, "roughness": convection.ROUGHNESS["mediumrough"]}
+        return [[name, MASSLESS_THICKNESS], self._fc_concrete()], faces, faces, None
+
+    def ffactor_layers(self, c):
+        F = self.r.number(c, "f_factor", low=0, low_open=True)
+        area = self.r.number(c, "area", low=0, low_open=True)
+        perimeter = self.r.number(c, "perimeterexposed", low=0)
+        return self._fc_layers(c, ffactor_fictitious_resistance(F, area, perimeter))
+
+    def cfactor_layers(self, c):
+        C = self.r.number(c, "c_factor", low=0, low_open=True)
+        height = self.r.number(c, "height", low=0)
+        return self._fc_layers(c, cfactor_fictitious_resistance(C, height))
 
     def _thickness(self, o):
         if o.obj_type.upper() == "MATERIAL":
@@ -430,24 +690,36 @@ class _Converter:
             self.materials[name] = {"conductivity": 0.003 / R, "density": GLASS_DENSITY,
                                     "specific_heat": GLASS_SPECIFIC_HEAT}
             tau = glazing.simple_glazing_transmittance(U, shgc)
+            # EnergyPlus's absorptance of the layer, split between its outer and inner face so that
+            # at the converter's films the part flowing in is SHGC - T (absorbing it all at the outer
+            # face took 0.58 of the sun there for U 2.04, SHGC 0.38, where EnergyPlus's layer takes
+            # 0.20 in all: the 2019 small office's windows ran 6.7 K warm outside)
+            alpha = glazing.simple_glazing_absorptance(U, shgc)
             h_o = FILMS.outside_convection(90.0, 1.5, 1.0, True, "country") + FILMS.radiative(0.84, FILMS.T_outside)
-            inward = (1 / (1 / U - 1 / h_out)) / (1 / (1 / U - 1 / h_out) + h_o)
-            alpha = min(1 - tau, max(0.0, (shgc - tau) / inward))
-            faces = {"emissivity": 0.84, "solar": alpha, "roughness": 1.0}
+            h_i = FILMS.inside_convection(90.0) + FILMS.radiative(0.84, FILMS.T_inside)
+            f_out = (1 / (R + 1 / h_i)) / (1 / (R + 1 / h_i) + h_o)  # inward share of the outer face's
+            f_in = h_i / (h_i + 1 / (R + 1 / h_o))  # ... and of the inner face's
+            inner = min(alpha, max(0.0, ((shgc - tau) - alpha * f_out) / (f_in - f_out)))
+            faces = {"emissivity": 0.84, "solar": alpha - inner, "roughness": 1.0}
             return [[name, 0.003]], faces, {"emissivity": 0.84, "solar": tau + alpha}, {
-                "tau": tau, "inner_alpha": 0.0, "angular": None}
+                "tau": tau, "inner_alpha": inner, "angular": None}
         panes, layers = [], []
         for k, o in enumerate(objs):
             kind = o.obj_type.upper()
-            expected = "WINDOWMATERIAL:GLAZING" if k % 2 == 0 else "WINDOWMATERIAL:GAS"
-            if kind != expected:
+            expected = ("WINDOWMATERIAL:GLAZING",) if k % 2 == 0 else ("WINDOWMATERIAL:GAS", "WINDOWMATERIAL:GASMIXTURE")
+            if kind not in expected:
                 self.r.fail(c, f"Layer {k + 1}", f"{o.name!r}: panes and gas gaps must alternate, a pane outermost "
                                                  "and innermost")
             if kind == "WINDOWMATERIAL:GLAZING":
-                if self.r.text(o, "optical_data_type", "SpectralAverage").lower() != "spectralaverage":
-                    self.r.fail(o, "Optical Data Type", "only SpectralAverage pane data are read")
-                T0 = self.r.number(o, "solar_transmittance_at_normal_incidence", low=0, low_open=True, high=1)
-                Rf = self.r.number(o, "front_side_solar_reflectance_at_normal_incidence", low=0, high=1)
+                optical = self.r.text(o, "optical_data_type", "SpectralAverage").lower()
+                if optical == "spectral":
+                    T0, Rf = self.spectral_pane(o)
+                elif optical == "spectralaverage":
+                    T0 = self.r.number(o, "solar_transmittance_at_normal_incidence", low=0, low_open=True, high=1)
+                    Rf = self.r.number(o, "front_side_solar_reflectance_at_normal_incidence", low=0, high=1)
+                else:
+                    self.r.fail(o, "Optical Data Type", f"{optical!r}: SpectralAverage and Spectral pane data are read "
+                                                        "(a BSDF pane is not)")
                 thickness = self.r.number(o, "thickness", low=0, low_open=True)
                 panes.append((T0, Rf, self.r.number(o, "front_side_infrared_hemispherical_emissivity", default=0.84),
                               self.r.number(o, "back_side_infrared_hemispherical_emissivity", default=0.84)))
@@ -456,13 +728,11 @@ class _Converter:
                                                  "density": GLASS_DENSITY, "specific_heat": GLASS_SPECIFIC_HEAT})
                 layers.append([name, thickness])
             else:
-                if self.r.text(o, "gas_type", "Air").lower() != "air":
-                    self.r.fail(o, "Gas Type", f"{self.r.text(o, 'gas_type')}: only air gaps are read")
                 layers.append([o, self.r.number(o, "thickness", low=0, low_open=True)])
         # a gap's conductance depends on the emissivities facing it and the pane's height
         for k in range(1, len(layers), 2):
             gap, d = layers[k]
-            h = glazing.gap_conductance(d, height or 1.5, panes[k // 2][3], panes[k // 2 + 1][2])
+            h = glazing.gap_conductance(d, height or 1.5, panes[k // 2][3], panes[k // 2 + 1][2], gas=self.gas(gap))
             name = f"{gap.name} in {c.name}"
             self.materials[name] = {"conductivity": h * d, "density": AIR_DENSITY, "specific_heat": AIR_SPECIFIC_HEAT}
             layers[k] = [name, d]
@@ -482,6 +752,52 @@ class _Converter:
         return layers, outer, inner, {"tau": tau, "inner_alpha": inner_alpha, "angular": {"angles": list(glazing.ANGLES), "factors": factors,
                                                               "diffuse": diffuse}}
 
+    def spectral_pane(self, o):
+        """(T, R_front) at normal incidence of a pane given by wavelength
+        (MaterialProperty:GlazingSpectralData): each averaged over the solar spectrum EnergyPlus
+        weighs with (`model.glazing.solar_average`)."""
+        data = self.r.get("MaterialProperty:GlazingSpectralData", self.r.text(o, "window_glass_spectral_data_set_name"),
+                          o, "Window Glass Spectral Data Set Name")
+        fields = data.to_dict()
+        rows = fields.get("extensions") or []
+        k = 1
+        while f"wavelength_{k}" in fields:  # the fields as numbered in the IDD
+            rows.append({f: fields.get(f"{f}_{k}") for f in ("wavelength", "transmittance", "front_reflectance")})
+            k += 1
+        if len(rows) < 2:
+            self.r.fail(data, "Wavelength 1", "a spectrum needs at least two wavelengths")
+        try:
+            table = np.array([[float(r["wavelength"]), float(r["transmittance"]), float(r["front_reflectance"])]
+                              for r in rows])
+        except (KeyError, TypeError, ValueError):
+            self.r.fail(data, "Wavelength 1", "a wavelength, transmittance or reflectance is not a number")
+        self.note("a pane's spectral data averaged over EnergyPlus's solar spectrum pane by pane (EnergyPlus "
+                  "integrates the whole glazing wavelength by wavelength)")
+        return (glazing.solar_average(table[:, 0], table[:, 1]), glazing.solar_average(table[:, 0], table[:, 2]))
+
+    def gas(self, o):
+        """A gap's gas as `model.glazing.gas_properties` reads it: a name, a Custom gas's own
+        coefficients, or a WindowMaterial:GasMixture's gases and fractions."""
+        if o.obj_type.upper() == "WINDOWMATERIAL:GASMIXTURE":
+            n = int(self.r.number(o, "number_of_gases_in_mixture", low=1, high=4))
+            mixture = []
+            for i in range(1, n + 1):
+                name = self.r.text(o, f"gas_{i}_type").lower()
+                if name not in glazing.GASES:
+                    self.r.fail(o, f"Gas {i} Type", f"{name!r} is none of {', '.join(glazing.GASES)}")
+                mixture.append((name, self.r.number(o, f"gas_{i}_fraction", low=0, low_open=True, high=1)))
+            self.note("a gas mixture's properties the mole-fraction-weighted means of its gases' (EnergyPlus mixes "
+                      "by ISO 15099's rules)")
+            return mixture
+        name = self.r.text(o, "gas_type", "Air").lower()
+        if name == "custom":
+            coefficients = [tuple(self.r.number(o, f"{p}_coefficient_{c}", default=0.0) for c in "abc")
+                            for p in ("conductivity", "viscosity", "specific_heat")]
+            return (*coefficients, self.r.number(o, "molecular_weight", low=0, low_open=True))
+        if name not in glazing.GASES:
+            self.r.fail(o, "Gas Type", f"{name!r} is none of Air, Argon, Krypton, Xenon, Custom")
+        return name
+
     # ---- zones, surfaces ----------------------------------------------------------------
     def building(self):
         site = self.site()
@@ -500,6 +816,9 @@ class _Converter:
         self.internal_masses(components)
         self.receivers(components)
         self.list_not_modelled()
+        if any(w["type"].lower() in ("window", "glassdoor") for s in surfaces.values() for w in s["subsurfaces"]):
+            self.note("no surface of the building shades its windows or walls (EnergyPlus's shadow calculation is "
+                      "not held)")
         names = [b.name for b in self.r.all("Building")]
         description = (f"Converted by nodeforce convert from {self.r.source} (EnergyPlus "
                        f"{'.'.join(map(str, self.r.doc.version[:2]))}). Surface coefficients are the converter's "
@@ -549,6 +868,8 @@ class _Converter:
                                            construction=self.r.text(s, "construction_name"), vertices=None,
                                            area=length * other, azimuth=azimuth, tilt=tilt,
                                            height=self._rect_height(s, zone, stype, other, tilt))
+                z0 = out[s.name.upper()]["height"] - 0.5 * other * np.sin(np.radians(tilt))
+                out[s.name.upper()]["z_range"] = tuple(sorted((z0, z0 + other * np.sin(np.radians(tilt)))))
         if not out:
             self.r.fail(None, "BuildingSurface:Detailed", "missing: the model has no heat transfer surface")
         for s in out.values():
@@ -557,6 +878,7 @@ class _Converter:
                 s["azimuth"], s["tilt"] = geometry.azimuth_tilt(normal)
                 s["area"] = geometry.area(s["vertices"])
                 s["height"] = float(np.mean(s["vertices"][:, 2]))
+                s["z_range"] = (float(s["vertices"][:, 2].min()), float(s["vertices"][:, 2].max()))
             s["subsurfaces"] = []
         for kind in SUBSURFACES:
             for w in self.r.all(kind):
@@ -598,7 +920,7 @@ class _Converter:
         name = self.r.text(obj, field)
         zone = self.zone_objs.get(name.upper())
         if zone is None:
-            self.r.fail(obj, _label(field), f"names no Zone ({name!r})")
+            self.r.fail(obj, _field_label(obj, field), f"names no Zone ({name!r})")
         return zone
 
     def vertices(self, s, zone):
@@ -618,34 +940,75 @@ class _Converter:
             self.r.fail(s, "Number of Vertices", f"{len(v)} vertices: a surface needs at least 3")
         if geometry.area(v) <= 1e-9:
             self.r.fail(s, "Vertex 1 X-coordinate", "the vertices enclose no area")
+        self.check_planar(s, v)
         origin, turn = self.zone_transform(zone)
         return geometry.rotate_z(v + origin, turn)
+
+    def zone_volume(self, z, own, floor):
+        """An autocalculated zone volume (m3), as EnergyPlus's CalculateZoneVolume: a zone its
+        surfaces close (their area-weighted outward normals sum to nothing) by the divergence
+        theorem, sum over faces of A (x . n) / 3; any other its floor area times its ceiling height
+        (the field's, else the height its surfaces span), exact for a prism."""
+        polygons = [s["vertices"] for s in own if s["vertices"] is not None]
+        if len(polygons) == len(own) and geometry_closed(polygons, self.ccw):
+            volume = geometry.enclosed_volume(polygons, self.ccw)
+            if volume > 0:
+                return volume
+        height = _field(z, "ceiling_height")
+        if _autocalculated(height):
+            height = max(s["z_range"][1] for s in own) - min(s["z_range"][0] for s in own)
+        else:
+            height = self.r.number(z, "ceiling_height", low=0, low_open=True)
+        if floor * height <= 0:
+            self.r.fail(z, "Volume", "autocalculated for a zone whose surfaces enclose no volume and that has no floor "
+                                     "area or height: give the volume")
+        self.note("a zone whose surfaces do not close it takes its floor area times its height as volume, as "
+                  "EnergyPlus does")
+        return floor * height
+
+    def check_planar(self, s, v):
+        """A polygon's vertices off its plane (Newell's normal through their centroid): beyond
+        PLANAR_LISTED listed (its area and orientation are its plane's), beyond PLANAR_REFUSED of
+        its size refused (no plane stands for it)."""
+        n = geometry.outward_normal(v)
+        off = np.abs((v - v.mean(axis=0)) @ n)
+        k = int(np.argmax(off))
+        if off[k] > PLANAR_REFUSED * np.sqrt(geometry.area(v)):
+            self.r.fail(s, f"Vertex {k + 1} X-coordinate", f"{off[k]:.3f} m off the surface's plane: not a planar "
+                                                           "surface")
+        if off[k] > PLANAR_LISTED:
+            self.approximated({"obj": s}, f"not planar (vertex {k + 1} {off[k]:.3f} m off its plane): its area and "
+                                          "orientation those of its best plane")
 
     def zone(self, z, surfaces):
         own = [s for s in surfaces.values() if s["zone"].upper() == z.name.upper()]
         if not own:
             self.r.fail(z, "Name", "no surface belongs to this zone")
-        multiplier = self.r.number(z, "multiplier", default=1.0)
+        multiplier = self.r.number(z, "multiplier", default=1.0, low=1)
         if multiplier != 1:
-            self.r.fail(z, "Multiplier", f"{multiplier:g}: a zone multiplier is not held by the building file")
-        volume_field = _field(z, "volume")
-        if _blank(volume_field) or str(volume_field).lower() == "autocalculate":
-            polygons = [s["vertices"] for s in own if s["vertices"] is not None]
-            if len(polygons) != len(own):
-                self.r.fail(z, "Volume", "autocalculated for a zone with rectangular surfaces: give the volume")
-            volume = geometry.enclosed_volume(polygons, self.ccw)
-            if volume <= 0:
-                self.r.fail(z, "Volume", "autocalculated from surfaces that enclose no volume: give the volume")
+            # its copies are identical zones: free-floating, each has the one zone's temperature;
+            # what a copy exchanges with another zone is counted once
+            self.not_modelled.append(f"Zone {z.name}: multiplier {multiplier:g} not held; the zone is modelled once "
+                                     "(each copy's air as its own; its partitions with other zones counted once)")
+        # faces of other zones' surfaces whose outside names this zone (a plenum's floor is often only
+        # the ceilings below naming it): part of its enclosure, seen from it reversed
+        beyond = [dict(s, vertices=None if s["vertices"] is None else s["vertices"][::-1],
+                       type={"ceiling": "floor", "floor": "ceiling", "roof": "floor"}.get(s["type"].lower(), s["type"]))
+                  for s in surfaces.values() if s["zone"].upper() != z.name.upper()
+                  and s["boundary"].lower() in ("zone", "surface") and s["other"].upper() == z.name.upper()]
+        floor = sum(s["area"] for s in own + beyond if s["type"].lower() == "floor")
+        if not _autocalculated(_field(z, "floor_area")):
+            floor = self.r.number(z, "floor_area", low=0, low_open=True)
+        if _autocalculated(_field(z, "volume")):
+            volume = self.zone_volume(z, own + beyond, floor)
         else:
             volume = self.r.number(z, "volume", low=0, low_open=True)
-        floor = sum(s["area"] for s in own if s["type"].lower() == "floor")
-        floor_field = _field(z, "floor_area")
-        if not _blank(floor_field) and str(floor_field).lower() != "autocalculate":
-            floor = self.r.number(z, "floor_area", low=0, low_open=True)
         data = {"name": z.name, "volume": round(volume, 6), "_floor_area": floor}
         exterior = sum(s["area"] for s in own if s["boundary"].lower() == "outdoors")
         walls = sum(s["area"] for s in own if s["boundary"].lower() == "outdoors" and s["type"].lower() == "wall")
-        flow, scheduled = self.air_flows(z, volume, floor, exterior, walls)
+        heights = [s["height"] for s in own if s.get("height") is not None]
+        flow, scheduled = self.air_flows(z, volume, floor, exterior, walls,
+                                         float(np.mean(heights)) if heights else FLOW_WIND_HEIGHT)
         if flow:
             data["air_change_rate"] = flow / volume
         if scheduled:
@@ -662,13 +1025,13 @@ class _Converter:
             return [self.zone_objs[name.upper()].name]
         zl = self.r.by_name.get("ZONELIST", {}).get(name.upper())
         if zl is None:
-            self.r.fail(obj, _label(field), f"names no Zone or ZoneList ({name!r})")
+            self.r.fail(obj, _field_label(obj, field), f"names no Zone or ZoneList ({name!r})")
         fields = zl.to_dict()
         if isinstance(fields.get("zones"), list):
             return [d["zone_name"] for d in fields["zones"]]
         return [v for k, v in fields.items() if k != "name" and not _blank(v)]
 
-    def air_flows(self, z, volume, floor, exterior, walls):
+    def air_flows(self, z, volume, floor, exterior, walls, wind_height=FLOW_WIND_HEIGHT):
         """The zone's constant outdoor air flow (m3/h) from its design flow rate objects, and its
         scheduled ones (the building file's `ventilation`)."""
         total, scheduled = 0.0, []
@@ -679,7 +1042,8 @@ class _Converter:
                     continue
                 method = self.r.text(o, "design_flow_rate_calculation_method", "Flow/Zone").lower()
                 per = {"flow/zone": ("design_flow_rate", 3600.0),
-                       "flow/area": ("flow_per_zone_floor_area", 3600.0 * floor),
+                       "flow/area": ("flow_per_zone_floor_area" if kind == FLOWS[0] else "flow_rate_per_zone_floor_area",
+                                     3600.0 * floor),
                        "flow/exteriorarea": ("flow_per_exterior_surface_area", 3600.0 * exterior),
                        "flow/exteriorwallarea": ("flow_per_exterior_surface_area", 3600.0 * walls),
                        "airchanges/hour": ("air_changes_per_hour", volume),
@@ -688,20 +1052,26 @@ class _Converter:
                     self.r.fail(o, "Design Flow Rate Calculation Method", f"{method!r} is not read (Flow/Zone, Flow/Area, "
                                 "Flow/ExteriorArea, Flow/ExteriorWallArea, AirChanges/Hour are)")
                 field, scale = per[method]
-                flow = self.r.number(o, field, low=0) * scale
+                flow = self.design_value(o, field) * scale
+                # EnergyPlus's flow is the design flow times A + B |dT| + C v + D v^2; the building
+                # file's flows do not vary with either, so the terms are taken at a stated |dT| and
+                # the zone's wind
                 A = self.r.number(o, "constant_term_coefficient", default=1.0)
-                dropped = [(label, self.r.number(o, f, default=0.0)) for label, f in (
-                    ("temperature term", "temperature_term_coefficient"), ("velocity term", "velocity_term_coefficient"),
-                    ("velocity squared term", "velocity_squared_term_coefficient"))]
-                dropped = [f"{label} {v:g}" for label, v in dropped if v != 0]
-                if dropped:
-                    self.not_modelled.append(f"{kind} {o.name}: {', '.join(dropped)} not held (the building file's "
-                                             f"air flows do not vary with temperature or wind); its constant term kept")
+                B, C, D = (self.r.number(o, f, default=0.0) for f in (
+                    "temperature_term_coefficient", "velocity_term_coefficient", "velocity_squared_term_coefficient"))
+                if B or C or D:
+                    v = float(convection.wind_at_height(FILMS.wind, wind_height, self.terrain))
+                    A = A + B * AIRFLOW_DELTA_T + C * v + D * v * v
+                    self.not_modelled.append(
+                        f"{kind} {o.name}: its temperature and wind terms (B {B:g}, C {C:g}, D {D:g}) taken at "
+                        f"|dT| {AIRFLOW_DELTA_T:g} K and the zone's wind {v:.2f} m/s ({FILMS.wind:g} m/s at the "
+                        f"station): A + B |dT| + C v + D v^2 = {A:.4g}, the building file's air flows do not vary "
+                        "with temperature or wind")
                 if kind == "ZoneVentilation:DesignFlowRate":
-                    limits = [_label(f) for f in ("minimum_indoor_temperature", "maximum_indoor_temperature",
-                                                  "delta_temperature", "minimum_outdoor_temperature",
-                                                  "maximum_outdoor_temperature", "maximum_wind_speed")
-                              if not _blank(o.get(f)) and f in o.to_dict()]
+                    limits = [_field_label(o, f) for f in ("minimum_indoor_temperature", "maximum_indoor_temperature",
+                                                           "delta_temperature", "minimum_outdoor_temperature",
+                                                           "maximum_outdoor_temperature", "maximum_wind_speed")
+                              if not _blank(_field(o, f))]
                     if limits:
                         self.not_modelled.append(f"{kind} {o.name}: its controls ({', '.join(limits)}) not held; "
                                                  "the flow runs as scheduled")
@@ -725,23 +1095,20 @@ class _Converter:
                 if kind == "People":
                     out.append(self.people(o, floor))
                     continue
-                if kind == "Lights":
-                    method_field, fields = "design_level_calculation_method", {
-                        "lightinglevel": "lighting_level", "watts/area": "watts_per_zone_floor_area"}
-                else:
-                    method_field, fields = "design_level_calculation_method", {
-                        "equipmentlevel": "design_level", "watts/area": "power_per_zone_floor_area"}
+                method_field, fields = "design_level_calculation_method", GAIN_FIELDS[kind]
                 method = self.r.text(o, method_field).lower()
                 if method not in fields:
                     self.r.fail(o, _label(method_field), f"{method!r} is not read ({', '.join(fields)} are)")
-                power = self.r.number(o, fields[method]) * (floor if method == "watts/area" else 1.0)
+                power = self.design_value(o, fields[method]) * (floor if method == "watts/area" else 1.0)
                 if kind == "Lights":
                     radiant = self.r.number(o, "fraction_radiant", default=0.0) + self.r.number(o, "fraction_visible", default=0.0)
                     returned = self.r.number(o, "return_air_fraction", default=0.0)
                     if returned:
-                        self.not_modelled.append(f"Lights {o.name}: return air fraction {returned:g} given to the zone's "
-                                                 "air (no return air plenum in a free-floating model)")
-                    sensible = 1.0
+                        # EnergyPlus puts it in the return air; without an air system (free-floating) no
+                        # zone gets it: 28.4 C in the 2004 medium office's mid core, 30.1 C given to the zone
+                        self.not_modelled.append(f"Lights {o.name}: return air fraction {returned:g} leaves with the "
+                                                 "return air, as in EnergyPlus without an air system (no zone gets it)")
+                    sensible = 1.0 - returned
                 else:
                     radiant = self.r.number(o, "fraction_radiant", default=0.0)
                     sensible = 1.0 - self.r.number(o, "fraction_latent", default=0.0) - self.r.number(o, "fraction_lost", default=0.0)
@@ -763,14 +1130,23 @@ class _Converter:
         else:
             gain["power"] *= value
 
+    def design_value(self, o, field):
+        """The number a gain's or flow's calculation method reads; blank is 0, as EnergyPlus reads
+        a blank number (its other methods' fields are never required)."""
+        if _blank(_field(o, field)):
+            self.note(f"a blank design level of a {o.obj_type} read as 0, as EnergyPlus reads it")
+            return 0.0
+        return self.r.number(o, field, low=0)
+
     def people(self, o, floor):
         method = self.r.text(o, "number_of_people_calculation_method", "People").lower()
         if method == "people":
-            n = self.r.number(o, "number_of_people", low=0)
+            n = self.design_value(o, "number_of_people")
         elif method == "people/area":
-            n = self.r.number(o, "people_per_floor_area", low=0) * floor
+            n = self.design_value(o, "people_per_zone_floor_area") * floor
         elif method == "area/person":
-            n = floor / self.r.number(o, "floor_area_per_person", low=0, low_open=True)
+            per = self.design_value(o, "zone_floor_area_per_person")
+            n = floor / per if per > 0 else 0.0
         else:
             self.r.fail(o, "Number of People Calculation Method", f"{method!r} is not read")
         activity = self.constant_schedule_value(self.r.text(o, "activity_level_schedule_name"), o,
@@ -778,7 +1154,7 @@ class _Converter:
         if activity is None:
             self.r.fail(o, "Activity Level Schedule Name", "varies in time: a gain has one schedule; give a constant activity")
         sensible = _field(o, "sensible_heat_fraction")
-        if _blank(sensible) or str(sensible).lower() == "autocalculate":
+        if _blank(sensible) or str(sensible).lower() in ("autocalculate", "autosize"):
             # EnergyPlus's polynomial in the activity and the zone's air, at the converter's air temperature
             heat = people_sensible_heat(activity)
             self.note(f"a person's sensible heat EnergyPlus's polynomial at {PEOPLE_T:g} C")
@@ -789,9 +1165,22 @@ class _Converter:
         self._gain_schedule(gain, o, "number_of_people_schedule_name")
         return gain
 
+    def pair_owner(self, s, surfaces):
+        """Of two surfaces naming each other, the one that becomes the partition (its inside the
+        first's zone): the one whose zone comes first in the file's zones, then by name, so that the
+        order of the two objects does not change the building."""
+        other = surfaces.get(s["other"].upper())
+        if other is None or other["other"].upper() != s["obj"].name.upper() or other is s:
+            return s
+        order = {name: k for k, name in enumerate(self.zone_objs)}
+        key = lambda t: (order[t["zone"].upper()], t["obj"].name.upper())  # noqa: E731
+        return min((s, other), key=key)
+
     def components(self, surfaces):
         comps, done = [], set()
         for key, s in surfaces.items():
+            if s["boundary"].lower() == "surface" and self.pair_owner(s, surfaces) is not s:
+                continue  # its partner, which comes first, is the partition
             if key in done:
                 continue
             done.add(key)
@@ -803,12 +1192,12 @@ class _Converter:
             if net <= 1e-9:
                 self.r.fail(obj, "Vertex 1 X-coordinate", f"its windows and doors ({s['area'] - net:.3f} m2) fill all "
                                                           f"of its {s['area']:.3f} m2")
-            comps.append(self.component(obj.name, net, s, layers, inner, outside))
+            comps.append(self.component(obj.name, net, s, layers, inner, outside, outer))
             for w in s["subsurfaces"]:
                 height = w["height"]
                 layers, outer, inner, glass = self.layers(w["construction"], w["obj"], "Construction Name", height)
                 w_outside = self.outside(s, boundary, outer, surfaces, done, subsurface=w)
-                c = self.component(w["obj"].name, w["area"], s, layers, inner, w_outside)
+                c = self.component(w["obj"].name, w["area"], s, layers, inner, w_outside, outer)
                 if glass is not None:
                     c["solar_transmittance"] = round(glass["tau"], 6)
                     c["transmitted_solar_to"] = None  # set once every component is known (`receivers`)
@@ -821,9 +1210,15 @@ class _Converter:
                 comps.append(c)
         return comps
 
-    def component(self, name, area, s, layers, inner, outside):
+    def component(self, name, area, s, layers, inner, outside, outer=None):
+        # each face the zones' sun can land on: (zone, its type seen from that zone, solar absorptance);
+        # a partition's outer face is in the other zone (a ceiling there is its floor)
+        faces = [(s["zone"], s["type"].lower(), inner["solar"])]
+        if outside["type"] == "zone" and outer is not None:
+            flip = {"ceiling": "floor", "floor": "ceiling", "roof": "floor"}
+            faces.append((outside["zone"], flip.get(s["type"].lower(), s["type"].lower()), outer["solar"]))
         # EnergyPlus lists a construction's layers outside first; the building file inside first
-        return {"name": name, "area": round(area, 6), "tilt": round(s["tilt"], 6), "azimuth": round(s["azimuth"] % 360, 6),
+        return {"_faces": faces, "name": name, "area": round(area, 6), "tilt": round(s["tilt"], 6), "azimuth": round(s["azimuth"] % 360, 6),
                 "layers": [[m, t] for m, t in reversed(layers)], "nodes": {"max_spacing": MAX_SPACING},
                 "inside": {"zone": s["zone"], "h_conv": FILMS.inside_convection(s["tilt"], self.inside_algorithm(s["zone"])),
                            "h_rad": round(FILMS.radiative(inner["emissivity"], FILMS.T_inside), 4)},
@@ -850,27 +1245,110 @@ class _Converter:
                 other_zone = zone.name
             else:
                 other = surfaces.get(other_name.upper())
-                if other is None:
-                    self.r.fail(obj, "Outside Boundary Condition Object", f"names no surface ({other_name!r})")
-                if other["other"].upper() != obj.name.upper():
-                    self.r.fail(obj, "Outside Boundary Condition Object",
-                                f"{other_name!r} names {other['other']!r} back, not this surface")
-                done.add(other_name.upper())  # one partition for the pair
-                other_zone = other["zone"]
+                if other is None and other_name.upper() in self.zone_objs:
+                    # a Wall:Interzone (or Ceiling/Floor) may name the zone on its other side
+                    other_zone = self.zone_objs[other_name.upper()].name
+                elif other is None:
+                    self.r.fail(obj, "Outside Boundary Condition Object", f"names no surface or zone ({other_name!r})")
+                elif other is s:
+                    # its own other side: EnergyPlus sets its outer face to its inner face's temperature,
+                    # no heat crossing its middle; the nearest the file holds is an adiabatic outer face
+                    self.approximated(s, "its other side is itself: read with an adiabatic outer face (the zone "
+                                         "sees its inner face alone, as EnergyPlus has it)")
+                    return {"type": "adiabatic"}
+                elif other["other"].upper() != obj.name.upper():
+                    # not a pair: this face sees the other surface's zone, the other is its own component
+                    self.approximated(s, f"names {other_name!r}, which names {other['other']!r} back: read as "
+                                         f"facing the air of {other['zone']!r}")
+                    other_zone = other["zone"]
+                else:
+                    done.add(other_name.upper())  # one partition for the pair
+                    other_zone = other["zone"]
             h_c = FILMS.inside_convection(180.0 - s["tilt"], self.inside_algorithm(other_zone))
             return {"type": "zone", "zone": other_zone, "h_conv": h_c,
                     "h_rad": round(FILMS.radiative(outer["emissivity"], FILMS.T_inside), 4)}
+        reader = NEAREST_BOUNDARY.get(boundary)
+        if reader is not None:
+            return reader(self, s)
         self.r.fail(obj, "Outside Boundary Condition", f"{s['boundary']!r} is not read (Outdoors, Ground, Adiabatic, "
-                                                       "Surface, Zone are)")
+                                                       "Surface, Zone and the approximated "
+                                                       f"{', '.join(sorted(NEAREST_LABELS))} are)")
+
+    # ---- boundaries the building file holds only approximately: the nearest it holds, listed ----
+    def approximated(self, s, text):
+        line = f"{s['obj'].obj_type} {s['obj'].name}: {text}"
+        if line not in self.not_modelled:
+            self.not_modelled.append(line)
+
+    def fc_ground(self, s):
+        """GroundFCfactorMethod: the face at Site:GroundTemperature:FCfactorMethod's months (EnergyPlus
+        takes the weather file's 0.5 m ground temperatures where the IDF has none: the converter does
+        not read the weather, and holds the building surface's ground temperature instead, said so)."""
+        if self.r.all("Site:GroundTemperature:FCfactorMethod"):
+            return {"type": "boundary", "temperature": self.monthly_schedule(
+                "FC-factor ground temperature", "Site:GroundTemperature:FCfactorMethod", DEFAULT_GROUND), "h": FILMS.ground}
+        self.note("no Site:GroundTemperature:FCfactorMethod: the F- and C-factor surfaces' ground is the building "
+                  "surfaces' ground temperature (EnergyPlus takes the weather file's 0.5 m ground temperatures)")
+        return {"type": "boundary", "temperature": self.ground_schedule(), "h": FILMS.ground}
+
+    def preprocessed_ground(self, s):
+        self.approximated(s, f"outside boundary {s['boundary']} read as Ground (the ground temperature schedule), "
+                             "the preprocessor's temperatures not held")
+        return {"type": "boundary", "temperature": self.ground_schedule(), "h": FILMS.ground}
+
+    def foundation(self, s):
+        """Foundation (Kiva's 2-D ground): the face held at the ground temperature, as Ground, through the
+        construction as written; Kiva's soil, insulation and footing are not held."""
+        self.approximated(s, "outside boundary Foundation (Kiva) read as Ground: the face held at the ground "
+                             "temperature schedule, Kiva's soil and foundation insulation not held")
+        return {"type": "boundary", "temperature": self.ground_schedule(), "h": FILMS.ground}
+
+    def other_side_model(self, s):
+        """OtherSideConditionsModel: a ground-coupled one as Ground, a ventilated cavity
+        (GapConvectionRadiation) as outdoor air shading the face from the sun, with natural convection."""
+        model = self.r.get("SurfaceProperty:OtherSideConditionsModel", s["other"], s["obj"],
+                           "Outside Boundary Condition Object")
+        kind = self.r.text(model, "type_of_modeling", "GapConvectionRadiation").lower()
+        if kind in ("groundcoupledsurface", "undergroundpipingsystemsurface"):
+            self.approximated(s, f"outside boundary OtherSideConditionsModel ({kind}) read as Ground")
+            return {"type": "boundary", "temperature": self.ground_schedule(), "h": FILMS.ground}
+        self.approximated(s, f"outside boundary OtherSideConditionsModel ({kind}) read as outdoor air behind a "
+                             "shading cavity: no sun, natural convection, the cavity's own balance not held")
+        return self._sheltered(s)
+
+    def _sheltered(self, s):
+        emissivity = 0.9
+        return {"type": "exterior", "h_conv": round(float(convection.natural_convection(s["tilt"], FILMS.delta_T)), 4),
+                "h_rad": round(FILMS.radiative(emissivity, FILMS.T_outside), 4), "solar_absorptance": 0.0,
+                "sky_view_factor": 0.0}
+
+    def other_side_coefficients(self, s):
+        """OtherSideCoefficients: T = C2 T_const + C3 T_out + ... with film C1: a constant temperature
+        alone is a boundary at it (through C1, or the face held at it); any other term is read as
+        outdoor air without sun, said so."""
+        o = self.r.get("SurfaceProperty:OtherSideCoefficients", s["other"], s["obj"], "Outside Boundary Condition Object")
+        h = self.r.number(o, "combined_convective_radiative_film_coefficient", default=0.0, low=0)
+        T = self.r.number(o, "constant_temperature", default=0.0)
+        c_const = self.r.number(o, "constant_temperature_coefficient", default=1.0)
+        others = [f for f in ("external_dry_bulb_temperature_coefficient", "ground_temperature_coefficient",
+                              "wind_speed_coefficient", "zone_air_temperature_coefficient")
+                  if self.r.number(o, f, default=0.0) != 0]
+        if not others and _blank(_field(o, "constant_temperature_schedule_name")):
+            return {"type": "boundary", "temperature": round(c_const * T, 6), "h": h if h > 0 else FILMS.ground}
+        self.approximated(s, "outside boundary OtherSideCoefficients read as outdoor air without sun "
+                             f"(its {', '.join(_label(f) for f in others) or 'scheduled temperature'} not held)")
+        return self._sheltered(s)
 
     def internal_masses(self, components):
         for o in self.r.all("InternalMass"):
-            zone = self.zone_of(o, "zone_or_zonelist_name" if "zone_or_zonelist_name" in o.to_dict() else "zone_name")
+            zones = self._targets(o, "zone_name")  # a ZoneList gives each of its zones the whole area
             layers, _, inner, _ = self.layers(self.r.text(o, "construction_name"), o, "Construction Name")
-            # EnergyPlus's internal mass sees the zone on one face, the other adiabatic
-            s = {"tilt": 90.0, "azimuth": 0.0, "zone": zone.name, "type": "internalmass"}
-            components.append(self.component(o.name, self.r.number(o, "surface_area", low=0, low_open=True), s,
-                                             layers[::-1], inner, {"type": "adiabatic"}))
+            area = self.r.number(o, "surface_area", low=0, low_open=True)
+            for zone in zones:
+                # EnergyPlus's internal mass sees the zone on one face, the other adiabatic
+                s = {"tilt": 90.0, "azimuth": 0.0, "zone": self.zone_objs[zone.upper()].name, "type": "internalmass"}
+                name = o.name if len(zones) == 1 else f"{o.name} {s['zone']}"
+                components.append(self.component(name, area, s, layers[::-1], inner, {"type": "adiabatic"}))
 
     def receivers(self, components):
         """Where the sun a zone's windows let in lands, as EnergyPlus's FullInteriorAndExterior
@@ -880,31 +1358,60 @@ class _Converter:
         proportion to its area times its absorptance, A_i alpha_i / sum_j A_j alpha_j, the
         glazings' share leaving the zone. Applied to the diffuse sun too (the building file has
         one transmitted input per glazing)."""
+        faces = {}  # zone: [(component, type, absorptance, glazing?)] of every face in it
+        for k in components:
+            for zone, kind, alpha in k["_faces"]:
+                faces.setdefault(zone, []).append((k, kind, alpha, "solar_transmittance" in k))
         for c in components:
             if "transmitted_solar_to" not in c:
                 continue
-            own = [k for k in components if k["_zone"] == c["_zone"] and k["inside"]["zone"] == c["_zone"]]
-            opaque = [k for k in own if "solar_transmittance" not in k]
-            floors = [k for k in opaque if k["_type"] == "floor"] or opaque
-            floor = max(floors, key=lambda k: k["area"])
-            c["transmitted_solar_to"] = floor["name"]
-            total = sum(k["area"] * k["_absorbs"] for k in own)
-            reflected = 1 - floor["_absorbs"]
-            shares = {k["name"]: reflected * k["area"] * k["_absorbs"] / total for k in opaque if k["_absorbs"] > 0}
-            shares[floor["name"]] = shares.get(floor["name"], 0.0) + floor["_absorbs"]
+            own = faces[c["_zone"]]
+            opaque = [f for f in own if not f[3]]
+            floors = [f for f in opaque if f[1] == "floor"] or opaque
+            floor = max(floors, key=lambda f: f[0]["area"])
+            c["transmitted_solar_to"] = floor[0]["name"]
+            total = sum(k["area"] * alpha for k, _, alpha, _ in own)
+            reflected = 1 - floor[2]
+            shares = {k["name"]: reflected * k["area"] * alpha / total for k, _, alpha, _ in opaque if alpha > 0}
+            shares[floor[0]["name"]] = shares.get(floor[0]["name"], 0.0) + floor[2]
             c["solar_distribution"] = {name: round(f, 6) for name, f in shares.items()}
         for c in components:
-            c.pop("_zone"), c.pop("_type"), c.pop("_absorbs")
+            c.pop("_zone"), c.pop("_type"), c.pop("_absorbs"), c.pop("_faces")
 
     def list_not_modelled(self):
         for obj in self.r.doc.all_objects:
             kind = obj.obj_type
-            if kind.upper() in {k.upper() for k in READ} or kind.startswith(NOT_PHYSICS):
+            if kind.upper() in {k.upper() for k in READ} or (kind.startswith(NOT_PHYSICS) and kind not in LISTED_RUN):
+                continue
+            if kind == "RunPeriodControl:DaylightSavingTime":
+                self.not_modelled.append(f"{kind}: not applied; the schedules run on standard time all year")
                 continue
             # an object without a name (ZoneHVAC:EquipmentConnections) is known by its first field
             name = next((str(v) for v in obj.to_dict().values() if not _blank(v)), "")
             self.not_modelled.append(f"{kind} {name}: not held by the building file")
 
+
+def monthly(temps):
+    """A building file's schedule of twelve monthly values."""
+    ends = ("01-31", "02-28", "03-31", "04-30", "05-31", "06-30", "07-31", "08-31", "09-30", "10-31",
+            "11-30", "12-31")
+    if len(set(temps)) == 1:
+        return {"constant": temps[0]}
+    return {"days": {m: [[24, t]] for m, t in zip(MONTHS, temps)},
+            "periods": [{"through": e, "week": [m] * 7} for m, e in zip(MONTHS, ends)]}
+
+
+# The outside boundaries the building file holds only approximately, each read as the nearest it holds
+NEAREST_BOUNDARY = {
+    "groundfcfactormethod": _Converter.fc_ground, "foundation": _Converter.foundation,
+    "othersideconditionsmodel": _Converter.other_side_model, "othersidecoefficients": _Converter.other_side_coefficients,
+    **{b: _Converter.preprocessed_ground for b in ("groundslabpreprocessoraverage", "groundslabpreprocessorcore",
+                                                   "groundslabpreprocessorperimeter", "groundbasementpreprocessoraveragewall",
+                                                   "groundbasementpreprocessoraveragefloor",
+                                                   "groundbasementpreprocessorupperwall",
+                                                   "groundbasementpreprocessorlowerwall")}}
+NEAREST_LABELS = ("GroundFCfactorMethod", "Foundation", "OtherSideConditionsModel", "OtherSideCoefficients",
+                  "GroundSlabPreprocessor*", "GroundBasementPreprocessor*")
 
 YEAR = 2017  # the calendar on which the schedules' weekdays are read (its 1 January is a Sunday)
 

@@ -105,14 +105,66 @@ GAP_T_MEAN = 283.15  # K
 GAP_DELTA_T = 15.0  # K
 
 
-def gap_conductance(thickness, height, emissivity_1, emissivity_2, T_mean=GAP_T_MEAN, delta_T=GAP_DELTA_T):
-    """Conductance (W/m2/K) of an air gap of `thickness` m between two panes `height` m high:
-    conduction and convection, Nu k / d with ISO 15099's Nusselt number of a vertical cavity at
-    the Rayleigh number of (T_mean K, delta_T K), plus the radiative exchange of its two faces."""
-    k = AIR_CONDUCTIVITY[0] + AIR_CONDUCTIVITY[1] * T_mean
-    mu = 3.723e-6 + 4.94e-8 * T_mean  # Pa s
-    rho = 101325 * 0.02897 / (8.314462 * T_mean)  # kg/m3
-    cp = 1002.737 + 1.2324e-2 * T_mean  # J/kg/K
+# EnergyPlus's fill gases (its Material module's table, the IDD's defaults, ISO 15099): the
+# coefficients (a, b, c) of conductivity (W/m/K), viscosity (kg/m/s) and specific heat (J/kg/K),
+# each a + b T + c T^2 at T in K, and the molecular weight (g/mol)
+GASES = {
+    "air": ((2.873e-3, 7.760e-5, 0.0), (3.723e-6, 4.940e-8, 0.0), (1002.737, 1.2324e-2, 0.0), 28.97),
+    "argon": ((2.285e-3, 5.149e-5, 0.0), (3.379e-6, 6.451e-8, 0.0), (521.929, 0.0, 0.0), 39.948),
+    "krypton": ((9.443e-4, 2.826e-5, 0.0), (2.213e-6, 7.777e-8, 0.0), (248.091, 0.0, 0.0), 83.8),
+    "xenon": ((4.538e-4, 1.723e-5, 0.0), (1.069e-6, 7.414e-8, 0.0), (158.340, 0.0, 0.0), 131.3),
+}
+
+
+def solar_spectrum():
+    """(wavelengths um, irradiance W/m2/um) of the solar spectrum EnergyPlus and WINDOW weigh pane
+    data with: ASTM E891-87 Table 1, direct normal at AM1.5 (ISO 9845-1), as LBNL's pywincalc ships it."""
+    import os
+
+    import pywincalc
+    path = os.path.join(pywincalc.standard_path, "ASTM E891 Table 1 Direct AM1_5.ssp")
+    rows = [line.split() for line in open(path)]
+    table = np.array([[float(a), float(b)] for a, b, *_ in (r for r in rows if len(r) >= 2 and r[0][0].isdigit())])
+    return table[:, 0], table[:, 1]
+
+
+_trapezoid = getattr(np, "trapezoid", None) or np.trapz  # numpy 2 renamed it
+
+
+def solar_average(wavelengths, values):
+    """A spectral property (at `wavelengths` um) averaged over the solar spectrum: the integral of
+    value x irradiance over that of irradiance, both by the trapezoid rule on the spectrum's
+    wavelengths within the data's range (the value interpolated linearly)."""
+    lam, E = solar_spectrum()
+    inside = (lam >= np.min(wavelengths)) & (lam <= np.max(wavelengths))
+    lam, E = lam[inside], E[inside]
+    order = np.argsort(wavelengths)
+    v = np.interp(lam, np.asarray(wavelengths)[order], np.asarray(values)[order])
+    return float(_trapezoid(v * E, lam) / _trapezoid(E, lam))
+
+
+def gas_properties(gas, T):
+    """(conductivity W/m/K, viscosity kg/m/s, specific heat J/kg/K, molecular weight g/mol) at T (K)
+    of a gas: a name of `GASES`, a tuple of its own coefficients as GASES holds them, or a mixture
+    [(gas, mole fraction), ...], whose properties are the mole-fraction-weighted means (EnergyPlus
+    mixes by ISO 15099's rules; for argon or krypton in air the two differ by a few per cent in k)."""
+    if isinstance(gas, list):
+        parts = [(gas_properties(g, T), x) for g, x in gas]
+        total = sum(x for _, x in parts)
+        return tuple(sum(p[i] * x for p, x in parts) / total for i in range(4))
+    k, mu, cp, M = GASES[gas] if isinstance(gas, str) else gas
+    value = lambda c: c[0] + c[1] * T + c[2] * T * T  # noqa: E731
+    return value(k), value(mu), value(cp), M
+
+
+def gap_conductance(thickness, height, emissivity_1, emissivity_2, T_mean=GAP_T_MEAN, delta_T=GAP_DELTA_T,
+                    gas="air"):
+    """Conductance (W/m2/K) of a gas gap (`gas` as `gas_properties` reads it, air unless given) of
+    `thickness` m between two panes `height` m high: conduction and convection, Nu k / d with ISO
+    15099's Nusselt number of a vertical cavity at the Rayleigh number of (T_mean K, delta_T K),
+    plus the radiative exchange of its two faces."""
+    k, mu, cp, M = gas_properties(gas, T_mean)  # W/m/K, Pa s, J/kg/K, g/mol
+    rho = 101325 * M / 1000 / (8.314462 * T_mean)  # kg/m3
     ra = rho ** 2 * thickness ** 3 * 9.81 * cp * delta_T / (mu * k * T_mean)
     aspect = height / thickness
     if ra > 5e4:
@@ -148,6 +200,22 @@ def simple_glazing_films(U):
     to include (Engineering Reference, "Simple Window Model", step 2)."""
     h_in = 0.359073 * np.log(U) + 6.949915 if U < 5.85 else 1.788041 * U - 2.886625
     return float(h_in), 0.025342 * U + 29.163853
+
+
+def simple_glazing_absorptance(U, shgc):
+    """Solar absorptance of EnergyPlus's simple glazing system's equivalent layer (Engineering
+    Reference, "Simple Window Model", step 4): (SHGC - T) / Fr_in, the inward-flowing fraction
+    Fr_in = (R_o,s + R_l / 2) / (R_o,s + R_l + R_i,s) of what the layer absorbs at its middle, R_l the
+    layer's resistance left by U and step 2's films, R_o,s and R_i,s the films of the solar
+    (summer) condition as functions of SHGC - T."""
+    tau = simple_glazing_transmittance(U, shgc)
+    x = max(shgc - tau, 0.0)
+    h_in, h_out = simple_glazing_films(U)
+    R_l = 1 / U - 1 / h_in - 1 / h_out
+    R_is = 1 / (29.436546 * x ** 3 - 21.943415 * x ** 2 + 9.945872 * x + 7.426151)
+    R_os = 1 / (2.225824 * x + 20.57708)
+    inward = (R_os + 0.5 * R_l) / (R_os + R_l + R_is)
+    return min(1.0 - tau, x / inward)
 
 
 def pane_absorptances(panes):

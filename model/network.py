@@ -332,7 +332,12 @@ def assemble(building, names=None):
         if c.solar_transmittance is not None:
             sun = col[c.transmitted_input]
             for name, fraction in c.receivers:
-                receiver = building.component(name).node_ids[0] - 1
+                # the receiving face is the one in the glazing's zone: a partition's outer face
+                # where only that face is in it
+                r = building.component(name)
+                face_out = (r.inside.zone != c.inside.zone and isinstance(r.outside, Surface)
+                            and r.outside.zone == c.inside.zone)
+                receiver = (r.node_ids[-1] if face_out else r.node_ids[0]) - 1
                 transmitted = c.solar_transmittance * c.area * fraction
                 if c.shading:
                     # tau A I (s + f (1 - s)): a closed shading (s = 0) still lets in the part f
