@@ -31,6 +31,7 @@ import numpy as np
 from scipy.special import chdtrc
 
 from nodeforce.model.effects import EFFECTS, bridge_parts
+from nodeforce.model.score import Yardstick
 
 
 def _frozen(table):
@@ -55,16 +56,12 @@ class Policy:
     # Whole days a calibration window must hold for the cross-validation (days): one fold needs
     # another day to be fitted on.
     min_blocks: int = 2
-    # Standard deviations of J of pure noise, sd^2 sqrt(2 n), a change of J must exceed to be more
-    # than noise (dimensionless): three keep a record with no fault from gaining an effect.
-    noise_sds: float = 3.0
-    # The least fall of J worth an effect, as a share of the model's cross-validated J
-    # (dimensionless): where the noise is unknown or nil, a tiny gain is not a fault.
-    least_fall_share: float = 0.01
-    # Standard errors of its day-to-day scatter a fall must exceed, and the width of the band of
-    # candidates the data cannot tell apart (dimensionless): one, not a Student t quantile, since a
-    # real effect's size follows the weather from day to day.
-    standard_errors: float = 1.0
+    # The noise yardstick of a fall of J and the pass rule (`model.score.Yardstick`): how many sds
+    # of J of pure noise a change must exceed, the least fall as a share of J, the standard errors
+    # of its day-to-day scatter a fall must exceed (and the width of the band of candidates the
+    # data cannot tell apart), and the share of J that is rounding; the forcing search's
+    # parsimony reads the same.
+    yardstick: Yardstick = Yardstick()
 
     # -- 2. objections
     # A scale parameter, or a derived quantity, is identifiable when its sd is under this share
@@ -112,9 +109,6 @@ class Policy:
     prior_level: float = 0.05
 
     # -- 3. the band
-    # A difference of J below this share of the model's cross-validated J is the simulation's
-    # rounding (dimensionless).
-    rounding_share: float = 1e-9
     # The most a sensor other than the objective air counts in the evidence (dimensionless): a
     # sensor the model follows to the noise counts fully, one it misses by more, sd^2 over its
     # mean squared residual.
@@ -137,29 +131,27 @@ class Policy:
     # share of both and the one it displaced lead their round.
     revisited: int = 5
 
-    # ---- the yardsticks
+    # ---- the yardsticks (`model.score.Yardstick`)
+    @property
+    def standard_errors(self):
+        return self.yardstick.standard_errors
+
     def noise_J(self, sd, n):
-        """J (C2) of n residuals of noise of sd `sd` (C) alone, n sd^2; 0 if sd is unknown."""
-        return 0.0 if sd is None else n * sd ** 2
+        return self.yardstick.noise_J(sd, n)
 
     def noise_change(self, sd, n):
-        """The change of J (C2) noise of sd `sd` (C) alone can make on n residuals,
-        `noise_sds` sd^2 sqrt(2 n); 0 if sd is unknown."""
-        return 0.0 if sd is None else self.noise_sds * sd ** 2 * math.sqrt(2 * n)
+        return self.yardstick.noise_change(sd, n)
 
     def least_fall(self, J, sd, n):
-        """The fall of J (C2) from a model of J `J` (C2) on n residuals that noise of sd `sd` (C)
-        could make, at least `least_fall_share` of J."""
-        return max(self.least_fall_share * J, self.noise_change(sd, n))
+        return self.yardstick.least_fall(J, sd, n)
 
     def at_noise(self, J, n, sd):
         """Whether an error J (C2) on n residuals is what an error of sd `sd` (C) alone leaves
         (the sensors' noise and the file's numerical error: `model.score.Noise.floor_sd`)."""
-        return J <= self.noise_J(sd, n) + self.noise_change(sd, n)
+        return self.yardstick.at_noise(J, n, sd)
 
     def rounding(self, J):
-        """A difference of J (C2) below which two candidates differ by rounding, for a model of J `J`."""
-        return self.rounding_share * J
+        return self.yardstick.rounding(J)
 
     def identifiable(self, value, sd, unit):
         """Whether an estimate `value` +- `sd` in `unit` is tight enough to act on."""

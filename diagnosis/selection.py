@@ -78,6 +78,7 @@ from nodeforce.diagnosis.result import Decision, Verdict
 from nodeforce.model.effects import bridge_parts
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
+from nodeforce.model.score import fall
 
 
 def blocks(n_steps, scored_from, dt, source="measurements"):
@@ -107,13 +108,6 @@ def on_block(shapes, record, block):
 def block_J(residuals, masks):
     """J (C2) of residuals ((N_t, zones), NaN where not scored) on each block."""
     return np.array([np.nansum(np.square(residuals[m])) for m in masks])
-
-
-def fall(base, scores):
-    """The fall of J from per-block J `base` to `scores` (C2) and its standard error from the
-    per-block falls (blocks as the unit; 0 for one block, which has no scatter to measure)."""
-    d = np.asarray(base, dtype=float) - np.asarray(scores, dtype=float)
-    return float(d.sum()), float(math.sqrt(len(d)) * d.std(ddof=1)) if len(d) > 1 else 0.0
 
 
 def distance(a, b):
@@ -164,10 +158,10 @@ def harmed(base, scores, floor_sd, groups):
     out = []
     for group in groups:
         rows = np.asarray(group["blocks"], dtype=int)
-        down, se = fall(base[rows], scores[rows])
-        needed = max(POLICY.least_fall(float(base[rows].sum()), floor_sd, group["n"]), POLICY.standard_errors * se)
-        if down < -needed:
-            out.append({"record": group["record"], "cv_fall": down, "needed": needed})
+        judged = POLICY.yardstick.judge(base[rows], scores[rows],
+                                        POLICY.least_fall(float(base[rows].sum()), floor_sd, group["n"]))
+        if judged.reversed:
+            out.append({"record": group["record"], "cv_fall": judged.fall, "needed": judged.needed})
     return out
 
 
@@ -240,10 +234,9 @@ def candidate_test(result, base, margin, floor_sd, groups, sigma, air_at_noise=F
     air unless `air_at_noise`, or on its own sensors), the records it harms and the objection of
     physics, None if none."""
     blocks = np.asarray(result.cv.blocks)
-    down, se = fall(base, blocks)
-    needed = max(margin, POLICY.standard_errors * se)
     # the other days than its best must gain too: one day alone is no evidence
-    others = down - float(np.max(base - blocks))
+    judged = POLICY.yardstick.judge(base, blocks, margin)
+    down = judged.fall
     own = own_test(result.sensors.own, sigma)
     by_own = bool(own is not None and own["passes"] and down > -margin)
     harms = harmed(base, blocks, floor_sd, groups)
@@ -253,9 +246,9 @@ def candidate_test(result, base, margin, floor_sd, groups, sigma, air_at_noise=F
             f"{h['record']} (its cross-validated J there rises by {-h['cv_fall']:.3g} C2, beyond the "
             f"{h['needed']:.3g} C2 the noise and the day-to-day scatter could make)" for h in harms)
             + ": a correction of the building must hold on every record of it"]))
-    by_air = bool(down > needed and others > 0) and not air_at_noise
-    return Verdict(down, se, needed, others, float(result.evidence().sum()), by_air or by_own, harms, said, own,
-                   by_own)
+    by_air = bool(judged.beats) and not air_at_noise
+    return Verdict(down, judged.se, judged.needed, judged.other_days, float(result.evidence().sum()), by_air or by_own,
+                   harms, said, own, by_own)
 
 
 def own_test(own, sigma):
@@ -277,12 +270,10 @@ def own_test(own, sigma):
     if own is None or not own.n:
         return None
     before, after = np.asarray(own.before, dtype=float), np.asarray(own.after, dtype=float)
-    down, se = fall(before, after)
     floor = math.hypot(sigma, own.numerical)
-    needed = max(POLICY.least_fall(float(before.sum()), floor, own.n), POLICY.standard_errors * se)
-    others = down - float(np.max(before - after))
+    judged = POLICY.yardstick.judge(before, after, POLICY.least_fall(float(before.sum()), floor, own.n))
     mended = POLICY.at_noise(float(after.sum()), own.n, floor)
-    return {"fall": down, "se": se, "needed": needed, "passes": bool(down > needed and others > 0 and mended)}
+    return {"fall": judged.fall, "se": judged.se, "needed": judged.needed, "passes": bool(judged.beats and mended)}
 
 
 def claim(result):

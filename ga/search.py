@@ -43,8 +43,9 @@ from tqdm import tqdm
 from nodeforce.ga import checkpoint as ckpt
 from nodeforce.ga.evaluation import FitnessCache, log, open_backend
 from nodeforce.ga.operators import bit_flip_mutation, one_point_crossover, roulette_selection
-from nodeforce.ga.parsimony import (ROUNDING, Paired, explains, forward_backward, noise_J, noise_tolerance,
-                                    smallest_subset, tolerance)
+from nodeforce.ga.parsimony import (Paired, explains, forward_backward, noise_J, noise_tolerance, smallest_subset,
+                                    tolerance)
+from nodeforce.model.score import Yardstick
 
 # Generations without a significant fall of the best J before the GA stops. Measured on the
 # paper's verification cases (benchmarks/bench_search.py --cases, README): successive falls of
@@ -325,7 +326,7 @@ def _answer(cache, nodes, noise_sigma, n_residuals, factory=None) -> dict:
     explained = explains(J_unforced, J_min, noise_sigma, n_residuals)
     if explained:
         start = parsimonious_best(cache.J_of, tol)
-        paired = (Paired(factory, cache.J_many, ROUNDING * J_unforced)
+        paired = (Paired(factory, cache.J_many, Yardstick().rounding(J_unforced))
                   if getattr(factory, "keeps_residuals", False) else None)
         try:
             chosen = smallest_subset(cache.J_many, start, cache.J_of[start] + tol,
