@@ -6,7 +6,6 @@ effects are shapes, and what physics refuses are the choice's (`diagnosis.policy
 """
 import math
 
-from nodeforce.diagnosis.policy import POLICY
 from nodeforce.model.effects import EFFECTS, bridge_parts, bridge_target, pair_parts
 from nodeforce.model.network import RHO_C_AIR
 
@@ -26,7 +25,7 @@ ZONE_START = {("internal_mass", "C_m"): 10.0,
 INSIDE = 1e-3
 
 
-def physical(building, evidence, zones, measured_ids, located_nodes=()):
+def physical(building, evidence, zones, measured_ids, policy, located_nodes=()):
     """(effect, target) pairs every round calibrates, whatever the residual's statistics say: a
     building physicist's list of what could be wrong, which the cross-validated choice
     (`diagnosis.selection`) then judges.
@@ -34,7 +33,7 @@ def physical(building, evidence, zones, measured_ids, located_nodes=()):
     - Every zone effect of each objective zone (`zone_effects`), and of any zone whose air the
       forcing search located.
     - The component effects (`component_effects`) of the components the forcing evidence ranks
-      highest (at least `POLICY.top_components`, and any removing `POLICY.evident_share` of J
+      highest (at least `policy.top_components`, and any removing `policy.evident_share` of J
       above the noise), and of
       every component of an objective zone that no sensor sits in: forcing cannot point at a
       component without a sensor; a calibration can.
@@ -45,19 +44,20 @@ def physical(building, evidence, zones, measured_ids, located_nodes=()):
     evidence : ga.locate's `components`: [{"component", "share", ...}], most evident first
     zones : names of the objective zones
     measured_ids : node ids with a measurement column
+    policy : the `diagnosis.policy.Policy`: how many components, which effects are shapes
     located_nodes : node ids the forcing search located
     """
     located = set(located_nodes)
     air_zones = list(zones) + [z.name for z in building.zones if z.air_node in located]
     pairs = [pair for name in dict.fromkeys(air_zones) for pair in zone_effects(building, name)]
     ranked = [e["component"] for i, e in enumerate(evidence)
-              if i < POLICY.top_components or e["share"] >= POLICY.evident_share]
+              if i < policy.top_components or e["share"] >= policy.evident_share]
     measured = set(measured_ids)
     # a component of an objective zone: one of its faces faces the zone (a partition's either side)
     facing = {i for zone in zones for i in building.facing(zone)}
     unsensed = [c.name for c in building.components if facing & set(c.node_ids) and not measured & set(c.node_ids)]
     for name in dict.fromkeys(ranked + unsensed):
-        pairs += component_effects(building, name)
+        pairs += component_effects(building, name, policy)
     return list(dict.fromkeys(pairs))
 
 
@@ -95,13 +95,13 @@ def house_effects(building, zone):
     return pairs
 
 
-def component_effects(building, name):
+def component_effects(building, name, policy):
     """The effects of one component: those whose target it is (a ground coupling under an
     adiabatic face, its outside absorptance, its conductivity, a glazing's transmittance), and
-    a glazing's transmittance where the component receives its sun."""
+    a glazing's transmittance where the component receives its sun; no shape (`policy.shapes`)."""
     nodes = set(building.component(name).node_ids)
     components = {c.name for c in building.components}
-    return [(effect.id, target) for effect in EFFECTS.values() if not POLICY.is_shape(effect.id)
+    return [(effect.id, target) for effect in EFFECTS.values() if not policy.is_shape(effect.id)
             for target in effect.targets(building) if target in components
             and (target == name or nodes & set(effect.points_at(building, target)))]
 

@@ -53,7 +53,7 @@ from nodeforce import lifetime
 from nodeforce.cluster import Cluster
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
-from nodeforce.diagnosis.assess import assess, protocols
+from nodeforce.diagnosis.assess import RoundInputs, assess, protocols
 from nodeforce.diagnosis.calibrate import Candidate
 from nodeforce.diagnosis.candidates import physical, shaped_inputs, shapes
 from nodeforce.diagnosis.compare import compare
@@ -61,9 +61,9 @@ from nodeforce.diagnosis.loss import heat_loss
 from nodeforce.diagnosis.report import write_report
 from nodeforce.diagnosis.phases import phase_errors, worsened
 from nodeforce.diagnosis.residuals import diagnostics as residual_diagnostics
-from nodeforce.diagnosis.policy import POLICY
-from nodeforce.diagnosis.result import (CrossValidation, Diagnosis, Fit, LaterRecord, OwnSensors, RecordOutcome,
-                                        SensorEvidence, added_effects, last_change)
+from nodeforce.diagnosis.policy import Policy
+from nodeforce.diagnosis.result import (Baseline, CrossValidation, Diagnosis, Fit, LaterRecord, OwnSensors,
+                                        RecordOutcome, SensorEvidence, added_effects, last_change)
 from nodeforce.diagnosis.selection import decide, revisited
 from nodeforce.diagnosis.sensitivity import sensitivity
 from nodeforce.diagnosis.windows import Record, Windows, period
@@ -108,21 +108,19 @@ class Model:
         return Model(building, runs, windows.metrics(objective, runs), bases)
 
 
-def assess_all(model, pairs, windows, objective, sigma, folder, seed, runner, beside=(), held=None):
-    """Each (effect, target) added to `model`, calibrated on every record's calibration window
-    (t_0..t_k) with a fold per block, and run over each record, where `runner` runs tasks (this
-    process, `lifetime.InProcess`; the command's `lifetime.Workers`; a Dask
-    `nodeforce.cluster.Cluster`'s workers), each candidate's building file written in
-    `folder`: their `Assessed`, in the order of `pairs`. `sigma`: the sensors' noise (C),
-    against which a component's own nodes are weighed in its fit (`calibrate.own_weights`).
-    `beside`: effects `model` holds ((effect, target)) refitted together with each candidate,
-    those of their parameters `held` ({label: names}) kept as they are (`calibrate.Candidate`)."""
-    shared = (model.building, model.bases, windows.calibrations, windows.cases, objective, windows.blocks,
-              windows.sensors, windows.calibration_numerical(), windows.calibration_numerical(sensors=True), sigma,
-              seed, tuple(beside), held or {})
+def assess_all(inputs, pairs, folder, runner):
+    """Each (effect, target) added to the model of the round's `inputs` (`assess.RoundInputs`),
+    calibrated on every record's calibration window (t_0..t_k) with a fold per block, and run
+    over each record, where `runner` runs tasks (this process, `lifetime.InProcess`; the
+    command's `lifetime.Workers`; a Dask `nodeforce.cluster.Cluster`'s workers), each
+    candidate's building file written in `folder`: their `Assessed`, in the order of `pairs`.
+    The inputs' `sigma`, the sensors' noise (C), is what a component's own nodes are weighed
+    against in its fit (`calibrate.own_weights`); their `beside`, the effects the model holds
+    refitted together with each candidate, those of their parameters `held` kept as they are
+    (`calibrate.Candidate`)."""
     with tqdm(total=len(pairs), desc="calibrating candidate effects", unit="candidate",
               disable=not sys.stderr.isatty()) as bar:
-        assessed = runner.map_shared(assess, shared, pairs, done=bar.update)
+        assessed = runner.map_shared(assess, inputs, pairs, done=bar.update)
     for (effect, target), a in zip(pairs, assessed):
         (folder / f"{effect}@{target}.json").write_text(json.dumps(a.building, indent=2) + "\n")
     return list(assessed)
@@ -142,7 +140,7 @@ def fits_of(model, base, pairs, assessed, windows, objective, sigma, number=1, o
     for (effect, target), a in zip(pairs, assessed):
         metrics = windows.metrics(objective, a.runs)
         sensor_blocks, sensor_residuals, readings, counted = windows.sensor_scores(a.sensed, weights)
-        physics = POLICY.facts(model.building, effect, target, sensed)
+        physics = windows.policy.facts(model.building, effect, target, sensed)
         fit = Fit(effect, target, a.parameters, a.determined, physics,
                   CrossValidation([float(np.nansum(np.square(f["residuals"]))) for f in a.folds], n,
                                   [f["values"] for f in a.folds],
@@ -172,7 +170,7 @@ def own_sensors(building, component, windows, base, sensed):
 
 def diagnose(building, records, objective, workdir, *, source="measurements", fraction=0.6, calibration_end=None,
              seed=0, workers=None, scheduler=None, population=30, generations=400, fmu_kind="python",
-             search_fmu="auto", reference=None, noise=None, phases=None, later=()):
+             search_fmu="auto", reference=None, noise=None, phases=None, later=(), policy=None):
     """Run the whole loop, its stages in order (`prepare`, `localise`, `rounds`, `write`); write the
     artifacts in `workdir`; return the `Diagnosis` (report.json is its `to_json()`).
 
@@ -191,7 +189,9 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
     `workers` processes; an unreachable one is an InputError before any work.
     `later`: `Record`s of the same building under the building file's protocol, read from their
     files (`nodeforce.read_record`), which nothing but the final comparison reads (`scored_later`):
-    no fit, no choice, no cross-validation."""
+    no fit, no choice, no cross-validation. `policy`: the `diagnosis.policy.Policy` every choice
+    is made under (default `Policy()`), recorded in report.json."""
+    policy = Policy() if policy is None else policy
     if not isinstance(records, (list, tuple)):
         records = [Record(records, source, source, fraction, calibration_end, tuple(phases or ()))]
     names = [r.name for r in [*records, *later]]
@@ -209,7 +209,7 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
     count = workers or os.cpu_count()
     with Cluster(scheduler) if scheduler is not None else \
             lifetime.worker_pool(count) if count > 1 else nullcontext(lifetime.InProcess()) as runner:
-        prepared = prepare(building, records, bases, objective, workdir, fmu_kind, noise)
+        prepared = prepare(building, records, bases, objective, workdir, fmu_kind, noise, policy)
         search = dict(seed=seed, workers=runner, population=population, generations=generations,
                       fmu_kind=search_fmu, noise=prepared.noise.sigma if prepared.noise.given else None)
         located = localise(building, prepared, objective, workdir, search)
@@ -230,6 +230,11 @@ class Prepared:
     noise: Noise
     n: int
     fmu: Path | None = None  # the building's own FMU (model_before.fmu), where a record is under its protocol
+
+    @property
+    def policy(self):
+        """The `diagnosis.policy.Policy` every choice is made under (the windows')."""
+        return self.windows.policy
 
 
 @dataclass
@@ -259,12 +264,12 @@ class Made:
         return added_effects(self.decisions)
 
 
-def prepare(building, records, bases, objective, workdir, fmu_kind, noise):
-    """Stage 1: the records' windows; the building as described (each record's protocol's,
-    `bases`: `protocol` of each record) built as an FMU and run over each record
-    (`model_before.fmu`); the file's own numerical error beside it; the noise (C), `noise` if the
-    user gave it."""
-    windows = Windows.of(records, objective)
+def prepare(building, records, bases, objective, workdir, fmu_kind, noise, policy):
+    """Stage 1: the records' windows, judged under `policy`; the building as described (each
+    record's protocol's, `bases`: `protocol` of each record) built as an FMU and run over each
+    record (`model_before.fmu`); the file's own numerical error beside it; the noise (C), `noise`
+    if the user gave it."""
+    windows = Windows.of(records, objective, policy)
     before_runs, fmus = [], {}  # {the record's protocol's index, None for the building's own: its FMU}
     for i, (case, base) in enumerate(zip(windows.cases, bases)):
         key = None if base is None else i
@@ -298,17 +303,17 @@ def localise(building, prepared, objective, workdir, search):
 
 
 def rounds(prepared, localization, objective, workdir, seed, runner=lifetime.InProcess()):
-    """Stage 3: rounds of candidates, `POLICY.max_rounds` at most, each on top of the last,
+    """Stage 3: rounds of candidates, `Policy.max_rounds` at most, each on top of the last,
     while the error left is above the noise and one is chosen (`selection.decide`); the
     candidates where `runner` runs tasks, which ran the forcing search (`assess_all`)."""
-    windows, n, noise = prepared.windows, prepared.n, prepared.noise
+    windows, n, noise, policy = prepared.windows, prepared.n, prepared.noise, prepared.policy
     folder = workdir / "candidates"
     folder.mkdir(exist_ok=True)
     measured_ids = sorted({i for case in windows.cases for i in case.measured_ids})
     model, decisions, results, runs, sensitivities = prepared.model, [], [], {}, {}
-    for number in range(POLICY.max_rounds):
+    for number in range(policy.max_rounds):
         base_blocks = windows.block_J(model.runs)
-        air_at_noise = bool(number) and POLICY.at_noise(base_blocks.sum(), n, noise.floor_sd)
+        air_at_noise = bool(number) and policy.at_noise(base_blocks.sum(), n, noise.floor_sd)
         base_sensed = windows.sensed_by(model)  # the round's model at the other sensors: one run per record
         if air_at_noise and not windows.disagreeing(model.building, base_sensed, noise.sigma):
             break  # the error left is the noise's, at the air and at every component's own sensors
@@ -318,25 +323,25 @@ def rounds(prepared, localization, objective, workdir, seed, runner=lifetime.InP
         into = folder / f"round{number + 1}" if number else folder
         into.mkdir(exist_ok=True)
         pairs = [p for p in physical(model.building, localization["components"], objective.zones,
-                                     measured_ids, localization["best_nodes"]) if "@".join(p) not in done]
-        assessed = assess_all(model, pairs, windows, objective, noise.sigma, into, seed, runner)
+                                     measured_ids, policy, localization["best_nodes"]) if "@".join(p) not in done]
+        inputs = RoundInputs.of(model, windows, objective, noise.sigma, seed)
+        assessed = assess_all(inputs, pairs, into, runner)
         tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma, number + 1,
                                 done)
         # shapes only where no physical candidate physics admits brings the error left to the
         # noise; the residual's statistics then choose which
-        if not any(POLICY.at_noise(r.cv.J, n, noise.floor_sd) and not POLICY.objection_of(
+        if not any(policy.at_noise(r.cv.J, n, noise.floor_sd) and not policy.objection_of(
                 r.effect, r.parameters, r.derived, r.physics) for r in tried):
             more = [p for p in shapes(model.building, left_by(windows, model), objective.zones)
                     if "@".join(p) not in done]
-            pairs, assessed = pairs + more, assessed + assess_all(model, more, windows, objective, noise.sigma,
-                                                                  into, seed, runner)
+            pairs, assessed = pairs + more, assessed + assess_all(inputs, more, into, runner)
             # every sensor's weight from the least misfit any candidate of the round leaves
             tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma,
                                     number + 1, done)
         simulations = sum(a.simulations for a in assessed)
         # a round run for a component's own sensors alone: only they can make a candidate pass
-        decision = decide(tried, base_blocks, noise.sigma, n, windows.groups(), noise.floor_sd,
-                          air_at_noise=air_at_noise)
+        decision = decide(tried, Baseline(base_blocks, noise.sigma, n, windows.groups(), noise.floor_sd,
+                                          air_at_noise=air_at_noise), policy)
         decision.cost = {"candidates": len(tried), "simulations": simulations,
                          "seconds": round(time.perf_counter() - started, 1)}
         decisions.append(decision)
@@ -369,7 +374,7 @@ def revisit(prepared, made, fit, objective, folder, seed, runner):
     effects would keep the share of the revisited one they took on top of it; refitted
     together, each candidate is judged as the rounds judge, the model around it fitted anew.
     The last round's choice is not revisited: the earlier ones were refitted with it."""
-    windows, n, noise = prepared.windows, prepared.n, prepared.noise
+    windows, n, noise, policy = prepared.windows, prepared.n, prepared.noise, prepared.policy
     number = len(made.decisions) + 1
     others = [a for a in made.added if a.label != fit.label]
     model = made.model.without(fit.effect, fit.target, prepared.model, windows, objective)
@@ -377,18 +382,19 @@ def revisit(prepared, made, fit, objective, folder, seed, runner):
     tried_in = {r.label: r for r in made.results if r.round == chosen_in.chosen.round}
     nearest = sorted((v.evidence, label) for label, v in chosen_in.verdicts.items()
                      if v.passes and not v.objection and label in tried_in and label not in {a.label for a in others})
-    labels = [fit.label] + [label for _, label in nearest if label != fit.label][:POLICY.revisited - 1]
+    labels = [fit.label] + [label for _, label in nearest if label != fit.label][:policy.revisited - 1]
     pairs = [(tried_in[label].effect, tried_in[label].target) for label in labels]
     started = time.perf_counter()
     into = folder / f"revisit{number}"
     into.mkdir(exist_ok=True)
     base_sensed = windows.sensed_by(model)
-    assessed = assess_all(model, pairs, windows, objective, noise.sigma, into, seed, runner,
-                          [(a.effect, a.target) for a in others],
-                          {a.label: [name for name, p in a.parameters.items() if p.get("prior")] for a in others})
+    inputs = RoundInputs.of(model, windows, objective, noise.sigma, seed, [(a.effect, a.target) for a in others],
+                            {a.label: [name for name, p in a.parameters.items() if p.get("prior")] for a in others})
+    assessed = assess_all(inputs, pairs, into, runner)
     tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma, number,
                             [a.label for a in others])
-    decision = decide(tried, windows.block_J(model.runs), noise.sigma, n, windows.groups(), noise.floor_sd)
+    decision = decide(tried, Baseline(windows.block_J(model.runs), noise.sigma, n, windows.groups(), noise.floor_sd),
+                      policy)
     chosen = decision.chosen
     decision = revisited(decision, fit.label, [a.label for a in others],
                          chosen and assessed[[t.label for t in tried].index(chosen.label)].beside)
@@ -461,7 +467,7 @@ def write(building, prepared, located, made, objective, workdir, fmu_kind, refer
         after=model.metrics, localization=located.localization, candidates=made.results, rounds=made.decisions,
         structure_left=left_by(windows, model)["sentence"],
         heat_loss=heat_loss(building, model.building, added, made.results, prepared.noise.sigma,
-                            last_change(made.decisions)),
+                            prepared.policy.yardstick, last_change(made.decisions)),
         residuals=validation_residuals(prepared, made), sensitivity=made.sensitivities, noise=prepared.noise,
         assumptions=list(dict.fromkeys(a for case in windows.cases for a in case.assumptions)),
         node_names={str(i): name for i, name in building.node_names().items()},
@@ -472,7 +478,7 @@ def write(building, prepared, located, made, objective, workdir, fmu_kind, refer
                                str(protocols_after[i]) if i in protocols_after else None)
                  for i, r in enumerate(records)] if len(records) > 1 else [],
         worsened_phases=worsened(by_phase, "before", "after") if by_phase and added else None,
-        phases=by_phase or None, reference=reference or None, later=later)
+        phases=by_phase or None, reference=reference or None, later=later, policy=prepared.policy)
     idf = idf_of(building)
     if idf is not None:  # a converted EnergyPlus model: its corrections written back into it
         diagnosis.energyplus = write_corrections(building, model.building, [(a.effect, a.target) for a in added],

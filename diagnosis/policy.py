@@ -1,5 +1,5 @@
 """How the diagnosis chooses an effect: every threshold, table and order of the choice, in one
-frozen object (`POLICY`), read by the rest of the loop and by nothing else re-derived.
+frozen object (`Policy`), passed in and recorded in report.json.
 
 The choice of a round, in order (docs/method.md, "Choosing an effect"; `diagnosis.selection.decide`):
 
@@ -24,7 +24,7 @@ there), and a candidate passes. The yardsticks say their units: `noise_J` and `n
 the sd they are computed from (`model.score.Noise.floor_sd`) is in C.
 """
 import math
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field, fields
 from types import MappingProxyType
 
 import numpy as np
@@ -130,6 +130,55 @@ class Policy:
     # far worse would need it to be most of the fault. With two faults, the effect that took a
     # share of both and the one it displaced lead their round.
     revisited: int = 5
+
+    # ---- as report.json records it
+    def to_json(self):
+        """Every value of the policy as JSON (an unbounded limit as null): report.json keeps it,
+        so that a replay (`diagnosis.result.Diagnosis.replay`) judges under the values the
+        diagnosis was made with, whatever the code's defaults have become since."""
+        def bound(v):
+            return None if math.isinf(v) else v
+        out = {}
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if f.name == "yardstick":
+                value = asdict(value)
+            elif f.name == "physical_limits":
+                value = [[effect, name, bound(low), bound(high)] for (effect, name), (low, high) in value.items()]
+            elif isinstance(value, MappingProxyType):
+                value = {k: list(v) for k, v in value.items()}
+            elif isinstance(value, tuple):
+                value = list(value)
+            out[f.name] = value
+        return out
+
+    @classmethod
+    def of_json(cls, d):
+        """The policy `to_json` wrote; a value it does not hold (a report of a policy with fewer
+        values) is the default."""
+        def tupled(v):
+            return tuple(tupled(x) for x in v) if isinstance(v, list) else v
+        given = {}
+        for f in fields(cls):
+            if f.name not in d:
+                continue
+            value = d[f.name]
+            if f.name == "yardstick":
+                value = Yardstick(**value)
+            elif f.name == "physical_limits":
+                value = MappingProxyType({(effect, name): (-math.inf if low is None else low,
+                                                           math.inf if high is None else high)
+                                          for effect, name, low, high in value})
+            elif isinstance(value, dict):
+                value = MappingProxyType({k: tupled(v) for k, v in value.items()})
+            elif isinstance(value, list):
+                value = tupled(value)
+            given[f.name] = value
+        return cls(**given)
+
+    def __reduce__(self):
+        # a read-only mapping does not pickle: a policy goes to the workers as its JSON
+        return (Policy.of_json, (self.to_json(),))
 
     # ---- the yardsticks (`model.score.Yardstick`)
     @property
@@ -257,6 +306,3 @@ def implausible(building, effect, target):
         return (f"{target} is declared unoccupied: the gain stands for a heat source the model lacks "
                 "(a heat input mis-measured, a flow of air or sun not modelled), not for occupants")
     return None
-
-
-POLICY = Policy()

@@ -8,7 +8,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from nodeforce.diagnosis.assess import columns_among
-from nodeforce.diagnosis.policy import POLICY
 from nodeforce.diagnosis.selection import block_J, blocks as blocks_of, on_block
 from nodeforce.model.case import measured_case
 from nodeforce.model.errors import InputError
@@ -74,7 +73,7 @@ class Windows:
     cross-validation blocks of all records in order, (record index, mask), and each one's other
     sensed nodes (`sensors`: the measured nodes besides the objective air, a wall's surface, a
     neighbouring zone's air) with their measurements (`sensed`, (N_t, len(sensors)), NaN where
-    not scored)."""
+    not scored), and the `diagnosis.policy.Policy` the scores on them are judged by."""
     records: list
     cases: list
     ks: list
@@ -83,11 +82,12 @@ class Windows:
     blocks: list
     sensors: list
     sensed: list
+    policy: object
     numerical: list = None
     sensor_numerical: list = None
 
     @classmethod
-    def of(cls, records, objective):
+    def of(cls, records, objective, policy):
         cases, ks, calibrations, measured, blocks, sensors, sensed = [], [], [], [], [], [], []
         for i, record in enumerate(records):
             # what no sensor sets (every wall of an air-only record) starts from the steady state of
@@ -99,10 +99,10 @@ class Windows:
             ks.append(k)
             calibrations.append(case.window(0, k))
             measured.append(objective.measured(case))
-            blocks += [(i, m) for m in blocks_of(k, case.burn_in_steps, case.dt, record.source)]
+            blocks += [(i, m) for m in blocks_of(k, case.burn_in_steps, case.dt, policy, record.source)]
             sensors.append([node for node in case.measured_ids if node not in objective.air_nodes])
             sensed.append(case.scored([node - 1 for node in sensors[-1]]))
-        return cls(list(records), cases, ks, calibrations, measured, blocks, sensors, sensed)
+        return cls(list(records), cases, ks, calibrations, measured, blocks, sensors, sensed, policy)
 
     def metrics(self, objective, runs, record=None):
         """{"calibration", "validation"}: the objective's metrics of `runs` (one (N_t, zones) per
@@ -179,7 +179,7 @@ class Windows:
                 out.append(np.zeros(0))
                 continue
             misfit = np.min([np.nanmean(np.square(self.sensed[i][:k] - run[i][:k]), axis=0) for run in runs], axis=0)
-            out.append(POLICY.sensor_weight(sigma, np.maximum(misfit, np.finfo(float).tiny)))
+            out.append(self.policy.sensor_weight(sigma, np.maximum(misfit, np.finfo(float).tiny)))
         return out
 
     def own_columns(self, nodes):
@@ -214,7 +214,7 @@ class Windows:
             if not any(columns):
                 continue
             J, n = self.own_J(sensed, columns)
-            if n and not POLICY.at_noise(float(J.sum()), n, math.hypot(sigma, self.own_numerical(columns))):
+            if n and not self.policy.at_noise(float(J.sum()), n, math.hypot(sigma, self.own_numerical(columns))):
                 out.append(c.name)
         return out
 

@@ -391,7 +391,7 @@ def locate(building, case, objective=None, workdir=None, source=SOURCE, **search
 
 def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibration_end=None, phases=(), seed=0,
              workers=None, scheduler=None, fmu_kind="python", search_fmu="auto", noise=None, reference=None,
-             population=30, generations=400, later=()):
+             population=30, generations=400, later=(), policy=None):
     """The whole loop of `nodeforce diagnose`; writes its files in `workdir` (docs/guide.md, Output
     files) and returns the `Diagnosis`: `summary()` the first screen, `to_json()` report.json's
     content, `added` the effects added, `rounds` each round's decision, `candidates` every fit.
@@ -445,6 +445,9 @@ def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibrati
         diagnosis's burn-in), which no fit, choice or cross-validation reads: after the rounds the
         building as written and as corrected are scored on each as `compare` scores them
         (`Diagnosis.later`, report.json's `later`, a line of the first screen).
+    policy : Policy, optional
+        Every threshold, table and order of the choice (`nodeforce.diagnosis.policy.Policy`),
+        default `Policy()`; report.json records it, and `Diagnosis.replay` judges under it.
 
     Returns
     -------
@@ -456,7 +459,7 @@ def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibrati
                              fraction=fraction, calibration_end=calibration_end, phases=phases, seed=seed,
                              workers=workers, scheduler=scheduler, fmu_kind=fmu_kind, search_fmu=search_fmu,
                              noise=noise, reference=reference, population=population, generations=generations,
-                             later=list(later))
+                             later=list(later), policy=policy)
 
 
 def compare(models, workdir=None, phases=(), fmu_kind="python"):

@@ -6,6 +6,7 @@ import pandas as pd
 import pytest
 
 from nodeforce.diagnosis.loop import diagnose
+from nodeforce.diagnosis.policy import Policy
 from nodeforce.diagnosis.windows import Record
 from nodeforce.diagnosis.selection import harmed
 from nodeforce.model.building_file import parse_building
@@ -56,11 +57,11 @@ def test_harm_is_a_fall_below_minus_the_rules_yardstick_on_one_records_blocks():
     base = [10.0, 10.0, 10.0, 5.0, 5.0]
     scores = [6.0, 6.0, 6.0, 8.0, 8.0]
     groups = [{"record": "a", "blocks": [0, 1, 2], "n": 144}, {"record": "b", "blocks": [3, 4], "n": 96}]
-    harms = harmed(base, scores, 0.01, groups)
+    harms = harmed(base, scores, 0.01, groups, Policy())
     assert [h["record"] for h in harms] == ["b"]
     assert harms[0]["cv_fall"] == pytest.approx(-6.0)
     # within the noise: a rise of 0.001 C2 on b is no harm
-    assert harmed(base, [6.0, 6.0, 6.0, 5.0005, 5.0005], 0.01, groups) == []
+    assert harmed(base, [6.0, 6.0, 6.0, 5.0005, 5.0005], 0.01, groups, Policy()) == []
 
 
 @pytest.mark.slow  # a diagnosis of two records
