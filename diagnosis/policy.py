@@ -1,27 +1,9 @@
-"""How the diagnosis chooses an effect: every threshold, table and order of the choice, in one
-frozen object (`Policy`), passed in and recorded in report.json.
-
-The choice of a round, in order (docs/method.md, "Choosing an effect"; `diagnosis.selection.decide`):
-
-1. Pass. A candidate's cross-validated fall of J (C2, whole days as blocks, at least
-   `min_blocks`) must beat `least_fall`, what noise alone could make of J, and
-   `standard_errors` standard errors of its day-to-day scatter, on more days than its best.
-2. Objections. Physics may refuse a candidate that passes (`objection`): a gain the file's
-   description rules out, a parameter on a bound or not identifiable (`identifiable`, unless the
-   quantity its parameters trade off along is: `trade_offs`), a value beyond `physical_limits`
-   or `room_convection` by more than `limit_sds` of its standard deviations.
-3. The band. Among the admissible, those whose evidence (the air left out and the other
-   sensors, each weighted by `sensor_weight`) exceeds the best's by no more than
-   `standard_errors` standard errors of the paired difference (at least `rounding_share` of J),
-   and by no more than `noise_change` where the best claims more, cannot be told from it.
-4. The order. Within the band the one that claims least is chosen (`claim`): a physical effect
-   before a shape (`shapes`), fewer parameters before more, a zone's effect before that of one
-   component no sensor of which is measured; then the lower evidence.
-
-Rounds go on, `max_rounds` at most, while the error left is above the noise (`at_noise`), at
-the objective air or at a component's own sensors (the noise and the file's numerical error
-there), and a candidate passes. The yardsticks say their units: `noise_J` and `noise_change` are J (C2);
-the sd they are computed from (`model.score.Noise.floor_sd`) is in C.
+"""Every threshold, table and order of the diagnosis' choice, in one frozen object (`Policy`),
+passed to the loop (`diagnosis.loop.diagnose`'s `policy`) and recorded in report.json
+(`Policy.to_json`), so that `diagnosis.result.Diagnosis.replay` judges a report under the values
+it was made with. Each field says what it sets and in which unit; how the choice uses them, step
+by step: docs/method.md, "Choosing an effect". The noise's yardstick and the pass rule are
+`model.score.Yardstick` (`Policy.yardstick`), which the forcing search reads too.
 """
 import math
 from dataclasses import asdict, dataclass, field, fields

@@ -1,73 +1,9 @@
-"""The one rule that chooses an effect: blocked cross-validation over whole days.
-
-The calibration window's scored steps (after the burn-in) are cut into blocks of whole days
-(`blocks`). Each candidate is fitted on all blocks but one and scored on the block left out, every
-block in turn (`diagnosis.calibrate`): the simulation runs through the whole window, the left-out
-block's residuals are only left out of the least squares, so every block is predicted from the
-state the days before it left, as the validation window is. A day is the unit because a
-building's residual is correlated over hours and repeats with the sun: within a day, steps are
-not independent pieces of evidence, and days nearly are.
-
-`decide` judges each candidate by its fall of cross-validated J from the model it would be added
-to, block by block:
-
-1. It passes when that fall beats what noise alone gives, the change of J the sensors' noise
-   could make (`diagnosis.policy.Policy.least_fall`), and what the days' disagreement gives: one standard
-   error of the fall computed from the per-block falls, blocks as the unit, so that residuals
-   correlated within a day cannot fake significance; and when it does not come from one day
-   alone (the other days together must gain too). A calibration window holds two to five days:
-   a Student t quantile on B - 1 degrees of freedom (6.3 for two days, 2.9 for three) would ask
-   the falls to be nearly equal from day to day, while a real effect's size follows the weather
-   (a ground coupling's drift shows on some days and hardly on others); the sensor noise is
-   judged by its own yardstick instead, and the days by their consistency.
-2. Physics may still refuse it (`diagnosis.policy.Policy.objection`: a gain in a zone declared
-   unoccupied, a parameter on its bound or not identifiable, a negative gain): then it is a
-   suggestion, with its reason, never added.
-3. Among the admissible candidates that pass, the one-standard-error rule on every temperature
-   the candidate predicts and no fit read (`evidence`): the objective air on the blocks left out,
-   and the other sensors (a wall's surface, a neighbouring zone's air) over the same blocks,
-   since the fits read the air alone. Look-alikes that predict nearly the same air (an air
-   change, a bridge, an envelope factor and inside convection in a mild month; a ground coupling
-   and inside convection) predict different surfaces: inside convection moves every surface
-   from the air, an envelope factor the walls' inner faces, an air change neither, a ground
-   coupling the floor. Where sensors besides the air are measured, they are the evidence that
-   tells such corrections apart; the air alone would leave them to the noise. Each sensor counts
-   as a measurement whose error is what the model already misses there, sigma^2 over its mean
-   squared residual (at most 1): a surface the model cannot follow does not choose for the air.
-   The candidates whose evidence exceeds the best's by no more than one standard error of that
-   paired difference cannot be told apart from it, and among them a physical effect before a shape,
-   then fewer parameters before more, then a zone's effect before that of a component no sensor of
-   which is measured, then the lower evidence. A component's correction says where the fault is;
-   where the zone's own (its envelope, its air change) predicts as well and nothing but the air
-   speaks for the place, the data have not placed it there, and the components are named beside
-   the zone's effect instead (an air-only record cannot tell its walls apart); where the
-   component's own sensor is in the evidence, the lower evidence chooses. That
-   standard error is the larger of two: the difference's scatter from block to block, and what the
-   sensors' noise alone makes of it (`noise_difference`); against a candidate that claims less
-   (a physical effect against a shape, fewer parameters, the zone's own effect against one
-   component's), a candidate must also gain beyond the noise's tolerance of J, as any candidate
-   must against the model (`parsimony`). Two corrections that predict nearly the same temperatures
-   differ by nearly the same small amount every day, so the blocks' scatter is tiny; yet another draw
-   of the noise would move that difference by 2 sigma |r_a - r_b|, and reverse it where it is
-   smaller. Components whose corrections cannot be told apart are named together in the reason.
-   Whether a candidate passes (1.) reads the air, the objective: the other sensors judge
-   between explanations of the air, never whether it needs one; except a component's own
-   sensors (`own_test`): a component whose correction, its surface on each day predicted by
-   the fit without that day (`calibrate.Own`), brings that surface to the noise and the file's
-   numerical error there, by a fall beyond what they could make, and leaves the air no worse
-   than the noise's margin, passes too. The paper's method places a fault by forcing the
-   sub-model's measured nodes; a second fault the air no longer points at (the first effect
-   brought it to the noise) is still placed by the component's own sensor.
-
-The validation window plays no part. A model built by earlier rounds is the baseline a later
-round's candidate must pass against (its parameters held).
-
-Several records of one building add their days to the blocks and their residuals to the sums;
-nothing above depends on the blocks coming from one record. One objection is theirs: a candidate
-that helps the records together but harms one of them, its cross-validated fall on that record's
-blocks below minus the same yardstick (the noise's tolerance of that record's J, and one standard
-error of that record's per-block falls), is a correction of the house that does not hold on every
-record of it: it is refused, with the record named (`harmed`).
+"""The choice of one round (`decide`): which candidates pass, which physics refuses, the band of
+those the data cannot tell from the best, and the one of it that claims least; the
+cross-validation blocks of whole days it reads (`blocks`), the records a candidate harms
+(`harmed`), and the decision in words. Why it is made so, step by step: docs/method.md,
+"Choosing an effect"; the formulas: docs/model.md 6.6. Every threshold is the `Policy` passed in
+(`diagnosis.policy`); the pass rule and the noise's yardstick are `model.score.Yardstick`'s.
 """
 import math
 
