@@ -49,8 +49,8 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from nodeforce import lifetime
-from nodeforce.cluster import Cluster
+from nodeforce.runtime import lifetime
+from nodeforce.runtime.cluster import Cluster
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnosis.assess import RoundInputs, assess, protocols
@@ -112,7 +112,7 @@ def assess_all(inputs, pairs, folder, runner):
     """Each (effect, target) added to the model of the round's `inputs` (`assess.RoundInputs`),
     calibrated on every record's calibration window (t_0..t_k) with a fold per block, and run
     over each record, where `runner` runs tasks (this process, `lifetime.InProcess`; the
-    command's `lifetime.Workers`; a Dask `nodeforce.cluster.Cluster`'s workers), each
+    command's `lifetime.Workers`; a Dask `runtime.cluster.Cluster`'s workers), each
     candidate's building file written in `folder`: their `Assessed`, in the order of `pairs`.
     The inputs' `sigma`, the sensors' noise (C), is what a component's own nodes are weighed
     against in its fit (`calibrate.own_weights`); their `beside`, the effects the model holds
@@ -185,7 +185,7 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
     (`fmu_build.build.build_fmu`'s kinds, or "auto", `ga.locate.evaluator_kind`); `search_fmu`:
     the FMUs the forcing search drives (`ga.locate.locate`'s `fmu_kind`; "auto": the standalone
     where it can run the building). `scheduler` ("tcp://host:port"): the forcing search and every
-    round's candidates run on that Dask cluster's workers (`nodeforce.cluster`) instead of
+    round's candidates run on that Dask cluster's workers (`runtime.cluster`) instead of
     `workers` processes; an unreachable one is an InputError before any work.
     `later`: `Record`s of the same building under the building file's protocol, read from their
     files (`nodeforce.read_record`), which nothing but the final comparison reads (`scored_later`):

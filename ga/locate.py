@@ -13,7 +13,7 @@ from scipy.sparse.csgraph import shortest_path
 
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.checkpoint import NAME as CHECKPOINT
-from nodeforce.model.compiled import find_compiler
+from nodeforce.runtime.compiler import find_compiler
 from nodeforce.ga.fitness import FmuFitness, RecordsFitness
 from nodeforce.ga.parsimony import EXPLAINED
 from nodeforce.ga.search import PATIENCE, search

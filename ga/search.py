@@ -72,7 +72,7 @@ def search(factory, chromosome_nodes, *, population=30, generations=400, pc=0.8,
         docstring); False: a random initial population (the paper).  PAPER = both off.
     workers: processes evaluating in parallel (default os.cpu_count(); 1 = in this process), or
         where a command runs its tasks (`lifetime.InProcess`, `lifetime.Workers`, a
-        `nodeforce.cluster.Cluster`), which its later stages use too.
+        `runtime.cluster.Cluster`), which its later stages use too.
     scheduler: a dask.distributed scheduler address ("tcp://host:port"); replaces `workers`.
     checkpoint: a file path; the state is written there after every generation, and a run
         started again with the same arguments resumes from it (other arguments: ignored).

@@ -9,13 +9,21 @@ The Python API (`nodeforce.api`, docs/api.md) is available here: `nodeforce.read
 import importlib
 import importlib.util
 
+# The runtime plumbing's modules by the names they had in this package before it moved to
+# `nodeforce.runtime`, for pages that still give them (docs/performance.md): attributes only, no
+# module of nodeforce imports them so (tests/test_imports.py).
+MOVED = {"tempdirs": "nodeforce.runtime.tempdirs", "lifetime": "nodeforce.runtime.lifetime",
+         "cluster": "nodeforce.runtime.cluster"}
+
 
 def __getattr__(name):
     if not name.startswith("__"):
-        # `from nodeforce import tempdirs` asks for the attribute before importing the submodule:
+        # `from nodeforce import model` asks for the attribute before importing the subpackage:
         # a submodule is imported as such, not looked for in the API (which may be importing it).
         if importlib.util.find_spec(f"{__name__}.{name}") is not None:
             return importlib.import_module(f"{__name__}.{name}")
+        if name in MOVED:
+            return importlib.import_module(MOVED[name])
         api = importlib.import_module("nodeforce.api")
         if name in api.__all__:
             return getattr(api, name)

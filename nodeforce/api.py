@@ -9,7 +9,7 @@ command line prints.
 from contextlib import contextmanager
 from pathlib import Path
 
-from nodeforce import tempdirs
+from nodeforce.runtime import tempdirs
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import input_table, simulate_fmu
 from nodeforce.diagnosis import windows as _windows
@@ -420,7 +420,7 @@ def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibrati
         A Dask scheduler's address, "tcp://host:port": the forcing search and every round's
         candidates run on its workers instead of `workers` processes (docs/performance.md). The
         answer is the same; a worker lost midway costs none; a lost scheduler raises
-        `nodeforce.lifetime.RunStopped`, an unreachable one `InputError`.
+        `runtime.lifetime.RunStopped`, an unreachable one `InputError`.
     fmu_kind : str
         The FMUs of the model before and after, run and written (`model_before.fmu`,
         `model_after.fmu`): "python" (the default, as on the command line), "standalone", or

@@ -1,6 +1,6 @@
 """The `nodeforce` command line (docs/guide.md). Bad input: one line on stderr, exit status 2; stopped
 by SIGINT, SIGTERM or a lost Dask scheduler: one line saying how to resume, 130, 143 or 75
-(nodeforce.lifetime)."""
+(runtime.lifetime)."""
 import argparse
 import json
 import sys
@@ -9,7 +9,9 @@ from pathlib import Path
 
 import numpy as np
 
-from nodeforce import api, lifetime, tempdirs
+from nodeforce import api
+
+from nodeforce.runtime import lifetime, tempdirs
 from nodeforce.ga.checkpoint import NAME as CHECKPOINT, resume_hint
 from nodeforce.ga.search import PAPER, PATIENCE
 from nodeforce.model.case import HISTORY_DAYS

@@ -1,4 +1,4 @@
-"""The diagnosis on a Dask cluster (`nodeforce.cluster`): the answer of the local run, a worker
+"""The diagnosis on a Dask cluster (`runtime.cluster`): the answer of the local run, a worker
 lost in the middle of a round costs none, a lost scheduler stops it in one line. (The forcing search's own cluster tests are in
 test_search.py and test_faults.py.)
 
@@ -11,7 +11,7 @@ import signal
 
 import pytest
 
-from nodeforce import lifetime
+from nodeforce.runtime import lifetime
 from nodeforce.diagnosis.loop import diagnose
 from nodeforce.model.building_file import load_building, parse_building
 from nodeforce.model.effects import EFFECTS

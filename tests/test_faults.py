@@ -20,7 +20,7 @@ from pathlib import Path
 
 import pytest
 
-from nodeforce import lifetime, tempdirs
+from nodeforce.runtime import lifetime, tempdirs
 from nodeforce.cli import main
 from nodeforce.ga import checkpoint as ckpt
 from nodeforce.ga.search import search

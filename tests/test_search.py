@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from nodeforce import lifetime
+from nodeforce.runtime import lifetime
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga import parsimony
 from nodeforce.model.score import Objective
