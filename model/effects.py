@@ -486,20 +486,6 @@ def structured_name(name):
     return "'" + name.replace("\\", "\\\\").replace("'", "\\'") + "'"
 
 
-def with_properties(building, values):
-    """A new Building with the properties of `values` ({FMU parameter name: value}) declared;
-    the building itself when there are none."""
-    if not values:
-        return building
-    found = {name: (p, target) for name, p, target in properties(building)}
-
-    def write(data):
-        for name, value in values.items():
-            p, target = found[name]
-            p.write(data, target, value)
-    return building.edited(write)
-
-
 def fmu_parameters(building, effect=None):
     """{name: declared value} of every parameter an FMU of the building exposes besides forcing
     and start values: its properties (`properties`), then the added effect's `<effect>.<name>`
