@@ -685,8 +685,35 @@ def fold(fit, train, lows, highs, residuals):
     return fit.x.copy()
 
 
-# The derived time constant (s) of the effects that add a node of capacity C and conductance H.
-TIME_CONSTANTS = {"internal_mass": "mass_time_constant", "heat_input_lag": "heater_time_constant"}
+class Derivation:
+    """What an effect's derived quantities read (`model.effects.Effect.derived`): the building and
+    target of the candidate, its fitted values `x` and their `bounds`, the heat loss coefficient at
+    `x` (`hlc`, W/K) and its gradient (`hlc_slope`); `nodes` and `hlc_at` simulate at other values,
+    `of` and `with_sd` give a quantity with its standard deviation by the delta method."""
+
+    def __init__(self, candidate, case, x, cov):
+        self.building, self.target, self.x, self.bounds = candidate.building, candidate.target, x, candidate.bounds
+        self._candidate, self._case = candidate, case
+        self.within = within_ranges(cov, candidate.bounds)
+        self.hlc, self.hlc_slope = gradient(self.hlc_at, x, candidate.bounds)
+
+    def hlc_at(self, values):
+        """The heat loss coefficient (W/K) of the model at `values`."""
+        return heat_loss_coefficient(*self._candidate.network(values))
+
+    def nodes(self, ids, values):
+        """The temperatures (C) of nodes `ids` simulated at `values` over the calibration window."""
+        return self._candidate.nodes(self._case, ids, values)
+
+    def with_sd(self, value, gradient, unit, cov=None):
+        """{"value", "std", "unit"}: sd^2 = g' cov g, cov the parameters' covariance combined with
+        their ranges (`within_ranges`) unless given."""
+        cov = self.within if cov is None else cov
+        return {"value": float(value), "std": float(np.sqrt(max(gradient @ cov @ gradient, 0.0))), "unit": unit}
+
+    def of(self, f, unit):
+        """`with_sd` of f(values) at `x`, its gradient by differences (`gradient`)."""
+        return self.with_sd(*gradient(f, self.x, self.bounds), unit)
 
 
 def derived(candidate, case, x, cov):
@@ -696,19 +723,16 @@ def derived(candidate, case, x, cov):
     - The heat loss coefficient of the model with the effect (docs/model.md section 8), W/K: what a
       record of the air and the heating power fixes well even where the effect's parameters, or
       the split of the loss among effects, it does not (`gradient`).
-    - A ground coupling acts through its heat flux density q = U (T_ground - T_face) (W/m2, into
-      the component), T_face the face's mean temperature simulated over the window: many (U,
-      T_ground) pairs give the same flux. g is q's gradient with the face simulated at each
-      parameter moved (`gradient`): where U is large beside the component's own conductance the
-      face follows T_ground, and holding it fixed would make a well-fixed flux look unknown.
-    - A zone's internal mass or heater node answers with its time constant tau = C / H (s): a
-      short record of the air fixes tau far better than C and H apart, which trade off along it.
-      g = (1 / H, -C / H^2).
-    - A component's conductivity factor acts through the heat the component loses (W/K): the HLC
-      with the factor less the HLC with the factor at its lower bound, where the layers pass
-      almost nothing. In series with the surface coefficients that loss saturates as the layers
-      conduct more, so a door twice as conductive as its wood and one ten times are told apart
-      by little, while the loss the data see is fixed. g is the HLC's.
+    - What its record derives (`Effect.derived`, on a `Derivation`): a ground coupling's heat flux
+      density q = U (T_ground - T_face) (W/m2), g its gradient with the face simulated at each
+      parameter moved, since where U is large beside the component's own conductance the face
+      follows T_ground, and holding it fixed would make a well-fixed flux look unknown; a zone's
+      internal mass or heater node's time constant tau = C / H (s), which a short record of the
+      air fixes far better than C and H apart, g = (1 / H, -C / H^2); a component's conductivity
+      factor's heat loss (W/K): the HLC with the factor less the HLC with the factor at its lower
+      bound, where the layers pass almost nothing. In series with the surface coefficients that
+      loss saturates as the layers conduct more, so a door twice as conductive as its wood and one
+      ten times are told apart by little, while the loss the data see is fixed; g is the HLC's.
 
     What the parameters trade off along (the flux, a time constant, a component's loss) reads
     their covariance combined with their ranges (`within_ranges`): the valley leaves it unchanged,
@@ -716,27 +740,10 @@ def derived(candidate, case, x, cov):
     covariance alone: with a ground coupling it changes along the valley (U = q / (T_ground -
     T_face), a hyperbola the range's linear extrapolation does not follow), and so is not fixed.
     """
-    within = within_ranges(cov, candidate.bounds)
-
-    def with_sd(value, gradient, unit, cov=within):
-        return {"value": float(value), "std": float(np.sqrt(max(gradient @ cov @ gradient, 0.0))), "unit": unit}
-
-    hlc, slope = gradient(lambda values: heat_loss_coefficient(*candidate.network(values)), x, candidate.bounds)
-    out = {"heat_loss_coefficient": with_sd(hlc, slope, "W/K", cov)}
-    if candidate.effect == "ground_coupling":
-        face = candidate.building.component(candidate.target).node_ids[-1]
-
-        def flux(values):
-            U, T_ground = values[:2]
-            return U * (T_ground - float(np.mean(candidate.nodes(case, [face], values))))
-        out["ground_heat_flux"] = with_sd(*gradient(flux, x, candidate.bounds), "W/m2")
-    if candidate.effect == "conductivity":
-        low = candidate.bounds[0][0]
-        out["component_loss"] = with_sd(hlc - heat_loss_coefficient(*candidate.network([low, *x[1:]])), slope, "W/K")
-    if candidate.effect in TIME_CONSTANTS:
-        C, H = x[:2]
-        out[TIME_CONSTANTS[candidate.effect]] = with_sd(C / H, np.r_[1.0 / H, -C / H ** 2, np.zeros(len(x) - 2)], "s")
-    return out
+    d = Derivation(candidate, case, x, cov)
+    out = {"heat_loss_coefficient": d.with_sd(d.hlc, d.hlc_slope, "W/K", cov)}
+    effect = EFFECTS[candidate.effect]
+    return {**out, **(effect.derived(d) if effect.derived else {})}
 
 
 def within_ranges(cov, bounds):

@@ -6,18 +6,13 @@ by step: docs/method.md, "Choosing an effect". The noise's yardstick and the pas
 `model.score.Yardstick` (`Policy.yardstick`), which the forcing search reads too.
 """
 import math
-from dataclasses import asdict, dataclass, field, fields
-from types import MappingProxyType
+from dataclasses import asdict, dataclass, fields
 
 import numpy as np
 from scipy.special import chdtrc
 
-from nodeforce.model.effects import EFFECTS, bridge_parts
+from nodeforce.model.effects import EFFECTS
 from nodeforce.model.score import Yardstick
-
-
-def _frozen(table):
-    return field(default_factory=lambda: MappingProxyType(dict(table)))
 
 
 @dataclass(frozen=True)
@@ -29,10 +24,6 @@ class Policy:
     # ... and any component whose forcing removes at least this share of J above the noise
     # (dimensionless), however far down the ranking.
     evident_share: float = 0.25
-    # The effects that stand for a heat source the model lacks rather than a property of the
-    # building: tried only where no physical effect brings the error to the noise, chosen only
-    # where none fits as well.
-    shapes: tuple = ("daily_gain", "proportional_gain")
 
     # -- 1. pass
     # Whole days a calibration window must hold for the cross-validation (days): one fold needs
@@ -55,34 +46,8 @@ class Policy:
     # (dimensionless): a door at ten times its wood's conductivity, estimated at 11.4 +- 1.5, may
     # well be at ten; only an estimate whose two-sided 95 % interval leaves the range is not.
     limit_sds: float = 2.0
-    # Physical limits (low, high) in the parameter's unit, tighter than the range a calibration
-    # explores: beyond them a value is a fit compensating something else. A gain to the air is a
-    # source (a sink would be a cooler the file declares); conductance scales within a factor of
-    # ten of the file's; a heater or meter off its reading by more than two is a fault the file
-    # should state.
-    physical_limits: MappingProxyType = _frozen({("internal_gain", "Q"): (0.0, math.inf),
-                                                 ("daily_gain", "mean"): (0.0, math.inf),
-                                                 ("conductivity", "factor"): (0.1, 10.0),
-                                                 ("envelope_conductance", "factor"): (0.1, 10.0),
-                                                 ("boundary_conductance", "factor"): (0.1, 10.0),
-                                                 ("supply_flow", "factor"): (0.1, 10.0),
-                                                 ("heat_input_factor", "factor"): (0.5, 2.0)})
-    # The area-weighted mean convective coefficient of a room's surfaces that air can give
-    # (W/m2/K): natural convection (Alamdari and Hammond) gives a still room about 0.6, forced
-    # convection at a hundred air changes an hour (Fisher and Pedersen) stays below 20. A limit
-    # on the coefficient, not the factor: a factor of 0.1 is 0.5 W/m2/K where a file declares 5.
-    room_convection: tuple = (0.5, 20.0)
-    # The parameters whose identifiability decides for an effect (default all): a daily
-    # profile's harmonics may each be near zero while its mean is determined.
-    judged: MappingProxyType = _frozen({"daily_gain": ("mean",)})
-    # What the data fix where an effect's parameters trade off (`diagnosis.calibrate.derived`),
-    # and whether a parameter on a bound is then waived: a ground coupling's (U, T_ground) is one
-    # of many pairs giving its flux, a bound included; a node's (C, H) and a conductivity factor,
-    # judged by their time constant and the heat the component loses, must still be inside.
-    trade_offs: MappingProxyType = _frozen({"ground_coupling": ("ground_heat_flux", True),
-                                            "conductivity": ("component_loss", False),
-                                            "heat_input_lag": ("heater_time_constant", False),
-                                            "internal_mass": ("mass_time_constant", False)})
+    # Each effect's physical limits, the parameters it is judged on and what its parameters trade
+    # off along are its record's (`model.effects.Effect`: `physical`, `judged`, `trade_off`).
 
     # -- priors (`diagnosis.calibrate`): where the data fix a combination of an effect's
     # parameters but not each one, a parameter with a physical prior (`model.effects.Prior`) is
@@ -115,20 +80,14 @@ class Policy:
 
     # ---- as report.json records it
     def to_json(self):
-        """Every value of the policy as JSON (an unbounded limit as null): report.json keeps it,
+        """Every value of the policy as JSON: report.json keeps it,
         so that a replay (`diagnosis.result.Diagnosis.replay`) judges under the values the
         diagnosis was made with, whatever the code's defaults have become since."""
-        def bound(v):
-            return None if math.isinf(v) else v
         out = {}
         for f in fields(self):
             value = getattr(self, f.name)
             if f.name == "yardstick":
                 value = asdict(value)
-            elif f.name == "physical_limits":
-                value = [[effect, name, bound(low), bound(high)] for (effect, name), (low, high) in value.items()]
-            elif isinstance(value, MappingProxyType):
-                value = {k: list(v) for k, v in value.items()}
             elif isinstance(value, tuple):
                 value = list(value)
             out[f.name] = value
@@ -147,20 +106,10 @@ class Policy:
             value = d[f.name]
             if f.name == "yardstick":
                 value = Yardstick(**value)
-            elif f.name == "physical_limits":
-                value = MappingProxyType({(effect, name): (-math.inf if low is None else low,
-                                                           math.inf if high is None else high)
-                                          for effect, name, low, high in value})
-            elif isinstance(value, dict):
-                value = MappingProxyType({k: tupled(v) for k, v in value.items()})
             elif isinstance(value, list):
                 value = tupled(value)
             given[f.name] = value
         return cls(**given)
-
-    def __reduce__(self):
-        # a read-only mapping does not pickle: a policy goes to the workers as its JSON
-        return (Policy.of_json, (self.to_json(),))
 
     # ---- the yardsticks (`model.score.Yardstick`)
     @property
@@ -201,35 +150,33 @@ class Policy:
 
     # ---- 2. objections
     def is_shape(self, effect):
-        return effect in self.shapes
+        """Whether an effect stands for a heat source the model lacks (its record's `shape`)."""
+        return EFFECTS[effect].shape
 
     def limits(self, building, effect, target, name):
-        """The physical (low, high) of a parameter: `physical_limits`; for a proportional gain an
-        area of sun that cannot be negative (an irradiance column) or a share of a heat input
-        that cannot take away more than the input (k >= -1); for inside convection the factors
-        that bring the zone's mean declared coefficient into `room_convection`."""
-        if effect == "inside_convection":
-            declared = building.mean_inside_convection(target)
-            return tuple(h / declared for h in self.room_convection)
-        if effect == "proportional_gain":
-            _, column = bridge_parts(target)
-            heat_inputs = {c for z in building.zones for c in z.heat_input}
-            return (-1.0 if column in heat_inputs else 0.0, math.inf)
-        return self.physical_limits.get((effect, name), (-math.inf, math.inf))
+        """The physical (low, high) of a parameter: its effect's record's (`Effect.physical`: a
+        gain to the air is a source; conductance scales within a factor of ten of the file's; a
+        heater or meter off its reading by at most two; a proportional gain's area of sun not
+        negative, its share of a heat input not below -1; inside convection within what air can
+        give a room)."""
+        return EFFECTS[effect].limits_of(building, target, name)
 
     def judged_parameters(self, effect):
-        """The parameters whose identifiability and limits decide for an effect (`judged`)."""
-        return self.judged.get(effect, tuple(p.name for p in EFFECTS[effect].parameters))
+        """The parameters whose identifiability and limits decide for an effect (`Effect.judged`)."""
+        return EFFECTS[effect].judged_parameters()
 
     def facts(self, building, effect, target, sensed=()):
         """What the choice reads of the building about one candidate, as report.json keeps it:
-        each judged parameter's physical limits ([low, high], None where unbounded), why the
-        file's description makes the effect implausible (None), whether its target is one
+        each judged parameter's physical limits ([low, high], None where unbounded), what the data
+        fix where its parameters trade off (`Effect.trade_off`: [derived quantity, whether a
+        bound is then waived], None), why the file's description makes the effect implausible
+        (`Effect.implausible`, None), whether its target is one
         component and whether one of that component's nodes is among the `sensed` node ids, the
         other sensors the evidence reads (`claim`)."""
         component = target in {c.name for c in building.components}
         return {"limits": {name: [None if math.isinf(v) else v for v in self.limits(building, effect, target, name)]
                            for name in self.judged_parameters(effect)},
+                "trade_off": list(EFFECTS[effect].trade_off) if EFFECTS[effect].trade_off else None,
                 "implausible": implausible(building, effect, target),
                 "component": component,
                 "sensed": component and bool(set(building.component(target).node_ids) & set(sensed))}
@@ -242,18 +189,20 @@ class Policy:
         """Why a calibrated effect may not be added to the model, or None: a gain the building
         file's description rules out (`implausible`), a parameter on a bound of its search range
         or not identifiable from the data (unless the quantity its parameters trade off along
-        is, `trade_offs`, or the calibration held it at its physical prior), or a value outside
-        physical limits beyond its uncertainty (`limit_sds`).
+        is, `Effect.trade_off`, or the calibration held it at its physical prior), or a value
+        outside physical limits beyond its uncertainty (`limit_sds`). The judged parameters, their
+        limits and the trade-off are the candidate's `facts`, as report.json records them.
 
         parameters : {name: {"value", "std", "identifiable", "on_bound"}} of `diagnosis.calibrate`
         derived : what the data determine besides (`diagnosis.calibrate.derived`)
         facts : what the building says of the candidate (`facts`)
         """
         reasons = [facts["implausible"]]
-        key, bounds_waived = self.trade_offs.get(effect, (None, False))
+        trade_off = facts["trade_off"] if "trade_off" in facts else EFFECTS[effect].trade_off
+        key, bounds_waived = trade_off or (None, False)
         fixed = (derived or {}).get(key)
         resolved = fixed is not None and fixed["std"] < self.identifiable_share * abs(fixed["value"])
-        for name in self.judged_parameters(effect):
+        for name in facts["limits"]:
             p, unit = parameters[name], EFFECTS[effect].parameter(name).unit
             low, high = (-math.inf if facts["limits"][name][0] is None else facts["limits"][name][0],
                          math.inf if facts["limits"][name][1] is None else facts["limits"][name][1])
@@ -263,7 +212,7 @@ class Policy:
                 reasons.append(f"{name} = {p['value']:.3g} +- {p['std']:.2g} {unit} is not identifiable from these data")
             margin = self.limit_sds * p["std"]
             if not low - margin <= p["value"] <= high + margin:
-                what = "a negative gain (a heat sink)" if low == 0.0 and "gain" in effect else "outside physical limits"
+                what = "a negative gain (a heat sink)" if low == 0.0 and EFFECTS[effect].source else "outside physical limits"
                 reasons.append(f"{name} = {p['value']:.3g} +- {p['std']:.2g} {unit} is {what} [{low:.3g}, {high:.3g}] "
                                f"by more than {self.limit_sds:g} standard deviations")
         return "; ".join(r for r in reasons if r) or None
@@ -281,10 +230,8 @@ class Policy:
 
 
 def implausible(building, effect, target):
-    """Why the building file's own description makes an effect implausible, or None: a constant
-    gain in a zone the file declares unoccupied stands for a heat source the model lacks, not for
-    occupants, and the report must say so."""
-    if effect in ("internal_gain", "daily_gain") and building.zone(target).occupied is False:
-        return (f"{target} is declared unoccupied: the gain stands for a heat source the model lacks "
-                "(a heat input mis-measured, a flow of air or sun not modelled), not for occupants")
-    return None
+    """Why the building file's own description makes an effect implausible (its record's
+    `implausible`: a constant gain in a zone the file declares unoccupied stands for a heat source
+    the model lacks, not for occupants), or None."""
+    record = EFFECTS[effect]
+    return record.implausible(building, target) if record.implausible else None

@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from nodeforce.diagnosis.result import Baseline, Decision, Verdict
-from nodeforce.model.effects import bridge_parts
+from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
 from nodeforce.model.score import fall
@@ -285,11 +285,6 @@ def _reason(chosen, alike, results, passing, base, n, verdicts, margin, componen
 
 
 def acting(result):
-    """How a shape's heat source acts, in words: with a daily profile, or in proportion to an input."""
-    values = result.values
-    if result.effect == "daily_gain":
-        amplitude = math.hypot(values.get("cos1", 0.0), values.get("sin1", 0.0))
-        return (f"with a daily profile (mean {values['mean']:.3g} W, first harmonic {amplitude:.3g} W) to the air "
-                f"of {result.target}")
-    zone, column = bridge_parts(result.target)
-    return f"in proportion to {column} (k = {values['k']:.3g}) to the air of {zone}"
+    """How a shape's heat source acts, in words (its record's `acting`): with a daily profile, or
+    in proportion to an input."""
+    return EFFECTS[result.effect].acting(result.target, result.values)
