@@ -69,7 +69,7 @@ from nodeforce.diagnosis.sensitivity import sensitivity
 from nodeforce.diagnosis.windows import Record, Windows, period
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.iotools.energyplus_corrections import idf_of, write_corrections
-from nodeforce.ga.locate import check_measured, evaluator_kind, locate
+from nodeforce.ga.locate import Execution, SearchSettings, check_measured, evaluator_kind, locate
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
 from nodeforce.model.score import Noise
@@ -126,13 +126,15 @@ def assess_all(inputs, pairs, folder, runner):
     return list(assessed)
 
 
-def fits_of(model, base, pairs, assessed, windows, objective, sigma, number=1, on_top_of=()):
+def fits_of(model, base, pairs, assessed, windows, inputs, number=1, on_top_of=()):
     """The candidates' `Fit`s and their `Model`s by label, from their `Assessed`: what each
     predicts of the air left out and of the other sensors over the blocks, each sensor weighted
     by the least misfit the model or any of these candidates leaves there
     (`Windows.sensor_weights`), and of its own component's sensors (`OwnSensors`); `base`: the
-    model's other sensed nodes (`Windows.sensed_by`); `sigma`: the air sensors' noise (C);
-    `number`: the round; `on_top_of`: the labels of the effects `model` holds."""
+    model's other sensed nodes (`Windows.sensed_by`); `inputs`: the round's
+    (`assess.RoundInputs`: its objective, the air sensors' noise `sigma`, C); `number`: the
+    round; `on_top_of`: the labels of the effects `model` holds."""
+    objective, sigma = inputs.objective, inputs.sigma
     n = windows.scored()
     sensed = {i for ids in windows.sensors for i in ids}
     weights = windows.sensor_weights([base] + [a.sensed for a in assessed], sigma)
@@ -168,32 +170,30 @@ def own_sensors(building, component, windows, base, sensed):
     return OwnSensors([float(v) for v in before], [float(v) for v in after], n, windows.own_numerical(columns))
 
 
-def diagnose(building, records, objective, workdir, *, source="measurements", fraction=0.6, calibration_end=None,
-             seed=0, workers=None, scheduler=None, population=30, generations=400, fmu_kind="python",
-             search_fmu="auto", reference=None, noise=None, phases=None, later=(), policy=None):
+def diagnose(building, records, workdir, objective, *, search=SearchSettings(), execution=Execution(), noise=None,
+             reference=None, later=(), policy=None):
     """Run the whole loop, its stages in order (`prepare`, `localise`, `rounds`, `write`); write the
     artifacts in `workdir`; return the `Diagnosis` (report.json is its `to_json()`).
 
-    `records` is a Case (one record: `source`, `fraction`, `calibration_end` and `phases` are
-    its) or a list of `Record`s of the same building, each with its own windows and phases: the
+    `records` is a Case (one record, its windows `Record`'s defaults) or a list of `Record`s of
+    the same building, each with its own windows and phases: the
     fits minimise the sum of every record's calibration J, the choice reads every record's
     blocks, and a candidate that harms one record is refused (`selection.decide`). The forcing
-    search reads every record's calibration window together, then, reported, each one's alone.
-    `reference` ({"label", "rmse": {phase: K}}), another model's error, is reported for scale;
-    `noise` (C) is the air sensors' noise sd if the user knows it, else it is estimated from
-    every record's air. `fmu_kind`: the FMUs of the model before and after, run and written
-    (`fmu_build.build.build_fmu`'s kinds, or "auto", `ga.locate.evaluator_kind`); `search_fmu`:
-    the FMUs the forcing search drives (`ga.locate.locate`'s `fmu_kind`; "auto": the standalone
-    where it can run the building). `scheduler` ("tcp://host:port"): the forcing search and every
-    round's candidates run on that Dask cluster's workers (`runtime.cluster`) instead of
-    `workers` processes; an unreachable one is an InputError before any work.
+    search reads every record's calibration window together, then, reported, each one's alone,
+    under `search` (`ga.locate.SearchSettings`: its seed, which the rounds' screening reads too,
+    its GA settings and the FMUs it drives). `execution` (`ga.locate.Execution`): the FMUs of the
+    model before and after, run and written, and where the work runs: a Dask scheduler's workers
+    (`runtime.cluster`; an unreachable one is an InputError before any work) or `workers`
+    processes. `reference` ({"label", "rmse": {phase: K}}), another model's error, is reported
+    for scale; `noise` (C) is the air sensors' noise sd if the user knows it, else it is estimated
+    from every record's air.
     `later`: `Record`s of the same building under the building file's protocol, read from their
     files (`nodeforce.read_record`), which nothing but the final comparison reads (`scored_later`):
     no fit, no choice, no cross-validation. `policy`: the `diagnosis.policy.Policy` every choice
     is made under (default `Policy()`), recorded in report.json."""
     policy = Policy() if policy is None else policy
     if not isinstance(records, (list, tuple)):
-        records = [Record(records, source, source, fraction, calibration_end, tuple(phases or ()))]
+        records = [Record(records, name="measurements")]
     names = [r.name for r in [*records, *later]]
     for r in [*records, *later]:
         if names.count(r.name) > 1:
@@ -204,17 +204,18 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
             raise InputError(r.source, "later", f"record {r.name}: a later record is read from its files "
                                                 f"(read_record) for the building diagnosed, {building.source}")
     bases = [protocol(building, r) for r in records]
-    fmu_kind = evaluator_kind(fmu_kind, [building, *filter(None, bases)])
+    fmu_kind = evaluator_kind(execution.fmu_kind, [building, *filter(None, bases)])
     # one set of workers for the search and the rounds, started first: their imports overlap `prepare`
-    count = workers or os.cpu_count()
-    with Cluster(scheduler) if scheduler is not None else \
+    count = execution.workers or os.cpu_count()
+    with Cluster(execution.scheduler) if execution.scheduler is not None else \
             lifetime.worker_pool(count) if count > 1 else nullcontext(lifetime.InProcess()) as runner:
         prepared = prepare(building, records, bases, objective, workdir, fmu_kind, noise, policy)
-        search = dict(seed=seed, workers=runner, population=population, generations=generations,
-                      fmu_kind=search_fmu, noise=prepared.noise.sigma if prepared.noise.given else None)
-        located = localise(building, prepared, objective, workdir, search)
-        made = rounds(prepared, located.localization, objective, workdir, seed, runner)
-    return write(building, prepared, located, made, objective, workdir, fmu_kind, reference, later)
+        settings = dict(seed=search.seed, workers=runner, population=search.population,
+                        generations=search.generations, fmu_kind=search.fmu_kind,
+                        noise=prepared.noise.sigma if prepared.noise.given else None)
+        located = localise(building, prepared, objective, workdir, settings)
+        made = rounds(prepared, located.localization, objective, workdir, search.seed, runner)
+    return write(building, prepared, located, made, objective, workdir, reference, later)
 
 
 @dataclass
@@ -222,13 +223,14 @@ class Prepared:
     """What every stage reads (`prepare`): the records, their windows (with the file's numerical
     error), each record's protocol's building (`bases`, None: the building's), the model as
     described (its runs over each record and its metrics), the noise, the residuals the
-    blocks score (`n`) and the building's FMU."""
+    blocks score (`n`), the kind of the model's FMUs and the building's FMU."""
     records: list
     windows: Windows
     bases: list
     model: Model
     noise: Noise
     n: int
+    fmu_kind: str  # the FMUs of the model before and after (`fmu_build.build.build_fmu`'s kinds)
     fmu: Path | None = None  # the building's own FMU (model_before.fmu), where a record is under its protocol
 
     @property
@@ -281,7 +283,7 @@ def prepare(building, records, bases, objective, workdir, fmu_kind, noise, polic
     model = Model(building, before_runs, windows.metrics(objective, before_runs), bases)
     windows = windows.with_numerical(before_runs, windows.sensed_by(model), building, bases, objective)
     noise = Noise.of_records(windows.measured, noise).with_numerical(windows.numerical_rms())
-    return Prepared(list(records), windows, bases, model, noise, windows.scored(), fmus.get(None))
+    return Prepared(list(records), windows, bases, model, noise, windows.scored(), fmu_kind, fmus.get(None))
 
 
 def localise(building, prepared, objective, workdir, search):
@@ -326,8 +328,7 @@ def rounds(prepared, localization, objective, workdir, seed, runner=lifetime.InP
                                      measured_ids, policy, localization["best_nodes"]) if "@".join(p) not in done]
         inputs = RoundInputs.of(model, windows, objective, noise.sigma, seed)
         assessed = assess_all(inputs, pairs, into, runner)
-        tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma, number + 1,
-                                done)
+        tried, models = fits_of(model, base_sensed, pairs, assessed, windows, inputs, number + 1, done)
         # shapes only where no physical candidate physics admits brings the error left to the
         # noise; the residual's statistics then choose which
         if not any(policy.at_noise(r.cv.J, n, noise.floor_sd) and not policy.objection_of(
@@ -336,8 +337,7 @@ def rounds(prepared, localization, objective, workdir, seed, runner=lifetime.InP
                     if "@".join(p) not in done]
             pairs, assessed = pairs + more, assessed + assess_all(inputs, more, into, runner)
             # every sensor's weight from the least misfit any candidate of the round leaves
-            tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma,
-                                    number + 1, done)
+            tried, models = fits_of(model, base_sensed, pairs, assessed, windows, inputs, number + 1, done)
         simulations = sum(a.simulations for a in assessed)
         # a round run for a component's own sensors alone: only they can make a candidate pass
         decision = decide(tried, Baseline(base_blocks, noise.sigma, n, windows.groups(), noise.floor_sd,
@@ -391,8 +391,7 @@ def revisit(prepared, made, fit, objective, folder, seed, runner):
     inputs = RoundInputs.of(model, windows, objective, noise.sigma, seed, [(a.effect, a.target) for a in others],
                             {a.label: [name for name, p in a.parameters.items() if p.get("prior")] for a in others})
     assessed = assess_all(inputs, pairs, into, runner)
-    tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma, number,
-                            [a.label for a in others])
+    tried, models = fits_of(model, base_sensed, pairs, assessed, windows, inputs, number, [a.label for a in others])
     decision = decide(tried, Baseline(windows.block_J(model.runs), noise.sigma, n, windows.groups(), noise.floor_sd),
                       policy)
     chosen = decision.chosen
@@ -445,12 +444,13 @@ def priors_stated(building, added):
     return building.edited(lambda data: data.update(description=" ".join([data.get("description", "")] + said).strip()))
 
 
-def write(building, prepared, located, made, objective, workdir, fmu_kind, reference, later=()):
+def write(building, prepared, located, made, objective, workdir, reference, later=()):
     """Stage 4: the model the rounds leave written (`building_after.json`, `model_after.fmu`,
     each protocol's building, `model_after.idf` for a converted EnergyPlus model), scored on
     each later record (`scored_later`), the `Diagnosis`, written as report.json, report.md and
     the plots; returns it."""
     windows, records, model, added = prepared.windows, prepared.records, made.model, made.added
+    fmu_kind = prepared.fmu_kind
     (workdir / "building_after.json").write_text(json.dumps(priors_stated(model.building, added).to_json(), indent=2)
                                                  + "\n")
     fmu_after = build_fmu(model.building, workdir / "model_after.fmu", kind=fmu_kind)

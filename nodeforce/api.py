@@ -455,11 +455,12 @@ def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibrati
     """
     from nodeforce.diagnosis import loop  # here: the report's plotting and statistics load with it
     with _folder(workdir) as folder:
-        return loop.diagnose(building, case, objective or Objective.of(building), folder, source=SOURCE,
-                             fraction=fraction, calibration_end=calibration_end, phases=phases, seed=seed,
-                             workers=workers, scheduler=scheduler, fmu_kind=fmu_kind, search_fmu=search_fmu,
-                             noise=noise, reference=reference, population=population, generations=generations,
-                             later=list(later), policy=policy)
+        records = case if isinstance(case, (list, tuple)) else \
+            [Record(case, SOURCE, SOURCE, fraction, calibration_end, tuple(phases or ()))]
+        return loop.diagnose(building, records, folder, objective or Objective.of(building),
+                             search=_locate.SearchSettings(seed, population, generations, search_fmu),
+                             execution=_locate.Execution(workers, scheduler, fmu_kind), noise=noise,
+                             reference=reference, later=list(later), policy=policy)
 
 
 def compare(models, workdir=None, phases=(), fmu_kind="python"):

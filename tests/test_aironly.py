@@ -14,6 +14,7 @@ import pytest
 from nodeforce.cli import locate_summary
 from nodeforce.diagnosis.candidates import physical
 from nodeforce.diagnosis.loop import diagnose
+from nodeforce.ga.locate import Execution, SearchSettings
 from nodeforce.diagnosis.loss import heat_loss
 from nodeforce.diagnosis.policy import Policy
 from nodeforce.diagnosis.result import CrossValidation, Fit
@@ -237,7 +238,8 @@ def test_an_air_only_record_names_the_undeclared_zone_effect(heated, heated_weat
     from the first day's steady state, so no initial-state bias is left for a slow parameter to
     absorb)."""
     truth, case = air_only(heated, heated_weather, id=effect, values=values)
-    report = diagnose(heated, case.with_burn_in(1), Objective.of(heated), tmp_path, workers=2, noise=NOISE).to_json()
+    report = diagnose(heated, case.with_burn_in(1), tmp_path, Objective.of(heated),
+                      execution=Execution(workers=2), noise=NOISE).to_json()
     assert [(e["effect"], e["target"]) for e in report["effects"]] == [(effect, "cell")], report["decision"]["reason"]
     first = report["effects"][0]
     assert report["after"]["validation"]["rmse"] < 1.2 * NOISE < 2 * NOISE < report["before"]["validation"]["rmse"]
