@@ -13,7 +13,7 @@ from nodeforce import api
 
 from nodeforce.runtime import lifetime, tempdirs
 from nodeforce.ga.checkpoint import NAME as CHECKPOINT, resume_hint
-from nodeforce.ga.search import PAPER, PATIENCE
+from nodeforce.ga.search import PAPER, PATIENCE, check_settings
 from nodeforce.model.case import HISTORY_DAYS
 from nodeforce.model.errors import InputError
 from nodeforce.iotools.timetable import instant
@@ -116,14 +116,9 @@ def cmd_inputs(args):
 
 
 def check_search_settings(args):
-    """The GA's settings, refused with the option named rather than deep inside the search."""
-    if args.population < 2:
-        raise InputError("--population", args.population, "a population needs at least 2 chromosomes")
-    if args.generations < 1:
-        raise InputError("--generations", args.generations, "at least one generation")
-    for option, p in (("--pc", args.pc), ("--pm", args.pm)):
-        if not 0.0 <= p <= 1.0:
-            raise InputError(option, p, "a probability, between 0 and 1")
+    """The GA's settings (`ga.search.check_settings`) and the workers, refused with the option
+    named before any work rather than deep inside the search."""
+    check_settings(args.population, args.generations, args.pc, args.pm, args.patience)
     check_workers(args)
 
 
@@ -132,8 +127,6 @@ def search_strategy(args):
     paper's (GA settings given explicitly still apply: they default to the paper's anyway)."""
     if args.paper and args.patience is not None:
         raise InputError("--patience", args.patience, "--paper runs every generation; leave out one of the two")
-    if args.patience is not None and args.patience < 1:
-        raise InputError("--patience", args.patience, "at least one generation")
     settings = dict(population=args.population, generations=args.generations, pc=args.pc, pm=args.pm)
     if args.paper:
         return {**PAPER, **settings}
