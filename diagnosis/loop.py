@@ -425,11 +425,11 @@ def screened(model, chosen, windows, objective, seed):
 def left_by(windows, model):
     """What the model's residual on the first record's calibration window follows (an input, the
     time of day)."""
-    first, k0 = windows.cases[0], windows.ks[0]
+    first, k0 = windows.each[0].case, windows.each[0].k
     shaped = shaped_inputs(model.building)
     inputs = {name: values for name, values in zip(first.input_names, first.U[1:k0 + 1].T) if name in shaped}
-    return residual_diagnostics(windows.calibrations[0].times[1:],
-                                windows.measured[0][:k0][:, 0] - model.runs[0][:k0, 0], inputs)
+    return residual_diagnostics(windows.each[0].calibration.times[1:],
+                                windows.each[0].measured[:k0][:, 0] - model.runs[0][:k0, 0], inputs)
 
 
 def priors_stated(building, added):
@@ -505,7 +505,7 @@ def validation_residuals(prepared, made):
     """What the first objective zone's residual on the first record's validation window follows
     (`diagnosis.residuals`), before and after."""
     windows = prepared.windows
-    first, k, measured = windows.cases[0], windows.ks[0], windows.measured[0]
+    first, k, measured = windows.each[0].case, windows.each[0].k, windows.each[0].measured
     validation = slice(k, None)
     return {state: residual_diagnostics(first.times[1:][validation], measured[validation, 0] - run[0][validation, 0],
                                         {name: values[validation] for name, values in
@@ -530,7 +530,7 @@ def plotted(prepared, located, made, objective):
     """The series the plots draw, from the first measurement: the weather's history before it is
     not the record."""
     windows = prepared.windows
-    first, k, measured = windows.cases[0], windows.ks[0], windows.measured[0]
+    first, k, measured = windows.each[0].case, windows.each[0].k, windows.each[0].measured
     times, h = first.times, first.history_steps
     return {"times": times[h + 1:], "validation_start": times[k + 1], "scored_from": times[first.burn_in_steps + 1],
             "convergence": located.convergence,
