@@ -110,34 +110,14 @@ class Windows:
                                      case.scored([node - 1 for node in sensors])))
         return cls(each, blocks, policy)
 
-    # the per-record views
-    @property
-    def records(self):
-        return [w.record for w in self.each]
-
-    @property
-    def cases(self):
-        return [w.case for w in self.each]
-
-    @property
-    def ks(self):
-        return [w.k for w in self.each]
-
-    @property
-    def calibrations(self):
-        return [w.calibration for w in self.each]
-
-    @property
-    def measured(self):
-        return [w.measured for w in self.each]
-
-    @property
-    def sensors(self):
-        return [w.sensors for w in self.each]
-
-    @property
-    def sensed(self):
-        return [w.sensed for w in self.each]
+    # the per-record views, in the records' order
+    records = property(lambda self: [w.record for w in self.each])
+    cases = property(lambda self: [w.case for w in self.each])
+    ks = property(lambda self: [w.k for w in self.each])
+    calibrations = property(lambda self: [w.calibration for w in self.each])
+    measured = property(lambda self: [w.measured for w in self.each])
+    sensors = property(lambda self: [w.sensors for w in self.each])
+    sensed = property(lambda self: [w.sensed for w in self.each])
 
     @property
     def numerical(self):
