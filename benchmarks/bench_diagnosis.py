@@ -65,7 +65,7 @@ def result_path(out, name, draw):
 
 
 # The code and data a result depends on: the package (the loop), the records, the baseline, the Twin House.
-CODE = ("nodeforce", "model", "fmu_build", "cosim", "ga", "diagnosis", "iotools", "benchmarks", "examples")
+CODE = ("nodeforce", "runtime", "model", "fmu_build", "cosim", "ga", "diagnosis", "iotools", "benchmarks", "examples")
 
 
 def code_digest():
@@ -99,7 +99,8 @@ def finished(path, name):
 def diagnose_one(task):
     """Generate one record, diagnose it with the loop and the baseline; return the result."""
     name, draw, path, population, generations, history_days = task
-    from nodeforce import api, tempdirs
+    from nodeforce import api
+    from nodeforce.runtime import tempdirs
     started = time.time()
     try:
         r = record(name, draw)
@@ -202,8 +203,8 @@ def run(tasks, workers, scheduler=None):
     """Each task in a worker process (2 by default), or on the workers of the Dask cluster at
     `scheduler`, with a progress bar; each result kept as it comes; the results as they came."""
     from concurrent.futures import as_completed
-    from nodeforce import lifetime
-    from nodeforce.cluster import Cluster
+    from nodeforce.runtime import lifetime
+    from nodeforce.runtime.cluster import Cluster
     if not tasks:
         return []
     done = []

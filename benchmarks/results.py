@@ -14,7 +14,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "benchmarks" / "results"
 # The folders whose files make a benchmark's figures: a change there is a change of what was run.
-CODE = ("nodeforce", "model", "fmu_build", "cosim", "ga", "diagnosis", "iotools", "benchmarks", "examples", "tests")
+CODE = ("nodeforce", "runtime", "model", "fmu_build", "cosim", "ga", "diagnosis", "iotools", "benchmarks", "examples", "tests")
 
 
 def cpu_model():

@@ -7,7 +7,7 @@ import numpy as np
 
 from benchmarks.catalogue import BURN_IN_DAYS, CALIBRATION_FRACTION
 from benchmarks.truth import at_scale, faulty, fine_weather, frame, neutral, truth_record
-from nodeforce.diagnosis.policy import POLICY
+from nodeforce.diagnosis.policy import Policy
 from nodeforce.model.case import measured_case
 from nodeforce.model.effects import EFFECTS
 
@@ -78,14 +78,14 @@ def fault_max_scale(building, fault):
         if fault.effect == "opening":
             return 0.9 * building.component(fault.target).area / fault.full["area"]
         if fault.effect == "envelope_films":  # the envelope factor's physical limit on the whole path
-            high = POLICY.limits(building, "envelope_conductance", fault.target, "factor")[1]
+            high = Policy().limits(building, "envelope_conductance", fault.target, "factor")[1]
             return 0.95 * (high - 1.0) / (fault.full["factor"] - 1.0)
         return 20.0
     effect = EFFECTS[fault.effect]
     base = neutral(building, fault)
     limit = 20.0
     for p, (low, high) in zip(effect.parameters, effect.bounds(building, fault.target)):
-        physical = POLICY.limits(building, fault.effect, fault.target, p.name)
+        physical = Policy().limits(building, fault.effect, fault.target, p.name)
         low, high = max(low, physical[0]), min(high, physical[1])
         if p.name in fault.full and p.name != "T_ground":
             delta = fault.full[p.name] - base[p.name]

@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 import pvlib
 
-from nodeforce import tempdirs
+from nodeforce.runtime import tempdirs
 from nodeforce.iotools.typical_year import convert_typical_year, relocate
 from nodeforce.iotools.weather import read_weather
 from nodeforce.model.building_file import load_building, parse_building

@@ -29,8 +29,8 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave, fmi2Boolean, fmi2True, fmi2Warning
 from fmpy.fmi3 import FMU3Slave, fmi3Boolean, fmi3Float64
 
-from nodeforce import tempdirs
-from nodeforce.model.compiled import compiled_function
+from nodeforce.runtime import tempdirs
+from nodeforce.runtime.compiler import compiled_function
 
 log = logging.getLogger("nodeforce.cosim")
 

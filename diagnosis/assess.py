@@ -1,12 +1,11 @@
 """One candidate effect calibrated and run: the task every worker process or Dask worker of a
 round runs (`diagnosis.loop.assess_all`), in a module of its own so that a worker imports what
 the calibration needs and nothing of the report (its plots, its tables) or the search."""
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from nodeforce.diagnosis.calibrate import Candidate, Own, calibrate
-from nodeforce.diagnosis.policy import POLICY
 from nodeforce.model.network import assemble, slowest_time_constant
 
 
@@ -30,21 +29,56 @@ class Assessed:
     beside: dict = None
 
 
-def assess(shared, pair):
+@dataclass
+class RoundInputs:
+    """What every candidate of a round reads (`assess`), sent once to each worker: the model's
+    building and each record's protocol's (`bases`), the records' calibration windows and whole
+    cases, the objective, the cross-validation blocks, each record's other sensed nodes (ids),
+    the file's numerical error at the objective air and at those sensors (one array per record
+    each, or None), the air sensors' noise sd (C), the seed, the effects the model holds that are
+    refitted together with each candidate ((effect, target)) with those of their parameters
+    `held` ({label: names}) kept as they are (`calibrate.Candidate`), and the
+    `diagnosis.policy.Policy`."""
+    building: object
+    bases: list
+    calibrations: list
+    cases: list
+    objective: object
+    blocks: list
+    sensors: list
+    numerical: list
+    at_sensors: list
+    sigma: float
+    seed: int
+    policy: object
+    beside: tuple = ()
+    held: dict = field(default_factory=dict)
+
+    @classmethod
+    def of(cls, model, windows, objective, sigma, seed, beside=(), held=None):
+        """The inputs of a round adding to `model` (`loop.Model`) on the `windows`, under their policy."""
+        return cls(model.building, model.bases, windows.calibrations, windows.cases, objective, windows.blocks,
+                   windows.sensors, windows.calibration_numerical(), windows.calibration_numerical(sensors=True),
+                   sigma, seed, windows.policy, tuple(beside), held or {})
+
+
+def assess(inputs, pair):
     """Calibrate one candidate effect, with its cross-validation folds, and run it: a task for a
-    worker process or a Dask worker; its `Assessed`. `shared`: what every candidate of the round
-    reads (`assess_all`), the effects the model holds that are refitted together with it among
+    worker process or a Dask worker; its `Assessed`. `inputs`: what every candidate of the round
+    reads (`RoundInputs`), the effects the model holds that are refitted together with it among
     them (`Candidate`'s `beside` and `held`); `pair`: the (effect, target).
 
     A candidate on a component whose own nodes are measured is fitted to them beside the air
     (`calibrate.Own`); those nodes on each block are then the fold's, fitted without that block,
     so that what the choice reads of its own sensors is, as of the air, what no fit read."""
-    (building, bases, calibrations, cases, objective, blocks, sensors, numerical, at_sensors, sigma, seed,
-     beside, held) = shared
+    building, bases, calibrations, cases = inputs.building, inputs.bases, inputs.calibrations, inputs.cases
+    objective, blocks, sensors, beside = inputs.objective, inputs.blocks, inputs.sensors, inputs.beside
     effect, target = pair
-    candidate = Candidate(building, effect, target, protocols(bases, calibrations, cases), beside, held)
-    own = own_nodes(building, [target, *(t for _, t in beside)], sensors, at_sensors, sigma)
-    fitted, determined, folds = calibrate(candidate, calibrations, objective, blocks, numerical, own)
+    candidate = Candidate(building, effect, target, protocols(bases, calibrations, cases), beside, inputs.held)
+    own = own_nodes(building, [target, *(t for _, t in beside)], sensors, inputs.at_sensors, inputs.sigma,
+                    inputs.policy)
+    fitted, determined, folds = calibrate(candidate, calibrations, objective, blocks, inputs.numerical, own,
+                                          inputs.policy)
     values = [fitted[name]["value"] for name in candidate.names]
     zones = len(objective.air_nodes)
     # the objective air and the other sensors (never the objective air) in one run of each record
@@ -61,11 +95,12 @@ def assess(shared, pair):
                     candidate.built(values).to_json(), refitted or None)
 
 
-def own_nodes(building, targets, sensors, numerical, sigma):
+def own_nodes(building, targets, sensors, numerical, sigma, policy):
     """The measured nodes of the components among `targets` among each record's other sensors
     (`sensors`, ids), with the file's numerical error there (`numerical`, one (N_t,
     len(sensors)) per record, or None), the noise `sigma` (C) and the components' memory of their
-    start as `building` describes them (the slowest's): a `calibrate.Own`; None where no target
+    start as `building` describes them (the slowest's, `policy.start_memory` of its time
+    constants): a `calibrate.Own`; None where no target
     is a component or none has a node measured. Effects refitted together read the own nodes of
     each, as each one's own fit did."""
     components = {c.name for c in building.components}
@@ -75,7 +110,7 @@ def own_nodes(building, targets, sensors, numerical, sigma):
     columns = columns_among(sensors, set(nodes))
     if not any(columns):
         return None
-    memory = POLICY.start_memory * slowest_time_constant(assemble(building), [i - 1 for i in nodes])
+    memory = policy.start_memory * slowest_time_constant(assemble(building), [i - 1 for i in nodes])
     return Own([[ids[j] for j in c] for ids, c in zip(sensors, columns)],
                None if numerical is None else [e[:, c] for e, c in zip(numerical, columns)], sigma, memory)
 

@@ -24,7 +24,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from nodeforce.diagnosis.candidates import calibration_start
-from nodeforce.diagnosis.policy import POLICY
+from nodeforce.diagnosis.policy import Policy
 from nodeforce.diagnosis.selection import on_block
 from nodeforce.model.case import as_cases
 from nodeforce.model.significance import bandwidth, parameter_covariance
@@ -406,7 +406,7 @@ class Residuals:
         return (slopes + np.outer(self.error, share_slope(r, self.error, self.counted, slopes))) * self.scale[:, None]
 
 
-def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None):
+def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None, policy=None):
     """Least-squares values of the candidate's parameters on the calibration windows of one or
     several records of the building (`cases`), on the residuals of every objective zone of every
     record together (the sum of each window's J), and the same fit with each block of steps left out.
@@ -439,6 +439,8 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None):
         is the component's. The fit to the air alone weighs each own node (`own_weights`), and
         the fit is made again with them beside the air, read once the component has forgotten
         the start the burn-in could not set (`Own.measured`)
+    policy : the `diagnosis.policy.Policy` that says what is identifiable, how a sensor weighs and
+        when a prior holds (default: `Policy()`)
 
     Returns
     -------
@@ -449,6 +451,7 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None):
     leave on it, and what they predict there of the own nodes ("own", C, (N_t, len(own ids)))
     """
     cases = as_cases(cases)
+    policy = Policy() if policy is None else policy
     blocks = [b if isinstance(b, tuple) else (0, b) for b in blocks]
     zones = len(objective.air_nodes)
     extra = own.ids if own is not None else [[] for _ in cases]
@@ -491,17 +494,17 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None):
     residuals = weighted([np.zeros(len(e)) for e in extra])
     fit = solve(residuals, x0, lows, highs, kept)
     if any(h[:, zones:].any() for h in have):
-        weights = own_weights(candidate, cases, ids, measured, numerical, zones, fit.x, own.sd)
+        weights = own_weights(candidate, cases, ids, measured, numerical, fit.x, own, policy)
         log.info("%s: its own nodes read beside the air, weighing %s", candidate.label,
                  "; ".join(", ".join(f"{n}: {w:.2g}" for n, w in zip(e, ws)) for e, ws in zip(extra, weights)))
         residuals = weighted(weights)
         fit = solve(residuals, fit.x, lows, highs, kept)
     cov = parameter_covariance(fit.jac, fit.fun, steps, lags)
-    priors = wanted_priors(candidate, cases, identified(candidate, fit, cov))
+    priors = wanted_priors(candidate, cases, identified(candidate, fit, cov, policy))
     if priors:
         held = solve(residuals, x0, lows, highs, {**kept, **{i: prior.value for i, prior in priors.items()}})
         statistic = score_statistic(held, list(priors), residuals, candidate.bounds, steps, lags)
-        if POLICY.holds_prior(statistic, len(priors)):
+        if policy.holds_prior(statistic, len(priors)):
             fit, cov = held, parameter_covariance(held.jac, held.fun, steps, lags)
             log.info("%s: %s, held at the physical prior: the data fix the parameters' combination only",
                      candidate.label, ", ".join(f"{candidate.parameters[i].name} = {prior.value:.4g} "
@@ -512,7 +515,7 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None):
     std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     result = {}
     for i, (p, name, value, sd, bound, fixed) in enumerate(zip(candidate.parameters, candidate.names, fit.x, std,
-                                                               fit.active_mask, identified(candidate, fit, cov))):
+                                                               fit.active_mask, identified(candidate, fit, cov, policy))):
         identifiable = bool(fixed and i not in priors)
         if not identifiable and i not in priors:
             log.info("%s: %s = %.4g +- %.2g %s is not identifiable from these data%s", candidate.label,
@@ -532,10 +535,12 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None):
     return result, derived(candidate, cases[0], fit.x, cov), folds
 
 
-def own_weights(candidate, cases, ids, measured, numerical, zones, x, sd):
+def own_weights(candidate, cases, ids, measured, numerical, x, own, policy):
     """Per case, each own node's weight beside the air in a component candidate's fit
-    (`Policy.sensor_weight`): sd_j^2 over its mean squared residual at `x`, the fit to the air
-    alone, sd_j the noise `sd` (C) and the file's numerical error there; 0 where it has no reading.
+    (`policy.sensor_weight`): sd_j^2 over its mean squared residual at `x`, the fit to the air
+    alone, sd_j the noise (`own.sd`, C) and the file's numerical error there; 0 where it has no
+    reading. `ids`, `measured`, `numerical`: per case, the objective air's columns then the own
+    nodes' (`own.ids`).
 
     A sensor is weighted as a measurement whose error is what the model leaves there: a surface
     the component's correction brings to the noise counts as the air does, and fixes the
@@ -543,13 +548,14 @@ def own_weights(candidate, cases, ids, measured, numerical, zones, x, sd):
     whatever the value (a real wall behind a simplified one) counts as little as its misfit says,
     and does not pull the fit of the air towards it."""
     out = []
-    for case, i, m, e in zip(cases, ids, measured, numerical):
+    for case, i, m, e, o in zip(cases, ids, measured, numerical, own.ids):
+        zones = len(i) - len(o)
         r, e = m[:, zones:] - candidate.nodes(case, i, x)[:, zones:], e[:, zones:]
         finite = np.isfinite(r)
         n = finite.sum(axis=0)
         mean_square = np.where(finite, np.square(r), 0.0).sum(axis=0) / np.maximum(n, 1)
-        floor = np.hypot(sd, np.sqrt(np.where(finite, np.square(e), 0.0).sum(axis=0) / np.maximum(n, 1)))
-        out.append(np.where(n > 0, POLICY.sensor_weight(floor, np.maximum(mean_square, np.finfo(float).tiny)), 0.0))
+        floor = np.hypot(own.sd, np.sqrt(np.where(finite, np.square(e), 0.0).sum(axis=0) / np.maximum(n, 1)))
+        out.append(np.where(n > 0, policy.sensor_weight(floor, np.maximum(mean_square, np.finfo(float).tiny)), 0.0))
     return out
 
 
@@ -580,11 +586,11 @@ def solve(residuals, x0, lows, highs, held=None):
     return SimpleNamespace(x=full(fit.x), fun=fit.fun, jac=jac, active_mask=active)
 
 
-def identified(candidate, fit, cov):
+def identified(candidate, fit, cov, policy):
     """Per parameter, whether the data fix it: its estimate tight enough to act on
-    (`Policy.identifiable`, sd from `cov`) and not on a bound."""
+    (`policy.identifiable`, sd from `cov`) and not on a bound."""
     std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    return [bool(POLICY.identifiable(value, sd, p.unit) and bound == 0)
+    return [bool(policy.identifiable(value, sd, p.unit) and bound == 0)
             for p, value, sd, bound in zip(candidate.parameters, fit.x, std, fit.active_mask)]
 
 
@@ -679,8 +685,35 @@ def fold(fit, train, lows, highs, residuals):
     return fit.x.copy()
 
 
-# The derived time constant (s) of the effects that add a node of capacity C and conductance H.
-TIME_CONSTANTS = {"internal_mass": "mass_time_constant", "heat_input_lag": "heater_time_constant"}
+class Derivation:
+    """What an effect's derived quantities read (`model.effects.Effect.derived`): the building and
+    target of the candidate, its fitted values `x` and their `bounds`, the heat loss coefficient at
+    `x` (`hlc`, W/K) and its gradient (`hlc_slope`); `nodes` and `hlc_at` simulate at other values,
+    `of` and `with_sd` give a quantity with its standard deviation by the delta method."""
+
+    def __init__(self, candidate, case, x, cov):
+        self.building, self.target, self.x, self.bounds = candidate.building, candidate.target, x, candidate.bounds
+        self._candidate, self._case = candidate, case
+        self.within = within_ranges(cov, candidate.bounds)
+        self.hlc, self.hlc_slope = gradient(self.hlc_at, x, candidate.bounds)
+
+    def hlc_at(self, values):
+        """The heat loss coefficient (W/K) of the model at `values`."""
+        return heat_loss_coefficient(*self._candidate.network(values))
+
+    def nodes(self, ids, values):
+        """The temperatures (C) of nodes `ids` simulated at `values` over the calibration window."""
+        return self._candidate.nodes(self._case, ids, values)
+
+    def with_sd(self, value, gradient, unit, cov=None):
+        """{"value", "std", "unit"}: sd^2 = g' cov g, cov the parameters' covariance combined with
+        their ranges (`within_ranges`) unless given."""
+        cov = self.within if cov is None else cov
+        return {"value": float(value), "std": float(np.sqrt(max(gradient @ cov @ gradient, 0.0))), "unit": unit}
+
+    def of(self, f, unit):
+        """`with_sd` of f(values) at `x`, its gradient by differences (`gradient`)."""
+        return self.with_sd(*gradient(f, self.x, self.bounds), unit)
 
 
 def derived(candidate, case, x, cov):
@@ -690,19 +723,16 @@ def derived(candidate, case, x, cov):
     - The heat loss coefficient of the model with the effect (docs/model.md section 8), W/K: what a
       record of the air and the heating power fixes well even where the effect's parameters, or
       the split of the loss among effects, it does not (`gradient`).
-    - A ground coupling acts through its heat flux density q = U (T_ground - T_face) (W/m2, into
-      the component), T_face the face's mean temperature simulated over the window: many (U,
-      T_ground) pairs give the same flux. g is q's gradient with the face simulated at each
-      parameter moved (`gradient`): where U is large beside the component's own conductance the
-      face follows T_ground, and holding it fixed would make a well-fixed flux look unknown.
-    - A zone's internal mass or heater node answers with its time constant tau = C / H (s): a
-      short record of the air fixes tau far better than C and H apart, which trade off along it.
-      g = (1 / H, -C / H^2).
-    - A component's conductivity factor acts through the heat the component loses (W/K): the HLC
-      with the factor less the HLC with the factor at its lower bound, where the layers pass
-      almost nothing. In series with the surface coefficients that loss saturates as the layers
-      conduct more, so a door twice as conductive as its wood and one ten times are told apart
-      by little, while the loss the data see is fixed. g is the HLC's.
+    - What its record derives (`Effect.derived`, on a `Derivation`): a ground coupling's heat flux
+      density q = U (T_ground - T_face) (W/m2), g its gradient with the face simulated at each
+      parameter moved, since where U is large beside the component's own conductance the face
+      follows T_ground, and holding it fixed would make a well-fixed flux look unknown; a zone's
+      internal mass or heater node's time constant tau = C / H (s), which a short record of the
+      air fixes far better than C and H apart, g = (1 / H, -C / H^2); a component's conductivity
+      factor's heat loss (W/K): the HLC with the factor less the HLC with the factor at its lower
+      bound, where the layers pass almost nothing. In series with the surface coefficients that
+      loss saturates as the layers conduct more, so a door twice as conductive as its wood and one
+      ten times are told apart by little, while the loss the data see is fixed; g is the HLC's.
 
     What the parameters trade off along (the flux, a time constant, a component's loss) reads
     their covariance combined with their ranges (`within_ranges`): the valley leaves it unchanged,
@@ -710,27 +740,10 @@ def derived(candidate, case, x, cov):
     covariance alone: with a ground coupling it changes along the valley (U = q / (T_ground -
     T_face), a hyperbola the range's linear extrapolation does not follow), and so is not fixed.
     """
-    within = within_ranges(cov, candidate.bounds)
-
-    def with_sd(value, gradient, unit, cov=within):
-        return {"value": float(value), "std": float(np.sqrt(max(gradient @ cov @ gradient, 0.0))), "unit": unit}
-
-    hlc, slope = gradient(lambda values: heat_loss_coefficient(*candidate.network(values)), x, candidate.bounds)
-    out = {"heat_loss_coefficient": with_sd(hlc, slope, "W/K", cov)}
-    if candidate.effect == "ground_coupling":
-        face = candidate.building.component(candidate.target).node_ids[-1]
-
-        def flux(values):
-            U, T_ground = values[:2]
-            return U * (T_ground - float(np.mean(candidate.nodes(case, [face], values))))
-        out["ground_heat_flux"] = with_sd(*gradient(flux, x, candidate.bounds), "W/m2")
-    if candidate.effect == "conductivity":
-        low = candidate.bounds[0][0]
-        out["component_loss"] = with_sd(hlc - heat_loss_coefficient(*candidate.network([low, *x[1:]])), slope, "W/K")
-    if candidate.effect in TIME_CONSTANTS:
-        C, H = x[:2]
-        out[TIME_CONSTANTS[candidate.effect]] = with_sd(C / H, np.r_[1.0 / H, -C / H ** 2, np.zeros(len(x) - 2)], "s")
-    return out
+    d = Derivation(candidate, case, x, cov)
+    out = {"heat_loss_coefficient": d.with_sd(d.hlc, d.hlc_slope, "W/K", cov)}
+    effect = EFFECTS[candidate.effect]
+    return {**out, **(effect.derived(d) if effect.derived else {})}
 
 
 def within_ranges(cov, bounds):

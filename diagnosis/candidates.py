@@ -1,32 +1,17 @@
-"""Which effects a diagnosis tries, and where their calibrations start.
-
-Kept apart from the effect records (`nodeforce.model.effects`), which an FMU bundles: changing
-them changes no FMU and throws away no saved search. How many components are tried, which
-effects are shapes, and what physics refuses are the choice's (`diagnosis.policy`).
+"""Which effects a diagnosis tries, and where their calibrations start: read from each effect's
+record (`nodeforce.model.effects.Effect`: which zones offer it, whether it is a shape, where a
+parameter declared absent starts); how many components are tried is the policy's
+(`diagnosis.policy`).
 """
 import math
 
-from nodeforce.diagnosis.policy import POLICY
-from nodeforce.model.effects import EFFECTS, bridge_parts, bridge_target, pair_parts
-from nodeforce.model.network import RHO_C_AIR
+from nodeforce.model.effects import EFFECTS, bridge_parts, bridge_target
 
-# Where the calibration of an effect the file does not declare starts (see calibration_start).
-ABSENT_START = {("ground_coupling", "U"): 1.0,  # W/m2/K
-                ("infiltration", "n"): 0.5,  # 1/h
-                ("thermal_bridge", "UA"): 5.0,  # W/K
-                ("shading_transmittance", "f"): 0.1,  # an external screen's openness and absorbed share
-                ("interzone_air_exchange", "V"): 50.0}  # m3/h: a door ajar, or the gap under a closed one
-# ... and, for the nodes a zone effect adds, in multiples of the zone air's capacity (J/K): a
-# room's furniture and inner mass are several times its air's, an electric heater's about its
-# air's; their conductances start at `effects.neutral_conductance` (the air's capacity over
-# half an hour), so the mass's time constant starts at hours and the heater's at half an hour.
-ZONE_START = {("internal_mass", "C_m"): 10.0,
-              ("heat_input_lag", "C_h"): 1.0}
 # How far inside its range (a fraction of it) a calibration starts a value declared on a bound.
 INSIDE = 1e-3
 
 
-def physical(building, evidence, zones, measured_ids, located_nodes=()):
+def physical(building, evidence, zones, measured_ids, policy, located_nodes=()):
     """(effect, target) pairs every round calibrates, whatever the residual's statistics say: a
     building physicist's list of what could be wrong, which the cross-validated choice
     (`diagnosis.selection`) then judges.
@@ -34,7 +19,7 @@ def physical(building, evidence, zones, measured_ids, located_nodes=()):
     - Every zone effect of each objective zone (`zone_effects`), and of any zone whose air the
       forcing search located.
     - The component effects (`component_effects`) of the components the forcing evidence ranks
-      highest (at least `POLICY.top_components`, and any removing `POLICY.evident_share` of J
+      highest (at least `policy.top_components`, and any removing `policy.evident_share` of J
       above the noise), and of
       every component of an objective zone that no sensor sits in: forcing cannot point at a
       component without a sensor; a calibration can.
@@ -45,13 +30,14 @@ def physical(building, evidence, zones, measured_ids, located_nodes=()):
     evidence : ga.locate's `components`: [{"component", "share", ...}], most evident first
     zones : names of the objective zones
     measured_ids : node ids with a measurement column
+    policy : the `diagnosis.policy.Policy`: how many components
     located_nodes : node ids the forcing search located
     """
     located = set(located_nodes)
     air_zones = list(zones) + [z.name for z in building.zones if z.air_node in located]
     pairs = [pair for name in dict.fromkeys(air_zones) for pair in zone_effects(building, name)]
     ranked = [e["component"] for i, e in enumerate(evidence)
-              if i < POLICY.top_components or e["share"] >= POLICY.evident_share]
+              if i < policy.top_components or e["share"] >= policy.evident_share]
     measured = set(measured_ids)
     # a component of an objective zone: one of its faces faces the zone (a partition's either side)
     facing = {i for zone in zones for i in building.facing(zone)}
@@ -62,65 +48,39 @@ def physical(building, evidence, zones, measured_ids, located_nodes=()):
 
 
 def zone_effects(building, name):
-    """The zone effects of the catalogue for one zone: its air change with the outside
-    (`thermal_bridge` where the zone has supply air, whose flow is known, `infiltration`
-    otherwise) and bridges to the boundary temperatures its surfaces see, a constant gain, inside
-    convection, one factor on its envelope, an internal mass, and where it has a heat input the
-    heater's lag and the input's split, and where it has shaded glazings their shadings' leak."""
-    zone = building.zone(name)
-    supplied = zone.supply is not None
-    pairs = [] if supplied else [("infiltration", name)]
-    for target in EFFECTS["thermal_bridge"].targets(building):
-        owner, to = bridge_parts(target)
-        if owner == name and (to != "outdoor" or supplied):
-            pairs.append(("thermal_bridge", target))
-    pairs += [(effect, name) for effect in ("internal_gain", "inside_convection", "envelope_conductance",
-                                            "internal_mass", "heat_input_lag", "heat_input_split",
-                                            "shading_transmittance")
-              if EFFECTS[effect].applies(building, name)]
-    return pairs + house_effects(building, name)
-
-
-def house_effects(building, zone):
-    """The house-level effects on a zone's air: its supply flow, its heat input's reading, the air
-    it exchanges with each zone it shares a component with, and the conductances to each boundary
-    column its surfaces or bridges see."""
-    pairs = [(effect, zone) for effect in ("supply_flow", "heat_input_factor")
-             if EFFECTS[effect].applies(building, zone)]
-    pairs += [("interzone_air_exchange", t) for t in EFFECTS["interzone_air_exchange"].targets(building)
-              if zone in pair_parts(t)]
-    seen = {to for t in EFFECTS["thermal_bridge"].targets(building) for z, to in [bridge_parts(t)] if z == zone}
-    seen |= {getattr(c.outside, "temperature", None) for c in building.components if c.inside.zone == zone}
-    pairs += [("boundary_conductance", c) for c in EFFECTS["boundary_conductance"].targets(building) if c in seen]
-    return pairs
+    """The effects the catalogue offers one zone's air (`Effect.offers`), the registry's order: its
+    air change with the outside (`thermal_bridge` where the zone has supply air, whose flow is
+    known, `infiltration` otherwise) and bridges to the boundary temperatures its surfaces see, a
+    constant gain, inside convection, one factor on its envelope, an internal mass, and where it
+    has a heat input the heater's lag and the input's split, and where it has shaded glazings
+    their shadings' leak; and the house-level effects on it: its supply flow, its heat input's
+    reading, the air it exchanges with each zone it shares a component with, and the
+    conductances to each boundary column its surfaces or bridges see."""
+    return [(effect.id, target) for effect in EFFECTS.values() if effect.offers is not None
+            for target in effect.offers(building, name)]
 
 
 def component_effects(building, name):
     """The effects of one component: those whose target it is (a ground coupling under an
     adiabatic face, its outside absorptance, its conductivity, a glazing's transmittance), and
-    a glazing's transmittance where the component receives its sun."""
+    a glazing's transmittance where the component receives its sun; no shape (`Effect.shape`)."""
     nodes = set(building.component(name).node_ids)
     components = {c.name for c in building.components}
-    return [(effect.id, target) for effect in EFFECTS.values() if not POLICY.is_shape(effect.id)
+    return [(effect.id, target) for effect in EFFECTS.values() if not effect.shape
             for target in effect.targets(building) if target in components
             and (target == name or nodes & set(effect.points_at(building, target)))]
 
 
 def calibration_start(building, effect, target):
     """Where a calibration starts: the declared values, except that an absent coupling (U = 0,
-    n = 0, UA = 0, a closed shading's leak f = 0) starts at `ABSENT_START` and an absent zone node
-    (C = 0) at `ZONE_START`: on its bound, a bounded trust-region step is scaled to nothing and the
-    fit stops where it began, and at U = 0 the ground temperature (at C = 0 the node's
-    conductance) has no influence to fit at all; an absent door, V = 0, likewise. Any other value
-    on or beyond a bound of the range (a heater declared all convective, f_r = 0) starts `INSIDE`
-    of the range inside it, for the same reason: declared there, the effect was never calibrated.
-    Every value returned is strictly inside the range a calibration explores."""
-    values = EFFECTS[effect].read(building, target)
-    for name, value in values.items():
-        if value == 0.0 and (effect, name) in ABSENT_START:
-            values[name] = ABSENT_START[(effect, name)]
-        if value == 0.0 and (effect, name) in ZONE_START:
-            values[name] = ZONE_START[(effect, name)] * RHO_C_AIR * building.zone(target).volume
+    n = 0, UA = 0, a closed shading's leak f = 0) or an absent zone node (C = 0) starts at its
+    record's `absent_start` (`Effect.start`): on its bound, a bounded trust-region step is scaled
+    to nothing and the fit stops where it began, and at U = 0 the ground temperature (at C = 0 the
+    node's conductance) has no influence to fit at all; an absent door, V = 0, likewise. Any other
+    value on or beyond a bound of the range (a heater declared all convective, f_r = 0) starts
+    `INSIDE` of the range inside it, for the same reason: declared there, the effect was never
+    calibrated. Every value returned is strictly inside the range a calibration explores."""
+    values = EFFECTS[effect].start(building, target)
     for p, (low, high) in zip(EFFECTS[effect].parameters, EFFECTS[effect].bounds(building, target)):
         step = INSIDE * (high - low if math.isfinite(high - low) else 1.0)
         if values[p.name] <= low:

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from nodeforce import tempdirs
+from nodeforce.runtime import tempdirs
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnosis.report.figures import plot_comparison

@@ -49,11 +49,11 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from nodeforce import lifetime
-from nodeforce.cluster import Cluster
+from nodeforce.runtime import lifetime
+from nodeforce.runtime.cluster import Cluster
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
-from nodeforce.diagnosis.assess import assess, protocols
+from nodeforce.diagnosis.assess import RoundInputs, assess, protocols
 from nodeforce.diagnosis.calibrate import Candidate
 from nodeforce.diagnosis.candidates import physical, shaped_inputs, shapes
 from nodeforce.diagnosis.compare import compare
@@ -61,15 +61,15 @@ from nodeforce.diagnosis.loss import heat_loss
 from nodeforce.diagnosis.report import write_report
 from nodeforce.diagnosis.phases import phase_errors, worsened
 from nodeforce.diagnosis.residuals import diagnostics as residual_diagnostics
-from nodeforce.diagnosis.policy import POLICY
-from nodeforce.diagnosis.result import (CrossValidation, Diagnosis, Fit, LaterRecord, OwnSensors, RecordOutcome,
-                                        SensorEvidence, added_effects, last_change)
+from nodeforce.diagnosis.policy import Policy
+from nodeforce.diagnosis.result import (Baseline, CrossValidation, Diagnosis, Fit, LaterRecord, OwnSensors,
+                                        RecordOutcome, SensorEvidence, added_effects, last_change)
 from nodeforce.diagnosis.selection import decide, revisited
 from nodeforce.diagnosis.sensitivity import sensitivity
 from nodeforce.diagnosis.windows import Record, Windows, period
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.iotools.energyplus_corrections import idf_of, write_corrections
-from nodeforce.ga.locate import check_measured, evaluator_kind, locate
+from nodeforce.ga.locate import Execution, SearchSettings, check_measured, evaluator_kind, locate
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
 from nodeforce.model.score import Noise
@@ -108,33 +108,33 @@ class Model:
         return Model(building, runs, windows.metrics(objective, runs), bases)
 
 
-def assess_all(model, pairs, windows, objective, sigma, folder, seed, runner, beside=(), held=None):
-    """Each (effect, target) added to `model`, calibrated on every record's calibration window
-    (t_0..t_k) with a fold per block, and run over each record, where `runner` runs tasks (this
-    process, `lifetime.InProcess`; the command's `lifetime.Workers`; a Dask
-    `nodeforce.cluster.Cluster`'s workers), each candidate's building file written in
-    `folder`: their `Assessed`, in the order of `pairs`. `sigma`: the sensors' noise (C),
-    against which a component's own nodes are weighed in its fit (`calibrate.own_weights`).
-    `beside`: effects `model` holds ((effect, target)) refitted together with each candidate,
-    those of their parameters `held` ({label: names}) kept as they are (`calibrate.Candidate`)."""
-    shared = (model.building, model.bases, windows.calibrations, windows.cases, objective, windows.blocks,
-              windows.sensors, windows.calibration_numerical(), windows.calibration_numerical(sensors=True), sigma,
-              seed, tuple(beside), held or {})
+def assess_all(inputs, pairs, folder, runner):
+    """Each (effect, target) added to the model of the round's `inputs` (`assess.RoundInputs`),
+    calibrated on every record's calibration window (t_0..t_k) with a fold per block, and run
+    over each record, where `runner` runs tasks (this process, `lifetime.InProcess`; the
+    command's `lifetime.Workers`; a Dask `runtime.cluster.Cluster`'s workers), each
+    candidate's building file written in `folder`: their `Assessed`, in the order of `pairs`.
+    The inputs' `sigma`, the sensors' noise (C), is what a component's own nodes are weighed
+    against in its fit (`calibrate.own_weights`); their `beside`, the effects the model holds
+    refitted together with each candidate, those of their parameters `held` kept as they are
+    (`calibrate.Candidate`)."""
     with tqdm(total=len(pairs), desc="calibrating candidate effects", unit="candidate",
               disable=not sys.stderr.isatty()) as bar:
-        assessed = runner.map_shared(assess, shared, pairs, done=bar.update)
+        assessed = runner.map_shared(assess, inputs, pairs, done=bar.update)
     for (effect, target), a in zip(pairs, assessed):
         (folder / f"{effect}@{target}.json").write_text(json.dumps(a.building, indent=2) + "\n")
     return list(assessed)
 
 
-def fits_of(model, base, pairs, assessed, windows, objective, sigma, number=1, on_top_of=()):
+def fits_of(model, base, pairs, assessed, windows, inputs, number=1, on_top_of=()):
     """The candidates' `Fit`s and their `Model`s by label, from their `Assessed`: what each
     predicts of the air left out and of the other sensors over the blocks, each sensor weighted
     by the least misfit the model or any of these candidates leaves there
     (`Windows.sensor_weights`), and of its own component's sensors (`OwnSensors`); `base`: the
-    model's other sensed nodes (`Windows.sensed_by`); `sigma`: the air sensors' noise (C);
-    `number`: the round; `on_top_of`: the labels of the effects `model` holds."""
+    model's other sensed nodes (`Windows.sensed_by`); `inputs`: the round's
+    (`assess.RoundInputs`: its objective, the air sensors' noise `sigma`, C); `number`: the
+    round; `on_top_of`: the labels of the effects `model` holds."""
+    objective, sigma = inputs.objective, inputs.sigma
     n = windows.scored()
     sensed = {i for ids in windows.sensors for i in ids}
     weights = windows.sensor_weights([base] + [a.sensed for a in assessed], sigma)
@@ -142,7 +142,7 @@ def fits_of(model, base, pairs, assessed, windows, objective, sigma, number=1, o
     for (effect, target), a in zip(pairs, assessed):
         metrics = windows.metrics(objective, a.runs)
         sensor_blocks, sensor_residuals, readings, counted = windows.sensor_scores(a.sensed, weights)
-        physics = POLICY.facts(model.building, effect, target, sensed)
+        physics = windows.policy.facts(model.building, effect, target, sensed)
         fit = Fit(effect, target, a.parameters, a.determined, physics,
                   CrossValidation([float(np.nansum(np.square(f["residuals"]))) for f in a.folds], n,
                                   [f["values"] for f in a.folds],
@@ -170,30 +170,30 @@ def own_sensors(building, component, windows, base, sensed):
     return OwnSensors([float(v) for v in before], [float(v) for v in after], n, windows.own_numerical(columns))
 
 
-def diagnose(building, records, objective, workdir, *, source="measurements", fraction=0.6, calibration_end=None,
-             seed=0, workers=None, scheduler=None, population=30, generations=400, fmu_kind="python",
-             search_fmu="auto", reference=None, noise=None, phases=None, later=()):
+def diagnose(building, records, workdir, objective, *, search=SearchSettings(), execution=Execution(), noise=None,
+             reference=None, later=(), policy=None):
     """Run the whole loop, its stages in order (`prepare`, `localise`, `rounds`, `write`); write the
     artifacts in `workdir`; return the `Diagnosis` (report.json is its `to_json()`).
 
-    `records` is a Case (one record: `source`, `fraction`, `calibration_end` and `phases` are
-    its) or a list of `Record`s of the same building, each with its own windows and phases: the
+    `records` is a Case (one record, its windows `Record`'s defaults) or a list of `Record`s of
+    the same building, each with its own windows and phases: the
     fits minimise the sum of every record's calibration J, the choice reads every record's
     blocks, and a candidate that harms one record is refused (`selection.decide`). The forcing
-    search reads every record's calibration window together, then, reported, each one's alone.
-    `reference` ({"label", "rmse": {phase: K}}), another model's error, is reported for scale;
-    `noise` (C) is the air sensors' noise sd if the user knows it, else it is estimated from
-    every record's air. `fmu_kind`: the FMUs of the model before and after, run and written
-    (`fmu_build.build.build_fmu`'s kinds, or "auto", `ga.locate.evaluator_kind`); `search_fmu`:
-    the FMUs the forcing search drives (`ga.locate.locate`'s `fmu_kind`; "auto": the standalone
-    where it can run the building). `scheduler` ("tcp://host:port"): the forcing search and every
-    round's candidates run on that Dask cluster's workers (`nodeforce.cluster`) instead of
-    `workers` processes; an unreachable one is an InputError before any work.
+    search reads every record's calibration window together, then, reported, each one's alone,
+    under `search` (`ga.locate.SearchSettings`: its seed, which the rounds' screening reads too,
+    its GA settings and the FMUs it drives). `execution` (`ga.locate.Execution`): the FMUs of the
+    model before and after, run and written, and where the work runs: a Dask scheduler's workers
+    (`runtime.cluster`; an unreachable one is an InputError before any work) or `workers`
+    processes. `reference` ({"label", "rmse": {phase: K}}), another model's error, is reported
+    for scale; `noise` (C) is the air sensors' noise sd if the user knows it, else it is estimated
+    from every record's air.
     `later`: `Record`s of the same building under the building file's protocol, read from their
     files (`nodeforce.read_record`), which nothing but the final comparison reads (`scored_later`):
-    no fit, no choice, no cross-validation."""
+    no fit, no choice, no cross-validation. `policy`: the `diagnosis.policy.Policy` every choice
+    is made under (default `Policy()`), recorded in report.json."""
+    policy = Policy() if policy is None else policy
     if not isinstance(records, (list, tuple)):
-        records = [Record(records, source, source, fraction, calibration_end, tuple(phases or ()))]
+        records = [Record(records, name="measurements")]
     names = [r.name for r in [*records, *later]]
     for r in [*records, *later]:
         if names.count(r.name) > 1:
@@ -204,17 +204,18 @@ def diagnose(building, records, objective, workdir, *, source="measurements", fr
             raise InputError(r.source, "later", f"record {r.name}: a later record is read from its files "
                                                 f"(read_record) for the building diagnosed, {building.source}")
     bases = [protocol(building, r) for r in records]
-    fmu_kind = evaluator_kind(fmu_kind, [building, *filter(None, bases)])
+    fmu_kind = evaluator_kind(execution.fmu_kind, [building, *filter(None, bases)])
     # one set of workers for the search and the rounds, started first: their imports overlap `prepare`
-    count = workers or os.cpu_count()
-    with Cluster(scheduler) if scheduler is not None else \
+    count = execution.workers or os.cpu_count()
+    with Cluster(execution.scheduler) if execution.scheduler is not None else \
             lifetime.worker_pool(count) if count > 1 else nullcontext(lifetime.InProcess()) as runner:
-        prepared = prepare(building, records, bases, objective, workdir, fmu_kind, noise)
-        search = dict(seed=seed, workers=runner, population=population, generations=generations,
-                      fmu_kind=search_fmu, noise=prepared.noise.sigma if prepared.noise.given else None)
-        located = localise(building, prepared, objective, workdir, search)
-        made = rounds(prepared, located.localization, objective, workdir, seed, runner)
-    return write(building, prepared, located, made, objective, workdir, fmu_kind, reference, later)
+        prepared = prepare(building, records, bases, objective, workdir, fmu_kind, noise, policy)
+        settings = dict(seed=search.seed, workers=runner, population=search.population,
+                        generations=search.generations, fmu_kind=search.fmu_kind,
+                        noise=prepared.noise.sigma if prepared.noise.given else None)
+        located = localise(building, prepared, objective, workdir, settings)
+        made = rounds(prepared, located.localization, objective, workdir, search.seed, runner)
+    return write(building, prepared, located, made, objective, workdir, reference, later)
 
 
 @dataclass
@@ -222,14 +223,20 @@ class Prepared:
     """What every stage reads (`prepare`): the records, their windows (with the file's numerical
     error), each record's protocol's building (`bases`, None: the building's), the model as
     described (its runs over each record and its metrics), the noise, the residuals the
-    blocks score (`n`) and the building's FMU."""
+    blocks score (`n`), the kind of the model's FMUs and the building's FMU."""
     records: list
     windows: Windows
     bases: list
     model: Model
     noise: Noise
     n: int
+    fmu_kind: str  # the FMUs of the model before and after (`fmu_build.build.build_fmu`'s kinds)
     fmu: Path | None = None  # the building's own FMU (model_before.fmu), where a record is under its protocol
+
+    @property
+    def policy(self):
+        """The `diagnosis.policy.Policy` every choice is made under (the windows')."""
+        return self.windows.policy
 
 
 @dataclass
@@ -259,12 +266,12 @@ class Made:
         return added_effects(self.decisions)
 
 
-def prepare(building, records, bases, objective, workdir, fmu_kind, noise):
-    """Stage 1: the records' windows; the building as described (each record's protocol's,
-    `bases`: `protocol` of each record) built as an FMU and run over each record
-    (`model_before.fmu`); the file's own numerical error beside it; the noise (C), `noise` if the
-    user gave it."""
-    windows = Windows.of(records, objective)
+def prepare(building, records, bases, objective, workdir, fmu_kind, noise, policy):
+    """Stage 1: the records' windows, judged under `policy`; the building as described (each
+    record's protocol's, `bases`: `protocol` of each record) built as an FMU and run over each
+    record (`model_before.fmu`); the file's own numerical error beside it; the noise (C), `noise`
+    if the user gave it."""
+    windows = Windows.of(records, objective, policy)
     before_runs, fmus = [], {}  # {the record's protocol's index, None for the building's own: its FMU}
     for i, (case, base) in enumerate(zip(windows.cases, bases)):
         key = None if base is None else i
@@ -276,7 +283,7 @@ def prepare(building, records, bases, objective, workdir, fmu_kind, noise):
     model = Model(building, before_runs, windows.metrics(objective, before_runs), bases)
     windows = windows.with_numerical(before_runs, windows.sensed_by(model), building, bases, objective)
     noise = Noise.of_records(windows.measured, noise).with_numerical(windows.numerical_rms())
-    return Prepared(list(records), windows, bases, model, noise, windows.scored(), fmus.get(None))
+    return Prepared(list(records), windows, bases, model, noise, windows.scored(), fmu_kind, fmus.get(None))
 
 
 def localise(building, prepared, objective, workdir, search):
@@ -298,17 +305,17 @@ def localise(building, prepared, objective, workdir, search):
 
 
 def rounds(prepared, localization, objective, workdir, seed, runner=lifetime.InProcess()):
-    """Stage 3: rounds of candidates, `POLICY.max_rounds` at most, each on top of the last,
+    """Stage 3: rounds of candidates, `Policy.max_rounds` at most, each on top of the last,
     while the error left is above the noise and one is chosen (`selection.decide`); the
     candidates where `runner` runs tasks, which ran the forcing search (`assess_all`)."""
-    windows, n, noise = prepared.windows, prepared.n, prepared.noise
+    windows, n, noise, policy = prepared.windows, prepared.n, prepared.noise, prepared.policy
     folder = workdir / "candidates"
     folder.mkdir(exist_ok=True)
     measured_ids = sorted({i for case in windows.cases for i in case.measured_ids})
     model, decisions, results, runs, sensitivities = prepared.model, [], [], {}, {}
-    for number in range(POLICY.max_rounds):
+    for number in range(policy.max_rounds):
         base_blocks = windows.block_J(model.runs)
-        air_at_noise = bool(number) and POLICY.at_noise(base_blocks.sum(), n, noise.floor_sd)
+        air_at_noise = bool(number) and policy.at_noise(base_blocks.sum(), n, noise.floor_sd)
         base_sensed = windows.sensed_by(model)  # the round's model at the other sensors: one run per record
         if air_at_noise and not windows.disagreeing(model.building, base_sensed, noise.sigma):
             break  # the error left is the noise's, at the air and at every component's own sensors
@@ -318,25 +325,23 @@ def rounds(prepared, localization, objective, workdir, seed, runner=lifetime.InP
         into = folder / f"round{number + 1}" if number else folder
         into.mkdir(exist_ok=True)
         pairs = [p for p in physical(model.building, localization["components"], objective.zones,
-                                     measured_ids, localization["best_nodes"]) if "@".join(p) not in done]
-        assessed = assess_all(model, pairs, windows, objective, noise.sigma, into, seed, runner)
-        tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma, number + 1,
-                                done)
+                                     measured_ids, policy, localization["best_nodes"]) if "@".join(p) not in done]
+        inputs = RoundInputs.of(model, windows, objective, noise.sigma, seed)
+        assessed = assess_all(inputs, pairs, into, runner)
+        tried, models = fits_of(model, base_sensed, pairs, assessed, windows, inputs, number + 1, done)
         # shapes only where no physical candidate physics admits brings the error left to the
         # noise; the residual's statistics then choose which
-        if not any(POLICY.at_noise(r.cv.J, n, noise.floor_sd) and not POLICY.objection_of(
+        if not any(policy.at_noise(r.cv.J, n, noise.floor_sd) and not policy.objection_of(
                 r.effect, r.parameters, r.derived, r.physics) for r in tried):
             more = [p for p in shapes(model.building, left_by(windows, model), objective.zones)
                     if "@".join(p) not in done]
-            pairs, assessed = pairs + more, assessed + assess_all(model, more, windows, objective, noise.sigma,
-                                                                  into, seed, runner)
+            pairs, assessed = pairs + more, assessed + assess_all(inputs, more, into, runner)
             # every sensor's weight from the least misfit any candidate of the round leaves
-            tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma,
-                                    number + 1, done)
+            tried, models = fits_of(model, base_sensed, pairs, assessed, windows, inputs, number + 1, done)
         simulations = sum(a.simulations for a in assessed)
         # a round run for a component's own sensors alone: only they can make a candidate pass
-        decision = decide(tried, base_blocks, noise.sigma, n, windows.groups(), noise.floor_sd,
-                          air_at_noise=air_at_noise)
+        decision = decide(tried, Baseline(base_blocks, noise.sigma, n, windows.groups(), noise.floor_sd,
+                                          air_at_noise=air_at_noise), policy)
         decision.cost = {"candidates": len(tried), "simulations": simulations,
                          "seconds": round(time.perf_counter() - started, 1)}
         decisions.append(decision)
@@ -369,7 +374,7 @@ def revisit(prepared, made, fit, objective, folder, seed, runner):
     effects would keep the share of the revisited one they took on top of it; refitted
     together, each candidate is judged as the rounds judge, the model around it fitted anew.
     The last round's choice is not revisited: the earlier ones were refitted with it."""
-    windows, n, noise = prepared.windows, prepared.n, prepared.noise
+    windows, n, noise, policy = prepared.windows, prepared.n, prepared.noise, prepared.policy
     number = len(made.decisions) + 1
     others = [a for a in made.added if a.label != fit.label]
     model = made.model.without(fit.effect, fit.target, prepared.model, windows, objective)
@@ -377,18 +382,18 @@ def revisit(prepared, made, fit, objective, folder, seed, runner):
     tried_in = {r.label: r for r in made.results if r.round == chosen_in.chosen.round}
     nearest = sorted((v.evidence, label) for label, v in chosen_in.verdicts.items()
                      if v.passes and not v.objection and label in tried_in and label not in {a.label for a in others})
-    labels = [fit.label] + [label for _, label in nearest if label != fit.label][:POLICY.revisited - 1]
+    labels = [fit.label] + [label for _, label in nearest if label != fit.label][:policy.revisited - 1]
     pairs = [(tried_in[label].effect, tried_in[label].target) for label in labels]
     started = time.perf_counter()
     into = folder / f"revisit{number}"
     into.mkdir(exist_ok=True)
     base_sensed = windows.sensed_by(model)
-    assessed = assess_all(model, pairs, windows, objective, noise.sigma, into, seed, runner,
-                          [(a.effect, a.target) for a in others],
-                          {a.label: [name for name, p in a.parameters.items() if p.get("prior")] for a in others})
-    tried, models = fits_of(model, base_sensed, pairs, assessed, windows, objective, noise.sigma, number,
-                            [a.label for a in others])
-    decision = decide(tried, windows.block_J(model.runs), noise.sigma, n, windows.groups(), noise.floor_sd)
+    inputs = RoundInputs.of(model, windows, objective, noise.sigma, seed, [(a.effect, a.target) for a in others],
+                            {a.label: [name for name, p in a.parameters.items() if p.get("prior")] for a in others})
+    assessed = assess_all(inputs, pairs, into, runner)
+    tried, models = fits_of(model, base_sensed, pairs, assessed, windows, inputs, number, [a.label for a in others])
+    decision = decide(tried, Baseline(windows.block_J(model.runs), noise.sigma, n, windows.groups(), noise.floor_sd),
+                      policy)
     chosen = decision.chosen
     decision = revisited(decision, fit.label, [a.label for a in others],
                          chosen and assessed[[t.label for t in tried].index(chosen.label)].beside)
@@ -420,11 +425,11 @@ def screened(model, chosen, windows, objective, seed):
 def left_by(windows, model):
     """What the model's residual on the first record's calibration window follows (an input, the
     time of day)."""
-    first, k0 = windows.cases[0], windows.ks[0]
+    first, k0 = windows.each[0].case, windows.each[0].k
     shaped = shaped_inputs(model.building)
     inputs = {name: values for name, values in zip(first.input_names, first.U[1:k0 + 1].T) if name in shaped}
-    return residual_diagnostics(windows.calibrations[0].times[1:],
-                                windows.measured[0][:k0][:, 0] - model.runs[0][:k0, 0], inputs)
+    return residual_diagnostics(windows.each[0].calibration.times[1:],
+                                windows.each[0].measured[:k0][:, 0] - model.runs[0][:k0, 0], inputs)
 
 
 def priors_stated(building, added):
@@ -439,12 +444,13 @@ def priors_stated(building, added):
     return building.edited(lambda data: data.update(description=" ".join([data.get("description", "")] + said).strip()))
 
 
-def write(building, prepared, located, made, objective, workdir, fmu_kind, reference, later=()):
+def write(building, prepared, located, made, objective, workdir, reference, later=()):
     """Stage 4: the model the rounds leave written (`building_after.json`, `model_after.fmu`,
     each protocol's building, `model_after.idf` for a converted EnergyPlus model), scored on
     each later record (`scored_later`), the `Diagnosis`, written as report.json, report.md and
     the plots; returns it."""
     windows, records, model, added = prepared.windows, prepared.records, made.model, made.added
+    fmu_kind = prepared.fmu_kind
     (workdir / "building_after.json").write_text(json.dumps(priors_stated(model.building, added).to_json(), indent=2)
                                                  + "\n")
     fmu_after = build_fmu(model.building, workdir / "model_after.fmu", kind=fmu_kind)
@@ -461,7 +467,7 @@ def write(building, prepared, located, made, objective, workdir, fmu_kind, refer
         after=model.metrics, localization=located.localization, candidates=made.results, rounds=made.decisions,
         structure_left=left_by(windows, model)["sentence"],
         heat_loss=heat_loss(building, model.building, added, made.results, prepared.noise.sigma,
-                            last_change(made.decisions)),
+                            prepared.policy.yardstick, last_change(made.decisions)),
         residuals=validation_residuals(prepared, made), sensitivity=made.sensitivities, noise=prepared.noise,
         assumptions=list(dict.fromkeys(a for case in windows.cases for a in case.assumptions)),
         node_names={str(i): name for i, name in building.node_names().items()},
@@ -472,7 +478,7 @@ def write(building, prepared, located, made, objective, workdir, fmu_kind, refer
                                str(protocols_after[i]) if i in protocols_after else None)
                  for i, r in enumerate(records)] if len(records) > 1 else [],
         worsened_phases=worsened(by_phase, "before", "after") if by_phase and added else None,
-        phases=by_phase or None, reference=reference or None, later=later)
+        phases=by_phase or None, reference=reference or None, later=later, policy=prepared.policy)
     idf = idf_of(building)
     if idf is not None:  # a converted EnergyPlus model: its corrections written back into it
         diagnosis.energyplus = write_corrections(building, model.building, [(a.effect, a.target) for a in added],
@@ -499,7 +505,7 @@ def validation_residuals(prepared, made):
     """What the first objective zone's residual on the first record's validation window follows
     (`diagnosis.residuals`), before and after."""
     windows = prepared.windows
-    first, k, measured = windows.cases[0], windows.ks[0], windows.measured[0]
+    first, k, measured = windows.each[0].case, windows.each[0].k, windows.each[0].measured
     validation = slice(k, None)
     return {state: residual_diagnostics(first.times[1:][validation], measured[validation, 0] - run[0][validation, 0],
                                         {name: values[validation] for name, values in
@@ -524,7 +530,7 @@ def plotted(prepared, located, made, objective):
     """The series the plots draw, from the first measurement: the weather's history before it is
     not the record."""
     windows = prepared.windows
-    first, k, measured = windows.cases[0], windows.ks[0], windows.measured[0]
+    first, k, measured = windows.each[0].case, windows.each[0].k, windows.each[0].measured
     times, h = first.times, first.history_steps
     return {"times": times[h + 1:], "validation_start": times[k + 1], "scored_from": times[first.burn_in_steps + 1],
             "convergence": located.convergence,

@@ -10,7 +10,6 @@ agree on the HLC, the report says the split is not the record's.
 """
 import math
 
-from nodeforce.diagnosis.policy import POLICY
 from nodeforce.model.hlc import heat_loss_coefficient
 
 HLC = "heat_loss_coefficient"
@@ -21,7 +20,7 @@ AGREE_Z = 2.0
 AGREE_RELATIVE = 0.05
 
 
-def heat_loss(before_building, after_building, added, results, sigma, last=None):
+def heat_loss(before_building, after_building, added, results, sigma, yardstick, last=None):
     """report.json's `heat_loss_coefficient`: {"before", "after", "after_sd"} (W/K) and "split",
     a sentence where the data fix the HLC but not how it splits among effects (else None).
 
@@ -32,6 +31,7 @@ def heat_loss(before_building, after_building, added, results, sigma, last=None)
         the model with the effect and its sd from the calibration's covariance)
     results : every candidate's `Fit`, each with the `round` it was tried in
     sigma : the air sensors' noise sd (C), which sets the change of J no test can tell apart
+    yardstick : the `model.score.Yardstick` that says what change of J the noise could make
     last : the `Fit` whose model is `after_building` (`result.last_change`), default the last added
     """
     last = last or (added[-1] if added else None)
@@ -40,7 +40,7 @@ def heat_loss(before_building, after_building, added, results, sigma, last=None)
     rounds = [[r for r in results if r.round == number] for number in range(1, len(added) + 1)]
     starts = [{"value": out["before"], "std": 0.0}] + [a.derived[HLC] for a in added]
     for chosen, start, tried in zip(added, starts, rounds):
-        alike = same_loss(chosen, tried, start, sigma)
+        alike = same_loss(chosen, tried, start, sigma, yardstick)
         if alike:
             hlc = chosen.derived[HLC]
             out["split"] = (f"The data fix the heat loss coefficient ({hlc['value']:.1f} ± {hlc['std']:.1f} W/K) "
@@ -52,17 +52,17 @@ def heat_loss(before_building, after_building, added, results, sigma, last=None)
     return out
 
 
-def same_loss(chosen, tried, start, sigma):
+def same_loss(chosen, tried, start, sigma, yardstick):
     """The other candidates of `chosen`'s round that change the loss from the round's `start`
     ({"value", "std"}, W/K) as the chosen does: the same HLC, each well determined, and a
     cross-validated J the chosen's does not beat by more than the noise could
-    (`diagnosis.policy.Policy.least_fall`).
+    (`model.score.Yardstick.least_fall`).
     None of them when the chosen changes no loss (a gain, a mass)."""
     hlc = chosen.derived.get(HLC)
     if not hlc or not moves(hlc, start):
         return []
     J, n = chosen.cv.J, chosen.cv.n
-    margin = POLICY.least_fall(J, sigma, n)
+    margin = yardstick.least_fall(J, sigma, n)
     return [r for r in tried if r.label != chosen.label and r.derived.get(HLC)
             and agree(hlc, r.derived[HLC]) and moves(r.derived[HLC], start)
             and r.cv.J - J <= margin]

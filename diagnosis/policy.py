@@ -1,40 +1,18 @@
-"""How the diagnosis chooses an effect: every threshold, table and order of the choice, in one
-frozen object (`POLICY`), read by the rest of the loop and by nothing else re-derived.
-
-The choice of a round, in order (docs/method.md, "Choosing an effect"; `diagnosis.selection.decide`):
-
-1. Pass. A candidate's cross-validated fall of J (C2, whole days as blocks, at least
-   `min_blocks`) must beat `least_fall`, what noise alone could make of J, and
-   `standard_errors` standard errors of its day-to-day scatter, on more days than its best.
-2. Objections. Physics may refuse a candidate that passes (`objection`): a gain the file's
-   description rules out, a parameter on a bound or not identifiable (`identifiable`, unless the
-   quantity its parameters trade off along is: `trade_offs`), a value beyond `physical_limits`
-   or `room_convection` by more than `limit_sds` of its standard deviations.
-3. The band. Among the admissible, those whose evidence (the air left out and the other
-   sensors, each weighted by `sensor_weight`) exceeds the best's by no more than
-   `standard_errors` standard errors of the paired difference (at least `rounding_share` of J),
-   and by no more than `noise_change` where the best claims more, cannot be told from it.
-4. The order. Within the band the one that claims least is chosen (`claim`): a physical effect
-   before a shape (`shapes`), fewer parameters before more, a zone's effect before that of one
-   component no sensor of which is measured; then the lower evidence.
-
-Rounds go on, `max_rounds` at most, while the error left is above the noise (`at_noise`), at
-the objective air or at a component's own sensors (the noise and the file's numerical error
-there), and a candidate passes. The yardsticks say their units: `noise_J` and `noise_change` are J (C2);
-the sd they are computed from (`model.score.Noise.floor_sd`) is in C.
+"""Every threshold, table and order of the diagnosis' choice, in one frozen object (`Policy`),
+passed to the loop (`diagnosis.loop.diagnose`'s `policy`) and recorded in report.json
+(`Policy.to_json`), so that `diagnosis.result.Diagnosis.replay` judges a report under the values
+it was made with. Each field says what it sets and in which unit; how the choice uses them, step
+by step: docs/method.md, "Choosing an effect". The noise's yardstick and the pass rule are
+`model.score.Yardstick` (`Policy.yardstick`), which the forcing search reads too.
 """
 import math
-from dataclasses import dataclass, field
-from types import MappingProxyType
+from dataclasses import asdict, dataclass, fields
 
 import numpy as np
 from scipy.special import chdtrc
 
-from nodeforce.model.effects import EFFECTS, bridge_parts
-
-
-def _frozen(table):
-    return field(default_factory=lambda: MappingProxyType(dict(table)))
+from nodeforce.model.effects import EFFECTS
+from nodeforce.model.score import Yardstick
 
 
 @dataclass(frozen=True)
@@ -46,25 +24,17 @@ class Policy:
     # ... and any component whose forcing removes at least this share of J above the noise
     # (dimensionless), however far down the ranking.
     evident_share: float = 0.25
-    # The effects that stand for a heat source the model lacks rather than a property of the
-    # building: tried only where no physical effect brings the error to the noise, chosen only
-    # where none fits as well.
-    shapes: tuple = ("daily_gain", "proportional_gain")
 
     # -- 1. pass
     # Whole days a calibration window must hold for the cross-validation (days): one fold needs
     # another day to be fitted on.
     min_blocks: int = 2
-    # Standard deviations of J of pure noise, sd^2 sqrt(2 n), a change of J must exceed to be more
-    # than noise (dimensionless): three keep a record with no fault from gaining an effect.
-    noise_sds: float = 3.0
-    # The least fall of J worth an effect, as a share of the model's cross-validated J
-    # (dimensionless): where the noise is unknown or nil, a tiny gain is not a fault.
-    least_fall_share: float = 0.01
-    # Standard errors of its day-to-day scatter a fall must exceed, and the width of the band of
-    # candidates the data cannot tell apart (dimensionless): one, not a Student t quantile, since a
-    # real effect's size follows the weather from day to day.
-    standard_errors: float = 1.0
+    # The noise yardstick of a fall of J and the pass rule (`model.score.Yardstick`): how many sds
+    # of J of pure noise a change must exceed, the least fall as a share of J, the standard errors
+    # of its day-to-day scatter a fall must exceed (and the width of the band of candidates the
+    # data cannot tell apart), and the share of J that is rounding; the forcing search's
+    # parsimony reads the same.
+    yardstick: Yardstick = Yardstick()
 
     # -- 2. objections
     # A scale parameter, or a derived quantity, is identifiable when its sd is under this share
@@ -76,34 +46,8 @@ class Policy:
     # (dimensionless): a door at ten times its wood's conductivity, estimated at 11.4 +- 1.5, may
     # well be at ten; only an estimate whose two-sided 95 % interval leaves the range is not.
     limit_sds: float = 2.0
-    # Physical limits (low, high) in the parameter's unit, tighter than the range a calibration
-    # explores: beyond them a value is a fit compensating something else. A gain to the air is a
-    # source (a sink would be a cooler the file declares); conductance scales within a factor of
-    # ten of the file's; a heater or meter off its reading by more than two is a fault the file
-    # should state.
-    physical_limits: MappingProxyType = _frozen({("internal_gain", "Q"): (0.0, math.inf),
-                                                 ("daily_gain", "mean"): (0.0, math.inf),
-                                                 ("conductivity", "factor"): (0.1, 10.0),
-                                                 ("envelope_conductance", "factor"): (0.1, 10.0),
-                                                 ("boundary_conductance", "factor"): (0.1, 10.0),
-                                                 ("supply_flow", "factor"): (0.1, 10.0),
-                                                 ("heat_input_factor", "factor"): (0.5, 2.0)})
-    # The area-weighted mean convective coefficient of a room's surfaces that air can give
-    # (W/m2/K): natural convection (Alamdari and Hammond) gives a still room about 0.6, forced
-    # convection at a hundred air changes an hour (Fisher and Pedersen) stays below 20. A limit
-    # on the coefficient, not the factor: a factor of 0.1 is 0.5 W/m2/K where a file declares 5.
-    room_convection: tuple = (0.5, 20.0)
-    # The parameters whose identifiability decides for an effect (default all): a daily
-    # profile's harmonics may each be near zero while its mean is determined.
-    judged: MappingProxyType = _frozen({"daily_gain": ("mean",)})
-    # What the data fix where an effect's parameters trade off (`diagnosis.calibrate.derived`),
-    # and whether a parameter on a bound is then waived: a ground coupling's (U, T_ground) is one
-    # of many pairs giving its flux, a bound included; a node's (C, H) and a conductivity factor,
-    # judged by their time constant and the heat the component loses, must still be inside.
-    trade_offs: MappingProxyType = _frozen({"ground_coupling": ("ground_heat_flux", True),
-                                            "conductivity": ("component_loss", False),
-                                            "heat_input_lag": ("heater_time_constant", False),
-                                            "internal_mass": ("mass_time_constant", False)})
+    # Each effect's physical limits, the parameters it is judged on and what its parameters trade
+    # off along are its record's (`model.effects.Effect`: `physical`, `judged`, `trade_off`).
 
     # -- priors (`diagnosis.calibrate`): where the data fix a combination of an effect's
     # parameters but not each one, a parameter with a physical prior (`model.effects.Prior`) is
@@ -112,9 +56,6 @@ class Policy:
     prior_level: float = 0.05
 
     # -- 3. the band
-    # A difference of J below this share of the model's cross-validated J is the simulation's
-    # rounding (dimensionless).
-    rounding_share: float = 1e-9
     # The most a sensor other than the objective air counts in the evidence (dimensionless): a
     # sensor the model follows to the noise counts fully, one it misses by more, sd^2 over its
     # mean squared residual.
@@ -137,29 +78,60 @@ class Policy:
     # share of both and the one it displaced lead their round.
     revisited: int = 5
 
-    # ---- the yardsticks
+    # ---- as report.json records it
+    def to_json(self):
+        """Every value of the policy as JSON: report.json keeps it,
+        so that a replay (`diagnosis.result.Diagnosis.replay`) judges under the values the
+        diagnosis was made with, whatever the code's defaults have become since."""
+        out = {}
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if f.name == "yardstick":
+                value = asdict(value)
+            elif isinstance(value, tuple):
+                value = list(value)
+            out[f.name] = value
+        return out
+
+    @classmethod
+    def of_json(cls, d):
+        """The policy `to_json` wrote; a value it does not hold (a report of a policy with fewer
+        values) is the default."""
+        def tupled(v):
+            return tuple(tupled(x) for x in v) if isinstance(v, list) else v
+        given = {}
+        for f in fields(cls):
+            if f.name not in d:
+                continue
+            value = d[f.name]
+            if f.name == "yardstick":
+                value = Yardstick(**value)
+            elif isinstance(value, list):
+                value = tupled(value)
+            given[f.name] = value
+        return cls(**given)
+
+    # ---- the yardsticks (`model.score.Yardstick`)
+    @property
+    def standard_errors(self):
+        return self.yardstick.standard_errors
+
     def noise_J(self, sd, n):
-        """J (C2) of n residuals of noise of sd `sd` (C) alone, n sd^2; 0 if sd is unknown."""
-        return 0.0 if sd is None else n * sd ** 2
+        return self.yardstick.noise_J(sd, n)
 
     def noise_change(self, sd, n):
-        """The change of J (C2) noise of sd `sd` (C) alone can make on n residuals,
-        `noise_sds` sd^2 sqrt(2 n); 0 if sd is unknown."""
-        return 0.0 if sd is None else self.noise_sds * sd ** 2 * math.sqrt(2 * n)
+        return self.yardstick.noise_change(sd, n)
 
     def least_fall(self, J, sd, n):
-        """The fall of J (C2) from a model of J `J` (C2) on n residuals that noise of sd `sd` (C)
-        could make, at least `least_fall_share` of J."""
-        return max(self.least_fall_share * J, self.noise_change(sd, n))
+        return self.yardstick.least_fall(J, sd, n)
 
     def at_noise(self, J, n, sd):
         """Whether an error J (C2) on n residuals is what an error of sd `sd` (C) alone leaves
         (the sensors' noise and the file's numerical error: `model.score.Noise.floor_sd`)."""
-        return J <= self.noise_J(sd, n) + self.noise_change(sd, n)
+        return self.yardstick.at_noise(J, n, sd)
 
     def rounding(self, J):
-        """A difference of J (C2) below which two candidates differ by rounding, for a model of J `J`."""
-        return self.rounding_share * J
+        return self.yardstick.rounding(J)
 
     def identifiable(self, value, sd, unit):
         """Whether an estimate `value` +- `sd` in `unit` is tight enough to act on."""
@@ -178,35 +150,33 @@ class Policy:
 
     # ---- 2. objections
     def is_shape(self, effect):
-        return effect in self.shapes
+        """Whether an effect stands for a heat source the model lacks (its record's `shape`)."""
+        return EFFECTS[effect].shape
 
     def limits(self, building, effect, target, name):
-        """The physical (low, high) of a parameter: `physical_limits`; for a proportional gain an
-        area of sun that cannot be negative (an irradiance column) or a share of a heat input
-        that cannot take away more than the input (k >= -1); for inside convection the factors
-        that bring the zone's mean declared coefficient into `room_convection`."""
-        if effect == "inside_convection":
-            declared = building.mean_inside_convection(target)
-            return tuple(h / declared for h in self.room_convection)
-        if effect == "proportional_gain":
-            _, column = bridge_parts(target)
-            heat_inputs = {c for z in building.zones for c in z.heat_input}
-            return (-1.0 if column in heat_inputs else 0.0, math.inf)
-        return self.physical_limits.get((effect, name), (-math.inf, math.inf))
+        """The physical (low, high) of a parameter: its effect's record's (`Effect.physical`: a
+        gain to the air is a source; conductance scales within a factor of ten of the file's; a
+        heater or meter off its reading by at most two; a proportional gain's area of sun not
+        negative, its share of a heat input not below -1; inside convection within what air can
+        give a room)."""
+        return EFFECTS[effect].limits_of(building, target, name)
 
     def judged_parameters(self, effect):
-        """The parameters whose identifiability and limits decide for an effect (`judged`)."""
-        return self.judged.get(effect, tuple(p.name for p in EFFECTS[effect].parameters))
+        """The parameters whose identifiability and limits decide for an effect (`Effect.judged`)."""
+        return EFFECTS[effect].judged_parameters()
 
     def facts(self, building, effect, target, sensed=()):
         """What the choice reads of the building about one candidate, as report.json keeps it:
-        each judged parameter's physical limits ([low, high], None where unbounded), why the
-        file's description makes the effect implausible (None), whether its target is one
+        each judged parameter's physical limits ([low, high], None where unbounded), what the data
+        fix where its parameters trade off (`Effect.trade_off`: [derived quantity, whether a
+        bound is then waived], None), why the file's description makes the effect implausible
+        (`Effect.implausible`, None), whether its target is one
         component and whether one of that component's nodes is among the `sensed` node ids, the
         other sensors the evidence reads (`claim`)."""
         component = target in {c.name for c in building.components}
         return {"limits": {name: [None if math.isinf(v) else v for v in self.limits(building, effect, target, name)]
                            for name in self.judged_parameters(effect)},
+                "trade_off": list(EFFECTS[effect].trade_off) if EFFECTS[effect].trade_off else None,
                 "implausible": implausible(building, effect, target),
                 "component": component,
                 "sensed": component and bool(set(building.component(target).node_ids) & set(sensed))}
@@ -219,18 +189,20 @@ class Policy:
         """Why a calibrated effect may not be added to the model, or None: a gain the building
         file's description rules out (`implausible`), a parameter on a bound of its search range
         or not identifiable from the data (unless the quantity its parameters trade off along
-        is, `trade_offs`, or the calibration held it at its physical prior), or a value outside
-        physical limits beyond its uncertainty (`limit_sds`).
+        is, `Effect.trade_off`, or the calibration held it at its physical prior), or a value
+        outside physical limits beyond its uncertainty (`limit_sds`). The judged parameters, their
+        limits and the trade-off are the candidate's `facts`, as report.json records them.
 
         parameters : {name: {"value", "std", "identifiable", "on_bound"}} of `diagnosis.calibrate`
         derived : what the data determine besides (`diagnosis.calibrate.derived`)
         facts : what the building says of the candidate (`facts`)
         """
         reasons = [facts["implausible"]]
-        key, bounds_waived = self.trade_offs.get(effect, (None, False))
+        trade_off = facts["trade_off"] if "trade_off" in facts else EFFECTS[effect].trade_off
+        key, bounds_waived = trade_off or (None, False)
         fixed = (derived or {}).get(key)
         resolved = fixed is not None and fixed["std"] < self.identifiable_share * abs(fixed["value"])
-        for name in self.judged_parameters(effect):
+        for name in facts["limits"]:
             p, unit = parameters[name], EFFECTS[effect].parameter(name).unit
             low, high = (-math.inf if facts["limits"][name][0] is None else facts["limits"][name][0],
                          math.inf if facts["limits"][name][1] is None else facts["limits"][name][1])
@@ -240,7 +212,7 @@ class Policy:
                 reasons.append(f"{name} = {p['value']:.3g} +- {p['std']:.2g} {unit} is not identifiable from these data")
             margin = self.limit_sds * p["std"]
             if not low - margin <= p["value"] <= high + margin:
-                what = "a negative gain (a heat sink)" if low == 0.0 and "gain" in effect else "outside physical limits"
+                what = "a negative gain (a heat sink)" if low == 0.0 and EFFECTS[effect].source else "outside physical limits"
                 reasons.append(f"{name} = {p['value']:.3g} +- {p['std']:.2g} {unit} is {what} [{low:.3g}, {high:.3g}] "
                                f"by more than {self.limit_sds:g} standard deviations")
         return "; ".join(r for r in reasons if r) or None
@@ -258,13 +230,8 @@ class Policy:
 
 
 def implausible(building, effect, target):
-    """Why the building file's own description makes an effect implausible, or None: a constant
-    gain in a zone the file declares unoccupied stands for a heat source the model lacks, not for
-    occupants, and the report must say so."""
-    if effect in ("internal_gain", "daily_gain") and building.zone(target).occupied is False:
-        return (f"{target} is declared unoccupied: the gain stands for a heat source the model lacks "
-                "(a heat input mis-measured, a flow of air or sun not modelled), not for occupants")
-    return None
-
-
-POLICY = Policy()
+    """Why the building file's own description makes an effect implausible (its record's
+    `implausible`: a constant gain in a zone the file declares unoccupied stands for a heat source
+    the model lacks, not for occupants), or None."""
+    record = EFFECTS[effect]
+    return record.implausible(building, target) if record.implausible else None

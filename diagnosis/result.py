@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from nodeforce.diagnosis.policy import Policy
 from nodeforce.model.score import Noise
 
 
@@ -171,6 +172,37 @@ class Verdict:
 
 
 @dataclass
+class Baseline:
+    """What a round's choice reads besides its candidates' fits (`diagnosis.selection.decide`),
+    as a decision's `inputs` keep it in report.json: the per-block J (C2) of the model the
+    candidates would be added to, the air sensors' noise sd (C; what a fixed pair's difference
+    moves by, `selection.noise_difference`), the residuals the blocks score, the records the
+    blocks come from (`selection.harmed`, where there are several), the sd (C) of what a right
+    model of the file leaves, the noise and the file's own numerical error
+    (`model.score.Noise.floor_sd`, the yardstick of a fall of J; sigma if None), the distance of
+    every two admissible candidates' residuals ({label: {label: C}}, computed from the residuals
+    if None), and whether the round runs only because a component's own sensors disagree, the
+    air's error left being the noise's (`Policy.at_noise`): a candidate then passes on its own
+    sensors alone."""
+    blocks_before: list
+    sigma: float
+    n: int
+    groups: list = ()
+    floor_sd: float = None
+    distances: dict = None
+    air_at_noise: bool = False
+
+    def to_json(self):
+        return {"blocks_before": self.blocks_before, "sigma": self.sigma, "floor_sd": self.floor_sd, "n": self.n,
+                "groups": self.groups, "distances": self.distances, "air_at_noise": self.air_at_noise}
+
+    @classmethod
+    def of_json(cls, d):
+        return cls(d["blocks_before"], d["sigma"], d["n"], d["groups"], d["floor_sd"], d["distances"],
+                   d.get("air_at_noise", False))
+
+
+@dataclass
 class Decision:
     """One round's decision (`diagnosis.selection.decide`): the candidate chosen (None), the reason
     in words, the model's cross-validated J (C2) over its blocks, the noise's margin (C2), the
@@ -305,6 +337,8 @@ class Diagnosis:
     worsened_phases, phases : the phases an added effect makes worse; every model's error per phase
     reference : another model's error, for scale; energyplus : the corrections written back
     later : each later record's score as written and as corrected (`LaterRecord`), read by nothing else
+    policy : the `diagnosis.policy.Policy` the choices were made under (report.json's `policy`);
+        a report without one was made under the default
     """
     objective: list
     period: dict
@@ -327,6 +361,7 @@ class Diagnosis:
     reference: dict = None
     energyplus: dict = None
     later: list = ()
+    policy: Policy = field(default_factory=Policy)
 
     @property
     def added(self):
@@ -366,7 +401,8 @@ class Diagnosis:
                           else {"effect": "none", "target": None, "parameters": {}}),
                "after": self.after, "heat_loss_coefficient": self.heat_loss, "assumptions": list(self.assumptions),
                "residuals": self.residuals, "sensitivity": self.sensitivity, "noise_sigma": self.noise.sigma,
-               "noise": self.noise.to_json(), "node_names": self.node_names, "artifacts": self.artifacts}
+               "noise": self.noise.to_json(), "node_names": self.node_names, "artifacts": self.artifacts,
+               "policy": self.policy.to_json()}
         if self.records:
             out["records"] = [r.to_json() for r in self.records]
         if self.later:
@@ -388,16 +424,16 @@ class Diagnosis:
         Path(path).write_text(json.dumps(self.to_json(), indent=2, default=_plain) + "\n")
 
     def replay(self):
-        """Each round's `Decision` recomputed from what the diagnosis holds alone, with the policy
-        (`diagnosis.selection.decide`): the round's candidates' fits and what its decision read
-        besides (`Decision.inputs`). On a diagnosis read from report.json it is the check that
-        the report holds every input of the choice."""
+        """Each round's `Decision` recomputed from what the diagnosis holds alone, under the policy
+        it was made with (`policy`, `diagnosis.selection.decide`): the round's candidates' fits
+        and what its decision read besides (`Decision.inputs`). On a diagnosis read from
+        report.json it is the check that the report holds every input of the choice, whatever
+        the code's default policy has become since."""
         from nodeforce.diagnosis.selection import decide, revisited  # the choice reads these records
         out = []
         for number, recorded in enumerate(self.rounds, start=1):
-            given, tried = recorded.inputs, [c for c in self.candidates if c.round == number]
-            decision = decide(tried, given["blocks_before"], given["sigma"], given["n"], given["groups"],
-                              given["floor_sd"], given["distances"], given.get("air_at_noise", False))
+            tried = [c for c in self.candidates if c.round == number]
+            decision = decide(tried, Baseline.of_json(recorded.inputs), self.policy)
             if recorded.replaces:  # a choice made again, the others refitted with each candidate
                 decision = revisited(decision, recorded.replaces, list(tried[0].on_top_of), recorded.refitted)
             out.append(decision)
@@ -417,7 +453,8 @@ class Diagnosis:
                    Noise.of_json(d["noise"]), d["assumptions"], d["node_names"], d["artifacts"],
                    [RecordOutcome.of_json(r) for r in d.get("records", ())], d["decision"].get("worsened_phases"),
                    d.get("phases"), d.get("reference"), d.get("energyplus"),
-                   [LaterRecord.of_json(r) for r in d.get("later", ())])
+                   [LaterRecord.of_json(r) for r in d.get("later", ())],
+                   Policy.of_json(d["policy"]) if "policy" in d else Policy())
 
 
 def _plain(value):

@@ -1,94 +1,30 @@
-"""The one rule that chooses an effect: blocked cross-validation over whole days.
-
-The calibration window's scored steps (after the burn-in) are cut into blocks of whole days
-(`blocks`). Each candidate is fitted on all blocks but one and scored on the block left out, every
-block in turn (`diagnosis.calibrate`): the simulation runs through the whole window, the left-out
-block's residuals are only left out of the least squares, so every block is predicted from the
-state the days before it left, as the validation window is. A day is the unit because a
-building's residual is correlated over hours and repeats with the sun: within a day, steps are
-not independent pieces of evidence, and days nearly are.
-
-`decide` judges each candidate by its fall of cross-validated J from the model it would be added
-to, block by block:
-
-1. It passes when that fall beats what noise alone gives, the change of J the sensors' noise
-   could make (`diagnosis.policy.Policy.least_fall`), and what the days' disagreement gives: one standard
-   error of the fall computed from the per-block falls, blocks as the unit, so that residuals
-   correlated within a day cannot fake significance; and when it does not come from one day
-   alone (the other days together must gain too). A calibration window holds two to five days:
-   a Student t quantile on B - 1 degrees of freedom (6.3 for two days, 2.9 for three) would ask
-   the falls to be nearly equal from day to day, while a real effect's size follows the weather
-   (a ground coupling's drift shows on some days and hardly on others); the sensor noise is
-   judged by its own yardstick instead, and the days by their consistency.
-2. Physics may still refuse it (`diagnosis.policy.Policy.objection`: a gain in a zone declared
-   unoccupied, a parameter on its bound or not identifiable, a negative gain): then it is a
-   suggestion, with its reason, never added.
-3. Among the admissible candidates that pass, the one-standard-error rule on every temperature
-   the candidate predicts and no fit read (`evidence`): the objective air on the blocks left out,
-   and the other sensors (a wall's surface, a neighbouring zone's air) over the same blocks,
-   since the fits read the air alone. Look-alikes that predict nearly the same air (an air
-   change, a bridge, an envelope factor and inside convection in a mild month; a ground coupling
-   and inside convection) predict different surfaces: inside convection moves every surface
-   from the air, an envelope factor the walls' inner faces, an air change neither, a ground
-   coupling the floor. Where sensors besides the air are measured, they are the evidence that
-   tells such corrections apart; the air alone would leave them to the noise. Each sensor counts
-   as a measurement whose error is what the model already misses there, sigma^2 over its mean
-   squared residual (at most 1): a surface the model cannot follow does not choose for the air.
-   The candidates whose evidence exceeds the best's by no more than one standard error of that
-   paired difference cannot be told apart from it, and among them a physical effect before a shape,
-   then fewer parameters before more, then a zone's effect before that of a component no sensor of
-   which is measured, then the lower evidence. A component's correction says where the fault is;
-   where the zone's own (its envelope, its air change) predicts as well and nothing but the air
-   speaks for the place, the data have not placed it there, and the components are named beside
-   the zone's effect instead (an air-only record cannot tell its walls apart); where the
-   component's own sensor is in the evidence, the lower evidence chooses. That
-   standard error is the larger of two: the difference's scatter from block to block, and what the
-   sensors' noise alone makes of it (`noise_difference`); against a candidate that claims less
-   (a physical effect against a shape, fewer parameters, the zone's own effect against one
-   component's), a candidate must also gain beyond the noise's tolerance of J, as any candidate
-   must against the model (`parsimony`). Two corrections that predict nearly the same temperatures
-   differ by nearly the same small amount every day, so the blocks' scatter is tiny; yet another draw
-   of the noise would move that difference by 2 sigma |r_a - r_b|, and reverse it where it is
-   smaller. Components whose corrections cannot be told apart are named together in the reason.
-   Whether a candidate passes (1.) reads the air, the objective: the other sensors judge
-   between explanations of the air, never whether it needs one; except a component's own
-   sensors (`own_test`): a component whose correction, its surface on each day predicted by
-   the fit without that day (`calibrate.Own`), brings that surface to the noise and the file's
-   numerical error there, by a fall beyond what they could make, and leaves the air no worse
-   than the noise's margin, passes too. The paper's method places a fault by forcing the
-   sub-model's measured nodes; a second fault the air no longer points at (the first effect
-   brought it to the noise) is still placed by the component's own sensor.
-
-The validation window plays no part. A model built by earlier rounds is the baseline a later
-round's candidate must pass against (its parameters held).
-
-Several records of one building add their days to the blocks and their residuals to the sums;
-nothing above depends on the blocks coming from one record. One objection is theirs: a candidate
-that helps the records together but harms one of them, its cross-validated fall on that record's
-blocks below minus the same yardstick (the noise's tolerance of that record's J, and one standard
-error of that record's per-block falls), is a correction of the house that does not hold on every
-record of it: it is refused, with the record named (`harmed`).
+"""The choice of one round (`decide`): which candidates pass, which physics refuses, the band of
+those the data cannot tell from the best, and the one of it that claims least; the
+cross-validation blocks of whole days it reads (`blocks`), the records a candidate harms
+(`harmed`), and the decision in words. Why it is made so, step by step: docs/method.md,
+"Choosing an effect"; the formulas: docs/model.md 6.6. Every threshold is the `Policy` passed in
+(`diagnosis.policy`); the pass rule and the noise's yardstick are `model.score.Yardstick`'s.
 """
 import math
 
 import numpy as np
 
-from nodeforce.diagnosis.policy import POLICY
-from nodeforce.diagnosis.result import Decision, Verdict
-from nodeforce.model.effects import bridge_parts
+from nodeforce.diagnosis.result import Baseline, Decision, Verdict
+from nodeforce.model.effects import EFFECTS
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
+from nodeforce.model.score import fall
 
 
-def blocks(n_steps, scored_from, dt, source="measurements"):
+def blocks(n_steps, scored_from, dt, policy, source="measurements"):
     """(B, n_steps) bool: the steps of each block, whole days of the scored steps
     `scored_from`..n_steps-1 (the steps t_1..t_N of a window), the part day left at the end joined
-    to the last block."""
+    to the last block; at least the `policy`'s `min_blocks`."""
     day = steps_per_day(dt)
     n_blocks = (n_steps - scored_from) // day
-    if n_blocks < POLICY.min_blocks:
+    if n_blocks < policy.min_blocks:
         raise InputError(source, "time", f"a calibration window of {n_steps - scored_from} scored steps of {dt:g} s "
-                                         f"leaves no calibration window of {POLICY.min_blocks} whole days after the burn-in "
+                                         f"leaves no calibration window of {policy.min_blocks} whole days after the burn-in "
                                          "for the cross-validation: give a longer calibration window")
     index = np.arange(n_steps)
     starts = scored_from + day * np.arange(n_blocks)
@@ -109,13 +45,6 @@ def block_J(residuals, masks):
     return np.array([np.nansum(np.square(residuals[m])) for m in masks])
 
 
-def fall(base, scores):
-    """The fall of J from per-block J `base` to `scores` (C2) and its standard error from the
-    per-block falls (blocks as the unit; 0 for one block, which has no scatter to measure)."""
-    d = np.asarray(base, dtype=float) - np.asarray(scores, dtype=float)
-    return float(d.sum()), float(math.sqrt(len(d)) * d.std(ddof=1)) if len(d) > 1 else 0.0
-
-
 def distance(a, b):
     """|r_a - r_b| (C) of two candidates' (`Fit`s) residuals their evidence (`Fit.evidence`) is
     made of: the air's left out and the other sensors' on the blocks; 0 where either lacks them."""
@@ -133,7 +62,7 @@ def noise_difference(distance, sigma):
     return float(2.0 * sigma * distance)
 
 
-def parsimony(result, sigma, n):
+def parsimony(result, sigma, n, policy):
     """The fall of evidence (C2) a candidate must add over one that claims less (a physical effect
     against a shape, fewer parameters against more, the zone's own effect against one
     component's) to be preferred to it: what the sensors' noise alone could make of J over the
@@ -145,10 +74,10 @@ def parsimony(result, sigma, n):
     neither the days' scatter nor a fixed pair's noise (`noise_difference`) would call small. One
     wall's factor bends that wall's dynamics, where the file's coarse nodes err, as the envelope's
     cannot: on the air alone it fits that error too. `n`: the air's scored residuals."""
-    return POLICY.noise_change(sigma, n + result.sensors.n_weighted)
+    return policy.noise_change(sigma, n + result.sensors.n_weighted)
 
 
-def harmed(base, scores, floor_sd, groups):
+def harmed(base, scores, floor_sd, groups, policy):
     """The records a candidate harms: those on whose blocks its cross-validated J rises by more
     than the noise's tolerance of that record's J and one standard error of its per-block falls;
     [{"record", "cv_fall", "needed"}] (C2).
@@ -159,45 +88,39 @@ def harmed(base, scores, floor_sd, groups):
     floor_sd : the sd (C) of what a right model of the file leaves (`decide`'s: the sensors'
         noise and the file's own numerical error)
     groups : [{"record": name, "blocks": indices into base, "n": residuals they score}]
+    policy : the `diagnosis.policy.Policy` whose yardstick judges
     """
     base, scores = np.asarray(base, dtype=float), np.asarray(scores, dtype=float)
     out = []
     for group in groups:
         rows = np.asarray(group["blocks"], dtype=int)
-        down, se = fall(base[rows], scores[rows])
-        needed = max(POLICY.least_fall(float(base[rows].sum()), floor_sd, group["n"]), POLICY.standard_errors * se)
-        if down < -needed:
-            out.append({"record": group["record"], "cv_fall": down, "needed": needed})
+        judged = policy.yardstick.judge(base[rows], scores[rows],
+                                        policy.least_fall(float(base[rows].sum()), floor_sd, group["n"]))
+        if judged.reversed:
+            out.append({"record": group["record"], "cv_fall": judged.fall, "needed": judged.needed})
     return out
 
 
-def decide(results, base, sigma, n, groups=(), floor_sd=None, distances=None, air_at_noise=False):
+def decide(results, baseline, policy):
     """The `Decision` of one round (module docstring), its steps in order: 1. which candidates
     pass, 2. which of them physics refuses (suggestions), 3. the band of those the data cannot
     tell from the best, 4. the one of the band that claims least; with each candidate's `Verdict`
-    and the reason in words. The thresholds are `diagnosis.policy.POLICY`'s.
+    and the reason in words.
 
     Parameters
     ----------
     results : the candidates' `Fit`s
-    base : per-block J (C2) of the model without them
-    sigma : the air sensors' noise sd (C), what a fixed pair's difference moves by (`noise_difference`)
-    n : residuals the blocks score
-    groups : the records the blocks come from (`harmed`), where there are several
-    floor_sd : the sd (C) of what a right model of the file leaves, the noise and the file's own
-        numerical error (`model.score.Noise.floor_sd`), the yardstick of a fall of J: a candidate
-        with a slow parameter fits part of that deterministic error as it fits a fault; sigma if
-        None
-    distances : {label: {label: C}}, the `distance` of every two admissible candidates' residuals,
-        as the decision keeps it (`inputs.distances`); computed from the residuals if None
-    air_at_noise : a later round run only because a component's own sensors disagree, the air's
-        error left being the noise's (`Policy.at_noise`): a fall of the air's J is then no
-        evidence of a fault, and a candidate passes on its own sensors alone
+    baseline : what the choice reads besides them (`diagnosis.result.Baseline`): the model's
+        per-block J, the noise, the residuals the blocks score, the records they come from
+    policy : the `diagnosis.policy.Policy` whose thresholds judge
     """
-    base = np.asarray(base, dtype=float)
-    floor_sd = sigma if floor_sd is None else floor_sd
-    margin = POLICY.least_fall(float(base.sum()), floor_sd, n)
-    verdicts = {r.label: candidate_test(r, base, margin, floor_sd, groups, sigma, air_at_noise) for r in results}
+    base = np.asarray(baseline.blocks_before, dtype=float)
+    sigma, n, groups, air_at_noise = baseline.sigma, baseline.n, baseline.groups, baseline.air_at_noise
+    floor_sd = sigma if baseline.floor_sd is None else baseline.floor_sd
+    distances = baseline.distances
+    margin = policy.least_fall(float(base.sum()), floor_sd, n)
+    verdicts = {r.label: candidate_test(r, base, margin, floor_sd, groups, sigma, policy, air_at_noise)
+                for r in results}
     passing = [r for r in results if verdicts[r.label].passes]  # 1.
     admissible = [r for r in passing if not verdicts[r.label].objection]  # 2.
     suggestions = [{"candidate": r.label, "reason": verdicts[r.label].objection, "cv_rmse": r.cv.rmse}
@@ -207,16 +130,16 @@ def decide(results, base, sigma, n, groups=(), floor_sd=None, distances=None, ai
     if admissible:
         if distances is None:
             distances = {a.label: {b.label: distance(a, b) for b in admissible} for a in admissible}
-        near = band(admissible, base, sigma, floor_sd, n, distances)  # 3.
-        chosen = min(near, key=lambda r: (claim(r), r.evidence().sum()))  # 4.
+        near = band(admissible, base, sigma, floor_sd, n, distances, policy)  # 3.
+        chosen = min(near, key=lambda r: (claim(r, policy), r.evidence().sum()))  # 4.
         alike = [r for r in near if r is not chosen]
     # the candidates physics refused are in `suggestions`; the report says them grouped by reason
-    reason = _reason(chosen, alike, results, passing, base, n, verdicts, margin, components, air_at_noise)
-    return Decision(chosen, reason, float(base.sum()), len(base), margin, POLICY.standard_errors, suggestions,
+    reason = _reason(chosen, alike, results, passing, base, n, verdicts, margin, components, air_at_noise, policy)
+    return Decision(chosen, reason, float(base.sum()), len(base), margin, policy.standard_errors, suggestions,
                     [r.label for r in alike], verdicts,
                     # what the steps read besides the candidates' fits: report.json can replay them
-                    {"blocks_before": [float(b) for b in base], "sigma": sigma, "floor_sd": floor_sd,
-                     "n": n, "groups": list(groups), "distances": distances or {}, "air_at_noise": air_at_noise})
+                    Baseline([float(b) for b in base], sigma, n, list(groups), floor_sd, distances or {},
+                             air_at_noise).to_json())
 
 
 def revisited(decision, replaces, others, refitted):
@@ -233,32 +156,31 @@ def revisited(decision, replaces, others, refitted):
     return decision
 
 
-def candidate_test(result, base, margin, floor_sd, groups, sigma, air_at_noise=False):
+def candidate_test(result, base, margin, floor_sd, groups, sigma, policy, air_at_noise=False):
     """One candidate's `Verdict` (steps 1 and 2): its cross-validated fall of J (C2) and the fall's
     standard error, what it needs (the noise's `margin`, C2, and `standard_errors` of its
     scatter), what the days other than its best gain, its evidence, whether it passes (on the
     air unless `air_at_noise`, or on its own sensors), the records it harms and the objection of
     physics, None if none."""
     blocks = np.asarray(result.cv.blocks)
-    down, se = fall(base, blocks)
-    needed = max(margin, POLICY.standard_errors * se)
     # the other days than its best must gain too: one day alone is no evidence
-    others = down - float(np.max(base - blocks))
-    own = own_test(result.sensors.own, sigma)
+    judged = policy.yardstick.judge(base, blocks, margin)
+    down = judged.fall
+    own = own_test(result.sensors.own, sigma, policy)
     by_own = bool(own is not None and own["passes"] and down > -margin)
-    harms = harmed(base, blocks, floor_sd, groups)
-    said = POLICY.objection_of(result.effect, result.parameters, result.derived, result.physics)
+    harms = harmed(base, blocks, floor_sd, groups, policy)
+    said = policy.objection_of(result.effect, result.parameters, result.derived, result.physics)
     if harms:
         said = "; ".join(filter(None, [said, "it helps the records together but harms " + "; ".join(
             f"{h['record']} (its cross-validated J there rises by {-h['cv_fall']:.3g} C2, beyond the "
             f"{h['needed']:.3g} C2 the noise and the day-to-day scatter could make)" for h in harms)
             + ": a correction of the building must hold on every record of it"]))
-    by_air = bool(down > needed and others > 0) and not air_at_noise
-    return Verdict(down, se, needed, others, float(result.evidence().sum()), by_air or by_own, harms, said, own,
-                   by_own)
+    by_air = bool(judged.beats) and not air_at_noise
+    return Verdict(down, judged.se, judged.needed, judged.other_days, float(result.evidence().sum()), by_air or by_own,
+                   harms, said, own, by_own)
 
 
-def own_test(own, sigma):
+def own_test(own, sigma, policy):
     """A component candidate's test on its own sensors (`result.OwnSensors`, None for another):
     {"fall", "se", "needed", "passes"} (C2), the fall of their J over the blocks from the model to
     the candidate, its standard error from the per-block falls, what it needs (the yardstick of
@@ -277,20 +199,18 @@ def own_test(own, sigma):
     if own is None or not own.n:
         return None
     before, after = np.asarray(own.before, dtype=float), np.asarray(own.after, dtype=float)
-    down, se = fall(before, after)
     floor = math.hypot(sigma, own.numerical)
-    needed = max(POLICY.least_fall(float(before.sum()), floor, own.n), POLICY.standard_errors * se)
-    others = down - float(np.max(before - after))
-    mended = POLICY.at_noise(float(after.sum()), own.n, floor)
-    return {"fall": down, "se": se, "needed": needed, "passes": bool(down > needed and others > 0 and mended)}
+    judged = policy.yardstick.judge(before, after, policy.least_fall(float(before.sum()), floor, own.n))
+    mended = policy.at_noise(float(after.sum()), own.n, floor)
+    return {"fall": judged.fall, "se": judged.se, "needed": judged.needed, "passes": bool(judged.beats and mended)}
 
 
-def claim(result):
+def claim(result, policy):
     """What a candidate's choice claims, least first (`Policy.claim`)."""
-    return POLICY.claim(result.effect, result.physics["component"], result.physics.get("sensed", False))
+    return policy.claim(result.effect, result.physics["component"], result.physics.get("sensed", False))
 
 
-def band(admissible, base, sigma, floor_sd, n, distances):
+def band(admissible, base, sigma, floor_sd, n, distances, policy):
     """Step 3: the admissible candidates the data cannot tell from the best (the lowest evidence),
     the best among them: those whose evidence exceeds the best's by no more than
     `standard_errors` standard errors of the paired difference (its scatter from day to day, or
@@ -298,19 +218,19 @@ def band(admissible, base, sigma, floor_sd, n, distances):
     the rounding; and,
     where the best claims more, by no more than the noise's tolerance (`parsimony`)."""
     best = min(admissible, key=lambda r: r.evidence().sum())
-    rounding = POLICY.rounding(float(base.sum()))
+    rounding = policy.rounding(float(base.sum()))
 
     def close(r):
         worse, se = fall(r.evidence(), best.evidence())
-        needed = max(POLICY.standard_errors * max(se, noise_difference(distances[r.label][best.label], sigma)),
+        needed = max(policy.standard_errors * max(se, noise_difference(distances[r.label][best.label], sigma)),
                      rounding)
-        if claim(r) < claim(best):
-            needed = max(needed, parsimony(best, floor_sd, n))
+        if claim(r, policy) < claim(best, policy):
+            needed = max(needed, parsimony(best, floor_sd, n, policy))
         return worse <= needed
     return [r for r in admissible if close(r)]
 
 
-def _reason(chosen, alike, results, passing, base, n, verdicts, margin, components, air_at_noise=False):
+def _reason(chosen, alike, results, passing, base, n, verdicts, margin, components, air_at_noise, policy):
     """The decision in words; `components` the building's component names."""
     B = len(base)
     rmse_before = math.sqrt(base.sum() / n)
@@ -325,10 +245,10 @@ def _reason(chosen, alike, results, passing, base, n, verdicts, margin, componen
     if not chosen:
         return (f"None of the {len(results)} candidates lowers the cross-validated J ({base.sum():.3g} C2 over "
                 f"{B} days) by more than the noise and the file's numerical error could ({margin:.3g} C2) and "
-                f"{POLICY.standard_errors:g} standard error of its fall from day to day, on more days than one"
+                f"{policy.standard_errors:g} standard error of its fall from day to day, on more days than one"
                 + (f" ({len(passing)} do, and physics or a record they harm refuses each)" if passing else "") + ": no effect is added.")
     what = (f"an unexplained heat source, acting {acting(chosen)} ({chosen.effect} on {chosen.target})"
-            if POLICY.is_shape(chosen.effect) else f"{chosen.effect} on {chosen.target}")
+            if policy.is_shape(chosen.effect) else f"{chosen.effect} on {chosen.target}")
     verdict = verdicts[chosen.label]
     if verdict.passes_by_own and (air_at_noise or not (verdict.cv_fall > verdict.needed and verdict.other_days > 0)):
         own = chosen.sensors.own
@@ -359,17 +279,12 @@ def _reason(chosen, alike, results, passing, base, n, verdicts, margin, componen
     elif others:
         said += (f". A correction of {' or '.join(dict.fromkeys(others))} alone explains the data as well: "
                  f"they do not place the fault in one component")
-    if POLICY.is_shape(chosen.effect):
+    if policy.is_shape(chosen.effect):
         said += "; no physical effect comes within one standard error of it"
     return said + "."
 
 
 def acting(result):
-    """How a shape's heat source acts, in words: with a daily profile, or in proportion to an input."""
-    values = result.values
-    if result.effect == "daily_gain":
-        amplitude = math.hypot(values.get("cos1", 0.0), values.get("sin1", 0.0))
-        return (f"with a daily profile (mean {values['mean']:.3g} W, first harmonic {amplitude:.3g} W) to the air "
-                f"of {result.target}")
-    zone, column = bridge_parts(result.target)
-    return f"in proportion to {column} (k = {values['k']:.3g}) to the air of {zone}"
+    """How a shape's heat source acts, in words (its record's `acting`): with a daily profile, or
+    in proportion to an input."""
+    return EFFECTS[result.effect].acting(result.target, result.values)

@@ -8,7 +8,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from nodeforce.diagnosis.assess import columns_among
-from nodeforce.diagnosis.policy import POLICY
 from nodeforce.diagnosis.selection import block_J, blocks as blocks_of, on_block
 from nodeforce.model.case import measured_case
 from nodeforce.model.errors import InputError
@@ -68,47 +67,73 @@ class Record:
 
 
 @dataclass
-class Windows:
-    """The records as the loop reads them: each one's case (steady start), the row k of its last
-    calibration time, its calibration window, its measured objective air (N_t, zones), the
-    cross-validation blocks of all records in order, (record index, mask), and each one's other
-    sensed nodes (`sensors`: the measured nodes besides the objective air, a wall's surface, a
-    neighbouring zone's air) with their measurements (`sensed`, (N_t, len(sensors)), NaN where
-    not scored)."""
-    records: list
-    cases: list
-    ks: list
-    calibrations: list
-    measured: list
-    blocks: list
+class RecordWindow:
+    """One record as the loop reads it (`Windows`): its `Record`, its case (steady start), the row
+    k of its last calibration time, its calibration window, its measured objective air (N_t,
+    zones), its other sensed nodes (`sensors`: the measured nodes besides the objective air, a
+    wall's surface, a neighbouring zone's air) with their measurements (`sensed`, (N_t,
+    len(sensors)), NaN where not scored), and the building file's own numerical error at the air
+    ((N_t, zones)) and at those sensors (None until `Windows.with_numerical`)."""
+    record: Record
+    case: object
+    k: int
+    calibration: object
+    measured: np.ndarray
     sensors: list
-    sensed: list
-    numerical: list = None
-    sensor_numerical: list = None
+    sensed: np.ndarray
+    numerical: np.ndarray = None
+    sensor_numerical: np.ndarray = None
+
+
+@dataclass
+class Windows:
+    """The records as the loop reads them: one `RecordWindow` per record (`each`), the
+    cross-validation blocks of all records in order, (record index, mask), and the
+    `diagnosis.policy.Policy` the scores on them are judged by. The per-record lists (`cases`,
+    `ks`, ...) are views of `each`, in the records' order."""
+    each: list
+    blocks: list
+    policy: object
 
     @classmethod
-    def of(cls, records, objective):
-        cases, ks, calibrations, measured, blocks, sensors, sensed = [], [], [], [], [], [], []
+    def of(cls, records, objective, policy):
+        each, blocks = [], []
         for i, record in enumerate(records):
             # what no sensor sets (every wall of an air-only record) starts from the steady state of
             # the first day, not at the air's temperature: a heavy component would carry that guess
             # for weeks, and the candidates' slow parameters would fit it
             case = record.case if record.case.steady_start else record.case.with_steady_start()
             k = split(case, record.source, record.fraction, record.calibration_end)
-            cases.append(case)
-            ks.append(k)
-            calibrations.append(case.window(0, k))
-            measured.append(objective.measured(case))
-            blocks += [(i, m) for m in blocks_of(k, case.burn_in_steps, case.dt, record.source)]
-            sensors.append([node for node in case.measured_ids if node not in objective.air_nodes])
-            sensed.append(case.scored([node - 1 for node in sensors[-1]]))
-        return cls(list(records), cases, ks, calibrations, measured, blocks, sensors, sensed)
+            blocks += [(i, m) for m in blocks_of(k, case.burn_in_steps, case.dt, policy, record.source)]
+            sensors = [node for node in case.measured_ids if node not in objective.air_nodes]
+            each.append(RecordWindow(record, case, k, case.window(0, k), objective.measured(case), sensors,
+                                     case.scored([node - 1 for node in sensors])))
+        return cls(each, blocks, policy)
+
+    # the per-record views, in the records' order
+    records = property(lambda self: [w.record for w in self.each])
+    cases = property(lambda self: [w.case for w in self.each])
+    ks = property(lambda self: [w.k for w in self.each])
+    calibrations = property(lambda self: [w.calibration for w in self.each])
+    measured = property(lambda self: [w.measured for w in self.each])
+    sensors = property(lambda self: [w.sensors for w in self.each])
+    sensed = property(lambda self: [w.sensed for w in self.each])
+
+    @property
+    def numerical(self):
+        """Per record the file's numerical error at the objective air, None if not known."""
+        return None if any(w.numerical is None for w in self.each) else [w.numerical for w in self.each]
+
+    @property
+    def sensor_numerical(self):
+        """Per record the file's numerical error at the other sensors, None if not known."""
+        return None if any(w.sensor_numerical is None for w in self.each) else [w.sensor_numerical for w in self.each]
 
     def metrics(self, objective, runs, record=None):
         """{"calibration", "validation"}: the objective's metrics of `runs` (one (N_t, zones) per
         record) on every record's window together, or on `record`'s (an index) alone."""
-        chosen = range(len(self.cases)) if record is None else [record]
-        return {window: objective.metrics(*(np.concatenate([part[i][rows(self.ks[i])] for i in chosen])
+        chosen = range(len(self.each)) if record is None else [record]
+        return {window: objective.metrics(*(np.concatenate([part[i][rows(self.each[i].k)] for i in chosen])
                                             for part in (self.measured, runs)))
                 for window, rows in (("calibration", lambda k: slice(None, k)),
                                      ("validation", lambda k: slice(k, None)))}
@@ -117,7 +142,7 @@ class Windows:
         """J (C2) of `runs` on every block, the records' in order, each less the share of the
         file's numerical error (`model.numerical.share`) the other blocks hold, as a candidate's
         left-out block is scored (`diagnosis.calibrate`)."""
-        residuals = [m[:k] - run[:k] for m, run, k in zip(self.measured, runs, self.ks)]
+        residuals = [w.measured[:w.k] - run[:w.k] for w, run in zip(self.each, runs)]
         errors = self.calibration_numerical() or [np.zeros_like(r) for r in residuals]
         r, e = (np.concatenate([a.ravel() for a in parts]) for parts in (residuals, errors))
         out = []
@@ -136,7 +161,8 @@ class Windows:
 
         sensed : the other sensed nodes' runs, one (N_t, len(sensors)) per record
         weights : one (len(sensors),) per record"""
-        parts = [((self.sensed[i][:self.ks[i]] - sensed[i][:self.ks[i]])[m], weights[i]) for i, m in self.blocks]
+        parts = [((self.each[i].sensed[:self.each[i].k] - sensed[i][:self.each[i].k])[m], weights[i])
+                 for i, m in self.blocks]
         return (np.array([float(np.nansum(w * np.square(r))) for r, w in parts]),
                 np.concatenate([(w * r)[np.isfinite(r)] for r, w in parts]),
                 int(sum(np.isfinite(r).sum() for r, _ in parts)),
@@ -146,7 +172,8 @@ class Windows:
         """Per record, the temperatures (C, (N_t, len(ids))) of its nodes `ids` (one sequence per
         record) under its protocol's building (`bases`, None: `building`)."""
         out = []
-        for case, nodes, base in zip(self.cases, ids, bases):
+        for w, nodes, base in zip(self.each, ids, bases):
+            case = w.case
             run = base or building
             out.append(case.with_inputs(run).run(run, np.asarray(nodes, dtype=int) - 1) if len(nodes)
                        else np.empty((len(case.times) - 1, 0)))
@@ -173,13 +200,13 @@ class Windows:
         disagrees with the model as written because that component is wrong, is the evidence
         that places the fault there, not a misfit to discount."""
         out = []
-        for i, ids in enumerate(self.sensors):
-            k = self.ks[i]
+        for i, w in enumerate(self.each):
+            ids, k = w.sensors, w.k
             if not ids:
                 out.append(np.zeros(0))
                 continue
-            misfit = np.min([np.nanmean(np.square(self.sensed[i][:k] - run[i][:k]), axis=0) for run in runs], axis=0)
-            out.append(POLICY.sensor_weight(sigma, np.maximum(misfit, np.finfo(float).tiny)))
+            misfit = np.min([np.nanmean(np.square(w.sensed[:k] - run[i][:k]), axis=0) for run in runs], axis=0)
+            out.append(self.policy.sensor_weight(sigma, np.maximum(misfit, np.finfo(float).tiny)))
         return out
 
     def own_columns(self, nodes):
@@ -191,15 +218,16 @@ class Windows:
         """J (C2) of the other sensors' `columns` (`own_columns`) on every block, the records' in
         order, unweighted, for the runs `sensed` (one (N_t, len(sensors)) per record); and the
         readings they score."""
-        parts = [(self.sensed[i][:self.ks[i]] - sensed[i][:self.ks[i]])[m][:, columns[i]] for i, m in self.blocks]
+        parts = [(self.each[i].sensed[:self.each[i].k] - sensed[i][:self.each[i].k])[m][:, columns[i]]
+                 for i, m in self.blocks]
         return (np.array([float(np.nansum(np.square(r))) for r in parts]),
                 int(sum(np.isfinite(r).sum() for r in parts)))
 
     def own_numerical(self, columns):
         """The root mean square (C) of the file's own numerical error (`sensor_numerical`) at the
         sensors' `columns` (one list per record), over the calibration window's scored readings."""
-        errors = [e[:k][:, c][np.isfinite(m[:k][:, c])] for e, k, m, c in
-                  zip(self.sensor_numerical or [], self.ks, self.sensed, columns)]
+        errors = [w.sensor_numerical[:w.k][:, c][np.isfinite(w.sensed[:w.k][:, c])]
+                  for w, c in zip(self.each, columns)] if self.sensor_numerical is not None else []
         squares = np.concatenate(errors) ** 2 if errors else np.zeros(0)
         return math.sqrt(float(squares.mean())) if squares.size else 0.0
 
@@ -214,7 +242,7 @@ class Windows:
             if not any(columns):
                 continue
             J, n = self.own_J(sensed, columns)
-            if n and not POLICY.at_noise(float(J.sum()), n, math.hypot(sigma, self.own_numerical(columns))):
+            if n and not self.policy.at_noise(float(J.sum()), n, math.hypot(sigma, self.own_numerical(columns))):
                 out.append(c.name)
         return out
 
@@ -224,40 +252,41 @@ class Windows:
         len(sensors)) per record): the file as run (`runs` at the air, `sensed` at the sensors,
         under the record's protocol's building in `bases`, else `building`) minus the file
         refined (`model.numerical.reference`)."""
-        numerical, at_sensors = [], []
-        for run, at, case, base, ids in zip(runs, sensed, self.cases, bases, self.sensors):
-            fine = reference(case, base or building, list(objective.air_nodes) + list(ids))
-            numerical.append(run - fine[:, :len(objective.air_nodes)])
-            at_sensors.append(at - fine[:, len(objective.air_nodes):])
-        return replace(self, numerical=numerical, sensor_numerical=at_sensors)
+        each = []
+        for run, at, w, base in zip(runs, sensed, self.each, bases):
+            fine = reference(w.case, base or building, list(objective.air_nodes) + list(w.sensors))
+            each.append(replace(w, numerical=run - fine[:, :len(objective.air_nodes)],
+                                sensor_numerical=at - fine[:, len(objective.air_nodes):]))
+        return replace(self, each=each)
 
     def numerical_rms(self):
         """The root mean square (C) of the file's numerical error over the residuals the blocks score."""
-        squares = [np.square(e[:k])[np.isfinite(m[:k])] for e, k, m in zip(self.numerical, self.ks, self.measured)]
+        squares = [np.square(w.numerical[:w.k])[np.isfinite(w.measured[:w.k])] for w in self.each]
         return float(np.sqrt(np.concatenate(squares).mean()))
 
     def calibration_numerical(self, sensors=False):
         """The file's numerical error on each record's calibration window, at the objective air
         (or at the other `sensors`), None if not known."""
         errors = self.sensor_numerical if sensors else self.numerical
-        return None if errors is None else [e[:k] for e, k in zip(errors, self.ks)]
+        return None if errors is None else [e[:w.k] for e, w in zip(errors, self.each)]
 
     def scored(self):
         """Residuals the blocks score, on every record."""
-        return sum(int(np.isfinite(m[:k]).sum()) for m, k in zip(self.measured, self.ks))
+        return sum(int(np.isfinite(w.measured[:w.k]).sum()) for w in self.each)
 
     def groups(self):
         """Per record, its name, the indices of its blocks and the residuals they score: what
         `selection.decide` needs to see a candidate that harms one record; [] for one record."""
-        if len(self.records) < 2:
+        if len(self.each) < 2:
             return []
-        return [{"record": r.name, "blocks": [b for b, (i, _) in enumerate(self.blocks) if i == j],
-                 "n": int(np.isfinite(self.measured[j][:self.ks[j]]).sum())} for j, r in enumerate(self.records)]
+        return [{"record": w.record.name, "blocks": [b for b, (i, _) in enumerate(self.blocks) if i == j],
+                 "n": int(np.isfinite(w.measured[:w.k]).sum())} for j, w in enumerate(self.each)]
 
 
 def period(windows, i):
     """The calibration and validation spans of record i, where its scoring starts and its blocks."""
-    times, k, case = windows.cases[i].times, windows.ks[i], windows.cases[i]
+    w = windows.each[i]
+    times, k, case = w.case.times, w.k, w.case
     return {"calibration": [case.start.isoformat(), times[k].isoformat()],
             "calibration_scored_from": times[case.burn_in_steps + 1].isoformat(),
             "validation": [times[k + 1].isoformat(), times[-1].isoformat()],

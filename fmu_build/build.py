@@ -21,7 +21,9 @@ import sys
 import zipfile
 from pathlib import Path
 
-from nodeforce import model, tempdirs
+from nodeforce import model
+
+from nodeforce.runtime import tempdirs
 from nodeforce.model.effects import EFFECTS, fmu_parameters
 from nodeforce.model.network import input_names
 

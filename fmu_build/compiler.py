@@ -8,7 +8,8 @@ compiled at a process's first export that needs it, and every later export copie
 import functools
 from pathlib import Path
 
-from nodeforce.model.compiled import C_DIR as MODEL_C_DIR, compile_library
+from nodeforce.model.compiled import C_DIR as MODEL_C_DIR
+from nodeforce.runtime.compiler import compile_library
 
 C_DIR = Path(__file__).with_name("c")
 
@@ -21,7 +22,7 @@ RPATH = ("-Wl,--disable-new-dtags", "-Wl,-rpath,$ORIGIN")
 def library(source, libraries=(), link_options=(), defines=()):
     """The shared library (bytes) of c/<source> (a file name, or a tuple of several) with the
     headers beside it and the direct model's (model/c/), compiled once per process
-    (`model.compiled.compile_library`, -O2: the binary is shipped to other machines).
+    (`runtime.compiler.compile_library`, -O2: the binary is shipped to other machines).
 
     libraries : names given to -l; link_options : options for the linker (-Wl,...), before them;
     defines : preprocessor names given to -D

@@ -15,7 +15,7 @@ import sys
 import sysconfig
 from pathlib import Path
 
-from nodeforce.model.compiled import find_compiler
+from nodeforce.runtime.compiler import find_compiler
 
 from .compiler import library
 

@@ -29,8 +29,8 @@ from contextlib import ExitStack
 from functools import partial
 from typing import Iterable, Sequence
 
-from nodeforce import lifetime
-from nodeforce.cluster import Cluster
+from nodeforce.runtime import lifetime
+from nodeforce.runtime.cluster import Cluster
 
 log = logging.getLogger("nodeforce.ga")
 
@@ -129,7 +129,7 @@ def _pool_task(path, masks):
 class ProcessBackend(_Backend):
     """Worker processes, each building its own evaluator from the factory on its first chunk:
     `workers`, a command's `lifetime.Workers` that other stages use after the search, or a count
-    of processes started for the search alone; they end with this process (nodeforce.lifetime).
+    of processes started for the search alone; they end with this process (runtime.lifetime).
     A worker that dies (a crash in a C library) breaks the pool: the processes are started anew."""
 
     def __init__(self, factory, workers: "int | lifetime.Workers"):
@@ -181,7 +181,7 @@ def _dask_close(token: str) -> None:
 
 
 class DaskBackend(_Backend):
-    """Chunks mapped over the workers of a dask.distributed scheduler through `nodeforce.cluster`
+    """Chunks mapped over the workers of a dask.distributed scheduler through `runtime.cluster`
     (`cluster`: its address, "tcp://host:port", or a command's `Cluster`, which it leaves
     open), the factory shipped once to every worker.
 

@@ -7,13 +7,14 @@ only the objective's air (a thermostat's) has nothing to force: its locate.json 
 `best_nodes` [], and the diagnosis goes on to the air's own equation.
 """
 import time
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.sparse.csgraph import shortest_path
 
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.checkpoint import NAME as CHECKPOINT
-from nodeforce.model.compiled import find_compiler
+from nodeforce.runtime.compiler import find_compiler
 from nodeforce.ga.fitness import FmuFitness, RecordsFitness
 from nodeforce.ga.parsimony import EXPLAINED
 from nodeforce.ga.search import PATIENCE, search
@@ -78,6 +79,27 @@ def chromosome_nodes(building, case, objective, source, nodes=None, include_alge
         chosen = set(nodes)
     distance = links_to(network, objective.air_nodes)
     return sorted(chosen, key=lambda i: (distance[i - 1], i))
+
+
+@dataclass(frozen=True)
+class SearchSettings:
+    """The forcing search's settings as a diagnosis runs it (`locate`): the seed of every random
+    draw, the GA's population and generations, and the FMUs it drives (`locate`'s `fmu_kind`;
+    "auto": the standalone where it can run the building)."""
+    seed: int = 0
+    population: int = 30
+    generations: int = 400
+    fmu_kind: str = "auto"
+
+
+@dataclass(frozen=True)
+class Execution:
+    """Where a command's work runs: `workers` processes (None: every core), or the workers of the
+    Dask scheduler at `scheduler` ("tcp://host:port"); and the FMUs of the model it runs and
+    writes (`fmu_build.build.build_fmu`'s kinds, or "auto", `evaluator_kind`)."""
+    workers: int | None = None
+    scheduler: str | None = None
+    fmu_kind: str = "python"
 
 
 def locate(building, case, objective, workdir, *, source="measurements", nodes=None,

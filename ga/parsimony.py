@@ -3,12 +3,13 @@
 The GA returns the chromosome of lowest J, but a node forced there may lower J only by chance
 (noise in the measurements) or not at all (a gene that drifted in and did no harm).  Lauret et
 al. read the located sub-models off the forced nodes, so we keep only the nodes the reduction
-needs, judged against the measurement noise:
+needs, judged against the measurement noise by the yardstick the diagnosis' choice reads too
+(`model.score.Yardstick`):
 
-    tolerance = max(Z_NOISE * sigma^2 * sqrt(2 n),  RELATIVE_FLOOR * J_unforced)
+    tolerance = max(noise_sds * sigma^2 * sqrt(2 n),  least_fall_share * J_unforced)
 
 With n residuals of independent noise of sd sigma, J of pure noise (sigma^2 times a chi-square
-with n degrees of freedom) has sd sigma^2 * sqrt(2 n): a change of J smaller than Z_NOISE such
+with n degrees of freedom) has sd sigma^2 * sqrt(2 n): a change of J smaller than noise_sds such
 sds could be noise alone.  The relative floor keeps a noise-free (or unknown-noise: sigma None)
 case from counting any tiny gain as real.
 
@@ -63,14 +64,11 @@ from itertools import combinations
 from typing import Callable, Sequence
 
 from nodeforce.model import significance
-from nodeforce.model.score import removed
+from nodeforce.model.score import Yardstick, removed
 
-Z_NOISE = 3.0
 EXPLAINED = 0.5
-RELATIVE_FLOOR = 0.01
 EXACT_MAX_NODES = 8
 EXACT_ANY = 2
-ROUNDING = 1e-9  # of J_unforced: a difference of J below it is the simulation's rounding
 # Above this many genes, pairs are not all scored (100 genes make 4,950 pairs, most of a search's
 # budget): only pairs among the PAIR_POOL single nodes that lower J most, by more than the noise
 # alone (larger sets come from the best chromosome). Measured in benchmarks/bench_scale.py.
@@ -78,21 +76,22 @@ ALL_PAIRS_UP_TO = 25
 PAIR_POOL = 10
 
 
-def tolerance(J_unforced: float, noise_sigma: "float | None", n_residuals: "int | None") -> float:
-    """The change of J (C2) that is not significant (see the module docstring)."""
-    return max(RELATIVE_FLOOR * J_unforced, noise_tolerance(noise_sigma, n_residuals))
+def tolerance(J_unforced: float, noise_sigma: "float | None", n_residuals: "int | None",
+              yardstick: Yardstick = Yardstick()) -> float:
+    """The change of J (C2) that is not significant (see the module docstring):
+    `Yardstick.least_fall` of J_unforced."""
+    return yardstick.least_fall(J_unforced, noise_sigma, n_residuals)
 
 
-def noise_tolerance(noise_sigma: "float | None", n_residuals: "int | None") -> float:
+def noise_tolerance(noise_sigma: "float | None", n_residuals: "int | None",
+                    yardstick: Yardstick = Yardstick()) -> float:
     """The change of J (C2) measurement noise of sd noise_sigma (C) alone can make; 0 if unknown."""
-    if noise_sigma is None:
-        return 0.0
-    return Z_NOISE * noise_sigma ** 2 * math.sqrt(2 * n_residuals)
+    return yardstick.noise_change(noise_sigma, n_residuals)
 
 
-def noise_J(noise_sigma: "float | None", n_residuals: "int | None") -> float:
+def noise_J(noise_sigma: "float | None", n_residuals: "int | None", yardstick: Yardstick = Yardstick()) -> float:
     """J (C2) of the noise alone, n sigma^2; 0 if the noise is unknown."""
-    return 0.0 if noise_sigma is None else n_residuals * noise_sigma ** 2
+    return yardstick.noise_J(noise_sigma, n_residuals)
 
 
 def explains(J_unforced: float, J_min: float, noise_sigma: "float | None", n_residuals: "int | None") -> bool:
@@ -171,7 +170,7 @@ class Paired:
 
     factory: a fitness factory whose evaluators have residuals(mask) (`keeps_residuals`, ga.fitness).
     J_many, floor: the search's scores and the difference of J (C2) that is rounding, whatever
-        the test says (ROUNDING of J_unforced): on a noise-free record two forcings that both
+        the test says (`Yardstick.rounding` of J_unforced): on a noise-free record two forcings that both
         cut a fault off differ by nothing else.
     """
 

@@ -43,8 +43,10 @@ from tqdm import tqdm
 from nodeforce.ga import checkpoint as ckpt
 from nodeforce.ga.evaluation import FitnessCache, log, open_backend
 from nodeforce.ga.operators import bit_flip_mutation, one_point_crossover, roulette_selection
-from nodeforce.ga.parsimony import (ROUNDING, Paired, explains, forward_backward, noise_J, noise_tolerance,
-                                    smallest_subset, tolerance)
+from nodeforce.ga.parsimony import (Paired, explains, forward_backward, noise_J, noise_tolerance, smallest_subset,
+                                    tolerance)
+from nodeforce.model.errors import InputError
+from nodeforce.model.score import Yardstick
 
 # Generations without a significant fall of the best J before the GA stops. Measured on the
 # paper's verification cases (benchmarks/bench_search.py --cases, README): successive falls of
@@ -71,7 +73,7 @@ def search(factory, chromosome_nodes, *, population=30, generations=400, pc=0.8,
         docstring); False: a random initial population (the paper).  PAPER = both off.
     workers: processes evaluating in parallel (default os.cpu_count(); 1 = in this process), or
         where a command runs its tasks (`lifetime.InProcess`, `lifetime.Workers`, a
-        `nodeforce.cluster.Cluster`), which its later stages use too.
+        `runtime.cluster.Cluster`), which its later stages use too.
     scheduler: a dask.distributed scheduler address ("tcp://host:port"); replaces `workers`.
     checkpoint: a file path; the state is written there after every generation, and a run
         started again with the same arguments resumes from it (other arguments: ignored).
@@ -148,15 +150,25 @@ def search(factory, chromosome_nodes, *, population=30, generations=400, pc=0.8,
     return answer
 
 
+def check_settings(population, generations, pc, pm, patience=None):
+    """The GA's settings, the one place they are checked: refused with the command-line option
+    that sets each named (InputError), by the command before any work and by `search` for a
+    caller of the API alike. `patience` None: no convergence criterion."""
+    if population < 2:
+        raise InputError("--population", population, "a population needs at least 2 chromosomes")
+    if generations < 1:
+        raise InputError("--generations", generations, "at least one generation")
+    for option, p in (("--pc", pc), ("--pm", pm)):
+        if not 0.0 <= p <= 1.0:
+            raise InputError(option, p, "a probability, between 0 and 1")
+    if patience is not None and patience < 1:
+        raise InputError("--patience", patience, "at least one generation")
+
+
 def _check_arguments(nodes, population, generations, pc, pm, patience, noise_sigma, n_residuals):
     if len(set(map(str, nodes))) != len(nodes):
         raise ValueError(f"chromosome nodes must be distinct: {nodes}")
-    if population < 2 or generations < 1:
-        raise ValueError("population must be >= 2 and generations >= 1")
-    if not (0 <= pc <= 1 and 0 <= pm <= 1):
-        raise ValueError("pc and pm are probabilities, in [0, 1]")
-    if patience is not None and patience < 1:
-        raise ValueError("patience must be >= 1 generation (None: no convergence criterion)")
+    check_settings(population, generations, pc, pm, patience)
     if noise_sigma is not None and not n_residuals:
         raise ValueError("noise_sigma needs n_residuals, the number of residuals in J")
 
@@ -325,7 +337,7 @@ def _answer(cache, nodes, noise_sigma, n_residuals, factory=None) -> dict:
     explained = explains(J_unforced, J_min, noise_sigma, n_residuals)
     if explained:
         start = parsimonious_best(cache.J_of, tol)
-        paired = (Paired(factory, cache.J_many, ROUNDING * J_unforced)
+        paired = (Paired(factory, cache.J_many, Yardstick().rounding(J_unforced))
                   if getattr(factory, "keeps_residuals", False) else None)
         try:
             chosen = smallest_subset(cache.J_many, start, cache.J_of[start] + tol,

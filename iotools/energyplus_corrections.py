@@ -8,6 +8,7 @@ from pathlib import Path
 from scipy.optimize import brentq
 
 from ..model import glazing
+from ..model.effects import EFFECTS
 from .energyplus import FILMS, SCHEMA_MIN, _field
 
 ALWAYS_ON = "nodeforce always on"
@@ -33,12 +34,12 @@ def write_corrections(before, after, effects, idf, out):
                           version=None if tuple(idfkit.get_idf_version(str(idf))[:2]) >= SCHEMA_MIN[:2] else SCHEMA_MIN)
     writer = _Writer(doc, before, after)
     for effect, target in effects:
-        handler = getattr(writer, effect, None)
+        handler = EFFECTS[effect].energyplus  # the effect's record says how it is written back
         if handler is None:
             writer.not_written.append(f"{effect} on {target}: no EnergyPlus object holds it; "
                                       "the corrected building file carries it")
         else:
-            handler(target)
+            handler(writer, target)
     idfkit.save_idf(doc, str(out))
     return {"idf_after": str(out), "changes": writer.changes, "not_written": writer.not_written}
 
@@ -72,7 +73,7 @@ class _Writer:
             self._add("Schedule:Constant", ALWAYS_ON, {"hourly_value": 1.0})
         return ALWAYS_ON
 
-    # ---- one method per effect of model/effects.py that an EnergyPlus object holds ----------
+    # ---- the corrections an effect's record writes back (`model.effects.Effect.energyplus`) ----
     def infiltration(self, zone):
         z0, z1 = self.before.zone(zone), self.after.zone(zone)
         delta = (z1.air_change_rate - z0.air_change_rate) * z0.volume / 3600.0  # m3/s

@@ -37,6 +37,16 @@ SENSOR_TOLERANCE = 1e-3
 SCHEMA = json.loads(files(__package__).joinpath("data/nodal-building.schema.json").read_text(encoding="utf-8"))
 
 
+def schema_default(definition, *path):
+    """The default the JSON Schema gives an optional field, the only place it is written: the
+    field `path` of one of its definitions ("site", "altitude"; "zone", "supply", "flow_factor";
+    "zone", "gains", "radiant_fraction" for a field of each item of a list)."""
+    node = SCHEMA["$defs"][definition]
+    for name in path:
+        node = node.get("items", node)["properties"][name]
+    return node["default"]
+
+
 def load_building(path):
     """Read and validate a building file (`parse_building`); return a `Building`."""
     try:
@@ -153,8 +163,10 @@ def parse_checked(data, source="<building>"):
     check = _Checker(source)
     site = data["site"]
     site = {"latitude": float(site["latitude"]), "longitude": float(site["longitude"]),
-            "altitude": float(site.get("altitude", 0.0)), "timezone": site.get("timezone", "UTC"),
-            "ground_albedo": float(site.get("ground_albedo", 0.2)), "air_density": float(site.get("air_density", 1.2))}
+            "altitude": float(site.get("altitude", schema_default("site", "altitude"))),
+            "timezone": site.get("timezone", schema_default("site", "timezone")),
+            "ground_albedo": float(site.get("ground_albedo", schema_default("site", "ground_albedo"))),
+            "air_density": float(site.get("air_density", schema_default("site", "air_density")))}
     if "ground_temperature" in data["site"]:
         site["ground_temperature"] = float(data["site"]["ground_temperature"])
     schedules = {name: _schedule(check, name, s, f"schedules.{name}") for name, s in data.get("schedules", {}).items()}
@@ -255,7 +267,8 @@ def _schedule_of(check, item, where, schedules):
 
 
 def _gains(check, z, where, schedules):
-    return tuple(Gain(name=g["name"], power=float(g["power"]), radiant_fraction=float(g.get("radiant_fraction", 0.0)),
+    return tuple(Gain(name=g["name"], power=float(g["power"]),
+                      radiant_fraction=float(g.get("radiant_fraction", schema_default("zone", "gains", "radiant_fraction"))),
                       schedule=_schedule_of(check, g, f"{where}.gains[{k}]", schedules))
                  for k, g in enumerate(z.get("gains", ())))
 
@@ -285,13 +298,18 @@ def _angular(check, c, where):
     return AngularTransmittance(angles=tuple(angles), factors=tuple(factors), diffuse=float(raw["diffuse"]))
 
 
+def _zone_value(z, name):
+    """A zone's number `name` as its description gives it, else the schema's default."""
+    return float(z.get(name, schema_default("zone", name)))
+
+
 def _zone(check, z, where, zone_names, explicit, next_id, schedules):
     heat_input = z.get("heat_input")
     heat_input = () if heat_input is None else (heat_input,) if isinstance(heat_input, str) else tuple(heat_input)
     supply = z.get("supply")
     if supply is not None:
         supply = Supply(flow=float(supply["flow"]), temperature=_temperature(supply["temperature"]),
-                        flow_factor=float(supply.get("flow_factor", 1.0)))
+                        flow_factor=float(supply.get("flow_factor", schema_default("zone", "supply", "flow_factor"))))
     for j, raw in enumerate(z.get("airflow_from", ())):
         if raw["zone"] not in zone_names:
             check.fail(f"{where}.airflow_from[{j}].zone", f"names no zone ({raw['zone']!r})")
@@ -313,20 +331,21 @@ def _zone(check, z, where, zone_names, explicit, next_id, schedules):
         volume=float(z["volume"]),
         air_node=air,
         radiant_node=radiant,
-        air_change_rate=float(z.get("air_change_rate", 0.0)),
-        internal_gain=float(z.get("internal_gain", 0.0)),
+        air_change_rate=_zone_value(z, "air_change_rate"),
+        internal_gain=_zone_value(z, "internal_gain"),
         heat_input=heat_input,
-        heat_input_radiative_fraction=float(z.get("heat_input_radiative_fraction", 0.0)),
+        heat_input_radiative_fraction=_zone_value(z, "heat_input_radiative_fraction"),
         supply=supply,
         airflow_from=tuple(Inflow(zone=raw["zone"], flow=float(raw["flow"])) for raw in z.get("airflow_from", ())),
         thermal_bridges=_floats(z.get("thermal_bridges", {})),
-        convection_factor=float(z.get("convection_factor", 1.0)),
+        convection_factor=_zone_value(z, "convection_factor"),
         occupied=z.get("occupied"),
-        daily_gain=() if daily is None else tuple((t, float(daily.get(t, 0.0))) for t in DAY_TERMS),
+        daily_gain=() if daily is None else tuple(
+            (t, float(daily.get(t, schema_default("zone", "daily_gain", t)))) for t in DAY_TERMS),
         proportional_gains=_floats(z.get("proportional_gains", {})),
-        envelope_factor=float(z.get("envelope_factor", 1.0)),
-        shading_transmittance=float(z.get("shading_transmittance", 0.0)),
-        heat_input_factor=float(z.get("heat_input_factor", 1.0)),
+        envelope_factor=_zone_value(z, "envelope_factor"),
+        shading_transmittance=_zone_value(z, "shading_transmittance"),
+        heat_input_factor=_zone_value(z, "heat_input_factor"),
         air_exchange=_floats(exchange),
         gains=_gains(check, z, where, schedules),
         ventilation=_ventilation(check, z, where, schedules),
@@ -394,7 +413,8 @@ def _depths(check, c, where, layers, sensor_depths):
     raw_nodes = c["nodes"]
     if isinstance(raw_nodes, dict):
         return None, generated_depths([t for _, t in layers], float(raw_nodes["max_spacing"]),
-                                      raw_nodes.get("layer_boundaries", True), sensor_depths.get(c["name"], ()))
+                                      raw_nodes.get("layer_boundaries", schema_default("node_rule", "layer_boundaries")),
+                                      sensor_depths.get(c["name"], ()))
     ids, depths = [node["id"] for node in raw_nodes], [float(node["depth"]) for node in raw_nodes]
     for j, depth in enumerate(depths):
         if depth > total + DEPTH_TOLERANCE:
@@ -428,11 +448,12 @@ def _component(check, c, where, materials, zone_names, sensor_depths):
         solar_transmittance=None if tau is None else float(tau),
         transmitted_solar_to=c["transmitted_solar_to"] if tau is not None else None,
         shading=c.get("shading"),
-        conductivity_factor=float(c.get("conductivity_factor", 1.0)),
-        capacity_factor=float(c.get("capacity_factor", 1.0)),
+        conductivity_factor=float(c.get("conductivity_factor", schema_default("component", "conductivity_factor"))),
+        capacity_factor=float(c.get("capacity_factor", schema_default("component", "capacity_factor"))),
         angular=_angular(check, c, where),
         solar_distribution=_distribution(check, c, where),
-        inner_solar_absorptance=float(c.get("inner_solar_absorptance", 0.0)),
+        inner_solar_absorptance=float(c.get("inner_solar_absorptance",
+                                            schema_default("component", "inner_solar_absorptance"))),
     )
 
 

@@ -1,5 +1,5 @@
-"""The direct model's runs of steps compiled (c/steps.c), where a C compiler is found; and the
-project's C compiler itself, which the FMUs' export uses too (`fmu_build.compiler`).
+"""The direct model's runs of steps compiled (c/steps.c), where a C compiler is found (the
+compiler is `runtime.compiler`'s, which the FMUs' export uses too: `fmu_build.compiler`).
 
 A run of backward-Euler steps under one step matrix (`integrate.ImplicitEuler.run`) is, in
 numpy, one product with the dense inverse of M a step: O(N^2), some 15 us on the Twin House's
@@ -22,18 +22,14 @@ Only the direct model loads it: the Python FMU steps in numpy alone (`fmu_build.
 import ctypes
 import functools
 import logging
-import os
-import shutil
-import subprocess
 import threading
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 from scipy import sparse
 from scipy.sparse.linalg import splu
 
-from nodeforce import tempdirs
+from nodeforce.runtime.compiler import compiled_function
 
 log = logging.getLogger("nodeforce.model")
 _LOCK = threading.Lock()
@@ -41,64 +37,6 @@ _DOUBLE, _INT = np.ctypeslib.ndpointer(np.float64, flags="C"), np.ctypeslib.ndpo
 
 
 C_DIR = Path(__file__).with_name("c")
-
-
-def find_compiler():
-    """The C compiler command ($CC, else cc or gcc) as a list, or None when there is none."""
-    command = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
-    if not command or not shutil.which(command.split()[0]):
-        return None
-    return command.split()
-
-
-@contextmanager
-def built_library(directory, source, libraries=(), link_options=(), defines=(), options=("-O2",), includes=()):
-    """The path of the shared library of `directory`/<source> (a file name, or a tuple of several)
-    with the headers beside it and in `includes` (folders), in a temporary folder removed at the
-    block's end.
-
-    Compiled in `directory` by relative name, without debug information: the bytes do not depend
-    on where nodeforce is installed, so the same model gives the same FMU.
-
-    libraries : names given to -l; link_options : options for the linker (-Wl,...), before them;
-    defines : preprocessor names given to -D; options : the compiler's (optimisation)
-
-    Raises RuntimeError without a C compiler or when compiling fails.
-    """
-    compiler = find_compiler()
-    if compiler is None:
-        raise RuntimeError("no C compiler found (cc, gcc or $CC): install one (e.g. apt-get install gcc)")
-    with tempdirs.folder("c") as tmp:
-        output = Path(tmp) / "library.so"
-        command = [*compiler, "-std=c99", *options, "-fPIC", "-shared", "-fvisibility=hidden",
-                   *(f"-I{folder}" for folder in includes), *(f"-D{d}" for d in defines), "-o", str(output),
-                   *([source] if isinstance(source, str) else source), *link_options,
-                   *(f"-l{name}" for name in libraries)]
-        done = subprocess.run(command, cwd=directory, capture_output=True, text=True)
-        if done.returncode:
-            raise RuntimeError(f"compiling {source!r} failed: {' '.join(command)}\n{done.stderr}")
-        yield output
-
-
-def compile_library(directory, source, **options):
-    """The shared library (bytes) `built_library` compiles, for an FMU's binaries."""
-    with built_library(directory, source, **options) as path:
-        return path.read_bytes()
-
-
-def compiled_function(directory, source, symbol, fallback, logger, options=("-O2",)):
-    """The function `symbol` of `directory`/`source` compiled here (`built_library`) and loaded
-    from its temporary folder, removed at once; None where it cannot be compiled (no C compiler,
-    or one that fails on it: `fallback`, what is done instead, said in `logger`'s log with the
-    compiler's first line). The caller declares its argument and result types."""
-    if find_compiler() is None:
-        return None
-    try:
-        with built_library(directory, source, options=options) as path:
-            return getattr(ctypes.CDLL(str(path)), symbol)
-    except RuntimeError as error:
-        logger.warning("%s: %s", fallback, str(error).splitlines()[0])
-        return None
 
 
 @functools.lru_cache(maxsize=None)

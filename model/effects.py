@@ -4,9 +4,14 @@ Each effect is a change of declared fields of the building file, so a model with
 an ordinary building that every command loads, and its FMU exposes the effect's parameters as
 `<effect>.<name>`. A record says what the effect adds, its parameters (unit and physical
 range), which targets it applies to, how it reads and writes the building, and which nodes'
-forcing points at it. Adding an effect is one record here (and its fields in the building file
-format, if it needs new ones). Which effects a diagnosis tries, and where a calibration starts,
-is the diagnosis' policy (`nodeforce.diagnosis.candidates`), not physics.
+forcing points at it; and all the diagnosis reads of it (docs/method.md, "Choosing an effect"):
+which zones' rounds offer it, where its calibration starts a parameter declared absent, its
+physical limits, the parameters it is judged on, what the data fix where its parameters trade
+off and the derived quantities that say it, why a building's description may rule it out,
+whether it is a shape (a heat source the model lacks) and how it acts, and how it is written back
+into an EnergyPlus model (`iotools.energyplus_corrections`). Adding an effect is one record here
+(and its fields in the building file format, if it needs new ones). How many candidates a round
+tries and the thresholds of the choice are the diagnosis' policy (`nodeforce.diagnosis.policy`).
 
 A `thermal_bridge` target is a zone name for a bridge to the outdoor air, or `<zone>-><column>`
 for a bridge to a boundary temperature column (attic, cellar, neighbour); a `proportional_gain`
@@ -14,6 +19,7 @@ target is `<zone>-><column>`, the column a heat input or a face's irradiance the
 a `boundary_conductance` target is a boundary temperature column; an `interzone_air_exchange`
 target is `<zone>|<zone>`, the two zones in the building file's order.
 """
+import math
 import re
 from dataclasses import dataclass
 from typing import Callable
@@ -61,6 +67,36 @@ class Effect:
     # (`diagnosis.calibrate.Superposition`)
     on_inputs: bool = False
 
+    # -- what the diagnosis reads of it (diagnosis/)
+    # (building, zone) -> the targets a round on that zone's air tries (`diagnosis.candidates`);
+    # None: offered by its targets among the components the search points at, or as a shape
+    offers: Callable | None = None
+    # a heat source the model lacks rather than a property of the building: tried only where no
+    # physical effect brings the error to the noise, chosen only where none fits as well
+    shape: bool = False
+    # (building, target) -> {name: value} where a calibration starts a parameter declared 0 (no
+    # coupling, no node): on its bound, a bounded step is scaled to nothing
+    absent_start: Callable | None = None
+    # (building, target) -> {name: (low, high)}: physical limits, tighter than the ranges a
+    # calibration explores; beyond them a value is a fit compensating something else
+    physical: Callable | None = None
+    # the parameters whose identifiability and limits decide for it (None: all)
+    judged: tuple | None = None
+    # Derivation -> {name: {"value", "std", "unit"}}: what the data fix where its parameters
+    # trade off (`diagnosis.calibrate.derived`)
+    derived: Callable | None = None
+    # (one of `derived`'s names, whether a parameter on a bound is waived when that is fixed)
+    trade_off: tuple | None = None
+    # (building, target) -> why the building file's description rules it out, or None
+    implausible: Callable | None = None
+    # a heat source: a value below its lower limit of 0 is a sink
+    source: bool = False
+    # (target, {name: value}) -> how a shape's heat source acts, in words
+    acting: Callable | None = None
+    # (writer, target) -> None: the correction written into the EnergyPlus model a building was
+    # converted from (`iotools.energyplus_corrections`); None: no EnergyPlus object holds it
+    energyplus: Callable | None = None
+
     def applies(self, building, target):
         return target in self.targets(building)
 
@@ -78,6 +114,21 @@ class Effect:
 
     def parameter(self, name):
         return next(p for p in self.parameters if p.name == name)
+
+    def limits_of(self, building, target, name):
+        """The physical (low, high) of a parameter (`physical`), unbounded where none is said."""
+        return (self.physical(building, target) if self.physical else {}).get(name, (-math.inf, math.inf))
+
+    def judged_parameters(self):
+        """The parameters whose identifiability and limits decide for it (`judged`, default all)."""
+        return self.judged if self.judged is not None else tuple(p.name for p in self.parameters)
+
+    def start(self, building, target):
+        """Where a calibration starts: the declared values, a parameter declared 0 at its
+        `absent_start` where it has one."""
+        values = self.read(building, target)
+        absent = self.absent_start(building, target) if self.absent_start else {}
+        return {name: absent[name] if value == 0.0 and name in absent else value for name, value in values.items()}
 
 
 def _component(data, name):
@@ -100,6 +151,11 @@ def _zone_field(key, parameter):
 
 def _zones(building):
     return [z.name for z in building.zones]
+
+
+def _heated(building):
+    """Zones with a measured heat input."""
+    return [z.name for z in building.zones if z.heat_input]
 
 
 def _own_nodes(building, target):
@@ -349,74 +405,216 @@ def _pair_write(data, target, values):
     _zone(data, owner).setdefault("air_exchange", {})[b if owner == a else a] = float(values["V"])
 
 
+# -- what the diagnosis reads of the effects (see `Effect`)
+
+def _offered(targets):
+    """`offers` of a zone effect whose target is the zone itself, where it applies."""
+    return lambda building, zone: [zone] if zone in targets(building) else []
+
+
+def _infiltration_offers(building, zone):
+    """A zone's air change, where no supply air of known flow is its exchange with the outside."""
+    return [] if building.zone(zone).supply is not None else [zone]
+
+
+def _bridge_offers(building, zone):
+    """A zone's bridges to the boundary columns its surfaces see, and to the outdoor air where its
+    supply air, whose flow is known, leaves no air change to try."""
+    supplied = building.zone(zone).supply is not None
+    return [t for t in _bridge_targets(building) for owner, to in [bridge_parts(t)]
+            if owner == zone and (to != "outdoor" or supplied)]
+
+
+def _pair_offers(building, zone):
+    """The air a zone exchanges with each zone it shares a component with."""
+    return [t for t in _pair_targets(building) if zone in pair_parts(t)]
+
+
+def _boundary_offers(building, zone):
+    """The conductances to each boundary column a zone's surfaces or bridges see."""
+    seen = {to for t in _bridge_targets(building) for z, to in [bridge_parts(t)] if z == zone}
+    seen |= {getattr(c.outside, "temperature", None) for c in building.components if c.inside.zone == zone}
+    return [c for c in building.boundary_columns if c in seen]
+
+
+def _absent(**values):
+    """`absent_start` of fixed values."""
+    return lambda building, target: values
+
+
+def _air_capacities(name, multiple):
+    """`absent_start` of a node a zone effect adds: `multiple` times the zone air's capacity (J/K): a
+    room's furniture and inner mass are several times its air's, an electric heater's about its
+    air's; their conductances start at `neutral_conductance`, so the mass's time constant starts
+    at hours and the heater's at half an hour."""
+    return lambda building, target: {name: multiple * RHO_C_AIR * building.zone(target).volume}
+
+
+def _fixed_limits(**limits):
+    """`physical` of fixed (low, high) per parameter."""
+    return lambda building, target: limits
+
+
+# A conductance scales within a factor of ten of the file's; a heater or meter off its reading by
+# more than two is a fault the file should state.
+SCALE_LIMITS = (0.1, 10.0)
+READING_LIMITS = (0.5, 2.0)
+# The area-weighted mean convective coefficient of a room's surfaces that air can give (W/m2/K):
+# natural convection (Alamdari and Hammond) gives a still room about 0.6, forced convection at a
+# hundred air changes an hour (Fisher and Pedersen) stays below 20. A limit on the coefficient, not
+# the factor: a factor of 0.1 is 0.5 W/m2/K where a file declares 5.
+ROOM_CONVECTION = (0.5, 20.0)
+
+
+def _convection_limits(building, target):
+    declared = building.mean_inside_convection(target)
+    return {"factor": tuple(h / declared for h in ROOM_CONVECTION)}
+
+
+def _proportional_limits(building, target):
+    """An area of sun cannot be negative (an irradiance column); a share of a heat input cannot
+    take away more than the input (k >= -1)."""
+    _, column = bridge_parts(target)
+    heat_inputs = {c for z in building.zones for c in z.heat_input}
+    return {"k": (-1.0 if column in heat_inputs else 0.0, math.inf)}
+
+
+def _unoccupied(building, target):
+    """A constant gain in a zone the file declares unoccupied stands for a heat source the model
+    lacks, not for occupants, and the report must say so."""
+    if building.zone(target).occupied is False:
+        return (f"{target} is declared unoccupied: the gain stands for a heat source the model lacks "
+                "(a heat input mis-measured, a flow of air or sun not modelled), not for occupants")
+    return None
+
+
+def _ground_flux(d):
+    """A ground coupling acts through its heat flux density q = U (T_ground - T_face) (W/m2, into
+    the component), T_face the face's mean temperature simulated over the window: many (U,
+    T_ground) pairs give the same flux."""
+    face = d.building.component(d.target).node_ids[-1]
+
+    def flux(values):
+        U, T_ground = values[:2]
+        return U * (T_ground - float(np.mean(d.nodes([face], values))))
+    return {"ground_heat_flux": d.of(flux, "W/m2")}
+
+
+def _component_loss(d):
+    """A component's conductivity factor acts through the heat the component loses (W/K): the HLC
+    with the factor less the HLC with the factor at its lower bound."""
+    low = d.bounds[0][0]
+    return {"component_loss": d.with_sd(d.hlc - d.hlc_at([low, *d.x[1:]]), d.hlc_slope, "W/K")}
+
+
+def _time_constant(name):
+    """A node of capacity C coupled by H answers with its time constant tau = C / H (s)."""
+    def derived(d):
+        C, H = d.x[:2]
+        return {name: d.with_sd(C / H, np.r_[1.0 / H, -C / H ** 2, np.zeros(len(d.x) - 2)], "s")}
+    return derived
+
+
+def _daily_acting(target, values):
+    amplitude = math.hypot(values.get("cos1", 0.0), values.get("sin1", 0.0))
+    return (f"with a daily profile (mean {values['mean']:.3g} W, first harmonic {amplitude:.3g} W) to the air "
+            f"of {target}")
+
+
+def _proportional_acting(target, values):
+    zone, column = bridge_parts(target)
+    return f"in proportion to {column} (k = {values['k']:.3g}) to the air of {zone}"
+
+
 EFFECTS = {e.id: e for e in (
     Effect("ground_coupling", "a conductance from an adiabatic face to a ground temperature",
            (Parameter("U", "W/m2/K", 0.0, 20.0), Parameter("T_ground", "C", -10.0, 40.0)),
            lambda b: [c.name for c in b.components if isinstance(c.outside, Adiabatic)],
-           _ground_read, _ground_write, _own_nodes, priors=_ground_priors),
+           _ground_read, _ground_write, _own_nodes, priors=_ground_priors,
+           absent_start=_absent(U=1.0), derived=_ground_flux, trade_off=("ground_heat_flux", True)),
     Effect("infiltration", "an air change with the outside",
            (Parameter("n", "1/h", 0.0, 20.0),), _zones,
-           *_zone_field("air_change_rate", "n"), _no_node),
+           *_zone_field("air_change_rate", "n"), _no_node,
+           offers=_infiltration_offers, absent_start=_absent(n=0.5), energyplus=lambda w, t: w.infiltration(t)),
     Effect("internal_gain", "a constant heat gain to the air",
            (Parameter("Q", "W", -5000.0, 5000.0),), _zones,
-           *_zone_field("internal_gain", "Q"), _no_node, on_inputs=True),
+           *_zone_field("internal_gain", "Q"), _no_node, on_inputs=True,
+           offers=_offered(_zones), physical=_fixed_limits(Q=(0.0, math.inf)), implausible=_unoccupied, source=True,
+           energyplus=lambda w, t: w.internal_gain(t)),
     Effect("solar_absorptance", "a corrected outside solar absorptance",
            (Parameter("alpha", "-", 0.0, 1.0),),
            lambda b: [c.name for c in b.exterior_components],
            lambda b, t: {"alpha": b.component(t).outside.solar_absorptance}, _absorptance_write, _own_nodes,
-           on_inputs=True),
+           on_inputs=True, energyplus=lambda w, t: w.solar_absorptance(t)),
     Effect("conductivity", "a scale on a component's conductances",
            (Parameter("factor", "-", 0.05, 20.0),), lambda b: [c.name for c in b.components],
-           lambda b, t: {"factor": b.component(t).conductivity_factor}, _conductivity_write, _own_nodes),
+           lambda b, t: {"factor": b.component(t).conductivity_factor}, _conductivity_write, _own_nodes,
+           physical=_fixed_limits(factor=SCALE_LIMITS), derived=_component_loss, trade_off=("component_loss", False),
+           energyplus=lambda w, t: w.conductivity(t)),
     Effect("inside_convection", "a scale on the inside convective coefficients",
            (Parameter("factor", "-", 0.01, 20.0),), _zones,
-           *_zone_field("convection_factor", "factor"), _no_node),
+           *_zone_field("convection_factor", "factor"), _no_node,
+           offers=_offered(_zones), physical=_convection_limits),
     Effect("solar_transmittance", "a corrected transmittance of a glazing",
            (Parameter("tau", "-", 0.0, 1.0),),
            lambda b: [c.name for c in b.components if c.solar_transmittance is not None],
            lambda b, t: {"tau": b.component(t).solar_transmittance}, _transmittance_write, _receiver_nodes,
-           on_inputs=True),
+           on_inputs=True, energyplus=lambda w, t: w.solar_transmittance(t)),
     Effect("thermal_bridge", "a conductance from a zone's air to the outdoor air or a boundary temperature",
-           (Parameter("UA", "W/K", 0.0, 200.0),), _bridge_targets, _bridge_read, _bridge_write, _no_node),
+           (Parameter("UA", "W/K", 0.0, 200.0),), _bridge_targets, _bridge_read, _bridge_write, _no_node,
+           offers=_bridge_offers, absent_start=_absent(UA=5.0)),
     Effect("heat_input_split", "a corrected radiative fraction of a zone's measured heat input",
-           (Parameter("f_r", "-", 0.0, 1.0),), lambda b: [z.name for z in b.zones if z.heat_input],
+           (Parameter("f_r", "-", 0.0, 1.0),), _heated,
            *_zone_field("heat_input_radiative_fraction", "f_r"),
-           lambda b, t: b.facing(t), on_inputs=True),
+           lambda b, t: b.facing(t), on_inputs=True, offers=_offered(_heated)),
     Effect("internal_mass", "the zone's furniture and undeclared internal mass: a node coupled to its air",
            (Parameter("C_m", "J/K", 0.0, 1e9), Parameter("H_m", "W/K", 0.01, 1e5)), _zones,
-           *_lumped_field("internal_mass", "C_m", "H_m"), _no_node, _lumped_limits("C_m")),
+           *_lumped_field("internal_mass", "C_m", "H_m"), _no_node, _lumped_limits("C_m"),
+           offers=_offered(_zones), absent_start=_air_capacities("C_m", 10.0),
+           derived=_time_constant("mass_time_constant"), trade_off=("mass_time_constant", False),
+           energyplus=lambda w, t: w.internal_mass(t)),
     Effect("heat_input_lag", "the heater's own capacity: a node between its measured heat input and the zone",
            (Parameter("C_h", "J/K", 0.0, 1e8), Parameter("H_h", "W/K", 0.01, 1e5)),
-           lambda b: [z.name for z in b.zones if z.heat_input],
-           *_lumped_field("heat_input_lag", "C_h", "H_h"), _no_node, _lumped_limits("C_h")),
+           _heated, *_lumped_field("heat_input_lag", "C_h", "H_h"), _no_node, _lumped_limits("C_h"),
+           offers=_offered(_heated), absent_start=_air_capacities("C_h", 1.0),
+           derived=_time_constant("heater_time_constant"), trade_off=("heater_time_constant", False)),
     Effect("envelope_conductance", "the envelope's materials conducting other than declared: one factor on "
                                    "the layer conductances of a zone's components to the outdoors and to "
                                    "boundaries, not their outside surface coefficients",
            (Parameter("factor", "-", 0.05, 20.0),), _envelope_targets,
-           *_zone_field("envelope_factor", "factor"), _no_node),
+           *_zone_field("envelope_factor", "factor"), _no_node,
+           offers=_offered(_envelope_targets), physical=_fixed_limits(factor=SCALE_LIMITS)),
     Effect("shading_transmittance", "the part of a glazing's sun that the zone's closed shading devices "
                                     "still let in (a screen's openness, the heat a blind absorbs and passes on)",
            (Parameter("f", "-", 0.0, 1.0),), _shading_targets,
-           *_zone_field("shading_transmittance", "f"), _shading_receivers, on_inputs=True),
+           *_zone_field("shading_transmittance", "f"), _shading_receivers, on_inputs=True,
+           offers=_offered(_shading_targets), absent_start=_absent(f=0.1)),
     Effect("daily_gain", "a heat gain to the air with a daily profile: its mean and harmonics of the local time",
            (Parameter("mean", "W", -5000.0, 5000.0), *(Parameter(t, "W", -5000.0, 5000.0) for t in DAY_TERMS)),
-           _zones, _daily_read, _daily_write, _no_node, on_inputs=True),
+           _zones, _daily_read, _daily_write, _no_node, on_inputs=True,
+           shape=True, physical=_fixed_limits(mean=(0.0, math.inf)), judged=("mean",), implausible=_unoccupied,
+           source=True, acting=_daily_acting),
     Effect("proportional_gain", "a heat gain to the air of k times an input column (W per unit of the column: "
                                 "dimensionless for a heat input, m2 for an irradiance)",
            (Parameter("k", "-", -10.0, 10.0),), _proportional_targets, _proportional_read, _proportional_write,
-           _no_node, on_inputs=True),
+           _no_node, on_inputs=True, shape=True, physical=_proportional_limits, source=True,
+           acting=_proportional_acting),
     Effect("boundary_conductance", "one factor on every conductance from the building to a boundary temperature "
                                    "column (attic, cellar, a neighbour): its components' layers and outside "
                                    "coefficients, and the zones' thermal bridges to it",
            (Parameter("factor", "-", 0.05, 20.0),), lambda b: list(b.boundary_columns),
-           _boundary_read, _boundary_write, _boundary_nodes),
+           _boundary_read, _boundary_write, _boundary_nodes,
+           offers=_boundary_offers, physical=_fixed_limits(factor=SCALE_LIMITS)),
     Effect("supply_flow", "a factor on a zone's mechanical supply air flow",
-           (Parameter("factor", "-", 0.0, 10.0),), _supply_targets, _supply_read, _supply_write, _no_node),
+           (Parameter("factor", "-", 0.0, 10.0),), _supply_targets, _supply_read, _supply_write, _no_node,
+           offers=_offered(_supply_targets), physical=_fixed_limits(factor=SCALE_LIMITS)),
     Effect("interzone_air_exchange", "air exchanged between two zones, a flow each way (an open internal door)",
-           (Parameter("V", "m3/h", 0.0, 3000.0),), _pair_targets, _pair_read, _pair_write, _no_node),
+           (Parameter("V", "m3/h", 0.0, 3000.0),), _pair_targets, _pair_read, _pair_write, _no_node,
+           offers=_pair_offers, absent_start=_absent(V=50.0)),
     Effect("heat_input_factor", "a factor on a zone's measured heat input: the heat its heater delivers per W read",
-           (Parameter("factor", "-", 0.0, 5.0),), lambda b: [z.name for z in b.zones if z.heat_input],
-           *_zone_field("heat_input_factor", "factor"), _no_node, on_inputs=True),
+           (Parameter("factor", "-", 0.0, 5.0),), _heated,
+           *_zone_field("heat_input_factor", "factor"), _no_node, on_inputs=True,
+           offers=_offered(_heated), physical=_fixed_limits(factor=READING_LIMITS)),
 )}
 
 
@@ -484,20 +682,6 @@ def structured_name(name):
     if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
         return name
     return "'" + name.replace("\\", "\\\\").replace("'", "\\'") + "'"
-
-
-def with_properties(building, values):
-    """A new Building with the properties of `values` ({FMU parameter name: value}) declared;
-    the building itself when there are none."""
-    if not values:
-        return building
-    found = {name: (p, target) for name, p, target in properties(building)}
-
-    def write(data):
-        for name, value in values.items():
-            p, target = found[name]
-            p.write(data, target, value)
-    return building.edited(write)
 
 
 def fmu_parameters(building, effect=None):

@@ -19,9 +19,10 @@ from functools import cached_property
 import numpy as np
 
 from .building import DAY_TERMS, Adiabatic, Boundary, Exterior, Surface
+from .building_file import schema_default
 from .discretise import capacities, conductances
 
-AIR_DENSITY = 1.2  # kg/m3, a building file's default (site.air_density)
+AIR_DENSITY = schema_default("site", "air_density")  # kg/m3, a building file's default
 C_AIR = 1005.0  # J/kg/K
 RHO_C_AIR = AIR_DENSITY * C_AIR  # J/m3/K
 

@@ -34,6 +34,90 @@ def metrics(measured, simulated):
             "sd": float(r.std(ddof=1)) if len(r) > 1 else 0.0, "n": int(len(r))}
 
 
+def fall(before, after):
+    """The fall of J from per-block J `before` to `after` (C2) and its standard error from the
+    per-block falls (blocks as the unit; 0 for one block, which has no scatter to measure)."""
+    d = np.asarray(before, dtype=float) - np.asarray(after, dtype=float)
+    return float(d.sum()), float(math.sqrt(len(d)) * d.std(ddof=1)) if len(d) > 1 else 0.0
+
+
+@dataclass(frozen=True)
+class Fall:
+    """A fall of J block by block (C2), judged by `Yardstick.judge`: the fall, its standard error
+    from the per-block falls, what it needs, and what the blocks other than its best gain."""
+    fall: float
+    se: float
+    needed: float
+    other_days: float
+
+    @property
+    def beats(self):
+        """The pass rule: the fall beats what it needs, on more blocks than its best."""
+        return self.fall > self.needed and self.other_days > 0
+
+    @property
+    def reversed(self):
+        """The rule read the other way: J rises by more than the fall would need."""
+        return self.fall < -self.needed
+
+
+@dataclass(frozen=True)
+class Yardstick:
+    """The noise yardstick of a change of J, read by the forcing search's parsimony
+    (`ga.parsimony`) and the diagnosis' choice (`diagnosis.policy.Policy.yardstick`) alike.
+
+    With n residuals of independent noise of sd sigma, J of pure noise (sigma^2 times a chi-square
+    with n degrees of freedom) has sd sigma^2 sqrt(2 n): a change of J smaller than `noise_sds`
+    such sds could be noise alone (`noise_change`). Where the noise is unknown or nil, a tiny gain
+    is not a fault: a fall must also exceed `least_fall_share` of the J it falls from
+    (`least_fall`). A difference of J below `rounding_share` of it is the simulation's rounding.
+    A fall judged block by block (`judge`) must also beat `standard_errors` standard errors of its
+    scatter from block to block, on more blocks than its best."""
+    # Standard deviations of J of pure noise a change of J must exceed to be more than noise
+    # (dimensionless): three keep a record with no fault from gaining an effect.
+    noise_sds: float = 3.0
+    # The least fall of J worth a node or an effect, as a share of the J it falls from
+    # (dimensionless).
+    least_fall_share: float = 0.01
+    # A difference of J below this share of J is the simulation's rounding (dimensionless).
+    rounding_share: float = 1e-9
+    # Standard errors of its block-to-block scatter a fall must exceed (dimensionless): one, not a
+    # Student t quantile, since a real effect's size follows the weather from day to day.
+    standard_errors: float = 1.0
+
+    def noise_J(self, sd, n):
+        """J (C2) of n residuals of noise of sd `sd` (C) alone, n sd^2; 0 if sd is unknown."""
+        return 0.0 if sd is None else n * sd ** 2
+
+    def noise_change(self, sd, n):
+        """The change of J (C2) noise of sd `sd` (C) alone can make on n residuals,
+        `noise_sds` sd^2 sqrt(2 n); 0 if sd is unknown."""
+        return 0.0 if sd is None else self.noise_sds * sd ** 2 * math.sqrt(2 * n)
+
+    def least_fall(self, J, sd, n):
+        """The fall of J (C2) from a model of J `J` (C2) on n residuals that noise of sd `sd` (C)
+        could make, at least `least_fall_share` of J."""
+        return max(self.least_fall_share * J, self.noise_change(sd, n))
+
+    def at_noise(self, J, n, sd):
+        """Whether an error J (C2) on n residuals is what an error of sd `sd` (C) alone leaves."""
+        return J <= self.noise_J(sd, n) + self.noise_change(sd, n)
+
+    def rounding(self, J):
+        """A difference of J (C2) below which two models differ by rounding, for a model of J `J`."""
+        return self.rounding_share * J
+
+    def judge(self, before, after, least):
+        """The pass rule, the one place it is written: the `Fall` of per-block J `before` to
+        `after` (C2), which needs max(`least`, `standard_errors` x its standard error) (C2), and
+        what the blocks other than its best gain; `Fall.beats` says whether it passes,
+        `Fall.reversed` whether J rises beyond it."""
+        before, after = np.asarray(before, dtype=float), np.asarray(after, dtype=float)
+        down, se = fall(before, after)
+        others = down - float(np.max(before - after)) if before.size else down
+        return Fall(down, se, max(least, self.standard_errors * se), others)
+
+
 # White noise gives second differences of lag-1 autocorrelation -2/3; a signal's curvature pulls
 # it towards +1. Below this bound the noise dominates the second differences and is seen.
 WHITE_LAG1 = -0.5

@@ -12,7 +12,7 @@ import importlib.util
 
 def __getattr__(name):
     if not name.startswith("__"):
-        # `from nodeforce import tempdirs` asks for the attribute before importing the submodule:
+        # `from nodeforce import model` asks for the attribute before importing the subpackage:
         # a submodule is imported as such, not looked for in the API (which may be importing it).
         if importlib.util.find_spec(f"{__name__}.{name}") is not None:
             return importlib.import_module(f"{__name__}.{name}")

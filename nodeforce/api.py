@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from nodeforce import tempdirs
+from nodeforce.runtime import tempdirs
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import input_table, simulate_fmu
 from nodeforce.diagnosis import windows as _windows
@@ -396,7 +396,7 @@ def locate(building, case, objective=None, workdir=None, source=SOURCE, **search
 
 def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibration_end=None, phases=(), seed=0,
              workers=None, scheduler=None, fmu_kind="python", search_fmu="auto", noise=None, reference=None,
-             population=30, generations=400, later=()):
+             population=30, generations=400, later=(), policy=None):
     """The whole loop of `nodeforce diagnose`; writes its files in `workdir` (docs/guide.md, Output
     files) and returns the `Diagnosis`: `summary()` the first screen, `to_json()` report.json's
     content, `added` the effects added, `rounds` each round's decision, `candidates` every fit.
@@ -425,7 +425,7 @@ def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibrati
         A Dask scheduler's address, "tcp://host:port": the forcing search and every round's
         candidates run on its workers instead of `workers` processes (docs/performance.md). The
         answer is the same; a worker lost midway costs none; a lost scheduler raises
-        `nodeforce.lifetime.RunStopped`, an unreachable one `InputError`.
+        `runtime.lifetime.RunStopped`, an unreachable one `InputError`.
     fmu_kind : str
         The FMUs of the model before and after, run and written (`model_before.fmu`,
         `model_after.fmu`): "python" (the default, as on the command line), "standalone", or
@@ -450,6 +450,9 @@ def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibrati
         diagnosis's burn-in), which no fit, choice or cross-validation reads: after the rounds the
         building as written and as corrected are scored on each as `compare` scores them
         (`Diagnosis.later`, report.json's `later`, a line of the first screen).
+    policy : Policy, optional
+        Every threshold, table and order of the choice (`nodeforce.diagnosis.policy.Policy`),
+        default `Policy()`; report.json records it, and `Diagnosis.replay` judges under it.
 
     Returns
     -------
@@ -457,11 +460,12 @@ def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibrati
     """
     from nodeforce.diagnosis import loop  # here: the report's plotting and statistics load with it
     with _folder(workdir) as folder:
-        return loop.diagnose(building, case, objective or Objective.of(building), folder, source=SOURCE,
-                             fraction=fraction, calibration_end=calibration_end, phases=phases, seed=seed,
-                             workers=workers, scheduler=scheduler, fmu_kind=fmu_kind, search_fmu=search_fmu,
-                             noise=noise, reference=reference, population=population, generations=generations,
-                             later=list(later))
+        records = case if isinstance(case, (list, tuple)) else \
+            [Record(case, SOURCE, SOURCE, fraction, calibration_end, tuple(phases or ()))]
+        return loop.diagnose(building, records, folder, objective or Objective.of(building),
+                             search=_locate.SearchSettings(seed, population, generations, search_fmu),
+                             execution=_locate.Execution(workers, scheduler, fmu_kind), noise=noise,
+                             reference=reference, later=list(later), policy=policy)
 
 
 def compare(models, workdir=None, phases=(), fmu_kind="python"):

@@ -1,6 +1,6 @@
 """The `nodeforce` command line (docs/guide.md). Bad input: one line on stderr, exit status 2; stopped
 by SIGINT, SIGTERM or a lost Dask scheduler: one line saying how to resume, 130, 143 or 75
-(nodeforce.lifetime)."""
+(runtime.lifetime)."""
 import argparse
 import json
 import sys
@@ -9,9 +9,11 @@ from pathlib import Path
 
 import numpy as np
 
-from nodeforce import api, lifetime, tempdirs
+from nodeforce import api
+
+from nodeforce.runtime import lifetime, tempdirs
 from nodeforce.ga.checkpoint import NAME as CHECKPOINT, resume_hint
-from nodeforce.ga.search import PAPER, PATIENCE
+from nodeforce.ga.search import PAPER, PATIENCE, check_settings
 from nodeforce.model.case import HISTORY_DAYS
 from nodeforce.model.errors import InputError
 from nodeforce.iotools.timetable import instant
@@ -124,14 +126,9 @@ def cmd_inputs(args):
 
 
 def check_search_settings(args):
-    """The GA's settings, refused with the option named rather than deep inside the search."""
-    if args.population < 2:
-        raise InputError("--population", args.population, "a population needs at least 2 chromosomes")
-    if args.generations < 1:
-        raise InputError("--generations", args.generations, "at least one generation")
-    for option, p in (("--pc", args.pc), ("--pm", args.pm)):
-        if not 0.0 <= p <= 1.0:
-            raise InputError(option, p, "a probability, between 0 and 1")
+    """The GA's settings (`ga.search.check_settings`) and the workers, refused with the option
+    named before any work rather than deep inside the search."""
+    check_settings(args.population, args.generations, args.pc, args.pm, args.patience)
     check_workers(args)
 
 
@@ -140,8 +137,6 @@ def search_strategy(args):
     paper's (GA settings given explicitly still apply: they default to the paper's anyway)."""
     if args.paper and args.patience is not None:
         raise InputError("--patience", args.patience, "--paper runs every generation; leave out one of the two")
-    if args.patience is not None and args.patience < 1:
-        raise InputError("--patience", args.patience, "at least one generation")
     settings = dict(population=args.population, generations=args.generations, pc=args.pc, pm=args.pm)
     if args.paper:
         return {**PAPER, **settings}

@@ -14,7 +14,9 @@ import pytest
 from nodeforce.cli import locate_summary
 from nodeforce.diagnosis.candidates import physical
 from nodeforce.diagnosis.loop import diagnose
+from nodeforce.ga.locate import Execution, SearchSettings
 from nodeforce.diagnosis.loss import heat_loss
+from nodeforce.diagnosis.policy import Policy
 from nodeforce.diagnosis.result import CrossValidation, Fit
 from nodeforce.diagnosis.report.tables import before_after_table
 from nodeforce.ga.locate import locate
@@ -108,7 +110,7 @@ def test_an_air_only_record_calibrates_every_zone_effect_and_every_component(hea
     """Nothing to force, so nothing points anywhere: every round calibrates the zone's effects
     (the heater's among them) and every component's, whatever the residual follows; the issue's
     furniture record left `internal_mass` untried because its residual followed the clock."""
-    pairs = physical(heated, [], ["cell"], [23])
+    pairs = physical(heated, [], ["cell"], [23], Policy())
     assert {("internal_mass", "cell"), ("heat_input_lag", "cell"), ("heat_input_split", "cell"),
             ("envelope_conductance", "cell"), ("infiltration", "cell")} <= set(pairs)
     assert ("ground_coupling", "floor") in pairs and ("conductivity", "door") in pairs
@@ -133,7 +135,7 @@ def test_the_report_says_when_the_data_fix_the_loss_but_not_its_split(heated):
     # 0.1 C of noise on 100 residuals: J may differ by 3 x 0.01 x sqrt(200) = 0.42 C2 by chance
     tried = [chosen, record("infiltration", hlc * 1.02, 0.06, 10.3), record("internal_gain", before, 0.0, 10.1),
              record("inside_convection", hlc * 1.03, 4.0, 10.2)]
-    out = heat_loss(heated, envelope, [chosen], tried, 0.1)
+    out = heat_loss(heated, envelope, [chosen], tried, 0.1, Policy().yardstick)
     assert out["before"] == pytest.approx(before) and out["after"] == pytest.approx(hlc)
     assert out["after_sd"] == 0.02
     assert "not how it splits" in out["split"] and "infiltration" in out["split"]
@@ -141,10 +143,10 @@ def test_the_report_says_when_the_data_fix_the_loss_but_not_its_split(heated):
     # an alternative that fits worse than the noise could make it, or loses differently, leaves
     # the split to the data
     tried[1] = replace(tried[1], cv=CrossValidation([11.0], 100))
-    assert heat_loss(heated, envelope, [chosen], tried, 0.1)["split"] is None
+    assert heat_loss(heated, envelope, [chosen], tried, 0.1, Policy().yardstick)["split"] is None
     tried[1] = replace(tried[1], cv=CrossValidation([10.3], 100),
                        derived={"heat_loss_coefficient": {"value": hlc * 1.2, "std": 0.06}})
-    assert heat_loss(heated, envelope, [chosen], tried, 0.1)["split"] is None
+    assert heat_loss(heated, envelope, [chosen], tried, 0.1, Policy().yardstick)["split"] is None
     report = {"effect": {"effect": "none"}, "before": {}, "after": {}, "objective": ["cell"],
               "heat_loss_coefficient": out, "assumptions": ["ghi split by erbs"]}
     table = before_after_table(report)
@@ -236,7 +238,8 @@ def test_an_air_only_record_names_the_undeclared_zone_effect(heated, heated_weat
     from the first day's steady state, so no initial-state bias is left for a slow parameter to
     absorb)."""
     truth, case = air_only(heated, heated_weather, id=effect, values=values)
-    report = diagnose(heated, case.with_burn_in(1), Objective.of(heated), tmp_path, workers=2, noise=NOISE).to_json()
+    report = diagnose(heated, case.with_burn_in(1), tmp_path, Objective.of(heated),
+                      execution=Execution(workers=2), noise=NOISE).to_json()
     assert [(e["effect"], e["target"]) for e in report["effects"]] == [(effect, "cell")], report["decision"]["reason"]
     first = report["effects"][0]
     assert report["after"]["validation"]["rmse"] < 1.2 * NOISE < 2 * NOISE < report["before"]["validation"]["rmse"]

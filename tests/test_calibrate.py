@@ -12,7 +12,7 @@ from scipy.optimize import least_squares
 
 from nodeforce.diagnosis.calibrate import (Candidate, Own, Superposition, calibrate, derived, fold, own_weights,
                                           score_statistic, solve, superposition_points, within_ranges)
-from nodeforce.diagnosis.policy import POLICY
+from nodeforce.diagnosis.policy import Policy
 from nodeforce.diagnosis.selection import blocks
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import measured_case, prepare_case
@@ -157,7 +157,7 @@ def test_a_fit_that_carries_the_files_numerical_error_finds_the_walls_of_the_fil
                          burn_in_days=1)
     B = case.burn_in_steps
     error = discretisation_error(case, testcell, [air])
-    days = blocks(len(case.times) - 1, B, case.dt)
+    days = blocks(len(case.times) - 1, B, case.dt, Policy())
 
     def fitted(T, numerical):
         measured = case.measured.copy()
@@ -204,8 +204,8 @@ def test_the_score_test_of_a_held_parameter_rejects_a_right_prior_at_its_level_a
         for shift in rejected:
             held = solve(lambda x: y - A @ x, np.zeros(2), lows, highs, {1: truth[1] + shift * sd})
             statistic = score_statistic(held, [1], lambda x: y - A @ x, list(zip(lows, highs)), steps, 0)
-            rejected[shift] += not POLICY.holds_prior(statistic, 1)
-    assert abs(rejected[0.0] / draws - POLICY.prior_level) < 0.03
+            rejected[shift] += not Policy().holds_prior(statistic, 1)
+    assert abs(rejected[0.0] / draws - Policy().prior_level) < 0.03
     assert rejected[3.0] / draws > 0.8
 
 
@@ -232,10 +232,10 @@ def test_the_score_test_of_a_prior_sees_it_where_the_held_fit_switches_its_effec
                 return y - x[0] * (x[1] - face)
             held = solve(residuals, np.array([1.0, prior]), lows, highs, {1: prior})
             statistic = score_statistic(held, [1], residuals, bounds, np.arange(n), 0)
-            rejected[U] += not POLICY.holds_prior(statistic, 1)
+            rejected[U] += not Policy().holds_prior(statistic, 1)
             if U:
                 assert held.x[0] == pytest.approx(0.0, abs=1e-9)
-    assert abs(rejected[0.0] / draws - POLICY.prior_level) < 0.03
+    assert abs(rejected[0.0] / draws - Policy().prior_level) < 0.03
     assert rejected[0.5] / draws > 0.95
 
 
@@ -273,7 +273,8 @@ def test_a_component_s_own_surface_read_beside_the_air_moves_its_value_to_the_tr
     def weight(surface_offset):
         c = with_offset(surface_offset)
         at = np.hstack([objective.measured(c), c.scored([door - 1])])
-        return own_weights(candidate, [c], [[air, door]], [at], [np.zeros_like(at)], 1, [alone], 0.1)[0][0]
+        return own_weights(candidate, [c], [[air, door]], [at], [np.zeros_like(at)], [alone],
+                           Own([[door]], None, 0.1, 0.0), Policy())[0][0]
 
     alone = fitted(own=False)
     assert abs(alone - 1.5) > 0.3  # the air alone is fooled by the window

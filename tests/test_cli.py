@@ -228,7 +228,7 @@ def test_demo_finds_the_ground_coupling_and_python_writes_the_same_report(tmp_pa
         assert (tmp_path / name).stat().st_size > 0
     # the search drives the standalone FMU where it can (--search-fmu auto); the model before and
     # after, which the candidates are measured against and the user takes away, the Python FMU
-    from nodeforce.model.compiled import find_compiler
+    from nodeforce.runtime.compiler import find_compiler
     standalone = {name: "resources/network.txt" in zipfile.ZipFile(tmp_path / name).namelist()
                   for name in ("model.fmu", "model_before.fmu", "model_after.fmu")}
     assert standalone == {"model.fmu": bool(find_compiler()), "model_before.fmu": False, "model_after.fmu": False}

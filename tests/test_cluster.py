@@ -1,4 +1,4 @@
-"""The diagnosis on a Dask cluster (`nodeforce.cluster`): the answer of the local run, a worker
+"""The diagnosis on a Dask cluster (`runtime.cluster`): the answer of the local run, a worker
 lost in the middle of a round costs none, a lost scheduler stops it in one line. (The forcing search's own cluster tests are in
 test_search.py and test_faults.py.)
 
@@ -11,8 +11,9 @@ import signal
 
 import pytest
 
-from nodeforce import lifetime
+from nodeforce.runtime import lifetime
 from nodeforce.diagnosis.loop import diagnose
+from nodeforce.ga.locate import Execution, SearchSettings
 from nodeforce.model.building_file import load_building, parse_building
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.case import prepare_case
@@ -40,7 +41,8 @@ def local(door, tmp_path_factory):
     """The diagnosis in this process: the answer every cluster run must give."""
     folder = tmp_path_factory.mktemp("local")
     building, case = door
-    return diagnose(building, case, Objective.of(building), folder, seed=0, workers=1).to_json(), folder
+    return diagnose(building, case, folder, Objective.of(building),
+                    search=SearchSettings(seed=0), execution=Execution(workers=1)).to_json(), folder
 
 
 def cluster():
@@ -74,8 +76,8 @@ def test_a_diagnosis_on_a_two_worker_cluster_gives_the_local_answer(door, local,
     building, case = door
     with cluster() as c, distributed.Client(c.scheduler_address) as client, \
             distributed.get_task_stream(client) as stream:
-        report = diagnose(building, case, Objective.of(building), tmp_path, seed=0,
-                          scheduler=c.scheduler_address).to_json()
+        report = diagnose(building, case, tmp_path, Objective.of(building),
+                          search=SearchSettings(seed=0), execution=Execution(scheduler=c.scheduler_address)).to_json()
     assert_same_answer(report, tmp_path, local)
     # every candidate was calibrated there, once: no worker was lost
     assert sum(task["key"].startswith("assess-") for task in stream.data) == len(report["candidates"])
@@ -103,8 +105,8 @@ def test_a_worker_killed_in_the_middle_of_a_round_costs_no_answer(door, local, t
     with cluster() as c, distributed.Client(c.scheduler_address) as client, \
             distributed.get_task_stream(client) as stream:
         client.run(kill_at_first_candidate, str(done))
-        report = diagnose(building, case, Objective.of(building), tmp_path / "out", seed=0,
-                          scheduler=c.scheduler_address).to_json()
+        report = diagnose(building, case, tmp_path / "out", Objective.of(building),
+                          search=SearchSettings(seed=0), execution=Execution(scheduler=c.scheduler_address)).to_json()
     assert done.exists()  # a worker was lost with a candidate in hand, the others under way
     # the scheduler gave its candidate to a worker alive: each one calibrated once to its end
     assert sum(task["key"].startswith("assess-") for task in stream.data) == len(report["candidates"])
@@ -118,7 +120,8 @@ def test_a_lost_scheduler_stops_the_diagnosis_in_one_line(door, tmp_path):
         with distributed.Client(address) as client:
             client.run(kill_at_first_candidate, str(done), scheduler.pid)
         with pytest.raises(lifetime.RunStopped) as stopped:
-            diagnose(building, case, Objective.of(building), tmp_path / "out", seed=0, scheduler=address)
+            diagnose(building, case, tmp_path / "out", Objective.of(building),
+                     search=SearchSettings(seed=0), execution=Execution(scheduler=address))
     assert done.exists()  # lost in the round, its search done
     [line] = str(stopped.value).splitlines()
     assert line.startswith(f"--scheduler: {address}: lost the Dask scheduler (")

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from nodeforce.model import compiled
+from nodeforce.runtime import compiler
 from nodeforce.model.building_file import load_building
 from nodeforce.model.integrate import ImplicitEuler, Sources
 from nodeforce.model.network import assemble
@@ -92,7 +93,7 @@ def test_a_singular_step_matrix_is_refused():
 def test_a_compiler_that_fails_leaves_the_steps_to_numpy(monkeypatch, caplog):
     def fails(*args, **kwargs):
         raise RuntimeError("compiling 'steps.c' failed: cc: error: unrecognized option")
-    monkeypatch.setattr(compiled, "built_library", fails)
+    monkeypatch.setattr(compiler, "built_library", fails)
     compiled._library.cache_clear()
     try:
         with caplog.at_level("WARNING", logger="nodeforce.model"):

@@ -8,13 +8,16 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from nodeforce.diagnosis.policy import POLICY
-from nodeforce.diagnosis.result import CrossValidation, Fit, OwnSensors, SensorEvidence, added_effects, last_change
+from nodeforce.diagnosis.policy import Policy
+from nodeforce.diagnosis.result import Baseline, CrossValidation, Fit, OwnSensors, SensorEvidence, added_effects, last_change
 from nodeforce.diagnosis.selection import blocks, decide
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.errors import InputError
 from nodeforce.model.score import Noise
 from tests.conftest import DATA
+
+
+POLICY = Policy()
 
 
 def parameter(value, std, identifiable=True, on_bound=False):
@@ -152,7 +155,7 @@ def candidate(effect, target, parameters, days):
 
 def choose(results, base, sigma, n, **options):
     """The round's (chosen fit, `Decision`)."""
-    decision = decide(results, base, sigma, n, **options)
+    decision = decide(results, Baseline(base, sigma, n, **options), POLICY)
     return decision.chosen, decision
 
 
@@ -167,12 +170,12 @@ def daily(days):
 
 
 def test_blocks_are_whole_days_of_the_scored_steps():
-    masks = blocks(4 * 96 + 30, 96, 900.0)
+    masks = blocks(4 * 96 + 30, 96, 900.0, POLICY)
     assert masks.shape == (3, 4 * 96 + 30) and not masks[:, :96].any()
     assert (masks.sum(axis=0)[96:] == 1).all()  # every scored step in one block
     assert [m.sum() for m in masks] == [96, 96, 96 + 30]  # the part day joins the last
     with pytest.raises(InputError, match="2 whole days"):
-        blocks(2 * 96 + 50, 96, 900.0)
+        blocks(2 * 96 + 50, 96, 900.0, POLICY)
 
 
 def test_a_physical_effect_wins_over_a_shape_the_data_cannot_tell_from_it():
@@ -234,7 +237,7 @@ def test_a_fall_the_files_own_numerical_error_could_make_does_not_pass():
     assert noise.floor_sd == pytest.approx(np.sqrt(SIGMA ** 2 + 0.08 ** 2))
     base = N / 4 * noise.floor_sd ** 2 * np.ones(4)
     wall = door(base - 0.2)
-    assert decide([wall], base, SIGMA, N).chosen is not None
+    assert choose([wall], base, SIGMA, N)[0] is not None
     chosen, decision = choose([wall], base, SIGMA, N, floor_sd=noise.floor_sd)
     assert chosen is None and decision.noise_margin == pytest.approx(3 * noise.floor_sd ** 2 * np.sqrt(2 * N))
 
@@ -413,11 +416,11 @@ def test_a_round_run_for_a_component_s_own_sensors_takes_no_effect_on_the_air_al
     # disagrees: a wall that lowers the air's J a little (noise it fits) is no evidence, the door
     # that mends its own surface is
     wall = candidate("conductivity", "west_wall", {"factor": parameter(2.0, 0.2)}, [b - 1.0 for b in BASE])
-    assert decide([wall], BASE, SIGMA, N).chosen is not None  # a first round would take it
-    decision = decide([wall], BASE, SIGMA, N, air_at_noise=True)
+    assert choose([wall], BASE, SIGMA, N)[0] is not None  # a first round would take it
+    _, decision = choose([wall], BASE, SIGMA, N, air_at_noise=True)
     assert decision.chosen is None and "own sensors" in decision.reason
     mends = with_own(door(BASE), [N * 0.25] * 4, [N * SIGMA ** 2] * 4)
-    assert decide([wall, mends], BASE, SIGMA, N, air_at_noise=True).chosen.target == "door"
+    assert choose([wall, mends], BASE, SIGMA, N, air_at_noise=True)[0].target == "door"
 
 
 def test_a_choice_revisited_takes_the_place_of_the_one_it_replaces_and_the_others_their_refitted_values():
@@ -430,7 +433,7 @@ def test_a_choice_revisited_takes_the_place_of_the_one_it_replaces_and_the_other
     air = replace(candidate("infiltration", "cell", {"n": parameter(0.45, 0.05)}, [1.9, 1.9]), round=3)
 
     def decision(chosen, replaces=None, refitted=None):
-        made = decide([chosen], [4.0, 4.0], 0.1, N)
+        _, made = choose([chosen], [4.0, 4.0], 0.1, N)
         return replace(made, replaces=replaces, refitted=refitted)
     rounds = [decision(envelope), decision(first_door)]
     assert [a.label for a in added_effects(rounds)] == ["envelope_conductance@cell", "conductivity@door"]

@@ -161,7 +161,7 @@ def test_documented_command_and_options_exist(page, command, options):
 
 # A file path in a code span: a slash, and a known ending; placeholders, globs and outputs left out.
 PATH_SPAN = re.compile(r"`([A-Za-z0-9_.][A-Za-z0-9_./-]*/[A-Za-z0-9_.-]+\.(?:py|json|md|csv|txt|gz|c|h|toml|html|png|cfg))`")
-# A name of the code: `model.network.assemble`, `diagnosis.policy.POLICY.identifiable_kelvin`, ...
+# A name of the code: `model.network.assemble`, `diagnosis.policy.Policy.identifiable_kelvin`, ...
 CODE_NAME = re.compile(r"`((?:model|diagnosis|ga|cosim|iotools|fmu_build|nodeforce)(?:\.[A-Za-z_][A-Za-z0-9_]*)+)`")
 MODEL = ROOT / "docs" / "model.md"
 
@@ -211,7 +211,7 @@ def test_every_name_of_the_code_the_docs_give_exists(page):
 
 def test_the_names_check_tells_a_wrong_name():
     assert resolves("model.network.assemble") and resolves("model.case.Case.with_burn_in")
-    assert resolves("iotools.hourly") and resolves("diagnosis.policy.POLICY.identifiable_share")
+    assert resolves("iotools.hourly") and resolves("diagnosis.policy.Policy.identifiable_share")
     assert not resolves("model.network.no_such_function") and not resolves("model.no_such_module")
 
 

@@ -331,7 +331,7 @@ def test_standalone_fmu_refuses_a_switched_conductance():
     b = b.edited(lambda d: d["zones"][0].update(ventilation=[{"name": "v", "flow": 10.0, "schedule": "s"}]))
     with pytest.raises(InputError, match="follows a schedule"):
         network_terms(b, None)
-    from nodeforce.model.compiled import find_compiler
+    from nodeforce.runtime.compiler import find_compiler
     from nodeforce.ga.locate import evaluator_kind
     # "auto" never picks the FMU that cannot run it, for the building or another record's protocol
     plain = "standalone" if find_compiler() else "python"

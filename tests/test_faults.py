@@ -20,7 +20,7 @@ from pathlib import Path
 
 import pytest
 
-from nodeforce import lifetime, tempdirs
+from nodeforce.runtime import lifetime, tempdirs
 from nodeforce.cli import main
 from nodeforce.ga import checkpoint as ckpt
 from nodeforce.ga.search import search
@@ -77,7 +77,7 @@ def session(sid):
 # candidate of a round is back from the workers and the others are still being calibrated.
 SIGNALLING = """
 import os, signal, sys
-from nodeforce import lifetime
+from nodeforce.runtime import lifetime
 from nodeforce.__main__ import main
 from nodeforce.ga import search
 when, signum, arguments = sys.argv[1], int(sys.argv[2]), sys.argv[3:]

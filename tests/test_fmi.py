@@ -10,7 +10,7 @@ from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.fmu_build.build import build_fmu, fmu_kind
 from nodeforce.model.building_file import parse_building
-from nodeforce.model import compiled as compiled_library
+from nodeforce.runtime import compiler as compiled_library
 
 pytestmark = pytest.mark.skipif(compiled_library.find_compiler() is None, reason="no C compiler: the steps are looped in Python")
 

@@ -13,7 +13,7 @@ from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnosis.calibrate import Candidate, calibrate
 from nodeforce.diagnosis.candidates import calibration_start, physical
-from nodeforce.diagnosis.policy import POLICY
+from nodeforce.diagnosis.policy import Policy
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.model.building_file import load_building, parse_building
 from nodeforce.model.case import Case
@@ -211,17 +211,17 @@ def test_a_building_file_that_declares_them_round_trips_and_bad_ones_are_refused
 
 def test_each_is_offered_where_the_building_has_what_it_acts_on(testcell):
     b = multizone_with_everything()
-    pairs = physical(b, [], ["A", "B"], [])
+    pairs = physical(b, [], ["A", "B"], [], Policy())
     for effect in HOUSE_EFFECTS:
         assert (effect, VALUES[effect][0]) in pairs, effect
     # a zone whose floor's outside is the cellar column is offered the cellar's conductances
-    assert ("boundary_conductance", "T_cellar") in physical(b, [], [b.component("floor").inside.zone], [])
+    assert ("boundary_conductance", "T_cellar") in physical(b, [], [b.component("floor").inside.zone], [], Policy())
     # the test cell has one zone, no supply, no boundary column and no heat input
-    assert not {e for e, _ in physical(testcell, [], ["cell"], [])} & set(HOUSE_EFFECTS)
+    assert not {e for e, _ in physical(testcell, [], ["cell"], [], Policy())} & set(HOUSE_EFFECTS)
     # an open door starts where it carries something; the physical limits of the factors
     assert calibration_start(b, "interzone_air_exchange", "A|B")["V"] > 0
-    assert POLICY.limits(b, "heat_input_factor", "B", "factor") == (0.5, 2.0)
-    assert POLICY.limits(b, "supply_flow", "A", "factor") == (0.1, 10.0)
+    assert Policy().limits(b, "heat_input_factor", "B", "factor") == (0.5, 2.0)
+    assert Policy().limits(b, "supply_flow", "A", "factor") == (0.1, 10.0)
 
 
 def random_case(b, n_rows, seed):

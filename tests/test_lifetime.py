@@ -3,7 +3,7 @@ import os
 
 from threadpoolctl import threadpool_info
 
-from nodeforce import lifetime
+from nodeforce.runtime import lifetime
 
 
 def blas_threads():

@@ -6,6 +6,8 @@ import pandas as pd
 import pytest
 
 from nodeforce.diagnosis.loop import diagnose
+from nodeforce.ga.locate import Execution, SearchSettings
+from nodeforce.diagnosis.policy import Policy
 from nodeforce.diagnosis.windows import Record
 from nodeforce.diagnosis.selection import harmed
 from nodeforce.model.building_file import parse_building
@@ -56,11 +58,11 @@ def test_harm_is_a_fall_below_minus_the_rules_yardstick_on_one_records_blocks():
     base = [10.0, 10.0, 10.0, 5.0, 5.0]
     scores = [6.0, 6.0, 6.0, 8.0, 8.0]
     groups = [{"record": "a", "blocks": [0, 1, 2], "n": 144}, {"record": "b", "blocks": [3, 4], "n": 96}]
-    harms = harmed(base, scores, 0.01, groups)
+    harms = harmed(base, scores, 0.01, groups, Policy())
     assert [h["record"] for h in harms] == ["b"]
     assert harms[0]["cv_fall"] == pytest.approx(-6.0)
     # within the noise: a rise of 0.001 C2 on b is no harm
-    assert harmed(base, [6.0, 6.0, 6.0, 5.0005, 5.0005], 0.01, groups) == []
+    assert harmed(base, [6.0, 6.0, 6.0, 5.0005, 5.0005], 0.01, groups, Policy()) == []
 
 
 @pytest.mark.slow  # a diagnosis of two records
@@ -74,7 +76,8 @@ def test_a_fault_one_record_shows_is_found_from_both_records(tmp_path):
     off = record(truth, b, "2014-04-20", 5, 0.0, seed=2)
     records = [Record(on, "on.csv", "heater on", calibration_end=on.times[0] + pd.Timedelta(days=4)),
                Record(off, "off.csv", "heater off", calibration_end=off.times[0] + pd.Timedelta(days=3))]
-    report = diagnose(b, records, Objective.of(b, ["A", "B"]), tmp_path, workers=1, noise=NOISE).to_json()
+    report = diagnose(b, records, tmp_path, Objective.of(b, ["A", "B"]),
+                      execution=Execution(workers=1), noise=NOISE).to_json()
     assert [(e["effect"], e["target"]) for e in report["effects"]][:1] == [("heat_input_factor", "B")]
     assert report["effects"][0]["parameters"]["factor"]["value"] == pytest.approx(0.7, abs=0.03)
     # before and after per record, zone and window; the record without the heater was right already
@@ -99,7 +102,8 @@ def test_a_correction_that_helps_one_record_and_harms_the_other_is_refused(tmp_p
     plain = record(b, b, "2014-04-20", 5, 0.0, seed=4)
     records = [Record(gained, "gained.csv", "one", calibration_end=gained.times[0] + pd.Timedelta(days=5)),
                Record(plain, "plain.csv", "two", calibration_end=plain.times[0] + pd.Timedelta(days=3))]
-    report = diagnose(b, records, Objective.of(b, ["A", "B"]), tmp_path, workers=1, noise=NOISE).to_json()
+    report = diagnose(b, records, tmp_path, Objective.of(b, ["A", "B"]),
+                      execution=Execution(workers=1), noise=NOISE).to_json()
     rounds = report["decision"]["rounds"]
     tests = {name: t for r in rounds for name, t in r["candidates"].items()}
     gain = tests["internal_gain@B"]

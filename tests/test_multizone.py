@@ -10,6 +10,7 @@ import pytest
 
 from nodeforce.api import convert_idf
 from nodeforce.diagnosis.loop import diagnose
+from nodeforce.ga.locate import Execution, SearchSettings
 from nodeforce.iotools.typical_year import convert_typical_year
 from nodeforce.iotools.weather import read_weather
 from nodeforce.model.case import prepare_case
@@ -41,8 +42,9 @@ def test_three_zones_diagnosed_end_to_end(tmp_path):
     measured = pseudo_measurements(truth, weather, times, airs, noise_sd=0.05, seed=1, history_days=14)
     case = prepare_case(building, weather, measured, history_days=14).with_burn_in(1)
     objective = Objective.of(building, [z.name for z in building.zones])
-    report = diagnose(building, case, objective, tmp_path / "out", seed=0, fmu_kind="python",
-                      population=12, generations=10).to_json()
+    report = diagnose(building, case, tmp_path / "out", objective,
+                      search=SearchSettings(seed=0, population=12, generations=10),
+                      execution=Execution(fmu_kind="python")).to_json()
     after = json.loads((tmp_path / "out" / "building_after.json").read_text())
     east = next(z for z in after["zones"] if z["name"] == "EAST OFFICE")
     assert east["air_change_rate"] == pytest.approx(1.2, abs=0.05)
@@ -68,8 +70,9 @@ def test_case600_corrections_written_back(tmp_path):
                  "-o", str(tmp_path / "m.csv")]) == 0
     weather, measured = read_weather(tmp_path / "w.csv"), read_measurements(tmp_path / "m.csv")
     case = prepare_case(building, weather, measured, history_days=14).with_burn_in(1)
-    report = diagnose(building, case, Objective.of(building), tmp_path / "out", seed=0, fmu_kind="python",
-                      population=12, generations=10).to_json()
+    report = diagnose(building, case, tmp_path / "out", Objective.of(building),
+                      search=SearchSettings(seed=0, population=12, generations=10),
+                      execution=Execution(fmu_kind="python")).to_json()
     assert report["effect"]["effect"] == "infiltration"
     doc = idfkit.load_idf(str(tmp_path / "out" / "model_after.idf"))
     infiltration = doc.getobject("ZONEINFILTRATION:DESIGNFLOWRATE", "INFILTRATION")

@@ -102,7 +102,8 @@ def test_the_model_a_candidate_is_measured_against_scores_each_day_with_the_shar
     all the others, as a candidate's left-out day is: the odd day with s = 0.6 (seven days of
     -0.6 e), leaving (0.6 - 0.2)^2 E; every other day with s = (6 x 0.6 + 0.2) / 7, leaving
     (0.6 - s)^2 E. Without the error given, every day keeps its whole residual, 0.36 E."""
-    from nodeforce.diagnosis.windows import Windows
+    from nodeforce.diagnosis.policy import Policy
+    from nodeforce.diagnosis.windows import RecordWindow, Windows
 
     day, days = 24, 4
     t = np.arange(day * days) / day
@@ -114,8 +115,8 @@ def test_the_model_a_candidate_is_measured_against_scores_each_day_with_the_shar
     blocks = [(i, m) for i in range(2) for m in masks]
 
     def windows(numerical):
-        return Windows([None] * 2, [None] * 2, [len(t)] * 2, [None] * 2, measured, blocks, [[], []], [None] * 2,
-                       numerical)
+        return Windows([RecordWindow(None, None, len(t), None, m, [], None, e)
+                        for m, e in zip(measured, numerical or [None] * 2)], blocks, Policy())
     s = (6 * 0.6 + 0.2) / 7
     odd = [i == 0 and m is masks[2] for i, m in blocks]
     expected = [(0.4 ** 2 if o else (0.6 - s) ** 2) * E for o in odd]

@@ -1,6 +1,6 @@
 """report.json holds every input of the choice: each round's decision, recomputed from the report
-alone with the policy (`diagnosis.policy.POLICY`, `diagnosis.selection.decide`), is the one the
-loop made."""
+alone under the policy it records (`diagnosis.policy.Policy`, `diagnosis.selection.decide`), is the
+one the loop made (tests/test_policy.py: after the code's default policy changes too)."""
 import json
 from dataclasses import replace
 
@@ -22,6 +22,7 @@ def check_replay(path):
     recorded = report["decision"]["rounds"]
     replayed = read.replay()
     assert read.rounds and len(replayed) == len(read.rounds)
+    assert report["policy"] == read.policy.to_json()
     for again, written in zip(replayed, recorded):
         assert again.to_json() == {k: v for k, v in written.items() if k != "cost"}
     # the effects the decisions add (a round's choice, or one that took an earlier one's place)

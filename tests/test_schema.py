@@ -347,3 +347,25 @@ def test_the_checks_references_inlined_find_the_errors_of_the_schema_as_written(
             found += error is not None
             assert best(inlined, changed) == error
     assert found > 40 * len(checks)  # most changes break a rule: the comparison is of errors, not of silence
+
+
+def test_the_parser_reads_its_defaults_from_the_schema(monkeypatch):
+    """An optional field the file leaves out takes the schema's `default`, the one place it is
+    written: a default changed there is what the parser gives (and the air's density the
+    network's default, `model.network.AIR_DENSITY`)."""
+    from nodeforce.model import building_file, network
+    bare = copy.deepcopy(TESTCELL)
+    del bare["site"]["ground_albedo"]
+    plain = parse_building(bare)
+    assert plain.site["ground_albedo"] == SCHEMA["$defs"]["site"]["properties"]["ground_albedo"]["default"]
+    assert plain.zones[0].envelope_factor == SCHEMA["$defs"]["zone"]["properties"]["envelope_factor"]["default"]
+    assert network.AIR_DENSITY == SCHEMA["$defs"]["site"]["properties"]["air_density"]["default"]
+    edited = copy.deepcopy(building_file.SCHEMA)
+    edited["$defs"]["site"]["properties"]["ground_albedo"]["default"] = 0.35
+    edited["$defs"]["zone"]["properties"]["envelope_factor"]["default"] = 1.5
+    edited["$defs"]["component"]["properties"]["capacity_factor"]["default"] = 2.0
+    monkeypatch.setattr(building_file, "SCHEMA", edited)
+    changed = building_file.parse_checked(bare)
+    assert changed.site["ground_albedo"] == 0.35 and changed.zones[0].envelope_factor == 1.5
+    assert all(c.capacity_factor == 2.0 for c in changed.components if "capacity_factor" not in
+               next(raw for raw in TESTCELL["components"] if raw["name"] == c.name))

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from nodeforce import lifetime
+from nodeforce.runtime import lifetime
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga import parsimony
 from nodeforce.model.score import Objective
@@ -510,3 +510,18 @@ def test_the_terminal_marks_the_nodes_the_noise_cannot_separate():
     header = next(i for i, line in enumerate(lines) if "J forced alone" in line)
     assert [line.split() for line in lines[header + 1:header + 4]] == [["7", "1.000", "a"], ["9", "1.100", "a"],
                                                                       ["16", "2.000"]]
+
+
+@pytest.mark.parametrize("settings,option", [(dict(population=1), "--population"), (dict(generations=0), "--generations"),
+                                             (dict(pc=1.5), "--pc"), (dict(pm=-0.1), "--pm"),
+                                             (dict(patience=0), "--patience")])
+def test_the_search_refuses_its_settings_as_the_command_line_does(settings, option):
+    """One check of the GA's settings (`ga.search.check_settings`), for the command's options and
+    the API's arguments alike: the same InputError, naming the option, before any evaluation."""
+    from nodeforce.ga.search import check_settings
+    from nodeforce.model.errors import InputError
+    with pytest.raises(InputError, match=option):
+        search(lambda: None, [1, 2, 3], **settings)
+    defaults = dict(population=30, generations=400, pc=0.8, pm=0.03, patience=None)
+    with pytest.raises(InputError, match=option):
+        check_settings(**{**defaults, **settings})

@@ -12,6 +12,7 @@ import pytest
 
 from nodeforce.diagnosis.calibrate import Candidate, calibrate
 from nodeforce.diagnosis.loop import diagnose
+from nodeforce.ga.locate import Execution, SearchSettings
 from nodeforce.iotools.typical_year import convert_typical_year, relocate
 from nodeforce.iotools.weather import read_weather
 from nodeforce.model.building_file import parse_building
@@ -71,8 +72,9 @@ def record(building, weather, start, days, step, sensors=SENSORS, noise=0.1, eff
 
 
 def run(building, case, tmp_path, noise=None):
-    return diagnose(building, case, Objective.of(building), tmp_path, seed=0, workers=2, generations=30,
-                    noise=noise).to_json()
+    return diagnose(building, case, tmp_path, Objective.of(building),
+                    search=SearchSettings(seed=0, generations=30),
+                    execution=Execution(workers=2), noise=noise).to_json()
 
 
 def added(report):

@@ -4,6 +4,7 @@ checked against a sensor offset by a known amount."""
 import numpy as np
 
 from nodeforce.diagnosis.loop import Model
+from nodeforce.diagnosis.policy import Policy
 from nodeforce.diagnosis.windows import Record, Windows
 from nodeforce.model.case import prepare_case
 from nodeforce.model.score import Objective
@@ -20,7 +21,7 @@ def test_a_sensor_the_model_misses_by_a_kelvin_weighs_sigma_squared_and_one_it_f
     measurements[offset] = measurements[offset] + 1.0
     case = prepare_case(testcell, weather, measurements).with_burn_in(1)
     objective = Objective.of(testcell)
-    windows = Windows.of([Record(case)], objective)
+    windows = Windows.of([Record(case)], objective, Policy())
     assert windows.sensors == [[1, 7, 9, 16, 17]]
     sigma = 0.1
     (weights,) = windows.sensor_weights([windows.sensed_by(Model(testcell, [], {}, [None]))], sigma)
@@ -37,7 +38,7 @@ def test_a_sensor_a_candidate_mends_counts_fully_and_one_none_mends_stays_discou
     measurements = pseudo_measurements(testcell, weather, record_times(), SENSORS, history_days=0)
     measurements["T9"] = measurements["T9"] + 1.0
     case = prepare_case(testcell, weather, measurements).with_burn_in(1)
-    windows = Windows.of([Record(case)], Objective.of(testcell))
+    windows = Windows.of([Record(case)], Objective.of(testcell), Policy())
     sigma = 0.1
     model = windows.sensed_by(Model(testcell, [], {}, [None]))
     follows = [np.nan_to_num(windows.sensed[0], nan=0.0) + 0.5 * sigma]  # within the noise everywhere: weight 1

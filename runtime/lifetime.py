@@ -10,7 +10,7 @@ worker, before any task:
   sends the signal when the thread that started the worker ends; nodeforce starts workers from
   the main thread, which lives as long as the process. Elsewhere a thread watches the parent;
 - SIGINT is ignored: a Ctrl-C reaches the whole process group, and the parent decides;
-- SIGTERM removes the worker's temporary folders (nodeforce.tempdirs) and ends it at once, with
+- SIGTERM removes the worker's temporary folders (runtime.tempdirs) and ends it at once, with
   status 143. An FMU it holds is not freed: the process ends, and the system takes its memory;
 - the BLAS and OpenMP thread pools get the worker's share of the cores (`share_cores`): a pool
   of as many workers as cores whose every numpy inverse also starts a thread per core asks the
@@ -44,7 +44,7 @@ from pathlib import Path
 
 from threadpoolctl import threadpool_limits
 
-from nodeforce import tempdirs
+from nodeforce.runtime import tempdirs
 
 PR_SET_PDEATHSIG = 1  # linux/prctl.h
 # Seconds a stopped worker has to remove its folders and exit before it is killed.
@@ -229,7 +229,7 @@ def _shared_task(function, path, item):
 
 class InProcess:
     """A command's tasks run in this process, one after another (one worker asked for): what
-    `Workers` and a Dask `nodeforce.cluster.Cluster` are for work spread over processes."""
+    `Workers` and a Dask `runtime.cluster.Cluster` are for work spread over processes."""
 
     def map_shared(self, function, value, items, done=None) -> list:
         """function(value, item) for each item, in order; `done()` after each."""

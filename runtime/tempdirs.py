@@ -10,7 +10,7 @@ it removes nothing).
 
 The folders a process made and those of its parent it reads are also listed here, so a worker
 told to stop by a signal removes its own, and its parent's if that parent is gone, before it
-exits (`remove_held`, nodeforce.lifetime).
+exits (`remove_held`, runtime.lifetime).
 """
 import os
 import re

@@ -18,7 +18,7 @@ as its exception, for the caller to judge. A lost scheduler raises `lifetime.Run
 """
 import logging
 
-from nodeforce import lifetime
+from nodeforce.runtime import lifetime
 from nodeforce.model.errors import InputError
 
 # The client's own logs are silenced while it serves a run: every failure it meets reaches the
