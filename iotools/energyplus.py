@@ -18,6 +18,7 @@ import numpy as np
 
 from ..model import convection, geometry, glazing
 from ..model.errors import InputError
+from .idf_text import closed_text
 from ..model.gains import PEOPLE_T, people_sensible_heat
 from ..model.network import air_density_at, sky_fraction_energyplus
 
@@ -112,18 +113,6 @@ NOT_PHYSICS = ("Output", "OutputControl", "LifeCycleCost", "Meter", "RunPeriod",
                "UtilityCost", "ComponentCost", "CurrencyType")
 
 
-def unterminated_object(text):
-    """The first line of the object an IDF text leaves open (its last object without the ';' that
-    ends it, as a truncated file does), None if every object is closed. Read before idfkit parses
-    the file: its object pattern backtracks exponentially on an open tail (20, 25, 30 characters:
-    0.03, 1.1, 40 s), where this reads the text once."""
-    code = [line.split("!", 1)[0] for line in text.splitlines()]
-    tail = "\n".join(code).rsplit(";", 1)[-1]
-    if tail.strip() == "":
-        return None
-    return next(line.strip() for line in tail.splitlines() if line.strip())
-
-
 def newest_schema():
     """The newest EnergyPlus version whose IDD idfkit holds, (major, minor, patch)."""
     import idfkit.schema
@@ -133,17 +122,7 @@ def newest_schema():
 def load_idf(path):
     """The idfkit document of an IDF; InputError naming the file for one that cannot be read."""
     import idfkit
-    try:
-        text = open(path, encoding="utf-8", errors="replace").read()
-    except FileNotFoundError:
-        raise InputError(path, "file", "not found") from None
-    except OSError as e:
-        raise InputError(path, "file", f"cannot be read ({e.strerror})") from None
-    open_object = unterminated_object(text)
-    if open_object is not None:
-        kind = open_object.split(",")[0].strip()
-        raise InputError(path, kind or "(file)", f"the object {open_object[:40]!r} has no closing ';': the file is "
-                                                 "truncated or its last object unterminated")
+    closed_text(path)
     try:
         version = idfkit.get_idf_version(str(path))
     except Exception as e:

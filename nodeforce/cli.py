@@ -2,22 +2,36 @@
 by SIGINT, SIGTERM or a lost Dask scheduler: one line saying how to resume, 130, 143 or 75
 (runtime.lifetime)."""
 import argparse
+import importlib.util
 import json
 import sys
 from importlib.resources import files
 from pathlib import Path
 
-import numpy as np
-
-from nodeforce import api
-
-from nodeforce.runtime import lifetime, tempdirs
-from nodeforce.ga.checkpoint import NAME as CHECKPOINT, resume_hint
-from nodeforce.ga.search import PAPER, PATIENCE, check_settings
-from nodeforce.model.case import HISTORY_DAYS
 from nodeforce.model.errors import InputError
-from nodeforce.iotools.timetable import instant
-from nodeforce.iotools.weather import TYPICAL_YEAR
+from nodeforce.runtime import lifetime, tempdirs
+
+
+def lazy(name):
+    """The module `name`, loaded at the first use of one of its names (importlib's LazyLoader): a
+    command loads what it uses, so that `convert` refuses a truncated file, and `--help` answers,
+    before numpy, pandas and the model load (some 2 s)."""
+    if name in sys.modules:
+        return sys.modules[name]
+    spec = importlib.util.find_spec(name)
+    spec.loader = importlib.util.LazyLoader(spec.loader)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+api = lazy("nodeforce.api")
+ga_checkpoint = lazy("nodeforce.ga.checkpoint")
+ga_search = lazy("nodeforce.ga.search")
+model_case = lazy("nodeforce.model.case")
+iotools_timetable = lazy("nodeforce.iotools.timetable")
+iotools_weather = lazy("nodeforce.iotools.weather")
 
 DATA = Path(str(files("nodeforce.model") / "data"))
 
@@ -79,6 +93,8 @@ def cmd_fmu(args):
 
 
 def cmd_convert(args):
+    from nodeforce.iotools.idf_text import closed_text
+    closed_text(args.idf)  # a missing or truncated file refused before the converter loads
     building = api.convert_idf(args.idf, args.output)
     for line in building.data["not_modelled"]:
         print(f"not modelled: {line}")
@@ -87,6 +103,8 @@ def cmd_convert(args):
 
 
 def cmd_simulate(args):
+    import numpy as np
+
     from nodeforce.model.case import force_mask
     from nodeforce.iotools.node_temperatures import write_node_names, write_node_temperatures
     if args.force and not args.measurements:
@@ -128,7 +146,7 @@ def cmd_inputs(args):
 def check_search_settings(args):
     """The GA's settings (`ga.search.check_settings`) and the workers, refused with the option
     named before any work rather than deep inside the search."""
-    check_settings(args.population, args.generations, args.pc, args.pm, args.patience)
+    ga_search.check_settings(args.population, args.generations, args.pc, args.pm, args.patience)
     check_workers(args)
 
 
@@ -139,8 +157,8 @@ def search_strategy(args):
         raise InputError("--patience", args.patience, "--paper runs every generation; leave out one of the two")
     settings = dict(population=args.population, generations=args.generations, pc=args.pc, pm=args.pm)
     if args.paper:
-        return {**PAPER, **settings}
-    return {**settings, "patience": PATIENCE if args.patience is None else args.patience}
+        return {**ga_search.PAPER, **settings}
+    return {**settings, "patience": ga_search.PATIENCE if args.patience is None else args.patience}
 
 
 def check_workers(args):
@@ -214,7 +232,7 @@ def cmd_synth(args):
                                             "positive, --noise and --history-days not negative")
     if abs(86400 / args.step - round(86400 / args.step)) > 1e-9:
         raise InputError("--step", args.step, "must divide a day (the warm-up replays whole days)")
-    start = instant("--start", args.start)
+    start = iotools_timetable.instant("--start", args.start)
     times = pd.date_range(start, periods=int(args.days * 86400 / args.step) + 1,
                           freq=pd.Timedelta(seconds=args.step), name="time")
     frame = api.synthesize(building, api.read_weather(args.weather, year=args.year, times=times), times, node_list("--sensors", args.sensors),
@@ -318,7 +336,7 @@ def read_record(building, fields, options, args):
     # a record run under another protocol (other flows, other blinds) reads the house as written for it
     return api.read_record(fields.get("building", building), weather_of(fields["weather"], args), fields["measurements"],
                            name=fields.get("name"), fraction=check_fraction(options[0], fraction),
-                           calibration_end=instant(options[1], end) if end else None,
+                           calibration_end=iotools_timetable.instant(options[1], end) if end else None,
                            phases=fields.get("phases", args.phases), burn_in_days=burn_in,
                            decomposition=args.decomposition, history_days=history(args))
 
@@ -399,7 +417,7 @@ def case_arguments(s, measurements_required, output_help, output_default=None):
 def year_argument(s):
     s.add_argument("--year", type=int, help="the calendar year an EPW is read in, as EnergyPlus reads any EPW "
                                             "(default: an actual year's own; a typical year's, the measurements' "
-                                            f"year, else {TYPICAL_YEAR})")
+                                            f"year, else {iotools_weather.TYPICAL_YEAR})")
 
 
 def decomposition_argument(s):
@@ -452,10 +470,10 @@ def start_arguments(s, burn_in):
     s.add_argument("--burn-in-days", type=float, default=burn_in,
                    help=f"days after the first measurement over which every measured node is forced and nothing "
                         f"is scored (docs/model.md section 5; default {burn_in:g})")
-    s.add_argument("--history-days", type=float, default=HISTORY_DAYS,
+    s.add_argument("--history-days", type=float, default=model_case.HISTORY_DAYS,
                    help=f"days of the weather before the first measurement simulated before it, nothing measured "
                         f"or scored, so that the walls start from the weather's past (docs/model.md section 5; "
-                        f"default {HISTORY_DAYS:g}, as far as the weather and every input reach; 0: none)")
+                        f"default {model_case.HISTORY_DAYS:g}, as far as the weather and every input reach; 0: none)")
 
 
 def history(args):
@@ -482,23 +500,21 @@ def objective_argument(s):
                                        "(default: the first zone of the building file)")
 
 
-def parser():
-    p = Parser(prog="nodeforce", description=__doc__)
-    sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
-
-    s = sub.add_parser("fmu", help="build the FMU of a building file")
+def fmu_command(s):
     s.add_argument("building")
     s.add_argument("-o", "--output", required=True, help="the .fmu to write")
     s.add_argument("--standalone", action="store_true", help="C, no Python at run time (needs a C compiler)")
     fmi_argument(s)
     s.set_defaults(run=cmd_fmu)
 
-    s = sub.add_parser("convert", help="an EnergyPlus model (IDF) as a building file")
+
+def convert_command(s):
     s.add_argument("idf")
     s.add_argument("-o", "--output", required=True, help="the building file (JSON) to write")
     s.set_defaults(run=cmd_convert)
 
-    s = sub.add_parser("simulate", help="simulate a building through its FMU")
+
+def simulate_command(s):
     case_arguments(s, False, "the CSV of node temperatures to write", output_default="sim.csv")
     s.add_argument("--force", help="node ids forced to their measurements, e.g. 1,7,9")
     fmi_argument(s)
@@ -506,14 +522,16 @@ def parser():
     objective_argument(s)
     s.set_defaults(run=cmd_simulate)
 
-    s = sub.add_parser("inputs", help="the FMU's input table of a record and its start values, for another tool")
+
+def inputs_command(s):
     case_arguments(s, False, "the CSV to write (the start values go beside it, <stem>.start.json)")
     s.add_argument("--force", help="node ids forced to their measurements, e.g. 1,7,9")
     s.add_argument("--burn-in-days", type=float, default=0.0,
                    help="days after the first measurement over which every measured node is forced (default 0)")
     s.set_defaults(run=cmd_inputs)
 
-    s = sub.add_parser("locate", help="search the forcing that best explains the measured air")
+
+def locate_command(s):
     case_arguments(s, True, "folder for locate.json")
     s.add_argument("--nodes", help="forcing candidates (default: every measured node but the air)")
     s.add_argument("--include-algebraic", action="store_true",
@@ -524,7 +542,7 @@ def parser():
     s.add_argument("--pm", type=float, default=0.03, help="mutation probability per gene")
     s.add_argument("--patience", type=int,
                    help=f"stop when the best J has not fallen by more than the noise for this many "
-                        f"generations (default {PATIENCE})")
+                        f"generations (default {ga_search.PATIENCE})")
     s.add_argument("--paper", action="store_true",
                    help="the paper's search: random initial population, every generation run, no "
                         "convergence criterion (with the paper's 30 x 400, pc 0.8, pm 0.03 unless given)")
@@ -540,7 +558,8 @@ def parser():
     objective_argument(s)
     s.set_defaults(run=cmd_locate)
 
-    s = sub.add_parser("diagnose", help="localise, add the missing effect, calibrate, report before/after")
+
+def diagnose_command(s):
     s.add_argument("building")
     s.add_argument("--weather")
     year_argument(s)
@@ -560,8 +579,8 @@ def parser():
     objective_argument(s)
     s.set_defaults(run=cmd_diagnose)
 
-    s = sub.add_parser("compare", help="building files run on one record none was fitted on: RMSE, mean, sd, "
-                                       "per phase, heat loss coefficient")
+
+def compare_command(s):
     s.add_argument("buildings", metavar="BUILDING", nargs="+")
     s.add_argument("--weather", required=True)
     year_argument(s)
@@ -574,7 +593,8 @@ def parser():
     objective_argument(s)
     s.set_defaults(run=cmd_compare)
 
-    s = sub.add_parser("synth", help="measurements of a building, optionally with an effect its file does not declare")
+
+def synth_command(s):
     s.add_argument("building")
     s.add_argument("--weather", required=True)
     year_argument(s)
@@ -593,7 +613,8 @@ def parser():
     decomposition_argument(s)
     s.set_defaults(run=cmd_synth)
 
-    s = sub.add_parser("table", help="columns of a Modelica CombiTimeTable text file as a weather or measurements CSV")
+
+def table_command(s):
     s.add_argument("table_file", metavar="TABLE")
     s.add_argument("--names", required=True, help="the table's column names, time first: a,b,c or a CSV "
                                                   "file with a 'name' column (and optionally 'column_1based')")
@@ -607,15 +628,46 @@ def parser():
     s.add_argument("--set", help="NAME=VALUE,...: constant columns the user states, e.g. shading_south=0")
     s.set_defaults(run=cmd_table)
 
-    s = sub.add_parser("demo", help="diagnose the bundled test cell, whose measurements carry an undeclared effect")
+
+def demo_command(s):
     s.add_argument("-o", "--output", default="out/demo")
     diagnosis_arguments(s)
     s.set_defaults(run=cmd_demo, decomposition="erbs")
+
+
+# Each command: its help, and what adds its arguments (the parser of the command run is the only
+# one built whole, so that a command loads only the modules its own defaults come from).
+COMMANDS = {
+    "fmu": ("build the FMU of a building file", fmu_command),
+    "convert": ("an EnergyPlus model (IDF) as a building file", convert_command),
+    "simulate": ("simulate a building through its FMU", simulate_command),
+    "inputs": ("the FMU's input table of a record and its start values, for another tool", inputs_command),
+    "locate": ("search the forcing that best explains the measured air", locate_command),
+    "diagnose": ("localise, add the missing effect, calibrate, report before/after", diagnose_command),
+    "compare": ("building files run on one record none was fitted on: RMSE, mean, sd, per phase, heat loss coefficient",
+               compare_command),
+    "synth": ("measurements of a building, optionally with an effect its file does not declare", synth_command),
+    "table": ("columns of a Modelica CombiTimeTable text file as a weather or measurements CSV", table_command),
+    "demo": ("diagnose the bundled test cell, whose measurements carry an undeclared effect", demo_command),
+}
+
+
+def parser(command=None):
+    """The command line's parser: every command's name and help, and the arguments of `command`
+    (None: of none, for the list of commands)."""
+    p = Parser(prog="nodeforce", description=__doc__)
+    sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
+    for name, (help_text, arguments) in COMMANDS.items():
+        s = sub.add_parser(name, help=help_text)
+        if command == name:
+            arguments(s)
     return p
 
 
 def main(argv=None):
-    args = parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else [str(a) for a in argv]
+    command = next((a for a in argv if not a.startswith("-")), None)  # the first word that is no option
+    args = parser(command).parse_args(argv)
     signals = lifetime.Signals()
     try:
         with lifetime.stop_on_signals() as signals:
@@ -630,7 +682,7 @@ def main(argv=None):
             raise
         status, why = stop
         searched = args.command in ("locate", "diagnose", "demo")
-        print(f"nodeforce: {why}; " + (resume_hint(Path(args.output) / CHECKPOINT) if searched else
+        print(f"nodeforce: {why}; " + (ga_checkpoint.resume_hint(Path(args.output) / ga_checkpoint.NAME) if searched else
                                        "run the same command again"), file=sys.stderr)
         return status
     return 0
