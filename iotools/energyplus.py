@@ -1132,11 +1132,12 @@ class _Converter:
 
     def design_value(self, o, field):
         """The number a gain's or flow's calculation method reads; blank is 0, as EnergyPlus reads
-        a blank number (its other methods' fields are never required)."""
+        a blank number (its other methods' fields are never required). An OtherEquipment's may be
+        negative: EnergyPlus's IDD has no minimum there, and a negative level removes heat."""
         if _blank(_field(o, field)):
             self.note(f"a blank design level of a {o.obj_type} read as 0, as EnergyPlus reads it")
             return 0.0
-        return self.r.number(o, field, low=0)
+        return self.r.number(o, field, low=None if o.obj_type.lower() == "otherequipment" else 0)
 
     def people(self, o, floor):
         method = self.r.text(o, "number_of_people_calculation_method", "People").lower()

@@ -446,3 +446,21 @@ def test_simple_glazing_absorbs_as_energyplus_layer_and_keeps_its_shgc(tmp_path)
     f_in = h_i / (h_i + 1 / (R + 1 / h_o))
     # the films the split was made at are a vertical window's at 1.5 m: case 600's are within 2 %
     assert w.solar_transmittance + a_out * f_out + a_in * f_in == pytest.approx(0.38, rel=0.02)
+
+
+# ---- gains ---------------------------------------------------------------------------------
+def test_a_negative_other_equipment_removes_heat(tmp_path):
+    """EnergyPlus's IDD sets no minimum on OtherEquipment's levels: a negative one removes heat
+    (its convective and radiant parts, level x (1 - latent - lost)). Other gains stay >= 0."""
+    floor = 8.0 * 6.0
+    other = ("OtherEquipment,\n  Sink,\n  None,\n  Z,\n  ON,\n  Watts/Area,\n  ,\n  -2,\n  ,\n  0,\n  0.3,\n  0.25;\n"
+             "OtherEquipment,\n  Source,\n  None,\n  Z,\n  ON,\n  EquipmentLevel,\n  352,\n  ,\n  ,\n  0,\n  0,\n  0;\n"
+             "Schedule:Constant,\n  ON,\n  ,\n  1;\n")
+    b = convert_idf(write(tmp_path, HEADER + zone("Z") + box("Z", "Z") + other))
+    gains = {g["name"]: g for g in b.data["zones"][0]["gains"]}
+    assert gains["Sink"]["power"] == pytest.approx(-2 * floor * (1 - 0.25))
+    assert gains["Sink"]["radiant_fraction"] == pytest.approx(0.3 / 0.75)
+    assert gains["Source"]["power"] == pytest.approx(352.0)
+    electric = "ElectricEquipment,\n  Sink,\n  Z,\n  ON,\n  EquipmentLevel,\n  -50,\n  ,\n  ,\n  0,\n  0,\n  0;\n"
+    with pytest.raises(InputError, match="Design Level: -50 must be >= 0"):
+        convert_idf(write(tmp_path, HEADER + zone("Z") + box("Z", "Z") + electric + "Schedule:Constant,\n  ON,\n  ,\n  1;\n"))
