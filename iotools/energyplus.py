@@ -12,7 +12,10 @@ constant are `FILMS`.
 """
 import difflib
 import functools
+import re
+import tempfile
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -161,10 +164,31 @@ def load_idf(path):
                                               "bring the file to a later version (EnergyPlus's IDFVersionUpdater)")
         override = SCHEMA_MIN
     try:
-        return idfkit.load_idf(str(path), version=override)
+        if override is None or not _OTHER_EQUIPMENT.search(_code(text)):
+            return idfkit.load_idf(str(path), version=override)
+        with tempfile.TemporaryDirectory() as tmp:
+            moved = Path(tmp) / "model.idf"
+            moved.write_text(to_schema_min(text), encoding="utf-8")
+            return idfkit.load_idf(str(moved), version=override)
     except Exception as e:
         message = str(e).splitlines()[0] if str(e) else type(e).__name__
         raise InputError(path, "(file)", f"not a readable IDF: {message}") from None
+
+
+def _code(text):
+    """An IDF's text without its comments."""
+    return "\n".join(line.split("!", 1)[0] for line in text.splitlines())
+
+
+# an OtherEquipment object up to the comma after its name (its fields counted past comments)
+_OTHER_EQUIPMENT = re.compile(r"(?i)((?:^|;)\s*OtherEquipment\s*,[^,;]*,)")
+
+
+def to_schema_min(text):
+    """The text of an 8.5 to 8.8 file for 8.9's IDD, which it is read against: of the objects the
+    converter reads, only OtherEquipment changed its fields, 8.9 inserting `Fuel Type` after the
+    name (EnergyPlus's 8.8 to 8.9 transition fills it with None, as here); comments dropped."""
+    return _OTHER_EQUIPMENT.sub(lambda m: m.group(1) + " None,", _code(text))
 
 
 # The version whose IDD names the fields this module asks for; a file of another version has its
@@ -208,9 +232,13 @@ def _field_names(obj_type, version):
 
 
 def _version_of(obj):
+    """The version whose IDD an object is read by: its file's, or for a file of 8.5 to 8.8 (no IDD
+    of which idfkit holds) 8.9's, the IDD `_load` reads it against."""
     doc = getattr(obj, "theidf", None)
     version = getattr(doc, "version", None)
-    return tuple(version) if version else REFERENCE_SCHEMA
+    if not version:
+        return REFERENCE_SCHEMA
+    return max(tuple(version), SCHEMA_MIN)
 
 
 def _own_name(obj, field):
