@@ -106,6 +106,7 @@ READ = set(("Version", "Site:Location", "GlobalGeometryRules", "Building", "Zone
             "WindowMaterial:SimpleGlazingSystem", "Site:GroundTemperature:BuildingSurface",
             "Site:GroundTemperature:Deep", "Timestep",
             "InternalMass", "Construction:FfactorGroundFloor", "Construction:CfactorUndergroundWall",
+            "Construction:WindowDataFile",
             "Site:GroundTemperature:FCfactorMethod", "SurfaceProperty:OtherSideCoefficients",
             "SurfaceProperty:OtherSideConditionsModel", "WindowMaterial:GasMixture", "MaterialProperty:GlazingSpectralData", "RunPeriodControl:SpecialDays", "SurfaceConvectionAlgorithm:Inside", "SurfaceConvectionAlgorithm:Outside") + SURFACES + tuple(SIMPLE_SURFACES) + SUBSURFACES + GAINS + FLOWS + SCHEDULES)
 # Objects about the run and its reports, not the building
@@ -374,9 +375,66 @@ def cfactor_fictitious_resistance(C, height):
     return max(FC_MIN_RESISTANCE, R_eff - FC_CONCRETE_PROPERTIES[0] / FC_CONCRETE_PROPERTIES[1])
 
 
+def read_window5(text, window):
+    """The first glazing system of a window in a WINDOW 5 data file (EnergyPlus's
+    Window5DataFile.dat format): {"panes": [{thickness m, conductivity, T, R_front, R_back,
+    emissivity_front, emissivity_back}], "gaps": [{thickness m, gas}]}, a gap's gas its gases'
+    own coefficients as `model.glazing.gas_properties` reads them, mole fractions for a mixture.
+    ValueError naming what is missing."""
+    blocks = re.split(r"(?im)^\s*Window name\s*:", text)[1:]
+    block = next((b for b in blocks if b.splitlines()[0].strip().upper() == window.strip().upper()), None)
+    if block is None:
+        raise ValueError(f"no window named {window!r} in the file")
+    lines = block.splitlines()
+
+    def rows_after(title):
+        """The value rows of a section: its first row after 'System1 :', continuation rows after."""
+        start = next((i for i, line in enumerate(lines) if line.strip().upper().startswith(title)), None)
+        if start is None:
+            raise ValueError(f"window {window!r} has no {title}")
+        out = []
+        for line in lines[start + 1:]:
+            body = line.split(":", 1)[1] if ":" in line else line
+            head = line.split(":", 1)[0].strip() if ":" in line else ""
+            if ":" in line and not head.upper().startswith("SYSTEM1"):
+                break
+            if not body.strip() or not re.match(r"^\s*[-0-9.]", body):
+                break
+            out.append(body.split())
+        return out
+
+    try:
+        (system,) = rows_after("GLAZING SYSTEM DATA")[:1]
+        n = int(system[2])
+        glass = rows_after("GLASS DATA")[:n]
+        panes = [{"thickness": float(r[1]) / 1000, "conductivity": float(r[2]), "T": float(r[3]),
+                  "R_front": float(r[4]), "R_back": float(r[5]), "emissivity_front": float(r[10]),
+                  "emissivity_back": float(r[11])} for r in glass]
+        gaps = []
+        if n > 1:
+            gap_rows = rows_after("GAP DATA")[:n - 1]
+            gas_rows = [line.split(":", 1)[1].split() for line in lines
+                        if re.match(r"(?i)^\s*System1\s+Gap\d+\s*:", line)]
+            for k, r in enumerate(gap_rows):
+                rows = [g for line, g in zip([ln for ln in lines if re.match(r"(?i)^\s*System1\s+Gap\d+\s*:", ln)],
+                                             gas_rows) if re.match(rf"(?i)^\s*System1\s+Gap{k + 1}\s*:", line)]
+                if len(rows) != int(r[2]):
+                    raise ValueError(f"gap {k + 1} of window {window!r} lists {len(rows)} gases, not {r[2]}")
+                # conductivity in W/m/K, viscosity in g/m/s and specific heat in kJ/kg/K (air's
+                # at 300 K: 0.026, 0.0185 and 1.006), brought to SI as gas_properties reads them
+                gases = [((tuple(map(float, g[3:6])), tuple(1e-3 * float(v) for v in g[6:9]),
+                           tuple(1e3 * float(v) for v in g[9:12]), float(g[2])), float(g[1])) for g in rows]
+                gaps.append({"thickness": float(r[1]) / 1000, "gas": gases[0][0] if len(gases) == 1 else gases})
+    except (IndexError, ValueError) as e:
+        raise ValueError(str(e) if isinstance(e, ValueError) and str(e).startswith(("gap", "window"))
+                         else f"window {window!r}: a glazing, glass or gap row is incomplete") from None
+    if len(panes) != n or len(gaps) != n - 1:
+        raise ValueError(f"window {window!r}: {n} panes declared, {len(panes)} glass and {len(gaps)} gap rows")
+    return {"panes": panes, "gaps": gaps}
+
+
 # Constructions the building file cannot hold, with why
 UNREAD_CONSTRUCTIONS = {
-    "Construction:WindowDataFile": "a window from a WINDOW data file is not read (give its layers)",
     "Construction:WindowEquivalentLayer": "an equivalent-layer window is not read (give its layers)",
     "Construction:ComplexFenestrationState": "a BSDF window is not read (give its layers)",
     "Construction:AirBoundary": "an air boundary between zones is not held by the building file",
@@ -609,6 +667,9 @@ class _Converter:
             c = self.r.by_name.get(kind.upper(), {}).get(str(construction_name).upper())
             if c is not None:
                 return equivalent(c)
+        c = self.r.by_name.get("CONSTRUCTION:WINDOWDATAFILE", {}).get(str(construction_name).upper())
+        if c is not None:
+            return self.window_data_file(c, height)
         for kind in UNREAD_CONSTRUCTIONS:
             c = self.r.by_name.get(kind.upper(), {}).get(str(construction_name).upper())
             if c is not None:
@@ -731,7 +792,7 @@ class _Converter:
             faces = {"emissivity": 0.84, "solar": alpha - inner, "roughness": 1.0}
             return [[name, 0.003]], faces, {"emissivity": 0.84, "solar": tau + alpha}, {
                 "tau": tau, "inner_alpha": inner, "angular": None}
-        panes, layers = [], []
+        panes, layers, gases = [], [], {}
         for k, o in enumerate(objs):
             kind = o.obj_type.upper()
             expected = ("WINDOWMATERIAL:GLAZING",) if k % 2 == 0 else ("WINDOWMATERIAL:GAS", "WINDOWMATERIAL:GASMIXTURE")
@@ -756,12 +817,18 @@ class _Converter:
                                                  "density": GLASS_DENSITY, "specific_heat": GLASS_SPECIFIC_HEAT})
                 layers.append([name, thickness])
             else:
-                layers.append([o, self.r.number(o, "thickness", low=0, low_open=True)])
+                layers.append([o.name, self.r.number(o, "thickness", low=0, low_open=True)])
+                gases[k] = self.gas(o)
+        return self._stack(c.name, panes, layers, gases, height)
+
+    def _stack(self, construction, panes, layers, gases, height):
+        """A layered glazing's layers, faces and optics from its panes (T0, Rf, front and back
+        emissivity), its layers ([name, thickness], panes and gaps alternating) and each gap's gas."""
         # a gap's conductance depends on the emissivities facing it and the pane's height
         for k in range(1, len(layers), 2):
             gap, d = layers[k]
-            h = glazing.gap_conductance(d, height or 1.5, panes[k // 2][3], panes[k // 2 + 1][2], gas=self.gas(gap))
-            name = f"{gap.name} in {c.name}"
+            h = glazing.gap_conductance(d, height or 1.5, panes[k // 2][3], panes[k // 2 + 1][2], gas=gases[k])
+            name = f"{gap} in {construction}"
             self.materials[name] = {"conductivity": h * d, "density": AIR_DENSITY, "specific_heat": AIR_SPECIFIC_HEAT}
             layers[k] = [name, d]
         pairs = [(T0, R0) for T0, R0, _, _ in panes]
@@ -779,6 +846,37 @@ class _Converter:
         inner = {"emissivity": panes[-1][3], "solar": 1 - glazing.stack_reflectance(pairs[::-1])}
         return layers, outer, inner, {"tau": tau, "inner_alpha": inner_alpha, "angular": {"angles": list(glazing.ANGLES), "factors": factors,
                                                               "diffuse": diffuse}}
+
+    def window_data_file(self, c, height):
+        """A Construction:WindowDataFile as EnergyPlus builds it: the panes and gaps of the window
+        of the construction's name in the WINDOW data file (its first glazing system), each pane's
+        spectral averages, each gap's gases at the file's own coefficients (`read_window5`)."""
+        written = self.r.text(c, "file_name") or "Window5DataFile.dat"
+        folder = Path(self.r.source).resolve().parent
+        relative = Path(written.replace("\\", "/"))
+        found = next((p for p in (folder / relative, folder / relative.name) if p.is_file()), None)
+        if found is None:
+            self.r.fail(c, "File Name", f"{written!r} is not found beside the IDF (EnergyPlus stops without it too)")
+        try:
+            window = read_window5(found.read_text(encoding="latin-1"), c.name)
+        except ValueError as e:
+            self.r.fail(c, "File Name", f"{written!r}: {e}")
+        panes, layers, gases = [], [], {}
+        for k, pane in enumerate(window["panes"]):
+            name = f"{c.name} pane {k + 1}"
+            self.materials[name] = {"conductivity": pane["conductivity"], "density": GLASS_DENSITY,
+                                    "specific_heat": GLASS_SPECIFIC_HEAT}
+            panes.append((pane["T"], pane["R_front"], pane["emissivity_front"], pane["emissivity_back"]))
+            layers.append([name, pane["thickness"]])
+            if k < len(window["gaps"]):
+                gap = window["gaps"][k]
+                layers.append([f"{c.name} gap {k + 1}", gap["thickness"]])
+                gases[len(layers) - 1] = gap["gas"]
+        line = (f"Construction:WindowDataFile {c.name}: its panes and gaps read from {found.name}; the file's "
+                "angle-dependent optical table, frame and divider not held (the panes' own angular behaviour used)")
+        if line not in self.not_modelled:
+            self.not_modelled.append(line)
+        return self._stack(c.name, panes, layers, gases, height)
 
     def spectral_pane(self, o):
         """(T, R_front) at normal incidence of a pane given by wavelength

@@ -477,3 +477,44 @@ def test_an_other_equipment_of_an_8_6_file_gains_its_fuel_type_field(tmp_path):
     (gain,) = b.data["zones"][0]["gains"]
     assert (gain["name"], gain["power"], gain["radiant_fraction"]) == ("Test 352a", pytest.approx(352.0), pytest.approx(0.25))
     assert E.to_schema_min("OtherEquipment,A,Z,S;") == "OtherEquipment,A, None,Z,S;"
+
+
+# ---- a window from a WINDOW data file -------------------------------------------------------
+def window5(gas):
+    """A WINDOW 5 data file of case 600's double glazing: its panes (3.175 mm, 1.06 W/m/K, T 0.86156,
+    R 0.07846, emissivity 0.84) and 13 mm gap of a gas given by coefficients as the file writes them:
+    conductivity W/m/K, viscosity g/m/s, specific heat kJ/kg/K."""
+    (k, mu, cp, M) = gas
+    coefficients = " ".join(f"{v:.9g}" for v in (*k, *(1e3 * v for v in mu), *(1e-3 * v for v in cp)))
+    pane = "3.175 1.06 0.86156 0.07846 0.07846 0.91325 0.082 0.082 0.00 0.84 0.84 CLEAR.DAT"
+    return ("Window5 Data File for EnergyPlus\nWindow name      : DOUBLE CLEAR\n# Glazing Systems: 1\n"
+            "GLAZING SYSTEM DATA: Height Width nPanes Uval-center SC-center SHGC-center Tvis-center\n"
+            " System1         :   2000   3000      2      2.9      0.88      0.76       0.81\n"
+            "GLASS DATA       : Layer#  Thickness  Cond Tsol Rfsol Rbsol Tvis Rfvis Rbvis  Tir  EmissF  EmissB  File\n"
+            f" System1         :   1   {pane}\n                     2   {pane}\n"
+            "GAP DATA         : Gap# Thick nGasses\n System1         :   1  13.0    1\n"
+            "GAS DATA         : GasName Fraction MolWeight ACond BCond CCond AVisc BVisc CVisc ASpHeat BSpHeat CSpHeat\n"
+            f" System1 Gap1    : Air 1.0000 {M} {coefficients}\n")
+
+
+def test_a_window_data_file_is_its_panes_and_gaps(tmp_path):
+    """Construction:WindowDataFile is built as EnergyPlus builds it, from the file's glass and gap
+    rows: with case 600's panes and EnergyPlus's air coefficients in the file's units, the window
+    is case 600's layer for layer; a missing file is refused in one line."""
+    layered = 'Construction,\n  DOUBLE CLEAR,                 !- Name\n  CLEAR PANE 3.175 MM,          !- Outside Layer\n' \
+              '  AIR GAP 13 MM,                !- Layer 2\n  CLEAR PANE 3.175 MM;          !- Layer 3\n'
+    assert layered in TEXT
+    (tmp_path / "data").mkdir()
+    (tmp_path / "data" / "W5.dat").write_text(window5(glazing.GASES["air"]))
+    text = TEXT.replace(layered, "Construction:WindowDataFile,\n  DOUBLE CLEAR,\n  ..\\data\\W5.dat;\n")
+    (tmp_path / "run").mkdir()
+    b = convert_idf(write(tmp_path / "run", text))
+    own, reference = b.component("SOUTH WINDOW WEST"), convert_idf(CASE600).component("SOUTH WINDOW WEST")
+    assert [t for _, t in own.layers] == pytest.approx([t for _, t in reference.layers])
+    assert [m.conductivity for m, _ in own.layers] == pytest.approx([m.conductivity for m, _ in reference.layers], rel=1e-9)
+    assert own.solar_transmittance == pytest.approx(reference.solar_transmittance)
+    assert own.inner_solar_absorptance == pytest.approx(reference.inner_solar_absorptance)
+    assert any(line.startswith("Construction:WindowDataFile DOUBLE CLEAR: its panes and gaps read from W5.dat")
+               for line in b.data["not_modelled"])
+    with pytest.raises(InputError, match=r"File Name: '..\\\\data\\\\W5.dat' is not found beside the IDF"):
+        convert_idf(write(tmp_path, text))
