@@ -1058,10 +1058,17 @@ class _Converter:
             while f"vertex_{k}_x_coordinate" in fields and not _blank(fields[f"vertex_{k}_x_coordinate"]):
                 v.append([fields[f"vertex_{k}_{a}_coordinate"] for a in "xyz"])
                 k += 1
-        try:
-            v = np.array(v, dtype=float)
-        except (TypeError, ValueError):
-            self.r.fail(s, "Vertex 1 X-coordinate", "a vertex coordinate is not a number")
+        for k, point in enumerate(v):
+            for axis, value in zip("XYZ", point):
+                try:
+                    float(value)
+                except (TypeError, ValueError):
+                    field = f"Vertex {k + 1} {axis}-coordinate"
+                    if str(value).strip().startswith("="):
+                        self.r.fail(s, field, f"{value!r} is a parametric expression: expand the file with "
+                                              "EnergyPlus's ParametricPreprocessor first, as EnergyPlus itself needs")
+                    self.r.fail(s, field, f"{value!r} is not a number")
+        v = np.array(v, dtype=float)
         if len(v) < 3:
             self.r.fail(s, "Number of Vertices", f"{len(v)} vertices: a surface needs at least 3")
         if geometry.area(v) <= 1e-9:

@@ -518,3 +518,12 @@ def test_a_window_data_file_is_its_panes_and_gaps(tmp_path):
                for line in b.data["not_modelled"])
     with pytest.raises(InputError, match=r"File Name: '..\\\\data\\\\W5.dat' is not found beside the IDF"):
         convert_idf(write(tmp_path, text))
+
+
+def test_a_parametric_vertex_is_refused_naming_its_field_and_the_preprocessor(tmp_path):
+    """EnergyPlus runs a file with `=$height` in a vertex only after its ParametricPreprocessor has
+    expanded it: the refusal names the coordinate that holds the expression."""
+    text = HEADER + zone("Z") + box("Z", "Z").replace("0, 0, 2.7,\n  0, 0, 0,", "0, 0, =$height,\n  0, 0, 0,", 1)
+    with pytest.raises(InputError, match=r"'Z S', field Vertex 1 Z-coordinate: '=\$height' is a parametric "
+                                         r"expression: expand the file with EnergyPlus's ParametricPreprocessor"):
+        convert_idf(write(tmp_path, text))
