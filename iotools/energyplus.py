@@ -106,7 +106,7 @@ READ = set(("Version", "Site:Location", "GlobalGeometryRules", "Building", "Zone
             "WindowMaterial:SimpleGlazingSystem", "Site:GroundTemperature:BuildingSurface",
             "Site:GroundTemperature:Deep", "Timestep",
             "InternalMass", "Construction:FfactorGroundFloor", "Construction:CfactorUndergroundWall",
-            "Construction:WindowDataFile",
+            "Construction:WindowDataFile", "SurfaceProperty:IncidentSolarMultiplier",
             "Site:GroundTemperature:FCfactorMethod", "SurfaceProperty:OtherSideCoefficients",
             "SurfaceProperty:OtherSideConditionsModel", "WindowMaterial:GasMixture", "MaterialProperty:GlazingSpectralData", "RunPeriodControl:SpecialDays", "SurfaceConvectionAlgorithm:Inside", "SurfaceConvectionAlgorithm:Outside") + SURFACES + tuple(SIMPLE_SURFACES) + SUBSURFACES + GAINS + FLOWS + SCHEDULES)
 # Objects about the run and its reports, not the building
@@ -1341,8 +1341,34 @@ class _Converter:
                         c["inner_solar_absorptance"] = round(glass["inner_alpha"], 6)
                     if w_outside["type"] != "exterior":
                         del c["solar_transmittance"], c["transmitted_solar_to"]
+                    else:
+                        self.incident_solar_multiplier(w["obj"], c)
                 comps.append(c)
         return comps
+
+    def incident_solar_multiplier(self, window, c):
+        """A SurfaceProperty:IncidentSolarMultiplier of an exterior window: EnergyPlus multiplies
+        the sun incident on its outside by it, so that what it transmits and what its panes absorb
+        scale with it; a constant one (its value times a constant schedule) scales the window's
+        transmittance and absorptances. One whose schedule varies is listed, not held."""
+        for o in self.r.all("SurfaceProperty:IncidentSolarMultiplier"):
+            if self.r.text(o, "surface_name").upper() != window.name.upper():
+                continue
+            m = self.r.number(o, "incident_solar_multiplier", default=1.0, low=0, high=1)
+            schedule = self.r.text(o, "incident_solar_multiplier_schedule_name")
+            if schedule:
+                value = self.constant_schedule_value(schedule, o, "Incident Solar Multiplier Schedule Name")
+                if value is None:
+                    self.not_modelled.append(f"SurfaceProperty:IncidentSolarMultiplier {window.name}: its schedule "
+                                             f"{schedule!r} varies: not held (the window takes its whole sun)")
+                    return
+                m *= value
+            c["solar_transmittance"] = round(c["solar_transmittance"] * m, 6)
+            c["outside"]["solar_absorptance"] = c["outside"]["solar_absorptance"] * m
+            if "inner_solar_absorptance" in c:
+                c["inner_solar_absorptance"] = round(c["inner_solar_absorptance"] * m, 6)
+            self.note(f"an incident solar multiplier of {m:g} on window {window.name} scales its transmittance "
+                      "and absorptances")
 
     def component(self, name, area, s, layers, inner, outside, outer=None):
         # each face the zones' sun can land on: (zone, its type seen from that zone, solar absorptance);

@@ -527,3 +527,41 @@ def test_a_parametric_vertex_is_refused_naming_its_field_and_the_preprocessor(tm
     with pytest.raises(InputError, match=r"'Z S', field Vertex 1 Z-coordinate: '=\$height' is a parametric "
                                          r"expression: expand the file with EnergyPlus's ParametricPreprocessor"):
         convert_idf(write(tmp_path, text))
+
+
+def box_24(multiplier=""):
+    """A 4 x 4 x 3 m box of EnergyPlus 24.1 with a 2 m2 south window of U 2, SHGC 0.6, and the
+    given SurfaceProperty:IncidentSolarMultiplier text."""
+    walls = {"S": [(0, 0, 3), (0, 0, 0), (4, 0, 0), (4, 0, 3)], "E": [(4, 0, 3), (4, 0, 0), (4, 4, 0), (4, 4, 3)],
+             "N": [(4, 4, 3), (4, 4, 0), (0, 4, 0), (0, 4, 3)], "W": [(0, 4, 3), (0, 4, 0), (0, 0, 0), (0, 0, 3)],
+             "F": [(4, 4, 0), (4, 0, 0), (0, 0, 0), (0, 4, 0)], "R": [(0, 4, 3), (0, 0, 3), (4, 0, 3), (4, 4, 3)]}
+    kinds = {"F": "Floor", "R": "Roof"}
+    text = ("Version, 24.1;\nSite:Location, Site, 40, -105, -7, 1600;\n"
+            "GlobalGeometryRules, UpperLeftCorner, CounterClockWise, World;\n"
+            "Material:NoMass, R2, Rough, 2.0, 0.9, 0.6, 0.6;\nConstruction, OPAQUE, R2;\n"
+            "WindowMaterial:SimpleGlazingSystem, SGS, 2.0, 0.6;\nConstruction, GLAZING, SGS;\n"
+            "Zone, Z, 0, 0, 0, 0, 1, 1, autocalculate, autocalculate;\n")
+    for key, points in walls.items():
+        flat = ", ".join(f"{x}, {y}, {z}" for x, y, z in points)
+        text += (f"BuildingSurface:Detailed, {key}, {kinds.get(key, 'Wall')}, OPAQUE, Z, , Outdoors, , SunExposed, "
+                 f"WindExposed, autocalculate, 4, {flat};\n")
+    text += "FenestrationSurface:Detailed, WIN, Window, GLAZING, S, , autocalculate, , 1, 4, 1, 0, 2, 1, 0, 1, 3, 0, 1, 3, 0, 2;\n"
+    return text + multiplier
+
+
+def test_a_constant_incident_solar_multiplier_scales_the_windows_sun(tmp_path):
+    """EnergyPlus multiplies the sun incident on the window by the multiplier times its schedule
+    (0.5 x 0.8 = 0.4): what it transmits and what its glazing absorbs, outside and inside, scale
+    by 0.4. A varying schedule is listed, not held."""
+    plain = convert_idf(write(tmp_path, box_24(), "plain.idf")).component("WIN")
+    scaled = convert_idf(write(tmp_path, box_24("SurfaceProperty:IncidentSolarMultiplier, WIN, 0.5, HALF;\n"
+                                                "Schedule:Constant, HALF, , 0.8;\n"), "scaled.idf")).component("WIN")
+    assert scaled.solar_transmittance == pytest.approx(0.4 * plain.solar_transmittance, abs=1e-6)
+    assert scaled.inner_solar_absorptance == pytest.approx(0.4 * plain.inner_solar_absorptance, abs=1e-6)
+    assert scaled.outside.solar_absorptance == pytest.approx(0.4 * plain.outside.solar_absorptance)
+    varying = box_24("SurfaceProperty:IncidentSolarMultiplier, WIN, 1, DAY;\n"
+                     "Schedule:Compact, DAY, , Through: 12/31, For: AllDays, Until: 12:00, 1, Until: 24:00, 0.5;\n")
+    b = convert_idf(write(tmp_path, varying, "varying.idf"))
+    assert b.component("WIN").solar_transmittance == pytest.approx(plain.solar_transmittance)
+    assert any(line.startswith("SurfaceProperty:IncidentSolarMultiplier WIN: its schedule 'DAY' varies")
+               for line in b.data["not_modelled"])
