@@ -1,8 +1,8 @@
 """An EnergyPlus model (IDF) into a nodal-building file (`nodeforce convert`, docs/guide.md).
 
 The IDF is read by idfkit (its epJSON schemas of EnergyPlus 8.9 to 26.x); a file of EnergyPlus
-8.5 to 8.8 is read against the 8.9 schema, which the transitions 8.5 -> 8.9 leave unchanged for
-every object this module reads. What the building file holds is mapped (docs/guide.md lists each
+8.4 to 8.8 is read against the 8.9 schema, which the transitions 8.4 -> 8.9 leave unchanged for
+every object this module reads but OtherEquipment (`to_schema_min`). What the building file holds is mapped (docs/guide.md lists each
 object and field); what it cannot hold (HVAC, thermostats, EMS, shading devices, airflow
 networks, a term of an air flow) is listed, one line per object, in the file's `not_modelled`;
 an object the conversion needs and cannot read is an `InputError` naming the file, the object,
@@ -24,7 +24,9 @@ from ..model.errors import InputError
 from ..model.gains import PEOPLE_T, people_sensible_heat
 from ..model.network import air_density_at, sky_fraction_energyplus
 
-MIN_VERSION, SCHEMA_MIN = (8, 5), (8, 9, 0)
+# 8.4 -> 8.5 changed no object read here (EnergyPlus's transition program for 8.5 renames an EMS
+# actuator's value and report variables only)
+MIN_VERSION, SCHEMA_MIN = (8, 4), (8, 9, 0)
 
 
 @dataclass(frozen=True)
@@ -161,7 +163,7 @@ def load_idf(path):
     override = None
     if tuple(version[:2]) < SCHEMA_MIN[:2]:
         if tuple(version[:2]) < MIN_VERSION:
-            raise InputError(path, "Version", f"EnergyPlus {'.'.join(map(str, version[:2]))} is older than 8.5: "
+            raise InputError(path, "Version", f"EnergyPlus {'.'.join(map(str, version[:2]))} is older than 8.4: "
                                               "bring the file to a later version (EnergyPlus's IDFVersionUpdater)")
         override = SCHEMA_MIN
     try:
@@ -186,7 +188,7 @@ _OTHER_EQUIPMENT = re.compile(r"(?i)((?:^|;)\s*OtherEquipment\s*,[^,;]*,)")
 
 
 def to_schema_min(text):
-    """The text of an 8.5 to 8.8 file for 8.9's IDD, which it is read against: of the objects the
+    """The text of an 8.4 to 8.8 file for 8.9's IDD, which it is read against: of the objects the
     converter reads, only OtherEquipment changed its fields, 8.9 inserting `Fuel Type` after the
     name (EnergyPlus's 8.8 to 8.9 transition fills it with None, as here); comments dropped."""
     return _OTHER_EQUIPMENT.sub(lambda m: m.group(1) + " None,", _code(text))
@@ -233,7 +235,7 @@ def _field_names(obj_type, version):
 
 
 def _version_of(obj):
-    """The version whose IDD an object is read by: its file's, or for a file of 8.5 to 8.8 (no IDD
+    """The version whose IDD an object is read by: its file's, or for a file of 8.4 to 8.8 (no IDD
     of which idfkit holds) 8.9's, the IDD `_load` reads it against."""
     doc = getattr(obj, "theidf", None)
     version = getattr(doc, "version", None)

@@ -466,14 +466,15 @@ def test_a_negative_other_equipment_removes_heat(tmp_path):
         convert_idf(write(tmp_path, HEADER + zone("Z") + box("Z", "Z") + electric + "Schedule:Constant,\n  ON,\n  ,\n  1;\n"))
 
 
-def test_an_other_equipment_of_an_8_6_file_gains_its_fuel_type_field(tmp_path):
-    """A file of 8.5 to 8.8 is read against 8.9's IDD, which inserted OtherEquipment's Fuel Type
-    after its name: the 8.6 object (name, zone, schedule, method, level, ...) still gives its zone
-    352 W, with a radiant fraction of 0.2 of the 0.8 not lost (0.25)."""
+@pytest.mark.parametrize("old", ["8.4", "8.6"])
+def test_an_other_equipment_of_an_8_x_file_gains_its_fuel_type_field(tmp_path, old):
+    """A file of 8.4 to 8.8 is read against 8.9's IDD, which inserted OtherEquipment's Fuel Type
+    after its name: the 8.4 or 8.6 object (name, zone, schedule, method, level, ...) still gives its
+    zone 352 W, with a radiant fraction of 0.2 of the 0.8 not lost (0.25)."""
     version = HEADER[HEADER.index("Version"):HEADER.index(";", HEADER.index("Version")) + 1]
     other = ("OtherEquipment,\n  Test 352a,  !- Name\n  Z,  !- Zone Name\n  ON,\n  EquipmentLevel,\n  440,\n  ,\n  ,\n"
              "  0,\n  0.2,\n  0.2;\n" "Schedule:Constant,\n  ON,\n  ,\n  1;\n")
-    b = convert_idf(write(tmp_path, HEADER.replace(version, "Version, 8.6;") + zone("Z") + box("Z", "Z") + other))
+    b = convert_idf(write(tmp_path, HEADER.replace(version, f"Version, {old};") + zone("Z") + box("Z", "Z") + other))
     (gain,) = b.data["zones"][0]["gains"]
     assert (gain["name"], gain["power"], gain["radiant_fraction"]) == ("Test 352a", pytest.approx(352.0), pytest.approx(0.25))
     assert E.to_schema_min("OtherEquipment,A,Z,S;") == "OtherEquipment,A, None,Z,S;"
