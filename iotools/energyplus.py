@@ -1,8 +1,8 @@
 """An EnergyPlus model (IDF) into a nodal-building file (`nodeforce convert`, docs/guide.md).
 
 The IDF is read by idfkit (its epJSON schemas of EnergyPlus 8.9 to 26.x); a file of EnergyPlus
-8.5 to 8.8 is read against the 8.9 schema, which the transitions 8.5 -> 8.9 leave unchanged for
-every object this module reads. What the building file holds is mapped (docs/guide.md lists each
+8.4 to 8.8 is read against the 8.9 schema, which the transitions 8.4 -> 8.9 leave unchanged for
+every object this module reads but OtherEquipment (`to_schema_min`). What the building file holds is mapped (docs/guide.md lists each
 object and field); what it cannot hold (HVAC, thermostats, EMS, shading devices, airflow
 networks, a term of an air flow) is listed, one line per object, in the file's `not_modelled`;
 an object the conversion needs and cannot read is an `InputError` naming the file, the object,
@@ -12,7 +12,10 @@ constant are `FILMS`.
 """
 import difflib
 import functools
+import re
+import tempfile
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -22,7 +25,9 @@ from .idf_text import closed_text
 from ..model.gains import PEOPLE_T, people_sensible_heat
 from ..model.network import air_density_at, sky_fraction_energyplus
 
-MIN_VERSION, SCHEMA_MIN = (8, 5), (8, 9, 0)
+# 8.4 -> 8.5 changed no object read here (EnergyPlus's transition program for 8.5 renames an EMS
+# actuator's value and report variables only)
+MIN_VERSION, SCHEMA_MIN = (8, 4), (8, 9, 0)
 
 
 @dataclass(frozen=True)
@@ -104,6 +109,7 @@ READ = set(("Version", "Site:Location", "GlobalGeometryRules", "Building", "Zone
             "WindowMaterial:SimpleGlazingSystem", "Site:GroundTemperature:BuildingSurface",
             "Site:GroundTemperature:Deep", "Timestep",
             "InternalMass", "Construction:FfactorGroundFloor", "Construction:CfactorUndergroundWall",
+            "Construction:WindowDataFile", "SurfaceProperty:IncidentSolarMultiplier",
             "Site:GroundTemperature:FCfactorMethod", "SurfaceProperty:OtherSideCoefficients",
             "SurfaceProperty:OtherSideConditionsModel", "WindowMaterial:GasMixture", "MaterialProperty:GlazingSpectralData", "RunPeriodControl:SpecialDays", "SurfaceConvectionAlgorithm:Inside", "SurfaceConvectionAlgorithm:Outside") + SURFACES + tuple(SIMPLE_SURFACES) + SUBSURFACES + GAINS + FLOWS + SCHEDULES)
 # Objects about the run and its reports, not the building
@@ -136,14 +142,35 @@ def load_idf(path):
     override = None
     if tuple(version[:2]) < SCHEMA_MIN[:2]:
         if tuple(version[:2]) < MIN_VERSION:
-            raise InputError(path, "Version", f"EnergyPlus {'.'.join(map(str, version[:2]))} is older than 8.5: "
+            raise InputError(path, "Version", f"EnergyPlus {'.'.join(map(str, version[:2]))} is older than 8.4: "
                                               "bring the file to a later version (EnergyPlus's IDFVersionUpdater)")
         override = SCHEMA_MIN
     try:
-        return idfkit.load_idf(str(path), version=override)
+        if override is None or not _OTHER_EQUIPMENT.search(_code(text)):
+            return idfkit.load_idf(str(path), version=override)
+        with tempfile.TemporaryDirectory() as tmp:
+            moved = Path(tmp) / "model.idf"
+            moved.write_text(to_schema_min(text), encoding="utf-8")
+            return idfkit.load_idf(str(moved), version=override)
     except Exception as e:
         message = str(e).splitlines()[0] if str(e) else type(e).__name__
         raise InputError(path, "(file)", f"not a readable IDF: {message}") from None
+
+
+def _code(text):
+    """An IDF's text without its comments."""
+    return "\n".join(line.split("!", 1)[0] for line in text.splitlines())
+
+
+# an OtherEquipment object up to the comma after its name (its fields counted past comments)
+_OTHER_EQUIPMENT = re.compile(r"(?i)((?:^|;)\s*OtherEquipment\s*,[^,;]*,)")
+
+
+def to_schema_min(text):
+    """The text of an 8.4 to 8.8 file for 8.9's IDD, which it is read against: of the objects the
+    converter reads, only OtherEquipment changed its fields, 8.9 inserting `Fuel Type` after the
+    name (EnergyPlus's 8.8 to 8.9 transition fills it with None, as here); comments dropped."""
+    return _OTHER_EQUIPMENT.sub(lambda m: m.group(1) + " None,", _code(text))
 
 
 # The version whose IDD names the fields this module asks for; a file of another version has its
@@ -187,9 +214,13 @@ def _field_names(obj_type, version):
 
 
 def _version_of(obj):
+    """The version whose IDD an object is read by: its file's, or for a file of 8.4 to 8.8 (no IDD
+    of which idfkit holds) 8.9's, the IDD `_load` reads it against."""
     doc = getattr(obj, "theidf", None)
     version = getattr(doc, "version", None)
-    return tuple(version) if version else REFERENCE_SCHEMA
+    if not version:
+        return REFERENCE_SCHEMA
+    return max(tuple(version), SCHEMA_MIN)
 
 
 def _own_name(obj, field):
@@ -325,9 +356,66 @@ def cfactor_fictitious_resistance(C, height):
     return max(FC_MIN_RESISTANCE, R_eff - FC_CONCRETE_PROPERTIES[0] / FC_CONCRETE_PROPERTIES[1])
 
 
+def read_window5(text, window):
+    """The first glazing system of a window in a WINDOW 5 data file (EnergyPlus's
+    Window5DataFile.dat format): {"panes": [{thickness m, conductivity, T, R_front, R_back,
+    emissivity_front, emissivity_back}], "gaps": [{thickness m, gas}]}, a gap's gas its gases'
+    own coefficients as `model.glazing.gas_properties` reads them, mole fractions for a mixture.
+    ValueError naming what is missing."""
+    blocks = re.split(r"(?im)^\s*Window name\s*:", text)[1:]
+    block = next((b for b in blocks if b.splitlines()[0].strip().upper() == window.strip().upper()), None)
+    if block is None:
+        raise ValueError(f"no window named {window!r} in the file")
+    lines = block.splitlines()
+
+    def rows_after(title):
+        """The value rows of a section: its first row after 'System1 :', continuation rows after."""
+        start = next((i for i, line in enumerate(lines) if line.strip().upper().startswith(title)), None)
+        if start is None:
+            raise ValueError(f"window {window!r} has no {title}")
+        out = []
+        for line in lines[start + 1:]:
+            body = line.split(":", 1)[1] if ":" in line else line
+            head = line.split(":", 1)[0].strip() if ":" in line else ""
+            if ":" in line and not head.upper().startswith("SYSTEM1"):
+                break
+            if not body.strip() or not re.match(r"^\s*[-0-9.]", body):
+                break
+            out.append(body.split())
+        return out
+
+    try:
+        (system,) = rows_after("GLAZING SYSTEM DATA")[:1]
+        n = int(system[2])
+        glass = rows_after("GLASS DATA")[:n]
+        panes = [{"thickness": float(r[1]) / 1000, "conductivity": float(r[2]), "T": float(r[3]),
+                  "R_front": float(r[4]), "R_back": float(r[5]), "emissivity_front": float(r[10]),
+                  "emissivity_back": float(r[11])} for r in glass]
+        gaps = []
+        if n > 1:
+            gap_rows = rows_after("GAP DATA")[:n - 1]
+            gas_rows = [line.split(":", 1)[1].split() for line in lines
+                        if re.match(r"(?i)^\s*System1\s+Gap\d+\s*:", line)]
+            for k, r in enumerate(gap_rows):
+                rows = [g for line, g in zip([ln for ln in lines if re.match(r"(?i)^\s*System1\s+Gap\d+\s*:", ln)],
+                                             gas_rows) if re.match(rf"(?i)^\s*System1\s+Gap{k + 1}\s*:", line)]
+                if len(rows) != int(r[2]):
+                    raise ValueError(f"gap {k + 1} of window {window!r} lists {len(rows)} gases, not {r[2]}")
+                # conductivity in W/m/K, viscosity in g/m/s and specific heat in kJ/kg/K (air's
+                # at 300 K: 0.026, 0.0185 and 1.006), brought to SI as gas_properties reads them
+                gases = [((tuple(map(float, g[3:6])), tuple(1e-3 * float(v) for v in g[6:9]),
+                           tuple(1e3 * float(v) for v in g[9:12]), float(g[2])), float(g[1])) for g in rows]
+                gaps.append({"thickness": float(r[1]) / 1000, "gas": gases[0][0] if len(gases) == 1 else gases})
+    except (IndexError, ValueError) as e:
+        raise ValueError(str(e) if isinstance(e, ValueError) and str(e).startswith(("gap", "window"))
+                         else f"window {window!r}: a glazing, glass or gap row is incomplete") from None
+    if len(panes) != n or len(gaps) != n - 1:
+        raise ValueError(f"window {window!r}: {n} panes declared, {len(panes)} glass and {len(gaps)} gap rows")
+    return {"panes": panes, "gaps": gaps}
+
+
 # Constructions the building file cannot hold, with why
 UNREAD_CONSTRUCTIONS = {
-    "Construction:WindowDataFile": "a window from a WINDOW data file is not read (give its layers)",
     "Construction:WindowEquivalentLayer": "an equivalent-layer window is not read (give its layers)",
     "Construction:ComplexFenestrationState": "a BSDF window is not read (give its layers)",
     "Construction:AirBoundary": "an air boundary between zones is not held by the building file",
@@ -560,6 +648,9 @@ class _Converter:
             c = self.r.by_name.get(kind.upper(), {}).get(str(construction_name).upper())
             if c is not None:
                 return equivalent(c)
+        c = self.r.by_name.get("CONSTRUCTION:WINDOWDATAFILE", {}).get(str(construction_name).upper())
+        if c is not None:
+            return self.window_data_file(c, height)
         for kind in UNREAD_CONSTRUCTIONS:
             c = self.r.by_name.get(kind.upper(), {}).get(str(construction_name).upper())
             if c is not None:
@@ -682,7 +773,7 @@ class _Converter:
             faces = {"emissivity": 0.84, "solar": alpha - inner, "roughness": 1.0}
             return [[name, 0.003]], faces, {"emissivity": 0.84, "solar": tau + alpha}, {
                 "tau": tau, "inner_alpha": inner, "angular": None}
-        panes, layers = [], []
+        panes, layers, gases = [], [], {}
         for k, o in enumerate(objs):
             kind = o.obj_type.upper()
             expected = ("WINDOWMATERIAL:GLAZING",) if k % 2 == 0 else ("WINDOWMATERIAL:GAS", "WINDOWMATERIAL:GASMIXTURE")
@@ -707,12 +798,18 @@ class _Converter:
                                                  "density": GLASS_DENSITY, "specific_heat": GLASS_SPECIFIC_HEAT})
                 layers.append([name, thickness])
             else:
-                layers.append([o, self.r.number(o, "thickness", low=0, low_open=True)])
+                layers.append([o.name, self.r.number(o, "thickness", low=0, low_open=True)])
+                gases[k] = self.gas(o)
+        return self._stack(c.name, panes, layers, gases, height)
+
+    def _stack(self, construction, panes, layers, gases, height):
+        """A layered glazing's layers, faces and optics from its panes (T0, Rf, front and back
+        emissivity), its layers ([name, thickness], panes and gaps alternating) and each gap's gas."""
         # a gap's conductance depends on the emissivities facing it and the pane's height
         for k in range(1, len(layers), 2):
             gap, d = layers[k]
-            h = glazing.gap_conductance(d, height or 1.5, panes[k // 2][3], panes[k // 2 + 1][2], gas=self.gas(gap))
-            name = f"{gap.name} in {c.name}"
+            h = glazing.gap_conductance(d, height or 1.5, panes[k // 2][3], panes[k // 2 + 1][2], gas=gases[k])
+            name = f"{gap} in {construction}"
             self.materials[name] = {"conductivity": h * d, "density": AIR_DENSITY, "specific_heat": AIR_SPECIFIC_HEAT}
             layers[k] = [name, d]
         pairs = [(T0, R0) for T0, R0, _, _ in panes]
@@ -730,6 +827,37 @@ class _Converter:
         inner = {"emissivity": panes[-1][3], "solar": 1 - glazing.stack_reflectance(pairs[::-1])}
         return layers, outer, inner, {"tau": tau, "inner_alpha": inner_alpha, "angular": {"angles": list(glazing.ANGLES), "factors": factors,
                                                               "diffuse": diffuse}}
+
+    def window_data_file(self, c, height):
+        """A Construction:WindowDataFile as EnergyPlus builds it: the panes and gaps of the window
+        of the construction's name in the WINDOW data file (its first glazing system), each pane's
+        spectral averages, each gap's gases at the file's own coefficients (`read_window5`)."""
+        written = self.r.text(c, "file_name") or "Window5DataFile.dat"
+        folder = Path(self.r.source).resolve().parent
+        relative = Path(written.replace("\\", "/"))
+        found = next((p for p in (folder / relative, folder / relative.name) if p.is_file()), None)
+        if found is None:
+            self.r.fail(c, "File Name", f"{written!r} is not found beside the IDF (EnergyPlus stops without it too)")
+        try:
+            window = read_window5(found.read_text(encoding="latin-1"), c.name)
+        except ValueError as e:
+            self.r.fail(c, "File Name", f"{written!r}: {e}")
+        panes, layers, gases = [], [], {}
+        for k, pane in enumerate(window["panes"]):
+            name = f"{c.name} pane {k + 1}"
+            self.materials[name] = {"conductivity": pane["conductivity"], "density": GLASS_DENSITY,
+                                    "specific_heat": GLASS_SPECIFIC_HEAT}
+            panes.append((pane["T"], pane["R_front"], pane["emissivity_front"], pane["emissivity_back"]))
+            layers.append([name, pane["thickness"]])
+            if k < len(window["gaps"]):
+                gap = window["gaps"][k]
+                layers.append([f"{c.name} gap {k + 1}", gap["thickness"]])
+                gases[len(layers) - 1] = gap["gas"]
+        line = (f"Construction:WindowDataFile {c.name}: its panes and gaps read from {found.name}; the file's "
+                "angle-dependent optical table, frame and divider not held (the panes' own angular behaviour used)")
+        if line not in self.not_modelled:
+            self.not_modelled.append(line)
+        return self._stack(c.name, panes, layers, gases, height)
 
     def spectral_pane(self, o):
         """(T, R_front) at normal incidence of a pane given by wavelength
@@ -911,10 +1039,17 @@ class _Converter:
             while f"vertex_{k}_x_coordinate" in fields and not _blank(fields[f"vertex_{k}_x_coordinate"]):
                 v.append([fields[f"vertex_{k}_{a}_coordinate"] for a in "xyz"])
                 k += 1
-        try:
-            v = np.array(v, dtype=float)
-        except (TypeError, ValueError):
-            self.r.fail(s, "Vertex 1 X-coordinate", "a vertex coordinate is not a number")
+        for k, point in enumerate(v):
+            for axis, value in zip("XYZ", point):
+                try:
+                    float(value)
+                except (TypeError, ValueError):
+                    field = f"Vertex {k + 1} {axis}-coordinate"
+                    if str(value).strip().startswith("="):
+                        self.r.fail(s, field, f"{value!r} is a parametric expression: expand the file with "
+                                              "EnergyPlus's ParametricPreprocessor first, as EnergyPlus itself needs")
+                    self.r.fail(s, field, f"{value!r} is not a number")
+        v = np.array(v, dtype=float)
         if len(v) < 3:
             self.r.fail(s, "Number of Vertices", f"{len(v)} vertices: a surface needs at least 3")
         if geometry.area(v) <= 1e-9:
@@ -1111,11 +1246,12 @@ class _Converter:
 
     def design_value(self, o, field):
         """The number a gain's or flow's calculation method reads; blank is 0, as EnergyPlus reads
-        a blank number (its other methods' fields are never required)."""
+        a blank number (its other methods' fields are never required). An OtherEquipment's may be
+        negative: EnergyPlus's IDD has no minimum there, and a negative level removes heat."""
         if _blank(_field(o, field)):
             self.note(f"a blank design level of a {o.obj_type} read as 0, as EnergyPlus reads it")
             return 0.0
-        return self.r.number(o, field, low=0)
+        return self.r.number(o, field, low=None if o.obj_type.lower() == "otherequipment" else 0)
 
     def people(self, o, floor):
         method = self.r.text(o, "number_of_people_calculation_method", "People").lower()
@@ -1186,8 +1322,34 @@ class _Converter:
                         c["inner_solar_absorptance"] = round(glass["inner_alpha"], 6)
                     if w_outside["type"] != "exterior":
                         del c["solar_transmittance"], c["transmitted_solar_to"]
+                    else:
+                        self.incident_solar_multiplier(w["obj"], c)
                 comps.append(c)
         return comps
+
+    def incident_solar_multiplier(self, window, c):
+        """A SurfaceProperty:IncidentSolarMultiplier of an exterior window: EnergyPlus multiplies
+        the sun incident on its outside by it, so that what it transmits and what its panes absorb
+        scale with it; a constant one (its value times a constant schedule) scales the window's
+        transmittance and absorptances. One whose schedule varies is listed, not held."""
+        for o in self.r.all("SurfaceProperty:IncidentSolarMultiplier"):
+            if self.r.text(o, "surface_name").upper() != window.name.upper():
+                continue
+            m = self.r.number(o, "incident_solar_multiplier", default=1.0, low=0, high=1)
+            schedule = self.r.text(o, "incident_solar_multiplier_schedule_name")
+            if schedule:
+                value = self.constant_schedule_value(schedule, o, "Incident Solar Multiplier Schedule Name")
+                if value is None:
+                    self.not_modelled.append(f"SurfaceProperty:IncidentSolarMultiplier {window.name}: its schedule "
+                                             f"{schedule!r} varies: not held (the window takes its whole sun)")
+                    return
+                m *= value
+            c["solar_transmittance"] = round(c["solar_transmittance"] * m, 6)
+            c["outside"]["solar_absorptance"] = c["outside"]["solar_absorptance"] * m
+            if "inner_solar_absorptance" in c:
+                c["inner_solar_absorptance"] = round(c["inner_solar_absorptance"] * m, 6)
+            self.note(f"an incident solar multiplier of {m:g} on window {window.name} scales its transmittance "
+                      "and absorptances")
 
     def component(self, name, area, s, layers, inner, outside, outer=None):
         # each face the zones' sun can land on: (zone, its type seen from that zone, solar absorptance);

@@ -254,7 +254,7 @@ def edited(replace_from, replace_to):
 
 BAD = {
     "no version": (edited("Version,\n  9.3;", ""), "Version"),
-    "old version": (edited("Version,\n  9.3;", "Version,\n  7.2;"), "older than 8.5"),
+    "old version": (edited("Version,\n  9.3;", "Version,\n  7.2;"), "older than 8.4"),
     "no site": (edited("Site:Location,", "Site:Locationx,"), "(file)"),
     "unknown material": (edited("  WALL FIBERGLASS QUILT,        !- Layer 2",
                                 "  NO SUCH MATERIAL,             !- Layer 2"), "Construction 'LIGHT WALL', field Layer 2"),

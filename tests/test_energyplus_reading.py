@@ -451,3 +451,123 @@ def test_simple_glazing_absorbs_as_energyplus_layer_and_keeps_its_shgc(tmp_path)
     f_in = h_i / (h_i + 1 / (R + 1 / h_o))
     # the films the split was made at are a vertical window's at 1.5 m: case 600's are within 2 %
     assert w.solar_transmittance + a_out * f_out + a_in * f_in == pytest.approx(0.38, rel=0.02)
+
+
+# ---- gains ---------------------------------------------------------------------------------
+def test_a_negative_other_equipment_removes_heat(tmp_path):
+    """EnergyPlus's IDD sets no minimum on OtherEquipment's levels: a negative one removes heat
+    (its convective and radiant parts, level x (1 - latent - lost)). Other gains stay >= 0."""
+    floor = 8.0 * 6.0
+    other = ("OtherEquipment,\n  Sink,\n  None,\n  Z,\n  ON,\n  Watts/Area,\n  ,\n  -2,\n  ,\n  0,\n  0.3,\n  0.25;\n"
+             "OtherEquipment,\n  Source,\n  None,\n  Z,\n  ON,\n  EquipmentLevel,\n  352,\n  ,\n  ,\n  0,\n  0,\n  0;\n"
+             "Schedule:Constant,\n  ON,\n  ,\n  1;\n")
+    b = convert_idf(write(tmp_path, HEADER + zone("Z") + box("Z", "Z") + other))
+    gains = {g["name"]: g for g in b.data["zones"][0]["gains"]}
+    assert gains["Sink"]["power"] == pytest.approx(-2 * floor * (1 - 0.25))
+    assert gains["Sink"]["radiant_fraction"] == pytest.approx(0.3 / 0.75)
+    assert gains["Source"]["power"] == pytest.approx(352.0)
+    electric = "ElectricEquipment,\n  Sink,\n  Z,\n  ON,\n  EquipmentLevel,\n  -50,\n  ,\n  ,\n  0,\n  0,\n  0;\n"
+    with pytest.raises(InputError, match="Design Level: -50 must be >= 0"):
+        convert_idf(write(tmp_path, HEADER + zone("Z") + box("Z", "Z") + electric + "Schedule:Constant,\n  ON,\n  ,\n  1;\n"))
+
+
+@pytest.mark.parametrize("old", ["8.4", "8.6"])
+def test_an_other_equipment_of_an_8_x_file_gains_its_fuel_type_field(tmp_path, old):
+    """A file of 8.4 to 8.8 is read against 8.9's IDD, which inserted OtherEquipment's Fuel Type
+    after its name: the 8.4 or 8.6 object (name, zone, schedule, method, level, ...) still gives its
+    zone 352 W, with a radiant fraction of 0.2 of the 0.8 not lost (0.25)."""
+    version = HEADER[HEADER.index("Version"):HEADER.index(";", HEADER.index("Version")) + 1]
+    other = ("OtherEquipment,\n  Test 352a,  !- Name\n  Z,  !- Zone Name\n  ON,\n  EquipmentLevel,\n  440,\n  ,\n  ,\n"
+             "  0,\n  0.2,\n  0.2;\n" "Schedule:Constant,\n  ON,\n  ,\n  1;\n")
+    b = convert_idf(write(tmp_path, HEADER.replace(version, f"Version, {old};") + zone("Z") + box("Z", "Z") + other))
+    (gain,) = b.data["zones"][0]["gains"]
+    assert (gain["name"], gain["power"], gain["radiant_fraction"]) == ("Test 352a", pytest.approx(352.0), pytest.approx(0.25))
+    assert E.to_schema_min("OtherEquipment,A,Z,S;") == "OtherEquipment,A, None,Z,S;"
+
+
+# ---- a window from a WINDOW data file -------------------------------------------------------
+def window5(gas):
+    """A WINDOW 5 data file of case 600's double glazing: its panes (3.175 mm, 1.06 W/m/K, T 0.86156,
+    R 0.07846, emissivity 0.84) and 13 mm gap of a gas given by coefficients as the file writes them:
+    conductivity W/m/K, viscosity g/m/s, specific heat kJ/kg/K."""
+    (k, mu, cp, M) = gas
+    coefficients = " ".join(f"{v:.9g}" for v in (*k, *(1e3 * v for v in mu), *(1e-3 * v for v in cp)))
+    pane = "3.175 1.06 0.86156 0.07846 0.07846 0.91325 0.082 0.082 0.00 0.84 0.84 CLEAR.DAT"
+    return ("Window5 Data File for EnergyPlus\nWindow name      : DOUBLE CLEAR\n# Glazing Systems: 1\n"
+            "GLAZING SYSTEM DATA: Height Width nPanes Uval-center SC-center SHGC-center Tvis-center\n"
+            " System1         :   2000   3000      2      2.9      0.88      0.76       0.81\n"
+            "GLASS DATA       : Layer#  Thickness  Cond Tsol Rfsol Rbsol Tvis Rfvis Rbvis  Tir  EmissF  EmissB  File\n"
+            f" System1         :   1   {pane}\n                     2   {pane}\n"
+            "GAP DATA         : Gap# Thick nGasses\n System1         :   1  13.0    1\n"
+            "GAS DATA         : GasName Fraction MolWeight ACond BCond CCond AVisc BVisc CVisc ASpHeat BSpHeat CSpHeat\n"
+            f" System1 Gap1    : Air 1.0000 {M} {coefficients}\n")
+
+
+def test_a_window_data_file_is_its_panes_and_gaps(tmp_path):
+    """Construction:WindowDataFile is built as EnergyPlus builds it, from the file's glass and gap
+    rows: with case 600's panes and EnergyPlus's air coefficients in the file's units, the window
+    is case 600's layer for layer; a missing file is refused in one line."""
+    layered = 'Construction,\n  DOUBLE CLEAR,                 !- Name\n  CLEAR PANE 3.175 MM,          !- Outside Layer\n' \
+              '  AIR GAP 13 MM,                !- Layer 2\n  CLEAR PANE 3.175 MM;          !- Layer 3\n'
+    assert layered in TEXT
+    (tmp_path / "data").mkdir()
+    (tmp_path / "data" / "W5.dat").write_text(window5(glazing.GASES["air"]))
+    text = TEXT.replace(layered, "Construction:WindowDataFile,\n  DOUBLE CLEAR,\n  ..\\data\\W5.dat;\n")
+    (tmp_path / "run").mkdir()
+    b = convert_idf(write(tmp_path / "run", text))
+    own, reference = b.component("SOUTH WINDOW WEST"), convert_idf(CASE600).component("SOUTH WINDOW WEST")
+    assert [t for _, t in own.layers] == pytest.approx([t for _, t in reference.layers])
+    assert [m.conductivity for m, _ in own.layers] == pytest.approx([m.conductivity for m, _ in reference.layers], rel=1e-9)
+    assert own.solar_transmittance == pytest.approx(reference.solar_transmittance)
+    assert own.inner_solar_absorptance == pytest.approx(reference.inner_solar_absorptance)
+    assert any(line.startswith("Construction:WindowDataFile DOUBLE CLEAR: its panes and gaps read from W5.dat")
+               for line in b.data["not_modelled"])
+    with pytest.raises(InputError, match=r"File Name: '..\\\\data\\\\W5.dat' is not found beside the IDF"):
+        convert_idf(write(tmp_path, text))
+
+
+def test_a_parametric_vertex_is_refused_naming_its_field_and_the_preprocessor(tmp_path):
+    """EnergyPlus runs a file with `=$height` in a vertex only after its ParametricPreprocessor has
+    expanded it: the refusal names the coordinate that holds the expression."""
+    text = HEADER + zone("Z") + box("Z", "Z").replace("0, 0, 2.7,\n  0, 0, 0,", "0, 0, =$height,\n  0, 0, 0,", 1)
+    with pytest.raises(InputError, match=r"'Z S', field Vertex 1 Z-coordinate: '=\$height' is a parametric "
+                                         r"expression: expand the file with EnergyPlus's ParametricPreprocessor"):
+        convert_idf(write(tmp_path, text))
+
+
+def box_24(multiplier=""):
+    """A 4 x 4 x 3 m box of EnergyPlus 24.1 with a 2 m2 south window of U 2, SHGC 0.6, and the
+    given SurfaceProperty:IncidentSolarMultiplier text."""
+    walls = {"S": [(0, 0, 3), (0, 0, 0), (4, 0, 0), (4, 0, 3)], "E": [(4, 0, 3), (4, 0, 0), (4, 4, 0), (4, 4, 3)],
+             "N": [(4, 4, 3), (4, 4, 0), (0, 4, 0), (0, 4, 3)], "W": [(0, 4, 3), (0, 4, 0), (0, 0, 0), (0, 0, 3)],
+             "F": [(4, 4, 0), (4, 0, 0), (0, 0, 0), (0, 4, 0)], "R": [(0, 4, 3), (0, 0, 3), (4, 0, 3), (4, 4, 3)]}
+    kinds = {"F": "Floor", "R": "Roof"}
+    text = ("Version, 24.1;\nSite:Location, Site, 40, -105, -7, 1600;\n"
+            "GlobalGeometryRules, UpperLeftCorner, CounterClockWise, World;\n"
+            "Material:NoMass, R2, Rough, 2.0, 0.9, 0.6, 0.6;\nConstruction, OPAQUE, R2;\n"
+            "WindowMaterial:SimpleGlazingSystem, SGS, 2.0, 0.6;\nConstruction, GLAZING, SGS;\n"
+            "Zone, Z, 0, 0, 0, 0, 1, 1, autocalculate, autocalculate;\n")
+    for key, points in walls.items():
+        flat = ", ".join(f"{x}, {y}, {z}" for x, y, z in points)
+        text += (f"BuildingSurface:Detailed, {key}, {kinds.get(key, 'Wall')}, OPAQUE, Z, , Outdoors, , SunExposed, "
+                 f"WindExposed, autocalculate, 4, {flat};\n")
+    text += "FenestrationSurface:Detailed, WIN, Window, GLAZING, S, , autocalculate, , 1, 4, 1, 0, 2, 1, 0, 1, 3, 0, 1, 3, 0, 2;\n"
+    return text + multiplier
+
+
+def test_a_constant_incident_solar_multiplier_scales_the_windows_sun(tmp_path):
+    """EnergyPlus multiplies the sun incident on the window by the multiplier times its schedule
+    (0.5 x 0.8 = 0.4): what it transmits and what its glazing absorbs, outside and inside, scale
+    by 0.4. A varying schedule is listed, not held."""
+    plain = convert_idf(write(tmp_path, box_24(), "plain.idf")).component("WIN")
+    scaled = convert_idf(write(tmp_path, box_24("SurfaceProperty:IncidentSolarMultiplier, WIN, 0.5, HALF;\n"
+                                                "Schedule:Constant, HALF, , 0.8;\n"), "scaled.idf")).component("WIN")
+    assert scaled.solar_transmittance == pytest.approx(0.4 * plain.solar_transmittance, abs=1e-6)
+    assert scaled.inner_solar_absorptance == pytest.approx(0.4 * plain.inner_solar_absorptance, abs=1e-6)
+    assert scaled.outside.solar_absorptance == pytest.approx(0.4 * plain.outside.solar_absorptance)
+    varying = box_24("SurfaceProperty:IncidentSolarMultiplier, WIN, 1, DAY;\n"
+                     "Schedule:Compact, DAY, , Through: 12/31, For: AllDays, Until: 12:00, 1, Until: 24:00, 0.5;\n")
+    b = convert_idf(write(tmp_path, varying, "varying.idf"))
+    assert b.component("WIN").solar_transmittance == pytest.approx(plain.solar_transmittance)
+    assert any(line.startswith("SurfaceProperty:IncidentSolarMultiplier WIN: its schedule 'DAY' varies")
+               for line in b.data["not_modelled"])
