@@ -128,7 +128,7 @@ def newest_schema():
 def load_idf(path):
     """The idfkit document of an IDF; InputError naming the file for one that cannot be read."""
     import idfkit
-    closed_text(path)
+    text = closed_text(path)
     try:
         version = idfkit.get_idf_version(str(path))
     except Exception as e:
