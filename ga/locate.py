@@ -7,7 +7,6 @@ only the objective's air (a thermostat's) has nothing to force: its locate.json 
 `best_nodes` [], and the diagnosis goes on to the air's own equation.
 """
 import time
-from dataclasses import dataclass
 
 import numpy as np
 from scipy.sparse.csgraph import shortest_path
@@ -17,7 +16,7 @@ from nodeforce.ga.checkpoint import NAME as CHECKPOINT
 from nodeforce.runtime.compiler import find_compiler
 from nodeforce.ga.fitness import FmuFitness, RecordsFitness
 from nodeforce.ga.parsimony import EXPLAINED
-from nodeforce.ga.search import PATIENCE, search
+from nodeforce.ga.search import Execution, SearchSettings, search as run_search
 from nodeforce.model.case import as_cases
 from nodeforce.model.errors import InputError
 from nodeforce.model.network import assemble
@@ -81,31 +80,8 @@ def chromosome_nodes(building, case, objective, source, nodes=None, include_alge
     return sorted(chosen, key=lambda i: (distance[i - 1], i))
 
 
-@dataclass(frozen=True)
-class SearchSettings:
-    """The forcing search's settings as a diagnosis runs it (`locate`): the seed of every random
-    draw, the GA's population and generations, and the FMUs it drives (`locate`'s `fmu_kind`;
-    "auto": the standalone where it can run the building)."""
-    seed: int = 0
-    population: int = 30
-    generations: int = 400
-    fmu_kind: str = "auto"
-
-
-@dataclass(frozen=True)
-class Execution:
-    """Where a command's work runs: `workers` processes (None: every core), or the workers of the
-    Dask scheduler at `scheduler` ("tcp://host:port"); and the FMUs of the model it runs and
-    writes (`fmu_build.build.build_fmu`'s kinds, or "auto", `evaluator_kind`)."""
-    workers: int | None = None
-    scheduler: str | None = None
-    fmu_kind: str = "python"
-
-
-def locate(building, case, objective, workdir, *, source="measurements", nodes=None,
-           include_algebraic=False, population=30, generations=400, pc=0.8, pm=0.03, seed=0,
-           patience=PATIENCE, seeded=True, workers=None, scheduler=None, warmup_days=2, progress=None,
-           fmu_kind="auto", noise=None, protocols=None):
+def locate(building, case, workdir, objective, *, search=SearchSettings(), execution=Execution(),
+           source="measurements", protocols=None):
     """Run the forcing search on a case; return the content of locate.json.
 
     `case` may be the Cases of several records of the building: J is then the sum of each
@@ -115,18 +91,22 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
     The FMUs (`model.fmu` of `building` where a record runs it, `model_<k>.fmu` of the k-th
     record's own building) and the search's
     checkpoint (`locate.checkpoint.json`) are written in
-    `workdir`, so a run stopped midway and started again resumes. `progress` is called after
-    every generation with (generation, total, best J, unique evaluations). `noise` is the air
-    sensors' noise sd (C) if the user knows it, else it is estimated (`model.score.Noise`) from
-    every record's air. patience and seeded
-    choose the search (ga.search: the defaults stop at convergence; ga.search.PAPER's values
-    give the paper's search). fmu_kind: "python", "standalone", or "auto" (`evaluator_kind`: the
-    command line's default and this one's), each with "-fmi3" for FMI 3.0.
+    `workdir`, so a run stopped midway and started again resumes. `search`
+    (`ga.search.SearchSettings`): the GA's settings (its defaults stop at convergence;
+    `SearchSettings.paper()` gives the paper's search), the nodes it may force
+    (`chromosome_nodes`), the FMUs it drives (`fmu_kind`: "python", "standalone", or "auto",
+    `evaluator_kind`, the command line's default and this one's, each with "-fmi3" for FMI 3.0),
+    the warm-up days and `noise`, the air sensors' noise sd (C) if the user knows it, else it is
+    estimated (`model.score.Noise`) from every record's air. `execution` (`ga.search.Execution`):
+    where the search runs (`workers`, `scheduler`) and its `progress`, called after every
+    generation with (generation, total, best J, unique evaluations); its `fmu_kind` is not read.
+    `source`: what an error about the measurements names.
     """
     cases = as_cases(case)
     protocols = list(protocols) if protocols is not None else [None] * len(cases)
-    candidates = chromosome_nodes(building, cases, objective, source, nodes, include_algebraic)
-    kind = evaluator_kind(fmu_kind, [building, *filter(None, protocols)])
+    candidates = chromosome_nodes(building, cases, objective, source,
+                                  None if search.nodes is None else list(search.nodes), search.include_algebraic)
+    kind = evaluator_kind(search.fmu_kind, [building, *filter(None, protocols)])
     # one FMU per building a record runs under: `building`'s only where a record runs it
     names = ["model.fmu" if own is None else f"model_{k + 1}.fmu" for k, own in enumerate(protocols)]
     built = {}
@@ -134,19 +114,15 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
         if name not in built:
             built[name] = build_fmu(own or building, workdir / name, kind=kind)
     fmus = [built[name] for name in names]
-    parts = [FmuFitness(path, c, candidates, objective, warmup_days) for path, c in zip(fmus, cases)]
+    parts = [FmuFitness(path, c, candidates, objective, search.warmup_days) for path, c in zip(fmus, cases)]
     fitness = parts[0] if len(parts) == 1 else RecordsFitness(parts)
     measured = [objective.measured(c) for c in cases]
-    noise = Noise.of_records(measured, noise)
+    noise = Noise.of_records(measured, search.noise)
     measured_ids = sorted(set().union(*(c.measured_ids for c in cases)))
     if not candidates:
         return nothing_to_force(building, measured_ids, objective, fitness, noise)
-    result = search(fitness, candidates,
-                    population=population, generations=generations, pc=pc, pm=pm, seed=seed,
-                    patience=patience, seeded=seeded,
-                    workers=workers, scheduler=scheduler, checkpoint=workdir / CHECKPOINT,
-                    progress=progress, noise_sigma=noise.sigma,
-                    n_residuals=int(sum(np.isfinite(m).sum() for m in measured)))
+    result = run_search(fitness, candidates, search, execution, checkpoint=workdir / CHECKPOINT,
+                        noise_sigma=noise.sigma, n_residuals=int(sum(np.isfinite(m).sum() for m in measured)))
     result = {"measured_nodes": measured_ids, "output_node": objective.air_nodes[0],
               "objective": list(objective.zones), "output_nodes": list(objective.air_nodes), **result,
               "noise": noise.to_json()}

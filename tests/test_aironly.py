@@ -69,7 +69,7 @@ def air_only(building, weather, days=5, **effect):
 
 def test_locate_with_nothing_to_force_says_so_and_finds_no_node(heated, heated_weather, tmp_path):
     _, case = air_only(heated, heated_weather, days=2)
-    result = locate(heated, case, Objective.of(heated), tmp_path)
+    result = locate(heated, case, tmp_path, Objective.of(heated))
     assert result["best_nodes"] == [] and result["chromosome_nodes"] == [] and result["node_scores"] == {}
     assert result["J_best"] == result["J_unforced"] > 0
     assert result["finding"].startswith("No forcing can be tested")
@@ -239,7 +239,7 @@ def test_an_air_only_record_names_the_undeclared_zone_effect(heated, heated_weat
     absorb)."""
     truth, case = air_only(heated, heated_weather, id=effect, values=values)
     report = diagnose(heated, case.with_burn_in(1), tmp_path, Objective.of(heated),
-                      execution=Execution(workers=2), noise=NOISE).to_json()
+                      search=SearchSettings(noise=NOISE), execution=Execution(workers=2)).to_json()
     assert [(e["effect"], e["target"]) for e in report["effects"]] == [(effect, "cell")], report["decision"]["reason"]
     first = report["effects"][0]
     assert report["after"]["validation"]["rmse"] < 1.2 * NOISE < 2 * NOISE < report["before"]["validation"]["rmse"]
