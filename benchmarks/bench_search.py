@@ -267,7 +267,7 @@ def measure(quick=True, repeats=20):
             print(f"running the {mode} search ({workers} workers) ...", flush=True)
             (tmp / mode).mkdir()
             searches[mode] = run_search(mode, lambda settings, execution: locate(
-                building, case, tmp / mode, objective, search=settings, execution=execution(workers=workers)))
+                building, case, tmp / mode, objective, search=settings, execution=execution(workers=workers)).to_json())
 
     overhead_us = (t_fmu - t_direct) / steps * 1e6
     t_budget = PAPER_BUDGET * t_bare

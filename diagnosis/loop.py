@@ -293,13 +293,13 @@ def localise(building, prepared, objective, workdir, search, execution):
     convergence = []
     followed = replace(execution, progress=lambda generation, total, J, unique: convergence.append((generation, J)))
     localization = locate(building, windows.calibrations, workdir, objective, search=search, execution=followed,
-                          source=records[0].source, protocols=bases)
+                          source=records[0].source, protocols=bases).to_json()
     alone = []
     for i, record in enumerate(records if len(records) > 1 else ()):
         into = workdir / "locate" / record.name
         into.mkdir(parents=True, exist_ok=True)
         alone.append(locate(building, [windows.calibrations[i]], into, objective, search=search, execution=execution,
-                            source=record.source, protocols=[bases[i]]))
+                            source=record.source, protocols=[bases[i]]).to_json())
     return Located(localization, alone, convergence)
 
 

@@ -6,7 +6,10 @@ sensors' noise given by the user or estimated from the measured air. A record th
 only the objective's air (a thermostat's) has nothing to force: its locate.json says so, with
 `best_nodes` [], and the diagnosis goes on to the air's own equation.
 """
+import json
 import time
+from dataclasses import dataclass, fields
+from pathlib import Path
 
 import numpy as np
 from scipy.sparse.csgraph import shortest_path
@@ -80,9 +83,71 @@ def chromosome_nodes(building, case, objective, source, nodes=None, include_alge
     return sorted(chosen, key=lambda i: (distance[i - 1], i))
 
 
+@dataclass(frozen=True)
+class Localization:
+    """What the forcing search found (`locate`), the content of locate.json: the nodes measured
+    and those it may force (`chromosome_nodes`), the objective's air (`output_node`, `objective`
+    its zones, `output_nodes`), J unforced and with `best_nodes` forced (`J_best`, None: the
+    simulation failed), each node's score forced alone (`node_scores`, by str(id)), the nodes
+    that lower J alone (`ranked_nodes`, lowest first) and the groups the noise cannot separate
+    (`tied_nodes`), how the search ran (`search`), the noise it judged by, the evidence per
+    component (`components`, `evidence`) and the `finding` in words. `to_json()` is locate.json,
+    `read(path)` reads one back, `summary()` is what `nodeforce locate` prints."""
+    measured_nodes: list
+    output_node: int
+    objective: list
+    output_nodes: list
+    chromosome_nodes: list
+    J_unforced: float | None
+    best_nodes: list
+    J_best: float | None
+    node_scores: dict
+    ranked_nodes: list
+    tied_nodes: list
+    search: dict
+    noise: dict
+    components: list
+    finding: str
+
+    @classmethod
+    def of(cls, data):
+        """From locate.json's content (a dict)."""
+        return cls(**{f.name: data[f.name] for f in fields(cls)})
+
+    @classmethod
+    def read(cls, path):
+        """A locate.json read back."""
+        return cls.of(json.loads(Path(path).read_text(encoding="utf-8")))
+
+    def to_json(self):
+        """locate.json's content."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    def summary(self):
+        """A short table of the single-node scores (the paper's Table 4) and the answer."""
+        lines = [f"J unforced: {self.J_unforced:.3f} C2 on the air of {', '.join(self.objective)}"]
+        # every node scored, most helpful first (the ranked ones, then those that lower nothing)
+        scores = self.node_scores
+        order = [str(n) for n in self.ranked_nodes]
+        order += sorted((n for n in scores if n not in order), key=lambda n: (scores[n] is None, scores[n]))
+        # nodes the noise cannot separate share a tie mark (a, b, ...): ranked by J, not reordered
+        tied = {str(n): chr(ord("a") + k) for k, group in enumerate(self.tied_nodes or []) for n in group}
+        if order:
+            lines.append(f"{'node':>6}{'J forced alone':>16}  tie")
+            lines += [f"{node:>6}{'failed' if scores[node] is None else format(scores[node], '.3f'):>16}  "
+                      f"{tied.get(node, '')}".rstrip() for node in order[:8]]
+        found = ", ".join(map(str, self.best_nodes)) or "none"
+        search = self.search
+        how = ("nothing to force" if search["method"] == "none" else
+               f"{search['method']} search, {search['unique_evaluations']} simulations in {search['seconds']:.1f} s")
+        lines.append(f"best nodes: {found} (J = {self.J_best:.3f}); {how}")
+        lines.append(self.finding)
+        return "\n".join(lines)
+
+
 def locate(building, case, workdir, objective, *, search=SearchSettings(), execution=Execution(),
            source="measurements", protocols=None):
-    """Run the forcing search on a case; return the content of locate.json.
+    """Run the forcing search on a case; return its `Localization` (locate.json's content).
 
     `case` may be the Cases of several records of the building: J is then the sum of each
     record's J, a forcing applied to every record (`ga.fitness.RecordsFitness`), and `protocols`
@@ -120,14 +185,14 @@ def locate(building, case, workdir, objective, *, search=SearchSettings(), execu
     noise = Noise.of_records(measured, search.noise)
     measured_ids = sorted(set().union(*(c.measured_ids for c in cases)))
     if not candidates:
-        return nothing_to_force(building, measured_ids, objective, fitness, noise)
+        return Localization.of(nothing_to_force(building, measured_ids, objective, fitness, noise))
     result = run_search(fitness, candidates, search, execution, checkpoint=workdir / CHECKPOINT,
                         noise_sigma=noise.sigma, n_residuals=int(sum(np.isfinite(m).sum() for m in measured)))
     result = {"measured_nodes": measured_ids, "output_node": objective.air_nodes[0],
               "objective": list(objective.zones), "output_nodes": list(objective.air_nodes), **result,
               "noise": noise.to_json()}
     result["components"] = evidence(building, result)
-    return {**result, "finding": finding(building, result)}
+    return Localization.of({**result, "finding": finding(building, result)})
 
 
 def evidence(building, result):

@@ -39,6 +39,8 @@ __all__ = ["InputError", "read_building", "convert_idf", "read_weather", "read_m
 # One record of a building among several in one diagnosis, or a later one: case, source, name,
 # fraction, calibration_end, phases, building, read_from (diagnosis.windows.Record).
 Record = _windows.Record
+# What the forcing search found: locate.json's content (ga.locate.Localization).
+Localization = _locate.Localization
 # What a diagnosis's report sets beside it: another model's error, later records (diagnosis.windows.Beside).
 Beside = _windows.Beside
 
@@ -424,8 +426,11 @@ def locate(building, case, workdir=None, objective=None, *, search=SearchSetting
 
     Returns
     -------
-    dict
-        `best_nodes`, `J_unforced`, `J_best`, `node_scores`, `ranked_nodes`, `search`, `finding`, ...
+    Localization
+        locate.json's content as an object (`nodeforce.ga.locate.Localization`): `best_nodes`,
+        `J_unforced`, `J_best`, `node_scores`, `ranked_nodes`, `search`, `finding`, ...;
+        `summary()` what `nodeforce locate` prints, `to_json()` locate.json, `Localization.read(path)`
+        one read back.
     """
     with _folder(workdir) as folder:
         return _locate.locate(building, case, folder, objective or Objective.of(building),
@@ -512,16 +517,18 @@ def compare(models, workdir=None, phases=(), fmu_kind="python"):
 
     Returns
     -------
-    dict
-        compare.json's content: per model its heat loss coefficient (W/K) and the RMSE, mean and
-        sd (C) of each objective zone's air residual, overall and per phase.
+    Comparison
+        compare.json's content as an object (`nodeforce.diagnosis.compare.Comparison`): `models`,
+        per model its heat loss coefficient (W/K) and the RMSE, mean and sd (C) of each objective
+        zone's air residual, overall and per phase; `summary()` what `nodeforce compare` prints,
+        `to_json()` compare.json, `Comparison.read(path)` one read back.
     """
-    from nodeforce.diagnosis.compare import compare as scored, write_compare  # as `diagnose`'s loop
+    from nodeforce.diagnosis.compare import Comparison, compare as scored, write_compare  # as `diagnose`'s loop
     result, series = scored(models, phases, fmu_kind=fmu_kind)
     if workdir is not None:
         Path(workdir).mkdir(parents=True, exist_ok=True)
         write_compare(Path(workdir), result, series)
-    return result
+    return Comparison.of(result)
 
 
 @contextmanager

@@ -149,31 +149,9 @@ def cmd_locate(args):
     building, case, objective = load_inputs(args)
     out = Path(args.output)
     result = api.locate(building, case, out, objective, search=search, execution=where, source=args.measurements)
-    (out / "locate.json").write_text(json.dumps(result, indent=2) + "\n")
-    print(locate_summary(result))
+    (out / "locate.json").write_text(json.dumps(result.to_json(), indent=2) + "\n")
+    print(result.summary())
     print(f"wrote {out / 'locate.json'}")
-
-
-def locate_summary(result):
-    """A short table of the single-node scores (the paper's Table 4) and the answer."""
-    lines = [f"J unforced: {result['J_unforced']:.3f} C2 on the air of {', '.join(result['objective'])}"]
-    # every node scored, most helpful first (the ranked ones, then those that lower nothing)
-    scores = result["node_scores"]
-    order = [str(n) for n in result["ranked_nodes"]]
-    order += sorted((n for n in scores if n not in order), key=lambda n: (scores[n] is None, scores[n]))
-    # nodes the noise cannot separate share a tie mark (a, b, ...): ranked by J, not reordered
-    tied = {str(n): chr(ord("a") + k) for k, group in enumerate(result.get("tied_nodes") or []) for n in group}
-    if order:
-        lines.append(f"{'node':>6}{'J forced alone':>16}  tie")
-        lines += [f"{node:>6}{'failed' if scores[node] is None else format(scores[node], '.3f'):>16}  "
-                  f"{tied.get(node, '')}".rstrip() for node in order[:8]]
-    found = ", ".join(map(str, result["best_nodes"])) or "none"
-    search = result["search"]
-    how = ("nothing to force" if search["method"] == "none" else
-           f"{search['method']} search, {search['unique_evaluations']} simulations in {search['seconds']:.1f} s")
-    lines.append(f"best nodes: {found} (J = {result['J_best']:.3f}); {how}")
-    lines.append(result["finding"])
-    return "\n".join(lines)
 
 
 def effect_spec(text):
@@ -351,10 +329,7 @@ def cmd_compare(args):
     said_assumed(a for _, _, case, _ in models for a in case.assumptions)
     result = api.compare(models, Path(args.output), api.read_phases(args.phases) if args.phases else (),
                          fmu_kind=args.fmu)
-    for m in result["models"]:
-        for zone, z in m["metrics"]["zones"].items():
-            print(f"{m['building']}: {zone} air RMSE {z['rmse']:.3f} C (mean {z['mean']:+.3f}, sd {z['sd']:.3f}); "
-                  f"heat loss coefficient {m['heat_loss_coefficient']:.1f} W/K")
+    print(result.summary())
     print("wrote " + ", ".join(str(Path(args.output) / name) for name in ("compare.json", "compare.md", "compare.png")))
 
 

@@ -54,7 +54,7 @@ def test_the_later_record_is_scored_as_compare_scores_the_files_written(diagnose
     for name in ("written", "after"):
         b = building if name == "written" else nodeforce.read_building(folder / "out" / "building_after.json")
         models.append((name, b, nodeforce.measured_case(b, weather, measured, burn_in_days=1), objective))
-    written, after = (m["metrics"] for m in nodeforce.compare(models)["models"])
+    written, after = (m["metrics"] for m in nodeforce.compare(models).models)
     for ours, theirs in ((later.before, written), (later.after, after)):
         assert ours["rmse"] == pytest.approx(theirs["rmse"], rel=1e-9)
         assert ours["n"] == theirs["n"]

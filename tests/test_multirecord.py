@@ -148,7 +148,7 @@ def test_the_forcing_search_of_two_records_forces_a_node_where_a_record_measures
     second = Case(second.times, STEP, second.input_names, second.U, measured, building=b).with_burn_in(1)
     objective = Objective.of(b, ["A", "B"])
     both = locate(b, [airs, second], tmp_path, objective, search=SearchSettings(noise=NOISE),
-                  execution=Execution(workers=1))
+                  execution=Execution(workers=1)).to_json()
     assert both["chromosome_nodes"] == [surface]
     J1, J2, J2_forced = (J_direct(b, airs, objective), J_direct(b, second, objective),
                          J_direct(b, second, objective, [surface]))
@@ -163,7 +163,7 @@ def test_the_forcing_search_of_two_records_forces_a_node_where_a_record_measures
     for name, case, protocols in (("first", airs, None), ("second", second, [house()])):
         (tmp_path / name).mkdir()
         alone[name] = locate(b, [case], tmp_path / name, objective, search=SearchSettings(noise=NOISE),
-                             execution=Execution(workers=1), protocols=protocols)
+                             execution=Execution(workers=1), protocols=protocols).to_json()
     assert alone["first"]["chromosome_nodes"] == []
     assert alone["second"]["best_nodes"] == [surface]
     assert [p.name for p in (tmp_path / "first").glob("*.fmu")] == ["model.fmu"]

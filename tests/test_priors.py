@@ -58,7 +58,7 @@ def test_the_papers_ground_finding_carried_two_weeks_on_is_no_worse_than_the_fil
     objective = api.objective(r.building, r.zones)
     result = api.compare([(name, b, two_weeks.case(building=b), objective)
                           for name, b in (("as written", r.building), ("corrected", after))])
-    as_written, corrected = (m["metrics"]["rmse"] for m in result["models"])
+    as_written, corrected = (m["metrics"]["rmse"] for m in result.models)
     assert corrected <= as_written
     assert corrected <= 1.5 * spec.noise
 
@@ -87,6 +87,6 @@ def test_the_demos_correction_holds_in_another_season_where_the_free_fits_end_of
     objective = api.objective(building)
     result = api.compare([(name, b, api.measured_case(b, weather, december, 1, history_days=60.0), objective)
                           for name, b in (("written", building), ("held", held), ("free", free))])
-    rmse = {m["building"]: m["metrics"]["rmse"] for m in result["models"]}
+    rmse = {m["building"]: m["metrics"]["rmse"] for m in result.models}
     assert rmse["held"] <= min(rmse["written"], 1.5 * 0.1)
     assert rmse["free"] > rmse["written"]

@@ -515,12 +515,13 @@ def test_the_finding_names_the_rule_that_decided(testcell):
 
 
 def test_the_terminal_marks_the_nodes_the_noise_cannot_separate():
-    from nodeforce.cli import locate_summary
+    from nodeforce.ga.locate import Localization
     result = {"J_unforced": 3.0, "objective": ["cell"], "node_scores": {"7": 1.0, "9": 1.1, "16": 2.0},
               "ranked_nodes": [7, 9, 16], "tied_nodes": [[7, 9]], "best_nodes": [7], "J_best": 1.0,
               "finding": "forcing node 7 ...", "search": {"method": "exhaustive", "unique_evaluations": 8,
                                                           "seconds": 0.1}}
-    lines = locate_summary(result).splitlines()
+    lines = Localization.of({"measured_nodes": [7, 9, 16, 23], "output_node": 23, "output_nodes": [23],
+                             "chromosome_nodes": [7, 9, 16], "noise": {}, "components": [], **result}).summary().splitlines()
     header = next(i for i, line in enumerate(lines) if "J forced alone" in line)
     assert [line.split() for line in lines[header + 1:header + 4]] == [["7", "1.000", "a"], ["9", "1.100", "a"],
                                                                       ["16", "2.000"]]
