@@ -388,7 +388,7 @@ def revisit(prepared, made, fit, objective, folder, seed, runner):
     into.mkdir(exist_ok=True)
     base_sensed = windows.sensed_by(model)
     inputs = RoundInputs.of(model, windows, objective, noise.sigma, seed, [(a.effect, a.target) for a in others],
-                            {a.label: [name for name, p in a.parameters.items() if p.get("prior")] for a in others})
+                            {a.label: [name for name, p in a.parameters.items() if p.prior] for a in others})
     assessed = assess_all(inputs, pairs, into, runner)
     tried, models = fits_of(model, base_sensed, pairs, assessed, windows, inputs, number, [a.label for a in others])
     decision = decide(tried, Baseline(windows.block_J(model.runs), noise.sigma, n, windows.groups(), noise.floor_sd),
@@ -435,9 +435,9 @@ def priors_stated(building, added):
     """The building with a sentence in its description for each parameter of an added effect
     (`Fit`s) held at its physical prior: a modeller reading the file learns which of its values
     the data did not fix and where it comes from."""
-    said = [f"{fit.effect} on {fit.target}: {name} = {p['value']:.4g} {EFFECTS[fit.effect].parameter(name).unit}, "
-            f"held at {p['prior']}: the data fixed the effect, not {name} apart (nodeforce diagnose)."
-            for fit in added for name, p in fit.parameters.items() if p.get("prior")]
+    said = [f"{fit.effect} on {fit.target}: {name} = {p.value:.4g} {EFFECTS[fit.effect].parameter(name).unit}, "
+            f"held at {p.prior}: the data fixed the effect, not {name} apart (nodeforce diagnose)."
+            for fit in added for name, p in fit.parameters.items() if p.prior]
     if not said:
         return building
     return building.edited(lambda data: data.update(description=" ".join([data.get("description", "")] + said).strip()))

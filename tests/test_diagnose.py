@@ -149,7 +149,7 @@ def test_the_sun_a_closed_blind_lets_in_is_named_as_the_blind_not_as_a_gain(tmp_
                          execution=Execution(workers=2))
     assert [e.label for e in diagnosis.added] == ["shading_transmittance@cell"], diagnosis.rounds[0].reason
     f = diagnosis.added[0].parameters["f"]
-    assert f["identifiable"] and abs(f["value"] - 0.3) <= max(0.25 * 0.3, 3 * f["std"])
+    assert f.identifiable and abs(f.value - 0.3) <= max(0.25 * 0.3, 3 * f.sd)
     before, after = diagnosis.before["validation"]["rmse"], diagnosis.after["validation"]["rmse"]
     assert after <= 1.5 * NOISE < before
 

@@ -49,8 +49,8 @@ def test_the_papers_ground_finding_carried_two_weeks_on_is_no_worse_than_the_fil
                              execution=api.Execution(workers=1))
     (fit,) = diagnosis.added
     assert fit.label == "ground_coupling@floor"
-    assert fit.parameters["T_ground"]["value"] == site_ground and fit.parameters["T_ground"]["prior"]
-    assert fit.parameters["U"]["identifiable"]
+    assert fit.parameters["T_ground"].value == site_ground and fit.parameters["T_ground"].prior
+    assert fit.parameters["U"].identifiable
     written = json.loads((tmp_path / "building_after.json").read_text())
     assert "T_ground" in written["description"] and "held at" in written["description"]
     after = api.read_building(tmp_path / "building_after.json")
@@ -77,7 +77,7 @@ def test_the_demos_correction_holds_in_another_season_where_the_free_fits_end_of
     diagnosis = api.diagnose(building, june, tmp_path / "d", search=api.SearchSettings(noise=0.1),
                              execution=api.Execution(workers=1))
     (fit,) = diagnosis.added
-    assert fit.parameters["T_ground"]["prior"] and fit.parameters["T_ground"]["value"] == building.site["ground_temperature"]
+    assert fit.parameters["T_ground"].prior and fit.parameters["T_ground"].value == building.site["ground_temperature"]
     held = api.read_building(tmp_path / "d" / "building_after.json")
     free = EFFECTS["ground_coupling"].apply(building, "floor", {"U": 0.08, "T_ground": 0.85})
     times = pd.date_range("2001-12-01T00:00-05:00", periods=14 * 96 + 1, freq="15min")

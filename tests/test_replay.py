@@ -80,3 +80,4 @@ def test_a_benchmark_record_of_two_rounds_is_recomputed_from_report_json_alone(t
                        execution=nodeforce.Execution(workers=1))
     read = check_replay(tmp_path / "report.json")
     assert len(read.rounds) >= 2 and len(read.added) == 2
+
