@@ -36,8 +36,8 @@ def measured(name):
     one = run_time(case, r.building, 5)
     with tempfile.TemporaryDirectory() as out, contextlib.redirect_stdout(io.StringIO()):
         started = time.perf_counter()
-        api.diagnose(r.building, case, Path(out), objective=api.objective(r.building, r.zones), workers=1,
-                     noise=r.spec.noise, seed=0)
+        api.diagnose(r.building, case, Path(out), objective=api.objective(r.building, r.zones),
+                     search=api.SearchSettings(noise=r.spec.noise, seed=0), execution=api.Execution(workers=1))
         wall = time.perf_counter() - started
         report = json.loads((Path(out) / "report.json").read_text())
     rounds = [d["cost"] for d in report["decision"]["rounds"]]

@@ -111,9 +111,11 @@ def diagnose_one(task):
         # the loop's own lines (its findings, the candidates' fits) would bury the progress bar
         with tempdirs.folder("bench-diagnosis") as tmp, contextlib.redirect_stdout(io.StringIO()), \
                 contextlib.redirect_stderr(io.StringIO()):
-            report = api.diagnose(r.building, case, tmp, objective=api.objective(r.building, r.zones), workers=1,
-                                  population=population, generations=generations, noise=r.spec.noise,
-                                  seed=0, later=[later]).to_json()
+            report = api.diagnose(r.building, case, tmp, objective=api.objective(r.building, r.zones),
+                                  search=api.SearchSettings(population=population, generations=generations,
+                                                            noise=r.spec.noise, seed=0),
+                                  execution=api.Execution(workers=1),
+                                  beside=api.Beside(later=[later])).to_json()
         seconds = time.time() - t
         scored, = report["later"]
         base = baseline(r.building, case.with_steady_start(), r.zones)

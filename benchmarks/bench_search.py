@@ -50,7 +50,7 @@ import numpy as np
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.fitness import FmuFitness, ModelFitness
 from nodeforce.ga.locate import chromosome_nodes, locate
-from nodeforce.ga.search import PAPER, PATIENCE, search
+from nodeforce.ga.search import PAPER, PATIENCE, Execution, SearchSettings, search
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.integrate import initial_state, simulate, warmup_rows
@@ -139,11 +139,13 @@ def significant_falls(history, J_start, tol):
 
 
 def run_search(mode, run):
-    """One search; `run(progress=..., **settings)` -> locate.json fields. Returns the row of the
+    """One search; `run(settings, execution)` -> locate.json fields, with the mode's
+    `SearchSettings` and an `Execution` whose progress is followed. Returns the row of the
     comparison table and the generations of significant falls."""
     history = []
     t0 = time.perf_counter()
-    result = run(progress=lambda g, total, J, unique: history.append((g, J)), **MODES[mode])
+    result = run(SearchSettings(seed=0, **MODES[mode]),
+                 lambda **where: Execution(**where, progress=lambda g, total, J, unique: history.append((g, J))))
     seconds = time.perf_counter() - t0
     s = result["search"]
     J_start = math.inf if s.get("J_stepwise") is None else s["J_stepwise"]
@@ -182,7 +184,7 @@ def all_cases():
             for mode in MODES:
                 print(f"  {name}: {mode} ...", flush=True)
                 result, seconds, falls = run_search(
-                    mode, lambda **kw: search(factory, nodes, seed=0, workers=1, **noise_kw, **kw))
+                    mode, lambda settings, execution: search(factory, nodes, settings, execution(workers=1), **noise_kw))
                 rows.append(row(name, mode, result, seconds, falls))
                 answers[mode] = result["best_nodes"]
                 gaps += [b - a for a, b in zip([0] + falls, falls)]
@@ -264,8 +266,8 @@ def measure(quick=True, repeats=20):
         for mode in modes:
             print(f"running the {mode} search ({workers} workers) ...", flush=True)
             (tmp / mode).mkdir()
-            searches[mode] = run_search(mode, lambda **kw: locate(building, case, objective, tmp / mode, seed=0,
-                                                                  workers=workers, **kw))
+            searches[mode] = run_search(mode, lambda settings, execution: locate(
+                building, case, tmp / mode, objective, search=settings, execution=execution(workers=workers)).to_json())
 
     overhead_us = (t_fmu - t_direct) / steps * 1e6
     t_budget = PAPER_BUDGET * t_bare

@@ -48,8 +48,9 @@ def timed_stages(name):
             setattr(loop, stage, timing(stage))
         with tempfile.TemporaryDirectory() as out, contextlib.redirect_stdout(io.StringIO()):
             started = time.perf_counter()
-            api.diagnose(r.building, case, Path(out), objective=api.objective(r.building, r.zones), workers=1,
-                         noise=r.spec.noise, seed=0)
+            api.diagnose(r.building, case, Path(out), objective=api.objective(r.building, r.zones),
+                         search=api.SearchSettings(noise=r.spec.noise, seed=0),
+                         execution=api.Execution(workers=1))
             whole = time.perf_counter() - started
     finally:
         for stage, original in originals.items():

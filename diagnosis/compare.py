@@ -9,6 +9,7 @@ measures heat fluxes at surfaces (the building's heat flux sensors), each model'
 that face is reported beside the reading: a check the fit never saw.
 """
 import json
+from dataclasses import dataclass, fields
 from pathlib import Path
 
 import numpy as np
@@ -58,6 +59,41 @@ def surface_fluxes(building, case, T):
             out[name] = {"component": component, "face": face, "measured_mean": float(measured[have].mean()),
                          "model_mean": float(model[have].mean()), **metrics(measured, model)}
     return out
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """Building files scored on one record (`compare`), the content of compare.json: the
+    record's first and last times (`record`), the objective's zones, the first time scored
+    (`scored_from`, after the burn-in), and per model (`models`, in order) its building, heat
+    loss coefficient (W/K), the RMSE, mean and sd (C) of each objective zone's air residual
+    (`metrics`), per phase (`phases`) and its surface heat fluxes beside the readings.
+    `to_json()` is compare.json, `read(path)` reads one back, `summary()` is what
+    `nodeforce compare` prints."""
+    record: list
+    objective: list
+    scored_from: str
+    models: list
+
+    @classmethod
+    def of(cls, data):
+        """From compare.json's content (a dict)."""
+        return cls(**{f.name: data[f.name] for f in fields(cls)})
+
+    @classmethod
+    def read(cls, path):
+        """A compare.json read back."""
+        return cls.of(json.loads(Path(path).read_text(encoding="utf-8")))
+
+    def to_json(self):
+        """compare.json's content."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    def summary(self):
+        """One line per model and objective zone: its air's error and its heat loss coefficient."""
+        return "\n".join(f"{m['building']}: {zone} air RMSE {z['rmse']:.3f} C (mean {z['mean']:+.3f}, sd {z['sd']:.3f}); "
+                         f"heat loss coefficient {m['heat_loss_coefficient']:.1f} W/K"
+                         for m in self.models for zone, z in m["metrics"]["zones"].items())
 
 
 def compare(models, phases=(), fmu_kind="python", fmus=None):

@@ -66,7 +66,7 @@ from nodeforce.diagnosis.result import (Baseline, CrossValidation, Diagnosis, Fi
                                         RecordOutcome, SensorEvidence, added_effects, last_change)
 from nodeforce.diagnosis.selection import decide, revisited
 from nodeforce.diagnosis.sensitivity import sensitivity
-from nodeforce.diagnosis.windows import Record, Windows, period
+from nodeforce.diagnosis.windows import Beside, Record, Windows, period
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.iotools.energyplus_corrections import idf_of, write_corrections
 from nodeforce.ga.locate import Execution, SearchSettings, check_measured, evaluator_kind, locate
@@ -170,8 +170,8 @@ def own_sensors(building, component, windows, base, sensed):
     return OwnSensors([float(v) for v in before], [float(v) for v in after], n, windows.own_numerical(columns))
 
 
-def diagnose(building, records, workdir, objective, *, search=SearchSettings(), execution=Execution(), noise=None,
-             reference=None, later=(), policy=None):
+def diagnose(building, records, workdir, objective, *, search=SearchSettings(), execution=Execution(),
+             beside=Beside(), policy=None):
     """Run the whole loop, its stages in order (`prepare`, `localise`, `rounds`, `write`); write the
     artifacts in `workdir`; return the `Diagnosis` (report.json is its `to_json()`).
 
@@ -181,17 +181,18 @@ def diagnose(building, records, workdir, objective, *, search=SearchSettings(), 
     blocks, and a candidate that harms one record is refused (`selection.decide`). The forcing
     search reads every record's calibration window together, then, reported, each one's alone,
     under `search` (`ga.locate.SearchSettings`: its seed, which the rounds' screening reads too,
-    its GA settings and the FMUs it drives). `execution` (`ga.locate.Execution`): the FMUs of the
+    its GA settings, the FMUs it drives, and `noise`, the air sensors' noise sd (C) if the user
+    knows it, else it is estimated from every record's air). `execution` (`ga.locate.Execution`): the FMUs of the
     model before and after, run and written, and where the work runs: a Dask scheduler's workers
     (`runtime.cluster`; an unreachable one is an InputError before any work) or `workers`
-    processes. `reference` ({"label", "rmse": {phase: K}}), another model's error, is reported
-    for scale; `noise` (C) is the air sensors' noise sd if the user knows it, else it is estimated
-    from every record's air.
-    `later`: `Record`s of the same building under the building file's protocol, read from their
-    files (`nodeforce.read_record`), which nothing but the final comparison reads (`scored_later`):
-    no fit, no choice, no cross-validation. `policy`: the `diagnosis.policy.Policy` every choice
+    processes. `beside` (`windows.Beside`): its `reference` ({"label", "rmse": {phase: K}}),
+    another model's error, is reported for scale; its `later`: `Record`s of the same building
+    under the building file's protocol, read from their files (`nodeforce.read_record`), which
+    nothing but the final comparison reads (`scored_later`): no fit, no choice, no
+    cross-validation. `policy`: the `diagnosis.policy.Policy` every choice
     is made under (default `Policy()`), recorded in report.json."""
     policy = Policy() if policy is None else policy
+    later = list(beside.later)
     if not isinstance(records, (list, tuple)):
         records = [Record(records, name="measurements")]
     names = [r.name for r in [*records, *later]]
@@ -209,13 +210,11 @@ def diagnose(building, records, workdir, objective, *, search=SearchSettings(), 
     count = execution.workers or os.cpu_count()
     with Cluster(execution.scheduler) if execution.scheduler is not None else \
             lifetime.worker_pool(count) if count > 1 else nullcontext(lifetime.InProcess()) as runner:
-        prepared = prepare(building, records, bases, objective, workdir, fmu_kind, noise, policy)
-        settings = dict(seed=search.seed, workers=runner, population=search.population,
-                        generations=search.generations, fmu_kind=search.fmu_kind,
-                        noise=prepared.noise.sigma if prepared.noise.given else None)
-        located = localise(building, prepared, objective, workdir, settings)
+        prepared = prepare(building, records, bases, objective, workdir, fmu_kind, search.noise, policy)
+        settings = replace(search, noise=prepared.noise.sigma if prepared.noise.given else None)
+        located = localise(building, prepared, objective, workdir, settings, Execution(workers=runner))
         made = rounds(prepared, located.localization, objective, workdir, search.seed, runner)
-    return write(building, prepared, located, made, objective, workdir, reference, later)
+    return write(building, prepared, located, made, objective, workdir, beside.reference, later)
 
 
 @dataclass
@@ -286,21 +285,21 @@ def prepare(building, records, bases, objective, workdir, fmu_kind, noise, polic
     return Prepared(list(records), windows, bases, model, noise, windows.scored(), fmu_kind, fmus.get(None))
 
 
-def localise(building, prepared, objective, workdir, search):
+def localise(building, prepared, objective, workdir, search, execution):
     """Stage 2: the forcing search (`ga.locate`) on every record's calibration window together,
     a forcing applying to all; and on each record alone, reported: a record's own sensors
     (experiment 2's surfaces) may point where the records together do not."""
     windows, records, bases = prepared.windows, prepared.records, prepared.bases
     convergence = []
-    localization = locate(building, windows.calibrations, objective, workdir, source=records[0].source,
-                          protocols=bases, progress=lambda generation, total, J, unique: convergence.append((generation, J)),
-                          **search)
+    followed = replace(execution, progress=lambda generation, total, J, unique: convergence.append((generation, J)))
+    localization = locate(building, windows.calibrations, workdir, objective, search=search, execution=followed,
+                          source=records[0].source, protocols=bases).to_json()
     alone = []
     for i, record in enumerate(records if len(records) > 1 else ()):
         into = workdir / "locate" / record.name
         into.mkdir(parents=True, exist_ok=True)
-        alone.append(locate(building, [windows.calibrations[i]], objective, into, source=record.source,
-                            protocols=[bases[i]], **search))
+        alone.append(locate(building, [windows.calibrations[i]], into, objective, search=search, execution=execution,
+                            source=record.source, protocols=[bases[i]]).to_json())
     return Located(localization, alone, convergence)
 
 
@@ -389,7 +388,7 @@ def revisit(prepared, made, fit, objective, folder, seed, runner):
     into.mkdir(exist_ok=True)
     base_sensed = windows.sensed_by(model)
     inputs = RoundInputs.of(model, windows, objective, noise.sigma, seed, [(a.effect, a.target) for a in others],
-                            {a.label: [name for name, p in a.parameters.items() if p.get("prior")] for a in others})
+                            {a.label: [name for name, p in a.parameters.items() if p.prior] for a in others})
     assessed = assess_all(inputs, pairs, into, runner)
     tried, models = fits_of(model, base_sensed, pairs, assessed, windows, inputs, number, [a.label for a in others])
     decision = decide(tried, Baseline(windows.block_J(model.runs), noise.sigma, n, windows.groups(), noise.floor_sd),
@@ -436,9 +435,9 @@ def priors_stated(building, added):
     """The building with a sentence in its description for each parameter of an added effect
     (`Fit`s) held at its physical prior: a modeller reading the file learns which of its values
     the data did not fix and where it comes from."""
-    said = [f"{fit.effect} on {fit.target}: {name} = {p['value']:.4g} {EFFECTS[fit.effect].parameter(name).unit}, "
-            f"held at {p['prior']}: the data fixed the effect, not {name} apart (nodeforce diagnose)."
-            for fit in added for name, p in fit.parameters.items() if p.get("prior")]
+    said = [f"{fit.effect} on {fit.target}: {name} = {p.value:.4g} {EFFECTS[fit.effect].parameter(name).unit}, "
+            f"held at {p.prior}: the data fixed the effect, not {name} apart (nodeforce diagnose)."
+            for fit in added for name, p in fit.parameters.items() if p.prior]
     if not said:
         return building
     return building.edited(lambda data: data.update(description=" ".join([data.get("description", "")] + said).strip()))

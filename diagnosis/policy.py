@@ -11,6 +11,7 @@ from dataclasses import asdict, dataclass, fields
 import numpy as np
 from scipy.special import chdtrc
 
+from nodeforce.diagnosis.estimate import ParameterEstimate
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.score import Yardstick
 
@@ -193,7 +194,7 @@ class Policy:
         outside physical limits beyond its uncertainty (`limit_sds`). The judged parameters, their
         limits and the trade-off are the candidate's `facts`, as report.json records them.
 
-        parameters : {name: {"value", "std", "identifiable", "on_bound"}} of `diagnosis.calibrate`
+        parameters : {name: `ParameterEstimate`}, or report.json's {"value", "std", "identifiable", "on_bound"}
         derived : what the data determine besides (`diagnosis.calibrate.derived`)
         facts : what the building says of the candidate (`facts`)
         """
@@ -203,17 +204,17 @@ class Policy:
         fixed = (derived or {}).get(key)
         resolved = fixed is not None and fixed["std"] < self.identifiable_share * abs(fixed["value"])
         for name in facts["limits"]:
-            p, unit = parameters[name], EFFECTS[effect].parameter(name).unit
+            p, unit = ParameterEstimate.of(parameters[name]), EFFECTS[effect].parameter(name).unit
             low, high = (-math.inf if facts["limits"][name][0] is None else facts["limits"][name][0],
                          math.inf if facts["limits"][name][1] is None else facts["limits"][name][1])
-            if p.get("on_bound") and not (resolved and bounds_waived):
-                reasons.append(f"{name} = {p['value']:.3g} {unit} ends on a bound of its range")
-            elif not p["identifiable"] and not resolved and not p.get("prior"):
-                reasons.append(f"{name} = {p['value']:.3g} +- {p['std']:.2g} {unit} is not identifiable from these data")
-            margin = self.limit_sds * p["std"]
-            if not low - margin <= p["value"] <= high + margin:
+            if p.on_bound and not (resolved and bounds_waived):
+                reasons.append(f"{name} = {p.value:.3g} {unit} ends on a bound of its range")
+            elif not p.identifiable and not resolved and not p.prior:
+                reasons.append(f"{name} = {p.value:.3g} +- {p.sd:.2g} {unit} is not identifiable from these data")
+            margin = self.limit_sds * p.sd
+            if not low - margin <= p.value <= high + margin:
                 what = "a negative gain (a heat sink)" if low == 0.0 and EFFECTS[effect].source else "outside physical limits"
-                reasons.append(f"{name} = {p['value']:.3g} +- {p['std']:.2g} {unit} is {what} [{low:.3g}, {high:.3g}] "
+                reasons.append(f"{name} = {p.value:.3g} +- {p.sd:.2g} {unit} is {what} [{low:.3g}, {high:.3g}] "
                                f"by more than {self.limit_sds:g} standard deviations")
         return "; ".join(r for r in reasons if r) or None
 

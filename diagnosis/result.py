@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from nodeforce.diagnosis.estimate import ParameterEstimate, estimates, estimates_json
 from nodeforce.diagnosis.policy import Policy
 from nodeforce.model.score import Noise
 
@@ -94,7 +95,7 @@ class SensorEvidence:
 @dataclass
 class Fit:
     """One candidate effect calibrated on the calibration window (`diagnosis.calibrate`): its
-    parameters ({name: {"value", "std", "identifiable", "on_bound", ...}}), what the data determine
+    parameters ({name: `ParameterEstimate`}, made so from report.json's dicts), what the data determine
     besides (`derived`), what the building says of it (`physics`, `Policy.facts`), its metrics on
     both windows ({"calibration", "validation"}), its cross-validation, the other sensors'
     evidence, the round it was tried in and the effects it was added on top of (labels)."""
@@ -109,6 +110,9 @@ class Fit:
     round: int = 1
     on_top_of: tuple = ()
 
+    def __post_init__(self):
+        self.parameters = estimates(self.parameters)
+
     @property
     def label(self):
         """"effect@target", the key of the decision, the runs and the sensitivity."""
@@ -117,7 +121,7 @@ class Fit:
     @property
     def values(self):
         """{name: value} of the calibrated parameters."""
-        return {name: p["value"] for name, p in self.parameters.items()}
+        return {name: p.value for name, p in self.parameters.items()}
 
     def evidence(self):
         """Per-block J (C2) the choice reads (`diagnosis.selection`): the objective air on each
@@ -136,10 +140,11 @@ class Fit:
 
     def effect_json(self, keys=("effect", "target", "parameters")):
         """The effect as report.json's `effects` and `effect` say it."""
-        return {key: getattr(self, key) for key in keys}
+        return {key: estimates_json(self.parameters) if key == "parameters" else getattr(self, key) for key in keys}
 
     def to_json(self):
-        return {"effect": self.effect, "target": self.target, "parameters": self.parameters, "derived": self.derived,
+        return {"effect": self.effect, "target": self.target, "parameters": estimates_json(self.parameters),
+                "derived": self.derived,
                 "physics": self.physics, **self.metrics, "cv": self.cv.to_json(), "sensors": self.sensors.to_json(),
                 "round": self.round, **({"on_top_of": list(self.on_top_of)} if self.on_top_of else {})}
 

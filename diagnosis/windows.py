@@ -66,6 +66,20 @@ class Record:
         return measured_case(building, **self.read_from)
 
 
+@dataclass(frozen=True)
+class Beside:
+    """What a diagnosis's report sets beside it, which no fit, choice or cross-validation reads:
+    `reference` ({"label", "rmse": {phase: K}}), another model's error, reported for scale; and
+    `later`, `Record`s of the same building under the building file's protocol, read from their
+    files (`nodeforce.read_record`), on which the building as written and as corrected are scored
+    after the rounds (`diagnosis.loop.scored_later`)."""
+    reference: dict | None = None
+    later: tuple = ()
+
+    def __post_init__(self):
+        object.__setattr__(self, "later", tuple(self.later))
+
+
 @dataclass
 class RecordWindow:
     """One record as the loop reads it (`Windows`): its `Record`, its case (steady start), the row

@@ -92,9 +92,10 @@ def main(argv=None):
 
     print(f"best forcing: {', '.join(f'{i} ({names[i]})' for i in mine) or 'none'}: "
           f"J = {J[tuple(mine)]:.3f} C2 (unforced {J_unforced:.3f}), cost {-value:.3f} C2")
-    located = nodeforce.locate(building, case, air, seed=args.seed, workers=1)
-    print(f"nodeforce locate: {located['best_nodes'] or 'none'}: J = {located['J_best']:.3f} C2")
-    ours, theirs = sub_models(building, mine), sub_models(building, located["best_nodes"])
+    located = nodeforce.locate(building, case, objective=air, search=nodeforce.SearchSettings(seed=args.seed),
+                               execution=nodeforce.Execution(workers=1))
+    print(f"nodeforce locate: {located.best_nodes or 'none'}: J = {located.J_best:.3f} C2")
+    ours, theirs = sub_models(building, mine), sub_models(building, located.best_nodes)
     if ours == theirs:
         print(f"agree: both force {', '.join(sorted(ours)) or 'nothing'}")
         return 0

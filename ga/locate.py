@@ -6,8 +6,10 @@ sensors' noise given by the user or estimated from the measured air. A record th
 only the objective's air (a thermostat's) has nothing to force: its locate.json says so, with
 `best_nodes` [], and the diagnosis goes on to the air's own equation.
 """
+import json
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
+from pathlib import Path
 
 import numpy as np
 from scipy.sparse.csgraph import shortest_path
@@ -17,7 +19,7 @@ from nodeforce.ga.checkpoint import NAME as CHECKPOINT
 from nodeforce.runtime.compiler import find_compiler
 from nodeforce.ga.fitness import FmuFitness, RecordsFitness
 from nodeforce.ga.parsimony import EXPLAINED
-from nodeforce.ga.search import PATIENCE, search
+from nodeforce.ga.search import Execution, SearchSettings, search as run_search
 from nodeforce.model.case import as_cases
 from nodeforce.model.errors import InputError
 from nodeforce.model.network import assemble
@@ -82,31 +84,70 @@ def chromosome_nodes(building, case, objective, source, nodes=None, include_alge
 
 
 @dataclass(frozen=True)
-class SearchSettings:
-    """The forcing search's settings as a diagnosis runs it (`locate`): the seed of every random
-    draw, the GA's population and generations, and the FMUs it drives (`locate`'s `fmu_kind`;
-    "auto": the standalone where it can run the building)."""
-    seed: int = 0
-    population: int = 30
-    generations: int = 400
-    fmu_kind: str = "auto"
+class Localization:
+    """What the forcing search found (`locate`), the content of locate.json: the nodes measured
+    and those it may force (`chromosome_nodes`), the objective's air (`output_node`, `objective`
+    its zones, `output_nodes`), J unforced and with `best_nodes` forced (`J_best`, None: the
+    simulation failed), each node's score forced alone (`node_scores`, by str(id)), the nodes
+    that lower J alone (`ranked_nodes`, lowest first) and the groups the noise cannot separate
+    (`tied_nodes`), how the search ran (`search`), the noise it judged by, the evidence per
+    component (`components`, `evidence`) and the `finding` in words. `to_json()` is locate.json,
+    `read(path)` reads one back, `summary()` is what `nodeforce locate` prints."""
+    measured_nodes: list
+    output_node: int
+    objective: list
+    output_nodes: list
+    chromosome_nodes: list
+    J_unforced: float | None
+    best_nodes: list
+    J_best: float | None
+    node_scores: dict
+    ranked_nodes: list
+    tied_nodes: list
+    search: dict
+    noise: dict
+    components: list
+    finding: str
+
+    @classmethod
+    def of(cls, data):
+        """From locate.json's content (a dict)."""
+        return cls(**{f.name: data[f.name] for f in fields(cls)})
+
+    @classmethod
+    def read(cls, path):
+        """A locate.json read back."""
+        return cls.of(json.loads(Path(path).read_text(encoding="utf-8")))
+
+    def to_json(self):
+        """locate.json's content."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    def summary(self):
+        """A short table of the single-node scores (the paper's Table 4) and the answer."""
+        lines = [f"J unforced: {self.J_unforced:.3f} C2 on the air of {', '.join(self.objective)}"]
+        # every node scored, most helpful first (the ranked ones, then those that lower nothing)
+        scores = self.node_scores
+        order = [str(n) for n in self.ranked_nodes]
+        order += sorted((n for n in scores if n not in order), key=lambda n: (scores[n] is None, scores[n]))
+        # nodes the noise cannot separate share a tie mark (a, b, ...): ranked by J, not reordered
+        tied = {str(n): chr(ord("a") + k) for k, group in enumerate(self.tied_nodes or []) for n in group}
+        if order:
+            lines.append(f"{'node':>6}{'J forced alone':>16}  tie")
+            lines += [f"{node:>6}{'failed' if scores[node] is None else format(scores[node], '.3f'):>16}  "
+                      f"{tied.get(node, '')}".rstrip() for node in order[:8]]
+        found = ", ".join(map(str, self.best_nodes)) or "none"
+        search = self.search
+        how = ("nothing to force" if search["method"] == "none" else
+               f"{search['method']} search, {search['unique_evaluations']} simulations in {search['seconds']:.1f} s")
+        lines.append(f"best nodes: {found} (J = {self.J_best:.3f}); {how}")
+        lines.append(self.finding)
+        return "\n".join(lines)
 
 
-@dataclass(frozen=True)
-class Execution:
-    """Where a command's work runs: `workers` processes (None: every core), or the workers of the
-    Dask scheduler at `scheduler` ("tcp://host:port"); and the FMUs of the model it runs and
-    writes (`fmu_build.build.build_fmu`'s kinds, or "auto", `evaluator_kind`)."""
-    workers: int | None = None
-    scheduler: str | None = None
-    fmu_kind: str = "python"
-
-
-def locate(building, case, objective, workdir, *, source="measurements", nodes=None,
-           include_algebraic=False, population=30, generations=400, pc=0.8, pm=0.03, seed=0,
-           patience=PATIENCE, seeded=True, workers=None, scheduler=None, warmup_days=2, progress=None,
-           fmu_kind="auto", noise=None, protocols=None):
-    """Run the forcing search on a case; return the content of locate.json.
+def locate(building, case, workdir, objective, *, search=SearchSettings(), execution=Execution(),
+           source="measurements", protocols=None):
+    """Run the forcing search on a case; return its `Localization` (locate.json's content).
 
     `case` may be the Cases of several records of the building: J is then the sum of each
     record's J, a forcing applied to every record (`ga.fitness.RecordsFitness`), and `protocols`
@@ -115,18 +156,22 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
     The FMUs (`model.fmu` of `building` where a record runs it, `model_<k>.fmu` of the k-th
     record's own building) and the search's
     checkpoint (`locate.checkpoint.json`) are written in
-    `workdir`, so a run stopped midway and started again resumes. `progress` is called after
-    every generation with (generation, total, best J, unique evaluations). `noise` is the air
-    sensors' noise sd (C) if the user knows it, else it is estimated (`model.score.Noise`) from
-    every record's air. patience and seeded
-    choose the search (ga.search: the defaults stop at convergence; ga.search.PAPER's values
-    give the paper's search). fmu_kind: "python", "standalone", or "auto" (`evaluator_kind`: the
-    command line's default and this one's), each with "-fmi3" for FMI 3.0.
+    `workdir`, so a run stopped midway and started again resumes. `search`
+    (`ga.search.SearchSettings`): the GA's settings (its defaults stop at convergence;
+    `SearchSettings.paper()` gives the paper's search), the nodes it may force
+    (`chromosome_nodes`), the FMUs it drives (`fmu_kind`: "python", "standalone", or "auto",
+    `evaluator_kind`, the command line's default and this one's, each with "-fmi3" for FMI 3.0),
+    the warm-up days and `noise`, the air sensors' noise sd (C) if the user knows it, else it is
+    estimated (`model.score.Noise`) from every record's air. `execution` (`ga.search.Execution`):
+    where the search runs (`workers`, `scheduler`) and its `progress`, called after every
+    generation with (generation, total, best J, unique evaluations); its `fmu_kind` is not read.
+    `source`: what an error about the measurements names.
     """
     cases = as_cases(case)
     protocols = list(protocols) if protocols is not None else [None] * len(cases)
-    candidates = chromosome_nodes(building, cases, objective, source, nodes, include_algebraic)
-    kind = evaluator_kind(fmu_kind, [building, *filter(None, protocols)])
+    candidates = chromosome_nodes(building, cases, objective, source,
+                                  None if search.nodes is None else list(search.nodes), search.include_algebraic)
+    kind = evaluator_kind(search.fmu_kind, [building, *filter(None, protocols)])
     # one FMU per building a record runs under: `building`'s only where a record runs it
     names = ["model.fmu" if own is None else f"model_{k + 1}.fmu" for k, own in enumerate(protocols)]
     built = {}
@@ -134,24 +179,20 @@ def locate(building, case, objective, workdir, *, source="measurements", nodes=N
         if name not in built:
             built[name] = build_fmu(own or building, workdir / name, kind=kind)
     fmus = [built[name] for name in names]
-    parts = [FmuFitness(path, c, candidates, objective, warmup_days) for path, c in zip(fmus, cases)]
+    parts = [FmuFitness(path, c, candidates, objective, search.warmup_days) for path, c in zip(fmus, cases)]
     fitness = parts[0] if len(parts) == 1 else RecordsFitness(parts)
     measured = [objective.measured(c) for c in cases]
-    noise = Noise.of_records(measured, noise)
+    noise = Noise.of_records(measured, search.noise)
     measured_ids = sorted(set().union(*(c.measured_ids for c in cases)))
     if not candidates:
-        return nothing_to_force(building, measured_ids, objective, fitness, noise)
-    result = search(fitness, candidates,
-                    population=population, generations=generations, pc=pc, pm=pm, seed=seed,
-                    patience=patience, seeded=seeded,
-                    workers=workers, scheduler=scheduler, checkpoint=workdir / CHECKPOINT,
-                    progress=progress, noise_sigma=noise.sigma,
-                    n_residuals=int(sum(np.isfinite(m).sum() for m in measured)))
+        return Localization.of(nothing_to_force(building, measured_ids, objective, fitness, noise))
+    result = run_search(fitness, candidates, search, execution, checkpoint=workdir / CHECKPOINT,
+                        noise_sigma=noise.sigma, n_residuals=int(sum(np.isfinite(m).sum() for m in measured)))
     result = {"measured_nodes": measured_ids, "output_node": objective.air_nodes[0],
               "objective": list(objective.zones), "output_nodes": list(objective.air_nodes), **result,
               "noise": noise.to_json()}
     result["components"] = evidence(building, result)
-    return {**result, "finding": finding(building, result)}
+    return Localization.of({**result, "finding": finding(building, result)})
 
 
 def evidence(building, result):

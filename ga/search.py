@@ -33,6 +33,7 @@ import os
 import sys
 import time
 from dataclasses import dataclass
+from typing import Callable
 from functools import partial
 from itertools import product
 
@@ -56,30 +57,97 @@ PATIENCE = 25
 PAPER = dict(population=30, generations=400, pc=0.8, pm=0.03, patience=None, seeded=False)
 
 
-def search(factory, chromosome_nodes, *, population=30, generations=400, pc=0.8, pm=0.03,
-           seed=0, patience=PATIENCE, seeded=True, workers=None, scheduler=None, checkpoint=None,
-           progress=None, noise_sigma=None, n_residuals=None) -> dict:
+def check_settings(population, generations, pc, pm, patience=None):
+    """The GA's settings, the one place they are checked, where a `SearchSettings` is made:
+    refused with the command-line option that sets each named (InputError), by the command
+    before any work and for a caller of the API alike. `patience` None: no convergence criterion."""
+    if population < 2:
+        raise InputError("--population", population, "a population needs at least 2 chromosomes")
+    if generations < 1:
+        raise InputError("--generations", generations, "at least one generation")
+    for option, p in (("--pc", pc), ("--pm", pm)):
+        if not 0.0 <= p <= 1.0:
+            raise InputError(option, p, "a probability, between 0 and 1")
+    if patience is not None and patience < 1:
+        raise InputError("--patience", patience, "at least one generation")
+
+
+@dataclass(frozen=True)
+class SearchSettings:
+    """The forcing search's settings, checked once where they are made (`check_settings`, an
+    InputError naming the command-line option): the seed of every random draw; the GA's
+    population, generations, crossover and mutation probabilities `pc`, `pm` (the paper: 30,
+    400, 0.8, 0.03); `patience` (stop once the best J has not fallen by more than the noise
+    tolerance for this many generations; None: run every generation, the paper) and `seeded`
+    (start from the single-node scores and a forward-backward pass; False: a random initial
+    population, the paper; PAPER = both off). `ga.locate.locate` reads the rest: the FMUs it
+    drives (`fmu_kind`, "auto": the standalone where it can run the building, `evaluator_kind`),
+    the nodes it may force (`nodes`, None: every measured node but the objective's air and,
+    unless `include_algebraic`, the algebraic radiant nodes), the `warmup_days` of every
+    simulation, and `noise`, the air sensors' noise sd (C) where the user knows it (None:
+    estimated from the air, `model.score.Noise`), which a diagnosis judges its choice by too."""
+    seed: int = 0
+    population: int = 30
+    generations: int = 400
+    fmu_kind: str = "auto"
+    pc: float = 0.8
+    pm: float = 0.03
+    patience: int | None = PATIENCE
+    seeded: bool = True
+    nodes: tuple | None = None
+    include_algebraic: bool = False
+    warmup_days: float = 2
+    noise: float | None = None
+
+    def __post_init__(self):
+        check_settings(self.population, self.generations, self.pc, self.pm, self.patience)
+        if self.nodes is not None:
+            object.__setattr__(self, "nodes", tuple(self.nodes))
+
+    @classmethod
+    def paper(cls, **settings):
+        """The paper's search (PAPER), with any other setting given."""
+        return cls(**{**PAPER, **settings})
+
+
+@dataclass(frozen=True)
+class Execution:
+    """Where a command's work runs, checked where it is made: `workers` processes (None: every
+    core; or a runner of `runtime.lifetime` or `runtime.cluster` a command has started, which its
+    later stages use too), or the workers of the Dask scheduler at `scheduler` ("tcp://host:port");
+    the FMUs of the model it runs and writes (`fmu_build.build.build_fmu`'s kinds, or "auto",
+    `ga.locate.evaluator_kind`); and `progress`, called after every generation of a forcing search
+    with (generation, total, best J, unique evaluations)."""
+    workers: object = None
+    scheduler: str | None = None
+    fmu_kind: str = "python"
+    progress: Callable | None = None
+
+    def __post_init__(self):
+        if isinstance(self.workers, int) and self.workers < 1:
+            raise InputError("--workers", self.workers, "at least one worker process")
+
+
+def search(factory, chromosome_nodes, settings=SearchSettings(), execution=Execution(), *, checkpoint=None,
+           noise_sigma=None, n_residuals=None) -> dict:
     """Search the forcing of lowest J over `chromosome_nodes`; return the locate.json fields.
 
     factory: picklable callable; factory() -> evaluator with J(mask: tuple[bool, ...]) -> float,
         mask over chromosome_nodes in order, and optionally close(), called when the search
         ends (ga.evaluation).  Called once per worker.  J may raise: that chromosome is unfit
         (J = inf), the reason logged on logger "nodeforce.ga".
-    population, generations, pc, pm: the GA settings (paper: 30, 400, 0.8, 0.03).
-    seed: seeds every random draw; same arguments and seed -> same answer.
-    patience: stop the GA once the best J has not fallen by more than the noise tolerance for
-        this many generations; None: run every generation (the paper).
-    seeded: start the GA from the single-node scores and a forward-backward pass (module
-        docstring); False: a random initial population (the paper).  PAPER = both off.
-    workers: processes evaluating in parallel (default os.cpu_count(); 1 = in this process), or
-        where a command runs its tasks (`lifetime.InProcess`, `lifetime.Workers`, a
-        `runtime.cluster.Cluster`), which its later stages use too.
-    scheduler: a dask.distributed scheduler address ("tcp://host:port"); replaces `workers`.
+    settings: `SearchSettings`: the seed (same arguments and seed -> same answer), population,
+        generations, pc, pm, patience and seeded; its other fields are `ga.locate.locate`'s.
+    execution: `Execution`: its `workers`, processes evaluating in parallel (default
+        os.cpu_count(); 1 = in this process), or where a command runs its tasks
+        (`lifetime.InProcess`, `lifetime.Workers`, a `runtime.cluster.Cluster`), which its later
+        stages use too; or its `scheduler`, a dask.distributed scheduler address
+        ("tcp://host:port"), which replaces `workers`; and its `progress`.
     checkpoint: a file path; the state is written there after every generation, and a run
         started again with the same arguments resumes from it (other arguments: ignored).
-    progress: optional callable progress(generation, total, J_min, unique_evaluations), called
-        after each generation (after the checkpoint is written).  A tqdm bar is shown as well
-        when stderr is a terminal.
+        `execution.progress`: optional callable progress(generation, total, J_min,
+        unique_evaluations), called after each generation (after the checkpoint is written).  A
+        tqdm bar is shown as well when stderr is a terminal.
     noise_sigma, n_residuals: measurement-noise sd (C) and the number of residuals in J, used to
         judge which reductions of J are significant (ga.parsimony); None = relative floor only.
 
@@ -103,7 +171,10 @@ def search(factory, chromosome_nodes, *, population=30, generations=400, pc=0.8,
     """
     started = time.monotonic()
     nodes = list(chromosome_nodes)
-    _check_arguments(nodes, population, generations, pc, pm, patience, noise_sigma, n_residuals)
+    _check_arguments(nodes, noise_sigma, n_residuals)
+    population, generations, pc, pm, seed = settings.population, settings.generations, settings.pc, settings.pm, settings.seed
+    patience, seeded, progress = settings.patience, settings.seeded, execution.progress
+    workers, scheduler = execution.workers, execution.scheduler
     k = len(nodes)
     exhaustive = 2 ** k <= population * generations
     settings = dict(method="exhaustive" if exhaustive else "ga", population=population,
@@ -150,25 +221,9 @@ def search(factory, chromosome_nodes, *, population=30, generations=400, pc=0.8,
     return answer
 
 
-def check_settings(population, generations, pc, pm, patience=None):
-    """The GA's settings, the one place they are checked: refused with the command-line option
-    that sets each named (InputError), by the command before any work and by `search` for a
-    caller of the API alike. `patience` None: no convergence criterion."""
-    if population < 2:
-        raise InputError("--population", population, "a population needs at least 2 chromosomes")
-    if generations < 1:
-        raise InputError("--generations", generations, "at least one generation")
-    for option, p in (("--pc", pc), ("--pm", pm)):
-        if not 0.0 <= p <= 1.0:
-            raise InputError(option, p, "a probability, between 0 and 1")
-    if patience is not None and patience < 1:
-        raise InputError("--patience", patience, "at least one generation")
-
-
-def _check_arguments(nodes, population, generations, pc, pm, patience, noise_sigma, n_residuals):
+def _check_arguments(nodes, noise_sigma, n_residuals):
     if len(set(map(str, nodes))) != len(nodes):
         raise ValueError(f"chromosome nodes must be distinct: {nodes}")
-    check_settings(population, generations, pc, pm, patience)
     if noise_sigma is not None and not n_residuals:
         raise ValueError("noise_sigma needs n_residuals, the number of residuals in J")
 

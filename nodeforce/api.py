@@ -7,6 +7,7 @@ shows them at work. Bad input raises `InputError` (a ValueError) with the one-li
 command line prints.
 """
 from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
@@ -17,6 +18,7 @@ from nodeforce.cosim.run import input_table, simulate_fmu
 from nodeforce.diagnosis import windows as _windows
 from nodeforce.fmu_build.build import build_fmu, fmu_kind as _fmu_kind
 from nodeforce.ga import locate as _locate
+from nodeforce.ga.search import Execution, SearchSettings
 from nodeforce.iotools.fmu_inputs import write_fmu_inputs
 from nodeforce.iotools.measurements import read_measurements
 from nodeforce.iotools.phases import read_phases
@@ -31,14 +33,46 @@ from nodeforce.model.score import Objective
 __all__ = ["InputError", "read_building", "convert_idf", "read_weather", "read_measurements", "read_phases", "measured_case",
            "read_case", "read_record", "objective", "synthesize", "convert_table", "simulate", "write_fmu",
            "fmu_inputs", "write_fmu_inputs", "open_fmu", "simulate_fmu", "forcing_candidates",
-           "score_forcing", "locate", "diagnose", "Record", "compare"]
+           "score_forcing", "locate", "diagnose", "Record", "SearchSettings", "Execution", "Beside", "compare",
+           "Reading", "SensorNoise", "Period"]
 
 # One record of a building among several in one diagnosis, or a later one: case, source, name,
 # fraction, calibration_end, phases, building, read_from (diagnosis.windows.Record).
 Record = _windows.Record
+# What the forcing search found: locate.json's content (ga.locate.Localization).
+Localization = _locate.Localization
+# What a diagnosis's report sets beside it: another model's error, later records (diagnosis.windows.Beside).
+Beside = _windows.Beside
 
 # The API's cases carry no file name: errors about their measurements say "measurements".
 SOURCE = "measurements"
+
+
+@dataclass(frozen=True)
+class Reading:
+    """How a record's files are made its case (`measured_case`'s settings, which it checks):
+    `burn_in_days`, the days forced after the first measurement; `decomposition`, the pvlib model
+    that splits ghi alone (`nodeforce.model.solar.DECOMPOSITIONS`); `history_days`, the days of
+    weather simulated before the record at most."""
+    burn_in_days: float = 0
+    decomposition: str = "erbs"
+    history_days: float = HISTORY_DAYS
+
+
+@dataclass(frozen=True)
+class SensorNoise:
+    """The Gaussian noise `synthesize` adds to what the sensors read: its standard deviation `sd`
+    (C) and the `seed` of its draws."""
+    sd: float = 0.0
+    seed: int = 0
+
+
+@dataclass(frozen=True)
+class Period:
+    """The rows `convert_table` keeps: from `start` to `end` (ISO 8601 times with UTC offset, both
+    ends included; None: the table's first or last row), parsed where the table is read."""
+    start: str | None = None
+    end: str | None = None
 
 
 def read_building(path):
@@ -112,8 +146,7 @@ def objective(building, zones=None, source="zones"):
     return Objective.of(building, zones, source=source)
 
 
-def read_case(building, weather, measurements=None, *, burn_in_days=0, decomposition="erbs",
-              history_days=HISTORY_DAYS):
+def read_case(building, weather, measurements=None, reading=Reading()):
     """The files of one record read and made its measured case: what every command that
     simulates reads first.
 
@@ -124,32 +157,33 @@ def read_case(building, weather, measurements=None, *, burn_in_days=0, decomposi
         The weather CSV or EPW (`read_weather`; an EPW typical year in the measurements' year).
     measurements : str or Path, optional
         The measurements CSV (`read_measurements`); None: a simulation without them.
-    burn_in_days, decomposition, history_days
-        `measured_case`'s: days forced after the first measurement, the pvlib model that splits
-        ghi alone, days of weather simulated before the record at most.
+    reading : Reading
+        `measured_case`'s settings: `burn_in_days`, days forced after the first measurement;
+        `decomposition`, the pvlib model that splits ghi alone; `history_days`, days of weather
+        simulated before the record at most.
 
     Returns
     -------
     (Building, Case)
         The case's `assumptions` say what was assumed about the files (the weather's history).
     """
-    building, read_from = _read(building, weather, measurements, burn_in_days, decomposition, history_days)
+    building, read_from = _read(building, weather, measurements, reading)
     return building, measured_case(building, **read_from)
 
 
-def _read(building, weather, measurements, burn_in_days, decomposition, history_days):
+def _read(building, weather, measurements, reading):
     """The building (read, unless given read) and the other arguments of `measured_case`, its
     files read: what `read_case` makes a case of, and what a `Record` keeps (`read_from`)."""
     building = building if isinstance(building, Building) else load_building(building)
     measurements = read_measurements(measurements) if measurements else None
     if not isinstance(weather, pd.DataFrame):
         weather = read_weather(weather, times=None if measurements is None else measurements.index)
-    return building, {"weather": weather, "measurements": measurements,
-                      "burn_in_days": burn_in_days, "decomposition": decomposition, "history_days": history_days}
+    return building, {"weather": weather, "measurements": measurements, "burn_in_days": reading.burn_in_days,
+                      "decomposition": reading.decomposition, "history_days": reading.history_days}
 
 
 def read_record(building, weather, measurements, *, name=None, fraction=0.6, calibration_end=None, phases=None,
-                burn_in_days=0, decomposition="erbs", history_days=HISTORY_DAYS):
+                reading=Reading()):
     """One record of a building for `diagnose`, read from its files.
 
     Parameters
@@ -167,8 +201,8 @@ def read_record(building, weather, measurements, *, name=None, fraction=0.6, cal
         `calibration_end` (a pandas Timestamp, the row at or before it).
     phases : str or Path, optional
         The record's `time,phase` CSV (`read_phases`).
-    burn_in_days, decomposition, history_days
-        As `read_case`.
+    reading : Reading
+        As `read_case`'s.
 
     Returns
     -------
@@ -176,14 +210,14 @@ def read_record(building, weather, measurements, *, name=None, fraction=0.6, cal
         Its `read_from` keeps the files as read, from which `diagnose` prepares a later record's
         case for the building as corrected.
     """
-    building, read_from = _read(building, weather, measurements, burn_in_days, decomposition, history_days)
+    building, read_from = _read(building, weather, measurements, reading)
     return Record(measured_case(building, **read_from), str(measurements),
                   name or Path(measurements).name.split(".")[0], fraction, calibration_end,
                   tuple(read_phases(phases)) if phases else (), building, read_from)
 
 
-def synthesize(building, weather, times, sensors, *, effects=(), noise_sd=0.0, seed=0, history_days=0.0,
-               decomposition="erbs", source="effects"):
+def synthesize(building, weather, times, sensors, *, effects=(), noise=SensorNoise(), reading=Reading(history_days=0.0),
+               source="effects"):
     """What the sensors of a building would read under a weather, with effects its file does not
     declare (`nodeforce synth`).
 
@@ -196,12 +230,11 @@ def synthesize(building, weather, times, sensors, *, effects=(), noise_sd=0.0, s
         The node ids measured.
     effects : sequence of (effect, target, {parameter: value})
         Effects of `model.effects.EFFECTS` added to the building, each in turn (several faults at once).
-    noise_sd : float
-        Standard deviation (C) of the Gaussian sensor noise added.
-    seed : int
-        The noise's.
-    history_days, decomposition
-        Days of the weather simulated before the record; pvlib's split of ghi alone.
+    noise : SensorNoise
+        The Gaussian sensor noise added: its standard deviation `sd` (C) and its `seed`.
+    reading : Reading
+        Its `history_days`, days of the weather simulated before the record (default here 0),
+        and `decomposition`, pvlib's split of ghi alone; its `burn_in_days` is not read.
     source : str
         What an error about an effect that does not apply names (the command line: `--effect`).
 
@@ -216,20 +249,22 @@ def synthesize(building, weather, times, sensors, *, effects=(), noise_sd=0.0, s
         if not EFFECTS[effect].applies(building, target):
             raise InputError(source, f"{effect}@{target}", f"does not apply to {building.source}")
         building = EFFECTS[effect].apply(building, target, values)
-    return pseudo_measurements(building, weather, times, list(sensors), noise_sd=noise_sd, seed=seed,
-                               history_days=history_days, decomposition=decomposition)
+    return pseudo_measurements(building, weather, times, list(sensors), noise_sd=noise.sd, seed=noise.seed,
+                               history_days=reading.history_days, decomposition=reading.decomposition)
 
 
-def convert_table(path, names, origin, select, output, *, table=None, start=None, end=None, constant=None):
+def convert_table(path, names, origin, select, output, *, table=None, period=Period(), constant=None):
     """Columns of a Modelica CombiTimeTable text file written as a weather or measurements CSV
-    (`nodeforce table`; the arguments are `nodeforce.iotools.table.convert_table`'s).
+    (`nodeforce table`; the arguments are `nodeforce.iotools.table.convert_table`'s, its `start`
+    and `end` the `Period`'s).
 
     Returns
     -------
     DataFrame
         What was written, indexed by time.
     """
-    return _convert_table(path, names, origin, select, output, table=table, start=start, end=end, constant=constant)
+    return _convert_table(path, names, origin, select, output, table=table, start=period.start, end=period.end,
+                          constant=constant)
 
 
 def simulate(building, weather, measurements=None, force=(), burn_in_days=0):
@@ -364,39 +399,46 @@ def score_forcing(instance, case, nodes, objective):
     return objective.J(objective.measured(case), air)
 
 
-def locate(building, case, objective=None, workdir=None, source=SOURCE, **search):
+def locate(building, case, workdir=None, objective=None, *, search=SearchSettings(), execution=Execution(),
+           source=SOURCE):
     """The forcing search of `nodeforce locate`: the content of locate.json (docs/guide.md).
 
     Parameters
     ----------
     building : Building
     case : Case from `measured_case`, with measurements
-    objective : Objective, optional
-        Default: the building's first zone.
     workdir : str or Path, optional
         Folder for the FMU and the search's checkpoint (a run started again resumes); default a
         temporary folder, removed at the end.
+    objective : Objective, optional
+        Default: the building's first zone.
+    search : SearchSettings
+        The search's settings (`nodeforce.ga.search.SearchSettings`, checked where it is made):
+        seed, population, generations, pc, pm, patience, seeded (`SearchSettings.paper()`: the
+        paper's search), the nodes it may force and include_algebraic, the FMUs it drives
+        (fmu_kind, default "auto"), warmup_days, and the air sensors' noise sd (C) if known.
+    execution : Execution
+        Where it runs (`nodeforce.ga.search.Execution`): workers, scheduler, and progress, called
+        after every generation. Worker processes (`workers`, default all cores) are spawned: a
+        script that uses more than one runs this under ``if __name__ == "__main__":``.
     source : str
         What an error about the measurements names (their file).
-    **search
-        `nodeforce.ga.locate.locate`'s settings: nodes, include_algebraic, population,
-        generations, pc, pm, patience, seeded, seed, workers, scheduler, fmu_kind, noise, progress.
-        Worker processes (`workers`, default all cores) are spawned: a script that uses more
-        than one runs this under ``if __name__ == "__main__":``.
 
     Returns
     -------
-    dict
-        `best_nodes`, `J_unforced`, `J_best`, `node_scores`, `ranked_nodes`, `search`, `finding`, ...
+    Localization
+        locate.json's content as an object (`nodeforce.ga.locate.Localization`): `best_nodes`,
+        `J_unforced`, `J_best`, `node_scores`, `ranked_nodes`, `search`, `finding`, ...;
+        `summary()` what `nodeforce locate` prints, `to_json()` locate.json, `Localization.read(path)`
+        one read back.
     """
     with _folder(workdir) as folder:
-        return _locate.locate(building, case, objective or Objective.of(building), folder,
-                              source=source, **search)
+        return _locate.locate(building, case, folder, objective or Objective.of(building),
+                              search=search, execution=execution, source=source)
 
 
-def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibration_end=None, phases=(), seed=0,
-             workers=None, scheduler=None, fmu_kind="python", search_fmu="auto", noise=None, reference=None,
-             population=30, generations=400, later=(), policy=None):
+def diagnose(building, case, workdir, objective=None, *, search=SearchSettings(), execution=Execution(),
+             beside=Beside(), policy=None):
     """The whole loop of `nodeforce diagnose`; writes its files in `workdir` (docs/guide.md, Output
     files) and returns the `Diagnosis`: `summary()` the first screen, `to_json()` report.json's
     content, `added` the effects added, `rounds` each round's decision, `candidates` every fit.
@@ -405,51 +447,44 @@ def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibrati
     ----------
     building : Building
     case : Case from `measured_case`, with measurements (its burn-in is `diagnose`'s; the command
-        line's default is one day); or a list of `Record`s, several records of the same building
-        (each its case, name, calibration window and phases): the fits minimise the sum of their
-        calibration windows' J, the choice reads every record's days, and a correction that
-        harms one record is refused
+        line's default is one day), its calibration window the first 60% of it by time; or a
+        list of `Record`s, several records of the same building (each its case, name,
+        calibration window, `fraction` or `calibration_end`, and phases, from `read_phases`): the
+        fits minimise the sum of their calibration windows' J, the choice reads every record's
+        days, and a correction that harms one record is refused
     workdir : str or Path
         Folder for report.json, report.md, the plots, building_after.json and model_after.fmu.
     objective : Objective, optional
         Default: the building's first zone.
-    fraction, calibration_end, phases
-        The calibration window of a single case: the first `fraction` of it by time, or up to
-        `calibration_end` (a pandas Timestamp); its phases (from `read_phases`). A `Record`
-        carries its own.
-    seed : int
-        Every random choice's (the forcing search, the screening).
-    workers : int, optional
-        Worker processes (default all cores), spawned as for `locate`.
-    scheduler : str, optional
-        A Dask scheduler's address, "tcp://host:port": the forcing search and every round's
-        candidates run on its workers instead of `workers` processes (docs/performance.md). The
-        answer is the same; a worker lost midway costs none; a lost scheduler raises
-        `runtime.lifetime.RunStopped`, an unreachable one `InputError`.
-    fmu_kind : str
-        The FMUs of the model before and after, run and written (`model_before.fmu`,
-        `model_after.fmu`): "python" (the default, as on the command line), "standalone", or
-        "auto", the standalone where a C compiler is at hand and it can run the building; each
-        with "-fmi3" for FMI 3.0. The candidates are fitted on the direct model, and the model
-        they are measured against runs through this FMU: the Python FMU repeats the direct
-        model's arithmetic (to 1e-14 C), the C FMU differs by rounding (1e-12 C), which a
-        candidate the data do not determine can turn into another of its many equally good fits.
-    search_fmu : str
-        The FMUs the forcing search drives (`model.fmu`), of the same kinds; default "auto", as
-        `locate`'s: the standalone, 4 to 6 times faster a simulation on the test cell
-        (docs/performance.md). Its J differs from the Python FMU's by rounding, far below the
-        noise its choice of nodes reads.
-    noise : float, optional
-        The air sensors' noise sd (C) where the user knows it; default estimated from the air.
-    reference : dict, optional
-        {"label", "rmse": {phase: K}}: another model's error, reported for scale.
-    population, generations : int
-        The forcing search's GA settings.
-    later : list of Record, optional
-        Later records of the same building, each from `read_record` (the building diagnosed, the
-        diagnosis's burn-in), which no fit, choice or cross-validation reads: after the rounds the
-        building as written and as corrected are scored on each as `compare` scores them
-        (`Diagnosis.later`, report.json's `later`, a line of the first screen).
+    search : SearchSettings
+        The forcing search's (`nodeforce.ga.search.SearchSettings`): its `seed`, every random
+        choice's (the forcing search, the screening); its GA settings (`population`,
+        `generations`, ...); `fmu_kind`, the FMUs the forcing search drives (`model.fmu`),
+        default "auto", as `locate`'s: the standalone, 4 to 6 times faster a simulation on the
+        test cell (docs/performance.md), whose J differs from the Python FMU's by rounding, far
+        below the noise its choice of nodes reads; and `noise`, the air sensors' noise sd (C)
+        where the user knows it, default estimated from the air.
+    execution : Execution
+        Where the work runs (`nodeforce.ga.search.Execution`): `workers` processes (default all
+        cores), spawned as for `locate`; or `scheduler`, a Dask scheduler's address,
+        "tcp://host:port": the forcing search and every round's candidates run on its workers
+        instead (docs/performance.md). The answer is the same; a worker lost midway costs none; a
+        lost scheduler raises `runtime.lifetime.RunStopped`, an unreachable one `InputError`.
+        Its `fmu_kind`: the FMUs of the model before and after, run and written
+        (`model_before.fmu`, `model_after.fmu`): "python" (the default, as on the command line),
+        "standalone", or "auto", the standalone where a C compiler is at hand and it can run the
+        building; each with "-fmi3" for FMI 3.0. The candidates are fitted on the direct model,
+        and the model they are measured against runs through this FMU: the Python FMU repeats
+        the direct model's arithmetic (to 1e-14 C), the C FMU differs by rounding (1e-12 C),
+        which a candidate the data do not determine can turn into another of its many equally
+        good fits.
+    beside : Beside
+        What the report sets beside the diagnosis (`nodeforce.diagnosis.windows.Beside`), which
+        no fit, choice or cross-validation reads: `reference`, {"label", "rmse": {phase: K}},
+        another model's error, reported for scale; `later`, later records of the same building,
+        each from `read_record` (the building diagnosed, the diagnosis's burn-in): after the
+        rounds the building as written and as corrected are scored on each as `compare` scores
+        them (`Diagnosis.later`, report.json's `later`, a line of the first screen).
     policy : Policy, optional
         Every threshold, table and order of the choice (`nodeforce.diagnosis.policy.Policy`),
         default `Policy()`; report.json records it, and `Diagnosis.replay` judges under it.
@@ -460,12 +495,9 @@ def diagnose(building, case, workdir, objective=None, *, fraction=0.6, calibrati
     """
     from nodeforce.diagnosis import loop  # here: the report's plotting and statistics load with it
     with _folder(workdir) as folder:
-        records = case if isinstance(case, (list, tuple)) else \
-            [Record(case, SOURCE, SOURCE, fraction, calibration_end, tuple(phases or ()))]
-        return loop.diagnose(building, records, folder, objective or Objective.of(building),
-                             search=_locate.SearchSettings(seed, population, generations, search_fmu),
-                             execution=_locate.Execution(workers, scheduler, fmu_kind), noise=noise,
-                             reference=reference, later=list(later), policy=policy)
+        records = case if isinstance(case, (list, tuple)) else [Record(case, SOURCE, SOURCE)]
+        return loop.diagnose(building, records, folder, objective or Objective.of(building), search=search,
+                             execution=execution, beside=beside, policy=policy)
 
 
 def compare(models, workdir=None, phases=(), fmu_kind="python"):
@@ -485,16 +517,18 @@ def compare(models, workdir=None, phases=(), fmu_kind="python"):
 
     Returns
     -------
-    dict
-        compare.json's content: per model its heat loss coefficient (W/K) and the RMSE, mean and
-        sd (C) of each objective zone's air residual, overall and per phase.
+    Comparison
+        compare.json's content as an object (`nodeforce.diagnosis.compare.Comparison`): `models`,
+        per model its heat loss coefficient (W/K) and the RMSE, mean and sd (C) of each objective
+        zone's air residual, overall and per phase; `summary()` what `nodeforce compare` prints,
+        `to_json()` compare.json, `Comparison.read(path)` one read back.
     """
-    from nodeforce.diagnosis.compare import compare as scored, write_compare  # as `diagnose`'s loop
+    from nodeforce.diagnosis.compare import Comparison, compare as scored, write_compare  # as `diagnose`'s loop
     result, series = scored(models, phases, fmu_kind=fmu_kind)
     if workdir is not None:
         Path(workdir).mkdir(parents=True, exist_ok=True)
         write_compare(Path(workdir), result, series)
-    return result
+    return Comparison.of(result)
 
 
 @contextmanager

@@ -56,8 +56,7 @@ def load_inputs(args):
     """The building, the case of its weather and measurements with its burn-in (`api.read_case`),
     and the objective of --objective; what was assumed printed."""
     building, case = api.read_case(args.building, weather_of(args.weather, args), getattr(args, "measurements", None),
-                                   burn_in_days=args.burn_in_days, decomposition=args.decomposition,
-                                   history_days=history(args))
+                                   reading(args))
     said_assumed(case.assumptions)
     return building, case, objective_of(building, args)
 
@@ -143,63 +142,34 @@ def cmd_inputs(args):
           f"start values in {start_path}")
 
 
-def check_search_settings(args):
-    """The GA's settings (`ga.search.check_settings`) and the workers, refused with the option
-    named before any work rather than deep inside the search."""
-    ga_search.check_settings(args.population, args.generations, args.pc, args.pm, args.patience)
-    check_workers(args)
-
-
-def search_strategy(args):
-    """locate()'s search settings from the options: the default search or, with --paper, the
-    paper's (GA settings given explicitly still apply: they default to the paper's anyway)."""
+def search_settings(args):
+    """locate()'s search settings from the options, checked where they are made (a
+    `SearchSettings`, before any work): the default search or, with --paper, the paper's (GA
+    settings given explicitly still apply: they default to the paper's anyway)."""
     if args.paper and args.patience is not None:
         raise InputError("--patience", args.patience, "--paper runs every generation; leave out one of the two")
-    settings = dict(population=args.population, generations=args.generations, pc=args.pc, pm=args.pm)
+    settings = dict(population=args.population, generations=args.generations, pc=args.pc, pm=args.pm,
+                    seed=args.seed, fmu_kind=kind_of(args), noise=noise(args),
+                    nodes=node_list("--nodes", args.nodes) if args.nodes else None,
+                    include_algebraic=args.include_algebraic)
     if args.paper:
-        return {**ga_search.PAPER, **settings}
-    return {**settings, "patience": ga_search.PATIENCE if args.patience is None else args.patience}
+        return ga_search.SearchSettings.paper(**settings)
+    return ga_search.SearchSettings(**settings, patience=ga_search.PATIENCE if args.patience is None else args.patience)
 
 
-def check_workers(args):
-    if args.workers is not None and args.workers < 1:
-        raise InputError("--workers", args.workers, "at least one worker process")
+def execution(args, **more):
+    """Where the work runs, from --workers and --scheduler, checked where it is made."""
+    return ga_search.Execution(workers=args.workers, scheduler=args.scheduler, **more)
 
 
 def cmd_locate(args):
-    check_search_settings(args)
-    strategy = search_strategy(args)
+    search, where = search_settings(args), execution(args)
     building, case, objective = load_inputs(args)
     out = Path(args.output)
-    result = api.locate(building, case, objective, out, source=args.measurements,
-                    nodes=node_list("--nodes", args.nodes) if args.nodes else None,
-                    include_algebraic=args.include_algebraic, **strategy, seed=args.seed,
-                    workers=args.workers, scheduler=args.scheduler, fmu_kind=kind_of(args), noise=noise(args))
-    (out / "locate.json").write_text(json.dumps(result, indent=2) + "\n")
-    print(locate_summary(result))
+    result = api.locate(building, case, out, objective, search=search, execution=where, source=args.measurements)
+    (out / "locate.json").write_text(json.dumps(result.to_json(), indent=2) + "\n")
+    print(result.summary())
     print(f"wrote {out / 'locate.json'}")
-
-
-def locate_summary(result):
-    """A short table of the single-node scores (the paper's Table 4) and the answer."""
-    lines = [f"J unforced: {result['J_unforced']:.3f} C2 on the air of {', '.join(result['objective'])}"]
-    # every node scored, most helpful first (the ranked ones, then those that lower nothing)
-    scores = result["node_scores"]
-    order = [str(n) for n in result["ranked_nodes"]]
-    order += sorted((n for n in scores if n not in order), key=lambda n: (scores[n] is None, scores[n]))
-    # nodes the noise cannot separate share a tie mark (a, b, ...): ranked by J, not reordered
-    tied = {str(n): chr(ord("a") + k) for k, group in enumerate(result.get("tied_nodes") or []) for n in group}
-    if order:
-        lines.append(f"{'node':>6}{'J forced alone':>16}  tie")
-        lines += [f"{node:>6}{'failed' if scores[node] is None else format(scores[node], '.3f'):>16}  "
-                  f"{tied.get(node, '')}".rstrip() for node in order[:8]]
-    found = ", ".join(map(str, result["best_nodes"])) or "none"
-    search = result["search"]
-    how = ("nothing to force" if search["method"] == "none" else
-           f"{search['method']} search, {search['unique_evaluations']} simulations in {search['seconds']:.1f} s")
-    lines.append(f"best nodes: {found} (J = {result['J_best']:.3f}); {how}")
-    lines.append(result["finding"])
-    return "\n".join(lines)
 
 
 def effect_spec(text):
@@ -236,8 +206,9 @@ def cmd_synth(args):
     times = pd.date_range(start, periods=int(args.days * 86400 / args.step) + 1,
                           freq=pd.Timedelta(seconds=args.step), name="time")
     frame = api.synthesize(building, api.read_weather(args.weather, year=args.year, times=times), times, node_list("--sensors", args.sensors),
-                           effects=effects, noise_sd=args.noise, seed=args.seed, history_days=args.history_days,
-                           decomposition=args.decomposition, source="--effect")
+                           effects=effects, noise=api.SensorNoise(args.noise, args.seed),
+                           reading=api.Reading(history_days=args.history_days, decomposition=args.decomposition),
+                           source="--effect")
     Path(args.output).parent.mkdir(parents=True, exist_ok=True)
     frame.round(4).to_csv(args.output, date_format="%Y-%m-%dT%H:%M:%S%z")
     print(f"wrote {args.output}: nodes {args.sensors}, {len(times)} times from {times[0].isoformat()}, "
@@ -247,11 +218,10 @@ def cmd_synth(args):
 def run_diagnosis(building, records, objective, out, args, later=()):
     """The loop on `records` (`api.Record`s) through `api.diagnose`, its summary printed;
     `later`: the records read for the final comparison alone."""
-    check_workers(args)
-    diagnosis = api.diagnose(building, records, out, objective, seed=args.seed, workers=args.workers,
-                             scheduler=args.scheduler, fmu_kind=kind_of(args),
-                             search_fmu=kind_of(args, "search_fmu"), noise=noise(args),
-                             reference=read_reference(args.reference) if args.reference else None, later=later)
+    search = ga_search.SearchSettings(seed=args.seed, fmu_kind=kind_of(args, "search_fmu"), noise=noise(args))
+    diagnosis = api.diagnose(building, records, out, objective, search=search,
+                             execution=execution(args, fmu_kind=kind_of(args)),
+                             beside=api.Beside(read_reference(args.reference) if args.reference else None, later))
     print(diagnosis.summary())
     print(f"wrote {out / 'report.json'}, {out / 'report.md'}, {out / 'building_after.json'}, {out / 'model_after.fmu'}")
 
@@ -315,8 +285,7 @@ def later_of(building, args):
     """The later records of --later (`api.read_record` under the building diagnosed, with the
     diagnosis's burn-in), read before any work so that a bad one stops the run at once."""
     later = [api.read_record(building, weather_of(fields["weather"], args), fields["measurements"], name=fields.get("name"),
-                             burn_in_days=args.burn_in_days, decomposition=args.decomposition,
-                             history_days=history(args))
+                             reading=reading(args))
              for fields in (record_fields(text, "--later", LATER_FIELDS) for text in args.later or ())]
     said_assumed(a for r in later for a in r.case.assumptions)
     return later
@@ -337,8 +306,13 @@ def read_record(building, fields, options, args):
     return api.read_record(fields.get("building", building), weather_of(fields["weather"], args), fields["measurements"],
                            name=fields.get("name"), fraction=check_fraction(options[0], fraction),
                            calibration_end=iotools_timetable.instant(options[1], end) if end else None,
-                           phases=fields.get("phases", args.phases), burn_in_days=burn_in,
-                           decomposition=args.decomposition, history_days=history(args))
+                           phases=fields.get("phases", args.phases), reading=reading(args, burn_in))
+
+
+def reading(args, burn_in_days=None):
+    """How the command makes a record's files its case (`api.Reading`): --burn-in-days (or a
+    record's own), --decomposition and --history-days."""
+    return api.Reading(args.burn_in_days if burn_in_days is None else burn_in_days, args.decomposition, history(args))
 
 
 def read_reference(path):
@@ -373,18 +347,15 @@ def cmd_compare(args):
     said_assumed(a for _, _, case, _ in models for a in case.assumptions)
     result = api.compare(models, Path(args.output), api.read_phases(args.phases) if args.phases else (),
                          fmu_kind=args.fmu)
-    for m in result["models"]:
-        for zone, z in m["metrics"]["zones"].items():
-            print(f"{m['building']}: {zone} air RMSE {z['rmse']:.3f} C (mean {z['mean']:+.3f}, sd {z['sd']:.3f}); "
-                  f"heat loss coefficient {m['heat_loss_coefficient']:.1f} W/K")
+    print(result.summary())
     print("wrote " + ", ".join(str(Path(args.output) / name) for name in ("compare.json", "compare.md", "compare.png")))
 
 
 def cmd_table(args):
     from nodeforce.iotools.table import column_names, constants, selection
     written = api.convert_table(args.table_file, column_names(args.names, args.table_file), args.origin,
-                                selection(args.select), args.output, table=args.table, start=args.start,
-                                end=args.end, constant=constants(args.set) if args.set else None)
+                                selection(args.select), args.output, table=args.table,
+                                period=api.Period(args.start, args.end), constant=constants(args.set) if args.set else None)
     print(f"wrote {args.output}: {', '.join(written.columns)} at {len(written)} times "
           f"({written.index[0].isoformat()} to {written.index[-1].isoformat()})")
 

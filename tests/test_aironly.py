@@ -4,6 +4,7 @@ Every command takes them; `locate` says it has nothing to force; the candidate p
 the zone effects of docs/model.md section 7 where the residual asks for them, and the diagnosis
 recovers each from an air-only synthetic record; the report gives the heat loss coefficient;
 weather with `ghi` alone is split by a pvlib decomposition."""
+import json
 from dataclasses import replace
 
 import numpy as np
@@ -11,7 +12,6 @@ import pandas as pd
 import pvlib
 import pytest
 
-from nodeforce.cli import locate_summary
 from nodeforce.diagnosis.candidates import physical
 from nodeforce.diagnosis.loop import diagnose
 from nodeforce.ga.locate import Execution, SearchSettings
@@ -19,7 +19,7 @@ from nodeforce.diagnosis.loss import heat_loss
 from nodeforce.diagnosis.policy import Policy
 from nodeforce.diagnosis.result import CrossValidation, Fit
 from nodeforce.diagnosis.report.tables import before_after_table
-from nodeforce.ga.locate import locate
+from nodeforce.ga.locate import Localization, locate
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.effects import EFFECTS
@@ -69,13 +69,16 @@ def air_only(building, weather, days=5, **effect):
 
 def test_locate_with_nothing_to_force_says_so_and_finds_no_node(heated, heated_weather, tmp_path):
     _, case = air_only(heated, heated_weather, days=2)
-    result = locate(heated, case, Objective.of(heated), tmp_path)
+    located = locate(heated, case, tmp_path, Objective.of(heated))
+    result = located.to_json()
     assert result["best_nodes"] == [] and result["chromosome_nodes"] == [] and result["node_scores"] == {}
     assert result["J_best"] == result["J_unforced"] > 0
     assert result["finding"].startswith("No forcing can be tested")
     assert result["finding"].count(". ") == 0  # one sentence
     assert "roof (node 9)" in result["finding"]  # the largest surface facing the air, where a sensor helps
-    summary = locate_summary(result)
+    summary = located.summary()
+    (tmp_path / "locate.json").write_text(json.dumps(result))
+    assert Localization.read(tmp_path / "locate.json") == located
     assert "J forced alone" not in summary and "best nodes: none" in summary
 
 
@@ -83,7 +86,8 @@ def test_locate_lists_the_one_scored_node_even_when_it_lowers_nothing():
     result = {"J_unforced": 3.0, "objective": ["cell"], "node_scores": {"7": 3.2}, "ranked_nodes": [],
               "best_nodes": [], "J_best": 3.0, "finding": "No forcing lowers J.",
               "search": {"method": "exhaustive", "unique_evaluations": 2, "seconds": 0.1}}
-    lines = locate_summary(result).splitlines()
+    lines = Localization.of({"measured_nodes": [7, 23], "output_node": 23, "output_nodes": [23], "chromosome_nodes": [7],
+                             "tied_nodes": [], "noise": {}, "components": [], **result}).summary().splitlines()
     header = next(i for i, line in enumerate(lines) if "J forced alone" in line)
     assert lines[header + 1].split() == ["7", "3.200"]
 
@@ -239,7 +243,7 @@ def test_an_air_only_record_names_the_undeclared_zone_effect(heated, heated_weat
     absorb)."""
     truth, case = air_only(heated, heated_weather, id=effect, values=values)
     report = diagnose(heated, case.with_burn_in(1), tmp_path, Objective.of(heated),
-                      execution=Execution(workers=2), noise=NOISE).to_json()
+                      search=SearchSettings(noise=NOISE), execution=Execution(workers=2)).to_json()
     assert [(e["effect"], e["target"]) for e in report["effects"]] == [(effect, "cell")], report["decision"]["reason"]
     first = report["effects"][0]
     assert report["after"]["validation"]["rmse"] < 1.2 * NOISE < 2 * NOISE < report["before"]["validation"]["rmse"]

@@ -68,8 +68,10 @@ def test_compare_through_the_api_scores_each_model_as_its_own_fmu_run_does(demo,
     models = [("written", building, case, objective),
               ("coupled", coupled, nodeforce.measured_case(coupled, weather, measured, burn_in_days=1), objective)]
     result = nodeforce.compare(models, workdir=tmp_path)
-    assert [m["building"] for m in result["models"]] == ["written", "coupled"]
-    for model, (_, b, c, _) in zip(result["models"], models):
+    assert [m["building"] for m in result.models] == ["written", "coupled"]
+    assert type(result).read(tmp_path / "compare.json") == result
+    assert result.summary().splitlines()[0].startswith("written: cell air RMSE")
+    for model, (_, b, c, _) in zip(result.models, models):
         with nodeforce.open_fmu(nodeforce.write_fmu(b, tmp_path / f"{model['building']}.fmu")) as fmu:
             T = nodeforce.simulate_fmu(fmu, c)[c.history_steps:]  # the weather's week before the record first
         r = (measured["T23"].to_numpy()[1:] - T[:, 22])[BURN_IN_STEPS:]

@@ -172,7 +172,8 @@ def test_look_alikes_of_a_mild_month_are_told_apart_by_the_other_sensors(name, t
     from nodeforce import api
     r = record(name, 0)
     diagnosis = api.diagnose(r.building, r.case(), tmp_path, objective=api.objective(r.building, r.zones),
-                             workers=1, generations=30, noise=r.spec.noise, seed=0)
+                             search=api.SearchSettings(generations=30, noise=r.spec.noise, seed=0),
+                             execution=api.Execution(workers=1))
     first = [(e.effect, e.target) for e in diagnosis.added][:1]
     assert first and first[0] in r.spec.answers, diagnosis.rounds[0].reason
     assert diagnosis.after["validation"]["rmse"] < 1.5 * r.spec.noise
@@ -187,7 +188,8 @@ def test_two_faults_are_both_found_when_one_component_s_own_sensor_disagrees(tmp
     from nodeforce import api
     r = record("mia-jun/door+roof-alpha-s", 0)
     diagnosis = api.diagnose(r.building, r.case(), tmp_path, objective=api.objective(r.building, r.zones),
-                             workers=1, generations=30, noise=r.spec.noise, seed=0)
+                             search=api.SearchSettings(generations=30, noise=r.spec.noise, seed=0),
+                             execution=api.Execution(workers=1))
     added = {(e.effect, e.target) for e in diagnosis.added}
     for fault in r.spec.faults:
         assert added & set(fault.answers), diagnosis.rounds[-1].reason

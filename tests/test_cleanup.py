@@ -22,10 +22,11 @@ def test_a_diagnosis_with_workers_leaves_the_temp_directory_empty(tmp_path, priv
     case = prepare_case(testcell, weather, measurements).with_burn_in(1)
     out = tmp_path / "out"
     out.mkdir()
-    diagnose(testcell, case, out, Objective.of(testcell),
-             search=SearchSettings(population=8, generations=4), execution=Execution(workers=2))
+    diagnose(testcell, case, out, Objective.of(testcell), search=SearchSettings(population=8, generations=4),
+             execution=Execution(workers=2))
     assert os.listdir(private_tmp) == []
     # and when the run fails half-way (no validation window left), too
     with pytest.raises(InputError):
-        diagnose(testcell, case.window(0, 2 * 96 + 10), out, Objective.of(testcell), execution=Execution(workers=2))
+        diagnose(testcell, case.window(0, 2 * 96 + 10), out, Objective.of(testcell),
+                 execution=Execution(workers=2))
     assert os.listdir(private_tmp) == []

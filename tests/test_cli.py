@@ -237,7 +237,8 @@ def test_demo_finds_the_ground_coupling_and_python_writes_the_same_report(tmp_pa
     building = nodeforce.read_building(DATA / "testcell_miami.json")
     case = nodeforce.measured_case(building, nodeforce.read_weather(DATA / "miami_tmy2.csv"),
                                    nodeforce.read_measurements(DATA / "demo_measurements.csv"), burn_in_days=1)
-    nodeforce.diagnose(building, case, tmp_path / "api", seed=0, workers=1)
+    nodeforce.diagnose(building, case, tmp_path / "api", search=nodeforce.SearchSettings(seed=0),
+                       execution=nodeforce.Execution(workers=1))
     cli, python = (untimed(folder / "report.json", folder) for folder in (tmp_path, tmp_path / "api"))
     assert cli == python
 

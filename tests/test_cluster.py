@@ -41,8 +41,8 @@ def local(door, tmp_path_factory):
     """The diagnosis in this process: the answer every cluster run must give."""
     folder = tmp_path_factory.mktemp("local")
     building, case = door
-    return diagnose(building, case, folder, Objective.of(building),
-                    search=SearchSettings(seed=0), execution=Execution(workers=1)).to_json(), folder
+    return diagnose(building, case, folder, Objective.of(building), search=SearchSettings(seed=0),
+                    execution=Execution(workers=1)).to_json(), folder
 
 
 def cluster():
@@ -76,8 +76,8 @@ def test_a_diagnosis_on_a_two_worker_cluster_gives_the_local_answer(door, local,
     building, case = door
     with cluster() as c, distributed.Client(c.scheduler_address) as client, \
             distributed.get_task_stream(client) as stream:
-        report = diagnose(building, case, tmp_path, Objective.of(building),
-                          search=SearchSettings(seed=0), execution=Execution(scheduler=c.scheduler_address)).to_json()
+        report = diagnose(building, case, tmp_path, Objective.of(building), search=SearchSettings(seed=0),
+                          execution=Execution(scheduler=c.scheduler_address)).to_json()
     assert_same_answer(report, tmp_path, local)
     # every candidate was calibrated there, once: no worker was lost
     assert sum(task["key"].startswith("assess-") for task in stream.data) == len(report["candidates"])
@@ -106,7 +106,8 @@ def test_a_worker_killed_in_the_middle_of_a_round_costs_no_answer(door, local, t
             distributed.get_task_stream(client) as stream:
         client.run(kill_at_first_candidate, str(done))
         report = diagnose(building, case, tmp_path / "out", Objective.of(building),
-                          search=SearchSettings(seed=0), execution=Execution(scheduler=c.scheduler_address)).to_json()
+                          search=SearchSettings(seed=0),
+                          execution=Execution(scheduler=c.scheduler_address)).to_json()
     assert done.exists()  # a worker was lost with a candidate in hand, the others under way
     # the scheduler gave its candidate to a worker alive: each one calibrated once to its end
     assert sum(task["key"].startswith("assess-") for task in stream.data) == len(report["candidates"])
@@ -120,8 +121,8 @@ def test_a_lost_scheduler_stops_the_diagnosis_in_one_line(door, tmp_path):
         with distributed.Client(address) as client:
             client.run(kill_at_first_candidate, str(done), scheduler.pid)
         with pytest.raises(lifetime.RunStopped) as stopped:
-            diagnose(building, case, tmp_path / "out", Objective.of(building),
-                     search=SearchSettings(seed=0), execution=Execution(scheduler=address))
+            diagnose(building, case, tmp_path / "out", Objective.of(building), search=SearchSettings(seed=0),
+                     execution=Execution(scheduler=address))
     assert done.exists()  # lost in the round, its search done
     [line] = str(stopped.value).splitlines()
     assert line.startswith(f"--scheduler: {address}: lost the Dask scheduler (")

@@ -69,8 +69,8 @@ def measured_with(testcell_data, weather, effect=None, seed=5):
 
 def run(tmp_path, testcell_data, testcell, weather, measurements, workers=1):
     case = prepare_case(testcell, weather, measurements).with_burn_in(1)
-    return diagnose(testcell, case, tmp_path, Objective.of(testcell),
-                    search=SearchSettings(seed=0), execution=Execution(workers=workers)).to_json()
+    return diagnose(testcell, case, tmp_path, Objective.of(testcell), search=SearchSettings(seed=0),
+                    execution=Execution(workers=workers)).to_json()
 
 
 @pytest.mark.parametrize("effect", list(TRUTH))
@@ -145,11 +145,11 @@ def test_the_sun_a_closed_blind_lets_in_is_named_as_the_blind_not_as_a_gain(tmp_
     truth = EFFECTS["shading_transmittance"].apply(building, "cell", {"f": 0.3})
     measurements = pseudo_measurements(truth, drawn, record(), SENSORS, noise_sd=NOISE, seed=5, history_days=7)
     case = prepare_case(building, drawn, measurements).with_burn_in(1)
-    diagnosis = diagnose(building, case, tmp_path, Objective.of(building),
-                         search=SearchSettings(seed=0), execution=Execution(workers=2))
+    diagnosis = diagnose(building, case, tmp_path, Objective.of(building), search=SearchSettings(seed=0),
+                         execution=Execution(workers=2))
     assert [e.label for e in diagnosis.added] == ["shading_transmittance@cell"], diagnosis.rounds[0].reason
     f = diagnosis.added[0].parameters["f"]
-    assert f["identifiable"] and abs(f["value"] - 0.3) <= max(0.25 * 0.3, 3 * f["std"])
+    assert f.identifiable and abs(f.value - 0.3) <= max(0.25 * 0.3, 3 * f.sd)
     before, after = diagnosis.before["validation"]["rmse"], diagnosis.after["validation"]["rmse"]
     assert after <= 1.5 * NOISE < before
 

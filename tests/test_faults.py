@@ -23,7 +23,7 @@ import pytest
 from nodeforce.runtime import lifetime, tempdirs
 from nodeforce.cli import main
 from nodeforce.ga import checkpoint as ckpt
-from nodeforce.ga.search import search
+from nodeforce.ga.search import Execution, SearchSettings, search
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.synth import pseudo_measurements
 from tests.conftest import DATA, SENSORS, record_times
@@ -224,7 +224,8 @@ class SignalledEvaluator:
 def test_a_signal_the_fmu_reports_as_a_failed_step_stops_the_search_and_scores_nothing_unfit(tmp_path):
     path = tmp_path / "search.json"
     with pytest.raises(lifetime.Interrupted), lifetime.stop_on_signals() as signals:
-        search(SignalledFmu(n=100), NODES12, workers=1, checkpoint=path, **BUDGET)
+        search(SignalledFmu(n=100), NODES12, SearchSettings(**BUDGET), execution=Execution(workers=1),
+               checkpoint=path)
     saved = json.loads(path.read_text())
     assert saved["generation"] >= 1 and None not in saved["cache"].values()
     assert lifetime.stopped(RuntimeError(), signals) == (143, "stopped by SIGTERM")
@@ -311,12 +312,14 @@ def test_a_dask_worker_killed_mid_search_costs_no_answer(tmp_path, caplog):
     # too, so the search goes on only once its nanny has restarted it and the scheduler has made
     # the factory again.
     with dask_cluster(tmp_path, 1, threads=2) as (address, _), caplog.at_level(logging.WARNING, "nodeforce.ga"):
-        result = search(spec, NODES12, scheduler=address, progress=arm_after(2, spec.armed), **BUDGET)
+        result = search(spec, NODES12, SearchSettings(**BUDGET),
+                        execution=Execution(scheduler=address, progress=arm_after(2, spec.armed)))
     assert Path(spec.done).exists()  # a worker was killed, in the middle of a generation
     print(f"Dask worker killed: the search took {result['search']['seconds']:.1f} s")
     # the scheduler gave its task to a worker alive: no chunk was lost and retried mask by mask
     assert "a worker died" not in caplog.text
-    assert without_time(result) == without_time(search(TWELVE, NODES12, workers=1, **BUDGET))
+    assert without_time(result) == without_time(search(TWELVE, NODES12, SearchSettings(**BUDGET),
+                                                       execution=Execution(workers=1)))
 
 
 @pytest.mark.slow
@@ -325,12 +328,14 @@ def test_a_lost_dask_scheduler_stops_the_search_with_a_checkpoint_that_resumes(t
     with dask_cluster(tmp_path, 1) as (address, scheduler):
         spec = Killing(armed=str(tmp_path / "armed"), done=str(tmp_path / "killed"), victim=scheduler.pid)
         with pytest.raises(lifetime.RunStopped) as stopped:
-            search(spec, NODES12, scheduler=address, checkpoint=path, progress=arm_after(2, spec.armed), **BUDGET)
+            search(spec, NODES12, SearchSettings(**BUDGET),
+                   execution=Execution(scheduler=address, progress=arm_after(2, spec.armed)), checkpoint=path)
         print(f"lost scheduler: the search stopped {time.time() - os.path.getmtime(spec.done):.2f} s after "
               "the scheduler was killed")
     [line] = str(stopped.value).splitlines()
     assert line.startswith(f"--scheduler: {address}: lost the Dask scheduler (")
     assert json.loads(path.read_text())["generation"] >= 2  # the generations done before the loss
     # nothing scored unfit for the loss: the rerun, here in this process, gives the whole answer
-    resumed = search(spec, NODES12, workers=1, checkpoint=path, **BUDGET)
-    assert without_time(resumed) == without_time(search(TWELVE, NODES12, workers=1, **BUDGET))
+    resumed = search(spec, NODES12, SearchSettings(**BUDGET), execution=Execution(workers=1), checkpoint=path)
+    assert without_time(resumed) == without_time(search(TWELVE, NODES12, SearchSettings(**BUDGET),
+                                                        execution=Execution(workers=1)))

@@ -23,7 +23,7 @@ def later_measurements(path):
     building = nodeforce.read_building(DATA / "testcell_miami.json")
     times = pd.date_range("2001-07-08 00:00", periods=7 * 96 + 1, freq="15min", tz="-05:00", name="time")
     frame = nodeforce.synthesize(building, nodeforce.read_weather(WEATHER), times, SENSORS, effects=[FAULT],
-                                 noise_sd=NOISE, seed=2, history_days=7)
+                                 noise=nodeforce.SensorNoise(NOISE, seed=2), reading=nodeforce.Reading(history_days=7))
     frame.round(4).to_csv(path, date_format="%Y-%m-%dT%H:%M:%S%z")
     return path
 
@@ -32,9 +32,13 @@ def later_measurements(path):
 def diagnosed(tmp_path_factory):
     folder = tmp_path_factory.mktemp("later")
     building = nodeforce.read_building(DATA / "testcell_miami.json")
-    record = nodeforce.read_record(building, WEATHER, DATA / "demo_measurements.csv", burn_in_days=1)
-    later = nodeforce.read_record(building, WEATHER, later_measurements(folder / "july.csv"), burn_in_days=1)
-    diagnosis = nodeforce.diagnose(building, [record], folder / "out", seed=0, workers=1, later=[later])
+    record = nodeforce.read_record(building, WEATHER, DATA / "demo_measurements.csv",
+                                   reading=nodeforce.Reading(burn_in_days=1))
+    later = nodeforce.read_record(building, WEATHER, later_measurements(folder / "july.csv"),
+                                  reading=nodeforce.Reading(burn_in_days=1))
+    diagnosis = nodeforce.diagnose(building, [record], folder / "out", search=nodeforce.SearchSettings(seed=0),
+                                   execution=nodeforce.Execution(workers=1),
+                                   beside=nodeforce.Beside(later=[later]))
     return building, folder, diagnosis
 
 
@@ -50,7 +54,7 @@ def test_the_later_record_is_scored_as_compare_scores_the_files_written(diagnose
     for name in ("written", "after"):
         b = building if name == "written" else nodeforce.read_building(folder / "out" / "building_after.json")
         models.append((name, b, nodeforce.measured_case(b, weather, measured, burn_in_days=1), objective))
-    written, after = (m["metrics"] for m in nodeforce.compare(models)["models"])
+    written, after = (m["metrics"] for m in nodeforce.compare(models).models)
     for ours, theirs in ((later.before, written), (later.after, after)):
         assert ours["rmse"] == pytest.approx(theirs["rmse"], rel=1e-9)
         assert ours["n"] == theirs["n"]
@@ -125,8 +129,9 @@ def test_a_later_record_not_read_from_its_files_is_refused_before_any_work(tmp_p
     """The building as corrected needs the record's case prepared anew (measured_case of its
     files), which a Record made from a case alone cannot give."""
     building = nodeforce.read_building(DATA / "testcell_miami.json")
-    record = nodeforce.read_record(building, WEATHER, DATA / "demo_measurements.csv", burn_in_days=1)
+    record = nodeforce.read_record(building, WEATHER, DATA / "demo_measurements.csv",
+                                   reading=nodeforce.Reading(burn_in_days=1))
     bare = nodeforce.Record(record.case, "july.csv", "july")
     with pytest.raises(nodeforce.InputError, match="july.csv: later: record july: .*read_record"):
-        nodeforce.diagnose(building, [record], tmp_path / "out", later=[bare])
+        nodeforce.diagnose(building, [record], tmp_path / "out", beside=nodeforce.Beside(later=[bare]))
     assert not any((tmp_path / "out").iterdir())

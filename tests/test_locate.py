@@ -9,7 +9,7 @@ import pytest
 from nodeforce.ga import parsimony
 from nodeforce.ga.fitness import ModelFitness
 from nodeforce.ga.locate import chromosome_nodes, locate
-from nodeforce.ga.search import PAPER, search
+from nodeforce.ga.search import PAPER, Execution, SearchSettings, search
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.effects import EFFECTS
@@ -64,7 +64,8 @@ def verification_case(testcell_data, testcell, weather, fault, noise):
 @pytest.mark.parametrize("fault", list(EXPECTED))
 def test_search_points_at_the_disturbed_sub_model(tmp_path, testcell_data, testcell, weather, fault, noise):
     case = verification_case(testcell_data, testcell, weather, fault, noise)
-    result = locate(testcell, case, Objective.of(testcell), tmp_path, seed=3, workers=2)
+    result = locate(testcell, case, tmp_path, Objective.of(testcell), search=SearchSettings(seed=3),
+                    execution=Execution(workers=2)).to_json()
     # the radiant node is algebraic: no sub-model, so not a candidate
     assert 22 not in result["chromosome_nodes"] and len(result["chromosome_nodes"]) == 21
     search = result["search"]
@@ -92,9 +93,10 @@ def test_default_search_gives_the_papers_answer_where_the_paper_is_exhaustive(te
     assert {7, 9} <= set(nodes)
     factory = ModelFitness(testcell, case, nodes, Objective.of(testcell))
     noise = dict(noise_sigma=noise_level(case.measured[:, 22]), n_residuals=len(case.times) - 1)
-    paper = search(factory, nodes, workers=1, **PAPER, **noise)
+    paper = search(factory, nodes, SearchSettings(**PAPER), execution=Execution(workers=1), **noise)
     assert paper["search"]["method"] == "exhaustive"
-    default = search(factory, nodes, generations=1023 // 30, workers=1, **noise)
+    default = search(factory, nodes, SearchSettings(generations=1023 // 30),
+                     execution=Execution(workers=1), **noise)
     assert default["search"]["method"] == "ga" and default["search"]["stopped"] == "converged"
     assert default["best_nodes"] == paper["best_nodes"]
     assert components(testcell, default["best_nodes"]) == ["door", "roof"] and 7 in default["best_nodes"]
@@ -162,8 +164,8 @@ def test_a_paired_comparison_names_the_floor_where_the_noise_of_one_J_names_a_wa
     nodes = chromosome_nodes(testcell, calibration, objective, "m")
     assert nodes.index(1) < nodes.index(16)  # the wall is preferred where the data cannot separate
     n = int(np.isfinite(objective.measured(calibration)).sum())
-    result = search(ModelFitness(testcell, calibration, nodes, objective), nodes, workers=1, noise_sigma=0.1,
-                    n_residuals=n)
+    result = search(ModelFitness(testcell, calibration, nodes, objective), nodes, execution=Execution(workers=1),
+                    noise_sigma=0.1, n_residuals=n)
     scores = result["node_scores"]
     assert scores["1"] - scores["16"] < parsimony.noise_tolerance(0.1, n)
     assert result["best_nodes"] in ([16], [17])

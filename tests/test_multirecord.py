@@ -76,8 +76,8 @@ def test_a_fault_one_record_shows_is_found_from_both_records(tmp_path):
     off = record(truth, b, "2014-04-20", 5, 0.0, seed=2)
     records = [Record(on, "on.csv", "heater on", calibration_end=on.times[0] + pd.Timedelta(days=4)),
                Record(off, "off.csv", "heater off", calibration_end=off.times[0] + pd.Timedelta(days=3))]
-    report = diagnose(b, records, tmp_path, Objective.of(b, ["A", "B"]),
-                      execution=Execution(workers=1), noise=NOISE).to_json()
+    report = diagnose(b, records, tmp_path, Objective.of(b, ["A", "B"]), search=SearchSettings(noise=NOISE),
+                      execution=Execution(workers=1)).to_json()
     assert [(e["effect"], e["target"]) for e in report["effects"]][:1] == [("heat_input_factor", "B")]
     assert report["effects"][0]["parameters"]["factor"]["value"] == pytest.approx(0.7, abs=0.03)
     # before and after per record, zone and window; the record without the heater was right already
@@ -102,8 +102,8 @@ def test_a_correction_that_helps_one_record_and_harms_the_other_is_refused(tmp_p
     plain = record(b, b, "2014-04-20", 5, 0.0, seed=4)
     records = [Record(gained, "gained.csv", "one", calibration_end=gained.times[0] + pd.Timedelta(days=5)),
                Record(plain, "plain.csv", "two", calibration_end=plain.times[0] + pd.Timedelta(days=3))]
-    report = diagnose(b, records, tmp_path, Objective.of(b, ["A", "B"]),
-                      execution=Execution(workers=1), noise=NOISE).to_json()
+    report = diagnose(b, records, tmp_path, Objective.of(b, ["A", "B"]), search=SearchSettings(noise=NOISE),
+                      execution=Execution(workers=1)).to_json()
     rounds = report["decision"]["rounds"]
     tests = {name: t for r in rounds for name, t in r["candidates"].items()}
     gain = tests["internal_gain@B"]
@@ -147,7 +147,8 @@ def test_the_forcing_search_of_two_records_forces_a_node_where_a_record_measures
     measured[:, surface - 1] = T_truth[:, surface - 1] + rng.normal(0.0, NOISE, len(measured))
     second = Case(second.times, STEP, second.input_names, second.U, measured, building=b).with_burn_in(1)
     objective = Objective.of(b, ["A", "B"])
-    both = locate(b, [airs, second], objective, tmp_path, workers=1, noise=NOISE)
+    both = locate(b, [airs, second], tmp_path, objective, search=SearchSettings(noise=NOISE),
+                  execution=Execution(workers=1)).to_json()
     assert both["chromosome_nodes"] == [surface]
     J1, J2, J2_forced = (J_direct(b, airs, objective), J_direct(b, second, objective),
                          J_direct(b, second, objective, [surface]))
@@ -161,7 +162,8 @@ def test_the_forcing_search_of_two_records_forces_a_node_where_a_record_measures
     # that changes nothing would be): it gets that building's FMU, and no unused one of `b`
     for name, case, protocols in (("first", airs, None), ("second", second, [house()])):
         (tmp_path / name).mkdir()
-        alone[name] = locate(b, [case], objective, tmp_path / name, workers=1, noise=NOISE, protocols=protocols)
+        alone[name] = locate(b, [case], tmp_path / name, objective, search=SearchSettings(noise=NOISE),
+                             execution=Execution(workers=1), protocols=protocols).to_json()
     assert alone["first"]["chromosome_nodes"] == []
     assert alone["second"]["best_nodes"] == [surface]
     assert [p.name for p in (tmp_path / "first").glob("*.fmu")] == ["model.fmu"]

@@ -57,3 +57,18 @@ def test_a_report_replays_under_the_policy_it_was_made_with_after_the_code_s_def
     assert again.to_json() == decision.to_json() and again.chosen.label == "conductivity@door"
     # judged under the new default, the same report would give another answer
     assert decide(read.candidates, Baseline.of_json(read.rounds[0].inputs), Policy()).chosen is None
+
+
+def test_a_fits_parameters_are_estimates_written_as_report_json_wrote_them():
+    """`Fit.parameters` are `ParameterEstimate`s, made from report.json's dicts and written back
+    as they were, key for key and in order: an old report reads and replays unchanged."""
+    from nodeforce.diagnosis.estimate import ParameterEstimate
+    held = {"value": 24.0, "std": 0.5, "identifiable": False, "on_bound": False, "prior": "the site's ground temperature"}
+    fitted = {"value": 0.8, "std": 0.1, "identifiable": True, "on_bound": True}
+    fit = Fit("ground_coupling", "floor", {"U": fitted, "T_ground": held}, {}, {}, CrossValidation([1.0, 2.0], 96))
+    assert fit.parameters["U"] == ParameterEstimate(0.8, 0.1, True, True)
+    assert fit.parameters["T_ground"].prior == held["prior"] and fit.values == {"U": 0.8, "T_ground": 24.0}
+    written = json.loads(json.dumps(fit.to_json()))
+    assert written["parameters"] == {"U": fitted, "T_ground": held}
+    assert [list(p) for p in written["parameters"].values()] == [list(fitted), list(held)]
+    assert Fit.of_json(written) == fit and fit.effect_json()["parameters"] == written["parameters"]

@@ -44,12 +44,13 @@ def test_the_papers_ground_finding_carried_two_weeks_on_is_no_worse_than_the_fil
     r = record(spec, 1)
     site_ground = file_building(spec).site["ground_temperature"]
     assert abs(site_ground - 24.0) < 1.0  # Miami's typical-year mean air: the deep ground under the cell
-    diagnosis = api.diagnose(r.building, r.case(), tmp_path, objective=api.objective(r.building, r.zones), workers=1,
-                             noise=spec.noise, seed=0)
+    diagnosis = api.diagnose(r.building, r.case(), tmp_path, objective=api.objective(r.building, r.zones),
+                             search=api.SearchSettings(noise=spec.noise, seed=0),
+                             execution=api.Execution(workers=1))
     (fit,) = diagnosis.added
     assert fit.label == "ground_coupling@floor"
-    assert fit.parameters["T_ground"]["value"] == site_ground and fit.parameters["T_ground"]["prior"]
-    assert fit.parameters["U"]["identifiable"]
+    assert fit.parameters["T_ground"].value == site_ground and fit.parameters["T_ground"].prior
+    assert fit.parameters["U"].identifiable
     written = json.loads((tmp_path / "building_after.json").read_text())
     assert "T_ground" in written["description"] and "held at" in written["description"]
     after = api.read_building(tmp_path / "building_after.json")
@@ -57,7 +58,7 @@ def test_the_papers_ground_finding_carried_two_weeks_on_is_no_worse_than_the_fil
     objective = api.objective(r.building, r.zones)
     result = api.compare([(name, b, two_weeks.case(building=b), objective)
                           for name, b in (("as written", r.building), ("corrected", after))])
-    as_written, corrected = (m["metrics"]["rmse"] for m in result["models"])
+    as_written, corrected = (m["metrics"]["rmse"] for m in result.models)
     assert corrected <= as_written
     assert corrected <= 1.5 * spec.noise
 
@@ -73,18 +74,19 @@ def test_the_demos_correction_holds_in_another_season_where_the_free_fits_end_of
     building = api.read_building(data / "testcell_miami.json")
     weather = api.read_weather(data / "miami_tmy2.csv")
     june = api.measured_case(building, weather, api.read_measurements(data / "demo_measurements.csv"), 1)
-    diagnosis = api.diagnose(building, june, tmp_path / "d", workers=1, noise=0.1)
+    diagnosis = api.diagnose(building, june, tmp_path / "d", search=api.SearchSettings(noise=0.1),
+                             execution=api.Execution(workers=1))
     (fit,) = diagnosis.added
-    assert fit.parameters["T_ground"]["prior"] and fit.parameters["T_ground"]["value"] == building.site["ground_temperature"]
+    assert fit.parameters["T_ground"].prior and fit.parameters["T_ground"].value == building.site["ground_temperature"]
     held = api.read_building(tmp_path / "d" / "building_after.json")
     free = EFFECTS["ground_coupling"].apply(building, "floor", {"U": 0.08, "T_ground": 0.85})
     times = pd.date_range("2001-12-01T00:00-05:00", periods=14 * 96 + 1, freq="15min")
     december = api.synthesize(building, weather, times, [1, 7, 9, 16, 17, 23],
-                              effects=[("ground_coupling", "floor", {"U": 0.8, "T_ground": 24.0})], noise_sd=0.1,
-                              seed=2, history_days=60.0)
+                              effects=[("ground_coupling", "floor", {"U": 0.8, "T_ground": 24.0})], noise=api.SensorNoise(0.1, seed=2),
+                              reading=api.Reading(history_days=60.0))
     objective = api.objective(building)
     result = api.compare([(name, b, api.measured_case(b, weather, december, 1, history_days=60.0), objective)
                           for name, b in (("written", building), ("held", held), ("free", free))])
-    rmse = {m["building"]: m["metrics"]["rmse"] for m in result["models"]}
+    rmse = {m["building"]: m["metrics"]["rmse"] for m in result.models}
     assert rmse["held"] <= min(rmse["written"], 1.5 * 0.1)
     assert rmse["free"] > rmse["written"]

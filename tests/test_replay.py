@@ -34,7 +34,8 @@ def test_the_demos_choice_is_recomputed_from_report_json_alone(tmp_path):
     building = nodeforce.read_building(DATA / "testcell_miami.json")
     case = nodeforce.measured_case(building, nodeforce.read_weather(DATA / "miami_tmy2.csv"),
                                    nodeforce.read_measurements(DATA / "demo_measurements.csv"), burn_in_days=1)
-    made = nodeforce.diagnose(building, case, tmp_path, seed=0, workers=1)
+    made = nodeforce.diagnose(building, case, tmp_path, search=nodeforce.SearchSettings(seed=0),
+                              execution=nodeforce.Execution(workers=1))
     read = check_replay(tmp_path / "report.json")
     # what the loop returned is what it wrote
     assert read.to_json() == json.loads(json.dumps(made.to_json()))
@@ -55,11 +56,14 @@ def test_a_diagnosis_of_two_faults_is_recomputed_round_by_round_from_report_json
     building = nodeforce.read_building(DATA / "testcell_miami.json")
     weather = nodeforce.read_weather(DATA / "miami_tmy2.csv")
     times = pd.date_range("2001-06-10 00:00", periods=10 * 96 + 1, freq="15min", tz="-05:00", name="time")
-    measured = nodeforce.synthesize(building, weather, times, SENSORS, noise_sd=0.1, seed=3, history_days=7,
+    measured = nodeforce.synthesize(building, weather, times, SENSORS, noise=nodeforce.SensorNoise(0.1, seed=3),
+                                    reading=nodeforce.Reading(history_days=7),
                                     effects=[("conductivity", "door", {"factor": 0.78 / 0.23}),
                                              ("infiltration", "cell", {"n": 1.5})])
     case = nodeforce.measured_case(building, weather, measured, burn_in_days=1)
-    nodeforce.diagnose(building, case, tmp_path, seed=0, workers=1, generations=30, noise=0.1)
+    nodeforce.diagnose(building, case, tmp_path,
+                       search=nodeforce.SearchSettings(seed=0, generations=30, noise=0.1),
+                       execution=nodeforce.Execution(workers=1))
     read = check_replay(tmp_path / "report.json")
     assert sorted(a.label for a in read.added) == ["conductivity@door", "infiltration@cell"]
     assert all(c.on_top_of == (read.added[0].label,) for c in read.candidates if c.round == 2)
@@ -72,6 +76,8 @@ def test_a_benchmark_record_of_two_rounds_is_recomputed_from_report_json_alone(t
     from benchmarks.records import record
     r = record("sdp-jul/opening-L", 2)
     nodeforce.diagnose(r.building, r.case(), tmp_path, objective=nodeforce.objective(r.building, r.zones),
-                       workers=1, generations=30, noise=r.spec.noise, seed=0)
+                       search=nodeforce.SearchSettings(generations=30, noise=r.spec.noise, seed=0),
+                       execution=nodeforce.Execution(workers=1))
     read = check_replay(tmp_path / "report.json")
     assert len(read.rounds) >= 2 and len(read.added) == 2
+

@@ -21,7 +21,7 @@ from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga import parsimony
 from nodeforce.model.score import Objective
 from nodeforce.ga.fitness import FmuFitness
-from nodeforce.ga.search import PAPER, search
+from nodeforce.ga.search import PAPER, Execution, SearchSettings, search
 from nodeforce.model.case import prepare_case
 from nodeforce.model.synth import pseudo_measurements
 from tests.conftest import SENSORS, record_times
@@ -103,7 +103,7 @@ LONG_GA = dict(population=30, generations=130)  # 3900 < 2^12, more than the sea
 
 
 def test_ga_finds_the_wrong_submodels():
-    result = search(TWELVE, NODES12, workers=1, **GA_BUDGET)
+    result = search(TWELVE, NODES12, SearchSettings(**GA_BUDGET), execution=Execution(workers=1))
     assert result["search"]["method"] == "ga"
     assert result["best_nodes"] == [3, 13, 19]
     assert result["J_best"] == pytest.approx(20.0)
@@ -121,20 +121,21 @@ def test_exhaustive_when_the_budget_covers_every_chromosome():
     pairs = tuple((i, j, float(w)) for (i, j), w in
                   zip(itertools.combinations(range(k), 2), rng.normal(0, 8, 15)))
     spec = Synthetic(tuple(rng.normal(0, 10, k)), pairs)
-    result = search(spec, list(range(k)), population=8, generations=8, workers=1)  # 64 = 2^6
+    result = search(spec, list(range(k)), SearchSettings(population=8, generations=8),
+                    execution=Execution(workers=1))  # 64 = 2^6
     J, _, mask = brute_force(spec, k)
     assert result["search"]["method"] == "exhaustive"
     assert result["search"]["unique_evaluations"] == 2 ** k
     assert result["search"]["J_min"] == pytest.approx(J)
     assert result["search"]["min_nodes"] == [i for i in range(k) if mask[i]]
     # one evaluation short of the budget: the GA runs instead
-    assert search(spec, list(range(k)), population=9, generations=7,
-                  workers=1)["search"]["method"] == "ga"
+    assert search(spec, list(range(k)), SearchSettings(population=9, generations=7),
+                  execution=Execution(workers=1))["search"]["method"] == "ga"
 
 
 def test_cache_never_simulates_a_chromosome_twice(tmp_path):
     spec = linear(12, {1: 40.0, 6: 25.0, 9: 15.0}, log_dir=str(tmp_path))
-    result = search(spec, NODES12, workers=1, **GA_BUDGET)
+    result = search(spec, NODES12, SearchSettings(**GA_BUDGET), execution=Execution(workers=1))
     seen = seen_masks(tmp_path)
     assert len(seen) == len(set(seen)) == result["search"]["unique_evaluations"]
     assert result["search"]["unique_evaluations"] < result["search"]["evaluations"]
@@ -146,7 +147,8 @@ def test_parsimony_drops_noise_level_nodes_and_keeps_real_ones():
     spec = linear(6, {0: 50.0, 2: 0.5, 4: 5.0})
     noise = dict(noise_sigma=0.1, n_residuals=1000)
     assert parsimony.tolerance(100.0, **noise) == pytest.approx(3 * 0.01 * np.sqrt(2000))
-    result = search(spec, list(range(6)), population=8, generations=8, workers=1, **noise)
+    result = search(spec, list(range(6)), SearchSettings(population=8, generations=8),
+                    execution=Execution(workers=1), **noise)
     assert result["search"]["min_nodes"] == [0, 2, 4]
     assert result["best_nodes"] == [0, 4]
     assert result["J_best"] == pytest.approx(45.0)
@@ -154,14 +156,15 @@ def test_parsimony_drops_noise_level_nodes_and_keeps_real_ones():
 
 def test_parsimony_without_noise_estimate_uses_the_relative_floor():
     spec = linear(6, {0: 50.0, 2: 0.5})  # 0.5 < 1 % of J_unforced = 1.0
-    result = search(spec, list(range(6)), population=8, generations=8, workers=1)
+    result = search(spec, list(range(6)), SearchSettings(population=8, generations=8),
+                    execution=Execution(workers=1))
     assert result["best_nodes"] == [0]
 
 
 def test_nothing_helps_gives_no_nodes():
     spec = linear(6, {3: 0.2})  # a gain far below the noise, every other node harmful
-    result = search(spec, list(range(6)), population=8, generations=8, workers=1,
-                    noise_sigma=0.1, n_residuals=1000)
+    result = search(spec, list(range(6)), SearchSettings(population=8, generations=8),
+                    execution=Execution(workers=1), noise_sigma=0.1, n_residuals=1000)
     assert result["search"]["min_nodes"] == [3]
     assert result["best_nodes"] == []
     assert result["J_best"] == result["J_unforced"]
@@ -181,7 +184,7 @@ def test_failed_simulations_score_unfit_and_the_run_goes_on(caplog):
     # forcing node index 4 would repair the most, but its simulation always fails
     spec = linear(12, {1: 60.0, 4: 80.0}, fail_index=4)
     with caplog.at_level(logging.WARNING, logger="nodeforce.ga"):
-        result = search(spec, NODES12, workers=1, **GA_BUDGET)
+        result = search(spec, NODES12, SearchSettings(**GA_BUDGET), execution=Execution(workers=1))
     assert result["best_nodes"] == [3]
     assert result["node_scores"]["9"] is None
     assert 9 not in result["ranked_nodes"]
@@ -193,12 +196,12 @@ def test_a_forcing_that_only_compensates_locates_nothing():
     # forcing node 2 lowers J by a fifth, well beyond the noise, but leaves most of the error:
     # the fault is where no forcing reaches (the paper's inside-convection case)
     spec = linear(6, {2: 20.0}, base=100.0)
-    result = search(spec, [1, 2, 3, 4, 5, 6], workers=1, noise_sigma=0.05, n_residuals=400)
+    result = search(spec, [1, 2, 3, 4, 5, 6], execution=Execution(workers=1), noise_sigma=0.05, n_residuals=400)
     assert result["search"]["min_nodes"] == [3]
     assert result["ranked_nodes"] == [3]
     assert result["best_nodes"] == []
     # the same gain, when it removes most of the error, locates node 3
-    located = search(linear(6, {2: 90.0}, base=100.0), [1, 2, 3, 4, 5, 6], workers=1,
+    located = search(linear(6, {2: 90.0}, base=100.0), [1, 2, 3, 4, 5, 6], execution=Execution(workers=1),
                      noise_sigma=0.05, n_residuals=400)
     assert located["best_nodes"] == [3]
 
@@ -207,7 +210,8 @@ def test_a_forcing_that_only_compensates_locates_nothing():
 def test_a_crashing_worker_only_loses_its_own_chromosome():
     # the best chromosome, nodes 1 and 3, kills its worker: the next best wins
     spec = linear(3, {0: 10.0, 2: 5.0}, penalty=20.0, crash_mask=(True, False, True))
-    result = search(spec, [1, 2, 3], population=4, generations=2, workers=2)
+    result = search(spec, [1, 2, 3], SearchSettings(population=4, generations=2),
+                    execution=Execution(workers=2))
     assert result["search"]["method"] == "exhaustive"
     assert result["search"]["min_nodes"] == [1]
     assert result["search"]["J_min"] == pytest.approx(90.0)
@@ -216,8 +220,8 @@ def test_a_crashing_worker_only_loses_its_own_chromosome():
 
 
 def test_same_seed_same_result():
-    first = search(TWELVE, NODES12, workers=1, seed=3, **GA_BUDGET)
-    again = search(TWELVE, NODES12, workers=1, seed=3, **GA_BUDGET)
+    first = search(TWELVE, NODES12, SearchSettings(seed=3, **GA_BUDGET), execution=Execution(workers=1))
+    again = search(TWELVE, NODES12, SearchSettings(seed=3, **GA_BUDGET), execution=Execution(workers=1))
     assert without_time(first) == without_time(again)
 
 
@@ -235,17 +239,18 @@ def stop_after(generation):
 @pytest.mark.parametrize("budget", [GA_BUDGET, dict(population=300, generations=20)],
                          ids=["ga", "exhaustive"])
 def test_interrupted_run_resumes_to_the_uninterrupted_answer(tmp_path, budget):
-    uninterrupted = search(TWELVE, NODES12, workers=1, **budget)
+    uninterrupted = search(TWELVE, NODES12, SearchSettings(**budget), execution=Execution(workers=1))
     spec = linear(12, {1: 40.0, 6: 25.0, 9: 15.0}, log_dir=str(tmp_path))
     path = tmp_path / "out" / "search.json"
     with pytest.raises(Interrupt):
-        search(spec, NODES12, workers=1, checkpoint=path, progress=stop_after(7), **budget)
-    resumed = search(spec, NODES12, workers=1, checkpoint=path, **budget)
+        search(spec, NODES12, SearchSettings(**budget), execution=Execution(workers=1, progress=stop_after(7)),
+               checkpoint=path)
+    resumed = search(spec, NODES12, SearchSettings(**budget), execution=Execution(workers=1), checkpoint=path)
     assert without_time(resumed) == without_time(uninterrupted)
     seen = seen_masks(tmp_path)  # the resumed run simulated nothing twice
     assert len(seen) == len(set(seen)) == resumed["search"]["unique_evaluations"]
     # a finished run's checkpoint answers a rerun without simulating anything
-    rerun = search(spec, NODES12, workers=1, checkpoint=path, **budget)
+    rerun = search(spec, NODES12, SearchSettings(**budget), execution=Execution(workers=1), checkpoint=path)
     assert without_time(rerun) == without_time(uninterrupted)
     assert len(seen_masks(tmp_path)) == len(seen)
 
@@ -253,18 +258,19 @@ def test_interrupted_run_resumes_to_the_uninterrupted_answer(tmp_path, budget):
 def test_checkpoint_of_other_arguments_is_not_resumed(tmp_path):
     path = tmp_path / "search.json"
     with pytest.raises(Interrupt):
-        search(TWELVE, NODES12, workers=1, seed=0, checkpoint=path, progress=stop_after(5),
-               **GA_BUDGET)
-    other = search(TWELVE, NODES12, workers=1, seed=1, checkpoint=path, **GA_BUDGET)
-    assert without_time(other) == without_time(search(TWELVE, NODES12, workers=1, seed=1,
-                                                      **GA_BUDGET))
+        search(TWELVE, NODES12, SearchSettings(seed=0, **GA_BUDGET),
+               execution=Execution(workers=1, progress=stop_after(5)), checkpoint=path)
+    other = search(TWELVE, NODES12, SearchSettings(seed=1, **GA_BUDGET), execution=Execution(workers=1),
+                   checkpoint=path)
+    assert without_time(other) == without_time(search(TWELVE, NODES12, SearchSettings(seed=1, **GA_BUDGET),
+                                                      execution=Execution(workers=1)))
 
 
 @pytest.mark.slow  # processes, a cluster or a whole diagnosis: not in `make check`
 def test_two_worker_processes_give_the_same_result(tmp_path):
-    serial = search(TWELVE, NODES12, workers=1, **GA_BUDGET)
+    serial = search(TWELVE, NODES12, SearchSettings(**GA_BUDGET), execution=Execution(workers=1))
     spec = linear(12, {1: 40.0, 6: 25.0, 9: 15.0}, log_dir=str(tmp_path))
-    parallel = search(spec, NODES12, workers=2, **GA_BUDGET)
+    parallel = search(spec, NODES12, SearchSettings(**GA_BUDGET), execution=Execution(workers=2))
     assert without_time(parallel) == without_time(serial)
     assert evaluators_built(tmp_path) == [1, 1]  # one evaluator per worker process
 
@@ -272,14 +278,14 @@ def test_two_worker_processes_give_the_same_result(tmp_path):
 @pytest.mark.slow  # processes, a cluster or a whole diagnosis: not in `make check`
 def test_searches_in_a_command_s_workers_run_in_its_processes_and_close_what_they_leave(tmp_path):
     # a diagnosis's searches (on the records together, then on each) and its rounds share its workers
-    serial = search(TWELVE, NODES12, workers=1, **GA_BUDGET)
+    serial = search(TWELVE, NODES12, SearchSettings(**GA_BUDGET), execution=Execution(workers=1))
     logs = [tmp_path / "first", tmp_path / "second"]
     with lifetime.worker_pool(2) as workers:
         results = []
         for log in logs:
             log.mkdir()
             results.append(search(linear(12, {1: 40.0, 6: 25.0, 9: 15.0}, log_dir=str(log)), NODES12,
-                                  workers=workers, **GA_BUDGET))
+                                  SearchSettings(**GA_BUDGET), execution=Execution(workers=workers)))
         processes = set(workers.pool._processes)
         first, second = (evaluator_logs(log) for log in logs)
         # every evaluator in the pool's two processes, the second search's in those of the first
@@ -297,11 +303,12 @@ def test_searches_in_a_command_s_workers_run_in_its_processes_and_close_what_the
 def test_dask_cluster_gives_the_same_result(tmp_path):
     distributed = pytest.importorskip("distributed")
     budget = dict(population=20, generations=15)
-    serial = search(TWELVE, NODES12, workers=1, **budget)
+    serial = search(TWELVE, NODES12, SearchSettings(**budget), execution=Execution(workers=1))
     spec = linear(12, {1: 40.0, 6: 25.0, 9: 15.0}, log_dir=str(tmp_path))
     with distributed.LocalCluster(n_workers=2, processes=True, threads_per_worker=1,
                                   dashboard_address=None) as cluster:
-        on_dask = search(spec, NODES12, scheduler=cluster.scheduler_address, **budget)
+        on_dask = search(spec, NODES12, SearchSettings(**budget),
+                         execution=Execution(scheduler=cluster.scheduler_address))
     assert without_time(on_dask) == without_time(serial)
     # one evaluator per Dask worker that ran tasks: the scheduler, not nodeforce, places them, and on
     # busy cores it may give every task to the worker that answered first
@@ -341,7 +348,7 @@ def test_default_search_beats_the_stepwise_pass_on_an_interaction():
     # stepwise pass, can find them; the GA must. The forward-backward pass stops at node 0.
     weights = [-10.0] + [1.0] * 11
     spec = Synthetic(tuple(weights), pairs=((4, 7, -60.0),))
-    result = search(spec, NODES12, workers=1, seed=1, **LONG_GA)
+    result = search(spec, NODES12, SearchSettings(seed=1, **LONG_GA), execution=Execution(workers=1))
     s = result["search"]
     assert s["stepwise_nodes"] == [1] and s["J_stepwise"] == pytest.approx(90.0)
     assert s["min_nodes"] == [1, 9, 15] and s["J_min"] == pytest.approx(32.0)
@@ -351,8 +358,8 @@ def test_default_search_beats_the_stepwise_pass_on_an_interaction():
 
 def test_convergence_stops_patience_generations_after_the_last_significant_fall():
     history = []
-    result = search(TWELVE, NODES12, workers=1, patience=7, **LONG_GA,
-                    progress=lambda g, total, J, unique: history.append(J))
+    result = search(TWELVE, NODES12, SearchSettings(patience=7, **LONG_GA),
+                    execution=Execution(workers=1, progress=lambda g, total, J, unique: history.append(J)))
     s = result["search"]
     assert s["stopped"] == "converged" and s["stopped_at"] == len(history)
     tol = s["tolerance"]
@@ -372,7 +379,8 @@ def test_paper_mode_is_the_unseeded_ga_to_the_last_generation(tmp_path):
     for mode, settings in (("default", {}), ("paper", PAPER)):
         (tmp_path / mode).mkdir()
         spec = linear(12, {1: 40.0, 6: 25.0, 9: 15.0}, log_dir=str(tmp_path / mode))
-        result = search(spec, NODES12, workers=1, **{**settings, **GA_BUDGET})
+        result = search(spec, NODES12, SearchSettings(**{**settings, **GA_BUDGET}),
+                        execution=Execution(workers=1))
         first = seen_masks(tmp_path / mode)[:13]  # one process: in the order simulated
         if mode == "paper":
             # PyGAD's random first population, every generation run, no stepwise pass
@@ -390,10 +398,12 @@ def test_paper_mode_is_the_unseeded_ga_to_the_last_generation(tmp_path):
 def test_a_converged_run_resumes_as_finished(tmp_path):
     path = tmp_path / "search.json"
     spec = linear(12, {1: 40.0, 6: 25.0, 9: 15.0}, log_dir=str(tmp_path))
-    first = search(spec, NODES12, workers=1, patience=5, checkpoint=path, **LONG_GA)
+    first = search(spec, NODES12, SearchSettings(patience=5, **LONG_GA), execution=Execution(workers=1),
+                   checkpoint=path)
     assert first["search"]["stopped"] == "converged"
     seen = len(seen_masks(tmp_path))
-    again = search(spec, NODES12, workers=1, patience=5, checkpoint=path, **LONG_GA)
+    again = search(spec, NODES12, SearchSettings(patience=5, **LONG_GA), execution=Execution(workers=1),
+                   checkpoint=path)
     assert without_time(again) == without_time(first)
     assert len(seen_masks(tmp_path)) == seen  # nothing simulated again
 
@@ -415,12 +425,14 @@ def test_the_fmu_evaluators_leave_no_extracted_folder(tmp_path, monkeypatch, tes
     during = []
     progress = lambda g, total, J, unique: during.append(len(list(private.iterdir())))  # noqa: E731
     for workers in (1, 2):
-        search(factory, [1, 7, 9], population=4, generations=2, workers=workers, progress=progress)
+        search(factory, [1, 7, 9], SearchSettings(population=4, generations=2),
+               execution=Execution(workers=workers, progress=progress))
         assert during[-1] >= 1  # the evaluators had extracted the FMU there
         assert list(private.iterdir()) == []
     # on failure too: a search stopped by an exception closes its evaluators
     with pytest.raises(Interrupt):
-        search(factory, [1, 7, 9], population=4, generations=2, workers=2, progress=stop_after(1))
+        search(factory, [1, 7, 9], SearchSettings(population=4, generations=2),
+               execution=Execution(workers=2, progress=stop_after(1)))
     assert list(private.iterdir()) == []
 
 
@@ -433,11 +445,13 @@ def test_parsimony_prefers_the_earlier_node_only_when_the_noise_cannot_separate(
     # node 0 compensates the fault at node 3 and fits the tolerance (J 5), but node 3 repairs it
     # (J 0), measurably better: node 3 is the answer though node 0 comes first
     spec = Synthetic((-995.0, 0.0, 0.0, -1000.0), pairs=((0, 3, 995.0),), base=1000.0)
-    result = search(spec, [1, 2, 3, 4], population=4, generations=4, workers=1, **noise)
+    result = search(spec, [1, 2, 3, 4], SearchSettings(population=4, generations=4),
+                    execution=Execution(workers=1), **noise)
     assert result["best_nodes"] == [4]
     # within the noise of each other (J 1 and 0), the earlier one is preferred
     spec = Synthetic((-999.0, 0.0, 0.0, -1000.0), pairs=((0, 3, 999.0),), base=1000.0)
-    result = search(spec, [1, 2, 3, 4], population=4, generations=4, workers=1, **noise)
+    result = search(spec, [1, 2, 3, 4], SearchSettings(population=4, generations=4),
+                    execution=Execution(workers=1), **noise)
     assert result["best_nodes"] == [1]
 
 
@@ -456,7 +470,7 @@ def test_parsimony_finds_the_pair_whatever_the_best_chromosome():
 def test_the_finding_says_what_the_best_forcing_removes_and_what_the_sensors_cover(testcell):
     from nodeforce.ga.locate import finding
     # node 3 forced removes 20 of the 99 C2 above the noise floor (400 x 0.05^2 = 1 C2): 20 %
-    result = search(linear(6, {2: 20.0}, base=100.0), [1, 2, 3, 4, 5, 6], workers=1,
+    result = search(linear(6, {2: 20.0}, base=100.0), [1, 2, 3, 4, 5, 6], execution=Execution(workers=1),
                     noise_sigma=0.05, n_residuals=400)
     said = finding(testcell, result)
     assert "No forcing locates the fault" in said
@@ -464,8 +478,8 @@ def test_the_finding_says_what_the_best_forcing_removes_and_what_the_sensors_cov
     assert "below the 50% needed" in said
     # nodes 1-6 belong to the east, west and south walls: 3 of the test cell's 8 components
     assert "Only 3 of the 8 components" in said and "east_wall, west_wall, south_wall" in said
-    located = finding(testcell, search(linear(6, {2: 90.0}, base=100.0), [1, 2, 3, 4, 5, 6], workers=1,
-                                       noise_sigma=0.05, n_residuals=400))
+    located = finding(testcell, search(linear(6, {2: 90.0}, base=100.0), [1, 2, 3, 4, 5, 6],
+                                       execution=Execution(workers=1), noise_sigma=0.05, n_residuals=400))
     assert located.startswith("forcing node 3 (west_wall at 0.000 m) removes 91% of J above the noise floor")
 
 
@@ -501,12 +515,13 @@ def test_the_finding_names_the_rule_that_decided(testcell):
 
 
 def test_the_terminal_marks_the_nodes_the_noise_cannot_separate():
-    from nodeforce.cli import locate_summary
+    from nodeforce.ga.locate import Localization
     result = {"J_unforced": 3.0, "objective": ["cell"], "node_scores": {"7": 1.0, "9": 1.1, "16": 2.0},
               "ranked_nodes": [7, 9, 16], "tied_nodes": [[7, 9]], "best_nodes": [7], "J_best": 1.0,
               "finding": "forcing node 7 ...", "search": {"method": "exhaustive", "unique_evaluations": 8,
                                                           "seconds": 0.1}}
-    lines = locate_summary(result).splitlines()
+    lines = Localization.of({"measured_nodes": [7, 9, 16, 23], "output_node": 23, "output_nodes": [23],
+                             "chromosome_nodes": [7, 9, 16], "noise": {}, "components": [], **result}).summary().splitlines()
     header = next(i for i, line in enumerate(lines) if "J forced alone" in line)
     assert [line.split() for line in lines[header + 1:header + 4]] == [["7", "1.000", "a"], ["9", "1.100", "a"],
                                                                       ["16", "2.000"]]
@@ -516,12 +531,13 @@ def test_the_terminal_marks_the_nodes_the_noise_cannot_separate():
                                              (dict(pc=1.5), "--pc"), (dict(pm=-0.1), "--pm"),
                                              (dict(patience=0), "--patience")])
 def test_the_search_refuses_its_settings_as_the_command_line_does(settings, option):
-    """One check of the GA's settings (`ga.search.check_settings`), for the command's options and
-    the API's arguments alike: the same InputError, naming the option, before any evaluation."""
+    """One check of the GA's settings (`ga.search.check_settings`), where a `SearchSettings` is
+    made, for the command's options and the API's arguments alike: the same InputError, naming
+    the option, before any evaluation."""
     from nodeforce.ga.search import check_settings
     from nodeforce.model.errors import InputError
     with pytest.raises(InputError, match=option):
-        search(lambda: None, [1, 2, 3], **settings)
+        SearchSettings(**settings)
     defaults = dict(population=30, generations=400, pc=0.8, pm=0.03, patience=None)
     with pytest.raises(InputError, match=option):
         check_settings(**{**defaults, **settings})

@@ -73,8 +73,8 @@ def record(building, weather, start, days, step, sensors=SENSORS, noise=0.1, eff
 
 def run(building, case, tmp_path, noise=None):
     return diagnose(building, case, tmp_path, Objective.of(building),
-                    search=SearchSettings(seed=0, generations=30),
-                    execution=Execution(workers=2), noise=noise).to_json()
+                    search=SearchSettings(seed=0, generations=30, noise=noise),
+                    execution=Execution(workers=2)).to_json()
 
 
 def added(report):
