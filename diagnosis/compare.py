@@ -9,12 +9,13 @@ measures heat fluxes at surfaces (the building's heat flux sensors), each model'
 that face is reported beside the reading: a check the fit never saw.
 """
 import json
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from nodeforce.runtime import tempdirs
+from nodeforce.runtime.jsonfile import JsonFile
 from nodeforce.cosim.fmi import FmuInstance
 from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnosis.report.figures import plot_comparison
@@ -62,7 +63,7 @@ def surface_fluxes(building, case, T):
 
 
 @dataclass(frozen=True)
-class Comparison:
+class Comparison(JsonFile):
     """Building files scored on one record (`compare`), the content of compare.json: the
     record's first and last times (`record`), the objective's zones, the first time scored
     (`scored_from`, after the burn-in), and per model (`models`, in order) its building, heat
@@ -74,20 +75,6 @@ class Comparison:
     objective: list
     scored_from: str
     models: list
-
-    @classmethod
-    def of(cls, data):
-        """From compare.json's content (a dict)."""
-        return cls(**{f.name: data[f.name] for f in fields(cls)})
-
-    @classmethod
-    def read(cls, path):
-        """A compare.json read back."""
-        return cls.of(json.loads(Path(path).read_text(encoding="utf-8")))
-
-    def to_json(self):
-        """compare.json's content."""
-        return {f.name: getattr(self, f.name) for f in fields(self)}
 
     def summary(self):
         """One line per model and objective zone: its air's error and its heat loss coefficient."""

@@ -6,10 +6,8 @@ sensors' noise given by the user or estimated from the measured air. A record th
 only the objective's air (a thermostat's) has nothing to force: its locate.json says so, with
 `best_nodes` [], and the diagnosis goes on to the air's own equation.
 """
-import json
 import time
-from dataclasses import dataclass, fields
-from pathlib import Path
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.sparse.csgraph import shortest_path
@@ -17,6 +15,7 @@ from scipy.sparse.csgraph import shortest_path
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.ga.checkpoint import NAME as CHECKPOINT
 from nodeforce.runtime.compiler import find_compiler
+from nodeforce.runtime.jsonfile import JsonFile
 from nodeforce.ga.fitness import FmuFitness, RecordsFitness
 from nodeforce.ga.parsimony import EXPLAINED
 from nodeforce.ga.search import Execution, SearchSettings, search as run_search
@@ -84,7 +83,7 @@ def chromosome_nodes(building, case, objective, source, nodes=None, include_alge
 
 
 @dataclass(frozen=True)
-class Localization:
+class Localization(JsonFile):
     """What the forcing search found (`locate`), the content of locate.json: the nodes measured
     and those it may force (`chromosome_nodes`), the objective's air (`output_node`, `objective`
     its zones, `output_nodes`), J unforced and with `best_nodes` forced (`J_best`, None: the
@@ -108,20 +107,6 @@ class Localization:
     noise: dict
     components: list
     finding: str
-
-    @classmethod
-    def of(cls, data):
-        """From locate.json's content (a dict)."""
-        return cls(**{f.name: data[f.name] for f in fields(cls)})
-
-    @classmethod
-    def read(cls, path):
-        """A locate.json read back."""
-        return cls.of(json.loads(Path(path).read_text(encoding="utf-8")))
-
-    def to_json(self):
-        """locate.json's content."""
-        return {f.name: getattr(self, f.name) for f in fields(self)}
 
     def summary(self):
         """A short table of the single-node scores (the paper's Table 4) and the answer."""
