@@ -90,10 +90,16 @@ def package_weather():
 
 def energyplus(doc, folder, epw):
     """{zone (upper case): hourly mean air (C), hour ending 01:00..24:00} of EnergyPlus 25.2's run."""
-    from pyenergyplus.api import EnergyPlusAPI
     folder.mkdir(parents=True, exist_ok=True)
     idf = folder / "model_25_2.idf"
     idfkit.save_idf(to_energyplus_25(doc), str(idf))
+    return zone_air(idf, folder, epw)
+
+
+def zone_air(idf, folder, epw):
+    """{zone (upper case): hourly mean air (C), hour ending 01:00..24:00} of EnergyPlus run on the
+    IDF at `idf` (its outputs in `folder`)."""
+    from pyenergyplus.api import EnergyPlusAPI
     api = EnergyPlusAPI()
     state = api.state_manager.new_state()
     if api.runtime.run_energyplus(state, ["-w", str(epw), "-d", str(folder), "-r", str(idf)]) != 0:

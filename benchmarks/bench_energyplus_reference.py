@@ -17,7 +17,7 @@ import pandas as pd
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "benchmarks"))
-from bench_energyplus import nodeforce  # noqa: E402
+from bench_energyplus import nodeforce, zone_air  # noqa: E402
 from convert_corpus import shipped_idfs  # noqa: E402
 
 from nodeforce.iotools.energyplus import READ  # noqa: E402
@@ -62,17 +62,8 @@ def free_floating(idf, out):
 
 def energyplus(idf, folder, epw):
     """{zone (upper case): hourly mean air (C), hour ending 01:00..24:00} of EnergyPlus's run."""
-    from pyenergyplus.api import EnergyPlusAPI
     folder.mkdir(parents=True, exist_ok=True)
-    model = free_floating(idf, folder / "free_floating.idf")
-    api = EnergyPlusAPI()
-    state = api.state_manager.new_state()
-    if api.runtime.run_energyplus(state, ["-w", str(epw), "-d", str(folder), "-r", str(model)]) != 0:
-        raise RuntimeError(f"EnergyPlus failed: {folder / 'eplusout.err'}")
-    api.state_manager.delete_state(state)
-    table = pd.read_csv(folder / "eplusout.csv")
-    return {c.split(":")[0].strip().upper(): table[c].to_numpy(float) for c in table.columns
-            if "Zone Mean Air Temperature" in c}
+    return zone_air(free_floating(idf, folder / "free_floating.idf"), folder, epw)
 
 
 def main(out, models):
