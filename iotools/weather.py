@@ -7,6 +7,7 @@ is read as EnergyPlus reads it: its months, days and hours in one calendar year.
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from nodeforce.model.errors import InputError
 from nodeforce.model.weather import IRRADIANCE_COLUMNS, REQUIRED_COLUMNS, TEMPERATURE_COLUMNS, utc_microseconds
@@ -92,7 +93,14 @@ def _read_epw_weather(source, year, record_year):
     typical = bool((np.diff(utc_microseconds(end_of_hour)) <= 0).any())
     if typical or year is not None:
         year = year if year is not None else record_year or TYPICAL_YEAR
-        end_of_hour, columns, _ = read_epw(source, coerce_year=year)
+        # each hour put in `year` by its start, so that the last (ending at 24:00 on 31 December)
+        # stays the year's, as pvlib's coerce_year does, without reading the file again
+        start = end_of_hour - pd.Timedelta(hours=1)
+        try:
+            start = pd.DatetimeIndex([t.replace(year=year) for t in start])
+        except ValueError:
+            raise InputError(source, "year", f"{year} has no 29 February, which the EPW has") from None
+        end_of_hour = start + pd.Timedelta(hours=1)
         # a year put in one calendar, as EnergyPlus runs it, is cyclic: its first hour follows its last
         weather = to_mid_hour(end_of_hour, columns, cyclic=True)
     else:
