@@ -105,6 +105,11 @@ def zone_air(idf, folder, epw):
     if api.runtime.run_energyplus(state, ["-w", str(epw), "-d", str(folder), "-r", str(idf)]) != 0:
         raise RuntimeError(f"EnergyPlus failed: {folder / 'eplusout.err'}")
     api.state_manager.delete_state(state)
+    return read_zone_air(folder)
+
+
+def read_zone_air(folder):
+    """{zone (upper case): hourly mean air (C)} of the EnergyPlus run whose outputs are in `folder`."""
     table = pd.read_csv(folder / "eplusout.csv")
     return {c.split(":")[0].strip().upper(): table[c].to_numpy(float) for c in table.columns
             if "Zone Mean Air Temperature" in c}

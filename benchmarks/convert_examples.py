@@ -1,19 +1,20 @@
 """`nodeforce convert` on every IDF of a folder of EnergyPlus's example files (an EnergyPlus
-install's ExampleFiles/, or the repository's testfiles/), then `nodeforce simulate` of each one that
-converts, free-floating over an EPW year: the table of docs/energyplus.md (file, version, zones,
-result and the refusal's reason, the zones' coldest and warmest air over the year), in Markdown on
-stdout, and the share converted.
+install's ExampleFiles/, or the repository's testfiles/) that describes a building envelope, then
+`nodeforce simulate` of each one that converts, free-floating over an EPW year. Every file's row
+(version, zones, result, the refusal's reason, seconds, the zones' coldest and warmest air over the
+year) goes to OUT/examples.csv; the summary of docs/energyplus.md (the share converted, the
+refusals by object type, the simulations) is printed in Markdown.
 
-    python benchmarks/convert_examples.py FOLDER [--out OUT] [--weather EPW] [--timeout S]
+    python benchmarks/convert_examples.py FOLDER [--out OUT] [--weather EPW] [--timeout S] [--jobs N]
 
 The weather defaults to the Golden, Colorado TMY3 EPW of the installed `energyplus` extra
 (pyenergyplus/data/weather); without the extra and without --weather nothing is simulated.
 """
 import argparse
+import functools
 import re
-import subprocess
 import sys
-import time
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +22,14 @@ import pandas as pd
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from convert_corpus import convert_one  # noqa: E402
+
+from nodeforce.iotools.weather import read_weather  # noqa: E402
+from nodeforce.model.building_file import load_building  # noqa: E402
+from nodeforce.model.case import simulate_building  # noqa: E402
+
+# A file describes a building envelope when it has a zone and a heat transfer surface
+ZONE = re.compile(r"(?im)^\s*Zone\s*,")
+SURFACE = re.compile(r"(?im)^\s*(BuildingSurface:Detailed|Wall:\w+|Floor:\w+|RoofCeiling:Detailed|Roof|Ceiling:\w+)\s*,")
 
 
 def default_weather():
@@ -33,57 +42,99 @@ def default_weather():
     return path if path.exists() else None
 
 
-def idf_version(idf):
+def idf_text(idf):
+    """The file's text without its comments."""
+    return re.sub(r"!.*", "", Path(idf).read_text(encoding="utf-8", errors="replace"))
+
+
+def idf_version(text):
     """The Version object's number, as written in the file."""
-    text = re.sub(r"!.*", "", Path(idf).read_text(encoding="utf-8", errors="replace"))
     found = re.search(r"(?i)\bVersion\s*,\s*([0-9.]+)\s*;", text)
     return found.group(1) if found else "?"
 
 
-def simulate_one(building, weather, out, timeout):
-    """(status, seconds, coldest zone air, warmest zone air) of `nodeforce simulate`."""
-    nodeforce = Path(sys.executable).parent / "nodeforce"
-    start = time.perf_counter()
+def describes_envelope(text):
+    return bool(ZONE.search(text) and SURFACE.search(text))
+
+
+@functools.lru_cache(maxsize=1)
+def weather_of(path):
+    return read_weather(path)
+
+
+def simulate_one(building, weather):
+    """(status, coldest zone air, warmest zone air) of the converted building simulated free-floating
+    over the weather's year by the direct model (`nodeforce simulate`'s model, without its file of
+    every node)."""
     try:
-        done = subprocess.run([str(nodeforce), "simulate", str(building), "--weather", str(weather), "-o", str(out)],
-                              capture_output=True, text=True, timeout=timeout)
-    except subprocess.TimeoutExpired:
-        return "timeout", time.perf_counter() - start, None, None
-    seconds = time.perf_counter() - start
-    if done.returncode != 0:
-        return f"failed: {done.stderr.strip().splitlines()[-1] if done.stderr.strip() else done.returncode}", \
-            seconds, None, None
-    names = pd.read_csv(Path(out).with_suffix(".nodes.csv"))
-    air = names.loc[names["name"].str.endswith(" air"), "column"].tolist()
-    T = pd.read_csv(out, usecols=air).to_numpy()
-    if not np.isfinite(T).all():
-        return "failed: a zone's air is not finite", seconds, None, None
-    return "simulated", seconds, float(T.min()), float(T.max())
+        loaded = load_building(building)
+        T = simulate_building(loaded, weather_of(weather))
+    except Exception as error:  # a row says what failed; the others go on
+        return f"failed: {type(error).__name__}: {error}", None, None
+    air = T[[f"T{z.air_node}" for z in loaded.zones]].to_numpy(float)
+    if not np.isfinite(air).all():
+        return "failed: a zone's air is not finite", None, None
+    return "simulated", float(air.min()), float(air.max())
 
 
-def main(folder, out, weather, timeout):
+def one_file(idf, version, out, weather, timeout):
+    """The row of one IDF: its conversion, then its simulation where it converted."""
+    status, seconds, data, stderr = convert_one(idf, out / f"{idf.stem}.json", timeout)
+    row = {"file": idf.stem, "version": version, "zones": None, "result": status, "reason": "",
+           "convert_s": round(seconds, 2), "simulation": "", "air_min": None, "air_max": None}
+    if data is None:
+        row["reason"] = stderr.strip().split(": ", 2)[-1] if stderr.strip() else status
+        return row
+    row["zones"] = len(data["zones"])
+    if weather is not None:
+        row["simulation"], row["air_min"], row["air_max"] = simulate_one(out / f"{idf.stem}.json", weather)
+    return row
+
+
+def refused_object(reason):
+    """The object type a refusal names (its first word), or the reason's start."""
+    return reason.split(" ", 1)[0].strip("'") if reason else "?"
+
+
+def summary(table, others, weather):
+    """The Markdown summary: the share converted, the refusals by object type, the simulations."""
+    converted = table[table.result == "converted"]
+    refused = table[table.result != "converted"]
+    lines = [f"{len(converted)} of {len(table)} files that describe a building envelope converted "
+             f"({100.0 * len(converted) / max(len(table), 1):.0f} %); {others} other files (plant loops, "
+             "water heaters, weather bins: no zone or no surface) not counted.", ""]
+    if len(refused):
+        lines += ["| refused at | files | reason (one of them) |", "|---|---|---|"]
+        for obj, group in refused.groupby(refused.reason.map(refused_object)):
+            lines.append(f"| {obj} | {len(group)} | {group.reason.iloc[0]} ({group.file.iloc[0]}) |")
+        lines.append("")
+    if weather is not None:
+        done = converted[converted.simulation == "simulated"]
+        lines.append(f"{len(done)} of {len(converted)} simulated free-floating over {Path(weather).name}; "
+                     f"zone air from {done.air_min.min():.1f} to {done.air_max.max():.1f} C; "
+                     f"conversion {converted.convert_s.median():.1f} s median, {converted.convert_s.max():.1f} s "
+                     "at most (the command's whole process, two at a time).")
+        failed = converted[converted.simulation != "simulated"]
+        for _, row in failed.iterrows():
+            lines.append(f"- {row.file}: {row.simulation}")
+    return "\n".join(lines)
+
+
+def main(folder, out, weather, timeout, jobs):
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    idfs = sorted(Path(folder).glob("*.idf"))
-    rows = ["| file | EnergyPlus | zones | result | free-floating air, min to max (C) |", "|---|---|---|---|---|"]
-    converted = simulated = 0
-    for idf in idfs:
-        status, seconds, data, stderr = convert_one(idf, out / f"{idf.stem}.json", timeout)
-        if data is None:
-            reason = stderr.strip().split(": ", 2)[-1] if stderr.strip() else status
-            rows.append(f"| {idf.stem} | {idf_version(idf)} | | {status}: {reason} | |")
-            continue
-        converted += 1
-        air = "not simulated (no weather)"
-        if weather is not None:
-            sim, _, low, high = simulate_one(out / f"{idf.stem}.json", weather, out / f"{idf.stem}.csv", timeout)
-            simulated += sim == "simulated"
-            air = f"{low:.1f} to {high:.1f}" if sim == "simulated" else sim
-        rows.append(f"| {idf.stem} | {idf_version(idf)} | {len(data['zones'])} | {status} | {air} |")
-    print("\n".join(rows))
-    share = 100.0 * converted / len(idfs) if idfs else 0.0
-    print(f"\n{converted} of {len(idfs)} converted ({share:.0f} %)"
-          + (f"; {simulated} of {converted} simulated over {Path(weather).name}" if weather is not None else ""))
+    texts = {idf: idf_text(idf) for idf in sorted(Path(folder).glob("*.idf"))}
+    envelopes = [idf for idf, text in texts.items() if describes_envelope(text)]
+    with ProcessPoolExecutor(jobs) as pool:
+        futures = [pool.submit(one_file, idf, idf_version(texts[idf]), out, weather, timeout) for idf in envelopes]
+        rows = []
+        for number, future in enumerate(futures, 1):
+            rows.append(future.result())
+            print(f"[{number}/{len(futures)}] {rows[-1]['file']}: {rows[-1]['result']} {rows[-1]['simulation']}",
+                  file=sys.stderr, flush=True)
+    table = pd.DataFrame(rows)
+    table.to_csv(out / "examples.csv", index=False)
+    print(summary(table, len(texts) - len(envelopes), weather))
 
 
 if __name__ == "__main__":
@@ -92,5 +143,6 @@ if __name__ == "__main__":
     parser.add_argument("--out", default="out/convert_examples")
     parser.add_argument("--weather", default=None, help="an EPW (default: the extra's Golden, CO TMY3)")
     parser.add_argument("--timeout", type=float, default=120.0)
+    parser.add_argument("--jobs", type=int, default=2, help="files converted and simulated at once")
     args = parser.parse_args()
-    main(args.folder, args.out, args.weather or default_weather(), args.timeout)
+    main(args.folder, args.out, args.weather or default_weather(), args.timeout, args.jobs)
