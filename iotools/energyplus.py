@@ -958,8 +958,7 @@ class _Converter:
                                            other=self.r.text(s, "outside_boundary_condition_object"),
                                            sun=self.r.text(s, "sun_exposure", "SunExposed").lower() == "sunexposed",
                                            wind=self.r.text(s, "wind_exposure", "WindExposed").lower() == "windexposed",
-                                           construction=self.r.text(s, "construction_name"), vertices=vertices,
-                                           ground_view=self._ground_view(s))
+                                           construction=self.r.text(s, "construction_name"), vertices=vertices)
         for kind, (stype, boundary) in SIMPLE_SURFACES.items():
             for s in self.r.all(kind):
                 zone = self.zone_of(s, "zone_name")
@@ -1008,13 +1007,6 @@ class _Converter:
                                                   construction=self.r.text(w, "construction_name"),
                                                   other=self.r.text(w, "outside_boundary_condition_object")))
         return out
-
-    def _ground_view(self, s):
-        """A surface's View Factor to Ground, None where autocalculated or absent."""
-        value = _field(s, "view_factor_to_ground")
-        if _blank(value) or str(value).lower() == "autocalculate":
-            return None
-        return self.r.number(s, "view_factor_to_ground", low=0, high=1)
 
     def _rect_height(self, s, zone, stype, other, tilt):
         """Centroid height (m) of a rectangular surface: its starting corner's z plus half its rise."""
@@ -1369,10 +1361,9 @@ class _Converter:
         obj = s["obj"]
         if boundary == "outdoors":
             h = round(FILMS.outside_convection(s["tilt"], s["height"], outer["roughness"], s["wind"], self.terrain), 4)
-            ground = s.get("ground_view")
             return {"type": "exterior", "h_conv": h, "h_rad": round(FILMS.radiative(outer["emissivity"], FILMS.T_outside), 4),
                     "solar_absorptance": outer["solar"] if s["sun"] else 0.0,
-                    "sky_view_factor": round(float(sky_fraction_energyplus(s["tilt"], ground)), 6)}
+                    "sky_view_factor": round(float(sky_fraction_energyplus(s["tilt"])), 6)}
         if boundary == "ground":
             return {"type": "boundary", "temperature": self.ground_schedule(), "h": FILMS.ground}
         if boundary == "adiabatic":

@@ -238,14 +238,15 @@ def sky_view_factor(tilt):
     return (1.0 + np.cos(np.radians(tilt))) / 2.0
 
 
-def sky_fraction_energyplus(tilt, ground_view=None):
+def sky_fraction_energyplus(tilt):
     """The part of a face's long-wave exchange that is with the sky as EnergyPlus takes it
-    (Engineering Reference, "Exterior/External Longwave Radiation"): its sky view F_sky (1 less
-    its view factor to the ground, (1 + cos tilt) / 2 where not given) of which the part
-    beta = sqrt((1 + cos tilt) / 2) is the sky and the rest the air near the ground, F_sky beta."""
+    (Engineering Reference, "External Longwave Radiation"): of its sky view
+    F_sky = (1 + cos tilt) / 2 the part beta = sqrt((1 + cos tilt) / 2) is the sky and the rest the
+    air near the horizon, F_sky beta; the ground, F_ground = (1 - cos tilt) / 2, is at the air's
+    temperature. Both views are the tilt's alone: EnergyPlus reads a surface's View Factor to
+    Ground for the sun the ground reflects, never for the long-wave exchange."""
     cos = np.cos(np.radians(tilt))
-    F_sky = (1.0 + cos) / 2.0 if ground_view is None else 1.0 - ground_view
-    return F_sky * np.sqrt((1.0 + cos) / 2.0)
+    return (1.0 + cos) / 2.0 * np.sqrt((1.0 + cos) / 2.0)
 
 
 def air_density_at(altitude, T=20.0):

@@ -399,14 +399,25 @@ def test_inner_absorptance_and_distribution_in_the_network():
         b.edited(lambda d: d["components"][0].update(solar_distribution={"f": 0.9, "w": 0.2}))
 
 
-def test_sky_fraction_is_energyplus_sky_and_air_split(case600):
-    """A wall of view factor to ground 0.5 sees the sky over 0.5 of its view, of which
-    beta = sqrt(1/2) is the sky itself; a roof all sky."""
+def test_sky_fraction_is_energyplus_sky_and_air_split(case600, tmp_path):
+    """A wall sees the sky over (1 + cos 90) / 2 = 0.5 of its view, of which beta = sqrt(1/2) is
+    the sky itself; a roof all sky. EnergyPlus takes both from the tilt alone: a View Factor to
+    Ground of 0.2 on the east wall changes its ground-reflected sun, not its long-wave split
+    (SurfaceGeometry.cc: ViewFactorSkyIR = (1 + cos tilt) / 2 whatever the field says)."""
     from nodeforce.model.network import sky_fraction_energyplus
     assert case600.component("EAST WALL").outside.sky_view_factor == pytest.approx(0.5 * np.sqrt(0.5), abs=1e-6)
     assert case600.component("ROOF").outside.sky_view_factor == pytest.approx(1.0)
-    assert sky_fraction_energyplus(90.0) == pytest.approx(0.5 * np.sqrt(0.5))
-    assert sky_fraction_energyplus(60.0, ground_view=0.2) == pytest.approx(0.8 * np.sqrt(0.75))
+    assert sky_fraction_energyplus(60.0) == pytest.approx(0.75 * np.sqrt(0.75))
+    idf = tmp_path / "ground.idf"
+    idf.write_text(edited("  EAST WALL,                    !- Name\n  Wall,                         !- Surface Type\n"
+                          "  LIGHT WALL,                   !- Construction Name\n"
+                          "  CASE 600 ZONE,                !- Zone Name\n  Outdoors,                     !- Outside Boundary Condition\n"
+                          "  ,                             !- Outside Boundary Condition Object\n"
+                          "  SunExposed,                   !- Sun Exposure\n  WindExposed,                  !- Wind Exposure\n"
+                          "  autocalculate,",
+                          "  EAST WALL,\n  Wall,\n  LIGHT WALL,\n  CASE 600 ZONE,\n  Outdoors,\n  ,\n  SunExposed,\n"
+                          "  WindExposed,\n  0.2,"))
+    assert convert_idf(idf).component("EAST WALL").outside.sky_view_factor == pytest.approx(0.5 * np.sqrt(0.5), abs=1e-6)
 
 
 def test_declared_sky_fraction_in_the_network():
