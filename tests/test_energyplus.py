@@ -431,6 +431,30 @@ def test_declared_sky_fraction_in_the_network():
     assert net.B[e, names.index("T_out")] == pytest.approx(10 * (10 + 4 * 0.7))
 
 
+def test_every_zone_exchanges_long_wave_by_script_f(case600):
+    """EnergyPlus always uses ScriptF: every zone gets it, each face its inner layer's thermal
+    absorptance (a simple glazing's 0.84) and its surface type's class (a window its own)."""
+    z = case600.zones[0]
+    assert z.longwave == "scriptf" and z.view_factors == ()
+    assert case600.component("SOUTH WINDOW WEST").inside.emissivity == 0.84  # simple glazing's
+    assert case600.component("FLOOR").inside.emissivity == 0.9  # the IDF's thermal absorptance
+    assert [case600.component(n).inside.face_class for n in ("FLOOR", "ROOF", "EAST WALL", "SOUTH WINDOW EAST")] \
+        == ["floor", "roof", "wall", "wall"]
+
+
+def test_user_view_factors_are_the_zones(tmp_path):
+    idf = tmp_path / "user.idf"
+    idf.write_text(TEXT + "\nZoneProperty:UserViewFactors:BySurfaceName,\n  CASE 600 ZONE,\n"
+                   "  FLOOR, ROOF, 0.6,\n  ROOF, FLOOR, 0.6,\n  FLOOR, EAST WALL, 0.4;\n")
+    b = convert_idf(idf)
+    assert set(b.zones[0].view_factors) == {("FLOOR", "ROOF", 0.6), ("ROOF", "FLOOR", 0.6), ("FLOOR", "EAST WALL", 0.4)}
+    bad = tmp_path / "bad.idf"
+    bad.write_text(TEXT + "\nZoneProperty:UserViewFactors:BySurfaceName,\n  CASE 600 ZONE,\n  FLOOR, CEILING, 0.6;\n")
+    with pytest.raises(InputError, match="(?i)ZoneProperty:UserViewFactors:BySurfaceName.*From Surface.*names no "
+                                         "surface of zone 'CASE 600 ZONE'"):
+        convert_idf(bad)
+
+
 def test_inside_convection_is_tarp_at_the_stated_difference(case600):
     """Case 600 declares TARP inside: 1.31 dT^(1/3) on a wall, the unstable form on the floor
     (a warm face looking up), the stable one on the ceiling (a warm face looking down)."""
