@@ -68,13 +68,20 @@ def chromosome_nodes(building, case, objective, source, nodes=None, include_alge
         check_measured(objective, c, source)
     network = assemble(building)
     measured = set().union(*(c.measured_ids for c in cases)) - set(objective.air_nodes)
+    # a node no other node reads (a zone's mean radiant temperature under longwave "scriptf")
+    # cuts off nothing when forced
+    read = np.any((network.A != 0.0) & ~np.eye(network.n_nodes, dtype=bool), axis=0)
+    unread = set(np.flatnonzero(~read) + 1)
     if nodes is None:
         algebraic = set(np.flatnonzero(network.algebraic) + 1)
-        chosen = measured if include_algebraic else measured - algebraic
+        chosen = (measured if include_algebraic else measured - algebraic) - unread
     else:
         for i in nodes:
             if i in objective.air_nodes:
                 raise InputError("--nodes", str(i), f"node {i} is an output (objective air), not a forcing candidate")
+            if i in unread:
+                raise InputError("--nodes", str(i), f"node {i} is read by no other node (a zone's mean radiant "
+                                                    "temperature): forcing it changes nothing")
             if i not in measured:
                 raise InputError(source, f"T{i}", f"node {i} is asked for in --nodes but has no measurement column")
         chosen = set(nodes)

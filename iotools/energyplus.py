@@ -28,6 +28,9 @@ from ..model.network import air_density_at, sky_fraction_energyplus
 # 8.4 -> 8.5 changed no object read here (EnergyPlus's transition program for 8.5 renames an EMS
 # actuator's value and report variables only)
 MIN_VERSION, SCHEMA_MIN = (8, 4), (8, 9, 0)
+# EnergyPlus's surface types as the classes of the approximate view factors (model.longwave):
+# a ceiling is no roof there
+FACE_CLASS = {"floor": "floor", "roof": "roof", "internalmass": "internal_mass"}
 
 
 @dataclass(frozen=True)
@@ -918,6 +921,7 @@ class _Converter:
         surfaces = self.surfaces()
         zone_data = [self.zone(z, surfaces) for z in zones]
         components = self.components(surfaces)
+        self.user_view_factors(zone_data, components, surfaces)
         for z in zone_data:
             z.pop("_floor_area")
         self.internal_masses(components)
@@ -958,8 +962,7 @@ class _Converter:
                                            other=self.r.text(s, "outside_boundary_condition_object"),
                                            sun=self.r.text(s, "sun_exposure", "SunExposed").lower() == "sunexposed",
                                            wind=self.r.text(s, "wind_exposure", "WindExposed").lower() == "windexposed",
-                                           construction=self.r.text(s, "construction_name"), vertices=vertices,
-                                           ground_view=self._ground_view(s))
+                                           construction=self.r.text(s, "construction_name"), vertices=vertices)
         for kind, (stype, boundary) in SIMPLE_SURFACES.items():
             for s in self.r.all(kind):
                 zone = self.zone_of(s, "zone_name")
@@ -1008,13 +1011,6 @@ class _Converter:
                                                   construction=self.r.text(w, "construction_name"),
                                                   other=self.r.text(w, "outside_boundary_condition_object")))
         return out
-
-    def _ground_view(self, s):
-        """A surface's View Factor to Ground, None where autocalculated or absent."""
-        value = _field(s, "view_factor_to_ground")
-        if _blank(value) or str(value).lower() == "autocalculate":
-            return None
-        return self.r.number(s, "view_factor_to_ground", low=0, high=1)
 
     def _rect_height(self, s, zone, stype, other, tilt):
         """Centroid height (m) of a rectangular surface: its starting corner's z plus half its rise."""
@@ -1313,6 +1309,10 @@ class _Converter:
                 layers, outer, inner, glass = self.layers(w["construction"], w["obj"], "Construction Name", height)
                 w_outside = self.outside(s, boundary, outer, surfaces, done, subsurface=w)
                 c = self.component(w["obj"].name, w["area"], s, layers, inner, w_outside, outer)
+                # a window or door is its own class, not its wall's or roof's
+                for face in (c["inside"], c["outside"]):
+                    if "face_class" in face:
+                        face["face_class"] = "wall"
                 if glass is not None:
                     c["solar_transmittance"] = round(glass["tau"], 6)
                     c["transmitted_solar_to"] = None  # set once every component is known (`receivers`)
@@ -1355,24 +1355,27 @@ class _Converter:
         # each face the zones' sun can land on: (zone, its type seen from that zone, solar absorptance);
         # a partition's outer face is in the other zone (a ceiling there is its floor)
         faces = [(s["zone"], s["type"].lower(), inner["solar"])]
+        flip = {"ceiling": "floor", "floor": "ceiling", "roof": "floor"}
         if outside["type"] == "zone" and outer is not None:
-            flip = {"ceiling": "floor", "floor": "ceiling", "roof": "floor"}
             faces.append((outside["zone"], flip.get(s["type"].lower(), s["type"].lower()), outer["solar"]))
+        if outside["type"] == "zone":
+            # the zones' long-wave exchange (ScriptF) sees the outer face by its own class
+            outside["face_class"] = FACE_CLASS.get(flip.get(s["type"].lower(), s["type"].lower()), "wall")
         # EnergyPlus lists a construction's layers outside first; the building file inside first
         return {"_faces": faces, "name": name, "area": round(area, 6), "tilt": round(s["tilt"], 6), "azimuth": round(s["azimuth"] % 360, 6),
                 "layers": [[m, t] for m, t in reversed(layers)], "nodes": {"max_spacing": MAX_SPACING},
                 "inside": {"zone": s["zone"], "h_conv": FILMS.inside_convection(s["tilt"], self.inside_algorithm(s["zone"])),
-                           "h_rad": round(FILMS.radiative(inner["emissivity"], FILMS.T_inside), 4)},
+                           "h_rad": round(FILMS.radiative(inner["emissivity"], FILMS.T_inside), 4),
+                           "emissivity": inner["emissivity"], "face_class": FACE_CLASS.get(s["type"].lower(), "wall")},
                 "outside": outside, "_zone": s["zone"], "_type": s["type"].lower(), "_absorbs": inner["solar"]}
 
     def outside(self, s, boundary, outer, surfaces, done, subsurface=None):
         obj = s["obj"]
         if boundary == "outdoors":
             h = round(FILMS.outside_convection(s["tilt"], s["height"], outer["roughness"], s["wind"], self.terrain), 4)
-            ground = s.get("ground_view")
             return {"type": "exterior", "h_conv": h, "h_rad": round(FILMS.radiative(outer["emissivity"], FILMS.T_outside), 4),
                     "solar_absorptance": outer["solar"] if s["sun"] else 0.0,
-                    "sky_view_factor": round(float(sky_fraction_energyplus(s["tilt"], ground)), 6)}
+                    "sky_view_factor": round(float(sky_fraction_energyplus(s["tilt"])), 6)}
         if boundary == "ground":
             return {"type": "boundary", "temperature": self.ground_schedule(), "h": FILMS.ground}
         if boundary == "adiabatic":
@@ -1407,7 +1410,8 @@ class _Converter:
                     other_zone = other["zone"]
             h_c = FILMS.inside_convection(180.0 - s["tilt"], self.inside_algorithm(other_zone))
             return {"type": "zone", "zone": other_zone, "h_conv": h_c,
-                    "h_rad": round(FILMS.radiative(outer["emissivity"], FILMS.T_inside), 4)}
+                    "h_rad": round(FILMS.radiative(outer["emissivity"], FILMS.T_inside), 4),
+                    "emissivity": outer["emissivity"]}
         reader = NEAREST_BOUNDARY.get(boundary)
         if reader is not None:
             return reader(self, s)
@@ -1490,6 +1494,30 @@ class _Converter:
                 s = {"tilt": 90.0, "azimuth": 0.0, "zone": self.zone_objs[zone.upper()].name, "type": "internalmass"}
                 name = o.name if len(zones) == 1 else f"{o.name} {s['zone']}"
                 components.append(self.component(name, area, s, layers[::-1], inner, {"type": "adiabatic"}))
+
+    def user_view_factors(self, zones, components, surfaces):
+        """Every zone exchanges long-wave radiation by ScriptF, as EnergyPlus always does, with the
+        view factors a ZoneProperty:UserViewFactors:BySurfaceName gives where one does. A surface
+        is named by its component: a partition's second surface by its pair's."""
+        for z in zones:
+            z["longwave"] = "scriptf"
+        by_zone = {z["name"].upper(): z for z in zones}
+        names = {c["name"].upper(): c["name"] for c in components}
+        for s in surfaces.values():
+            partner = self.pair_owner(s, surfaces)
+            if partner is not s:
+                names[s["obj"].name.upper()] = partner["obj"].name
+        for o in self.r.all("ZoneProperty:UserViewFactors:BySurfaceName"):
+            fields = o.to_dict()
+            label = next(k for k in fields if k.endswith("_name") and k != "name")
+            for zone_name in self._targets(o, label):
+                factors = by_zone[zone_name.upper()].setdefault("view_factors", {})
+                for row in fields.get("view_factors") or []:
+                    a, b = (names.get(str(row[k]).upper()) for k in ("from_surface", "to_surface"))
+                    if a is None or b is None:
+                        self.r.fail(o, "From Surface", f"names no surface of zone {zone_name!r} "
+                                                       f"({row['from_surface']!r} to {row['to_surface']!r})")
+                    factors.setdefault(a, {})[b] = float(row["view_factor"])
 
     def receivers(self, components):
         """Where the sun a zone's windows let in lands, as EnergyPlus's FullInteriorAndExterior

@@ -33,10 +33,14 @@ class Material:
 
 @dataclass(frozen=True)
 class Surface:
-    """A face seen by a zone: its air through h_conv, its radiant node through h_rad (W/m2/K)."""
+    """A face seen by a zone: its air through h_conv, its radiant node through h_rad (W/m2/K); in
+    a zone whose long-wave exchange is ScriptF, the zone's other faces by its thermal emissivity
+    and its class for the view factors (docs/model.md section 3.5)."""
     zone: str
     h_conv: float
     h_rad: float
+    emissivity: float = 0.9  # -, long-wave
+    face_class: str | None = None  # "wall", "floor", "roof", "internal_mass"; None: from its tilt
 
 
 @dataclass(frozen=True)
@@ -135,6 +139,8 @@ class Zone:
     air_exchange: tuple = ()  # (other zone, m3/h each way): air through an open internal door
     gains: tuple = ()  # Gain records
     ventilation: tuple = ()  # Ventilation records
+    longwave: str = "radiant_node"  # "radiant_node" (the star node) or "scriptf" (docs/model.md 3.5)
+    view_factors: tuple = ()  # (from component, to component, F) declared for "scriptf"; () approximated
     mass_node: int | None = None  # ids of the nodes those two add (docs/model.md section 7)
     heater_node: int | None = None
 
@@ -284,6 +290,18 @@ class Building:
         faces += [(c, c.outside, c.node_ids[-1]) for c in self.components
                   if isinstance(c.outside, Surface) and c.outside.zone == zone_name]
         return faces
+
+    def enclosure(self, zone_name):
+        """The faces of a zone's enclosure, for its long-wave exchange: (names, node ids, areas m2,
+        emissivities, tilts deg, azimuths deg, classes), each face's tilt and azimuth those of its
+        normal away from the zone (a partition's outside face turned round)."""
+        faces = self._faces(zone_name)
+        turned = [side is not c.inside for c, side, _ in faces]
+        return (tuple(c.name for c, _, _ in faces), tuple(i for _, _, i in faces),
+                tuple(c.area for c, _, _ in faces), tuple(side.emissivity for _, side, _ in faces),
+                tuple(180.0 - c.tilt if t else c.tilt for (c, _, _), t in zip(faces, turned)),
+                tuple((c.azimuth + 180.0) % 360.0 if t else c.azimuth for (c, _, _), t in zip(faces, turned)),
+                tuple(side.face_class for _, side, _ in faces))
 
     def facing(self, zone_name):
         """Ids of the surface nodes that face a zone (inside faces, and outside faces of partitions)."""

@@ -198,6 +198,7 @@ def parse_checked(data, source="<building>"):
                 check.fail(f"components[{i}].solar_distribution.{name}", f"names no component ({name!r})")
     _check_proportional_columns(check, zones, components)
     _check_air_exchanges(check, zones)
+    _check_view_factors(check, zones, components)
     boundary_factors = _boundary_factors(check, data, zones, components)
     _check_node_ids(check, zones, components)
     zones = _number_added_nodes(zones, sum(len(c.node_ids) for c in components) + 2 * len(zones))
@@ -351,6 +352,8 @@ def _zone(check, z, where, zone_names, explicit, next_id, schedules):
         ventilation=_ventilation(check, z, where, schedules),
         internal_mass=_lumped(z.get("internal_mass")),
         heat_input_lag=_lumped(z.get("heat_input_lag")),
+        longwave=z.get("longwave", schema_default("zone", "longwave")),
+        view_factors=tuple((a, b, float(F)) for a, row in z.get("view_factors", {}).items() for b, F in row.items()),
     )
 
 
@@ -384,7 +387,9 @@ def _number_added_nodes(zones, last):
 def _surface(check, raw, where, zone_names):
     if raw["zone"] not in zone_names:
         check.fail(f"{where}.zone", f"names no zone ({raw['zone']!r})")
-    return Surface(zone=raw["zone"], h_conv=float(raw["h_conv"]), h_rad=float(raw["h_rad"]))
+    return Surface(zone=raw["zone"], h_conv=float(raw["h_conv"]), h_rad=float(raw["h_rad"]),
+                   emissivity=float(raw.get("emissivity", schema_default("inside", "emissivity"))),
+                   face_class=raw.get("face_class"))
 
 
 def _outside(check, raw, where, zone_names):
@@ -536,6 +541,30 @@ def _check_air_exchanges(check, zones):
             if z.name in dict(next(o for o in zones if o.name == other).air_exchange):
                 check.fail(f"zones[{i}].air_exchange.{other}",
                            f"the exchange between {z.name} and {other} is declared on both zones: declare it once")
+
+
+def _check_view_factors(check, zones, components):
+    """A zone's declared view factors are for its ScriptF exchange, between faces it has, each
+    named by one component; their rows sum to at most 1."""
+    for i, z in enumerate(zones):
+        if not z.view_factors:
+            continue
+        where = f"zones[{i}].view_factors"
+        if z.longwave != "scriptf":
+            check.fail(where, f"view factors are read only with longwave \"scriptf\", not {z.longwave!r}")
+        faces = [c.name for c in components if c.inside.zone == z.name]
+        faces += [c.name for c in components if isinstance(c.outside, Surface) and c.outside.zone == z.name]
+        for a, b, _ in z.view_factors:
+            for name in (a, b):
+                if name not in faces:
+                    check.fail(f"{where}.{a}", f"{name!r} is no face of zone {z.name!r}")
+                if faces.count(name) > 1:
+                    check.fail(f"{where}.{a}", f"{name!r} faces zone {z.name!r} on both sides: its faces "
+                                               "cannot be told apart by name")
+        for a in dict.fromkeys(a for a, _, _ in z.view_factors):
+            total = sum(F for row, _, F in z.view_factors if row == a)
+            if total > 1 + 1e-6:
+                check.fail(f"{where}.{a}", f"the view factors add up to {total:g}: at most 1")
 
 
 def _check_node_ids(check, zones, components):

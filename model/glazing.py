@@ -7,7 +7,8 @@ Angles in degrees, conductances in W/m2/K, transmittances and reflectances dimen
 import numpy as np
 from scipy.optimize import brentq
 
-SIGMA = 5.670374419e-8  # W/m2/K4
+from .longwave import SIGMA
+
 # Angles (deg) at which a glazing's transmittance is tabulated in a building file
 ANGLES = tuple(range(0, 91, 10))
 

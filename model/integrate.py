@@ -258,7 +258,10 @@ class ImplicitEuler:
         `Modes.of` would find only after M's inverse is formed: such a mask has None at once."""
         if self._one_way is None:  # M's non-symmetric pairs, the same for every mask
             asymmetric = np.abs(self._M - self._M.T) > 1e-12 * np.abs(self._M).max(initial=0.0)
-            self._one_way = np.nonzero(asymmetric)
+            # a row no other node reads (a zone's mean radiant temperature, docs/model.md 3.5)
+            # leaves the other nodes' step symmetric
+            read = np.any((self._M != 0.0) & ~np.eye(len(self._M), dtype=bool), axis=0)
+            self._one_way = np.nonzero(asymmetric & read[:, None] & read[None, :])
         rows, cols = self._one_way
         if np.any(~forced[rows] & ~forced[cols]):
             return None

@@ -21,6 +21,7 @@ import numpy as np
 from .building import DAY_TERMS, Adiabatic, Boundary, Exterior, Surface
 from .building_file import schema_default
 from .discretise import capacities, conductances
+from .longwave import enclosure_exchange
 
 AIR_DENSITY = schema_default("site", "air_density")  # kg/m3, a building file's default
 C_AIR = 1005.0  # J/kg/K
@@ -238,14 +239,15 @@ def sky_view_factor(tilt):
     return (1.0 + np.cos(np.radians(tilt))) / 2.0
 
 
-def sky_fraction_energyplus(tilt, ground_view=None):
+def sky_fraction_energyplus(tilt):
     """The part of a face's long-wave exchange that is with the sky as EnergyPlus takes it
-    (Engineering Reference, "Exterior/External Longwave Radiation"): its sky view F_sky (1 less
-    its view factor to the ground, (1 + cos tilt) / 2 where not given) of which the part
-    beta = sqrt((1 + cos tilt) / 2) is the sky and the rest the air near the ground, F_sky beta."""
+    (Engineering Reference, "External Longwave Radiation"): of its sky view
+    F_sky = (1 + cos tilt) / 2 the part beta = sqrt((1 + cos tilt) / 2) is the sky and the rest the
+    air near the horizon, F_sky beta; the ground, F_ground = (1 - cos tilt) / 2, is at the air's
+    temperature. Both views are the tilt's alone: EnergyPlus reads a surface's View Factor to
+    Ground for the sun the ground reflects, never for the long-wave exchange."""
     cos = np.cos(np.radians(tilt))
-    F_sky = (1.0 + cos) / 2.0 if ground_view is None else 1.0 - ground_view
-    return F_sky * np.sqrt((1.0 + cos) / 2.0)
+    return (1.0 + cos) / 2.0 * np.sqrt((1.0 + cos) / 2.0)
 
 
 def air_density_at(altitude, T=20.0):
@@ -299,7 +301,27 @@ def assemble(building, names=None):
     def to_zone(node, area, surface):
         zone = building.zone(surface.zone)
         link(node, zone.air_node - 1, area * surface.h_conv * zone.convection_factor)
-        link(node, zone.radiant_node - 1, area * surface.h_rad)
+        if zone.longwave == "radiant_node":
+            link(node, zone.radiant_node - 1, area * surface.h_rad)
+
+    # where the radiant part of a zone's gains goes: [(node, share)], its radiant node or its faces
+    absorbers = {}
+    for z in building.zones:
+        if z.longwave == "radiant_node":
+            absorbers[z.name] = [(z.radiant_node - 1, 1.0)]
+            continue
+        face_names, ids, *faces = building.enclosure(z.name)
+        G, shares = enclosure_exchange(face_names, *faces, declared=z.view_factors)
+        nodes = np.array(ids) - 1
+        for a, b in zip(*np.triu_indices(len(nodes), 1)):
+            if G[a, b] != 0.0:
+                link(nodes[a], nodes[b], G[a, b])
+        # the radiant node carries nothing: it reads the faces' mean radiant temperature,
+        # sum A eps T_s / sum A eps (EnergyPlus's zone MRT), a row no other node reads
+        radiant = z.radiant_node - 1
+        A[radiant, nodes] += shares
+        A[radiant, radiant] -= 1.0
+        absorbers[z.name] = list(zip(nodes, shares))
 
     for c in building.components:
         idx = [i - 1 for i in c.node_ids]
@@ -350,7 +372,7 @@ def assemble(building, names=None):
 
     rho = building.site.get("air_density", AIR_DENSITY)
     for z in building.zones:
-        air, radiant = z.air_node - 1, z.radiant_node - 1
+        air, radiant = z.air_node - 1, absorbers[z.name]
         C[air] += rho * C_AIR * z.volume
         to_temperature(air, air_conductance(z.volume * z.air_change_rate, rho), "T_out")
         if z.supply is not None:
@@ -376,9 +398,9 @@ def assemble(building, names=None):
                            "T_out" if to == "outdoor" else to)
         q[air] += z.internal_gain
         for gain in z.gains:
-            # P s(t): the radiant fraction to the radiant node, the rest to the air
+            # P s(t): the radiant fraction to the radiant node (or the faces), the rest to the air
             schedule = building.schedules.get(gain.schedule) if gain.schedule is not None else None
-            for node, part in ((air, 1.0 - gain.radiant_fraction), (radiant, gain.radiant_fraction)):
+            for node, part in [(air, 1.0 - gain.radiant_fraction)] + [(r, gain.radiant_fraction * w) for r, w in radiant]:
                 if schedule is None or schedule.is_constant:
                     q[node] += part * gain.power * (1.0 if schedule is None else schedule.value)
                 else:
@@ -394,17 +416,19 @@ def assemble(building, names=None):
         f_r, gain = z.heat_input_radiative_fraction, z.heat_input_factor
         if z.heat_input_lag is not None:
             # the heater's node takes the heat input and gives it to the air and the radiant node
-            # in the heat input's split (docs/model.md section 7)
+            # (or the faces) in the heat input's split (docs/model.md section 7)
             heater = z.heater_node - 1
             C[heater] += z.heat_input_lag.capacity
             link(heater, air, (1.0 - f_r) * z.heat_input_lag.conductance)
-            link(heater, radiant, f_r * z.heat_input_lag.conductance)
+            for r, w in radiant:
+                link(heater, r, f_r * z.heat_input_lag.conductance * w)
             for name in z.heat_input:
                 B[heater, col[name]] += gain
         else:
             for name in z.heat_input:
                 B[air, col[name]] += gain * (1.0 - f_r)
-                B[radiant, col[name]] += gain * f_r
+                for r, w in radiant:
+                    B[r, col[name]] += gain * f_r * w
     return Network(C=C, A=A, B=B, q=q, input_names=names, products=tuple(products), switched=tuple(switched))
 
 

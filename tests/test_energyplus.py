@@ -399,14 +399,25 @@ def test_inner_absorptance_and_distribution_in_the_network():
         b.edited(lambda d: d["components"][0].update(solar_distribution={"f": 0.9, "w": 0.2}))
 
 
-def test_sky_fraction_is_energyplus_sky_and_air_split(case600):
-    """A wall of view factor to ground 0.5 sees the sky over 0.5 of its view, of which
-    beta = sqrt(1/2) is the sky itself; a roof all sky."""
+def test_sky_fraction_is_energyplus_sky_and_air_split(case600, tmp_path):
+    """A wall sees the sky over (1 + cos 90) / 2 = 0.5 of its view, of which beta = sqrt(1/2) is
+    the sky itself; a roof all sky. EnergyPlus takes both from the tilt alone: a View Factor to
+    Ground of 0.2 on the east wall changes its ground-reflected sun, not its long-wave split
+    (SurfaceGeometry.cc: ViewFactorSkyIR = (1 + cos tilt) / 2 whatever the field says)."""
     from nodeforce.model.network import sky_fraction_energyplus
     assert case600.component("EAST WALL").outside.sky_view_factor == pytest.approx(0.5 * np.sqrt(0.5), abs=1e-6)
     assert case600.component("ROOF").outside.sky_view_factor == pytest.approx(1.0)
-    assert sky_fraction_energyplus(90.0) == pytest.approx(0.5 * np.sqrt(0.5))
-    assert sky_fraction_energyplus(60.0, ground_view=0.2) == pytest.approx(0.8 * np.sqrt(0.75))
+    assert sky_fraction_energyplus(60.0) == pytest.approx(0.75 * np.sqrt(0.75))
+    idf = tmp_path / "ground.idf"
+    idf.write_text(edited("  EAST WALL,                    !- Name\n  Wall,                         !- Surface Type\n"
+                          "  LIGHT WALL,                   !- Construction Name\n"
+                          "  CASE 600 ZONE,                !- Zone Name\n  Outdoors,                     !- Outside Boundary Condition\n"
+                          "  ,                             !- Outside Boundary Condition Object\n"
+                          "  SunExposed,                   !- Sun Exposure\n  WindExposed,                  !- Wind Exposure\n"
+                          "  autocalculate,",
+                          "  EAST WALL,\n  Wall,\n  LIGHT WALL,\n  CASE 600 ZONE,\n  Outdoors,\n  ,\n  SunExposed,\n"
+                          "  WindExposed,\n  0.2,"))
+    assert convert_idf(idf).component("EAST WALL").outside.sky_view_factor == pytest.approx(0.5 * np.sqrt(0.5), abs=1e-6)
 
 
 def test_declared_sky_fraction_in_the_network():
@@ -418,6 +429,30 @@ def test_declared_sky_fraction_in_the_network():
     e = b.component("w").node_ids[-1] - 1
     assert net.B[e, names.index("T_sky")] == pytest.approx(10 * 4 * 0.3)
     assert net.B[e, names.index("T_out")] == pytest.approx(10 * (10 + 4 * 0.7))
+
+
+def test_every_zone_exchanges_long_wave_by_script_f(case600):
+    """EnergyPlus always uses ScriptF: every zone gets it, each face its inner layer's thermal
+    absorptance (a simple glazing's 0.84) and its surface type's class (a window its own)."""
+    z = case600.zones[0]
+    assert z.longwave == "scriptf" and z.view_factors == ()
+    assert case600.component("SOUTH WINDOW WEST").inside.emissivity == 0.84  # simple glazing's
+    assert case600.component("FLOOR").inside.emissivity == 0.9  # the IDF's thermal absorptance
+    assert [case600.component(n).inside.face_class for n in ("FLOOR", "ROOF", "EAST WALL", "SOUTH WINDOW EAST")] \
+        == ["floor", "roof", "wall", "wall"]
+
+
+def test_user_view_factors_are_the_zones(tmp_path):
+    idf = tmp_path / "user.idf"
+    idf.write_text(TEXT + "\nZoneProperty:UserViewFactors:BySurfaceName,\n  CASE 600 ZONE,\n"
+                   "  FLOOR, ROOF, 0.6,\n  ROOF, FLOOR, 0.6,\n  FLOOR, EAST WALL, 0.4;\n")
+    b = convert_idf(idf)
+    assert set(b.zones[0].view_factors) == {("FLOOR", "ROOF", 0.6), ("ROOF", "FLOOR", 0.6), ("FLOOR", "EAST WALL", 0.4)}
+    bad = tmp_path / "bad.idf"
+    bad.write_text(TEXT + "\nZoneProperty:UserViewFactors:BySurfaceName,\n  CASE 600 ZONE,\n  FLOOR, CEILING, 0.6;\n")
+    with pytest.raises(InputError, match="(?i)ZoneProperty:UserViewFactors:BySurfaceName.*From Surface.*names no "
+                                         "surface of zone 'CASE 600 ZONE'"):
+        convert_idf(bad)
 
 
 def test_inside_convection_is_tarp_at_the_stated_difference(case600):

@@ -49,6 +49,14 @@ def two_zones(data):
     return data
 
 
+def scriptf(data):
+    """A building whose zones exchange long-wave radiation face to face (docs/model.md 3.5)."""
+    data = copy.deepcopy(data)
+    for z in data["zones"]:
+        z["longwave"] = "scriptf"
+    return data
+
+
 def shaded(data):
     """The test cell with a blind on its glazing: the transmitted sun is then the product of
     two inputs, the irradiance and the blind's column."""
@@ -60,9 +68,11 @@ def shaded(data):
 
 @pytest.fixture(scope="module")
 def fmus(tmp_path_factory, testcell_data):
-    """{(building, kind): FMU path} for the test cell, the two-zone building and the shaded cell."""
+    """{(building, kind): FMU path} for the test cell, the two-zone building (its long-wave exchange
+    by a radiant node, and by ScriptF) and the shaded cell."""
     folder = tmp_path_factory.mktemp("standalone")
-    buildings = {"testcell": testcell_data, "two_zones": two_zones(testcell_data), "shaded": shaded(testcell_data)}
+    buildings = {"testcell": testcell_data, "two_zones": two_zones(testcell_data), "shaded": shaded(testcell_data),
+                 "two_zones_scriptf": scriptf(two_zones(testcell_data))}
     return {(name, kind): build_fmu(parse_building(data), folder / f"{name}_{kind}.fmu", kind=kind)
             for name, data in buildings.items() for kind in KINDS}
 
@@ -134,7 +144,7 @@ def run_c_host(fmu, parameters, inputs, outputs, dt, n_steps, tmp_path, env=None
     return done, (np.loadtxt(done.stdout.splitlines(), ndmin=2) if done.returncode == 0 else None)
 
 
-@pytest.mark.parametrize("building", ["testcell", "two_zones", "shaded"])
+@pytest.mark.parametrize("building", ["testcell", "two_zones", "shaded", "two_zones_scriptf"])
 def test_standalone_in_a_c_host_equals_the_python_fmu_in_fmpy(fmus, building, tmp_path):
     python_fmu, standalone = fmus[(building, "python")], fmus[(building, "standalone")]
     parameters, inputs, outputs, n_steps = scenario(python_fmu)
