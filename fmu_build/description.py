@@ -6,6 +6,7 @@ identifier, whether an execution tool (Python) is needed, and the source files. 
 hash of everything the FMU carries, so the same model gives the same FMU, byte for byte.
 """
 import hashlib
+import math
 import zipfile
 from dataclasses import dataclass
 from importlib.metadata import PackageNotFoundError, metadata
@@ -14,7 +15,7 @@ from xml.etree.ElementTree import Element, SubElement, indent, tostring
 from nodeforce.model.building import Boundary
 from nodeforce.model.effects import EFFECTS, fmu_parameters, properties
 from nodeforce.model.integrate import MAX_STEP, held_inputs
-from nodeforce.model.network import clock_input_names
+from nodeforce.model.network import WIND_DIRECTION, WIND_SPEED, clock_input_names
 
 from .guard import GUARD_GLIBC, PYTHONFMU_GLIBC
 
@@ -35,6 +36,8 @@ UNITS = {
     "1/h": ("AirChangeRate", {"s": "-1", "factor": str(1 / 3600)}),
     "m3/h": ("VolumeFlowRate", {"m": "3", "s": "-1", "factor": str(1 / 3600)}),
     "s": ("Time", {"s": "1"}),
+    "m/s": ("Velocity", {"m": "1", "s": "-1"}),
+    "deg": ("Angle", {"rad": "1", "factor": str(math.pi / 180)}),
 }
 EFFECT_UNITS = {"C": "degC", "-": None}  # effects.Parameter.unit spellings that differ from FMI's
 LOG_CATEGORIES = ("logStatusWarning", "logStatusDiscard", "logStatusError", "logStatusFatal", "logAll")
@@ -115,6 +118,10 @@ def _input_meaning(building, name):
         return "degC", "outdoor air temperature"
     if name == "T_sky":
         return "degC", "sky temperature"
+    if name == WIND_SPEED:
+        return "m/s", "the weather station's wind speed (10 m in open country)"
+    if name == WIND_DIRECTION:
+        return "deg", "the direction the wind comes from, clockwise from north"
     if name in clock_input_names(building):
         function, h = name.removeprefix("day_")[:3], name.removeprefix("day_")[3:]
         return None, (f"{function}(2 pi {h} tau / 24 h), tau the local clock time of day (h) at the site "

@@ -206,7 +206,7 @@ class NodalBuilding(Fmi2Slave):
         T_s = T_forced + dT_forced * s
         for j in range(k):
             i = 0 if held else j
-            T = stepper.step(T, sources[i], forced, T_s[j], None if switched is None else switched[i])
+            T = stepper.step(T, sources[i], forced, T_s[j], None if switched is None else switched[i], u_s[i])
         values[layout.T] = T
         values[layout.derivatives] = 0.0  # the next step's are set before it, or it holds its inputs
         self._time = current_time + step_size

@@ -553,8 +553,12 @@ class _Converter:
         self.default_inside = self.r.text(inside[0], "algorithm", "TARP") if inside else "TARP"
         outside = self.r.all("SurfaceConvectionAlgorithm:Outside")
         algorithm = self.r.text(outside[0], "algorithm", "DOE-2") if outside else "DOE-2"
-        self.notes.append(f"outside convection EnergyPlus's DOE-2 at a {FILMS.wind:g} m/s station wind and a "
-                          f"{FILMS.delta_T:g} K face-to-air difference" +
+        # TARP inside on every face, as the file may declare it, would take a glazing's inside face by
+        # TARP where EnergyPlus takes ISO 15099's: 900FF's minimum then falls to 0.49 C, below ASHRAE
+        # 140's 0.6 (docs/model.md 10.1), so the zones keep their constant inside coefficients
+        self.notes.append(f"outside convection EnergyPlus's DOE-2 from each hour's wind and each face's temperature, "
+                          f"its value at a {FILMS.wind:g} m/s station wind and a {FILMS.delta_T:g} K face-to-air "
+                          "difference in the step matrix" +
                           ("" if algorithm.lower() == "doe-2" else f" (the IDF's {algorithm} evaluated as DOE-2)"))
 
     def inside_algorithm(self, zone_name):
@@ -932,8 +936,8 @@ class _Converter:
                       "not held)")
         names = [b.name for b in self.r.all("Building")]
         description = (f"Converted by nodeforce convert from {self.r.source} (EnergyPlus "
-                       f"{'.'.join(map(str, self.r.doc.version[:2]))}). Surface coefficients are the converter's "
-                       "constants (docs/guide.md, nodeforce convert); " + "; ".join(self.notes or ["no other assumption"]) + ".")
+                       f"{'.'.join(map(str, self.r.doc.version[:2]))}). Inside surface coefficients are the "
+                       "converter's constants (docs/guide.md, nodeforce convert); " + "; ".join(self.notes or ["no other assumption"]) + ".")
         data = {"format": "nodal-building/1", "name": names[0] if names else "", "description": description,
                 "site": site, "materials": self.materials, "zones": zone_data, "components": components}
         if self.schedules:
@@ -1373,9 +1377,13 @@ class _Converter:
         obj = s["obj"]
         if boundary == "outdoors":
             h = round(FILMS.outside_convection(s["tilt"], s["height"], outer["roughness"], s["wind"], self.terrain), 4)
+            # h follows the hour's wind and the face's temperature as EnergyPlus's DOE-2 has it (h
+            # the constant above in the step matrix, docs/model.md 3.6); NoWind: natural alone
+            wind = float(convection.wind_at_height(1.0, s["height"], self.terrain)) if s["wind"] else 0.0
             return {"type": "exterior", "h_conv": h, "h_rad": round(FILMS.radiative(outer["emissivity"], FILMS.T_outside), 4),
                     "solar_absorptance": outer["solar"] if s["sun"] else 0.0,
-                    "sky_view_factor": round(float(sky_fraction_energyplus(s["tilt"])), 6)}
+                    "sky_view_factor": round(float(sky_fraction_energyplus(s["tilt"])), 6),
+                    "convection": {"algorithm": "doe2", "roughness": outer["roughness"], "wind_factor": round(wind, 6)}}
         if boundary == "ground":
             return {"type": "boundary", "temperature": self.ground_schedule(), "h": FILMS.ground}
         if boundary == "adiabatic":

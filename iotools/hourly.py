@@ -4,9 +4,9 @@ Time convention. These files' irradiance values are energies received over the h
 stamp (Wh/m2, i.e. the hour's mean W/m2) and their temperatures are readings at the stamp. A row
 here is one instant used for the sun position and for the model's inputs, so hourly rows are put
 at the *middle* of their hour (local standard time, the file's UTC offset): the irradiance keeps
-its value (the hour mean is the best estimate at mid-hour) and the temperature becomes the mean of
-the readings at the start and end of the hour (their linear interpolation at mid-hour, as
-`nodeforce.model.weather.weather_on_grid` would do). The infrared `ir_h` is an hour energy like
+its value (the hour mean is the best estimate at mid-hour) and the temperature (and the wind
+speed) becomes the mean of the readings at the start and end of the hour (their linear
+interpolation at mid-hour, as `nodeforce.model.weather.weather_on_grid` would do). The infrared `ir_h` is an hour energy like
 the other irradiances.
 
 Each reader returns `(end_of_hour, columns, meta)`: the tz-aware end-of-hour stamps, a dict of
@@ -21,8 +21,13 @@ from nodeforce.model.errors import InputError
 from .timetable import one_line
 
 
+# the columns read at an instant, not accumulated over the hour
+READINGS = ("T_out", "wind_speed")
+
+
 def read_epw(source, coerce_year=None):
-    """EPW hours: `T_out` C, `ghi`, `dni`, `dhi`, `ir_h` W/m2, missing-value codes as NaN."""
+    """EPW hours: `T_out` C, `ghi`, `dni`, `dhi`, `ir_h` W/m2, `wind_speed` m/s and `wind_direction`
+    deg from north (the station's, at 10 m), missing-value codes as NaN."""
     # pvlib stamps EPW hour h (energy over h-1..h, readings at h) at h-1, the start of the hour.
     try:
         data, meta = pvlib.iotools.read_epw(source, coerce_year=coerce_year)
@@ -34,6 +39,8 @@ def read_epw(source, coerce_year=None):
         "dni": data["dni"].where(data["dni"] < 9999),
         "dhi": data["dhi"].where(data["dhi"] < 9999),
         "ir_h": data["ghi_infrared"].where(data["ghi_infrared"] < 9999),
+        "wind_speed": data["wind_speed"].where(data["wind_speed"] < 999),
+        "wind_direction": data["wind_direction"].where(data["wind_direction"] < 999),
     }
     end_of_hour = data.index + pd.Timedelta(hours=1)
     meta = {**meta, "name": f"{meta['city'].strip()}, {meta['country'].strip()} (EPW {meta['WMO_code'].strip()})"}
@@ -61,12 +68,14 @@ def read_tmy2(source, year):
 
 
 def read_tmy3(source, year):
-    """TMY3 hours put in one calendar `year`: `T_out` C, `ghi`, `dni`, `dhi` W/m2."""
+    """TMY3 hours put in one calendar `year`: `T_out` C, `ghi`, `dni`, `dhi` W/m2, `wind_speed` m/s
+    and `wind_direction` deg from north."""
     # pvlib stamps TMY3 rows at the end of their hour; coerce_year puts the last (24:00) row in
     # January of the next year, which is where it belongs.
     data, meta = pvlib.iotools.read_tmy3(source, coerce_year=year, map_variables=True)
     columns = {name: data[col].to_numpy(float) for name, col in
-               (("T_out", "temp_air"), ("ghi", "ghi"), ("dni", "dni"), ("dhi", "dhi"))}
+               (("T_out", "temp_air"), ("ghi", "ghi"), ("dni", "dni"), ("dhi", "dhi"), ("wind_speed", "wind_speed"),
+                ("wind_direction", "wind_direction"))}
     station = meta["Name"].strip().strip('"').title()
     meta = {**meta, "name": f"{station}, {meta['State']} (TMY3 {meta['USAF']})"}
     return data.index, columns, meta
@@ -75,14 +84,17 @@ def read_tmy3(source, year):
 def to_mid_hour(end_of_hour, columns, cyclic):
     """The weather frame of hourly columns, rows at mid-hour (module docstring).
 
-    Hour energies stay as they are; `T_out` readings at the hour ends are averaged to the
-    mid-hour, the first row's earlier reading being the last of the file when `cyclic` (a typical
-    year) and missing (NaN) otherwise.
+    Hour energies stay as they are; `T_out` and `wind_speed` readings at the hour ends are
+    averaged to the mid-hour, the first row's earlier reading being the last of the file when
+    `cyclic` (a typical year) and missing (NaN) otherwise. A wind direction keeps its reading at
+    the hour's end: the mean of two directions either side of north is not their arithmetic one.
     """
     columns = dict(columns)
-    reading = columns["T_out"]
-    before = np.concatenate(([reading[-1] if cyclic else np.nan], reading[:-1]))
-    columns["T_out"] = (before + reading) / 2.0
+    for name in READINGS:
+        if name in columns:
+            reading = columns[name]
+            before = np.concatenate(([reading[-1] if cyclic else np.nan], reading[:-1]))
+            columns[name] = (before + reading) / 2.0
     index = pd.DatetimeIndex(end_of_hour - pd.Timedelta(minutes=30), name="time")
     return pd.DataFrame(columns, index=index)
 

@@ -37,7 +37,8 @@ def convert_typical_year(src_path, dst_csv_path, year=2001):
     src_path : str or Path
         Source file; its format is chosen by extension.
     dst_csv_path : str or Path
-        Weather CSV to write (columns time, T_out C, ghi, dni, dhi W/m2 [, ir_h W/m2]), numbers
+        Weather CSV to write (columns time, T_out C, ghi, dni, dhi W/m2 [, ir_h W/m2] [, wind_speed
+        m/s, wind_direction deg: EPW and TMY3]), numbers
         to 6 significant digits.
     year : int
         Calendar year given to the data; must not be a leap year (a typical year has 365 days).

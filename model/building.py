@@ -51,6 +51,16 @@ class Exterior:
     solar_absorptance: float  # -
     irradiance: str | None = None  # input column of the measured irradiance on the face, W/m2
     sky_view_factor: float | None = None  # part of the long-wave exchange with the sky; None: (1 + cos tilt) / 2
+    convection: "OutsideConvection | None" = None  # h_conv following the wind and the face; None: h_conv constant
+
+
+@dataclass(frozen=True)
+class OutsideConvection:
+    """An exterior face's convective coefficient computed at every step (docs/model.md section
+    3.6), h_conv held in the step matrix and the rest a source lagged one step."""
+    algorithm: str  # "doe2"
+    roughness: float = 1.0  # DOE-2's roughness multiplier R_f (1 glass, 1.67 Rough)
+    wind_factor: float = 1.0  # the face's wind over the weather station's, V_z / V_met
 
 
 @dataclass(frozen=True)
@@ -143,6 +153,7 @@ class Zone:
     view_factors: tuple = ()  # (from component, to component, F) declared for "scriptf"; () approximated
     mass_node: int | None = None  # ids of the nodes those two add (docs/model.md section 7)
     heater_node: int | None = None
+    inside_convection_algorithm: str = "simple"  # "simple": h_conv constant; "tarp": followed step by step
 
 
 @dataclass(frozen=True)
@@ -238,6 +249,15 @@ class Building:
     def exterior_components(self):
         """Components whose outside face sees the outdoor air, sky and sun."""
         return tuple(c for c in self.components if isinstance(c.outside, Exterior))
+
+    @property
+    def followed_convection(self):
+        """(where, field) of each zone and exterior face whose convective coefficient follows the
+        temperatures or the wind (docs/model.md section 3.6)."""
+        return (tuple((f"zone {z.name}", "inside_convection_algorithm") for z in self.zones
+                      if z.inside_convection_algorithm != "simple")
+                + tuple((f"component {c.name}", "outside.convection") for c in self.exterior_components
+                        if c.outside.convection is not None))
 
     @property
     def input_columns(self):

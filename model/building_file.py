@@ -20,8 +20,8 @@ from dataclasses import replace
 from importlib.resources import files
 
 from .building import (DAY_TERMS, Adiabatic, AngularTransmittance, Boundary, Building, Component, Exterior, Gain,
-                       Inflow, Lumped, Material, Supply, Surface, Ventilation, Zone, boundary_columns,
-                       json_copy)
+                       Inflow, Lumped, Material, OutsideConvection, Supply, Surface, Ventilation, Zone,
+                       boundary_columns, json_copy)
 from .discretise import generated_depths
 from .errors import InputError
 from .schedule import WEEKDAYS, Schedule
@@ -354,6 +354,8 @@ def _zone(check, z, where, zone_names, explicit, next_id, schedules):
         heat_input_lag=_lumped(z.get("heat_input_lag")),
         longwave=z.get("longwave", schema_default("zone", "longwave")),
         view_factors=tuple((a, b, float(F)) for a, row in z.get("view_factors", {}).items() for b, F in row.items()),
+        inside_convection_algorithm=z.get("inside_convection_algorithm",
+                                          schema_default("zone", "inside_convection_algorithm")),
     )
 
 
@@ -397,12 +399,22 @@ def _outside(check, raw, where, zone_names):
     if kind == "exterior":
         return Exterior(h_conv=float(raw["h_conv"]), h_rad=float(raw["h_rad"]),
                         solar_absorptance=float(raw["solar_absorptance"]), irradiance=raw.get("irradiance"),
-                        sky_view_factor=float(raw["sky_view_factor"]) if "sky_view_factor" in raw else None)
+                        sky_view_factor=float(raw["sky_view_factor"]) if "sky_view_factor" in raw else None,
+                        convection=_outside_convection(raw.get("convection")))
     if kind == "zone":
         return _surface(check, raw, where, zone_names)
     if kind == "boundary":
         return Boundary(temperature=_temperature(raw["temperature"]), h=float(raw["h"]))
     return Adiabatic()
+
+
+def _outside_convection(raw):
+    """The `OutsideConvection` an exterior face declares, or None (its h_conv constant)."""
+    if raw is None:
+        return None
+    default = functools.partial(schema_default, "outside_exterior", "convection")
+    return OutsideConvection(algorithm=raw["algorithm"], roughness=float(raw.get("roughness", default("roughness"))),
+                             wind_factor=float(raw.get("wind_factor", default("wind_factor"))))
 
 
 def _layers(check, c, where, materials):

@@ -19,7 +19,8 @@ import pandas as pd
 from .errors import InputError
 from .integrate import Plan, held_inputs, history_block, initial_state, simulate, steps_per_day, substeps
 from .building import DAY_TERMS
-from .network import assemble, clock_input_names, day_input, input_names, slowest_time_constant
+from .network import (WIND_DIRECTION, WIND_SPEED, assemble, clock_input_names, day_input, input_names,
+                      slowest_time_constant)
 from .units import check_celsius
 from .solar import (DECOMPOSITIONS, complete_irradiance, incident_irradiance, measured_irradiance, sky_temperature,
                     solar_position, transmitted_irradiance)
@@ -363,6 +364,12 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
     columns.update(clock_inputs(building, times))
     columns.update(schedule_inputs(building, times))
     names = input_names(building)
+    for name in set(names) & {WIND_SPEED, WIND_DIRECTION}:
+        if name not in w:
+            face = next(c.name for c in building.exterior_components if c.outside.convection is not None)
+            raise InputError(source, name, f"{face} of {building.source} declares an outside convection, which "
+                                           "reads the wind: the weather file has no such column")
+        columns[name] = w[name].to_numpy(float)
     U = np.column_stack([np.asarray(columns[n], dtype=float) for n in names])
     missing = ~np.isfinite(U)
     # the history begins after the last row before the first measurement that misses an input

@@ -51,7 +51,8 @@ def _library():
     function.restype = ctypes.c_int
     function.argtypes = [ctypes.c_int, _INT, _INT, _INT, _INT, _INT, ctypes.c_long, _INT, _DOUBLE, _DOUBLE,
                          ctypes.c_long, ctypes.c_int, _DOUBLE, _INT, _INT, _DOUBLE, _DOUBLE, ctypes.c_int, _INT, _DOUBLE,
-                         _DOUBLE, ctypes.c_int, _INT, _DOUBLE]
+                         _DOUBLE, ctypes.c_int, _INT, _DOUBLE, ctypes.c_int, _INT, _DOUBLE, ctypes.c_int, _INT, _DOUBLE,
+                         _INT]
     return function
 
 
@@ -117,7 +118,7 @@ def pattern(n, starts, rows):
     return Pattern(np.frombuffer(starts, dtype=np.int32), np.frombuffer(rows, dtype=np.int32), n)
 
 
-def steps(matrix, c, sources, forced, imposed, T, rows):
+def steps(matrix, c, sources, forced, imposed, T, rows, convection=None):
     """The temperatures after each of L steps M T^k+1 = c T^k + B t^k + q, the forced nodes' at
     their imposed temperatures, or None where the library cannot be compiled.
 
@@ -132,6 +133,8 @@ def steps(matrix, c, sources, forced, imposed, T, rows):
     imposed : (L, len(forced)) their temperatures (C), or None: zero
     T : (N,) C before the first step
     rows : indices of the nodes returned
+    convection : the network's `Convection`, whose lagged source each step adds from the
+        temperatures before it and the step's inputs (the first columns of its terms), or None
 
     Returns
     -------
@@ -150,11 +153,23 @@ def steps(matrix, c, sources, forced, imposed, T, rows):
                else np.ascontiguousarray(imposed, dtype=float).reshape(len(terms), len(forced)))
     rows = np.ascontiguousarray(rows, dtype=np.int32)
     path = np.empty((len(terms), len(rows)))
+    lagged = _convection_arrays(convection)
     if not _library()(p.n, p.order, p.lower_ptr, p.lower_col, p.upper_ptr, p.upper_col, len(p.slot), p.slot,
                       np.ascontiguousarray(values, dtype=float), np.ascontiguousarray(c, dtype=float), len(terms),
                       terms.shape[1], terms, source_ptr, columns.astype(np.int32),
                       np.ascontiguousarray(sources.B[nodes, columns], dtype=float),
                       np.ascontiguousarray(sources.q, dtype=float), len(forced), forced, imposed, T, len(rows), rows,
-                      path):
+                      path, *lagged):
         raise ValueError("the step matrix is singular")
     return path, T
+
+
+def _convection_arrays(convection):
+    """The arguments c/steps.c reads a `Convection` from (none of its faces without one)."""
+    if convection is None:
+        return (0, np.zeros(2, np.int32), np.zeros(3), 0, np.zeros(1, np.int32), np.zeros(6), np.zeros(3, np.int32))
+    return (len(convection.inside), np.ascontiguousarray(convection.inside_nodes, dtype=np.int32).ravel(),
+            np.ascontiguousarray(convection.inside, dtype=float).ravel(), len(convection.outside),
+            np.ascontiguousarray(convection.outside_nodes, dtype=np.int32),
+            np.ascontiguousarray(convection.outside, dtype=float).ravel(),
+            np.ascontiguousarray(convection.columns, dtype=np.int32))

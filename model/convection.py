@@ -81,3 +81,49 @@ def simple_inside(tilt, warmer=True):
         return SIMPLE_INSIDE["vertical"]
     unstable, stable = SIMPLE_INSIDE["horizontal" if c > 0.99 else "tilted"]
     return unstable if (tilt > 90) == warmer else stable
+
+
+# The steps' coefficients (docs/model.md section 3.6): the functions below take arrays of faces and
+# are what the direct model, the Python FMU and, in C, model/c/steps.c evaluate at every step.
+
+# EnergyPlus's floor on a face's inside coefficient (HeatBalanceAlgorithm's low limit), W/m2/K: a
+# face at the air's temperature still exchanges a little
+INSIDE_FLOOR = 0.1
+
+
+def tarp_natural(delta_T, cos_up):
+    """TARP's natural convection (W/m2/K) of faces at delta_T = T_s - T_air (K) whose normal into
+    the air makes cos_up with the vertical (1 a face looking up, 0 a wall, -1 looking down):
+    Walton's unstable 9.482 |dT|^(1/3) / (7.238 - |cos|) where the heat rises off the face (a warm
+    face looking up, a cool one looking down), else the stable 1.810 |dT|^(1/3) / (1.382 + |cos|);
+    on a wall (|cos| < 1e-6) ASHRAE's 1.31 |dT|^(1/3), which both come within 3e-4 of."""
+    delta_T, cos_up = np.asarray(delta_T, dtype=float), np.asarray(cos_up, dtype=float)
+    root, c = np.cbrt(np.abs(delta_T)), np.abs(cos_up)
+    unstable = delta_T * cos_up > 0.0
+    walton = np.where(unstable, 9.482 * root / (7.238 - c), 1.810 * root / (1.382 + c))
+    return np.where(c < 1e-6, 1.31 * root, walton)
+
+
+def tarp_inside_faces(delta_T, cos_up):
+    """EnergyPlus's TARP inside coefficient (W/m2/K): `tarp_natural`, at least `INSIDE_FLOOR`."""
+    return np.maximum(tarp_natural(delta_T, cos_up), INSIDE_FLOOR)
+
+
+def windward_faces(cos_up, azimuth, direction):
+    """Whether faces (their normal's cos_up with the vertical, azimuth deg from north) are
+    windward of a wind from `direction` (deg from north): as EnergyPlus takes it, a face within
+    0.98 of horizontal always, any other where the wind comes from within 90 deg of its normal."""
+    diff = np.abs(np.asarray(direction, dtype=float) - azimuth)
+    diff = np.where(diff - 180.0 > 0.001, diff - 360.0, diff)
+    return (np.abs(cos_up) >= 0.98) | (np.abs(diff) - 90.0 <= 0.001)
+
+
+def doe2_faces(speed, windward, delta_T, cos_up, roughness):
+    """DOE-2's exterior convective coefficient (W/m2/K) of faces at a local wind `speed` (m/s),
+    windward or not, at delta_T = T_e - T_out (K), of roughness multipliers R_f:
+    h = h_n + R_f (sqrt(h_n^2 + (a V^b)^2) - h_n), h_n `tarp_natural`, MoWiTT's (a, b) windward
+    (3.26, 0.89) or leeward (3.55, 0.617)."""
+    h_n = tarp_natural(delta_T, cos_up)
+    speed = np.maximum(np.asarray(speed, dtype=float), 0.0)
+    forced = np.where(windward, WINDWARD[0] * speed ** WINDWARD[1], LEEWARD[0] * speed ** LEEWARD[1])
+    return h_n + roughness * (np.sqrt(h_n ** 2 + forced ** 2) - h_n)

@@ -288,7 +288,7 @@ class ImplicitEuler:
         values[at] = diagonal[at]
         return (starts, rows), values
 
-    def run(self, T, sources, forced, imposed=None, switched=None, rows=None):
+    def run(self, T, sources, forced, imposed=None, switched=None, rows=None, inputs=None):
         """The temperatures of the nodes `rows` (indices, default every node) after each of L steps
         under one mask and switched conductances, (L, len(rows)), and every node's after the last
         (N,): compiled (`model.compiled`) where a C compiler is found, else step by step (`step`).
@@ -301,21 +301,26 @@ class ImplicitEuler:
         imposed : (L, N) each step's imposed temperatures (C), read where forced; None: zero (the
             temperatures' derivatives, which no parameter moves at a forced node)
         switched : (N,) the steps' switched conductances (`Network.switched_diagonal`), or None
+        inputs : (L, n_inputs) each step's inputs, from which and the temperatures before it the
+            network's `convection` adds its lagged source; None: no such source (the derivatives,
+            along which it is held frozen)
         """
         from . import compiled  # not in the Python FMU, which steps one doStep at a time
         rows = np.arange(len(T)) if rows is None else np.asarray(rows, dtype=int)
         index = np.flatnonzero(forced)
+        convection = None if inputs is None else self.network.convection
         if compiled.available():
             return compiled.steps(self.matrix(forced, switched), self.c_dt, sources, index,
-                                  None if imposed is None else imposed[:, index], T, rows)
+                                  None if imposed is None else imposed[:, index], T, rows, convection)
         zero = np.zeros(len(T))
         out = np.empty((len(sources), len(rows)))
         for k, source in enumerate(sources.dense()):
-            T = self.step(T, source, forced, zero if imposed is None else imposed[k], switched)
+            T = self.step(T, source, forced, zero if imposed is None else imposed[k], switched,
+                          None if convection is None else inputs[k])
             out[k] = T[rows]
         return out, T
 
-    def step(self, T, source, forced, T_forced, switched=None):
+    def step(self, T, source, forced, T_forced, switched=None, inputs=None):
         """Temperatures (C) at t_n+1 from T at t_n.
 
         Parameters
@@ -325,9 +330,13 @@ class ImplicitEuler:
         forced : (N,) bool, nodes imposed this step (their measurement exists at t_n+1)
         T_forced : (N,) imposed temperatures (C); read only where `forced`
         switched : (N,) the switched conductances at t_n+1 (`Network.switched_diagonal`), or None
+        inputs : (n_inputs,) the inputs at t_n+1, from which and T the network's `convection`, if
+            any, adds its lagged source (docs/model.md section 3.6); None: no such source
         """
         v = self.c_dt * T
         v += source
+        if inputs is not None and self.network.convection is not None:
+            v += self.network.convection.source(T, inputs)
         solve, index = self.solver(forced, switched)
         if not len(index):
             return solve(v)
@@ -606,7 +615,7 @@ class Plan:
             u, held, values = self.steady
             steady_stepper = ImplicitEuler(network, STEADY_STEP) if steady_stepper is None else steady_stepper
             switched, sources = network.switched_diagonal(u), Sources(*network.source_terms(u[None]))
-            before, (_, T) = T, steady_stepper.run(T, sources, held, values[None], switched)
+            before, (_, T) = T, steady_stepper.run(T, sources, held, values[None], switched, inputs=u[None])
             if derivatives:
                 _, S = sensitivity_steps(steady_stepper, network, derivatives, S, before[None], T[None], u[None],
                                          sources.terms, held, switched, [], [])
@@ -648,7 +657,9 @@ def steps(stepper, network, T, inputs, forced, imposed, kept, outputs, derivativ
     kept, outputs : indices of the steps and the nodes returned
     """
     from . import compiled  # not in the Python FMU, which steps one doStep at a time
-    modal = not compiled.available()
+    # a lagged source reads each step's start: no run of such steps is solved in its modes
+    modal = not compiled.available() and network.convection is None
+    lagged = None if network.convection is None else inputs
     terms, B, q = network.source_terms(inputs)
     switched = network.switched_diagonal(inputs)  # None where nothing switches
     bounds = runs(forced, switched)
@@ -674,7 +685,7 @@ def steps(stepper, network, T, inputs, forced, imposed, kept, outputs, derivativ
                                          kept[here] - a, outputs)
         else:  # every node's path where the derivatives' sources read it
             path, T = stepper.run(T, Sources(terms[a:b], B, q), mask, imposed[a:b], g,
-                                  None if derivatives else outputs)
+                                  None if derivatives else outputs, None if lagged is None else lagged[a:b])
             out[here] = path[kept[here] - a][:, outputs] if derivatives else path[kept[here] - a]
         if derivatives:
             d_out[here], S = sensitivity_steps(stepper, network, derivatives, S, np.vstack([before[None], path[:-1]]),

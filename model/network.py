@@ -12,6 +12,9 @@ fixed boundary and supply temperatures) go to q (W) rather than to a constant in
 holds only what varies in time. The transmitted solar of a shaded glazing, tau s(t) A I(t), is
 the product of two inputs: `products` holds those terms, and `sources` adds them, so the
 network stays linear in the temperatures and M is still factorised once per forcing mask.
+Convective coefficients that follow the state (docs/model.md section 3.6) keep their declared
+value in A; the rest is `convection`, a source each step evaluates from the temperatures at its
+start.
 """
 from dataclasses import dataclass
 from functools import cached_property
@@ -20,12 +23,53 @@ import numpy as np
 
 from .building import DAY_TERMS, Adiabatic, Boundary, Exterior, Surface
 from .building_file import schema_default
+from .convection import doe2_faces, tarp_inside_faces, windward_faces
 from .discretise import capacities, conductances
 from .longwave import enclosure_exchange
 
 AIR_DENSITY = schema_default("site", "air_density")  # kg/m3, a building file's default
 C_AIR = 1005.0  # J/kg/K
 RHO_C_AIR = AIR_DENSITY * C_AIR  # J/m3/K
+# the weather's inputs an exterior face's convection reads: m/s at the station, deg from north
+WIND_SPEED, WIND_DIRECTION = "wind_speed", "wind_direction"
+
+
+@dataclass(frozen=True)
+class Convection:
+    """The convective coefficients computed at every step (docs/model.md section 3.6): the step
+    matrix holds each face's declared h0, and the rest, from the temperatures before the step and
+    the inputs at its end, is a source: inside, A phi (h(T_s - T_air) - h0) (T_air - T_s) on the
+    face and its negative on the air (what one gains the other loses); outside,
+    A (h(V, windward, T_e - T_out) - h0) (T_out - T_e) on the face.
+
+    inside: ((face node, air node) int (n, 2), (A phi m2, h0 W/m2/K, cos_up) (n, 3)), cos_up the
+    cosine of the face's normal into the air with the vertical; outside: (face node int (m,),
+    (A m2, h0 W/m2/K, cos_up, azimuth deg, roughness multiplier R_f, wind factor V_z / V_met)
+    (m, 6)); columns: the input indices of T_out, the wind speed and direction (-1 without an
+    outside face)."""
+    inside_nodes: np.ndarray
+    inside: np.ndarray
+    outside_nodes: np.ndarray
+    outside: np.ndarray
+    columns: tuple
+
+    def source(self, T, u):
+        """(N,) W of the temperatures T (N,) before the step (C) and the inputs u at its end."""
+        q = np.zeros(len(T))
+        if len(self.inside):
+            face, air = self.inside_nodes.T
+            area, h0, cos_up = self.inside.T
+            dT = T[air] - T[face]
+            flow = area * (tarp_inside_faces(-dT, cos_up) - h0) * dT
+            np.add.at(q, face, flow)
+            np.add.at(q, air, -flow)
+        if len(self.outside):
+            t_out, speed, direction = (u[j] for j in self.columns)
+            area, h0, cos_up, azimuth, roughness, wind = self.outside.T
+            dT = t_out - T[self.outside_nodes]
+            h = doe2_faces(wind * speed, windward_faces(cos_up, azimuth, direction), -dT, cos_up, roughness)
+            np.add.at(q, self.outside_nodes, area * (h - h0) * dT)
+        return q
 
 
 @dataclass(frozen=True)
@@ -37,6 +81,7 @@ class Network:
     input_names: tuple  # names of the columns of B
     products: tuple = ()  # (node index, input a, input b, coefficient): coefficient u_a u_b W
     switched: tuple = ()  # (node index, input j, g): a conductance g u_j (W/K) from the node to T_out
+    convection: Convection | None = None  # coefficients that follow the state, lagged a step
 
     @property
     def n_nodes(self):
@@ -211,7 +256,7 @@ def moved(network, derivatives, steps):
         switched.append((node, j, g if (node, j) in seen else g + G[node, j]))
         seen.add((node, j))
     return Network(C=C, A=A, B=B[:, :n], q=q, input_names=network.input_names, products=products,
-                   switched=tuple(switched))
+                   switched=tuple(switched), convection=network.convection)
 
 
 def input_names(building):
@@ -219,8 +264,9 @@ def input_names(building):
     irradiance = tuple(dict.fromkeys(c.irradiance_input for c in building.exterior_components))
     named = tuple(n for n in building.input_columns if n not in irradiance)
     transmitted = tuple(c.transmitted_input for c in building.components if c.angular is not None)
+    wind = (WIND_SPEED, WIND_DIRECTION) if any(c.outside.convection for c in building.exterior_components) else ()
     return (("T_out", "T_sky") + irradiance + named + clock_input_names(building) + transmitted
-            + building.schedule_inputs)
+            + building.schedule_inputs + wind)
 
 
 def clock_input_names(building):
@@ -277,7 +323,7 @@ def assemble(building, names=None):
     A = np.zeros((n, n))
     B = np.zeros((n, len(names)))
     q = np.zeros(n)
-    products, switched = [], []
+    products, switched, inside, outside = [], [], [], []
 
     def link(i, j, g):
         """A conductance g (W/K) between nodes i and j (0-based)."""
@@ -298,11 +344,13 @@ def assemble(building, names=None):
         else:
             q[node] += g * temperature
 
-    def to_zone(node, area, surface):
+    def to_zone(node, area, surface, cos_up):
         zone = building.zone(surface.zone)
         link(node, zone.air_node - 1, area * surface.h_conv * zone.convection_factor)
         if zone.longwave == "radiant_node":
             link(node, zone.radiant_node - 1, area * surface.h_rad)
+        if zone.inside_convection_algorithm == "tarp":
+            inside.append(((node, zone.air_node - 1), (area * zone.convection_factor, surface.h_conv, cos_up)))
 
     # where the radiant part of a zone's gains goes: [(node, share)], its radiant node or its faces
     absorbers = {}
@@ -337,7 +385,9 @@ def assemble(building, names=None):
         C[idx] += c.area * capacities(c.layers, c.depths) * c.capacity_factor
         for k, g in enumerate(conductances(c.layers, c.depths)):
             link(idx[k], idx[k + 1], c.area * g * c.conductivity_factor * materials * boundary)
-        to_zone(idx[0], c.area, c.inside)
+        # the inside face's normal points into its zone, against the outside's
+        cos_up = float(np.cos(np.radians(c.tilt)))
+        to_zone(idx[0], c.area, c.inside, -cos_up)
         if isinstance(out, Exterior):
             F = sky_view_factor(c.tilt) if out.sky_view_factor is None else out.sky_view_factor
             A[e, e] -= c.area * (out.h_conv + out.h_rad)
@@ -346,8 +396,11 @@ def assemble(building, names=None):
             B[e, col[c.irradiance_input]] += c.area * out.solar_absorptance
             # a glazing's inner panes absorb part of the sun at the inside face (docs/model.md 4.1)
             B[idx[0], col[c.irradiance_input]] += c.area * c.inner_solar_absorptance
+            if out.convection is not None:
+                v = out.convection
+                outside.append((e, (c.area, out.h_conv, cos_up, c.azimuth, v.roughness, v.wind_factor)))
         elif isinstance(out, Surface):
-            to_zone(e, c.area, out)
+            to_zone(e, c.area, out, cos_up)
         elif isinstance(out, Boundary):
             to_temperature(e, c.area * out.h * boundary, out.temperature)
         else:
@@ -429,7 +482,16 @@ def assemble(building, names=None):
                 B[air, col[name]] += gain * (1.0 - f_r)
                 for r, w in radiant:
                     B[r, col[name]] += gain * f_r * w
-    return Network(C=C, A=A, B=B, q=q, input_names=names, products=tuple(products), switched=tuple(switched))
+    convection = None
+    if inside or outside:
+        convection = Convection(
+            inside_nodes=np.array([n for n, _ in inside], dtype=int).reshape(-1, 2),
+            inside=np.array([v for _, v in inside], dtype=float).reshape(-1, 3),
+            outside_nodes=np.array([n for n, _ in outside], dtype=int),
+            outside=np.array([v for _, v in outside], dtype=float).reshape(-1, 6),
+            columns=tuple(col.get(name, -1) for name in ("T_out", WIND_SPEED, WIND_DIRECTION)))
+    return Network(C=C, A=A, B=B, q=q, input_names=names, products=tuple(products), switched=tuple(switched),
+                   convection=convection)
 
 
 def face_heat_flux(building, network, T, U, component, face):

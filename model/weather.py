@@ -12,7 +12,7 @@ from nodeforce.model.errors import InputError
 REQUIRED_COLUMNS = ("T_out",)
 #: Needed only where some exterior face's irradiance is computed rather than measured.
 IRRADIANCE_COLUMNS = ("ghi", "dni", "dhi")
-OPTIONAL_COLUMNS = ("T_sky", "ir_h")
+OPTIONAL_COLUMNS = ("T_sky", "ir_h", "wind_speed", "wind_direction")
 TEMPERATURE_COLUMNS = ("T_out", "T_sky")
 
 #: Two weather rows further apart than this many typical (median) steps bound a gap: samples

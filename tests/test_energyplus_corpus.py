@@ -41,7 +41,7 @@ def test_each_shipped_idf_converts_or_is_refused_in_one_line(idf, tmp_path):
         sun = np.clip(np.sin(np.pi * (hour - 13) / 10), 0, None)  # a day of sun around 20:00 UTC (US noon)
         path = tmp_path / "w.csv"
         pd.DataFrame({"time": [t.isoformat() for t in times], "T_out": -5.0, "ghi": 500 * sun, "dni": 700 * sun,
-                      "dhi": 100 * sun}).to_csv(path, index=False)
+                      "dhi": 100 * sun, "wind_speed": 4.0, "wind_direction": 200.0}).to_csv(path, index=False)
         b = parse_building(data, source=str(tmp_path / "b.json"))
         T = simulate_building(b, read_weather(path))
         assert np.isfinite(np.array([T[f"T{z.air_node}"].to_numpy() for z in b.zones])).all()

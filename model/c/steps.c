@@ -12,10 +12,54 @@
    eliminates last, so L and U hold about as many entries as M. No pivoting: M is an M-matrix
    (its diagonal the node's capacity over the step and conductances, at least the sum of its
    row's links), and a forced row a unit row. Each step is then two sparse triangular solves,
-   O(entries), where a product with the dense inverse is O(N^2). */
+   O(entries), where a product with the dense inverse is O(N^2).
+
+   Where a building's convective coefficients follow its state (model/network.py, `Convection`;
+   docs/model.md section 3.6), each step adds to its sources what the coefficients computed
+   from the temperatures before it and its inputs give beyond the h0 of M: the same arithmetic as
+   model/convection.py's, face by face. */
+#include <math.h>
 #include <stdlib.h>
 
 #define EXPORT __attribute__((visibility("default")))
+#define INSIDE_FLOOR 0.1 /* W/m2/K, model/convection.py */
+
+/* TARP's natural convection (W/m2/K) at dT = T_s - T_air, cos_up the face's normal into the air
+   with the vertical: ASHRAE's on a wall, else Walton's unstable where the heat rises off the face,
+   else stable */
+static double tarp_natural(double dT, double cos_up) {
+    const double root = cbrt(fabs(dT)), c = fabs(cos_up);
+    if (c < 1e-6) return 1.31 * root;
+    return dT * cos_up > 0.0 ? 9.482 * root / (7.238 - c) : 1.810 * root / (1.382 + c);
+}
+
+/* The lagged convection's sources (W) into q (N), from T (N) before the step and the step's
+   inputs u: inside, per face, (face, air) and (A phi, h0, cos_up); outside, per face, its node
+   and (A, h0, cos_up, azimuth, R_f, wind factor); columns: u's T_out, wind speed and direction */
+static void convection(int n, const double *T, const double *u, int n_inside, const int *inside_nodes,
+                       const double *inside, int n_outside, const int *outside_nodes, const double *outside,
+                       const int *columns, double *q) {
+    int k;
+    for (k = 0; k < n; k++) q[k] = 0.0;
+    for (k = 0; k < n_inside; k++) {
+        const int face = inside_nodes[2 * k], air = inside_nodes[2 * k + 1];
+        const double *v = inside + 3 * k, dT = T[air] - T[face];
+        double h = tarp_natural(-dT, v[2]);
+        if (h < INSIDE_FLOOR) h = INSIDE_FLOOR;
+        q[face] += v[0] * (h - v[1]) * dT;
+        q[air] -= v[0] * (h - v[1]) * dT;
+    }
+    for (k = 0; k < n_outside; k++) {
+        const int face = outside_nodes[k];
+        const double *v = outside + 6 * k, dT = u[columns[0]] - T[face];
+        const double speed = u[columns[1]] * v[5] > 0.0 ? u[columns[1]] * v[5] : 0.0;
+        const double h_n = tarp_natural(-dT, v[2]);
+        double diff = fabs(u[columns[2]] - v[3]), forced;
+        if (diff - 180.0 > 0.001) diff -= 360.0;
+        forced = fabs(v[2]) >= 0.98 || fabs(diff) - 90.0 <= 0.001 ? 3.26 * pow(speed, 0.89) : 3.55 * pow(speed, 0.617);
+        q[face] += v[0] * (h_n + v[4] * (sqrt(h_n * h_n + forced * forced) - h_n) - v[1]) * dT;
+    }
+}
 
 /* order (N): the node of each position of the elimination order; lower_ptr/lower_col (N + 1,
    and columns): each row's entries of L left of the diagonal, in increasing column;
@@ -25,20 +69,25 @@
    of B, by term; q (N). forced (n_forced): the nodes imposed at every step, imposed (L x
    n_forced) their temperatures. T (N): the temperatures before the first step, after the last
    on return; path (L x R): the temperatures of the nodes rows (R) after each step. Returns 1, or
-   0 where a pivot is zero (M singular) or memory runs out. */
+   0 where a pivot is zero (M singular) or memory runs out. n_inside ... columns: the lagged
+   convection (`convection`), u each step's first columns of terms (the inputs). */
 EXPORT int nodeforce_steps(int n, const int *order, const int *lower_ptr, const int *lower_col,
                            const int *upper_ptr, const int *upper_col, long nonzeros, const int *slot,
                            const double *value, const double *c, long L, int m, const double *terms,
                            const int *source_ptr, const int *source_col, const double *source_value,
                            const double *q, int n_forced, const int *forced, const double *imposed, double *T,
-                           int n_rows, const int *rows, double *path) {
+                           int n_rows, const int *rows, double *path, int n_inside, const int *inside_nodes,
+                           const double *inside, int n_outside, const int *outside_nodes, const double *outside,
+                           const int *columns) {
     long entries = (long)n + lower_ptr[n] + upper_ptr[n], s, e;
     double *f = calloc((size_t)entries + 1, sizeof(double)), *w = calloc((size_t)n + 1, sizeof(double));
     double *y = malloc(((size_t)n + 1) * sizeof(double));
     int *position = malloc(((size_t)n + 1) * sizeof(int));
+    const int lagged = n_inside > 0 || n_outside > 0;
+    double *extra = calloc((size_t)n + 1, sizeof(double));
     double *diagonal = f, *lower = f + n, *upper = f + n + lower_ptr[n];
     int i, p, k, ok = 0;
-    if (!f || !w || !y || !position) goto done;
+    if (!f || !w || !y || !position || !extra) goto done;
     for (e = 0; e < nonzeros; e++) f[slot[e]] += value[e];
     /* row by row (Doolittle): row i less its multiples of the rows above it that L says */
     for (i = 0; i < n; i++) {
@@ -60,9 +109,11 @@ EXPORT int nodeforce_steps(int n, const int *order, const int *lower_ptr, const 
     for (s = 0; s < L; s++) {
         const double *t_s = terms + s * m;
         double *out = path + s * n_rows;
+        if (lagged)
+            convection(n, T, t_s, n_inside, inside_nodes, inside, n_outside, outside_nodes, outside, columns, extra);
         for (i = 0; i < n; i++) {
             const int node = order[i];
-            double sum = q[node];
+            double sum = q[node] + extra[node];
             for (p = source_ptr[node]; p < source_ptr[node + 1]; p++) sum += source_value[p] * t_s[source_col[p]];
             /* a node without capacity (c = 0) has no past to carry, whatever T held */
             y[i] = c[node] != 0.0 ? c[node] * T[node] + sum : sum;
@@ -83,6 +134,6 @@ EXPORT int nodeforce_steps(int n, const int *order, const int *lower_ptr, const 
     }
     ok = 1;
 done:
-    free(f); free(w); free(y); free(position);
+    free(f); free(w); free(y); free(position); free(extra);
     return ok;
 }

@@ -1,0 +1,159 @@
+"""Convective coefficients that follow the state (docs/model.md section 3.6): EnergyPlus's TARP and
+DOE-2 by hand, the lagged source's energy balance and limit, and the same steps in numpy, in C and
+through the Python FMU."""
+import copy
+
+import numpy as np
+import pytest
+
+from nodeforce.model import compiled
+from nodeforce.model.building_file import parse_building
+from nodeforce.model.case import prepare_case
+from nodeforce.model.convection import doe2_faces, tarp_inside_faces, windward_faces
+from nodeforce.model.errors import InputError
+from nodeforce.model.integrate import simulate
+from nodeforce.model.network import WIND_DIRECTION, WIND_SPEED, assemble
+
+
+def followed(data, roughness=1.67, wind_factor=0.9):
+    """The building with TARP inside every zone and DOE-2 outside every exterior face."""
+    data = copy.deepcopy(data)
+    for z in data["zones"]:
+        z["inside_convection_algorithm"] = "tarp"
+    for c in data["components"]:
+        if c["outside"]["type"] == "exterior":
+            c["outside"]["convection"] = {"algorithm": "doe2", "roughness": roughness, "wind_factor": wind_factor}
+    return data
+
+
+def windy(weather):
+    """The weather with a wind that rises and falls and turns round the compass every 30 h."""
+    w = weather.copy()
+    hours = (w.index - w.index[0]).total_seconds().to_numpy() / 3600.0
+    w[WIND_SPEED] = 3.0 + 2.5 * np.sin(2 * np.pi * hours / 17.0)
+    w[WIND_DIRECTION] = (12.0 * hours) % 360.0
+    return w
+
+
+def test_a_wall_4_K_warmer_than_the_air_gets_ashrae_s_vertical_coefficient():
+    # Engineering Reference, ASHRAE vertical wall: h = 1.31 |dT|^(1/3) = 1.31 * 1.587401 = 2.079495
+    assert tarp_inside_faces(4.0, 0.0) == pytest.approx(2.079495, abs=1e-6)
+    assert tarp_inside_faces(-4.0, 0.0) == pytest.approx(2.079495, abs=1e-6)
+
+
+def test_a_warm_floor_is_unstable_and_a_warm_ceiling_stable():
+    # a floor 3 K warmer than the room looks up (cos_up 1): Walton's unstable
+    # 9.482 |dT|^(1/3) / (7.238 - |cos|) = 9.482 * 1.44225 / 6.238 = 2.1922
+    assert tarp_inside_faces(3.0, 1.0) == pytest.approx(2.1922, abs=1e-4)
+    # a ceiling 3 K warmer looks down: the stable 1.810 |dT|^(1/3) / (1.382 + |cos|) = 1.0959
+    assert tarp_inside_faces(3.0, -1.0) == pytest.approx(1.0959, abs=1e-4)
+    # a face at the air's temperature keeps EnergyPlus's floor of 0.1 W/m2/K
+    assert tarp_inside_faces(0.0, 1.0) == 0.1
+
+
+def test_a_roof_windward_at_5_m_s_gets_doe2_s_coefficient():
+    # a Rough roof (R_f 1.67) 2 K colder than the air at a local wind of 5 m/s: stable natural
+    # convection h_n = 1.810 * 2^(1/3) / 2.382 = 0.95737; MoWiTT windward a V^b = 3.26 * 5^0.89 =
+    # 3.26 * 4.18874 = 13.6553; h = h_n + R_f (sqrt(h_n^2 + 13.6553^2) - h_n) = 0.95737 + 1.67 * 12.7314
+    # = 22.2189
+    windward = windward_faces(1.0, 0.0, 123.0)
+    assert windward
+    assert doe2_faces(5.0, windward, -2.0, 1.0, 1.67) == pytest.approx(22.2189, abs=1e-3)
+    # the same roof leeward would take (3.55, 0.617): 3.55 * 5^0.617 = 9.5828
+    leeward = 0.95737 + 1.67 * (np.hypot(0.95737, 3.55 * 5 ** 0.617) - 0.95737)
+    assert doe2_faces(5.0, False, -2.0, 1.0, 1.67) == pytest.approx(leeward, abs=1e-3)
+
+
+def test_a_wall_is_windward_where_the_wind_comes_from_within_90_degrees_of_its_normal():
+    south = dict(cos_up=0.0, azimuth=180.0)
+    assert windward_faces(direction=200.0, **south)
+    assert windward_faces(direction=91.0, **south)
+    assert not windward_faces(direction=0.0, **south)
+    assert not windward_faces(direction=300.0, **south)
+    # a north wall with the wind from 350 or 10 deg: across north, 10 and 20 deg from its normal
+    assert windward_faces(0.0, 0.0, 350.0) and windward_faces(0.0, 0.0, 10.0)
+
+
+def test_what_the_faces_gain_the_air_loses(testcell_data):
+    data = followed(testcell_data)
+    for c in data["components"]:  # inside convection alone
+        c["outside"].pop("convection", None)
+    building = parse_building(data)
+    network = assemble(building)
+    rng = np.random.default_rng(1)
+    T = 20.0 + 5.0 * rng.standard_normal(network.n_nodes)
+    q = network.convection.source(T, np.zeros(len(network.input_names)))
+    air = building.zones[0].air_node - 1
+    faces = network.convection.inside_nodes[:, 0]
+    assert np.count_nonzero(q[faces]) == len(faces)
+    assert q[air] == pytest.approx(-q[faces].sum(), rel=1e-12)
+    assert abs(q.sum()) < 1e-12 * np.abs(q).sum()
+    # each face's term is A (h(dT) - h0) (T_air - T_s) by TARP's formula
+    k = 0
+    face, (area, h0, cos_up) = faces[k], network.convection.inside[k]
+    h = tarp_inside_faces(T[face] - T[air], cos_up)
+    assert q[face] == pytest.approx(area * (h - h0) * (T[air] - T[face]), rel=1e-12)
+
+
+def test_a_building_at_one_temperature_steps_as_with_constant_coefficients(testcell_data):
+    """The limit: every face at the air's temperature and the outdoors' leaves no lagged source,
+    and the building with the option steps as the one without (to the rounding of the solves,
+    which leave the nodes 1e-14 K apart)."""
+    plain, with_option = parse_building(testcell_data), parse_building(followed(testcell_data))
+    n0, n1 = assemble(plain), assemble(with_option)
+    L = 200
+    U = np.zeros((L + 1, len(n1.input_names)))
+    U[:, n1.input_names.index("T_out")] = U[:, n1.input_names.index("T_sky")] = 20.0
+    U[:, n1.input_names.index(WIND_SPEED)] = 4.0
+    U[:, n1.input_names.index(WIND_DIRECTION)] = 180.0
+    T0 = simulate(plain, n0, U[:, :len(n0.input_names)], 300.0, warmup_days=0)
+    T1 = simulate(with_option, n1, U, 300.0, warmup_days=0)
+    assert np.abs(T1 - T0).max() < 1e-12
+    assert np.abs(T1 - 20.0).max() < 1e-12
+
+
+def test_the_coefficients_move_the_air_and_c_and_numpy_step_alike(testcell_data, weather, monkeypatch):
+    from tests.conftest import record_times
+    building, plain = parse_building(followed(testcell_data)), parse_building(testcell_data)
+    w = windy(weather)
+    times = record_times(days=3)
+    w = w[(w.index >= times[0] - np.timedelta64(2, "h")) & (w.index <= times[-1] + np.timedelta64(2, "h"))]
+    case = prepare_case(building, w)
+    network = assemble(building)
+    T = simulate(building, network, case.U, case.dt, substeps=case.substeps)
+    constant = simulate(plain, assemble(plain), case.U[:, :-2], case.dt, substeps=case.substeps)
+    air = building.zones[0].air_node - 1
+    assert np.abs(T[:, air] - constant[:, air]).max() > 0.1
+    if compiled.available():
+        monkeypatch.setattr(compiled, "available", lambda: False)
+        stepped = simulate(building, network, case.U, case.dt, substeps=case.substeps)
+        assert np.abs(stepped - T).max() < 1e-10 * np.abs(T).max()
+
+
+def test_the_weather_must_give_the_wind(testcell_data, weather):
+    with pytest.raises(InputError, match="wind_speed|wind_direction"):
+        prepare_case(parse_building(followed(testcell_data)), weather)
+
+
+def test_the_standalone_fmu_refuses_coefficients_that_follow_the_state(testcell_data, tmp_path):
+    from nodeforce.fmu_build.standalone import network_terms
+    with pytest.raises(InputError, match="inside_convection_algorithm.*standalone C FMU"):
+        network_terms(parse_building(followed(testcell_data)), None)
+
+
+@pytest.mark.slow
+def test_the_python_fmu_steps_as_the_direct_model(testcell_data, weather, tmp_path):
+    from nodeforce.cosim.fmi import FmuInstance
+    from nodeforce.cosim.run import simulate_fmu
+    from nodeforce.fmu_build.build import build_fmu
+    from tests.conftest import record_times
+    building = parse_building(followed(testcell_data))
+    times = record_times(days=2)
+    w = windy(weather)
+    w = w[(w.index >= times[0] - np.timedelta64(2, "h")) & (w.index <= times[-1] + np.timedelta64(2, "h"))]
+    case = prepare_case(building, w)
+    direct = simulate(building, assemble(building), case.U, case.dt, case.measured, substeps=case.substeps)
+    fmu = build_fmu(building, tmp_path / "followed.fmu")
+    with FmuInstance(fmu) as instance:
+        through_fmu = simulate_fmu(instance, case)
+    assert np.abs(through_fmu - direct).max() < 1e-9
