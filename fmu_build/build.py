@@ -36,8 +36,8 @@ SLAVE = Path(__file__).with_name("slave.py")
 VARIABLES = Path(__file__).with_name("variables.py")
 MODEL_DIR = Path(model.__file__).parent
 # The modules the FMU imports; weather and solar stay outside (their results are inputs).
-PHYSICS_MODULES = ("__init__", "errors", "building", "building_file", "discretise", "schedule", "effects", "network",
-                   "modal", "integrate")
+PHYSICS_MODULES = ("__init__", "errors", "building", "building_file", "geometry", "discretise", "schedule", "effects",
+                   "network", "modal", "integrate")
 SCHEMA = "data/nodal-building.schema.json"
 
 
