@@ -98,14 +98,20 @@ def sunlit_fraction(vertices, normal, shades, sun, holes=()):
         return fraction
     s, cos = s[lit], cos[lit]
     axes = np.column_stack(plane_axes(n))
-    shadows = []
-    for p in front:
+    low, high = np.array(face.bounds[:2]), np.array(face.bounds[2:])
+    shadows = np.full((len(front), len(s)), None, dtype=object)
+    for k, p in enumerate(front):
         depth = (p - origin) @ n  # (m,), m in front of the plane
         projected = p[None, :, :] - s[:, None, :] * (depth[None, :] / cos[:, None])[:, :, None]
         rings = (projected - origin) @ axes  # (T, m, 2) in the face's axes
-        shadows.append(shapely.make_valid(shapely.polygons(rings)))
-    shadow = shapely.union_all(shapely.intersection(np.array(shadows), face), axis=0)
-    fraction[lit] = 1.0 - shapely.area(shadow) / face.area
+        # GEOS only where the shadow's bounding box meets the face's: most of a building's
+        # surfaces shade a face at few hours
+        meets = np.all((rings.min(axis=1) < high) & (rings.max(axis=1) > low), axis=1)
+        shadows[k, meets] = shapely.intersection(shapely.make_valid(shapely.polygons(rings[meets])), face)
+    hit = np.flatnonzero((shadows != None).any(axis=0))  # noqa: E711 (elementwise on objects)
+    shaded = np.zeros(len(s))
+    shaded[hit] = shapely.area(shapely.union_all(shadows[:, hit], axis=0))
+    fraction[lit] = 1.0 - shaded / face.area
     return np.clip(fraction, 0.0, 1.0)
 
 
