@@ -930,9 +930,6 @@ class _Converter:
         self.internal_masses(components)
         self.receivers(components)
         self.list_not_modelled()
-        if any(w["type"].lower() in ("window", "glassdoor") for s in surfaces.values() for w in s["subsurfaces"]):
-            self.note("the building's own surfaces cast no shadow on its windows and walls (EnergyPlus's "
-                      "self-shading is not held)")
         names = [b.name for b in self.r.all("Building")]
         description = (f"Converted by nodeforce convert from {self.r.source} (EnergyPlus "
                        f"{'.'.join(map(str, self.r.doc.version[:2]))}). Surface coefficients are the converter's "
@@ -1383,9 +1380,11 @@ class _Converter:
     def shading(self, components, surfaces):
         """The building file's `shading`: every shading object's polygon (true-north coordinates, m,
         as EnergyPlus builds it), with the sunlit exterior faces it stands in front of
-        (`may_shade`); those faces get their polygon (`vertices`, their windows as `holes`). A
-        shading object's transmittance schedule is listed, the surface held opaque. Under the
-        IDF's MinimalShadowing solar distribution EnergyPlus casts no shadow outside: none."""
+        (`may_shade`), and every outdoor surface of the building with the faces it and they stand
+        in front of each other; those faces get their polygon (`vertices`, their windows as
+        `holes`). A shading object's transmittance schedule is listed, the surface held opaque.
+        Under the IDF's MinimalShadowing solar distribution EnergyPlus casts no shadow outside:
+        none."""
         buildings = self.r.all("Building")
         if buildings and self.r.text(buildings[0], "solar_distribution").lower() == "minimalshadowing":
             if any(self.r.all(kind) for kind in SHADING):
@@ -1425,6 +1424,17 @@ class _Converter:
             named = [c["name"] for c in faces if may_shade(polygon, c["_polygon"][0], normals[c["name"]])]
             if named:
                 out.append({"name": name, "vertices": _rounded(polygon), "faces": named})
+        # the building shades itself (EnergyPlus's self-shading): an outdoor surface shades a face
+        # only where each stands in front of the other's plane, a ray reaching a surface from
+        # behind having crossed the building before
+        for s in surfaces.values():
+            if s["vertices"] is None or s["boundary"].lower() != "outdoors":
+                continue
+            normal = geometry.outward_normal(s["vertices"], self.ccw)
+            named = [c["name"] for c in faces if may_shade(s["vertices"], c["_polygon"][0], normals[c["name"]])
+                     and may_shade(c["_polygon"][0], s["vertices"], normal)]
+            if named:
+                out.append({"name": s["obj"].name, "vertices": _rounded(s["vertices"]), "faces": named})
         shaded = {name: [s["vertices"] for s in out if name in s["faces"]] for name in normals}
         # the building file lists a face's vertices counterclockwise seen from outside
         order = (lambda p: p) if self.ccw else (lambda p: p[::-1])  # noqa: E731

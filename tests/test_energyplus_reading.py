@@ -398,12 +398,11 @@ def test_a_flat_spectral_pane_is_its_spectral_average(tmp_path):
     assert w.outside.solar_absorptance == pytest.approx(w0.outside.solar_absorptance, abs=1e-6)
 
 
-def test_daylight_saving_and_self_shading_are_said(tmp_path):
+def test_daylight_saving_is_said(tmp_path):
     text = TEXT + "RunPeriodControl:DaylightSavingTime,\n  2nd Sunday in March,\n  1st Sunday in November;\n"
     b = convert_idf(write(tmp_path, text))
     assert "RunPeriodControl:DaylightSavingTime: not applied; the schedules run on standard time all year" in \
         b.data["not_modelled"]
-    assert "the building's own surfaces cast no shadow on its windows and walls" in b.data["description"]
 
 
 def test_an_infiltrations_wind_and_temperature_terms_are_taken_at_stated_conditions(tmp_path):
@@ -625,3 +624,23 @@ def test_minimal_shadowing_casts_no_shadow(tmp_path):
     assert b.shading == () and all(c.vertices is None for c in b.components)
     assert "MinimalShadowing" in b.data["description"]
     assert not any("OVERHANG" in line for line in b.data["not_modelled"])
+
+
+def test_the_building_shades_itself_where_two_faces_stand_in_front_of_each_other(tmp_path):
+    """Two boxes 2 m apart, A (8 x 6 m) west of B (6 x 12 m), both 2.7 m high: A's east wall and B's
+    west wall face each other and shade each other (EnergyPlus's self-shading), as A's north wall
+    and B's west wall north of it do; a box's own walls and roof stand behind one another's planes
+    and shade nothing. With the sun due east at an
+    altitude a, B's west wall leaves A's east wall sunlit from 2.7 - 2 tan(a) up."""
+    from nodeforce.model.shading import sunlit_fraction
+    text = HEADER + zone("A") + box("A", "A") + zone("B", x=10.0) + box("B", "B", L=6.0, W=12.0)
+    b = convert_idf(write(tmp_path, text))
+    casts = {s.name: s.faces for s in b.shading}
+    assert casts == {"A E": ("B W",), "A N": ("B W",), "B W": ("A E", "A N")}
+    wall = b.component("A E")
+    a = np.radians(30.0)
+    sun = np.array([[np.cos(a), 0.0, np.sin(a)]])
+    expected = 2.0 * np.tan(a) / 2.7
+    assert sunlit_fraction(wall.vertices, np.array([1.0, 0.0, 0.0]), b.shades_of("A E"), sun)[0] == \
+        pytest.approx(expected, abs=1e-9)
+    assert convert_idf(CASE600).shading == ()
