@@ -1,11 +1,14 @@
 """EnergyPlus as a second reference (issue 44, item 5): the same IDF run by EnergyPlus 25.2
 (pyenergyplus-lbnl, an optional dependency: `pip install -e '.[energyplus]'`) and by nodeforce
 (`nodeforce convert`, the direct model), free-floating over a Denver year: the ASHRAE 140 cases
-made from examples/bestest/case600.idf and examples/multizone/three_zones.idf; per zone the hourly
+made from examples/bestest/case600.idf, 610FF (600FF with case 610's overhang: 1 m deep along
+the roof over the south windows, ASHRAE 140-2020 section 5.2.2.1.2) and
+examples/multizone/three_zones.idf; per zone the hourly
 air's RMSE and mean difference (nodeforce - EnergyPlus) and each program's minimum, maximum and
 mean. docs/performance.md carries the table.
 
-    python benchmarks/bench_energyplus.py [OUT] [--weather EPW]     (default out/bench_energyplus)
+    python benchmarks/bench_energyplus.py [OUT] [--weather EPW] [--only MODEL ...]
+                                                        (default out/bench_energyplus, every model)
 
 The weather is, unless --weather names another EPW, the Denver TMY3 year the installed
 pyenergyplus package ships (pyenergyplus/data/weather/USA_CO_Denver-Aurora-Buckley.AFB.724695_TMY3.epw),
@@ -115,6 +118,23 @@ def read_zone_air(folder):
             if "Zone Mean Air Temperature" in c}
 
 
+def case_610ff():
+    """600FF with case 610's overhang: 1 m deep across the south wall's 8 m at the roof's 2.7 m."""
+    doc = cases.case_600ff()
+    doc.add("Shading:Building:Detailed", "CASE 610 OVERHANG", {"number_of_vertices": 4, "vertices": [
+        {"vertex_x_coordinate": x, "vertex_y_coordinate": y, "vertex_z_coordinate": 2.7}
+        for x, y in ((0, -1), (0, 0), (8, 0), (8, -1))]})
+    return doc
+
+
+def models():
+    """{name: a function making the model's idfkit document}: the free-float cases, 610FF, three_zones."""
+    out = dict(cases.CASES)
+    out["610FF"] = case_610ff
+    out["three_zones"] = lambda: idfkit.load_idf(str(ROOT / "examples" / "multizone" / "three_zones.idf"))
+    return out
+
+
 def nodeforce(path, weather):
     """{zone (upper case): air (C) at 01:30..23:30 of the year} of the converted building."""
     building = convert_idf(path)
@@ -122,15 +142,15 @@ def nodeforce(path, weather):
     return {z.name.upper(): T[f"T{z.air_node}"].to_numpy(float) for z in building.zones}
 
 
-def main(out, epw):
+def main(out, epw, only=None):
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     convert_typical_year(epw, out / "weather.csv", year=YEAR)
     weather = read_weather(out / "weather.csv")
-    models = {name: make for name, make in cases.CASES.items()}
-    models["three_zones"] = lambda: idfkit.load_idf(str(ROOT / "examples" / "multizone" / "three_zones.idf"))
     rows = []
-    for name, make in models.items():
+    for name, make in models().items():
+        if only and name not in only:
+            continue
         doc = make()
         idfkit.save_idf(doc, str(out / f"{name}.idf"))
         ours = nodeforce(out / f"{name}.idf", weather)
@@ -153,6 +173,7 @@ if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("out", nargs="?", default=ROOT / "out" / "bench_energyplus", type=Path)
     parser.add_argument("--weather", type=Path, help="an EPW (default: pyenergyplus's Denver TMY3)")
+    parser.add_argument("--only", nargs="+", choices=list(models()), help="run these models alone")
     args = parser.parse_args()
     try:
         epw = args.weather or package_weather()
@@ -160,4 +181,4 @@ if __name__ == "__main__":
         sys.exit(print("bench_energyplus needs EnergyPlus: pip install -e '.[energyplus]'", file=sys.stderr) or 2)
     if not epw.is_file():
         sys.exit(print(f"{epw}: no such weather file", file=sys.stderr) or 2)
-    main(args.out, epw)
+    main(args.out, epw, args.only)

@@ -2,7 +2,7 @@
 90.1 prototype IDF named (pyenergyplus-lbnl's, the `energyplus` extra) converted by `nodeforce
 convert` and simulated over its own city's TMY3 year, and run by EnergyPlus 25.2 on the same EPW
 with only the objects the converter reads (`iotools.energyplus.READ`, its holidays): no HVAC, no
-thermostat, no shading object, no daylight saving. Per zone the hourly air's RMSE and mean
+thermostat, no daylight saving. Per zone the hourly air's RMSE and mean
 difference (nodeforce - EnergyPlus) and each program's mean; docs/energyplus.md carries the table.
 A building EnergyPlus does not run to its end is a row saying so, with EnergyPlus's own first
 severe error, and the others go on.

@@ -21,9 +21,11 @@ import numpy as np
 
 from ..model import convection, geometry, glazing
 from ..model.errors import InputError
+from .energyplus_shading import fin, may_shade, on_surface, overhang, rectangle, window_frame
 from .idf_text import closed_text
 from ..model.gains import PEOPLE_T, people_sensible_heat
 from ..model.network import air_density_at, sky_fraction_energyplus
+from ..model.shading import sky_diffuse_ratio
 
 # 8.4 -> 8.5 changed no object read here (EnergyPlus's transition program for 8.5 renames an EMS
 # actuator's value and report variables only)
@@ -104,6 +106,10 @@ GAIN_FIELDS = {kind: {"equipmentlevel": "design_level", "watts/area": "power_per
 GAIN_FIELDS["ElectricEquipment"] = {"equipmentlevel": "design_level", "watts/area": "watts_per_zone_floor_area"}
 GAIN_FIELDS["Lights"] = {"lightinglevel": "lighting_level", "watts/area": "watts_per_zone_floor_area"}
 FLOWS = ("ZoneInfiltration:DesignFlowRate", "ZoneVentilation:DesignFlowRate")
+# The shading objects the building file holds as shading polygons (`_Converter.shading`)
+SHADING = ("Shading:Site:Detailed", "Shading:Building:Detailed", "Shading:Zone:Detailed", "Shading:Site",
+           "Shading:Building", "Shading:Overhang", "Shading:Overhang:Projection", "Shading:Fin",
+           "Shading:Fin:Projection")
 SCHEDULES = ("Schedule:Compact", "Schedule:Constant", "Schedule:Year", "Schedule:Week:Daily",
              "Schedule:Week:Compact", "Schedule:Day:Interval", "Schedule:Day:Hourly", "Schedule:Day:List",
              "ScheduleTypeLimits")
@@ -114,7 +120,7 @@ READ = set(("Version", "Site:Location", "GlobalGeometryRules", "Building", "Zone
             "InternalMass", "Construction:FfactorGroundFloor", "Construction:CfactorUndergroundWall",
             "Construction:WindowDataFile", "SurfaceProperty:IncidentSolarMultiplier",
             "Site:GroundTemperature:FCfactorMethod", "SurfaceProperty:OtherSideCoefficients",
-            "SurfaceProperty:OtherSideConditionsModel", "WindowMaterial:GasMixture", "MaterialProperty:GlazingSpectralData", "RunPeriodControl:SpecialDays", "SurfaceConvectionAlgorithm:Inside", "SurfaceConvectionAlgorithm:Outside") + SURFACES + tuple(SIMPLE_SURFACES) + SUBSURFACES + GAINS + FLOWS + SCHEDULES)
+            "SurfaceProperty:OtherSideConditionsModel", "WindowMaterial:GasMixture", "MaterialProperty:GlazingSpectralData", "RunPeriodControl:SpecialDays", "SurfaceConvectionAlgorithm:Inside", "SurfaceConvectionAlgorithm:Outside") + SURFACES + tuple(SIMPLE_SURFACES) + SUBSURFACES + GAINS + FLOWS + SCHEDULES + SHADING)
 # Objects about the run and its reports, not the building
 # ... but these run objects change what the building sees, and are listed
 LISTED_RUN = ("RunPeriodControl:DaylightSavingTime",)
@@ -926,20 +932,20 @@ class _Converter:
         zone_data = [self.zone(z, surfaces) for z in zones]
         components = self.components(surfaces)
         self.user_view_factors(zone_data, components, surfaces)
+        shading = self.shading(components, surfaces)
         for z in zone_data:
             z.pop("_floor_area")
         self.internal_masses(components)
         self.receivers(components)
         self.list_not_modelled()
-        if any(w["type"].lower() in ("window", "glassdoor") for s in surfaces.values() for w in s["subsurfaces"]):
-            self.note("no surface of the building shades its windows or walls (EnergyPlus's shadow calculation is "
-                      "not held)")
         names = [b.name for b in self.r.all("Building")]
         description = (f"Converted by nodeforce convert from {self.r.source} (EnergyPlus "
                        f"{'.'.join(map(str, self.r.doc.version[:2]))}). Inside surface coefficients are the "
                        "converter's constants (docs/guide.md, nodeforce convert); " + "; ".join(self.notes or ["no other assumption"]) + ".")
         data = {"format": "nodal-building/1", "name": names[0] if names else "", "description": description,
                 "site": site, "materials": self.materials, "zones": zone_data, "components": components}
+        if shading:
+            data["shading"] = shading
         if self.schedules:
             data["schedules"] = self.schedules
         data["not_modelled"] = self.not_modelled
@@ -1001,17 +1007,24 @@ class _Converter:
                 if parent is None:
                     self.r.fail(w, "Building Surface Name", f"names no heat transfer surface ({parent_name!r})")
                 multiplier = self.r.number(w, "multiplier", default=1.0, low=1)
+                vertices = None
                 if kind == "FenestrationSurface:Detailed":
-                    zone = self.zone_objs[parent["zone"].upper()]
-                    area = geometry.area(self.vertices(w, zone)) * multiplier
+                    vertices = self.vertices(w, self.zone_objs[parent["zone"].upper()])
+                    area = geometry.area(vertices) * multiplier
                     stype = self.r.text(w, "surface_type", "Window")
-                    height = np.ptp(self.vertices(w, zone)[:, 2]) or None
+                    height = np.ptp(vertices[:, 2]) or None
                 else:
-                    area = (self.r.number(w, "length", low=0, low_open=True) *
-                            self.r.number(w, "height", low=0, low_open=True) * multiplier)
-                    stype = kind.split(":")[0]
+                    length = self.r.number(w, "length", low=0, low_open=True)
                     height = self.r.number(w, "height", low=0, low_open=True)
-                parent["subsurfaces"].append(dict(obj=w, type=stype, area=area, height=height,
+                    area = length * height * multiplier
+                    stype = kind.split(":")[0]
+                    if parent["vertices"] is not None:  # where a shade's shadow falls on it
+                        base = parent["vertices"] if self.ccw else parent["vertices"][::-1]
+                        vertices = on_surface(base, parent["azimuth"], parent["tilt"],
+                                              self.r.number(w, "starting_x_coordinate", default=0.0),
+                                              self.r.number(w, "starting_z_coordinate", default=0.0), length, height)
+                        vertices = vertices if self.ccw else vertices[::-1]
+                parent["subsurfaces"].append(dict(obj=w, type=stype, area=area, height=height, vertices=vertices,
                                                   construction=self.r.text(w, "construction_name"),
                                                   other=self.r.text(w, "outside_boundary_condition_object")))
         return out
@@ -1031,6 +1044,13 @@ class _Converter:
         return zone
 
     def vertices(self, s, zone):
+        """A surface's vertices (n, 3) in true-north coordinates, m, as its zone places them."""
+        origin, turn = self.zone_transform(zone)
+        return geometry.rotate_z(self.points(s) + origin, turn)
+
+    def points(self, s):
+        """A surface's vertices (n, 3) as the object writes them, m, checked to be numbers and a
+        plane polygon."""
         fields = s.to_dict()
         if isinstance(fields.get("vertices"), list):
             v = [[p["vertex_x_coordinate"], p["vertex_y_coordinate"], p["vertex_z_coordinate"]] for p in fields["vertices"]]
@@ -1055,8 +1075,7 @@ class _Converter:
         if geometry.area(v) <= 1e-9:
             self.r.fail(s, "Vertex 1 X-coordinate", "the vertices enclose no area")
         self.check_planar(s, v)
-        origin, turn = self.zone_transform(zone)
-        return geometry.rotate_z(v + origin, turn)
+        return v
 
     def zone_volume(self, z, own, floor):
         """An autocalculated zone volume (m3), as EnergyPlus's CalculateZoneVolume: a zone its
@@ -1308,6 +1327,10 @@ class _Converter:
                 self.r.fail(obj, "Vertex 1 X-coordinate", f"its windows and doors ({s['area'] - net:.3f} m2) fill all "
                                                           f"of its {s['area']:.3f} m2")
             comps.append(self.component(obj.name, net, s, layers, inner, outside, outer))
+            lit = outside["type"] == "exterior" and s["sun"] and s["vertices"] is not None
+            if lit:
+                comps[-1]["_polygon"] = (s["vertices"], [w["vertices"] for w in s["subsurfaces"]
+                                                         if w["vertices"] is not None])
             for w in s["subsurfaces"]:
                 height = w["height"]
                 layers, outer, inner, glass = self.layers(w["construction"], w["obj"], "Construction Name", height)
@@ -1328,6 +1351,8 @@ class _Converter:
                         del c["solar_transmittance"], c["transmitted_solar_to"]
                     else:
                         self.incident_solar_multiplier(w["obj"], c)
+                if lit and w["vertices"] is not None and w_outside["type"] == "exterior":
+                    c["_polygon"] = (w["vertices"], [])
                 comps.append(c)
         return comps
 
@@ -1354,6 +1379,120 @@ class _Converter:
                 c["inner_solar_absorptance"] = round(c["inner_solar_absorptance"] * m, 6)
             self.note(f"an incident solar multiplier of {m:g} on window {window.name} scales its transmittance "
                       "and absorptances")
+
+    # ---- shading surfaces ------------------------------------------------------------------
+    def shading(self, components, surfaces):
+        """The building file's `shading`: every shading object's polygon (true-north coordinates, m,
+        as EnergyPlus builds it), with the sunlit exterior faces it stands in front of
+        (`may_shade`), and every outdoor surface of the building with the faces it and they stand
+        in front of each other; those faces get their polygon (`vertices`, their windows as
+        `holes`). A shading object's transmittance schedule is listed, the surface held opaque.
+        Under the IDF's MinimalShadowing solar distribution EnergyPlus casts no shadow outside:
+        none."""
+        buildings = self.r.all("Building")
+        if buildings and self.r.text(buildings[0], "solar_distribution").lower() == "minimalshadowing":
+            if any(self.r.all(kind) for kind in SHADING):
+                self.note("the IDF's shading surfaces cast no shadow, as EnergyPlus's MinimalShadowing solar "
+                          "distribution has it")
+            for c in components:
+                c.pop("_polygon", None)
+            return []
+        shades = [(o.name, self.points(o)) for o in self.r.all("Shading:Site:Detailed")]
+        shades += [(o.name, geometry.rotate_z(self.points(o), self.north))
+                   for o in self.r.all("Shading:Building:Detailed")]
+        for o in self.r.all("Shading:Zone:Detailed"):
+            base = surfaces.get(self.r.text(o, "base_surface_name").upper())
+            if base is None:
+                self.r.fail(o, "Base Surface Name", f"names no heat transfer surface "
+                                                    f"({self.r.text(o, 'base_surface_name')!r})")
+            shades.append((o.name, self.vertices(o, self.zone_objs[base["zone"].upper()])))
+        for kind in ("Shading:Site", "Shading:Building"):
+            turn = self.north if kind == "Shading:Building" else 0.0
+            for o in self.r.all(kind):
+                corner = geometry.rotate_z([[self.r.number(o, f"starting_{a}_coordinate", default=0.0) for a in "xyz"]],
+                                           turn)[0]
+                shades.append((o.name, rectangle(corner, self.r.number(o, "azimuth_angle", default=0.0) + turn,
+                                                 self.r.number(o, "tilt_angle", default=90.0),
+                                                 self.r.number(o, "length", low=0, low_open=True),
+                                                 self.r.number(o, "height", low=0, low_open=True))))
+        shades += self.window_shades(surfaces)
+        for kind in SHADING[:3]:
+            for o in self.r.all(kind):
+                if self.r.text(o, "transmittance_schedule_name"):
+                    self.not_modelled.append(f"{kind} {o.name}: its transmittance schedule not held (the surface "
+                                             "is opaque)")
+        faces = [c for c in components if "_polygon" in c]
+        normals = {c["name"]: geometry.outward_normal(c["_polygon"][0], self.ccw) for c in faces}
+        out = []
+        for name, polygon in shades:
+            named = [c["name"] for c in faces if may_shade(polygon, c["_polygon"][0], normals[c["name"]])]
+            if named:
+                out.append({"name": name, "vertices": _rounded(polygon), "faces": named})
+        # the building shades itself (EnergyPlus's self-shading): an outdoor surface shades a face
+        # only where each stands in front of the other's plane, a ray reaching a surface from
+        # behind having crossed the building before
+        for s in surfaces.values():
+            if s["vertices"] is None or s["boundary"].lower() != "outdoors":
+                continue
+            normal = geometry.outward_normal(s["vertices"], self.ccw)
+            named = [c["name"] for c in faces if may_shade(s["vertices"], c["_polygon"][0], normals[c["name"]])
+                     and may_shade(c["_polygon"][0], s["vertices"], normal)]
+            if named:
+                out.append({"name": s["obj"].name, "vertices": _rounded(s["vertices"]), "faces": named})
+        shaded = {name: [s["vertices"] for s in out if name in s["faces"]] for name in normals}
+        # the building file lists a face's vertices counterclockwise seen from outside
+        order = (lambda p: p) if self.ccw else (lambda p: p[::-1])  # noqa: E731
+        for c in components:
+            polygon = c.pop("_polygon", None)
+            if shaded.get(c["name"]):
+                c["vertices"] = _rounded(order(polygon[0]))
+                if polygon[1]:
+                    c["holes"] = [_rounded(order(h)) for h in polygon[1]]
+                # the shades hide sky from the face's long-wave exchange as from its diffuse sun
+                # (EnergyPlus's ViewFactorSkyIR times DifShdgRatioIsoSky); what they hide is
+                # exchanged with the air, as the ground's part is
+                ratio = sky_diffuse_ratio(polygon[0], normals[c["name"]], shaded[c["name"]], polygon[1])
+                c["outside"]["sky_view_factor"] = round(c["outside"]["sky_view_factor"] * ratio, 6)
+        return out
+
+    def window_shades(self, surfaces):
+        """[(name, polygon)] of the overhangs and fins of the file's windows (`overhang`, `fin`): a
+        fin object gives a left and a right fin, named as EnergyPlus names them."""
+        windows = {w["obj"].name.upper(): (w, s) for s in surfaces.values() for w in s["subsurfaces"]}
+        out = []
+        for kind in ("Shading:Overhang", "Shading:Overhang:Projection", "Shading:Fin", "Shading:Fin:Projection"):
+            for o in self.r.all(kind):
+                name = self.r.text(o, "window_or_door_name")
+                w, s = windows.get(name.upper(), (None, None))
+                if w is None:
+                    self.r.fail(o, "Window or Door Name", f"names no window or door ({name!r})")
+                if w["vertices"] is None:
+                    self.not_modelled.append(f"{kind} {o.name}: its window {name} has no vertices (a rectangular "
+                                             "Window object): not held")
+                    continue
+                frame = (w["vertices"], s["azimuth"], s["tilt"])
+                _, width, height, _, _ = window_frame(*frame)
+                projection = kind.endswith(":Projection")
+                if kind.startswith("Shading:Overhang"):
+                    depth = (self.r.number(o, "depth_as_fraction_of_window_door_height", low=0) * height if projection
+                             else self.r.number(o, "depth", low=0))
+                    if depth > 0:  # EnergyPlus makes no surface of no depth
+                        out.append((o.name, overhang(
+                            *frame, self.r.number(o, "height_above_window_or_door", default=0.0),
+                            self.r.number(o, "tilt_angle_from_window_door", default=90.0),
+                            self.r.number(o, "left_extension_from_window_door_width", default=0.0),
+                            self.r.number(o, "right_extension_from_window_door_width", default=0.0), depth)))
+                    continue
+                for side in ("left", "right"):
+                    depth = (self.r.number(o, f"{side}_depth_as_fraction_of_window_door_width", default=0.0, low=0)
+                             * width if projection else self.r.number(o, f"{side}_depth", default=0.0, low=0))
+                    if depth > 0:
+                        out.append((f"{o.name} {side.title()}", fin(
+                            *frame, side, self.r.number(o, f"{side}_extension_from_window_door", default=0.0),
+                            self.r.number(o, f"{side}_distance_above_top_of_window", default=0.0),
+                            self.r.number(o, f"{side}_distance_below_bottom_of_window", default=0.0),
+                            self.r.number(o, f"{side}_tilt_angle_from_window_door", default=90.0), depth)))
+        return out
 
     def component(self, name, area, s, layers, inner, outside, outer=None):
         # each face the zones' sun can land on: (zone, its type seen from that zone, solar absorptance);
@@ -1628,3 +1767,8 @@ def compress_schedule(days, year=YEAR):
         fill = next(iter(week.values()))
         out.append({"through": f"{end.month:02d}-{end.day:02d}", "week": [week.get(d, fill) for d in range(7)]})
     return {"days": profiles, "periods": out}
+
+
+def _rounded(polygon):
+    """A polygon's vertices as the building file writes them, m to the micrometre."""
+    return [[round(float(x), 6) for x in p] for p in polygon]

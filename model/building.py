@@ -125,6 +125,14 @@ class AngularTransmittance:
 
 
 @dataclass(frozen=True)
+class ShadingSurface:
+    """An opaque polygon ((x, y, z) m) that shades the exterior faces it names (docs/model.md 4.2)."""
+    name: str
+    vertices: tuple
+    faces: tuple  # component names
+
+
+@dataclass(frozen=True)
 class Zone:
     name: str
     volume: float  # m3
@@ -175,6 +183,8 @@ class Component:
     angular: AngularTransmittance | None = None  # the transmittance with the angle of incidence
     solar_distribution: tuple = ()  # (component, fraction) of the transmitted sun; () all to transmitted_solar_to
     inner_solar_absorptance: float = 0.0  # part of the sun on the outside face absorbed at the inside face
+    vertices: tuple | None = None  # the outside face's polygon ((x, y, z) m, counterclockwise from outside)
+    holes: tuple = ()  # polygons cut out of it (its windows), m
 
     @property
     def receivers(self):
@@ -217,6 +227,7 @@ class Building:
     flux_sensors: dict = field(default_factory=dict)  # sensor name -> (component, "inside" or "outside")
     boundary_factors: dict = field(default_factory=dict)  # boundary column -> factor on its conductances
     schedules: dict = field(default_factory=dict)  # name -> Schedule
+    shading: tuple = ()  # ShadingSurface records
     source: str = field(default="<building>", compare=False)
     data: dict = field(default_factory=dict, compare=False, repr=False)  # the JSON it was read from
     # what reads an edit again, (data, source=, edited_from=) -> Building: `building_file.parse_building`,
@@ -299,6 +310,10 @@ class Building:
 
     def zone(self, name):
         return next(z for z in self.zones if z.name == name)
+
+    def shades_of(self, component_name):
+        """The polygons of the shading surfaces that name a component among their faces."""
+        return tuple(s.vertices for s in self.shading if component_name in s.faces)
 
     def component(self, name):
         return next(c for c in self.components if c.name == name)

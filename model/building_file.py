@@ -19,9 +19,12 @@ import math
 from dataclasses import replace
 from importlib.resources import files
 
+import numpy as np
+
 from .building import (DAY_TERMS, Adiabatic, AngularTransmittance, Boundary, Building, Component, Exterior, Gain,
-                       Inflow, Lumped, Material, OutsideConvection, Supply, Surface, Ventilation, Zone,
-                       boundary_columns, json_copy)
+                       Inflow, Lumped, Material, OutsideConvection, ShadingSurface, Supply, Surface, Ventilation,
+                       Zone, boundary_columns, json_copy)
+from . import geometry
 from .discretise import generated_depths
 from .errors import InputError
 from .schedule import WEEKDAYS, Schedule
@@ -208,7 +211,7 @@ def parse_checked(data, source="<building>"):
                if name not in flux_sensors}
     return Building(name=str(data.get("name", "")), site=site, zones=zones, components=components,
                     sensors=sensors, flux_sensors=flux_sensors, boundary_factors=boundary_factors,
-                    schedules=schedules, source=source, data=json_copy(data),
+                    schedules=schedules, shading=_shading(check, data, components), source=source, data=json_copy(data),
                     reader=parse_building)
 
 
@@ -471,7 +474,51 @@ def _component(check, c, where, materials, zone_names, sensor_depths):
         solar_distribution=_distribution(check, c, where),
         inner_solar_absorptance=float(c.get("inner_solar_absorptance",
                                             schema_default("component", "inner_solar_absorptance"))),
+        vertices=_face_polygon(check, c, where),
+        holes=tuple(_polygon(h) for h in c.get("holes", ())),
     )
+
+
+# How far (deg) a face's vertices may turn from its declared tilt and azimuth: a converter's are
+# rounded to 1e-6 deg, a hand-written file's to a degree at worst
+ORIENTATION_TOLERANCE = 1.0
+
+
+def _polygon(raw):
+    return tuple(tuple(float(x) for x in p) for p in raw)
+
+
+def _face_polygon(check, c, where):
+    """A component's outside polygon, checked to enclose an area and to face its tilt and azimuth."""
+    if "vertices" not in c:
+        return None
+    vertices = _polygon(c["vertices"])
+    n = geometry.newell_normal(vertices)
+    if np.linalg.norm(n) <= 1e-9:
+        check.fail(f"{where}.vertices", "enclose no area")
+    azimuth, tilt = geometry.azimuth_tilt(n / np.linalg.norm(n))
+    turn = abs((azimuth - float(c["azimuth"]) + 180) % 360 - 180) if 1e-6 < tilt < 180 - 1e-6 else 0.0
+    if abs(tilt - float(c["tilt"])) > ORIENTATION_TOLERANCE or turn > ORIENTATION_TOLERANCE:
+        check.fail(f"{where}.vertices", f"face tilt {tilt:.1f} deg, azimuth {azimuth:.1f} deg (counterclockwise seen "
+                                        f"from outside), not the component's {float(c['tilt']):g} and "
+                                        f"{float(c['azimuth']):g}")
+    return vertices
+
+
+def _shading(check, data, components):
+    """The file's shading surfaces, each naming exterior components that declare their vertices."""
+    faces = {c.name: c for c in components}
+    out = []
+    for i, raw in enumerate(data.get("shading", ())):
+        for name in raw["faces"]:
+            c = faces.get(name)
+            if c is None:
+                check.fail(f"shading[{i}].faces", f"names no component ({name!r})")
+            if c.vertices is None:
+                check.fail(f"shading[{i}].faces", f"{name!r} declares no vertices for a shadow to fall on")
+        out.append(ShadingSurface(name=raw["name"], vertices=_polygon(raw["vertices"]), faces=tuple(raw["faces"])))
+    check.unique([s.name for s in out], "shading", "shading surface name")
+    return tuple(out)
 
 
 def _distribution(check, c, where):

@@ -22,6 +22,8 @@ from .building import DAY_TERMS
 from .network import (WIND_DIRECTION, WIND_SPEED, assemble, clock_input_names, day_input, input_names,
                       slowest_time_constant)
 from .units import check_celsius
+from .geometry import outward_normal
+from .shading import sky_diffuse_ratio, sun_vectors, sunlit_fraction
 from .solar import (DECOMPOSITIONS, complete_irradiance, incident_irradiance, measured_irradiance, sky_temperature,
                     solar_position, transmitted_irradiance)
 from .weather import IRRADIANCE_COLUMNS, check_columns, weather_on_grid
@@ -355,12 +357,14 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
             assumptions.append(f"The weather {source} lacks {', '.join(n for n in IRRADIANCE_COLUMNS if n not in given)}: "
                                f"{said}.")
         for c in computed:
+            sunlit, sky = face_shading(c, building.shades_of(c.name), position)
             columns[f"I_{c.name}"] = incident_irradiance(position, ghi, dni, dhi, c.tilt, c.azimuth,
-                                                         site["ground_albedo"])
+                                                         site["ground_albedo"], sunlit, sky)
             if c.angular is not None:
                 a = c.angular
                 columns[c.transmitted_input] = transmitted_irradiance(
-                    position, ghi, dni, dhi, c.tilt, c.azimuth, site["ground_albedo"], a.angles, a.factors, a.diffuse)
+                    position, ghi, dni, dhi, c.tilt, c.azimuth, site["ground_albedo"], a.angles, a.factors, a.diffuse,
+                    sunlit, sky)
     columns.update(clock_inputs(building, times))
     columns.update(schedule_inputs(building, times))
     names = input_names(building)
@@ -392,6 +396,19 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
     return Case(times=times, dt=dt, input_names=names, U=U, measured=measured, assumptions=tuple(assumptions),
                 fluxes=fluxes, building=building, substeps=substeps(dt), burn_in_steps=before, history_steps=before,
                 steady_start=bool(before))
+
+
+def face_shading(component, shades, position):
+    """(sunlit fraction at each time of `position` (-), the part of its sky diffuse it gets (-))
+    of an exterior face under shading polygons (`model.shading`, docs/model.md section 4.2):
+    (1.0, 1.0) where none shades it."""
+    if not shades:
+        return 1.0, 1.0
+    normal = outward_normal(component.vertices)
+    sun = sun_vectors(position["apparent_zenith"], position["azimuth"])
+    sun[np.asarray(position["apparent_zenith"]) >= 90] = 0.0  # no direct sun at night: no shadow to cast
+    return (sunlit_fraction(component.vertices, normal, shades, sun, component.holes),
+            sky_diffuse_ratio(component.vertices, normal, shades, component.holes))
 
 
 def start_memory(building, seconds=None):

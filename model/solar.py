@@ -117,7 +117,7 @@ _POSITIONS = OrderedDict()
 _KEPT_LOCK = threading.Lock()
 
 
-def incident_irradiance(position, ghi, dni, dhi, tilt, azimuth, albedo):
+def incident_irradiance(position, ghi, dni, dhi, tilt, azimuth, albedo, sunlit=1.0, sky=1.0):
     """Solar irradiance incident on a plane surface, W/m2, isotropic sky.
 
     Parameters
@@ -132,15 +132,24 @@ def incident_irradiance(position, ghi, dni, dhi, tilt, azimuth, albedo):
         Direction the surface faces, degrees clockwise from north (180 = south).
     albedo : float
         Ground reflectance, 0..1.
+    sunlit, sky : array_like or float
+        The face's sunlit fraction at each time and the part of its sky diffuse it gets, both
+        1 for a face no shading surface shades (`model.shading`, docs/model.md section 4.2).
 
     Returns
     -------
     numpy.ndarray
-        pvlib's isotropic `get_total_irradiance(...)["poa_global"]`, W/m2, with NaN and negative
-        values set to 0: a missing weather sample contributes no sun (docs/model.md section 4).
+        pvlib's isotropic `poa_direct sunlit + (poa_sky_diffuse sky + poa_ground_diffuse)`, W/m2
+        (its `poa_global` where unshaded), with NaN and negative values set to 0: a missing
+        weather sample contributes no sun (docs/model.md section 4).
     """
-    poa = np.asarray(_isotropic(position, ghi, dni, dhi, tilt, azimuth, albedo)["poa_global"], dtype=float)
+    poa = _isotropic(position, ghi, dni, dhi, tilt, azimuth, albedo)
+    poa = _array(poa["poa_direct"]) * sunlit + (_array(poa["poa_sky_diffuse"]) * sky + _array(poa["poa_ground_diffuse"]))
     return np.where(np.isfinite(poa) & (poa > 0.0), poa, 0.0)
+
+
+def _array(values):
+    return np.asarray(values, dtype=float)
 
 
 def _isotropic(position, ghi, dni, dhi, tilt, azimuth, albedo):
@@ -212,20 +221,21 @@ def decompose(ghi, zenith, model="erbs"):
 
 
 
-def transmitted_irradiance(position, ghi, dni, dhi, tilt, azimuth, albedo, angles, factors, diffuse):
+def transmitted_irradiance(position, ghi, dni, dhi, tilt, azimuth, albedo, angles, factors, diffuse, sunlit=1.0,
+                           sky=1.0):
     """The sun a glazing lets in per m2, relative to its normal-incidence transmittance (W/m2,
     docs/model.md section 4.1): the direct sun times the factor at its angle of incidence (linear
     between the tabulated angles, 0 beyond 90 deg) plus the isotropic sky's and the ground's diffuse
     sun times the diffuse factor,
 
-        I_t = f(theta) dni max(cos theta, 0) + f_d [dhi (1 + cos beta) / 2 + ghi rho_g (1 - cos beta) / 2]
+        I_t = f(theta) f_sun dni max(cos theta, 0) + f_d [R_sky dhi (1 + cos beta) / 2 + ghi rho_g (1 - cos beta) / 2]
 
-    Parameters as `incident_irradiance`; angles (deg) and factors (-) the glazing's table, diffuse
-    its factor for diffuse sun (-)."""
+    Parameters as `incident_irradiance`'s (`sunlit` f_sun, `sky` R_sky: 1 unshaded); angles (deg)
+    and factors (-) the glazing's table, diffuse its factor for diffuse sun (-)."""
     poa = _isotropic(position, ghi, dni, dhi, tilt, azimuth, albedo)
     zenith = np.asarray(position["apparent_zenith"], dtype=float)
     theta = pvlib.irradiance.aoi(tilt, azimuth, zenith, np.asarray(position["azimuth"], dtype=float))
     f = np.interp(np.asarray(theta, dtype=float), list(angles) + [90.0 + 1e-9], list(factors) + [0.0], right=0.0)
-    beam = np.where(zenith < 90, np.asarray(poa["poa_direct"], dtype=float), 0.0)
-    sun = f * beam + diffuse * np.asarray(poa["poa_diffuse"], dtype=float)
+    beam = np.where(zenith < 90, _array(poa["poa_direct"]), 0.0)
+    sun = f * beam * sunlit + diffuse * (_array(poa["poa_sky_diffuse"]) * sky + _array(poa["poa_ground_diffuse"]))
     return np.where(np.isfinite(sun) & (sun > 0.0), sun, 0.0)

@@ -527,7 +527,11 @@ def test_three_zones_gains_and_flows(three_zones):
     assert b.schedules["ground temperature"].at(np.array([7]), np.array([15]), np.array([0]), np.array([1.0]))[0] == 16
     lines = b.data["not_modelled"]
     assert any(l.startswith("ThermostatSetpoint:SingleHeating WEST HEATING SETPOINT") for l in lines)
-    assert any(l.startswith("Shading:Building:Detailed SOUTH OVERHANG") for l in lines)
+    assert not any("SOUTH OVERHANG" in l for l in lines)
+    # the overhang's (0, -1, 3) turned 30 deg clockwise with the building: (-sin 30, -cos 30, 3)
+    overhang = next(s for s in b.shading if s.name == "SOUTH OVERHANG")
+    assert overhang.vertices[0] == pytest.approx((-0.5, -np.sqrt(3) / 2, 3.0), abs=1e-6)
+    assert "WEST SOUTH WINDOW" in overhang.faces and "WEST NORTH WALL" not in overhang.faces
 
 
 # ---- corrections written back (model_after.idf) ------------------------------------------

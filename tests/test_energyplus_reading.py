@@ -398,12 +398,11 @@ def test_a_flat_spectral_pane_is_its_spectral_average(tmp_path):
     assert w.outside.solar_absorptance == pytest.approx(w0.outside.solar_absorptance, abs=1e-6)
 
 
-def test_daylight_saving_and_self_shading_are_said(tmp_path):
+def test_daylight_saving_is_said(tmp_path):
     text = TEXT + "RunPeriodControl:DaylightSavingTime,\n  2nd Sunday in March,\n  1st Sunday in November;\n"
     b = convert_idf(write(tmp_path, text))
     assert "RunPeriodControl:DaylightSavingTime: not applied; the schedules run on standard time all year" in \
         b.data["not_modelled"]
-    assert "no surface of the building shades its windows" in b.data["description"]
 
 
 def test_an_infiltrations_wind_and_temperature_terms_are_taken_at_stated_conditions(tmp_path):
@@ -571,3 +570,77 @@ def test_a_constant_incident_solar_multiplier_scales_the_windows_sun(tmp_path):
     assert b.component("WIN").solar_transmittance == pytest.approx(plain.solar_transmittance)
     assert any(line.startswith("SurfaceProperty:IncidentSolarMultiplier WIN: its schedule 'DAY' varies")
                for line in b.data["not_modelled"])
+
+
+# ---- shading surfaces ----------------------------------------------------------------------
+def test_a_projection_overhang_and_fins_are_the_polygons_written_by_hand(tmp_path):
+    """Case 610's overhang (1 m deep along the 8 m south wall at the roof's 2.7 m) as a
+    Shading:Overhang:Projection over the west window (3 x 2 m, sill 0.2 m, 0.5 m from the west
+    wall): 0.5 m above its head, 0.5 m beyond its left edge and 4.5 m beyond its right, depth 0.5 of
+    its height; and its fins (0.1 m beyond each edge, 0.2 m over the head, 0.1 m under the sill,
+    0.2 of its width deep), against the same surfaces written as Shading:Zone:Detailed."""
+    projected = ("Shading:Overhang:Projection,\n  OVERHANG,\n  SOUTH WINDOW WEST,\n  0.5,\n  90,\n  0.5,\n  4.5,\n"
+                 "  0.5;\n"
+                 "Shading:Fin:Projection,\n  FIN,\n  SOUTH WINDOW WEST,\n  0.1,\n  0.2,\n  0.1,\n  90,\n  0.2,\n"
+                 "  0.1,\n  0.2,\n  0.1,\n  90,\n  0.2;\n")
+
+    def detailed(name, points):
+        return (f"Shading:Zone:Detailed,\n  {name},\n  SOUTH WALL,\n  ,\n  {len(points)},\n  "
+                + ",\n  ".join(f"{x}, {y}, {z}" for x, y, z in points) + ";\n")
+    by_hand = (detailed("OVERHANG", [(0, -1, 2.7), (0, 0, 2.7), (8, 0, 2.7), (8, -1, 2.7)])
+               + detailed("FIN Left", [(0.4, 0, 2.4), (0.4, 0, 0.1), (0.4, -0.6, 0.1), (0.4, -0.6, 2.4)])
+               + detailed("FIN Right", [(3.6, 0, 2.4), (3.6, 0, 0.1), (3.6, -0.6, 0.1), (3.6, -0.6, 2.4)]))
+    a, b = (convert_idf(write(tmp_path, TEXT + extra, f"{k}.idf")) for k, extra in enumerate((projected, by_hand)))
+    assert [s.name for s in a.shading] == [s.name for s in b.shading] == ["OVERHANG", "FIN Left", "FIN Right"]
+    for s, t in zip(a.shading, b.shading):
+        assert np.allclose(s.vertices, t.vertices, atol=1e-9) and s.faces == t.faces
+    # the overhang over the whole south wall; each fin stands in front of the south wall alone
+    assert a.shading[0].faces == ("SOUTH WALL", "SOUTH WINDOW WEST", "SOUTH WINDOW EAST")
+    assert a.shading[1].faces == ("SOUTH WALL", "SOUTH WINDOW WEST", "SOUTH WINDOW EAST")
+    wall = a.component("SOUTH WALL")
+    assert len(wall.holes) == 2 and wall.vertices[1] == (0.0, 0.0, 0.0)
+    assert not any(line.startswith("Shading:") for line in a.data["not_modelled"])
+
+
+def test_a_shaded_face_sees_less_sky_for_its_long_wave_exchange(tmp_path):
+    """EnergyPlus scales a face's sky view for long-wave exchange by its diffuse shading ratio."""
+    from nodeforce.model.shading import sky_diffuse_ratio
+    overhang = ("Shading:Building:Detailed,\n  OVERHANG,\n  ,\n  4,\n  0, -1, 2.7,\n  0, 0, 2.7,\n  8, 0, 2.7,\n"
+                "  8, -1, 2.7;\n")
+    shaded, plain = (convert_idf(write(tmp_path, TEXT + extra, f"{k}.idf")) for k, extra in enumerate((overhang, "")))
+    window, window0 = shaded.component("SOUTH WINDOW WEST"), plain.component("SOUTH WINDOW WEST")
+    ratio = sky_diffuse_ratio(window.vertices, np.array([0.0, -1.0, 0.0]), [shaded.shading[0].vertices])
+    assert 0.5 < ratio < 1.0
+    assert window.outside.sky_view_factor == pytest.approx(window0.outside.sky_view_factor * ratio, abs=1e-6)
+    assert shaded.component("NORTH WALL").outside == plain.component("NORTH WALL").outside
+
+
+def test_minimal_shadowing_casts_no_shadow(tmp_path):
+    """EnergyPlus's MinimalShadowing solar distribution shades no exterior face: nor does the file."""
+    overhang = ("Shading:Building:Detailed,\n  OVERHANG,\n  ,\n  4,\n  0, -1, 2.7,\n  0, 0, 2.7,\n  8, 0, 2.7,\n"
+                "  8, -1, 2.7;\n")
+    text = TEXT.replace("FullInteriorAndExterior,      !- Solar Distribution", "MinimalShadowing,  !- Solar Distribution")
+    b = convert_idf(write(tmp_path, text + overhang))
+    assert b.shading == () and all(c.vertices is None for c in b.components)
+    assert "MinimalShadowing" in b.data["description"]
+    assert not any("OVERHANG" in line for line in b.data["not_modelled"])
+
+
+def test_the_building_shades_itself_where_two_faces_stand_in_front_of_each_other(tmp_path):
+    """Two boxes 2 m apart, A (8 x 6 m) west of B (6 x 12 m), both 2.7 m high: A's east wall and B's
+    west wall face each other and shade each other (EnergyPlus's self-shading), as A's north wall
+    and B's west wall north of it do; a box's own walls and roof stand behind one another's planes
+    and shade nothing. With the sun due east at an
+    altitude a, B's west wall leaves A's east wall sunlit from 2.7 - 2 tan(a) up."""
+    from nodeforce.model.shading import sunlit_fraction
+    text = HEADER + zone("A") + box("A", "A") + zone("B", x=10.0) + box("B", "B", L=6.0, W=12.0)
+    b = convert_idf(write(tmp_path, text))
+    casts = {s.name: s.faces for s in b.shading}
+    assert casts == {"A E": ("B W",), "A N": ("B W",), "B W": ("A E", "A N")}
+    wall = b.component("A E")
+    a = np.radians(30.0)
+    sun = np.array([[np.cos(a), 0.0, np.sin(a)]])
+    expected = 2.0 * np.tan(a) / 2.7
+    assert sunlit_fraction(wall.vertices, np.array([1.0, 0.0, 0.0]), b.shades_of("A E"), sun)[0] == \
+        pytest.approx(expected, abs=1e-9)
+    assert convert_idf(CASE600).shading == ()
