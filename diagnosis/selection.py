@@ -142,17 +142,33 @@ def decide(results, baseline, policy):
                              air_at_noise).to_json())
 
 
-def revisited(decision, replaces, others, refitted):
+def revisited(decision, replaces, others, refitted, refit):
     """The `decision` of a choice made again once the rounds end (`diagnosis.loop.revisit`): of
     the effect `replaces` (its label), among candidates each fitted with the model's `others`
-    (labels) refitted together with it; `refitted` ({label: {name: {"value", ...}}}) their values
-    refitted with the one chosen, kept where it takes the place of `replaces`. The reason says it."""
+    (labels) refitted together with it, against the model without it, the others refitted
+    together without it (`refit`, their `Fit`, whose cross-validated J per block the decision
+    read); `refitted` ({label: {name: {"value", ...}}}) their values refitted with the one
+    chosen, kept where it takes the place of `replaces`, or, where none is chosen, refitted
+    without it: the effect is removed. The reason says which, in the effect's own numbers."""
     effect, target = replaces.split("@", 1)
-    decision.replaces = replaces
-    decision.refitted = refitted if decision.changes_model else {}
+    decision.replaces, decision.refit = replaces, refit
+    decision.refitted = refitted if decision.changes_model or decision.chosen is None else {}
+    if decision.changes_model:
+        outcome = f"it takes the place of {effect} on {target}."
+    elif decision.chosen is not None:
+        outcome = "it stays."
+    else:
+        own = decision.verdicts[replaces]
+        why = (f"it passes, but is refused: {own.objection}" if own.passes else
+               f"its own cross-validated fall, {own.cv_fall:.3g} C2, is short of the {own.needed:.3g} C2 it needs"
+               if own.cv_fall <= own.needed else
+               f"its own cross-validated fall, {own.cv_fall:.3g} C2, comes from one day: the others gain "
+               f"{own.other_days:.3g} C2")
+        outcome = (f"{effect} on {target} is removed: {why}; the model keeps {', '.join(others)}, refitted "
+                   f"without it (cross-validated J {refit.cv.J:.3g} C2, {refit.cv.rmse:.3f} C, against "
+                   f"{refit.cv.J - own.cv_fall:.3g} C2 with it).")
     decision.reason = (f"{effect} on {target} chosen again, the other effects refitted together with each candidate "
-                       f"({', '.join(others)}): {decision.reason[:-1]}; "
-                       + (f"it takes the place of {effect} on {target}." if decision.changes_model else "it stays."))
+                       f"and without it ({', '.join(others)}): {decision.reason[:-1]}; {outcome}")
     return decision
 
 

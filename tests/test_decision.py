@@ -10,7 +10,7 @@ import pytest
 
 from nodeforce.diagnosis.policy import Policy
 from nodeforce.diagnosis.result import Baseline, CrossValidation, Fit, OwnSensors, SensorEvidence, added_effects, last_change
-from nodeforce.diagnosis.selection import blocks, decide
+from nodeforce.diagnosis.selection import blocks, decide, revisited
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.errors import InputError
 from nodeforce.model.score import Noise
@@ -445,3 +445,33 @@ def test_a_choice_revisited_takes_the_place_of_the_one_it_replaces_and_the_other
     assert [a.label for a in after] == ["infiltration@cell", "conductivity@door"]
     assert after[1].values == {"factor": 1.58} and first_door.values == {"factor": 1.26}
     assert last_change(rounds + [stays]) is first_door and last_change(rounds + [swapped]) is air
+
+
+def test_a_revisit_that_finds_the_effect_no_longer_lowers_j_by_its_margin_removes_it():
+    """Once the door is in the model, the envelope factor chosen before it makes the left-out days
+    worse (the model without it, the door refitted alone, leaves 4 C2 a day; with it, the door
+    refitted beside it, 5): no candidate passes, itself included, so it is removed, and the door
+    keeps the value refitted without it. The reason says so in the numbers the decision
+    records."""
+    envelope = candidate("envelope_conductance", "cell", {"factor": parameter(1.2, 0.05)}, [3.0, 3.0])
+    first_door = replace(door([2.0, 2.0], factor=1.26), round=2)
+    rounds = [choose([envelope], [4.0, 4.0], 0.1, N)[1], choose([first_door], [4.0, 4.0], 0.1, N)[1]]
+    worse = replace(envelope, cv=CrossValidation([5.0, 5.0], N), round=3)
+    refit = replace(door([4.0, 4.0], factor=1.58), round=3)
+    _, again = choose([worse], [4.0, 4.0], 0.1, N)
+    removal = revisited(again, "envelope_conductance@cell", ["conductivity@door"],
+                        {"conductivity@door": {"factor": parameter(1.58, 0.03)}}, refit)
+    assert removal.removes and not removal.changes_model
+    after = added_effects(rounds + [removal])
+    assert [a.label for a in after] == ["conductivity@door"] and after[0].values == {"factor": 1.58}
+    assert last_change(rounds + [removal]) is refit
+    # the reason, read against the numbers it stands for: the effect's fall of -2 C2 (8 -> 10),
+    # short of what it needs, and the 8 C2 the door leaves refitted alone, against 10 with it
+    verdict = removal.verdicts["envelope_conductance@cell"]
+    assert verdict.cv_fall == pytest.approx(-2.0) and verdict.needed > 0
+    assert f"cross-validated fall, {-2.0:.3g} C2, is short of the {verdict.needed:.3g} C2" in removal.reason
+    assert "envelope_conductance on cell is removed" in removal.reason and "it stays" not in removal.reason
+    assert f"cross-validated J {8.0:.3g} C2" in removal.reason and f"against {10.0:.3g} C2 with it" in removal.reason
+    written = removal.to_json()
+    assert written["removed"] == "envelope_conductance@cell" and written["chosen"] is None
+    assert written["refit"]["cv"]["J"] == pytest.approx(8.0)
