@@ -281,8 +281,14 @@ def _reason(chosen, alike, results, passing, base, n, verdicts, margin, componen
                 f"numerical error and the day-to-day scatter could make; {len(passing)} of {len(results)} candidates pass")
     sensed = chosen.sensors.n
     if sensed and len(passing) > 1:
-        said += (f"; among them it best predicts the air left out together with the other sensors over the "
-                 f"same days ({sensed} readings no fit read; J {chosen.evidence().sum():.3g} C2)")
+        best = min(passing, key=lambda r: r.evidence().sum())
+        what = (f"the air left out together with the other sensors over the same days ({sensed} readings no fit "
+                f"read; J {best.evidence().sum():.3g} C2")
+        # the best predictor may be one physics refuses, or one of the band that claims more
+        said += (f"; among them it best predicts {what})" if best is chosen else
+                 f"; among them {best.effect} on {best.target} best predicts {what}, against its "
+                 f"{chosen.evidence().sum():.3g} C2)"
+                 + (f", but is refused: {verdicts[best.label].objection}" if verdicts[best.label].objection else ""))
     if alike:
         said += ("; within one standard error of the best, and so not told apart by these data: "
                  + ", ".join(f"{r.effect} on {r.target} ({r.evidence().sum():.3g} C2)" for r in alike)

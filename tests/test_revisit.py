@@ -14,6 +14,7 @@ from nodeforce.model.score import Objective
 from nodeforce.model.synth import pseudo_measurements
 from nodeforce.runtime.lifetime import InProcess
 from tests.conftest import SENSORS
+from tests.test_report_sentences import check_round
 
 pytestmark = pytest.mark.slow  # calibrations on a simulated record: not in `make check`
 
@@ -53,6 +54,7 @@ def test_a_gain_the_door_explains_away_is_removed_and_the_door_refitted_alone_fi
     assert decision.removes and decision.chosen is None, decision.reason
     verdict = decision.verdicts[gain.label]
     assert not verdict.passes and "internal_gain on cell is removed" in decision.reason
+    check_round(decision.to_json())
     # the door refitted without the gain finds the truth, which neither value before held
     kept, = added_effects(made.decisions)
     factor = kept.parameters["factor"]
