@@ -217,7 +217,10 @@ class Decision:
     what the round cost. A decision made once the rounds end, on an effect an earlier round chose
     (`diagnosis.loop.revisit`), names it (`replaces`), and where another takes its place, the
     values the model's other effects take refitted with that one (`refitted`, {label: {name:
-    {"value", "std", ...}}})."""
+    {"value", "std", ...}}}), judged against `refit`, the fit of the model's other effects
+    refitted together without it (the first with the others beside it: its cross-validation is
+    the model's without it); where none is chosen, itself included, the effect is removed, the
+    others at the values `refit` gave them, which `refitted` holds."""
     chosen: Fit
     reason: str
     cv_J_before: float
@@ -231,12 +234,20 @@ class Decision:
     cost: dict = None
     replaces: str = None
     refitted: dict = None
+    refit: Fit = None
 
     @property
     def changes_model(self):
-        """Whether the decision changes the model: a round's choice, or a revisit's that takes
-        another's place."""
+        """Whether the decision adds an effect to the model: a round's choice, or a revisit's that
+        takes another's place."""
         return self.chosen is not None and self.chosen.label != self.replaces
+
+    @property
+    def removes(self):
+        """Whether the decision removes the effect it revisits (`replaces`): no candidate, itself
+        included, lowers the cross-validated J of the model without it by its margin, or physics
+        refuses each that does."""
+        return self.replaces is not None and self.chosen is None
 
     def to_json(self):
         return {"chosen": self.chosen.label if self.chosen else None, "reason": self.reason,
@@ -244,34 +255,40 @@ class Decision:
                 "standard_errors": self.standard_errors, "suggestions": self.suggestions,
                 "indistinct": self.indistinct, "candidates": {k: v.to_json() for k, v in self.verdicts.items()},
                 "inputs": self.inputs, **({"cost": self.cost} if self.cost is not None else {}),
-                **({"replaces": self.replaces, "refitted": self.refitted} if self.replaces else {})}
+                **({"replaces": self.replaces, "refitted": self.refitted, "refit": self.refit.to_json()}
+                   if self.replaces else {}),
+                **({"removed": self.replaces} if self.removes else {})}
 
     @classmethod
     def of_json(cls, d, chosen):
         """The decision report.json records, `chosen` its chosen candidate's `Fit` (None)."""
         return cls(chosen, d["reason"], d["cv_J_before"], d["blocks"], d["noise_margin"], d["standard_errors"],
                    d["suggestions"], d["indistinct"], {k: Verdict(**v) for k, v in d["candidates"].items()},
-                   d["inputs"], d.get("cost"), d.get("replaces"), d.get("refitted"))
+                   d["inputs"], d.get("cost"), d.get("replaces"), d.get("refitted"),
+                   Fit.of_json(d["refit"]) if d.get("refit") else None)
 
 
 def added_effects(decisions):
     """The effects the `decisions` add, in order (their `Fit`s): each round's choice, where a
     later decision (`Decision.replaces`) put another in its place, that one, and the others with
-    the values refitted with it."""
+    the values refitted with it; where a later decision removed one (`Decision.removes`), the
+    others with the values refitted without it."""
     out = []
     for d in decisions:
         if d.replaces is None:
             out += [d.chosen] if d.changes_model else []
-        elif d.changes_model:
+        elif d.changes_model or d.removes:
             out = [d.chosen if a.label == d.replaces else
-                   replace(a, parameters={**a.parameters, **d.refitted.get(a.label, {})}) for a in out]
+                   replace(a, parameters={**a.parameters, **d.refitted.get(a.label, {})})
+                   for a in out if not (d.removes and a.label == d.replaces)]
     return out
 
 
 def last_change(decisions):
-    """The `Fit` of the last of the `decisions` that changed the model (a round's choice, or one
-    that took another's place), whose `derived` are those of the model they leave; None."""
-    changed = [d.chosen for d in decisions if d.changes_model]
+    """The `Fit` of the last of the `decisions` that changed the model (a round's choice, one
+    that took another's place, or the refit of the effects left where one was removed), whose
+    `derived` are those of the model they leave; None."""
+    changed = [d.refit if d.removes else d.chosen for d in decisions if d.changes_model or d.removes]
     return changed[-1] if changed else None
 
 
@@ -440,7 +457,8 @@ class Diagnosis:
             tried = [c for c in self.candidates if c.round == number]
             decision = decide(tried, Baseline.of_json(recorded.inputs), self.policy)
             if recorded.replaces:  # a choice made again, the others refitted with each candidate
-                decision = revisited(decision, recorded.replaces, list(tried[0].on_top_of), recorded.refitted)
+                decision = revisited(decision, recorded.replaces, list(tried[0].on_top_of), recorded.refitted,
+                                     recorded.refit)
             out.append(decision)
         return out
 

@@ -142,17 +142,33 @@ def decide(results, baseline, policy):
                              air_at_noise).to_json())
 
 
-def revisited(decision, replaces, others, refitted):
+def revisited(decision, replaces, others, refitted, refit):
     """The `decision` of a choice made again once the rounds end (`diagnosis.loop.revisit`): of
     the effect `replaces` (its label), among candidates each fitted with the model's `others`
-    (labels) refitted together with it; `refitted` ({label: {name: {"value", ...}}}) their values
-    refitted with the one chosen, kept where it takes the place of `replaces`. The reason says it."""
+    (labels) refitted together with it, against the model without it, the others refitted
+    together without it (`refit`, their `Fit`, whose cross-validated J per block the decision
+    read); `refitted` ({label: {name: {"value", ...}}}) their values refitted with the one
+    chosen, kept where it takes the place of `replaces`, or, where none is chosen, refitted
+    without it: the effect is removed. The reason says which, in the effect's own numbers."""
     effect, target = replaces.split("@", 1)
-    decision.replaces = replaces
-    decision.refitted = refitted if decision.changes_model else {}
+    decision.replaces, decision.refit = replaces, refit
+    decision.refitted = refitted if decision.changes_model or decision.chosen is None else {}
+    if decision.changes_model:
+        outcome = f"it takes the place of {effect} on {target}."
+    elif decision.chosen is not None:
+        outcome = "it stays."
+    else:
+        own = decision.verdicts[replaces]
+        why = (f"it passes, but is refused: {own.objection}" if own.passes else
+               f"its own cross-validated fall, {own.cv_fall:.3g} C2, is short of the {own.needed:.3g} C2 it needs"
+               if own.cv_fall <= own.needed else
+               f"its own cross-validated fall, {own.cv_fall:.3g} C2, comes from one day: the others gain "
+               f"{own.other_days:.3g} C2")
+        outcome = (f"{effect} on {target} is removed: {why}; the model keeps {', '.join(others)}, refitted "
+                   f"without it (cross-validated J {refit.cv.J:.3g} C2, {refit.cv.rmse:.3f} C, against "
+                   f"{refit.cv.J - own.cv_fall:.3g} C2 with it).")
     decision.reason = (f"{effect} on {target} chosen again, the other effects refitted together with each candidate "
-                       f"({', '.join(others)}): {decision.reason[:-1]}; "
-                       + (f"it takes the place of {effect} on {target}." if decision.changes_model else "it stays."))
+                       f"and without it ({', '.join(others)}): {decision.reason[:-1]}; {outcome}")
     return decision
 
 
@@ -265,8 +281,15 @@ def _reason(chosen, alike, results, passing, base, n, verdicts, margin, componen
                 f"numerical error and the day-to-day scatter could make; {len(passing)} of {len(results)} candidates pass")
     sensed = chosen.sensors.n
     if sensed and len(passing) > 1:
-        said += (f"; among them it best predicts the air left out together with the other sensors over the "
-                 f"same days ({sensed} readings no fit read; J {chosen.evidence().sum():.3g} C2)")
+        best = min(passing, key=lambda r: r.evidence().sum())
+        what = (f"the air left out together with the other sensors over the same days ({sensed} readings no fit "
+                f"read; J {best.evidence().sum():.3g} C2")
+        # the best predictor may be one physics refuses, or one of the band that claims more
+        said += (f"; among them it best predicts {what})" if best is chosen else
+                 f"; among them {best.effect} on {best.target} best predicts {what}, against its "
+                 f"{chosen.evidence().sum():.3g} C2)"
+                 + (f", but is refused: {verdicts[best.label].objection}" if verdicts[best.label].objection else ""))
+    said += _loose(chosen, passing, verdicts, policy)
     if alike:
         said += ("; within one standard error of the best, and so not told apart by these data: "
                  + ", ".join(f"{r.effect} on {r.target} ({r.evidence().sum():.3g} C2)" for r in alike)
@@ -282,6 +305,33 @@ def _reason(chosen, alike, results, passing, base, n, verdicts, margin, componen
     if policy.is_shape(chosen.effect):
         said += "; no physical effect comes within one standard error of it"
     return said + "."
+
+
+def _loose(chosen, passing, verdicts, policy):
+    """The clause of the reason on the chosen candidate's loose values (`Policy.loose`), "" where
+    none is: each with its sd, and the best predictor among the admissible whose values are all
+    tight, where the chosen predicts better than it: the choice follows what each predicts."""
+    def loose(r):
+        return policy.loose(r.effect, r.parameters, r.derived, r.physics)
+    values = loose(chosen)
+    if not values:
+        return ""
+
+    def spread(name, p):
+        unit = EFFECTS[chosen.effect].parameter(name).unit
+        share = (f"over {policy.identifiable_kelvin:g} K" if unit == "C" else
+                 f"{100 * p.sd / abs(p.value):.0f} % of it" if p.value else "about a value of 0")
+        return f"{name}, {p.value:.3g} +- {p.sd:.2g} {unit} ({share})"
+    said = (f"; its {', '.join(spread(name, p) for name, p in values.items())}, "
+            f"{'is' if len(values) == 1 else 'are'} loose: the data fix what it predicts more than its value")
+    tight = [r for r in passing if r is not chosen and not verdicts[r.label].objection and not loose(r)]
+    if tight:
+        best = min(tight, key=lambda r: r.evidence().sum())
+        if best.evidence().sum() > chosen.evidence().sum():
+            said += (f", and it predicts what no fit read better than the best of the candidates whose values are "
+                     f"tight, {best.effect} on {best.target} (J {chosen.evidence().sum():.3g} against "
+                     f"{best.evidence().sum():.3g} C2): the choice follows the prediction")
+    return said
 
 
 def acting(result):

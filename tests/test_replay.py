@@ -10,13 +10,15 @@ import pytest
 import nodeforce
 from nodeforce.diagnosis.result import Diagnosis
 from tests.conftest import DATA, SENSORS
+from tests.test_report_sentences import check_sentences
 
 pytestmark = pytest.mark.slow  # diagnoses: not in `make check`
 
 
 def check_replay(path):
     """Every round of the diagnosis report.json at `path` holds recomputed from the report alone:
-    the same choice, band, suggestions, verdicts and reason; returns the diagnosis read."""
+    the same choice, band, suggestions, verdicts and reason, each sentence of it true of the
+    numbers report.json records; returns the diagnosis read."""
     read = Diagnosis.read(path)
     report = json.loads(path.read_text())
     recorded = report["decision"]["rounds"]
@@ -27,6 +29,7 @@ def check_replay(path):
         assert again.to_json() == {k: v for k, v in written.items() if k != "cost"}
     # the effects the decisions add (a round's choice, or one that took an earlier one's place)
     assert [a.effect_json() for a in read.added] == report["effects"]
+    check_sentences(report)  # and what each round's reason says is true of its numbers
     return read
 
 

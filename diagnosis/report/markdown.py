@@ -35,14 +35,15 @@ def decision_lines(report):
         cost = r.get("cost") or {}
         which = (f"round {number}: cross-validated J of the model it starts from" if not r.get("replaces") else
                  f"{r['replaces']} chosen again, the other effects refitted together with each candidate: "
-                 "cross-validated J of the model without it")
+                 "cross-validated J of the model without it, the others refitted without it")
         lines.append(f"- {which} {fmt_sig(r.get('cv_J_before'))} C² "
                      f"over {r.get('blocks', NA)} days left out in turn; a candidate must lower it by more than the "
                      f"sensor noise and the file's numerical error could ({fmt_sig(r.get('noise_margin'))} C²) and by more than "
                      f"{fmt_sig(r.get('standard_errors'), 3)} standard error of its fall from day to day, on more "
                      f"days than its best (the fall needed, per candidate, in the candidates table); {cost.get('candidates', NA)} candidates, "
                      f"{cost.get('simulations', NA)} simulations, {cost.get('seconds', NA)} s; "
-                     f"chosen: {r.get('chosen') or 'none'}")
+                     f"chosen: {r.get('chosen') or 'none'}"
+                     + (f"; removed: {r['removed']}" if r.get("removed") else ""))
     lines.append(f"- chosen: {d.get('chosen') or 'none'}")
     return lines
 
