@@ -350,17 +350,19 @@ def test_an_interzone_pair_is_the_same_building_whatever_its_order(tmp_path):
 
 def test_each_face_of_a_partition_takes_its_own_zones_sun():
     """EAST OFFICE's window lights the partition's face in EAST OFFICE, its outer face: the share
-    of its area times its absorptance, and the network puts it on that face's node."""
+    of its area times its absorptance, of the direct sun and of the diffuse, and the network puts
+    each on that face's node."""
     from nodeforce.model.network import assemble, input_names
     b = convert_idf(MULTIZONE)
     w = b.component("EAST SOUTH WINDOW")
-    shares = dict(w.solar_distribution)
-    assert shares.get("WEST TO EAST", 0.0) > 0
     net = assemble(b)
     p = b.component("WEST TO EAST")
-    j = input_names(b).index(w.transmitted_input)
-    assert net.B[p.node_ids[-1] - 1, j] == pytest.approx(w.solar_transmittance * w.area * shares["WEST TO EAST"])
-    assert net.B[p.node_ids[0] - 1, j] == 0.0
+    for sun, shares in w.sun_inputs:
+        shares = dict(shares)
+        assert shares.get("WEST TO EAST", 0.0) > 0
+        j = input_names(b).index(sun)
+        assert net.B[p.node_ids[-1] - 1, j] == pytest.approx(w.solar_transmittance * w.area * shares["WEST TO EAST"])
+        assert net.B[p.node_ids[0] - 1, j] == 0.0
 
 
 def test_wall_interzone_may_name_the_zone_beyond(tmp_path):

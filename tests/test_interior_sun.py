@@ -8,6 +8,7 @@ import pytest
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import prepare_case, simulate_building
 from nodeforce.model.errors import InputError
+from nodeforce.model.interior_sun import beam_fractions, diffuse_fractions
 from nodeforce.model.network import assemble
 
 
@@ -70,3 +71,44 @@ def test_a_diffuse_distribution_is_refused_where_it_adds_up_over_1_or_names_no_c
         split_cell(testcell_data, {"floor": 0.9}, {"floor": 0.8, "roof": 0.3})
     with pytest.raises(InputError, match="diffuse_distribution.attic"):
         split_cell(testcell_data, {"floor": 0.9}, {"attic": 0.5})
+
+
+# ---- EnergyPlus's interior distribution (model.interior_sun) --------------------------------
+# a 4 m x 4 m x 3 m box: floor (alpha 0.6), ceiling (0.3), 44 m2 of walls (0.5) and a 4 m2 window
+# whose panes absorb 0.1 of the room's diffuse sun and let 0.6 of it out
+AREA, ALPHA, OUT = [16.0, 16.0, 44.0, 4.0], [0.6, 0.3, 0.5, 0.1], [0.0, 0.0, 0.0, 0.6]
+FLOOR = [True, False, False, False]
+
+
+def test_the_diffuse_sun_goes_by_area_times_absorptance():
+    """S = 16 x 0.6 + 16 x 0.3 + 44 x 0.5 + 4 x (0.1 + 0.6) = 39.2 m2: the floor takes 9.6 / 39.2,
+    the window's panes 0.4 / 39.2, and 2.4 / 39.2 leaves; absorbed and leaving add up to 1."""
+    phi = diffuse_fractions(AREA, ALPHA, OUT)
+    assert phi == pytest.approx([9.6 / 39.2, 4.8 / 39.2, 22.0 / 39.2, 0.4 / 39.2])
+    assert phi.sum() + 2.4 / 39.2 == pytest.approx(1.0)
+
+
+def test_the_direct_sun_falls_on_the_floor_and_its_reflection_joins_the_diffuse():
+    """The floor absorbs 0.6 and reflects 0.4 into the diffuse split: 0.6 + 0.4 x 9.6 / 39.2 on
+    the floor, 0.4 x 2.4 / 39.2 leaving."""
+    phi = beam_fractions(AREA, ALPHA, OUT, FLOOR)
+    assert phi[0] == pytest.approx(0.6 + 0.4 * 9.6 / 39.2)
+    assert phi[2] == pytest.approx(0.4 * 22.0 / 39.2)
+    assert 1 - phi.sum() == pytest.approx(0.4 * 2.4 / 39.2)
+
+
+def test_two_floors_take_the_direct_sun_by_area():
+    """A 10 m2 floor of alpha 0.6 and a 6 m2 one of 0.3 (the box's floor split): 10/16 x 0.6 and
+    6/16 x 0.3 absorbed at once, 1 - 0.4875 reflected."""
+    area, alpha, out = [10.0, 6.0, 16.0, 44.0, 4.0], [0.6, 0.3, 0.3, 0.5, 0.1], [0, 0, 0, 0, 0.6]
+    phi = beam_fractions(area, alpha, out, [True, True, False, False, False])
+    S = 6.0 + 1.8 + 4.8 + 22.0 + 2.8
+    assert phi[:2] == pytest.approx([10 / 16 * 0.6 + 0.5125 * 6.0 / S, 6 / 16 * 0.3 + 0.5125 * 1.8 / S])
+    assert 1 - phi.sum() == pytest.approx(0.5125 * 2.4 / S)
+
+
+def test_a_zone_without_a_window_keeps_all_its_sun():
+    """No face lets any out: the fractions add up to 1, direct and diffuse."""
+    area, alpha, out = AREA[:3], ALPHA[:3], OUT[:3]
+    assert diffuse_fractions(area, alpha, out).sum() == pytest.approx(1.0, abs=1e-12)
+    assert beam_fractions(area, alpha, out, FLOOR[:3]).sum() == pytest.approx(1.0, abs=1e-12)
