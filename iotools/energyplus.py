@@ -771,9 +771,12 @@ class _Converter:
             f_in = h_i / (h_i + 1 / (R + 1 / h_o))  # ... and of the inner face's
             inner = min(alpha, max(0.0, ((shgc - tau) - alpha * f_out) / (f_in - f_out)))
             faces = {"emissivity": 0.84, "solar": alpha - inner, "roughness": 1.0}
+            factors = [float(glazing.simple_glazing_factors(U, shgc, a)) for a in glazing.ANGLES]
+            diffuse = glazing.hemispherical(lambda a: glazing.simple_glazing_factors(U, shgc, a))
             # the one layer absorbs alike from either side
             return [[name, 0.003]], faces, {"emissivity": 0.84, "solar": tau + alpha}, {
-                "tau": tau, "inner_alpha": inner, "back_alpha": alpha, "angular": None}
+                "tau": tau, "inner_alpha": inner, "back_alpha": alpha,
+                "angular": {"angles": list(glazing.ANGLES), "factors": factors, "diffuse": diffuse}}
         panes, layers, gases = [], [], {}
         for k, o in enumerate(objs):
             kind = o.obj_type.upper()
@@ -1319,7 +1322,7 @@ class _Converter:
                 if glass is not None:
                     c["solar_transmittance"] = round(glass["tau"], 6)
                     c["transmitted_solar_to"] = None  # set once every component is known (`receivers`)
-                    if glass["angular"] is not None and "exterior" == w_outside["type"]:
+                    if "exterior" == w_outside["type"]:
                         c["angular_transmittance"] = glass["angular"]
                     if glass["inner_alpha"] > 0 and "exterior" == w_outside["type"]:
                         c["inner_solar_absorptance"] = round(glass["inner_alpha"], 6)
@@ -1327,8 +1330,7 @@ class _Converter:
                         del c["solar_transmittance"], c["transmitted_solar_to"]
                     else:
                         # seen from the room: the diffuse sun it absorbs and the part it lets out
-                        f_d = glass["angular"]["diffuse"] if glass["angular"] is not None else 1.0
-                        c["_back"] = (glass["back_alpha"], glass["tau"] * f_d)
+                        c["_back"] = (glass["back_alpha"], glass["tau"] * glass["angular"]["diffuse"])
                         self.incident_solar_multiplier(w["obj"], c)
                 comps.append(c)
         return comps
