@@ -128,10 +128,13 @@ def _input_meaning(building, name):
                       f"({building.site['timezone']}), the basis of the zones' daily gains")
     if name in building.schedule_inputs:
         return None, f"schedule {name} of the building file, on the site's local clock"
-    glazings = [c.name for c in building.components if c.angular is not None and c.transmitted_input == name]
+    glazings = [(c, k) for c in building.components for k, (sun, _) in enumerate(c.sun_inputs)
+                if sun == name and sun != c.irradiance_input]
     if glazings:
-        return "W/m2", (f"sun {glazings[0]} lets in per m2 over its normal-incidence transmittance (its angular "
-                        "transmittance applied)")
+        c, k = glazings[0]
+        part = "" if len(c.sun_inputs) == 1 else ("direct " if k == 0 else "diffuse ")
+        applied = " (its angular transmittance applied)" if c.angular is not None else ""
+        return "W/m2", f"{part}sun {c.name} lets in per m2 over its normal-incidence transmittance{applied}"
     faces = [c.name for c in building.exterior_components if c.irradiance_input == name]
     if faces:
         return "W/m2", f"solar irradiance on the outside face of {', '.join(faces)}"

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..model import convection, geometry, glazing
+from ..model import convection, geometry, glazing, interior_sun
 from ..model.errors import InputError
 from .energyplus_shading import fin, may_shade, on_surface, overhang, rectangle, window_frame
 from .idf_text import closed_text
@@ -784,8 +784,12 @@ class _Converter:
             f_in = h_i / (h_i + 1 / (R + 1 / h_o))  # ... and of the inner face's
             inner = min(alpha, max(0.0, ((shgc - tau) - alpha * f_out) / (f_in - f_out)))
             faces = {"emissivity": 0.84, "solar": alpha - inner, "roughness": 1.0}
+            factors = [float(glazing.simple_glazing_factors(U, shgc, a)) for a in glazing.ANGLES]
+            diffuse = glazing.hemispherical(lambda a: glazing.simple_glazing_factors(U, shgc, a))
+            # the one layer absorbs alike from either side
             return [[name, 0.003]], faces, {"emissivity": 0.84, "solar": tau + alpha}, {
-                "tau": tau, "inner_alpha": inner, "angular": None}
+                "tau": tau, "inner_alpha": inner, "back_alpha": alpha,
+                "angular": {"angles": list(glazing.ANGLES), "factors": factors, "diffuse": diffuse}}
         panes, layers, gases = [], [], {}
         for k, o in enumerate(objs):
             kind = o.obj_type.upper()
@@ -838,8 +842,10 @@ class _Converter:
         # seen from the room, a glazing takes the diffuse sun it does not reflect (out, or into its panes)
         outer = {"emissivity": panes[0][2], "solar": alpha, "roughness": 1.0}  # glass is very smooth
         inner = {"emissivity": panes[-1][3], "solar": 1 - glazing.stack_reflectance(pairs[::-1])}
-        return layers, outer, inner, {"tau": tau, "inner_alpha": inner_alpha, "angular": {"angles": list(glazing.ANGLES), "factors": factors,
-                                                              "diffuse": diffuse}}
+        return layers, outer, inner, {"tau": tau, "inner_alpha": inner_alpha,
+                                      "back_alpha": sum(glazing.pane_absorptances(pairs[::-1])),
+                                      "angular": {"angles": list(glazing.ANGLES), "factors": factors,
+                                                  "diffuse": diffuse}}
 
     def window_data_file(self, c, height):
         """A Construction:WindowDataFile as EnergyPlus builds it: the panes and gaps of the window
@@ -1343,13 +1349,15 @@ class _Converter:
                 if glass is not None:
                     c["solar_transmittance"] = round(glass["tau"], 6)
                     c["transmitted_solar_to"] = None  # set once every component is known (`receivers`)
-                    if glass["angular"] is not None and "exterior" == w_outside["type"]:
+                    if "exterior" == w_outside["type"]:
                         c["angular_transmittance"] = glass["angular"]
                     if glass["inner_alpha"] > 0 and "exterior" == w_outside["type"]:
                         c["inner_solar_absorptance"] = round(glass["inner_alpha"], 6)
                     if w_outside["type"] != "exterior":
                         del c["solar_transmittance"], c["transmitted_solar_to"]
                     else:
+                        # seen from the room: the diffuse sun it absorbs and the part it lets out
+                        c["_back"] = (glass["back_alpha"], glass["tau"] * glass["angular"]["diffuse"])
                         self.incident_solar_multiplier(w["obj"], c)
                 if lit and w["vertices"] is not None and w_outside["type"] == "exterior":
                     c["_polygon"] = (w["vertices"], [])
@@ -1667,32 +1675,46 @@ class _Converter:
                     factors.setdefault(a, {})[b] = float(row["view_factor"])
 
     def receivers(self, components):
-        """Where the sun a zone's windows let in lands, as EnergyPlus's FullInteriorAndExterior
-        distributes it (Engineering Reference, interior solar distribution): the direct sun on the
-        zone's largest floor (its largest opaque surface if it has none), which absorbs its solar
-        absorptance alpha_f of it; the rest reflected diffusely onto every inside surface in
-        proportion to its area times its absorptance, A_i alpha_i / sum_j A_j alpha_j, the
-        glazings' share leaving the zone. Applied to the diffuse sun too (the building file has
-        one transmitted input per glazing)."""
-        faces = {}  # zone: [(component, type, absorptance, glazing?)] of every face in it
+        """Where the sun a zone's windows let in is absorbed, as EnergyPlus distributes it
+        (`model.interior_sun`): the diffuse sun over every inside face by its area times its
+        absorptance, a window's by its panes' back-side absorptance (onto its own inside face) and
+        its diffuse transmittance (leaving); the direct sun on the zone's floors (its opaque faces
+        if it has none), by area, each absorbing its alpha and reflecting the rest into the diffuse
+        split. The direct sun's split is the window's solar_distribution, the diffuse sun's its
+        diffuse_distribution; transmitted_solar_to names the largest floor."""
+        self.beam_on_floor()
+        faces = {}  # zone: [(component, type, absorptance, transmittance out)] of every face in it
         for k in components:
             for zone, kind, alpha in k["_faces"]:
-                faces.setdefault(zone, []).append((k, kind, alpha, "solar_transmittance" in k))
+                faces.setdefault(zone, []).append((k, kind, *k.get("_back", (alpha, 0.0))))
         for c in components:
             if "transmitted_solar_to" not in c:
                 continue
             own = faces[c["_zone"]]
-            opaque = [f for f in own if not f[3]]
-            floors = [f for f in opaque if f[1] == "floor"] or opaque
-            floor = max(floors, key=lambda f: f[0]["area"])
-            c["transmitted_solar_to"] = floor[0]["name"]
-            total = sum(k["area"] * alpha for k, _, alpha, _ in own)
-            reflected = 1 - floor[2]
-            shares = {k["name"]: reflected * k["area"] * alpha / total for k, _, alpha, _ in opaque if alpha > 0}
-            shares[floor[0]["name"]] = shares.get(floor[0]["name"], 0.0) + floor[2]
-            c["solar_distribution"] = {name: round(f, 6) for name, f in shares.items()}
+            opaque = ["_back" not in f[0] for f in own]
+            floor = [o and f[1] == "floor" for o, f in zip(opaque, own)]
+            floor = floor if any(floor) else opaque
+            area = np.array([f[0]["area"] for f in own])
+            alpha, tau = np.array([f[2] for f in own]), np.array([f[3] for f in own])
+            largest = max((f for f, on in zip(own, floor) if on), key=lambda f: f[0]["area"])
+            c["transmitted_solar_to"] = largest[0]["name"]
+            for field, shares in (("solar_distribution", interior_sun.beam_fractions(area, alpha, tau, floor)),
+                                  ("diffuse_distribution", interior_sun.diffuse_fractions(area, alpha, tau))):
+                split = {}
+                for f, share in zip(own, shares):
+                    if share > 0:
+                        split[f[0]["name"]] = split.get(f[0]["name"], 0.0) + float(share)
+                c[field] = {name: round(share, 6) for name, share in split.items()}
         for c in components:
-            c.pop("_zone"), c.pop("_type"), c.pop("_absorbs"), c.pop("_faces")
+            c.pop("_zone"), c.pop("_type"), c.pop("_absorbs"), c.pop("_faces"), c.pop("_back", None)
+
+    def beam_on_floor(self):
+        """Say where the Building's Solar Distribution would put the direct sun other than on the floor."""
+        buildings = self.r.all("Building")
+        method = self.r.text(buildings[0], "solar_distribution", "FullExterior") if buildings else "FullExterior"
+        if method.lower().startswith("fullinterior"):
+            self.note(f"the direct sun a window lets in falls on the zone's floor (the IDF's {method} follows it "
+                      "onto every face it reaches)")
 
     def list_not_modelled(self):
         for obj in self.r.doc.all_objects:

@@ -185,6 +185,7 @@ class Component:
     inner_solar_absorptance: float = 0.0  # part of the sun on the outside face absorbed at the inside face
     vertices: tuple | None = None  # the outside face's polygon ((x, y, z) m, counterclockwise from outside)
     holes: tuple = ()  # polygons cut out of it (its windows), m
+    diffuse_distribution: tuple = ()  # (component, fraction) of the transmitted diffuse sun; () as the direct
 
     @property
     def receivers(self):
@@ -193,6 +194,23 @@ class Component:
         if self.solar_transmittance is None:
             return ()
         return self.solar_distribution or ((self.transmitted_solar_to, 1.0),)
+
+    @property
+    def sun_inputs(self):
+        """((input name, receivers), ...): the inputs of the sun a glazing lets in and the split of
+        each (docs/model.md section 4.1). One input split by `receivers`; where the glazing declares
+        a `diffuse_distribution`, its direct sun `Itb_<component>` split by `receivers` and its
+        diffuse sun `Itd_<component>` by the diffuse distribution. () for an opaque component."""
+        if self.solar_transmittance is None:
+            return ()
+        if not self.diffuse_distribution:
+            return ((self.transmitted_input, self.receivers),)
+        return ((f"Itb_{self.name}", self.receivers), (f"Itd_{self.name}", self.diffuse_distribution))
+
+    @property
+    def sun_receivers(self):
+        """Names of the components on which the sun a glazing lets in lands, direct or diffuse."""
+        return tuple(dict.fromkeys(name for _, receivers in self.sun_inputs for name, _ in receivers))
 
     @property
     def transmitted_input(self):

@@ -196,9 +196,11 @@ def parse_checked(data, source="<building>"):
         if c.transmitted_solar_to is not None and c.transmitted_solar_to not in names:
             check.fail(f"components[{i}].transmitted_solar_to",
                        f"names no component ({c.transmitted_solar_to!r})")
-        for name, _ in c.solar_distribution:
-            if name not in names:
-                check.fail(f"components[{i}].solar_distribution.{name}", f"names no component ({name!r})")
+        for field, fractions in (("solar_distribution", c.solar_distribution),
+                                 ("diffuse_distribution", c.diffuse_distribution)):
+            for name, _ in fractions:
+                if name not in names:
+                    check.fail(f"components[{i}].{field}.{name}", f"names no component ({name!r})")
     _check_proportional_columns(check, zones, components)
     _check_air_exchanges(check, zones)
     _check_view_factors(check, zones, components)
@@ -471,7 +473,8 @@ def _component(check, c, where, materials, zone_names, sensor_depths):
         conductivity_factor=float(c.get("conductivity_factor", schema_default("component", "conductivity_factor"))),
         capacity_factor=float(c.get("capacity_factor", schema_default("component", "capacity_factor"))),
         angular=_angular(check, c, where),
-        solar_distribution=_distribution(check, c, where),
+        solar_distribution=_distribution(check, c, where, "solar_distribution"),
+        diffuse_distribution=_distribution(check, c, where, "diffuse_distribution"),
         inner_solar_absorptance=float(c.get("inner_solar_absorptance",
                                             schema_default("component", "inner_solar_absorptance"))),
         vertices=_face_polygon(check, c, where),
@@ -521,10 +524,10 @@ def _shading(check, data, components):
     return tuple(out)
 
 
-def _distribution(check, c, where):
-    fractions = _floats(c.get("solar_distribution", {}))
+def _distribution(check, c, where, field):
+    fractions = _floats(c.get(field, {}))
     if sum(f for _, f in fractions) > 1 + 1e-9:
-        check.fail(f"{where}.solar_distribution", f"the fractions add up to {sum(f for _, f in fractions):g}: at most "
+        check.fail(f"{where}.{field}", f"the fractions add up to {sum(f for _, f in fractions):g}: at most "
                                                   "1 (the rest leaves through the glazings)")
     return fractions
 

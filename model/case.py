@@ -25,7 +25,7 @@ from .units import check_celsius
 from .geometry import outward_normal
 from .shading import sky_diffuse_ratio, sun_vectors, sunlit_fraction
 from .solar import (DECOMPOSITIONS, complete_irradiance, incident_irradiance, measured_irradiance, sky_temperature,
-                    solar_position, transmitted_irradiance)
+                    solar_position, transmitted_irradiance, transmitted_split)
 from .weather import IRRADIANCE_COLUMNS, check_columns, weather_on_grid
 
 
@@ -336,8 +336,9 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
         measured_sun = measured_irradiance(c, w.columns)
         if measured_sun is None:
             computed.append(c)
-        elif c.angular is not None:
-            raise InputError(source, measured_sun, f"{c.name} declares an angular_transmittance, which needs the "
+        elif c.angular is not None or c.diffuse_distribution:
+            declared = "an angular_transmittance" if c.angular is not None else "a diffuse_distribution"
+            raise InputError(source, measured_sun, f"{c.name} declares {declared}, which needs the "
                                                    "direct and diffuse sun apart: its irradiance is computed from "
                                                    "ghi, dni, dhi, not read from a measured column")
         else:
@@ -360,11 +361,14 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
             sunlit, sky = face_shading(c, building.shades_of(c.name), position)
             columns[f"I_{c.name}"] = incident_irradiance(position, ghi, dni, dhi, c.tilt, c.azimuth,
                                                          site["ground_albedo"], sunlit, sky)
-            if c.angular is not None:
-                a = c.angular
+            table = () if c.angular is None else (c.angular.angles, c.angular.factors, c.angular.diffuse)
+            if c.diffuse_distribution:
+                (direct, _), (diffuse, _) = c.sun_inputs
+                columns[direct], columns[diffuse] = transmitted_split(
+                    position, ghi, dni, dhi, c.tilt, c.azimuth, site["ground_albedo"], *table, sunlit=sunlit, sky=sky)
+            elif c.angular is not None:
                 columns[c.transmitted_input] = transmitted_irradiance(
-                    position, ghi, dni, dhi, c.tilt, c.azimuth, site["ground_albedo"], a.angles, a.factors, a.diffuse,
-                    sunlit, sky)
+                    position, ghi, dni, dhi, c.tilt, c.azimuth, site["ground_albedo"], *table, sunlit=sunlit, sky=sky)
     columns.update(clock_inputs(building, times))
     columns.update(schedule_inputs(building, times))
     names = input_names(building)

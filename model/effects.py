@@ -212,7 +212,7 @@ def _transmittance_write(data, target, values):
 
 
 def _receiver_nodes(building, target):
-    return tuple(i for name, _ in building.component(target).receivers for i in building.component(name).node_ids)
+    return tuple(i for name in building.component(target).sun_receivers for i in building.component(name).node_ids)
 
 
 # thermal bridge: a conductance UA from a zone's air to the outdoor air or a boundary column
@@ -336,7 +336,7 @@ def _shading_targets(building):
 
 def _shading_receivers(building, target):
     return tuple(i for c in shaded_glazings(building, target)
-                 for name, _ in c.receivers for i in building.component(name).node_ids)
+                 for name in c.sun_receivers for i in building.component(name).node_ids)
 
 
 # boundary conductance: one factor on every conductance from the building to a boundary column

@@ -1,6 +1,7 @@
 """Glazing physics (docs/model.md section 4.1): a pane's and a stack of panes' solar
 transmittance with the angle of incidence, its hemispherical (diffuse) mean, the conductance of a
-gas gap, and the solar transmittance EnergyPlus's simple glazing model gives a (U, SHGC) pair.
+gas gap, and the solar transmittance EnergyPlus's simple glazing model gives a (U, SHGC) pair and
+its change with the angle of incidence.
 
 Angles in degrees, conductances in W/m2/K, transmittances and reflectances dimensionless.
 """
@@ -194,6 +195,115 @@ def simple_glazing_transmittance(U, shgc):
         return low(shgc)
     w = (U - 3.4) / 1.1
     return (1 - w) * low(shgc) + w * high(shgc)
+
+
+# EnergyPlus's simple glazing system: the transmittance relative to its value at normal incidence,
+# as quartics in cos(angle) without a constant term (Engineering Reference, "Simple Window Model",
+# angular dependence; WindowManager.cc, TransAndReflAtPhi): coefficients of c^4, c^3, c^2, c, 1
+SIMPLE_TRANSMITTANCE_CURVES = {
+    "A": (0.01, 1.49, -3.85, 3.36, 0.0),
+    "B": (0.55, 0.04, -2.42, 2.83, 0.0),
+    "C": (0.77, -0.64, -1.58, 2.45, 0.0),
+    "D": (0.35, 0.40, -2.58, 2.85, 0.0),
+    "E": (2.88, -5.87, 2.49, 1.51, 0.0),
+    "F": (3.03, -6.37, 3.14, 1.21, 0.0),
+    "G": (3.23, -6.84, 3.54, 1.09, 0.0),
+    "H": (3.33, -7.13, 3.83, 0.98, 0.0),
+    "I": (3.15, -6.86, 3.93, 0.79, 0.0),
+    "J": (3.74, -8.84, 6.02, 0.08, 0.0),
+}
+
+
+def simple_glazing_curve(U, shgc, angle):
+    """The transmittance of EnergyPlus's simple glazing system of U-factor U (W/m2/K) and SHGC (-)
+    at an angle of incidence (deg) relative to its normal-incidence one (-), unbounded: the curve
+    (SIMPLE_TRANSMITTANCE_CURVES) of the (U, SHGC) region of the Engineering Reference's map, or
+    between the curves of the neighbouring regions, linearly in U or SHGC or both. FGHI is the
+    mean of F, G, H and I; FH of F and H; BDCD of B, D, C and D (twice D, as EnergyPlus has it).
+    1 at normal incidence exactly."""
+    c = np.cos(np.radians(np.asarray(angle, dtype=float)))
+    value = {k: np.polyval(p, c) for k, p in SIMPLE_TRANSMITTANCE_CURVES.items()}
+    E, J, A, D = value["E"], value["J"], value["A"], value["D"]
+    FGHI = (value["F"] + value["G"] + value["H"] + value["I"]) / 4.0
+    FH = (value["F"] + value["H"]) / 2.0
+    BDCD = (value["B"] + value["D"] + value["C"] + value["D"]) / 4.0
+
+    def along(x, x0, x1, f0, f1):
+        return f0 + (x - x0) / (x1 - x0) * (f1 - f0)
+
+    def across(s0, s1, f00, f01, f10, f11, u0, u1):
+        """Bilinear in (U, SHGC) between (u0, s0), (u0, s1), (u1, s0), (u1, s1)."""
+        w = (u1 - u0) * (s1 - s0)
+        return (f00 * (u1 - U) * (s1 - shgc) + f10 * (U - u0) * (s1 - shgc) + f01 * (u1 - U) * (shgc - s0)
+                + f11 * (U - u0) * (shgc - s0)) / w
+
+    if U < 1.4195:
+        f = E if shgc > 0.45 else along(shgc, 0.35, 0.45, J, E) if shgc >= 0.35 else J
+    elif U <= 1.7034:
+        u = (1.4195, 1.7034)
+        if shgc > 0.55:
+            f = E
+        elif shgc > 0.5:
+            f = across(0.5, 0.55, E, E, FGHI, E, *u)
+        elif shgc > 0.45:
+            f = along(U, *u, E, FGHI)
+        elif shgc > 0.35:
+            f = across(0.35, 0.45, J, E, FGHI, FGHI, *u)
+        elif shgc > 0.3:
+            f = along(U, *u, J, FGHI)
+        elif shgc > 0.25:
+            f = across(0.25, 0.3, J, J, FH, FGHI, *u)
+        else:
+            f = along(U, *u, J, FH)
+    elif U < 3.4068:
+        if shgc > 0.55:
+            f = E
+        elif shgc >= 0.5:
+            f = along(shgc, 0.5, 0.55, FGHI, E)
+        elif shgc > 0.3:
+            f = FGHI
+        elif shgc >= 0.25:
+            f = along(shgc, 0.25, 0.3, FH, FGHI)
+        else:
+            f = FH
+    elif U <= 4.5424:
+        u = (3.4068, 4.5424)
+        if shgc > 0.65:
+            f = along(U, *u, E, A)
+        elif shgc > 0.6:
+            f = across(0.6, 0.65, E, E, BDCD, A, *u)
+        elif shgc > 0.55:
+            f = along(U, *u, E, BDCD)
+        elif shgc > 0.5:
+            f = across(0.5, 0.55, FGHI, E, BDCD, BDCD, *u)
+        elif shgc > 0.45:
+            f = along(U, *u, FGHI, BDCD)
+        elif shgc > 0.3:
+            f = across(0.3, 0.45, FGHI, FGHI, D, BDCD, *u)
+        elif shgc > 0.25:
+            f = across(0.25, 0.3, FH, FGHI, D, D, *u)
+        else:
+            f = along(U, *u, FH, D)
+    else:
+        if shgc > 0.65:
+            f = A
+        elif shgc >= 0.6:
+            f = along(shgc, 0.6, 0.65, BDCD, A)
+        elif shgc > 0.45:
+            f = BDCD
+        elif shgc >= 0.3:
+            f = along(shgc, 0.3, 0.45, D, BDCD)
+        else:
+            f = D
+    return np.where(c == 1.0, 1.0, f)
+
+
+def simple_glazing_factors(U, shgc, angle):
+    """The simple glazing system's transmittance at an angle of incidence (deg) relative to its
+    normal-incidence T (`simple_glazing_transmittance`): T f_T(angle) held within 0..1, as
+    EnergyPlus holds it, over T (-)."""
+    tau = simple_glazing_transmittance(U, shgc)
+    return np.clip(tau * simple_glazing_curve(U, shgc, angle), 0.0, 1.0) / tau
 
 
 def simple_glazing_films(U):

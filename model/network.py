@@ -263,7 +263,7 @@ def input_names(building):
     """The input vector's names, in the order of the columns of B."""
     irradiance = tuple(dict.fromkeys(c.irradiance_input for c in building.exterior_components))
     named = tuple(n for n in building.input_columns if n not in irradiance)
-    transmitted = tuple(c.transmitted_input for c in building.components if c.angular is not None)
+    transmitted = tuple(name for c in building.components for name, _ in c.sun_inputs if name != c.irradiance_input)
     wind = (WIND_SPEED, WIND_DIRECTION) if any(c.outside.convection for c in building.exterior_components) else ()
     return (("T_out", "T_sky") + irradiance + named + clock_input_names(building) + transmitted
             + building.schedule_inputs + wind)
@@ -405,9 +405,9 @@ def assemble(building, names=None):
             to_temperature(e, c.area * out.h * boundary, out.temperature)
         else:
             assert isinstance(out, Adiabatic)
-        if c.solar_transmittance is not None:
-            sun = col[c.transmitted_input]
-            for name, fraction in c.receivers:
+        for sun_input, receivers in c.sun_inputs:
+            sun = col[sun_input]
+            for name, fraction in receivers:
                 # the receiving face is the one in the glazing's zone: a partition's outer face
                 # where only that face is in it
                 r = building.component(name)

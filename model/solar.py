@@ -232,10 +232,26 @@ def transmitted_irradiance(position, ghi, dni, dhi, tilt, azimuth, albedo, angle
 
     Parameters as `incident_irradiance`'s (`sunlit` f_sun, `sky` R_sky: 1 unshaded); angles (deg)
     and factors (-) the glazing's table, diffuse its factor for diffuse sun (-)."""
+    direct, diffuse_sun = _transmitted_parts(position, ghi, dni, dhi, tilt, azimuth, albedo, angles, factors, diffuse,
+                                             sunlit, sky)
+    sun = direct + diffuse_sun
+    return np.where(np.isfinite(sun) & (sun > 0.0), sun, 0.0)
+
+
+def transmitted_split(position, ghi, dni, dhi, tilt, azimuth, albedo, angles=(0.0, 90.0),
+                      factors=(1.0, 1.0), diffuse=1.0, sunlit=1.0, sky=1.0):
+    """(I_b, I_d) W/m2: `transmitted_irradiance`'s two terms apart, the direct
+    f(theta) f_sun dni max(cos theta, 0) and the diffuse f_d [...], each 0 where not positive or not
+    finite; the default table (f = 1 up to 90 deg, f_d = 1) is a glazing's without one."""
+    parts = _transmitted_parts(position, ghi, dni, dhi, tilt, azimuth, albedo, angles, factors, diffuse, sunlit, sky)
+    return tuple(np.where(np.isfinite(p) & (p > 0.0), p, 0.0) for p in parts)
+
+
+def _transmitted_parts(position, ghi, dni, dhi, tilt, azimuth, albedo, angles, factors, diffuse, sunlit, sky):
+    """(direct, diffuse) W/m2 of `transmitted_irradiance`, unclipped."""
     poa = _isotropic(position, ghi, dni, dhi, tilt, azimuth, albedo)
     zenith = np.asarray(position["apparent_zenith"], dtype=float)
     theta = pvlib.irradiance.aoi(tilt, azimuth, zenith, np.asarray(position["azimuth"], dtype=float))
     f = np.interp(np.asarray(theta, dtype=float), list(angles) + [90.0 + 1e-9], list(factors) + [0.0], right=0.0)
     beam = np.where(zenith < 90, _array(poa["poa_direct"]), 0.0)
-    sun = f * beam * sunlit + diffuse * (_array(poa["poa_sky_diffuse"]) * sky + _array(poa["poa_ground_diffuse"]))
-    return np.where(np.isfinite(sun) & (sun > 0.0), sun, 0.0)
+    return f * beam * sunlit, diffuse * (_array(poa["poa_sky_diffuse"]) * sky + _array(poa["poa_ground_diffuse"]))

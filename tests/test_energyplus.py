@@ -194,16 +194,24 @@ def test_case600_window(case600):
 
 
 def test_case600_interior_solar_distribution(case600):
-    """The floor absorbs 0.6 of the direct sun; the 0.4 it reflects spreads over every inside
-    surface as area x absorptance, the windows' share (12 m2 x 1 - R_back) leaving."""
+    """EnergyPlus's interior distribution by hand (Engineering Reference, interior solar
+    distribution): the diffuse sun over every face as area x absorptance, S = sum A alpha with each
+    window's 6 m2 counted as its panes' back-side absorptance plus its diffuse transmittance out;
+    the direct sun on the floor, which absorbs 0.6 and reflects 0.4 into that split."""
     w = case600.component("SOUTH WINDOW WEST")
-    shares = dict(w.solar_distribution)
+    direct, diffuse = dict(w.solar_distribution), dict(w.diffuse_distribution)
     T, R = 0.86156, 0.07846
-    glazing_take = 1 - (R + T * T * R / (1 - R * R))
-    S = (48 + 48 + 16.2 + 16.2 + 21.6 + 9.6) * 0.6 + 12 * glazing_take
-    assert shares["FLOOR"] == pytest.approx(0.6 + 0.4 * 48 * 0.6 / S, abs=1e-5)
-    assert shares["ROOF"] == pytest.approx(0.4 * 48 * 0.6 / S, abs=1e-5)
-    assert 1 - sum(shares.values()) == pytest.approx(0.4 * 12 * glazing_take / S, abs=1e-5)
+    a = 1 - T - R
+    # two alike panes: the inner absorbs a (1 + T R / (1 - R^2)) of the room's sun, the outer a T / (1 - R^2)
+    back = a * (1 + T * R / (1 - R * R)) + a * T / (1 - R * R)
+    out = T * T / (1 - R * R) * w.angular.diffuse
+    S = (48 + 48 + 16.2 + 16.2 + 21.6 + 9.6) * 0.6 + 12 * (back + out)
+    assert diffuse["FLOOR"] == pytest.approx(48 * 0.6 / S, abs=1e-5)
+    assert diffuse["SOUTH WINDOW WEST"] == pytest.approx(6 * back / S, abs=1e-5)
+    assert 1 - sum(diffuse.values()) == pytest.approx(12 * out / S, abs=1e-5)
+    assert direct["FLOOR"] == pytest.approx(0.6 + 0.4 * 48 * 0.6 / S, abs=1e-5)
+    assert direct["ROOF"] == pytest.approx(0.4 * 48 * 0.6 / S, abs=1e-5)
+    assert 1 - sum(direct.values()) == pytest.approx(0.4 * 12 * out / S, abs=1e-5)
 
 
 def test_case600_exterior_convection_is_doe2_at_the_reference_wind(case600):

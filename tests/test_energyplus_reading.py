@@ -350,17 +350,19 @@ def test_an_interzone_pair_is_the_same_building_whatever_its_order(tmp_path):
 
 def test_each_face_of_a_partition_takes_its_own_zones_sun():
     """EAST OFFICE's window lights the partition's face in EAST OFFICE, its outer face: the share
-    of its area times its absorptance, and the network puts it on that face's node."""
+    of its area times its absorptance, of the direct sun and of the diffuse, and the network puts
+    each on that face's node."""
     from nodeforce.model.network import assemble, input_names
     b = convert_idf(MULTIZONE)
     w = b.component("EAST SOUTH WINDOW")
-    shares = dict(w.solar_distribution)
-    assert shares.get("WEST TO EAST", 0.0) > 0
     net = assemble(b)
     p = b.component("WEST TO EAST")
-    j = input_names(b).index(w.transmitted_input)
-    assert net.B[p.node_ids[-1] - 1, j] == pytest.approx(w.solar_transmittance * w.area * shares["WEST TO EAST"])
-    assert net.B[p.node_ids[0] - 1, j] == 0.0
+    for sun, shares in w.sun_inputs:
+        shares = dict(shares)
+        assert shares.get("WEST TO EAST", 0.0) > 0
+        j = input_names(b).index(sun)
+        assert net.B[p.node_ids[-1] - 1, j] == pytest.approx(w.solar_transmittance * w.area * shares["WEST TO EAST"])
+        assert net.B[p.node_ids[0] - 1, j] == 0.0
 
 
 def test_wall_interzone_may_name_the_zone_beyond(tmp_path):
@@ -450,6 +452,50 @@ def test_simple_glazing_absorbs_as_energyplus_layer_and_keeps_its_shgc(tmp_path)
     f_in = h_i / (h_i + 1 / (R + 1 / h_o))
     # the films the split was made at are a vertical window's at 1.5 m: case 600's are within 2 %
     assert w.solar_transmittance + a_out * f_out + a_in * f_in == pytest.approx(0.38, rel=0.02)
+
+
+# the simple glazing's angular curves at 60 deg (cos 0.5), summed by hand from the Engineering
+# Reference's coefficients: c1/2 + c2/4 + c3/8 + c4/16 (no constant term: 0 at 90 deg)
+E60 = 1.51 / 2 + 2.49 / 4 - 5.87 / 8 + 2.88 / 16  # 0.82375
+J60 = 0.08 / 2 + 6.02 / 4 - 8.84 / 8 + 3.74 / 16  # 0.67375
+A60 = 3.36 / 2 - 3.85 / 4 + 1.49 / 8 + 0.01 / 16  # 0.904375
+B60 = 2.83 / 2 - 2.42 / 4 + 0.04 / 8 + 0.55 / 16  # 0.849375
+C60 = 2.45 / 2 - 1.58 / 4 - 0.64 / 8 + 0.77 / 16  # 0.798125
+D60 = 2.85 / 2 - 2.58 / 4 + 0.40 / 8 + 0.35 / 16  # 0.851875
+F60 = 1.21 / 2 + 3.14 / 4 - 6.37 / 8 + 3.03 / 16  # 0.783125
+G60 = 1.09 / 2 + 3.54 / 4 - 6.84 / 8 + 3.23 / 16  # 0.776875
+H60 = 0.98 / 2 + 3.83 / 4 - 7.13 / 8 + 3.33 / 16  # 0.764375
+I60 = 0.79 / 2 + 3.93 / 4 - 6.86 / 8 + 3.15 / 16  # 0.716875
+
+
+@pytest.mark.parametrize("U, shgc, at_60", [
+    (1.0, 0.6, E60),  # region E: low U, high SHGC
+    (1.0, 0.2, J60),  # J: low U, low SHGC
+    (2.5, 0.4, (F60 + G60 + H60 + I60) / 4),  # F, G, H, I averaged
+    (2.5, 0.2, (F60 + H60) / 2),  # F and H
+    (5.0, 0.7, A60),  # A: single clear
+    (5.0, 0.5, (B60 + D60 + C60 + D60) / 4),  # B, C, D (D twice, as EnergyPlus averages them)
+    (5.0, 0.2, D60),  # D
+    (1.0, 0.4, (E60 + J60) / 2),  # halfway between E and J in SHGC
+    ((3.4068 + 4.5424) / 2, 0.7, (E60 + A60) / 2),  # halfway between E and A in U
+])
+def test_simple_glazing_angular_transmittance_by_region(U, shgc, at_60):
+    """EnergyPlus's simple glazing: T(angle) / T(0) the curve of the (U, SHGC) region, 1 at
+    normal incidence, 0 at grazing incidence."""
+    f = glazing.simple_glazing_factors(U, shgc, np.array([0.0, 60.0, 90.0]))
+    assert f == pytest.approx([1.0, at_60, 0.0], abs=1e-9)
+
+
+def test_simple_glazing_writes_its_angular_table(tmp_path):
+    """The converted simple glazing (U 2.0441736, SHGC 0.38: region F, G, H, I) carries the
+    curve every 10 deg, its diffuse factor the table's hemispherical mean: below 1, above the
+    factor at 60 deg."""
+    text = TEXT.replace("  DOUBLE CLEAR,                 !- Name\n", "  DOUBLE CLEAR,\n  SIMPLE;\nConstruction,\n  UNUSED,\n", 1)
+    text += "WindowMaterial:SimpleGlazingSystem,\n  SIMPLE,\n  2.0441736,\n  0.38;\n"
+    a = convert_idf(write(tmp_path, text)).component("SOUTH WINDOW WEST").angular
+    assert a.angles[6] == 60 and a.factors[6] == pytest.approx((F60 + G60 + H60 + I60) / 4, abs=1e-9)
+    assert a.factors[0] == 1.0 and a.factors[-1] == pytest.approx(0.0, abs=1e-12)
+    assert a.factors[6] < a.diffuse < 1.0
 
 
 # ---- gains ---------------------------------------------------------------------------------

@@ -1,0 +1,38 @@
+"""Where the sun a zone's windows let in is absorbed (docs/model.md section 4.1), as EnergyPlus
+distributes it (Engineering Reference, "Interior Solar Distribution" and "Interior Diffuse Solar";
+HeatBalanceSurfaceManager.cc, ComputeIntSWAbsorpFactors; SolarShading.cc,
+ComputeIntSolarAbsorpFactors).
+
+Each function takes one entry per inside face of the zone: area A (m2), solar absorptance alpha
+(-; a window's back-side absorptance of its panes) and transmittance tau_out (-; 0 for an opaque
+face, a window's diffuse transmittance back out). Fractions are of the sun entering the zone (-).
+"""
+import numpy as np
+
+
+def diffuse_fractions(area, absorptance, transmittance):
+    """Fraction of the diffuse sun in a zone that each face absorbs,
+
+        psi_i = A_i alpha_i / sum_j A_j (alpha_j + tau_out,j)
+
+    every interreflection counted: what the faces reflect stays in the zone's diffuse pool until it
+    is absorbed or leaves through a window, so the pool goes out in proportion to A (alpha + tau).
+    What leaves is sum_j A_j tau_out,j / the same sum, 1 - sum_i psi_i; a zone without windows
+    keeps all of it."""
+    area, alpha, tau = (np.asarray(x, dtype=float) for x in (area, absorptance, transmittance))
+    return area * alpha / np.sum(area * (alpha + tau))
+
+
+def beam_fractions(area, absorptance, transmittance, floor):
+    """Fraction of the direct sun in a zone that each face absorbs where it all falls on the floor
+    (EnergyPlus's MinimalShadowing and FullExterior solar distributions): the floors (the faces of
+    the boolean mask `floor`) take it in proportion to their areas, each absorbing its alpha, and
+    what they reflect joins the diffuse pool (`diffuse_fractions`),
+
+        phi_i = [floor_i] A_i alpha_i / A_floor + rho_b psi_i,
+        rho_b = 1 - sum over the floors of A_i alpha_i / A_floor."""
+    area, alpha, tau = (np.asarray(x, dtype=float) for x in (area, absorptance, transmittance))
+    floor = np.asarray(floor, dtype=bool)
+    share = np.where(floor, area, 0.0) / np.sum(area[floor])
+    absorbed = share * alpha
+    return absorbed + (1.0 - np.sum(absorbed)) * diffuse_fractions(area, alpha, tau)

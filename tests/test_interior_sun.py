@@ -1,0 +1,114 @@
+"""The sun inside a zone (docs/model.md section 4.1): a glazing's direct and diffuse sun as two
+inputs with their own splits, and where EnergyPlus has each absorbed."""
+import copy
+
+import numpy as np
+import pytest
+
+from nodeforce.model.building_file import parse_building
+from nodeforce.model.case import prepare_case, simulate_building
+from nodeforce.model.errors import InputError
+from nodeforce.model.interior_sun import beam_fractions, diffuse_fractions
+from nodeforce.model.network import assemble
+
+
+def split_cell(data, direct, diffuse):
+    data = copy.deepcopy(data)
+    window = next(c for c in data["components"] if c["name"] == "window")
+    window["solar_distribution"] = direct
+    if diffuse is not None:
+        window["diffuse_distribution"] = diffuse
+    return parse_building(data)
+
+
+def test_direct_and_diffuse_inputs_add_up_to_the_sun_on_the_glazing(testcell_data, weather):
+    """Without an angular table the two inputs are the isotropic sky's two terms, dni cos theta
+    and the sky's and ground's diffuse: together the face's irradiance; the direct one is 0 at
+    night."""
+    b = split_cell(testcell_data, {"floor": 0.9}, {"floor": 0.5, "roof": 0.3})
+    case = prepare_case(b, weather.iloc[:24 * 14])
+    column = {name: case.U[:, k] for k, name in enumerate(case.input_names)}
+    direct, diffuse = column["Itb_window"], column["Itd_window"]
+    assert direct + diffuse == pytest.approx(column["I_window"], abs=1e-9)
+    night = column["I_window"] == 0
+    assert night.any() and (direct[night] == 0).all()
+    assert (diffuse > 0).any() and ((direct > 0) & (diffuse > 0)).any()
+
+
+def test_each_input_lands_by_its_own_split(testcell_data):
+    """B[face, input] = tau A phi: 0.8 x A x the fraction of each split, the window's face its own
+    irradiance's absorbed part alone."""
+    b = split_cell(testcell_data, {"floor": 0.9}, {"floor": 0.5, "roof": 0.3})
+    net = assemble(b)
+    w, floor, roof = (b.component(n) for n in ("window", "floor", "roof"))
+    col = {name: k for k, name in enumerate(net.input_names)}
+    assert net.B[floor.node_ids[0] - 1, col["Itb_window"]] == pytest.approx(0.8 * w.area * 0.9)
+    assert net.B[floor.node_ids[0] - 1, col["Itd_window"]] == pytest.approx(0.8 * w.area * 0.5)
+    assert net.B[roof.node_ids[0] - 1, col["Itd_window"]] == pytest.approx(0.8 * w.area * 0.3)
+    assert net.B[roof.node_ids[0] - 1, col["Itb_window"]] == 0.0
+    assert net.B[floor.node_ids[0] - 1, col["I_window"]] == 0.0
+
+
+def test_one_split_declared_twice_is_the_undeclared_building(testcell_data, weather):
+    """The same split for the direct and the diffuse sun is, by superposition, the one split the
+    file gives for both without a diffuse_distribution: the same temperatures."""
+    split = {"floor": 0.7, "roof": 0.1, "north_wall": 0.1}
+    one = simulate_building(split_cell(testcell_data, split, None), weather.iloc[:24 * 10])
+    two = simulate_building(split_cell(testcell_data, split, split), weather.iloc[:24 * 10])
+    assert np.abs(one.to_numpy() - two.to_numpy()).max() < 1e-9
+
+
+def test_a_split_glazing_refuses_a_measured_irradiance(testcell_data, weather):
+    b = split_cell(testcell_data, {"floor": 0.9}, {"floor": 0.5})
+    measured = weather.iloc[:48].assign(I_window=100.0)
+    measured.attrs = weather.attrs
+    with pytest.raises(InputError, match="diffuse_distribution"):
+        prepare_case(b, measured)
+
+
+def test_a_diffuse_distribution_is_refused_where_it_adds_up_over_1_or_names_no_component(testcell_data):
+    with pytest.raises(InputError, match="diffuse_distribution.*at most 1"):
+        split_cell(testcell_data, {"floor": 0.9}, {"floor": 0.8, "roof": 0.3})
+    with pytest.raises(InputError, match="diffuse_distribution.attic"):
+        split_cell(testcell_data, {"floor": 0.9}, {"attic": 0.5})
+
+
+# ---- EnergyPlus's interior distribution (model.interior_sun) --------------------------------
+# a 4 m x 4 m x 3 m box: floor (alpha 0.6), ceiling (0.3), 44 m2 of walls (0.5) and a 4 m2 window
+# whose panes absorb 0.1 of the room's diffuse sun and let 0.6 of it out
+AREA, ALPHA, OUT = [16.0, 16.0, 44.0, 4.0], [0.6, 0.3, 0.5, 0.1], [0.0, 0.0, 0.0, 0.6]
+FLOOR = [True, False, False, False]
+
+
+def test_the_diffuse_sun_goes_by_area_times_absorptance():
+    """S = 16 x 0.6 + 16 x 0.3 + 44 x 0.5 + 4 x (0.1 + 0.6) = 39.2 m2: the floor takes 9.6 / 39.2,
+    the window's panes 0.4 / 39.2, and 2.4 / 39.2 leaves; absorbed and leaving add up to 1."""
+    phi = diffuse_fractions(AREA, ALPHA, OUT)
+    assert phi == pytest.approx([9.6 / 39.2, 4.8 / 39.2, 22.0 / 39.2, 0.4 / 39.2])
+    assert phi.sum() + 2.4 / 39.2 == pytest.approx(1.0)
+
+
+def test_the_direct_sun_falls_on_the_floor_and_its_reflection_joins_the_diffuse():
+    """The floor absorbs 0.6 and reflects 0.4 into the diffuse split: 0.6 + 0.4 x 9.6 / 39.2 on
+    the floor, 0.4 x 2.4 / 39.2 leaving."""
+    phi = beam_fractions(AREA, ALPHA, OUT, FLOOR)
+    assert phi[0] == pytest.approx(0.6 + 0.4 * 9.6 / 39.2)
+    assert phi[2] == pytest.approx(0.4 * 22.0 / 39.2)
+    assert 1 - phi.sum() == pytest.approx(0.4 * 2.4 / 39.2)
+
+
+def test_two_floors_take_the_direct_sun_by_area():
+    """A 10 m2 floor of alpha 0.6 and a 6 m2 one of 0.3 (the box's floor split): 10/16 x 0.6 and
+    6/16 x 0.3 absorbed at once, 1 - 0.4875 reflected."""
+    area, alpha, out = [10.0, 6.0, 16.0, 44.0, 4.0], [0.6, 0.3, 0.3, 0.5, 0.1], [0, 0, 0, 0, 0.6]
+    phi = beam_fractions(area, alpha, out, [True, True, False, False, False])
+    S = 6.0 + 1.8 + 4.8 + 22.0 + 2.8
+    assert phi[:2] == pytest.approx([10 / 16 * 0.6 + 0.5125 * 6.0 / S, 6 / 16 * 0.3 + 0.5125 * 1.8 / S])
+    assert 1 - phi.sum() == pytest.approx(0.5125 * 2.4 / S)
+
+
+def test_a_zone_without_a_window_keeps_all_its_sun():
+    """No face lets any out: the fractions add up to 1, direct and diffuse."""
+    area, alpha, out = AREA[:3], ALPHA[:3], OUT[:3]
+    assert diffuse_fractions(area, alpha, out).sum() == pytest.approx(1.0, abs=1e-12)
+    assert beam_fractions(area, alpha, out, FLOOR[:3]).sum() == pytest.approx(1.0, abs=1e-12)
