@@ -31,12 +31,12 @@ def evaluator_kind(kind, buildings):
     network, else the Python FMU; any other kind is itself. Measured (benchmarks/bench_scale.py,
     docs/performance.md): a simulation of a new mask costs at least 1.7 times less through the
     standalone FMU than through the Python FMU, from the test cell's 23 nodes to 2,922. A building
-    with a scheduled air flow runs the Python FMU: the standalone steps one constant matrix."""
+    with a scheduled air flow, or a scheduled gain that follows the air's temperature, runs the
+    Python FMU: the standalone steps one constant matrix."""
     base, _, version = kind.partition("-fmi")
     if base != "auto":
         return kind
-    scheduled = any(v.schedule is not None and not b.schedules[v.schedule].is_constant
-                    for b in buildings for z in b.zones for v in z.ventilation)
+    scheduled = any(b.switched for b in buildings)
     return ("python" if scheduled or not find_compiler() else "standalone") + (f"-fmi{version}" if version else "")
 
 
