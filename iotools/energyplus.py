@@ -22,7 +22,7 @@ import numpy as np
 from ..model import convection, geometry, glazing
 from ..model.errors import InputError
 from .idf_text import closed_text
-from ..model.gains import PEOPLE_T, people_sensible_heat
+from ..model.gains import PEOPLE_T, people_sensible_heat, people_sensible_slope
 from ..model.network import air_density_at, sky_fraction_energyplus
 
 # 8.4 -> 8.5 changed no object read here (EnergyPlus's transition program for 8.5 renames an EMS
@@ -1269,14 +1269,17 @@ class _Converter:
         if activity is None:
             self.r.fail(o, "Activity Level Schedule Name", "varies in time: a gain has one schedule; give a constant activity")
         sensible = _field(o, "sensible_heat_fraction")
+        gain = {"name": o.name, "radiant_fraction": self.r.number(o, "fraction_radiant", default=0.0, low=0, high=1)}
         if _blank(sensible) or str(sensible).lower() in ("autocalculate", "autosize"):
-            # EnergyPlus's polynomial in the activity and the zone's air, at the converter's air temperature
-            heat = people_sensible_heat(activity)
-            self.note(f"a person's sensible heat EnergyPlus's polynomial at {PEOPLE_T:g} C")
+            # EnergyPlus's polynomial in the activity and the zone's air, linearised about PEOPLE_T:
+            # free-floating zones run 26 to 35 C, where a person gives 90 to 35 W, not 70
+            gain["power"] = n * people_sensible_heat(activity)
+            slope = n * people_sensible_slope(activity)
+            if slope < 0:
+                gain.update(temperature_slope=slope, reference_temperature=PEOPLE_T)
+            self.note(f"a person's sensible heat EnergyPlus's polynomial linearised about {PEOPLE_T:g} C")
         else:
-            heat = activity * self.r.number(o, "sensible_heat_fraction", low=0, high=1)
-        gain = {"name": o.name, "power": n * heat,
-                "radiant_fraction": self.r.number(o, "fraction_radiant", default=0.0, low=0, high=1)}
+            gain["power"] = n * activity * self.r.number(o, "sensible_heat_fraction", low=0, high=1)
         self._gain_schedule(gain, o, "number_of_people_schedule_name")
         return gain
 

@@ -571,3 +571,37 @@ def test_a_constant_incident_solar_multiplier_scales_the_windows_sun(tmp_path):
     assert b.component("WIN").solar_transmittance == pytest.approx(plain.solar_transmittance)
     assert any(line.startswith("SurfaceProperty:IncidentSolarMultiplier WIN: its schedule 'DAY' varies")
                for line in b.data["not_modelled"])
+
+
+# ---- internal gains -----------------------------------------------------------------------
+def test_a_persons_sensible_heat_is_energyplus_polynomial():
+    """The Engineering Reference's polynomial at 120 W and 23 C, by hand:
+    120.457227 (1, M, M^2 terms) + 23 x 0.45282168 - 23^2 x 0.107280448 = 74.1208 W;
+    its slope at 24 C, 0.45282168 - 2 x 24 x 0.107280448 = -4.69664 W/K, against a central
+    difference; a 10 W activity bounded at 10 W, as EnergyPlus bounds it, with no slope."""
+    from nodeforce.model.gains import people_sensible_heat, people_sensible_slope
+    assert people_sensible_heat(120.0, 23.0) == pytest.approx(74.1208, abs=1e-4)
+    assert people_sensible_slope(120.0, 24.0) == pytest.approx(-4.69664, abs=1e-5)
+    assert people_sensible_slope(120.0, 24.0) == pytest.approx(
+        (people_sensible_heat(120.0, 24.01) - people_sensible_heat(120.0, 23.99)) / 0.02, rel=1e-6)
+    assert (people_sensible_heat(10.0, 24.0), people_sensible_slope(10.0, 24.0)) == (10.0, 0.0)
+
+
+def test_a_zones_gains_as_energyplus_splits_them(tmp_path):
+    """An 8 x 6 m zone: 0.1 person/m2 at 120 W (4.8 people, sensible heat by the polynomial),
+    10 W/m2 of lights of which 0.2 goes to the return air, 500 W of equipment 0.1 latent and
+    0.2 lost. By hand, with the air at T: people 4.8 (69.5314 - 4.69664 (T - 24)) W, radiant
+    0.3 of 69.5314; lights 480 x 0.8 = 384 W, (0.4 + 0.2) / 0.8 = 0.75 of it radiant;
+    equipment 500 x 0.7 = 350 W, 0.3 / 0.7 of it radiant: 1067.75 W at 24 C."""
+    text = (HEADER + zone("Z") + box("Z", "Z") + "Schedule:Constant,\n  ACTIVITY,\n  ,\n  120;\n"
+            + "People,\n  P,\n  Z,\n  ,\n  People/Area,\n  ,\n  0.1,\n  ,\n  0.3,\n  autocalculate,\n  ACTIVITY;\n"
+            + "Lights,\n  L,\n  Z,\n  ,\n  Watts/Area,\n  ,\n  10,\n  ,\n  0.2,\n  0.4,\n  0.2,\n  1;\n"
+            + "ElectricEquipment,\n  E,\n  Z,\n  ,\n  EquipmentLevel,\n  500,\n  ,\n  ,\n  0.1,\n  0.3,\n  0.2;\n")
+    gains = {g.name: g for g in convert_idf(write(tmp_path, text)).zone("Z").gains}
+    people, lights, equipment = gains["P"], gains["L"], gains["E"]
+    assert people.power == pytest.approx(4.8 * 69.5314, abs=1e-3) and people.radiant_fraction == 0.3
+    assert (people.temperature_slope, people.reference_temperature) == (pytest.approx(4.8 * -4.69664), 24.0)
+    assert (lights.power, lights.radiant_fraction) == pytest.approx((384.0, 0.75))
+    assert (equipment.power, equipment.radiant_fraction) == pytest.approx((350.0, 0.3 / 0.7))
+    assert people.power + lights.power + equipment.power == pytest.approx(1067.75, abs=1e-2)
+    assert not lights.temperature_slope and not equipment.temperature_slope
