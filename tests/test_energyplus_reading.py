@@ -56,11 +56,11 @@ def write(tmp_path, text, name="model.idf"):
 # ---- fields through each version's IDD ------------------------------------------------------
 READ_FIELDS = {  # every field the converter asks of an object kind, named as 8.9's IDD names it
     "Lights": ["zone_or_zonelist_name", "schedule_name", "design_level_calculation_method", "lighting_level",
-               "watts_per_zone_floor_area", "return_air_fraction", "fraction_radiant", "fraction_visible"],
-    "ElectricEquipment": ["zone_or_zonelist_name", "design_level", "watts_per_zone_floor_area", "fraction_latent",
-                          "fraction_radiant", "fraction_lost"],
-    "GasEquipment": ["zone_or_zonelist_name", "design_level", "power_per_zone_floor_area"],
-    "OtherEquipment": ["zone_or_zonelist_name", "design_level", "power_per_zone_floor_area"],
+               "watts_per_zone_floor_area", "watts_per_person", "return_air_fraction", "fraction_radiant", "fraction_visible"],
+    "ElectricEquipment": ["zone_or_zonelist_name", "design_level", "watts_per_zone_floor_area", "watts_per_person",
+                          "fraction_latent", "fraction_radiant", "fraction_lost"],
+    "GasEquipment": ["zone_or_zonelist_name", "design_level", "power_per_zone_floor_area", "power_per_person"],
+    "OtherEquipment": ["zone_or_zonelist_name", "design_level", "power_per_zone_floor_area", "power_per_person"],
     "People": ["zone_or_zonelist_name", "number_of_people_schedule_name", "number_of_people_calculation_method",
                "number_of_people", "people_per_zone_floor_area", "zone_floor_area_per_person", "fraction_radiant",
                "sensible_heat_fraction", "activity_level_schedule_name"],
@@ -605,3 +605,16 @@ def test_a_zones_gains_as_energyplus_splits_them(tmp_path):
     assert (equipment.power, equipment.radiant_fraction) == pytest.approx((350.0, 0.3 / 0.7))
     assert people.power + lights.power + equipment.power == pytest.approx(1067.75, abs=1e-2)
     assert not lights.temperature_slope and not equipment.temperature_slope
+
+
+def test_a_level_per_person_takes_the_zones_people(tmp_path):
+    """EnergyPlus multiplies a Watts/Person level by the zone's occupants, its People's numbers:
+    two People objects in the 8 x 6 m zone, 3 people and one per 12 m2 (4), so 7 people; lights
+    at 20 W a person give 140 W, 0.5 of it to the return air: 70 W."""
+    people = "People,\n  {},\n  Z,\n  ,\n  {},\n  {},\n  ,\n  {},\n  0.3,\n  0.6,\n  ACTIVITY;\n"
+    text = (HEADER + zone("Z") + box("Z", "Z") + "Schedule:Constant,\n  ACTIVITY,\n  ,\n  120;\n"
+            + people.format("P1", "People", 3, "") + people.format("P2", "Area/Person", "", 12)
+            + "Lights,\n  L,\n  Z,\n  ,\n  Watts/Person,\n  ,\n  ,\n  20,\n  0.5,\n  0.4,\n  0.1,\n  1;\n")
+    gains = {g.name: g for g in convert_idf(write(tmp_path, text)).zone("Z").gains}
+    assert gains["L"].power == pytest.approx(70.0)
+    assert gains["P1"].power + gains["P2"].power == pytest.approx(7 * 120 * 0.6)
