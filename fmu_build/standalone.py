@@ -85,12 +85,10 @@ def network_terms(building, effect):
     by a different fraction, checks that split.
 
     Raises ValueError if the network is not of that form (to 1e-9 relative)."""
-    scheduled = [f"{z.name}: {v.name}" for z in building.zones for v in z.ventilation
-                 if v.schedule is not None and not building.schedules[v.schedule].is_constant]
-    if scheduled:
+    if building.switched:
         from nodeforce.model.errors import InputError
-        raise InputError(building.source, "ventilation", f"{scheduled[0]} follows a schedule: the standalone C FMU "
-                                                         "steps a constant matrix; use the Python FMU")
+        raise InputError(building.source, "zones", f"{building.switched[0]} follows a schedule: the standalone C FMU "
+                         "steps a constant matrix; use the Python FMU")
     if building.followed_convection:
         from nodeforce.model.errors import InputError
         where, field = building.followed_convection[0]

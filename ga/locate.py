@@ -31,14 +31,13 @@ def evaluator_kind(kind, buildings):
     network, else the Python FMU; any other kind is itself. Measured (benchmarks/bench_scale.py,
     docs/performance.md): a simulation of a new mask costs at least 1.7 times less through the
     standalone FMU than through the Python FMU, from the test cell's 23 nodes to 2,922. A building
-    with a scheduled air flow, or convective coefficients that follow its state (docs/model.md
-    3.6), runs the Python FMU: the standalone steps one constant matrix and constant sources."""
+    with a scheduled air flow, a scheduled gain that follows the air's temperature, or convective
+    coefficients that follow its state (docs/model.md 3.6), runs the Python FMU: the standalone
+    steps one constant matrix and constant sources."""
     base, _, version = kind.partition("-fmi")
     if base != "auto":
         return kind
-    scheduled = any(v.schedule is not None and not b.schedules[v.schedule].is_constant
-                    for b in buildings for z in b.zones for v in z.ventilation)
-    scheduled |= any(b.followed_convection for b in buildings)
+    scheduled = any(b.switched or b.followed_convection for b in buildings)
     return ("python" if scheduled or not find_compiler() else "standalone") + (f"-fmi{version}" if version else "")
 
 

@@ -23,7 +23,7 @@ from ..model import convection, geometry, glazing, interior_sun
 from ..model.errors import InputError
 from .energyplus_shading import fin, may_shade, on_surface, overhang, rectangle, window_frame
 from .idf_text import closed_text
-from ..model.gains import PEOPLE_T, people_sensible_heat
+from ..model.gains import PEOPLE_T, people_sensible_heat, people_sensible_slope
 from ..model.network import air_density_at, sky_fraction_energyplus
 from ..model.shading import sky_diffuse_ratio
 
@@ -101,10 +101,13 @@ SUBSURFACES = ("FenestrationSurface:Detailed", "Window", "Door", "GlazedDoor", "
 GAINS = ("People", "Lights", "ElectricEquipment", "GasEquipment", "HotWaterEquipment", "SteamEquipment",
          "OtherEquipment")
 # A gain's design level by its calculation method: the field each method reads (as 8.9's IDD names it)
-GAIN_FIELDS = {kind: {"equipmentlevel": "design_level", "watts/area": "power_per_zone_floor_area"}
+GAIN_FIELDS = {kind: {"equipmentlevel": "design_level", "watts/area": "power_per_zone_floor_area",
+                      "watts/person": "power_per_person"}
                for kind in ("GasEquipment", "HotWaterEquipment", "SteamEquipment", "OtherEquipment")}
-GAIN_FIELDS["ElectricEquipment"] = {"equipmentlevel": "design_level", "watts/area": "watts_per_zone_floor_area"}
-GAIN_FIELDS["Lights"] = {"lightinglevel": "lighting_level", "watts/area": "watts_per_zone_floor_area"}
+GAIN_FIELDS["ElectricEquipment"] = {"equipmentlevel": "design_level", "watts/area": "watts_per_zone_floor_area",
+                                    "watts/person": "watts_per_person"}
+GAIN_FIELDS["Lights"] = {"lightinglevel": "lighting_level", "watts/area": "watts_per_zone_floor_area",
+                         "watts/person": "watts_per_person"}
 FLOWS = ("ZoneInfiltration:DesignFlowRate", "ZoneVentilation:DesignFlowRate")
 # The shading objects the building file holds as shading polygons (`_Converter.shading`)
 SHADING = ("Shading:Site:Detailed", "Shading:Building:Detailed", "Shading:Zone:Detailed", "Shading:Site",
@@ -1227,6 +1230,9 @@ class _Converter:
 
     def gains(self, z, floor):
         out = []
+        # EnergyPlus's zone occupants, which a Watts/Person level multiplies: its People's numbers
+        occupants = sum(self.people_count(o, floor) for o in self.r.all("People")
+                        if z.name.upper() in [t.upper() for t in self._targets(o, "zone_or_zonelist_name")])
         for kind in GAINS:
             for o in self.r.all(kind):
                 if z.name.upper() not in [t.upper() for t in self._targets(o, "zone_or_zonelist_name")]:
@@ -1238,7 +1244,8 @@ class _Converter:
                 method = self.r.text(o, method_field).lower()
                 if method not in fields:
                     self.r.fail(o, _label(method_field), f"{method!r} is not read ({', '.join(fields)} are)")
-                power = self.design_value(o, fields[method]) * (floor if method == "watts/area" else 1.0)
+                power = self.design_value(o, fields[method]) * {"watts/area": floor,
+                                                                "watts/person": occupants}.get(method, 1.0)
                 if kind == "Lights":
                     radiant = self.r.number(o, "fraction_radiant", default=0.0) + self.r.number(o, "fraction_visible", default=0.0)
                     returned = self.r.number(o, "return_air_fraction", default=0.0)
@@ -1278,30 +1285,36 @@ class _Converter:
             return 0.0
         return self.r.number(o, field, low=None if o.obj_type.lower() == "otherequipment" else 0)
 
-    def people(self, o, floor):
+    def people_count(self, o, floor):
+        """A People object's number of people in a zone of `floor` m2, by its calculation method."""
         method = self.r.text(o, "number_of_people_calculation_method", "People").lower()
         if method == "people":
-            n = self.design_value(o, "number_of_people")
-        elif method == "people/area":
-            n = self.design_value(o, "people_per_zone_floor_area") * floor
-        elif method == "area/person":
+            return self.design_value(o, "number_of_people")
+        if method == "people/area":
+            return self.design_value(o, "people_per_zone_floor_area") * floor
+        if method == "area/person":
             per = self.design_value(o, "zone_floor_area_per_person")
-            n = floor / per if per > 0 else 0.0
-        else:
-            self.r.fail(o, "Number of People Calculation Method", f"{method!r} is not read")
+            return floor / per if per > 0 else 0.0
+        self.r.fail(o, "Number of People Calculation Method", f"{method!r} is not read")
+
+    def people(self, o, floor):
+        n = self.people_count(o, floor)
         activity = self.constant_schedule_value(self.r.text(o, "activity_level_schedule_name"), o,
                                                 "Activity Level Schedule Name")
         if activity is None:
             self.r.fail(o, "Activity Level Schedule Name", "varies in time: a gain has one schedule; give a constant activity")
         sensible = _field(o, "sensible_heat_fraction")
+        gain = {"name": o.name, "radiant_fraction": self.r.number(o, "fraction_radiant", default=0.0, low=0, high=1)}
         if _blank(sensible) or str(sensible).lower() in ("autocalculate", "autosize"):
-            # EnergyPlus's polynomial in the activity and the zone's air, at the converter's air temperature
-            heat = people_sensible_heat(activity)
-            self.note(f"a person's sensible heat EnergyPlus's polynomial at {PEOPLE_T:g} C")
+            # EnergyPlus's polynomial in the activity and the zone's air, linearised about PEOPLE_T:
+            # free-floating zones run 26 to 35 C, where a person gives 90 to 35 W, not 70
+            gain["power"] = n * people_sensible_heat(activity)
+            slope = n * people_sensible_slope(activity)
+            if slope < 0:
+                gain.update(temperature_slope=slope, reference_temperature=PEOPLE_T)
+            self.note(f"a person's sensible heat EnergyPlus's polynomial linearised about {PEOPLE_T:g} C")
         else:
-            heat = activity * self.r.number(o, "sensible_heat_fraction", low=0, high=1)
-        gain = {"name": o.name, "power": n * heat,
-                "radiant_fraction": self.r.number(o, "fraction_radiant", default=0.0, low=0, high=1)}
+            gain["power"] = n * activity * self.r.number(o, "sensible_heat_fraction", low=0, high=1)
         self._gain_schedule(gain, o, "number_of_people_schedule_name")
         return gain
 

@@ -98,11 +98,14 @@ class Lumped:
 @dataclass(frozen=True)
 class Gain:
     """A scheduled heat gain (docs/model.md section 3.4): power W times its schedule's value, the
-    radiant fraction to the radiant node, the rest to the air."""
+    radiant fraction to the radiant node, the rest to the air; with a temperature slope k, plus
+    k (T_air - reference_temperature) times the schedule's value, to the air."""
     name: str
-    power: float  # W at a schedule value of 1
+    power: float  # W at a schedule value of 1 (and the air at reference_temperature)
     radiant_fraction: float = 0.0  # -
     schedule: str | None = None  # None: always 1
+    temperature_slope: float = 0.0  # W/K at a schedule value of 1, <= 0
+    reference_temperature: float | None = None  # C, where the power is `power`; given with a slope
 
 
 @dataclass(frozen=True)
@@ -306,6 +309,15 @@ class Building:
             if c.shading:
                 names.append(c.shading)
         return tuple(n for n in dict.fromkeys(names) if n not in self.schedules)
+
+    @property
+    def switched(self):
+        """"zone's ventilation (or gain) name" of each air flow and gain whose conductance follows a
+        varying schedule (`Network.switched`): the network's matrix then changes in time."""
+        varying = lambda name: name is not None and not self.schedules[name].is_constant  # noqa: E731
+        return tuple(f"{z.name}'s ventilation {v.name}" for z in self.zones for v in z.ventilation
+                     if varying(v.schedule)) + tuple(f"{z.name}'s gain {g.name}" for z in self.zones for g in z.gains
+                                                     if g.temperature_slope and varying(g.schedule))
 
     @property
     def schedule_inputs(self):

@@ -273,10 +273,27 @@ def _schedule_of(check, item, where, schedules):
 
 
 def _gains(check, z, where, schedules):
-    return tuple(Gain(name=g["name"], power=float(g["power"]),
-                      radiant_fraction=float(g.get("radiant_fraction", schema_default("zone", "gains", "radiant_fraction"))),
-                      schedule=_schedule_of(check, g, f"{where}.gains[{k}]", schedules))
-                 for k, g in enumerate(z.get("gains", ())))
+    gains = []
+    for k, g in enumerate(z.get("gains", ())):
+        gw = f"{where}.gains[{k}]"
+        schedule = _schedule_of(check, g, gw, schedules)
+        slope = float(g.get("temperature_slope", schema_default("zone", "gains", "temperature_slope")))
+        if slope and "reference_temperature" not in g:
+            check.fail(f"{gw}.reference_temperature", "is required with a temperature_slope")
+        if slope and schedule is not None and _negative(schedules[schedule]):
+            check.fail(f"{gw}.schedule", f"{schedule!r} takes negative values: with a temperature_slope it is >= 0")
+        gains.append(Gain(name=g["name"], power=float(g["power"]),
+                          radiant_fraction=float(g.get("radiant_fraction",
+                                                       schema_default("zone", "gains", "radiant_fraction"))),
+                          schedule=schedule, temperature_slope=slope,
+                          reference_temperature=float(g["reference_temperature"]) if slope else None))
+    return tuple(gains)
+
+
+def _negative(schedule):
+    """Whether a schedule takes a value below 0 (a conductance it multiplies would be negative)."""
+    values = [schedule.constant] if schedule.constant is not None else [v for _, p in schedule.days for _, v in p]
+    return min(values) < 0
 
 
 def _ventilation(check, z, where, schedules):
@@ -284,8 +301,7 @@ def _ventilation(check, z, where, schedules):
     for k, v in enumerate(z.get("ventilation", ())):
         vw = f"{where}.ventilation[{k}]"
         schedule = _schedule_of(check, v, vw, schedules)
-        if schedule is not None and not schedules[schedule].is_constant and any(
-                value < 0 for _, profile in schedules[schedule].days for _, value in profile):
+        if schedule is not None and not schedules[schedule].is_constant and _negative(schedules[schedule]):
             check.fail(f"{vw}.schedule", f"{schedule!r} takes negative values: an air flow is >= 0")
         flows.append(Ventilation(name=v["name"], flow=float(v["flow"]), schedule=schedule))
     return tuple(flows)

@@ -5,14 +5,26 @@
 # 1, M, M^2, T, T M, T M^2, T^2, T^2 M, T^2 M^2
 PEOPLE_SENSIBLE = (6.461927, 0.946892, 0.0000255737, 7.139322, -0.0627909, 0.0000589172, -0.198550, 0.000940018,
                    -0.00000149532)
-# The zone temperature (C) at which a converted model takes a person's sensible heat: the
-# polynomial depends on it, the building file's gains do not
+# The zone temperature (C) about which a converted model linearises a person's sensible heat
+# (the building file's gain and its temperature slope)
 PEOPLE_T = 24.0
 
 
 def people_sensible_heat(activity, T=PEOPLE_T):
-    """Sensible heat of one person (W) at an activity level (W) and an air temperature (C)."""
+    """Sensible heat of one person (W) at an activity level (W) and an air temperature (C),
+    within 0 and the activity level, where EnergyPlus bounds it."""
     c = PEOPLE_SENSIBLE
     M = activity
-    return (c[0] + c[1] * M + c[2] * M ** 2 + T * (c[3] + c[4] * M + c[5] * M ** 2)
+    heat = (c[0] + c[1] * M + c[2] * M ** 2 + T * (c[3] + c[4] * M + c[5] * M ** 2)
             + T ** 2 * (c[6] + c[7] * M + c[8] * M ** 2))
+    return min(max(heat, 0.0), M)
+
+
+def people_sensible_slope(activity, T=PEOPLE_T):
+    """d(sensible heat)/dT of one person (W/K) at an activity level (W) and an air temperature
+    (C): the polynomial's derivative, 0 where the bounds hold it."""
+    c = PEOPLE_SENSIBLE
+    M = activity
+    if not 0.0 < people_sensible_heat(activity, T) < M:
+        return 0.0
+    return c[3] + c[4] * M + c[5] * M ** 2 + 2 * T * (c[6] + c[7] * M + c[8] * M ** 2)

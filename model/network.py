@@ -458,6 +458,14 @@ def assemble(building, names=None):
                     q[node] += part * gain.power * (1.0 if schedule is None else schedule.value)
                 else:
                     B[node, col[gain.schedule]] += part * gain.power
+            if gain.temperature_slope:
+                # s(t) k (T_air - T_ref), k <= 0: a conductance -k s(t) to T_ref, switched where s varies
+                g = -gain.temperature_slope
+                if schedule is None or schedule.is_constant:
+                    to_temperature(air, g * (1.0 if schedule is None else schedule.value), gain.reference_temperature)
+                else:
+                    switched.append((air, col[gain.schedule], g))
+                    B[air, col[gain.schedule]] += g * gain.reference_temperature
         for term, W in z.daily_gain:
             B[air, col[day_input(term)]] += W
         for column, k in z.proportional_gains:

@@ -332,6 +332,49 @@ def test_scheduled_ventilation_steady_states(tmp_path):
     assert air[pd.Timestamp("2017-03-03 05:45", tz="UTC")] == pytest.approx(100 / g, rel=1e-3)
 
 
+def test_gain_following_the_air_steady_states(tmp_path):
+    """A zone of adiabatic walls losing to 0 C outdoors through 100 m3/h (g W/K), its gain
+    s(t) (P + k (T_air - T_ref)) with P 300 W, k -6 W/K, T_ref 24 C, half of P radiant, s 1 by
+    night and 0.25 by day: each half day ends at the steady state of
+    0 = -g T + s (P + k (T - T_ref)), T = s (P - k T_ref) / (g - s k)."""
+    from nodeforce.iotools.weather import read_weather
+    from nodeforce.model.case import simulate_building
+    light = {"conductivity": 1.0, "density": 1.0, "specific_heat": 100.0}
+    b = minimal_building(
+        materials={"m": light},
+        schedules={"night": {"days": {"d": [[6, 1.0], [18, 0.25], [24, 1.0]]},
+                             "periods": [{"through": "12-31", "week": ["d"] * 7}]}})
+    b = b.edited(lambda d: d["zones"][0].update(ventilation=[{"name": "vent", "flow": 100.0}], gains=[
+        {"name": "people", "power": 300.0, "radiant_fraction": 0.5, "schedule": "night", "temperature_slope": -6.0,
+         "reference_temperature": 24.0}]))
+    assert b.switched == ("z's gain people",)
+    times = pd.date_range("2017-03-01", periods=3 * 24 * 4 + 1, freq="15min", tz="UTC")
+    path = tmp_path / "w.csv"
+    pd.DataFrame({"time": [t.isoformat() for t in times], "T_out": 0.0, "ghi": 0.0, "dni": 0.0,
+                  "dhi": 0.0}).to_csv(path, index=False)
+    T = simulate_building(b, read_weather(path))
+    air = pd.Series(T[f"T{b.zones[0].air_node}"].to_numpy(), index=times[1:])
+    g = 1.2 * 1005 * 100 / 3600
+    steady = lambda s: s * (300.0 + 6.0 * 24.0) / (g + 6.0 * s)  # noqa: E731
+    assert air[pd.Timestamp("2017-03-02 17:45", tz="UTC")] == pytest.approx(steady(0.25), rel=1e-3)
+    assert air[pd.Timestamp("2017-03-03 05:45", tz="UTC")] == pytest.approx(steady(1.0), rel=1e-3)
+    # without a schedule the conductance is constant: no switched term, the same steady state
+    constant = b.edited(lambda d: d["zones"][0]["gains"][0].pop("schedule"))
+    assert not constant.switched and not assemble(constant).switched
+    T = simulate_building(constant, read_weather(path))
+    assert T[f"T{b.zones[0].air_node}"].iloc[-1] == pytest.approx(steady(1.0), rel=1e-3)
+
+
+@pytest.mark.parametrize("gain, expected", [
+    ({"temperature_slope": -1.0}, "reference_temperature: is required with a temperature_slope"),
+    ({"temperature_slope": 1.0, "reference_temperature": 24.0}, "temperature_slope"),
+    ({"temperature_slope": -1.0, "reference_temperature": 24.0, "schedule": "minus"}, "takes negative values")])
+def test_gain_temperature_slope_refused(gain, expected):
+    with pytest.raises(InputError, match=expected):
+        minimal_building(schedules={"minus": {"constant": -1.0}}).edited(
+            lambda d: d["zones"][0].update(gains=[dict({"name": "g", "power": 10.0}, **gain)]))
+
+
 def test_standalone_fmu_refuses_a_switched_conductance():
     from nodeforce.fmu_build.standalone import network_terms
     b = minimal_building(schedules={"s": {"days": {"d": [[12, 0.0], [24, 1.0]]},

@@ -56,11 +56,11 @@ def write(tmp_path, text, name="model.idf"):
 # ---- fields through each version's IDD ------------------------------------------------------
 READ_FIELDS = {  # every field the converter asks of an object kind, named as 8.9's IDD names it
     "Lights": ["zone_or_zonelist_name", "schedule_name", "design_level_calculation_method", "lighting_level",
-               "watts_per_zone_floor_area", "return_air_fraction", "fraction_radiant", "fraction_visible"],
-    "ElectricEquipment": ["zone_or_zonelist_name", "design_level", "watts_per_zone_floor_area", "fraction_latent",
-                          "fraction_radiant", "fraction_lost"],
-    "GasEquipment": ["zone_or_zonelist_name", "design_level", "power_per_zone_floor_area"],
-    "OtherEquipment": ["zone_or_zonelist_name", "design_level", "power_per_zone_floor_area"],
+               "watts_per_zone_floor_area", "watts_per_person", "return_air_fraction", "fraction_radiant", "fraction_visible"],
+    "ElectricEquipment": ["zone_or_zonelist_name", "design_level", "watts_per_zone_floor_area", "watts_per_person",
+                          "fraction_latent", "fraction_radiant", "fraction_lost"],
+    "GasEquipment": ["zone_or_zonelist_name", "design_level", "power_per_zone_floor_area", "power_per_person"],
+    "OtherEquipment": ["zone_or_zonelist_name", "design_level", "power_per_zone_floor_area", "power_per_person"],
     "People": ["zone_or_zonelist_name", "number_of_people_schedule_name", "number_of_people_calculation_method",
                "number_of_people", "people_per_zone_floor_area", "zone_floor_area_per_person", "fraction_radiant",
                "sensible_heat_fraction", "activity_level_schedule_name"],
@@ -690,3 +690,50 @@ def test_the_building_shades_itself_where_two_faces_stand_in_front_of_each_other
     assert sunlit_fraction(wall.vertices, np.array([1.0, 0.0, 0.0]), b.shades_of("A E"), sun)[0] == \
         pytest.approx(expected, abs=1e-9)
     assert convert_idf(CASE600).shading == ()
+
+
+# ---- internal gains -----------------------------------------------------------------------
+def test_a_persons_sensible_heat_is_energyplus_polynomial():
+    """The Engineering Reference's polynomial at 120 W and 23 C, by hand:
+    120.457227 (1, M, M^2 terms) + 23 x 0.45282168 - 23^2 x 0.107280448 = 74.1208 W;
+    its slope at 24 C, 0.45282168 - 2 x 24 x 0.107280448 = -4.69664 W/K, against a central
+    difference; a 10 W activity bounded at 10 W, as EnergyPlus bounds it, with no slope."""
+    from nodeforce.model.gains import people_sensible_heat, people_sensible_slope
+    assert people_sensible_heat(120.0, 23.0) == pytest.approx(74.1208, abs=1e-4)
+    assert people_sensible_slope(120.0, 24.0) == pytest.approx(-4.69664, abs=1e-5)
+    assert people_sensible_slope(120.0, 24.0) == pytest.approx(
+        (people_sensible_heat(120.0, 24.01) - people_sensible_heat(120.0, 23.99)) / 0.02, rel=1e-6)
+    assert (people_sensible_heat(10.0, 24.0), people_sensible_slope(10.0, 24.0)) == (10.0, 0.0)
+
+
+def test_a_zones_gains_as_energyplus_splits_them(tmp_path):
+    """An 8 x 6 m zone: 0.1 person/m2 at 120 W (4.8 people, sensible heat by the polynomial),
+    10 W/m2 of lights of which 0.2 goes to the return air, 500 W of equipment 0.1 latent and
+    0.2 lost. By hand, with the air at T: people 4.8 (69.5314 - 4.69664 (T - 24)) W, radiant
+    0.3 of 69.5314; lights 480 x 0.8 = 384 W, (0.4 + 0.2) / 0.8 = 0.75 of it radiant;
+    equipment 500 x 0.7 = 350 W, 0.3 / 0.7 of it radiant: 1067.75 W at 24 C."""
+    text = (HEADER + zone("Z") + box("Z", "Z") + "Schedule:Constant,\n  ACTIVITY,\n  ,\n  120;\n"
+            + "People,\n  P,\n  Z,\n  ,\n  People/Area,\n  ,\n  0.1,\n  ,\n  0.3,\n  autocalculate,\n  ACTIVITY;\n"
+            + "Lights,\n  L,\n  Z,\n  ,\n  Watts/Area,\n  ,\n  10,\n  ,\n  0.2,\n  0.4,\n  0.2,\n  1;\n"
+            + "ElectricEquipment,\n  E,\n  Z,\n  ,\n  EquipmentLevel,\n  500,\n  ,\n  ,\n  0.1,\n  0.3,\n  0.2;\n")
+    gains = {g.name: g for g in convert_idf(write(tmp_path, text)).zone("Z").gains}
+    people, lights, equipment = gains["P"], gains["L"], gains["E"]
+    assert people.power == pytest.approx(4.8 * 69.5314, abs=1e-3) and people.radiant_fraction == 0.3
+    assert (people.temperature_slope, people.reference_temperature) == (pytest.approx(4.8 * -4.69664), 24.0)
+    assert (lights.power, lights.radiant_fraction) == pytest.approx((384.0, 0.75))
+    assert (equipment.power, equipment.radiant_fraction) == pytest.approx((350.0, 0.3 / 0.7))
+    assert people.power + lights.power + equipment.power == pytest.approx(1067.75, abs=1e-2)
+    assert not lights.temperature_slope and not equipment.temperature_slope
+
+
+def test_a_level_per_person_takes_the_zones_people(tmp_path):
+    """EnergyPlus multiplies a Watts/Person level by the zone's occupants, its People's numbers:
+    two People objects in the 8 x 6 m zone, 3 people and one per 12 m2 (4), so 7 people; lights
+    at 20 W a person give 140 W, 0.5 of it to the return air: 70 W."""
+    people = "People,\n  {},\n  Z,\n  ,\n  {},\n  {},\n  ,\n  {},\n  0.3,\n  0.6,\n  ACTIVITY;\n"
+    text = (HEADER + zone("Z") + box("Z", "Z") + "Schedule:Constant,\n  ACTIVITY,\n  ,\n  120;\n"
+            + people.format("P1", "People", 3, "") + people.format("P2", "Area/Person", "", 12)
+            + "Lights,\n  L,\n  Z,\n  ,\n  Watts/Person,\n  ,\n  ,\n  20,\n  0.5,\n  0.4,\n  0.1,\n  1;\n")
+    gains = {g.name: g for g in convert_idf(write(tmp_path, text)).zone("Z").gains}
+    assert gains["L"].power == pytest.approx(70.0)
+    assert gains["P1"].power + gains["P2"].power == pytest.approx(7 * 120 * 0.6)
