@@ -74,6 +74,12 @@ GLASS_DENSITY, GLASS_SPECIFIC_HEAT = 2500.0, 840.0  # kg/m3, J/kg/K
 # A massless layer (Material:NoMass, Material:AirGap) is written as a layer this thick with its
 # resistance and no capacity: only thickness / conductivity matters
 MASSLESS_THICKNESS = 0.001  # m
+# Material:InfraredTransparent as EnergyPlus holds it (Material.cc): a massless layer whose faces
+# absorb all the sun and (nearly) all long-wave radiation
+IR_TRANSPARENT_RESISTANCE = 0.01  # m2K/W
+IR_TRANSPARENT_FACE = {"emissivity": 0.9999, "solar": 1.0}
+THERMOCHROMIC_T = 20.0  # C, the pane temperature at which a thermochromic group's optics are taken
+PANES = ("WINDOWMATERIAL:GLAZING", "WINDOWMATERIAL:GLAZING:REFRACTIONEXTINCTIONMETHOD")
 MAX_SPACING = 0.025  # m, the largest cell of a generated component
 AIR_DENSITY, AIR_SPECIFIC_HEAT = 1.2, 1006.0  # a gas gap's capacity, kg/m3 and J/kg/K
 # EnergyPlus's ground temperature where the IDF gives none (its Site:GroundTemperature:BuildingSurface default)
@@ -105,7 +111,9 @@ SCHEDULES = ("Schedule:Compact", "Schedule:Constant", "Schedule:Year", "Schedule
              "Schedule:Week:Compact", "Schedule:Day:Interval", "Schedule:Day:Hourly", "Schedule:Day:List",
              "ScheduleTypeLimits")
 READ = set(("Version", "Site:Location", "GlobalGeometryRules", "Building", "Zone", "ZoneList", "Construction",
-            "Material", "Material:NoMass", "Material:AirGap", "WindowMaterial:Glazing", "WindowMaterial:Gas",
+            "Material", "Material:NoMass", "Material:AirGap", "Material:InfraredTransparent", "Material:RoofVegetation",
+            "WindowMaterial:Glazing", "WindowMaterial:Glazing:RefractionExtinctionMethod",
+            "WindowMaterial:GlazingGroup:Thermochromic", "WindowMaterial:Gas",
             "WindowMaterial:SimpleGlazingSystem", "Site:GroundTemperature:BuildingSurface",
             "Site:GroundTemperature:Deep", "Timestep",
             "InternalMass", "Construction:FfactorGroundFloor", "Construction:CfactorUndergroundWall",
@@ -666,8 +674,9 @@ class _Converter:
         names = [n for n in names if not _blank(n)]
         if not names:
             self.r.fail(c, "Outside Layer", "missing: a construction needs a layer")
-        kinds = ("Material", "Material:NoMass", "Material:AirGap", "WindowMaterial:Glazing", "WindowMaterial:Gas",
-                 "WindowMaterial:GasMixture",
+        kinds = ("Material", "Material:NoMass", "Material:AirGap", "Material:InfraredTransparent",
+                 "Material:RoofVegetation", "WindowMaterial:Glazing", "WindowMaterial:Glazing:RefractionExtinctionMethod",
+                 "WindowMaterial:GlazingGroup:Thermochromic", "WindowMaterial:Gas", "WindowMaterial:GasMixture",
                  "WindowMaterial:SimpleGlazingSystem")
         objs = []
         for k, n in enumerate(names):
@@ -678,6 +687,9 @@ class _Converter:
             if obj is None:
                 self.r.fail(c, "Outside Layer" if k == 0 else f"Layer {k + 1}",
                             f"names no material this converter reads ({n!r}; it reads {', '.join(kinds)})")
+            if obj.obj_type.upper() == "WINDOWMATERIAL:GLAZINGGROUP:THERMOCHROMIC":
+                obj = self.thermochromic_pane(obj)
+            self._approximated_material(obj)
             objs.append(obj)
         window = [o.obj_type.upper().startswith("WINDOWMATERIAL") for o in objs]
         if any(window) and not all(window):
@@ -711,8 +723,43 @@ class _Converter:
         height = self.r.number(c, "height", low=0)
         return self._fc_layers(c, cfactor_fictitious_resistance(C, height))
 
+    def thermochromic_pane(self, group):
+        """The WindowMaterial:Glazing of a thermochromic group at the optical data temperature
+        nearest THERMOCHROMIC_T (the group's pane at 20 C where it has one, its coolest where all
+        are warmer): the building file's panes do not change with their temperature."""
+        fields = group.to_dict()
+        rows = list(next((v for v in fields.values() if isinstance(v, list)), []))  # its extensible group
+        k = 1
+        while f"optical_data_temperature_{k}" in fields:  # the fields as numbered in the IDD
+            rows.append({f: fields.get(f"{f}_{k}") for f in ("optical_data_temperature", "window_material_glazing_name")})
+            k += 1
+        try:
+            rows = [(float(r["optical_data_temperature"]), str(r["window_material_glazing_name"])) for r in rows
+                    if not _blank(r.get("window_material_glazing_name"))]
+        except (KeyError, TypeError, ValueError):
+            self.r.fail(group, "Optical Data Temperature 1", "a temperature is not a number")
+        if not rows:
+            self.r.fail(group, "Window Material Glazing Name 1", "missing: a thermochromic group needs a pane")
+        T, name = min(rows, key=lambda row: (abs(row[0] - THERMOCHROMIC_T), row[0]))
+        line = (f"WindowMaterial:GlazingGroup:Thermochromic {group.name}: its pane at {T:g} C ({name}) at every "
+                "temperature; the switching of its optics with the pane's temperature not held")
+        if line not in self.not_modelled:
+            self.not_modelled.append(line)
+        return self.r.get("WindowMaterial:Glazing", name, group, "Window Material Glazing Name")
+
+    def _approximated_material(self, o):
+        """List once what a material EnergyPlus reads beyond the building file's layers carries."""
+        kind = o.obj_type.upper()
+        text = {"MATERIAL:INFRAREDTRANSPARENT": "a massless layer of resistance 0.01 m2K/W, as EnergyPlus holds it; "
+                                                "the long-wave radiation it lets cross between the zones not held",
+                "MATERIAL:ROOFVEGETATION": "its soil layer, of the dry soil's properties; the plants' shading and "
+                                           "evapotranspiration and the soil's moisture not held"}.get(kind)
+        line = f"{o.obj_type} {o.name}: {text}"
+        if text and line not in self.not_modelled:
+            self.not_modelled.append(line)
+
     def _thickness(self, o):
-        if o.obj_type.upper() == "MATERIAL":
+        if o.obj_type.upper() in ("MATERIAL", "MATERIAL:ROOFVEGETATION"):
             return self.r.number(o, "thickness", low=0, low_open=True)
         return MASSLESS_THICKNESS
 
@@ -721,6 +768,8 @@ class _Converter:
         defaults where a field is blank; an air gap is no face EnergyPlus would put outermost)."""
         if o.obj_type.upper() == "MATERIAL:AIRGAP":
             return {"emissivity": 0.9, "solar": 0.7, "roughness": convection.ROUGHNESS["mediumrough"]}
+        if o.obj_type.upper() == "MATERIAL:INFRAREDTRANSPARENT":
+            return dict(IR_TRANSPARENT_FACE, roughness=convection.ROUGHNESS["mediumrough"])
         roughness = self.r.text(o, "roughness", "MediumRough").lower()
         if roughness not in convection.ROUGHNESS:
             self.r.fail(o, "Roughness", f"{roughness!r} is none of EnergyPlus's roughnesses")
@@ -737,8 +786,16 @@ class _Converter:
             self.materials[name] = {"conductivity": self.r.number(o, "conductivity", low=0, low_open=True),
                                     "density": self.r.number(o, "density", low=0, low_open=True),
                                     "specific_heat": self.r.number(o, "specific_heat", low=100)}
+        elif kind == "MATERIAL:ROOFVEGETATION":
+            self.materials[name] = {"conductivity": self.r.number(o, "conductivity_of_dry_soil", default=0.35, low=0,
+                                                                  low_open=True),
+                                    "density": self.r.number(o, "density_of_dry_soil", default=1100.0, low=0,
+                                                             low_open=True),
+                                    "specific_heat": self.r.number(o, "specific_heat_of_dry_soil", default=1200.0,
+                                                                   low=100)}
         else:
-            R = self.r.number(o, "thermal_resistance", low=0, low_open=True)
+            R = IR_TRANSPARENT_RESISTANCE if kind == "MATERIAL:INFRAREDTRANSPARENT" else \
+                self.r.number(o, "thermal_resistance", low=0, low_open=True)
             self.materials[name] = {"conductivity": MASSLESS_THICKNESS / R, "density": 0.0, "specific_heat": 0.0}
         return name
 
@@ -776,11 +833,19 @@ class _Converter:
         panes, layers, gases = [], [], {}
         for k, o in enumerate(objs):
             kind = o.obj_type.upper()
-            expected = ("WINDOWMATERIAL:GLAZING",) if k % 2 == 0 else ("WINDOWMATERIAL:GAS", "WINDOWMATERIAL:GASMIXTURE")
+            expected = PANES if k % 2 == 0 else ("WINDOWMATERIAL:GAS", "WINDOWMATERIAL:GASMIXTURE")
             if kind not in expected:
                 self.r.fail(c, f"Layer {k + 1}", f"{o.name!r}: panes and gas gaps must alternate, a pane outermost "
                                                  "and innermost")
-            if kind == "WINDOWMATERIAL:GLAZING":
+            if kind == "WINDOWMATERIAL:GLAZING:REFRACTIONEXTINCTIONMETHOD":
+                T0, Rf = glazing.pane_from_refraction(
+                    self.r.number(o, "thickness", low=0, low_open=True),
+                    self.r.number(o, "solar_index_of_refraction", low=1, low_open=True),
+                    self.r.number(o, "solar_extinction_coefficient", low=0, low_open=True))
+                emissivity = self.r.number(o, "infrared_hemispherical_emissivity", default=0.84, low=0, low_open=True,
+                                           high=1)
+                panes.append((T0, Rf, emissivity, emissivity))
+            elif kind == "WINDOWMATERIAL:GLAZING":
                 optical = self.r.text(o, "optical_data_type", "SpectralAverage").lower()
                 if optical == "spectral":
                     T0, Rf = self.spectral_pane(o)
@@ -790,9 +855,10 @@ class _Converter:
                 else:
                     self.r.fail(o, "Optical Data Type", f"{optical!r}: SpectralAverage and Spectral pane data are read "
                                                         "(a BSDF pane is not)")
-                thickness = self.r.number(o, "thickness", low=0, low_open=True)
                 panes.append((T0, Rf, self.r.number(o, "front_side_infrared_hemispherical_emissivity", default=0.84),
                               self.r.number(o, "back_side_infrared_hemispherical_emissivity", default=0.84)))
+            if kind in PANES:
+                thickness = self.r.number(o, "thickness", low=0, low_open=True)
                 name = o.name
                 self.materials.setdefault(name, {"conductivity": self.r.number(o, "conductivity", low=0, low_open=True),
                                                  "density": GLASS_DENSITY, "specific_heat": GLASS_SPECIFIC_HEAT})

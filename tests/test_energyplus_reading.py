@@ -571,3 +571,67 @@ def test_a_constant_incident_solar_multiplier_scales_the_windows_sun(tmp_path):
     assert b.component("WIN").solar_transmittance == pytest.approx(plain.solar_transmittance)
     assert any(line.startswith("SurfaceProperty:IncidentSolarMultiplier WIN: its schedule 'DAY' varies")
                for line in b.data["not_modelled"])
+
+
+# ---- materials read as the building file's layers ---------------------------------------------
+def test_a_refraction_extinction_pane_is_energyplus_normal_incidence_optics(tmp_path):
+    """A 3 mm pane of n = 1.526, K = 30 /m: one face reflects r = (0.526/2.526)^2, the glass passes
+    tau = exp(-0.09); with the pane's interreflections T0 = (1 - r)^2 tau / (1 - r^2 tau^2) and
+    R0 = r (1 + (1 - r)^2 tau^2 / (1 - r^2 tau^2)). Inverting (T0, R0) gives r and tau back, and the
+    window of that pane alone transmits T0 at normal incidence."""
+    r, tau = (0.526 / 2.526) ** 2, np.exp(-30 * 0.003)
+    T0 = (1 - r) ** 2 * tau / (1 - r ** 2 * tau ** 2)
+    R0 = r * (1 + (1 - r) ** 2 * tau ** 2 / (1 - r ** 2 * tau ** 2))
+    assert glazing.pane_from_refraction(0.003, 1.526, 30.0) == pytest.approx((T0, R0), rel=1e-12)
+    assert glazing.pane_optics(T0, R0) == pytest.approx((r, tau), rel=1e-9)
+    text = box_24().replace("WindowMaterial:SimpleGlazingSystem, SGS, 2.0, 0.6;\nConstruction, GLAZING, SGS;\n",
+                            "WindowMaterial:Glazing:RefractionExtinctionMethod, GLASS, 0.003, 1.526, 30, 1.526, 30, 0, "
+                            "0.84, 0.9, 1, No;\nConstruction, GLAZING, GLASS;\n")
+    window = convert_idf(write(tmp_path, text)).component("WIN")
+    assert window.solar_transmittance == pytest.approx(T0, abs=1e-6)  # the file keeps 6 decimals
+    ((glass, thickness),) = window.layers
+    assert thickness == 0.003 and glass.conductivity == 0.9
+
+
+def test_an_infrared_transparent_layer_is_energyplus_massless_hundredth(tmp_path):
+    """Material:InfraredTransparent is a massless 0.01 m2K/W in EnergyPlus, its face absorbing the
+    sun wholly and long-wave radiation at 0.9999: the wall R2 + IRT conducts through 2.01 m2K/W,
+    its inside face is the transparent layer's, and the transparency is listed."""
+    text = box_24().replace("Construction, OPAQUE, R2;", "Material:InfraredTransparent, IRT;\nConstruction, OPAQUE, R2, IRT;")
+    b = convert_idf(write(tmp_path, text))
+    wall = b.component("N")
+    assert sum(t / m.conductivity for m, t in wall.layers) == pytest.approx(2.01, rel=1e-9)
+    assert sum(m.density for m, _ in wall.layers) == 0.0
+    assert any(line.startswith("Material:InfraredTransparent IRT: a massless layer of resistance 0.01")
+               for line in b.data["not_modelled"])
+
+
+def test_a_vegetated_roof_is_its_dry_soil(tmp_path):
+    """Material:RoofVegetation's soil: 0.1 m of dry soil at k 0.4 W/m/K, 641 kg/m3, 1100 J/kg/K,
+    outside the roof's R2, its face absorbing the sun at 0.7; the plants are listed as not held."""
+    eco = ("Material:RoofVegetation, ECO, 0.2, 5, 0.2, 0.95, 180, SOIL, MediumRough, 0.1, 0.4, 641, 1100, "
+           "0.95, 0.7, 0.75, 0.3, 0.01, 0.1, Simple;\nConstruction, GREEN, ECO, R2;\n")
+    text = box_24().replace("Construction, OPAQUE, R2;\n", "Construction, OPAQUE, R2;\n" + eco)
+    text = text.replace("R, Roof, OPAQUE", "R, Roof, GREEN")
+    b = convert_idf(write(tmp_path, text))
+    roof = b.component("R")
+    soil, thickness = roof.layers[-1]  # the layers run from the inside face outwards
+    assert (soil.conductivity, soil.density, soil.specific_heat, thickness) == (0.4, 641.0, 1100.0, 0.1)
+    assert sum(t / m.conductivity for m, t in roof.layers) == pytest.approx(2.0 + 0.1 / 0.4, rel=1e-9)
+    assert roof.outside.solar_absorptance == 0.7
+    assert any(line.startswith("Material:RoofVegetation ECO: its soil layer") for line in b.data["not_modelled"])
+
+
+@pytest.mark.parametrize("temperatures, taken", [((25, 35), 25), ((15, 20, 30), 20)])
+def test_a_thermochromic_group_is_its_pane_nearest_20_c(tmp_path, temperatures, taken):
+    """Each temperature's pane transmits a different T0 (0.8 - T/100); the window transmits the
+    pane's at 20 C where the group has one, its coolest where all are warmer, and says so."""
+    panes = "".join(f"WindowMaterial:Glazing, TC{T}, SpectralAverage, , 0.003, {0.8 - T / 100:g}, 0.08, 0.08, 0.8, "
+                    "0.08, 0.08, 0, 0.84, 0.84, 0.9;\n" for T in temperatures)
+    group = "WindowMaterial:GlazingGroup:Thermochromic, TC, " + ", ".join(f"{T}, TC{T}" for T in temperatures) + ";\n"
+    text = box_24().replace("WindowMaterial:SimpleGlazingSystem, SGS, 2.0, 0.6;\nConstruction, GLAZING, SGS;\n",
+                            panes + group + "Construction, GLAZING, TC;\n")
+    b = convert_idf(write(tmp_path, text))
+    assert b.component("WIN").solar_transmittance == pytest.approx(0.8 - taken / 100, rel=1e-9)
+    assert any(line.startswith(f"WindowMaterial:GlazingGroup:Thermochromic TC: its pane at {taken} C")
+               for line in b.data["not_modelled"])
