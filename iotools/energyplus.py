@@ -102,10 +102,13 @@ SUBSURFACES = ("FenestrationSurface:Detailed", "Window", "Door", "GlazedDoor", "
 GAINS = ("People", "Lights", "ElectricEquipment", "GasEquipment", "HotWaterEquipment", "SteamEquipment",
          "OtherEquipment")
 # A gain's design level by its calculation method: the field each method reads (as 8.9's IDD names it)
-GAIN_FIELDS = {kind: {"equipmentlevel": "design_level", "watts/area": "power_per_zone_floor_area"}
+GAIN_FIELDS = {kind: {"equipmentlevel": "design_level", "watts/area": "power_per_zone_floor_area",
+                      "watts/person": "power_per_person"}
                for kind in ("GasEquipment", "HotWaterEquipment", "SteamEquipment", "OtherEquipment")}
-GAIN_FIELDS["ElectricEquipment"] = {"equipmentlevel": "design_level", "watts/area": "watts_per_zone_floor_area"}
-GAIN_FIELDS["Lights"] = {"lightinglevel": "lighting_level", "watts/area": "watts_per_zone_floor_area"}
+GAIN_FIELDS["ElectricEquipment"] = {"equipmentlevel": "design_level", "watts/area": "watts_per_zone_floor_area",
+                                    "watts/person": "watts_per_person"}
+GAIN_FIELDS["Lights"] = {"lightinglevel": "lighting_level", "watts/area": "watts_per_zone_floor_area",
+                         "watts/person": "watts_per_person"}
 FLOWS = ("ZoneInfiltration:DesignFlowRate", "ZoneVentilation:DesignFlowRate")
 SCHEDULES = ("Schedule:Compact", "Schedule:Constant", "Schedule:Year", "Schedule:Week:Daily",
              "Schedule:Week:Compact", "Schedule:Day:Interval", "Schedule:Day:Hourly", "Schedule:Day:List",
@@ -1279,7 +1282,8 @@ class _Converter:
                 method = self.r.text(o, method_field).lower()
                 if method not in fields:
                     self.r.fail(o, _label(method_field), f"{method!r} is not read ({', '.join(fields)} are)")
-                power = self.design_value(o, fields[method]) * (floor if method == "watts/area" else 1.0)
+                per = {"watts/area": floor, "watts/person": self.zone_people(z, floor)}.get(method, 1.0)
+                power = self.design_value(o, fields[method]) * per
                 if kind == "Lights":
                     radiant = self.r.number(o, "fraction_radiant", default=0.0) + self.r.number(o, "fraction_visible", default=0.0)
                     returned = self.r.number(o, "return_air_fraction", default=0.0)
@@ -1319,17 +1323,26 @@ class _Converter:
             return 0.0
         return self.r.number(o, field, low=None if o.obj_type.lower() == "otherequipment" else 0)
 
-    def people(self, o, floor):
+    def people_count(self, o, floor):
+        """A People object's design number of people in a zone of `floor` m2, by its own method."""
         method = self.r.text(o, "number_of_people_calculation_method", "People").lower()
         if method == "people":
-            n = self.design_value(o, "number_of_people")
-        elif method == "people/area":
-            n = self.design_value(o, "people_per_zone_floor_area") * floor
-        elif method == "area/person":
+            return self.design_value(o, "number_of_people")
+        if method == "people/area":
+            return self.design_value(o, "people_per_zone_floor_area") * floor
+        if method == "area/person":
             per = self.design_value(o, "zone_floor_area_per_person")
-            n = floor / per if per > 0 else 0.0
-        else:
-            self.r.fail(o, "Number of People Calculation Method", f"{method!r} is not read")
+            return floor / per if per > 0 else 0.0
+        self.r.fail(o, "Number of People Calculation Method", f"{method!r} is not read")
+
+    def zone_people(self, z, floor):
+        """The zone's design number of people, the sum of its People objects' (EnergyPlus's
+        TotOccupants, on which a Watts/Person gain's design level stands)."""
+        return sum(self.people_count(o, floor) for o in self.r.all("People")
+                   if z.name.upper() in [t.upper() for t in self._targets(o, "zone_or_zonelist_name")])
+
+    def people(self, o, floor):
+        n = self.people_count(o, floor)
         activity = self.constant_schedule_value(self.r.text(o, "activity_level_schedule_name"), o,
                                                 "Activity Level Schedule Name")
         if activity is None:

@@ -635,3 +635,19 @@ def test_a_thermochromic_group_is_its_pane_nearest_20_c(tmp_path, temperatures, 
     assert b.component("WIN").solar_transmittance == pytest.approx(0.8 - taken / 100, rel=1e-9)
     assert any(line.startswith(f"WindowMaterial:GlazingGroup:Thermochromic TC: its pane at {taken} C")
                for line in b.data["not_modelled"])
+
+
+def test_a_watts_per_person_gain_stands_on_the_zones_people(tmp_path):
+    """EnergyPlus's Watts/Person level is the W a person times the zone's design occupants, the sum
+    of its People objects each by its own method: 3 people, plus one per 12 m2 of the 8 x 6 m floor
+    (4), plus 0.05 per m2 (2.4): 9.4 people; lights at 10 W and gas equipment at 5 W a person."""
+    text = HEADER + zone("Z") + box("Z", "Z") + "Schedule:Constant,\n  ACTIVITY,\n  ,\n  120;\n"
+    for name, method, values in (("P1", "People", "3, , "), ("P2", "Area/Person", ", , 12"),
+                                 ("P3", "People/Area", ", 0.05, ")):
+        text += f"People, {name}, Z, , {method}, {values}, 0.3, 0.6, ACTIVITY;\n"
+    text += "Lights, L, Z, , Watts/Person, , , 10, 0, 0.4, 0.2, 1;\n"
+    text += "GasEquipment, G, Z, , Watts/Person, , , 5, 0, 0.3, 0;\n"
+    gains = {g.name: g for g in convert_idf(write(tmp_path, text)).zone("Z").gains}
+    assert gains["L"].power == pytest.approx(10 * (3 + 48 / 12 + 0.05 * 48), rel=1e-9)
+    assert gains["G"].power == pytest.approx(5 * (3 + 48 / 12 + 0.05 * 48), rel=1e-9)
+    assert gains["P1"].power == pytest.approx(3 * 120 * 0.6, rel=1e-9)
