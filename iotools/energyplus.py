@@ -120,7 +120,7 @@ READ = set(("Version", "Site:Location", "GlobalGeometryRules", "Building", "Zone
             "WindowMaterial:SimpleGlazingSystem", "Site:GroundTemperature:BuildingSurface",
             "Site:GroundTemperature:Deep", "Timestep",
             "InternalMass", "Construction:FfactorGroundFloor", "Construction:CfactorUndergroundWall",
-            "Construction:WindowDataFile", "SurfaceProperty:IncidentSolarMultiplier",
+            "Construction:WindowDataFile", "Construction:AirBoundary", "SurfaceProperty:IncidentSolarMultiplier",
             "Site:GroundTemperature:FCfactorMethod", "SurfaceProperty:OtherSideCoefficients",
             "SurfaceProperty:OtherSideConditionsModel", "WindowMaterial:GasMixture", "MaterialProperty:GlazingSpectralData", "RunPeriodControl:SpecialDays", "SurfaceConvectionAlgorithm:Inside", "SurfaceConvectionAlgorithm:Outside") + SURFACES + tuple(SIMPLE_SURFACES) + SUBSURFACES + GAINS + FLOWS + SCHEDULES)
 # Objects about the run and its reports, not the building
@@ -429,7 +429,6 @@ def read_window5(text, window):
 UNREAD_CONSTRUCTIONS = {
     "Construction:WindowEquivalentLayer": "an equivalent-layer window is not read (give its layers)",
     "Construction:ComplexFenestrationState": "a BSDF window is not read (give its layers)",
-    "Construction:AirBoundary": "an air boundary between zones is not held by the building file",
 }
 
 
@@ -986,6 +985,7 @@ class _Converter:
         self.zone_objs = {z.name.upper(): z for z in zones}
         surfaces = self.surfaces()
         zone_data = [self.zone(z, surfaces) for z in zones]
+        self.air_boundaries(surfaces, zone_data)
         components = self.components(surfaces)
         for z in zone_data:
             z.pop("_floor_area")
@@ -1370,9 +1370,58 @@ class _Converter:
         key = lambda t: (order[t["zone"].upper()], t["obj"].name.upper())  # noqa: E731
         return min((s, other), key=key)
 
+    def air_boundary(self, s):
+        """The Construction:AirBoundary a surface is made of, or None."""
+        return self.r.by_name.get("CONSTRUCTION:AIRBOUNDARY", {}).get(s["construction"].upper())
+
+    def air_boundaries(self, surfaces, zone_data):
+        """Each pair of zones an air boundary joins exchanges air both ways, as EnergyPlus's
+        SimpleMixing makes a pair of ZoneMixing objects: V = ACH x the smaller zone's volume (m3/h),
+        the air of each zone entering the other (the building file's `airflow_from`). The surface
+        conducts nothing; the radiant and solar exchange across the opening are not held."""
+        by_zone = {z["name"].upper(): z for z in zone_data}
+        done = set()
+        for s in surfaces.values():
+            c = self.air_boundary(s)
+            if c is None:
+                continue
+            boundary, other_name = s["boundary"].lower(), s["other"].upper()
+            other = surfaces.get(other_name)
+            beyond = other["zone"] if other is not None else \
+                self.zone_objs[other_name].name if other_name in self.zone_objs else None
+            if boundary not in ("surface", "zone") or beyond is None or beyond.upper() == s["zone"].upper():
+                self.r.fail(s["obj"], "Outside Boundary Condition Object",
+                            f"{c.name!r} is a Construction:AirBoundary: it needs another zone on its other side")
+            pair = tuple(sorted((s["zone"].upper(), beyond.upper())))
+            method = self.r.text(c, "air_exchange_method", "None").lower()
+            first, second = sorted((s["zone"], beyond), key=str.upper)
+            line = (f"Construction:AirBoundary {c.name} between {first} and {second}: not a conducting surface; "
+                    "the radiant and solar exchange through the opening not held")
+            if line not in self.not_modelled:
+                self.not_modelled.append(line)
+            if method != "simplemixing" or pair in done:
+                continue
+            done.add(pair)
+            ach = self.r.number(c, "simple_mixing_air_changes_per_hour", default=0.5, low=0)
+            scale = 1.0
+            name = self.r.text(c, "simple_mixing_schedule_name")
+            if name:
+                scale = self.constant_schedule_value(name, c, "Simple Mixing Schedule Name")
+                if scale is None:
+                    scale = max(v for day in self.schedules[name]["days"].values() for _, v in day)
+                    self.not_modelled.append(f"Construction:AirBoundary {c.name}: its schedule {name!r} varies: the "
+                                             f"mixing taken at its largest value, {scale:g}, all year")
+            a, b = (by_zone[z] for z in pair)
+            flow = ach * scale * min(a["volume"], b["volume"])
+            if flow > 0:
+                for into, source in ((a, b), (b, a)):
+                    into.setdefault("airflow_from", []).append({"zone": source["name"], "flow": round(flow, 6)})
+
     def components(self, surfaces):
         comps, done = [], set()
         for key, s in surfaces.items():
+            if self.air_boundary(s) is not None:
+                continue  # an opening between zones: their air exchange (`air_boundaries`)
             if s["boundary"].lower() == "surface" and self.pair_owner(s, surfaces) is not s:
                 continue  # its partner, which comes first, is the partition
             if key in done:

@@ -651,3 +651,24 @@ def test_a_watts_per_person_gain_stands_on_the_zones_people(tmp_path):
     assert gains["L"].power == pytest.approx(10 * (3 + 48 / 12 + 0.05 * 48), rel=1e-9)
     assert gains["G"].power == pytest.approx(5 * (3 + 48 / 12 + 0.05 * 48), rel=1e-9)
     assert gains["P1"].power == pytest.approx(3 * 120 * 0.6, rel=1e-9)
+
+
+def test_an_air_boundary_exchanges_the_smaller_zones_volume_both_ways(tmp_path):
+    """three_zones.idf with the west office's wall to the corridor an air boundary of SimpleMixing
+    at 2 /h: EnergyPlus makes a ZoneMixing each way of 2 x the smaller zone's volume (the office's
+    6 x 5 x 3 m, 90 m3, beside the corridor's 108), 180 m3/h. The wall conducts nothing, every other
+    component is as before, and the opening's radiant and solar exchange are listed."""
+    text = MULTIZONE.read_text()
+    for name in ("WEST TO CORRIDOR", "CORRIDOR TO WEST"):
+        text = text.replace(f"    {name},Wall,INT WALL,", f"    {name},Wall,AIR WALL,")
+    # 9.3's fields: the solar and radiant methods (grouped zones), then the air exchange
+    text += "Construction:AirBoundary, AIR WALL, GroupedZones, GroupedZones, SimpleMixing, 2, ;\n"
+    b, before = convert_idf(write(tmp_path, text)), convert_idf(MULTIZONE)
+    assert [(f.zone, f.flow) for f in b.zone("WEST OFFICE").airflow_from] == [("CORRIDOR", pytest.approx(180.0))]
+    assert [(f.zone, f.flow) for f in b.zone("CORRIDOR").airflow_from] == [("WEST OFFICE", pytest.approx(180.0))]
+    assert b.zone("EAST OFFICE").airflow_from == ()
+    assert {c.name for c in before.components} - {c.name for c in b.components} == {"WEST TO CORRIDOR"}
+    assert any(line.startswith("Construction:AirBoundary AIR WALL between CORRIDOR and WEST OFFICE")
+               for line in b.data["not_modelled"])
+    none = convert_idf(write(tmp_path, text.replace("SimpleMixing, 2", "None, 2"), "none.idf"))
+    assert none.zone("WEST OFFICE").airflow_from == () and none.zone("CORRIDOR").airflow_from == ()
