@@ -113,7 +113,8 @@ FLOWS = ("ZoneInfiltration:DesignFlowRate", "ZoneVentilation:DesignFlowRate")
 SCHEDULES = ("Schedule:Compact", "Schedule:Constant", "Schedule:Year", "Schedule:Week:Daily",
              "Schedule:Week:Compact", "Schedule:Day:Interval", "Schedule:Day:Hourly", "Schedule:Day:List",
              "ScheduleTypeLimits")
-READ = set(("Version", "Site:Location", "GlobalGeometryRules", "Building", "Zone", "ZoneList", "Construction",
+READ = set(("Version", "Site:Location", "GlobalGeometryRules", "Building", "Zone", "ZoneList", "Space", "SpaceList",
+            "Construction",
             "Material", "Material:NoMass", "Material:AirGap", "Material:InfraredTransparent", "Material:RoofVegetation",
             "WindowMaterial:Glazing", "WindowMaterial:Glazing:RefractionExtinctionMethod",
             "WindowMaterial:GlazingGroup:Thermochromic", "WindowMaterial:Gas",
@@ -983,7 +984,7 @@ class _Converter:
         if not zones:
             self.r.fail(None, "Zone", "missing: the model has no zone")
         self.zone_objs = {z.name.upper(): z for z in zones}
-        surfaces = self.surfaces()
+        surfaces = self.surfaces_by_name = self.surfaces()
         zone_data = [self.zone(z, surfaces) for z in zones]
         self.air_boundaries(surfaces, zone_data)
         components = self.components(surfaces)
@@ -1028,7 +1029,7 @@ class _Converter:
                                            sun=self.r.text(s, "sun_exposure", "SunExposed").lower() == "sunexposed",
                                            wind=self.r.text(s, "wind_exposure", "WindExposed").lower() == "windexposed",
                                            construction=self.r.text(s, "construction_name"), vertices=vertices,
-                                           ground_view=self._ground_view(s))
+                                           ground_view=self._ground_view(s), space=self.r.text(s, "space_name"))
         for kind, (stype, boundary) in SIMPLE_SURFACES.items():
             for s in self.r.all(kind):
                 zone = self.zone_of(s, "zone_name")
@@ -1042,7 +1043,8 @@ class _Converter:
                                            other=self.r.text(s, "outside_boundary_condition_object"),
                                            sun=boundary == "Outdoors", wind=boundary == "Outdoors",
                                            construction=self.r.text(s, "construction_name"), vertices=None,
-                                           area=length * other, azimuth=azimuth, tilt=tilt,
+                                           space=self.r.text(s, "space_name"), area=length * other, azimuth=azimuth,
+                                           tilt=tilt,
                                            height=self._rect_height(s, zone, stype, other, tilt))
                 z0 = out[s.name.upper()]["height"] - 0.5 * other * np.sin(np.radians(tilt))
                 out[s.name.upper()]["z_range"] = tuple(sorted((z0, z0 + other * np.sin(np.radians(tilt)))))
@@ -1203,16 +1205,67 @@ class _Converter:
 
     def _targets(self, obj, field):
         """The zones an object's Zone or ZoneList name field names."""
+        return [zone for zone, _ in self._places(obj, field)]
+
+    def _places(self, obj, field):
+        """[(zone name, Space name or None)] of what an object's Zone, ZoneList, Space or SpaceList
+        name field names: a Space acts on its zone."""
         name = self.r.text(obj, field)
         if name.upper() in self.zone_objs:
-            return [self.zone_objs[name.upper()].name]
-        zl = self.r.by_name.get("ZONELIST", {}).get(name.upper())
-        if zl is None:
-            self.r.fail(obj, _field_label(obj, field), f"names no Zone or ZoneList ({name!r})")
-        fields = zl.to_dict()
-        if isinstance(fields.get("zones"), list):
-            return [d["zone_name"] for d in fields["zones"]]
-        return [v for k, v in fields.items() if k != "name" and not _blank(v)]
+            return [(self.zone_objs[name.upper()].name, None)]
+        if name.upper() in self.r.by_name.get("SPACE", {}):
+            return [self._space_place(name, obj, field)]
+        for kind in ("ZONELIST", "SPACELIST"):
+            members = self.r.by_name.get(kind, {}).get(name.upper())
+            if members is None:
+                continue
+            fields = members.to_dict()
+            listed = next((v for v in fields.values() if isinstance(v, list)), None)  # its extensible group
+            names = ([next(iter(d.values())) for d in listed] if listed is not None
+                     else [v for k, v in fields.items() if k != "name" and not _blank(v)])
+            if kind == "ZONELIST":
+                return [(n, None) for n in names]
+            return [self._space_place(n, members, "Space Name") for n in names]
+        self.r.fail(obj, _field_label(obj, field), f"names no Zone, ZoneList, Space or SpaceList ({name!r})")
+
+    def _space_place(self, name, referrer, field):
+        space = self.r.get("Space", name, referrer, field)
+        return self.zone_of(space, "zone_name").name, space.name
+
+    def _in_space(self, s, space):
+        """Whether a surface is in a Space: it names it, or names none in a zone of that one Space
+        (EnergyPlus puts it in the zone's only space)."""
+        named = s.get("space", "")
+        if named:
+            return named.upper() == space.upper()
+        return [o.name.upper() for o in self.r.all("Space")
+                if self.r.text(o, "zone_name").upper() == s["zone"].upper()] == [space.upper()]
+
+    def place_measures(self, z, space, measures):
+        """(floor m2, volume m3, exterior m2, exterior walls m2) over which a per-area method acts in
+        zone z: the zone's `measures`, or its Space's: the Space's floor area field, else its floor
+        surfaces', its exterior surfaces', its Volume field, else the zone's volume in proportion to
+        floor area."""
+        if space is None:
+            return measures
+        floor, volume = measures[:2]
+        own = [s for s in self.surfaces_by_name.values()
+               if s["zone"].upper() == z.name.upper() and self._in_space(s, space)]
+        obj = self.r.get("Space", space, None, "Space")
+        area = sum(s["area"] for s in own if s["type"].lower() == "floor")
+        if not _autocalculated(_field(obj, "floor_area")):
+            area = self.r.number(obj, "floor_area", low=0)
+        share = volume * area / floor if floor > 0 else 0.0
+        if not _autocalculated(_field(obj, "volume")):
+            share = self.r.number(obj, "volume", low=0)
+        outdoor = [s for s in own if s["boundary"].lower() == "outdoors"]
+        return (area, share, sum(s["area"] for s in outdoor),
+                sum(s["area"] for s in outdoor if s["type"].lower() == "wall"))
+
+    def _acting(self, obj, z, measures, field="zone_or_zonelist_name"):
+        """The measures (`place_measures`) of each place in zone z that an object acts on."""
+        return [self.place_measures(z, space, measures) for zone, space in self._places(obj, field)
+                if zone.upper() == z.name.upper()]
 
     def air_flows(self, z, volume, floor, exterior, walls, wind_height=FLOW_WIND_HEIGHT):
         """The zone's constant outdoor air flow (m3/h) from its design flow rate objects, and its
@@ -1220,22 +1273,22 @@ class _Converter:
         total, scheduled = 0.0, []
         for kind in FLOWS:
             for o in self.r.all(kind):
-                if z.name not in self._targets(o, "zone_or_zonelist_name") and \
-                        z.name.upper() not in [t.upper() for t in self._targets(o, "zone_or_zonelist_name")]:
+                places = self._acting(o, z, (floor, volume, exterior, walls))
+                if not places:
                     continue
                 method = self.r.text(o, "design_flow_rate_calculation_method", "Flow/Zone").lower()
-                per = {"flow/zone": ("design_flow_rate", 3600.0),
+                per = {"flow/zone": ("design_flow_rate", lambda m: 3600.0),
                        "flow/area": ("flow_per_zone_floor_area" if kind == FLOWS[0] else "flow_rate_per_zone_floor_area",
-                                     3600.0 * floor),
-                       "flow/exteriorarea": ("flow_per_exterior_surface_area", 3600.0 * exterior),
-                       "flow/exteriorwallarea": ("flow_per_exterior_surface_area", 3600.0 * walls),
-                       "airchanges/hour": ("air_changes_per_hour", volume),
+                                     lambda m: 3600.0 * m[0]),
+                       "flow/exteriorarea": ("flow_per_exterior_surface_area", lambda m: 3600.0 * m[2]),
+                       "flow/exteriorwallarea": ("flow_per_exterior_surface_area", lambda m: 3600.0 * m[3]),
+                       "airchanges/hour": ("air_changes_per_hour", lambda m: m[1]),
                        "flow/person": ("flow_rate_per_person", None)}
                 if method not in per or per[method][1] is None:
                     self.r.fail(o, "Design Flow Rate Calculation Method", f"{method!r} is not read (Flow/Zone, Flow/Area, "
                                 "Flow/ExteriorArea, Flow/ExteriorWallArea, AirChanges/Hour are)")
                 field, scale = per[method]
-                flow = self.design_value(o, field) * scale
+                flow = self.design_value(o, field) * sum(scale(m) for m in places)
                 # EnergyPlus's flow is the design flow times A + B |dT| + C v + D v^2; the building
                 # file's flows do not vary with either, so the terms are taken at a stated |dT| and
                 # the zone's wind
@@ -1273,16 +1326,21 @@ class _Converter:
         out = []
         for kind in GAINS:
             for o in self.r.all(kind):
-                if z.name.upper() not in [t.upper() for t in self._targets(o, "zone_or_zonelist_name")]:
+                floors = [m[0] for m in self._acting(o, z, (floor, 0.0, 0.0, 0.0))]
+                if not floors:
                     continue
                 if kind == "People":
-                    out.append(self.people(o, floor))
+                    out.append(self.people(o, floors))
                     continue
                 method_field, fields = "design_level_calculation_method", GAIN_FIELDS[kind]
                 method = self.r.text(o, method_field).lower()
                 if method not in fields:
                     self.r.fail(o, _label(method_field), f"{method!r} is not read ({', '.join(fields)} are)")
-                per = {"watts/area": floor, "watts/person": self.zone_people(z, floor)}.get(method, 1.0)
+                # each place (a zone, or a space) of the object's list gets the whole level
+                spaces = [space for zone, space in self._places(o, "zone_or_zonelist_name")
+                          if zone.upper() == z.name.upper()]
+                per = {"watts/area": sum(floors),
+                       "watts/person": sum(self.zone_people(z, floor, space) for space in spaces)}.get(method, len(floors))
                 power = self.design_value(o, fields[method]) * per
                 if kind == "Lights":
                     radiant = self.r.number(o, "fraction_radiant", default=0.0) + self.r.number(o, "fraction_visible", default=0.0)
@@ -1335,14 +1393,25 @@ class _Converter:
             return floor / per if per > 0 else 0.0
         self.r.fail(o, "Number of People Calculation Method", f"{method!r} is not read")
 
-    def zone_people(self, z, floor):
-        """The zone's design number of people, the sum of its People objects' (EnergyPlus's
-        TotOccupants, on which a Watts/Person gain's design level stands)."""
-        return sum(self.people_count(o, floor) for o in self.r.all("People")
-                   if z.name.upper() in [t.upper() for t in self._targets(o, "zone_or_zonelist_name")])
+    def zone_people(self, z, floor, space=None):
+        """The design number of people of a zone, the sum of its People objects' (EnergyPlus's
+        TotOccupants, on which a Watts/Person gain's design level stands), or of one of its Spaces:
+        the People naming it, and the zone's own People in proportion to the space's floor area."""
+        share = 1.0 if space is None else self.place_measures(z, space, (floor, 0.0, 0.0, 0.0))[0] / floor
+        total = 0.0
+        for o in self.r.all("People"):
+            for zone, where in self._places(o, "zone_or_zonelist_name"):
+                if zone.upper() != z.name.upper():
+                    continue
+                area = self.place_measures(z, where, (floor, 0.0, 0.0, 0.0))[0]
+                if space is None or where is None:
+                    total += self.people_count(o, area) * (share if where is None else 1.0)
+                elif where.upper() == space.upper():
+                    total += self.people_count(o, area)
+        return total
 
-    def people(self, o, floor):
-        n = self.people_count(o, floor)
+    def people(self, o, floors):
+        n = sum(self.people_count(o, area) for area in floors)
         activity = self.constant_schedule_value(self.r.text(o, "activity_level_schedule_name"), o,
                                                 "Activity Level Schedule Name")
         if activity is None:
@@ -1389,9 +1458,11 @@ class _Converter:
             other = surfaces.get(other_name)
             beyond = other["zone"] if other is not None else \
                 self.zone_objs[other_name].name if other_name in self.zone_objs else None
-            if boundary not in ("surface", "zone") or beyond is None or beyond.upper() == s["zone"].upper():
+            if boundary not in ("surface", "zone") or beyond is None:
                 self.r.fail(s["obj"], "Outside Boundary Condition Object",
-                            f"{c.name!r} is a Construction:AirBoundary: it needs another zone on its other side")
+                            f"{c.name!r} is a Construction:AirBoundary: it needs a zone on its other side")
+            if beyond.upper() == s["zone"].upper():
+                continue  # between two spaces of one zone: one air, one radiant enclosure already
             pair = tuple(sorted((s["zone"].upper(), beyond.upper())))
             method = self.r.text(c, "air_exchange_method", "None").lower()
             first, second = sorted((s["zone"], beyond), key=str.upper)

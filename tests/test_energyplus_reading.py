@@ -672,3 +672,24 @@ def test_an_air_boundary_exchanges_the_smaller_zones_volume_both_ways(tmp_path):
                for line in b.data["not_modelled"])
     none = convert_idf(write(tmp_path, text.replace("SimpleMixing, 2", "None, 2"), "none.idf"))
     assert none.zone("WEST OFFICE").airflow_from == () and none.zone("CORRIDOR").airflow_from == ()
+
+
+def test_a_gain_or_flow_naming_a_space_acts_on_its_zone_with_the_spaces_floor(tmp_path):
+    """The 4 x 4 m zone Z holds space S1 (its floor surface, 16 m2) and S2 (6 m2 by its Floor Area
+    field, after 24.1's Ceiling Height and Volume). Lights of 10 W/m2 on S1 give 160 W; of 5 W/m2 on the SpaceList of both, 5 x 22 = 110 W;
+    of 20 W a person on S2 with its 2 people, 40 W; 100 W of equipment on S2 is 100 W; an
+    infiltration of 0.001 m3/s per m2 of S2 is 0.006 m3/s, 21.6 m3/h of the zone's air."""
+    text = box_24().replace("F, Floor, OPAQUE, Z, ,", "F, Floor, OPAQUE, Z, S1,")
+    text += ("Space, S1, Z, , , , Office;\nSpace, S2, Z, , , 6, Office;\nSpaceList, BOTH, S1, S2;\n"
+             "Schedule:Constant, ACTIVITY, , 120;\n"
+             "Lights, L1, S1, , Watts/Area, , 10, , 0, 0.4, 0.2, 1;\n"
+             "Lights, L2, BOTH, , Watts/Area, , 5, , 0, 0.4, 0.2, 1;\n"
+             "Lights, L3, S2, , Watts/Person, , , 20, 0, 0.4, 0.2, 1;\n"
+             "People, P, S2, , People, 2, , , 0.3, 0.6, ACTIVITY;\n"
+             "ElectricEquipment, E, S2, , EquipmentLevel, 100, , , 0, 0.3, 0;\n"
+             "ZoneInfiltration:DesignFlowRate, I, S2, , Flow/Area, , 0.001, , , 1, 0, 0, 0;\n")
+    b = convert_idf(write(tmp_path, text))
+    z = b.zone("Z")
+    gains = {g.name: g.power for g in z.gains}
+    assert gains == pytest.approx({"L1": 160.0, "L2": 110.0, "L3": 40.0, "P": 2 * 120 * 0.6, "E": 100.0}, rel=1e-9)
+    assert z.air_change_rate * z.volume == pytest.approx(21.6, rel=1e-9)
