@@ -1397,7 +1397,9 @@ class _Converter:
         """The design number of people of a zone, the sum of its People objects' (EnergyPlus's
         TotOccupants, on which a Watts/Person gain's design level stands), or of one of its Spaces:
         the People naming it, and the zone's own People in proportion to the space's floor area."""
-        share = 1.0 if space is None else self.place_measures(z, space, (floor, 0.0, 0.0, 0.0))[0] / floor
+        share = 1.0  # the part of the zone's own People in the space
+        if space is not None:
+            share = self.place_measures(z, space, (floor, 0.0, 0.0, 0.0))[0] / floor if floor > 0 else 0.0
         total = 0.0
         for o in self.r.all("People"):
             for zone, where in self._places(o, "zone_or_zonelist_name"):
