@@ -79,6 +79,12 @@ GLASS_DENSITY, GLASS_SPECIFIC_HEAT = 2500.0, 840.0  # kg/m3, J/kg/K
 # A massless layer (Material:NoMass, Material:AirGap) is written as a layer this thick with its
 # resistance and no capacity: only thickness / conductivity matters
 MASSLESS_THICKNESS = 0.001  # m
+# Material:InfraredTransparent as EnergyPlus holds it (Material.cc): a massless layer whose faces
+# absorb all the sun and (nearly) all long-wave radiation
+IR_TRANSPARENT_RESISTANCE = 0.01  # m2K/W
+IR_TRANSPARENT_FACE = {"emissivity": 0.9999, "solar": 1.0}
+THERMOCHROMIC_T = 20.0  # C, the pane temperature at which a thermochromic group's optics are taken
+PANES = ("WINDOWMATERIAL:GLAZING", "WINDOWMATERIAL:GLAZING:REFRACTIONEXTINCTIONMETHOD")
 MAX_SPACING = 0.025  # m, the largest cell of a generated component
 AIR_DENSITY, AIR_SPECIFIC_HEAT = 1.2, 1006.0  # a gas gap's capacity, kg/m3 and J/kg/K
 # EnergyPlus's ground temperature where the IDF gives none (its Site:GroundTemperature:BuildingSurface default)
@@ -116,12 +122,15 @@ SHADING = ("Shading:Site:Detailed", "Shading:Building:Detailed", "Shading:Zone:D
 SCHEDULES = ("Schedule:Compact", "Schedule:Constant", "Schedule:Year", "Schedule:Week:Daily",
              "Schedule:Week:Compact", "Schedule:Day:Interval", "Schedule:Day:Hourly", "Schedule:Day:List",
              "ScheduleTypeLimits")
-READ = set(("Version", "Site:Location", "GlobalGeometryRules", "Building", "Zone", "ZoneList", "Construction",
-            "Material", "Material:NoMass", "Material:AirGap", "WindowMaterial:Glazing", "WindowMaterial:Gas",
+READ = set(("Version", "Site:Location", "GlobalGeometryRules", "Building", "Zone", "ZoneList", "Space", "SpaceList",
+            "Construction",
+            "Material", "Material:NoMass", "Material:AirGap", "Material:InfraredTransparent", "Material:RoofVegetation",
+            "WindowMaterial:Glazing", "WindowMaterial:Glazing:RefractionExtinctionMethod",
+            "WindowMaterial:GlazingGroup:Thermochromic", "WindowMaterial:Gas",
             "WindowMaterial:SimpleGlazingSystem", "Site:GroundTemperature:BuildingSurface",
             "Site:GroundTemperature:Deep", "Timestep",
             "InternalMass", "Construction:FfactorGroundFloor", "Construction:CfactorUndergroundWall",
-            "Construction:WindowDataFile", "SurfaceProperty:IncidentSolarMultiplier",
+            "Construction:WindowDataFile", "Construction:AirBoundary", "SurfaceProperty:IncidentSolarMultiplier",
             "Site:GroundTemperature:FCfactorMethod", "SurfaceProperty:OtherSideCoefficients",
             "SurfaceProperty:OtherSideConditionsModel", "WindowMaterial:GasMixture", "MaterialProperty:GlazingSpectralData", "RunPeriodControl:SpecialDays", "SurfaceConvectionAlgorithm:Inside", "SurfaceConvectionAlgorithm:Outside") + SURFACES + tuple(SIMPLE_SURFACES) + SUBSURFACES + GAINS + FLOWS + SCHEDULES + SHADING)
 # Objects about the run and its reports, not the building
@@ -430,7 +439,6 @@ def read_window5(text, window):
 UNREAD_CONSTRUCTIONS = {
     "Construction:WindowEquivalentLayer": "an equivalent-layer window is not read (give its layers)",
     "Construction:ComplexFenestrationState": "a BSDF window is not read (give its layers)",
-    "Construction:AirBoundary": "an air boundary between zones is not held by the building file",
 }
 
 
@@ -682,8 +690,9 @@ class _Converter:
         names = [n for n in names if not _blank(n)]
         if not names:
             self.r.fail(c, "Outside Layer", "missing: a construction needs a layer")
-        kinds = ("Material", "Material:NoMass", "Material:AirGap", "WindowMaterial:Glazing", "WindowMaterial:Gas",
-                 "WindowMaterial:GasMixture",
+        kinds = ("Material", "Material:NoMass", "Material:AirGap", "Material:InfraredTransparent",
+                 "Material:RoofVegetation", "WindowMaterial:Glazing", "WindowMaterial:Glazing:RefractionExtinctionMethod",
+                 "WindowMaterial:GlazingGroup:Thermochromic", "WindowMaterial:Gas", "WindowMaterial:GasMixture",
                  "WindowMaterial:SimpleGlazingSystem")
         objs = []
         for k, n in enumerate(names):
@@ -694,6 +703,9 @@ class _Converter:
             if obj is None:
                 self.r.fail(c, "Outside Layer" if k == 0 else f"Layer {k + 1}",
                             f"names no material this converter reads ({n!r}; it reads {', '.join(kinds)})")
+            if obj.obj_type.upper() == "WINDOWMATERIAL:GLAZINGGROUP:THERMOCHROMIC":
+                obj = self.thermochromic_pane(obj)
+            self._approximated_material(obj)
             objs.append(obj)
         window = [o.obj_type.upper().startswith("WINDOWMATERIAL") for o in objs]
         if any(window) and not all(window):
@@ -727,8 +739,43 @@ class _Converter:
         height = self.r.number(c, "height", low=0)
         return self._fc_layers(c, cfactor_fictitious_resistance(C, height))
 
+    def thermochromic_pane(self, group):
+        """The WindowMaterial:Glazing of a thermochromic group at the optical data temperature
+        nearest THERMOCHROMIC_T (the group's pane at 20 C where it has one, its coolest where all
+        are warmer): the building file's panes do not change with their temperature."""
+        fields = group.to_dict()
+        rows = list(next((v for v in fields.values() if isinstance(v, list)), []))  # its extensible group
+        k = 1
+        while f"optical_data_temperature_{k}" in fields:  # the fields as numbered in the IDD
+            rows.append({f: fields.get(f"{f}_{k}") for f in ("optical_data_temperature", "window_material_glazing_name")})
+            k += 1
+        try:
+            rows = [(float(r["optical_data_temperature"]), str(r["window_material_glazing_name"])) for r in rows
+                    if not _blank(r.get("window_material_glazing_name"))]
+        except (KeyError, TypeError, ValueError):
+            self.r.fail(group, "Optical Data Temperature 1", "a temperature is not a number")
+        if not rows:
+            self.r.fail(group, "Window Material Glazing Name 1", "missing: a thermochromic group needs a pane")
+        T, name = min(rows, key=lambda row: (abs(row[0] - THERMOCHROMIC_T), row[0]))
+        line = (f"WindowMaterial:GlazingGroup:Thermochromic {group.name}: its pane at {T:g} C ({name}) at every "
+                "temperature; the switching of its optics with the pane's temperature not held")
+        if line not in self.not_modelled:
+            self.not_modelled.append(line)
+        return self.r.get("WindowMaterial:Glazing", name, group, "Window Material Glazing Name")
+
+    def _approximated_material(self, o):
+        """List once what a material EnergyPlus reads beyond the building file's layers carries."""
+        kind = o.obj_type.upper()
+        text = {"MATERIAL:INFRAREDTRANSPARENT": "a massless layer of resistance 0.01 m2K/W, as EnergyPlus holds it; "
+                                                "the long-wave radiation it lets cross between the zones not held",
+                "MATERIAL:ROOFVEGETATION": "its soil layer, of the dry soil's properties; the plants' shading and "
+                                           "evapotranspiration and the soil's moisture not held"}.get(kind)
+        line = f"{o.obj_type} {o.name}: {text}"
+        if text and line not in self.not_modelled:
+            self.not_modelled.append(line)
+
     def _thickness(self, o):
-        if o.obj_type.upper() == "MATERIAL":
+        if o.obj_type.upper() in ("MATERIAL", "MATERIAL:ROOFVEGETATION"):
             return self.r.number(o, "thickness", low=0, low_open=True)
         return MASSLESS_THICKNESS
 
@@ -737,6 +784,8 @@ class _Converter:
         defaults where a field is blank; an air gap is no face EnergyPlus would put outermost)."""
         if o.obj_type.upper() == "MATERIAL:AIRGAP":
             return {"emissivity": 0.9, "solar": 0.7, "roughness": convection.ROUGHNESS["mediumrough"]}
+        if o.obj_type.upper() == "MATERIAL:INFRAREDTRANSPARENT":
+            return dict(IR_TRANSPARENT_FACE, roughness=convection.ROUGHNESS["mediumrough"])
         roughness = self.r.text(o, "roughness", "MediumRough").lower()
         if roughness not in convection.ROUGHNESS:
             self.r.fail(o, "Roughness", f"{roughness!r} is none of EnergyPlus's roughnesses")
@@ -753,8 +802,16 @@ class _Converter:
             self.materials[name] = {"conductivity": self.r.number(o, "conductivity", low=0, low_open=True),
                                     "density": self.r.number(o, "density", low=0, low_open=True),
                                     "specific_heat": self.r.number(o, "specific_heat", low=100)}
+        elif kind == "MATERIAL:ROOFVEGETATION":
+            self.materials[name] = {"conductivity": self.r.number(o, "conductivity_of_dry_soil", default=0.35, low=0,
+                                                                  low_open=True),
+                                    "density": self.r.number(o, "density_of_dry_soil", default=1100.0, low=0,
+                                                             low_open=True),
+                                    "specific_heat": self.r.number(o, "specific_heat_of_dry_soil", default=1200.0,
+                                                                   low=100)}
         else:
-            R = self.r.number(o, "thermal_resistance", low=0, low_open=True)
+            R = IR_TRANSPARENT_RESISTANCE if kind == "MATERIAL:INFRAREDTRANSPARENT" else \
+                self.r.number(o, "thermal_resistance", low=0, low_open=True)
             self.materials[name] = {"conductivity": MASSLESS_THICKNESS / R, "density": 0.0, "specific_heat": 0.0}
         return name
 
@@ -796,11 +853,19 @@ class _Converter:
         panes, layers, gases = [], [], {}
         for k, o in enumerate(objs):
             kind = o.obj_type.upper()
-            expected = ("WINDOWMATERIAL:GLAZING",) if k % 2 == 0 else ("WINDOWMATERIAL:GAS", "WINDOWMATERIAL:GASMIXTURE")
+            expected = PANES if k % 2 == 0 else ("WINDOWMATERIAL:GAS", "WINDOWMATERIAL:GASMIXTURE")
             if kind not in expected:
                 self.r.fail(c, f"Layer {k + 1}", f"{o.name!r}: panes and gas gaps must alternate, a pane outermost "
                                                  "and innermost")
-            if kind == "WINDOWMATERIAL:GLAZING":
+            if kind == "WINDOWMATERIAL:GLAZING:REFRACTIONEXTINCTIONMETHOD":
+                T0, Rf = glazing.pane_from_refraction(
+                    self.r.number(o, "thickness", low=0, low_open=True),
+                    self.r.number(o, "solar_index_of_refraction", low=1, low_open=True),
+                    self.r.number(o, "solar_extinction_coefficient", low=0, low_open=True))
+                emissivity = self.r.number(o, "infrared_hemispherical_emissivity", default=0.84, low=0, low_open=True,
+                                           high=1)
+                panes.append((T0, Rf, emissivity, emissivity))
+            elif kind == "WINDOWMATERIAL:GLAZING":
                 optical = self.r.text(o, "optical_data_type", "SpectralAverage").lower()
                 if optical == "spectral":
                     T0, Rf = self.spectral_pane(o)
@@ -810,9 +875,10 @@ class _Converter:
                 else:
                     self.r.fail(o, "Optical Data Type", f"{optical!r}: SpectralAverage and Spectral pane data are read "
                                                         "(a BSDF pane is not)")
-                thickness = self.r.number(o, "thickness", low=0, low_open=True)
                 panes.append((T0, Rf, self.r.number(o, "front_side_infrared_hemispherical_emissivity", default=0.84),
                               self.r.number(o, "back_side_infrared_hemispherical_emissivity", default=0.84)))
+            if kind in PANES:
+                thickness = self.r.number(o, "thickness", low=0, low_open=True)
                 name = o.name
                 self.materials.setdefault(name, {"conductivity": self.r.number(o, "conductivity", low=0, low_open=True),
                                                  "density": GLASS_DENSITY, "specific_heat": GLASS_SPECIFIC_HEAT})
@@ -937,8 +1003,9 @@ class _Converter:
         if not zones:
             self.r.fail(None, "Zone", "missing: the model has no zone")
         self.zone_objs = {z.name.upper(): z for z in zones}
-        surfaces = self.surfaces()
+        surfaces = self.surfaces_by_name = self.surfaces()
         zone_data = [self.zone(z, surfaces) for z in zones]
+        self.air_boundaries(surfaces, zone_data)
         components = self.components(surfaces)
         self.user_view_factors(zone_data, components, surfaces)
         shading = self.shading(components, surfaces)
@@ -981,7 +1048,8 @@ class _Converter:
                                            other=self.r.text(s, "outside_boundary_condition_object"),
                                            sun=self.r.text(s, "sun_exposure", "SunExposed").lower() == "sunexposed",
                                            wind=self.r.text(s, "wind_exposure", "WindExposed").lower() == "windexposed",
-                                           construction=self.r.text(s, "construction_name"), vertices=vertices)
+                                           construction=self.r.text(s, "construction_name"), vertices=vertices,
+                                           space=self.r.text(s, "space_name"))
         for kind, (stype, boundary) in SIMPLE_SURFACES.items():
             for s in self.r.all(kind):
                 zone = self.zone_of(s, "zone_name")
@@ -995,7 +1063,8 @@ class _Converter:
                                            other=self.r.text(s, "outside_boundary_condition_object"),
                                            sun=boundary == "Outdoors", wind=boundary == "Outdoors",
                                            construction=self.r.text(s, "construction_name"), vertices=None,
-                                           area=length * other, azimuth=azimuth, tilt=tilt,
+                                           space=self.r.text(s, "space_name"), area=length * other, azimuth=azimuth,
+                                           tilt=tilt,
                                            height=self._rect_height(s, zone, stype, other, tilt))
                 z0 = out[s.name.upper()]["height"] - 0.5 * other * np.sin(np.radians(tilt))
                 out[s.name.upper()]["z_range"] = tuple(sorted((z0, z0 + other * np.sin(np.radians(tilt)))))
@@ -1162,16 +1231,67 @@ class _Converter:
 
     def _targets(self, obj, field):
         """The zones an object's Zone or ZoneList name field names."""
+        return [zone for zone, _ in self._places(obj, field)]
+
+    def _places(self, obj, field):
+        """[(zone name, Space name or None)] of what an object's Zone, ZoneList, Space or SpaceList
+        name field names: a Space acts on its zone."""
         name = self.r.text(obj, field)
         if name.upper() in self.zone_objs:
-            return [self.zone_objs[name.upper()].name]
-        zl = self.r.by_name.get("ZONELIST", {}).get(name.upper())
-        if zl is None:
-            self.r.fail(obj, _field_label(obj, field), f"names no Zone or ZoneList ({name!r})")
-        fields = zl.to_dict()
-        if isinstance(fields.get("zones"), list):
-            return [d["zone_name"] for d in fields["zones"]]
-        return [v for k, v in fields.items() if k != "name" and not _blank(v)]
+            return [(self.zone_objs[name.upper()].name, None)]
+        if name.upper() in self.r.by_name.get("SPACE", {}):
+            return [self._space_place(name, obj, field)]
+        for kind in ("ZONELIST", "SPACELIST"):
+            members = self.r.by_name.get(kind, {}).get(name.upper())
+            if members is None:
+                continue
+            fields = members.to_dict()
+            listed = next((v for v in fields.values() if isinstance(v, list)), None)  # its extensible group
+            names = ([next(iter(d.values())) for d in listed] if listed is not None
+                     else [v for k, v in fields.items() if k != "name" and not _blank(v)])
+            if kind == "ZONELIST":
+                return [(n, None) for n in names]
+            return [self._space_place(n, members, "Space Name") for n in names]
+        self.r.fail(obj, _field_label(obj, field), f"names no Zone, ZoneList, Space or SpaceList ({name!r})")
+
+    def _space_place(self, name, referrer, field):
+        space = self.r.get("Space", name, referrer, field)
+        return self.zone_of(space, "zone_name").name, space.name
+
+    def _in_space(self, s, space):
+        """Whether a surface is in a Space: it names it, or names none in a zone of that one Space
+        (EnergyPlus puts it in the zone's only space)."""
+        named = s.get("space", "")
+        if named:
+            return named.upper() == space.upper()
+        return [o.name.upper() for o in self.r.all("Space")
+                if self.r.text(o, "zone_name").upper() == s["zone"].upper()] == [space.upper()]
+
+    def place_measures(self, z, space, measures):
+        """(floor m2, volume m3, exterior m2, exterior walls m2) over which a per-area method acts in
+        zone z: the zone's `measures`, or its Space's: the Space's floor area field, else its floor
+        surfaces', its exterior surfaces', its Volume field, else the zone's volume in proportion to
+        floor area."""
+        if space is None:
+            return measures
+        floor, volume = measures[:2]
+        own = [s for s in self.surfaces_by_name.values()
+               if s["zone"].upper() == z.name.upper() and self._in_space(s, space)]
+        obj = self.r.get("Space", space, None, "Space")
+        area = sum(s["area"] for s in own if s["type"].lower() == "floor")
+        if not _autocalculated(_field(obj, "floor_area")):
+            area = self.r.number(obj, "floor_area", low=0)
+        share = volume * area / floor if floor > 0 else 0.0
+        if not _autocalculated(_field(obj, "volume")):
+            share = self.r.number(obj, "volume", low=0)
+        outdoor = [s for s in own if s["boundary"].lower() == "outdoors"]
+        return (area, share, sum(s["area"] for s in outdoor),
+                sum(s["area"] for s in outdoor if s["type"].lower() == "wall"))
+
+    def _acting(self, obj, z, measures, field="zone_or_zonelist_name"):
+        """The measures (`place_measures`) of each place in zone z that an object acts on."""
+        return [self.place_measures(z, space, measures) for zone, space in self._places(obj, field)
+                if zone.upper() == z.name.upper()]
 
     def air_flows(self, z, volume, floor, exterior, walls, wind_height=FLOW_WIND_HEIGHT):
         """The zone's constant outdoor air flow (m3/h) from its design flow rate objects, and its
@@ -1179,22 +1299,22 @@ class _Converter:
         total, scheduled = 0.0, []
         for kind in FLOWS:
             for o in self.r.all(kind):
-                if z.name not in self._targets(o, "zone_or_zonelist_name") and \
-                        z.name.upper() not in [t.upper() for t in self._targets(o, "zone_or_zonelist_name")]:
+                places = self._acting(o, z, (floor, volume, exterior, walls))
+                if not places:
                     continue
                 method = self.r.text(o, "design_flow_rate_calculation_method", "Flow/Zone").lower()
-                per = {"flow/zone": ("design_flow_rate", 3600.0),
+                per = {"flow/zone": ("design_flow_rate", lambda m: 3600.0),
                        "flow/area": ("flow_per_zone_floor_area" if kind == FLOWS[0] else "flow_rate_per_zone_floor_area",
-                                     3600.0 * floor),
-                       "flow/exteriorarea": ("flow_per_exterior_surface_area", 3600.0 * exterior),
-                       "flow/exteriorwallarea": ("flow_per_exterior_surface_area", 3600.0 * walls),
-                       "airchanges/hour": ("air_changes_per_hour", volume),
+                                     lambda m: 3600.0 * m[0]),
+                       "flow/exteriorarea": ("flow_per_exterior_surface_area", lambda m: 3600.0 * m[2]),
+                       "flow/exteriorwallarea": ("flow_per_exterior_surface_area", lambda m: 3600.0 * m[3]),
+                       "airchanges/hour": ("air_changes_per_hour", lambda m: m[1]),
                        "flow/person": ("flow_rate_per_person", None)}
                 if method not in per or per[method][1] is None:
                     self.r.fail(o, "Design Flow Rate Calculation Method", f"{method!r} is not read (Flow/Zone, Flow/Area, "
                                 "Flow/ExteriorArea, Flow/ExteriorWallArea, AirChanges/Hour are)")
                 field, scale = per[method]
-                flow = self.design_value(o, field) * scale
+                flow = self.design_value(o, field) * sum(scale(m) for m in places)
                 # EnergyPlus's flow is the design flow times A + B |dT| + C v + D v^2; the building
                 # file's flows do not vary with either, so the terms are taken at a stated |dT| and
                 # the zone's wind
@@ -1230,22 +1350,24 @@ class _Converter:
 
     def gains(self, z, floor):
         out = []
-        # EnergyPlus's zone occupants, which a Watts/Person level multiplies: its People's numbers
-        occupants = sum(self.people_count(o, floor) for o in self.r.all("People")
-                        if z.name.upper() in [t.upper() for t in self._targets(o, "zone_or_zonelist_name")])
         for kind in GAINS:
             for o in self.r.all(kind):
-                if z.name.upper() not in [t.upper() for t in self._targets(o, "zone_or_zonelist_name")]:
+                floors = [m[0] for m in self._acting(o, z, (floor, 0.0, 0.0, 0.0))]
+                if not floors:
                     continue
                 if kind == "People":
-                    out.append(self.people(o, floor))
+                    out.append(self.people(o, floors))
                     continue
                 method_field, fields = "design_level_calculation_method", GAIN_FIELDS[kind]
                 method = self.r.text(o, method_field).lower()
                 if method not in fields:
                     self.r.fail(o, _label(method_field), f"{method!r} is not read ({', '.join(fields)} are)")
-                power = self.design_value(o, fields[method]) * {"watts/area": floor,
-                                                                "watts/person": occupants}.get(method, 1.0)
+                # each place (a zone, or a space) of the object's list gets the whole level
+                spaces = [space for zone, space in self._places(o, "zone_or_zonelist_name")
+                          if zone.upper() == z.name.upper()]
+                per = {"watts/area": sum(floors),
+                       "watts/person": sum(self.zone_people(z, floor, space) for space in spaces)}.get(method, len(floors))
+                power = self.design_value(o, fields[method]) * per
                 if kind == "Lights":
                     radiant = self.r.number(o, "fraction_radiant", default=0.0) + self.r.number(o, "fraction_visible", default=0.0)
                     returned = self.r.number(o, "return_air_fraction", default=0.0)
@@ -1286,7 +1408,7 @@ class _Converter:
         return self.r.number(o, field, low=None if o.obj_type.lower() == "otherequipment" else 0)
 
     def people_count(self, o, floor):
-        """A People object's number of people in a zone of `floor` m2, by its calculation method."""
+        """A People object's design number of people in a zone of `floor` m2, by its own method."""
         method = self.r.text(o, "number_of_people_calculation_method", "People").lower()
         if method == "people":
             return self.design_value(o, "number_of_people")
@@ -1297,8 +1419,27 @@ class _Converter:
             return floor / per if per > 0 else 0.0
         self.r.fail(o, "Number of People Calculation Method", f"{method!r} is not read")
 
-    def people(self, o, floor):
-        n = self.people_count(o, floor)
+    def zone_people(self, z, floor, space=None):
+        """The design number of people of a zone, the sum of its People objects' (EnergyPlus's
+        TotOccupants, on which a Watts/Person gain's design level stands), or of one of its Spaces:
+        the People naming it, and the zone's own People in proportion to the space's floor area."""
+        share = 1.0  # the part of the zone's own People in the space
+        if space is not None:
+            share = self.place_measures(z, space, (floor, 0.0, 0.0, 0.0))[0] / floor if floor > 0 else 0.0
+        total = 0.0
+        for o in self.r.all("People"):
+            for zone, where in self._places(o, "zone_or_zonelist_name"):
+                if zone.upper() != z.name.upper():
+                    continue
+                area = self.place_measures(z, where, (floor, 0.0, 0.0, 0.0))[0]
+                if space is None or where is None:
+                    total += self.people_count(o, area) * (share if where is None else 1.0)
+                elif where.upper() == space.upper():
+                    total += self.people_count(o, area)
+        return total
+
+    def people(self, o, floors):
+        n = sum(self.people_count(o, area) for area in floors)
         activity = self.constant_schedule_value(self.r.text(o, "activity_level_schedule_name"), o,
                                                 "Activity Level Schedule Name")
         if activity is None:
@@ -1329,9 +1470,60 @@ class _Converter:
         key = lambda t: (order[t["zone"].upper()], t["obj"].name.upper())  # noqa: E731
         return min((s, other), key=key)
 
+    def air_boundary(self, s):
+        """The Construction:AirBoundary a surface is made of, or None."""
+        return self.r.by_name.get("CONSTRUCTION:AIRBOUNDARY", {}).get(s["construction"].upper())
+
+    def air_boundaries(self, surfaces, zone_data):
+        """Each pair of zones an air boundary joins exchanges air both ways, as EnergyPlus's
+        SimpleMixing makes a pair of ZoneMixing objects: V = ACH x the smaller zone's volume (m3/h),
+        the air of each zone entering the other (the building file's `airflow_from`). The surface
+        conducts nothing; the radiant and solar exchange across the opening are not held."""
+        by_zone = {z["name"].upper(): z for z in zone_data}
+        done = set()
+        for s in surfaces.values():
+            c = self.air_boundary(s)
+            if c is None:
+                continue
+            boundary, other_name = s["boundary"].lower(), s["other"].upper()
+            other = surfaces.get(other_name)
+            beyond = other["zone"] if other is not None else \
+                self.zone_objs[other_name].name if other_name in self.zone_objs else None
+            if boundary not in ("surface", "zone") or beyond is None:
+                self.r.fail(s["obj"], "Outside Boundary Condition Object",
+                            f"{c.name!r} is a Construction:AirBoundary: it needs a zone on its other side")
+            if beyond.upper() == s["zone"].upper():
+                continue  # between two spaces of one zone: one air, one radiant enclosure already
+            pair = tuple(sorted((s["zone"].upper(), beyond.upper())))
+            method = self.r.text(c, "air_exchange_method", "None").lower()
+            first, second = sorted((s["zone"], beyond), key=str.upper)
+            line = (f"Construction:AirBoundary {c.name} between {first} and {second}: not a conducting surface; "
+                    "the radiant and solar exchange through the opening not held")
+            if line not in self.not_modelled:
+                self.not_modelled.append(line)
+            if method != "simplemixing" or pair in done:
+                continue
+            done.add(pair)
+            ach = self.r.number(c, "simple_mixing_air_changes_per_hour", default=0.5, low=0)
+            scale = 1.0
+            name = self.r.text(c, "simple_mixing_schedule_name")
+            if name:
+                scale = self.constant_schedule_value(name, c, "Simple Mixing Schedule Name")
+                if scale is None:
+                    scale = max(v for day in self.schedules[name]["days"].values() for _, v in day)
+                    self.not_modelled.append(f"Construction:AirBoundary {c.name}: its schedule {name!r} varies: the "
+                                             f"mixing taken at its largest value, {scale:g}, all year")
+            a, b = (by_zone[z] for z in pair)
+            flow = ach * scale * min(a["volume"], b["volume"])
+            if flow > 0:
+                for into, source in ((a, b), (b, a)):
+                    into.setdefault("airflow_from", []).append({"zone": source["name"], "flow": round(flow, 6)})
+
     def components(self, surfaces):
         comps, done = [], set()
         for key, s in surfaces.items():
+            if self.air_boundary(s) is not None:
+                continue  # an opening between zones: their air exchange (`air_boundaries`)
             if s["boundary"].lower() == "surface" and self.pair_owner(s, surfaces) is not s:
                 continue  # its partner, which comes first, is the partition
             if key in done:

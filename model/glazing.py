@@ -37,6 +37,18 @@ def pane_optics(T0, R0):
     return r, tau_of(r)
 
 
+def pane_from_refraction(thickness, n, K):
+    """(T0, R0), the solar transmittance and reflectance at normal incidence of an uncoated pane of
+    thickness (m), index of refraction n and extinction coefficient K (1/m), as EnergyPlus reads a
+    WindowMaterial:Glazing:RefractionExtinctionMethod: one interface reflects r = ((n - 1)/(n + 1))^2,
+    the glass transmits tau = exp(-K thickness), and the pane's interreflections sum as in
+    `pane_optics` (whose inverse this is)."""
+    r = ((n - 1) / (n + 1)) ** 2
+    tau = np.exp(-K * thickness)
+    d = 1 - (r * tau) ** 2
+    return (1 - r) ** 2 * tau / d, r * (1 + (1 - r) ** 2 * tau ** 2 / d)
+
+
 def pane_at(T0, R0, angle):
     """(T, R) of an uncoated pane at an angle of incidence (deg, 0 normal): Fresnel's interface
     reflectances for s and p light at the refractive index r gives, the glass's absorption over the

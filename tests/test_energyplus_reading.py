@@ -737,3 +737,125 @@ def test_a_level_per_person_takes_the_zones_people(tmp_path):
     gains = {g.name: g for g in convert_idf(write(tmp_path, text)).zone("Z").gains}
     assert gains["L"].power == pytest.approx(70.0)
     assert gains["P1"].power + gains["P2"].power == pytest.approx(7 * 120 * 0.6)
+
+
+# ---- materials read as the building file's layers ---------------------------------------------
+def test_a_refraction_extinction_pane_is_energyplus_normal_incidence_optics(tmp_path):
+    """A 3 mm pane of n = 1.526, K = 30 /m: one face reflects r = (0.526/2.526)^2, the glass passes
+    tau = exp(-0.09); with the pane's interreflections T0 = (1 - r)^2 tau / (1 - r^2 tau^2) and
+    R0 = r (1 + (1 - r)^2 tau^2 / (1 - r^2 tau^2)). Inverting (T0, R0) gives r and tau back, and the
+    window of that pane alone transmits T0 at normal incidence."""
+    r, tau = (0.526 / 2.526) ** 2, np.exp(-30 * 0.003)
+    T0 = (1 - r) ** 2 * tau / (1 - r ** 2 * tau ** 2)
+    R0 = r * (1 + (1 - r) ** 2 * tau ** 2 / (1 - r ** 2 * tau ** 2))
+    assert glazing.pane_from_refraction(0.003, 1.526, 30.0) == pytest.approx((T0, R0), rel=1e-12)
+    assert glazing.pane_optics(T0, R0) == pytest.approx((r, tau), rel=1e-9)
+    text = box_24().replace("WindowMaterial:SimpleGlazingSystem, SGS, 2.0, 0.6;\nConstruction, GLAZING, SGS;\n",
+                            "WindowMaterial:Glazing:RefractionExtinctionMethod, GLASS, 0.003, 1.526, 30, 1.526, 30, 0, "
+                            "0.84, 0.9, 1, No;\nConstruction, GLAZING, GLASS;\n")
+    window = convert_idf(write(tmp_path, text)).component("WIN")
+    assert window.solar_transmittance == pytest.approx(T0, abs=1e-6)  # the file keeps 6 decimals
+    ((glass, thickness),) = window.layers
+    assert thickness == 0.003 and glass.conductivity == 0.9
+
+
+def test_an_infrared_transparent_layer_is_energyplus_massless_hundredth(tmp_path):
+    """Material:InfraredTransparent is a massless 0.01 m2K/W in EnergyPlus, its face absorbing the
+    sun wholly and long-wave radiation at 0.9999: the wall R2 + IRT conducts through 2.01 m2K/W,
+    its inside face is the transparent layer's, and the transparency is listed."""
+    text = box_24().replace("Construction, OPAQUE, R2;", "Material:InfraredTransparent, IRT;\nConstruction, OPAQUE, R2, IRT;")
+    b = convert_idf(write(tmp_path, text))
+    wall = b.component("N")
+    assert sum(t / m.conductivity for m, t in wall.layers) == pytest.approx(2.01, rel=1e-9)
+    assert sum(m.density for m, _ in wall.layers) == 0.0
+    assert any(line.startswith("Material:InfraredTransparent IRT: a massless layer of resistance 0.01")
+               for line in b.data["not_modelled"])
+
+
+def test_a_vegetated_roof_is_its_dry_soil(tmp_path):
+    """Material:RoofVegetation's soil: 0.1 m of dry soil at k 0.4 W/m/K, 641 kg/m3, 1100 J/kg/K,
+    outside the roof's R2, its face absorbing the sun at 0.7; the plants are listed as not held."""
+    eco = ("Material:RoofVegetation, ECO, 0.2, 5, 0.2, 0.95, 180, SOIL, MediumRough, 0.1, 0.4, 641, 1100, "
+           "0.95, 0.7, 0.75, 0.3, 0.01, 0.1, Simple;\nConstruction, GREEN, ECO, R2;\n")
+    text = box_24().replace("Construction, OPAQUE, R2;\n", "Construction, OPAQUE, R2;\n" + eco)
+    text = text.replace("R, Roof, OPAQUE", "R, Roof, GREEN")
+    b = convert_idf(write(tmp_path, text))
+    roof = b.component("R")
+    soil, thickness = roof.layers[-1]  # the layers run from the inside face outwards
+    assert (soil.conductivity, soil.density, soil.specific_heat, thickness) == (0.4, 641.0, 1100.0, 0.1)
+    assert sum(t / m.conductivity for m, t in roof.layers) == pytest.approx(2.0 + 0.1 / 0.4, rel=1e-9)
+    assert roof.outside.solar_absorptance == 0.7
+    assert any(line.startswith("Material:RoofVegetation ECO: its soil layer") for line in b.data["not_modelled"])
+
+
+@pytest.mark.parametrize("temperatures, taken", [((25, 35), 25), ((15, 20, 30), 20)])
+def test_a_thermochromic_group_is_its_pane_nearest_20_c(tmp_path, temperatures, taken):
+    """Each temperature's pane transmits a different T0 (0.8 - T/100); the window transmits the
+    pane's at 20 C where the group has one, its coolest where all are warmer, and says so."""
+    panes = "".join(f"WindowMaterial:Glazing, TC{T}, SpectralAverage, , 0.003, {0.8 - T / 100:g}, 0.08, 0.08, 0.8, "
+                    "0.08, 0.08, 0, 0.84, 0.84, 0.9;\n" for T in temperatures)
+    group = "WindowMaterial:GlazingGroup:Thermochromic, TC, " + ", ".join(f"{T}, TC{T}" for T in temperatures) + ";\n"
+    text = box_24().replace("WindowMaterial:SimpleGlazingSystem, SGS, 2.0, 0.6;\nConstruction, GLAZING, SGS;\n",
+                            panes + group + "Construction, GLAZING, TC;\n")
+    b = convert_idf(write(tmp_path, text))
+    assert b.component("WIN").solar_transmittance == pytest.approx(0.8 - taken / 100, rel=1e-9)
+    assert any(line.startswith(f"WindowMaterial:GlazingGroup:Thermochromic TC: its pane at {taken} C")
+               for line in b.data["not_modelled"])
+
+
+def test_a_watts_per_person_gain_stands_on_the_zones_people(tmp_path):
+    """EnergyPlus's Watts/Person level is the W a person times the zone's design occupants, the sum
+    of its People objects each by its own method: 3 people, plus one per 12 m2 of the 8 x 6 m floor
+    (4), plus 0.05 per m2 (2.4): 9.4 people; lights at 10 W and gas equipment at 5 W a person."""
+    text = HEADER + zone("Z") + box("Z", "Z") + "Schedule:Constant,\n  ACTIVITY,\n  ,\n  120;\n"
+    for name, method, values in (("P1", "People", "3, , "), ("P2", "Area/Person", ", , 12"),
+                                 ("P3", "People/Area", ", 0.05, ")):
+        text += f"People, {name}, Z, , {method}, {values}, 0.3, 0.6, ACTIVITY;\n"
+    text += "Lights, L, Z, , Watts/Person, , , 10, 0, 0.4, 0.2, 1;\n"
+    text += "GasEquipment, G, Z, , Watts/Person, , , 5, 0, 0.3, 0;\n"
+    gains = {g.name: g for g in convert_idf(write(tmp_path, text)).zone("Z").gains}
+    assert gains["L"].power == pytest.approx(10 * (3 + 48 / 12 + 0.05 * 48), rel=1e-9)
+    assert gains["G"].power == pytest.approx(5 * (3 + 48 / 12 + 0.05 * 48), rel=1e-9)
+    assert gains["P1"].power == pytest.approx(3 * 120 * 0.6, rel=1e-9)
+
+
+def test_an_air_boundary_exchanges_the_smaller_zones_volume_both_ways(tmp_path):
+    """three_zones.idf with the west office's wall to the corridor an air boundary of SimpleMixing
+    at 2 /h: EnergyPlus makes a ZoneMixing each way of 2 x the smaller zone's volume (the office's
+    6 x 5 x 3 m, 90 m3, beside the corridor's 108), 180 m3/h. The wall conducts nothing, every other
+    component is as before, and the opening's radiant and solar exchange are listed."""
+    text = MULTIZONE.read_text()
+    for name in ("WEST TO CORRIDOR", "CORRIDOR TO WEST"):
+        text = text.replace(f"    {name},Wall,INT WALL,", f"    {name},Wall,AIR WALL,")
+    # 9.3's fields: the solar and radiant methods (grouped zones), then the air exchange
+    text += "Construction:AirBoundary, AIR WALL, GroupedZones, GroupedZones, SimpleMixing, 2, ;\n"
+    b, before = convert_idf(write(tmp_path, text)), convert_idf(MULTIZONE)
+    assert [(f.zone, f.flow) for f in b.zone("WEST OFFICE").airflow_from] == [("CORRIDOR", pytest.approx(180.0))]
+    assert [(f.zone, f.flow) for f in b.zone("CORRIDOR").airflow_from] == [("WEST OFFICE", pytest.approx(180.0))]
+    assert b.zone("EAST OFFICE").airflow_from == ()
+    assert {c.name for c in before.components} - {c.name for c in b.components} == {"WEST TO CORRIDOR"}
+    assert any(line.startswith("Construction:AirBoundary AIR WALL between CORRIDOR and WEST OFFICE")
+               for line in b.data["not_modelled"])
+    none = convert_idf(write(tmp_path, text.replace("SimpleMixing, 2", "None, 2"), "none.idf"))
+    assert none.zone("WEST OFFICE").airflow_from == () and none.zone("CORRIDOR").airflow_from == ()
+
+
+def test_a_gain_or_flow_naming_a_space_acts_on_its_zone_with_the_spaces_floor(tmp_path):
+    """The 4 x 4 m zone Z holds space S1 (its floor surface, 16 m2) and S2 (6 m2 by its Floor Area
+    field, after 24.1's Ceiling Height and Volume). Lights of 10 W/m2 on S1 give 160 W; of 5 W/m2 on the SpaceList of both, 5 x 22 = 110 W;
+    of 20 W a person on S2 with its 2 people, 40 W; 100 W of equipment on S2 is 100 W; an
+    infiltration of 0.001 m3/s per m2 of S2 is 0.006 m3/s, 21.6 m3/h of the zone's air."""
+    text = box_24().replace("F, Floor, OPAQUE, Z, ,", "F, Floor, OPAQUE, Z, S1,")
+    text += ("Space, S1, Z, , , , Office;\nSpace, S2, Z, , , 6, Office;\nSpaceList, BOTH, S1, S2;\n"
+             "Schedule:Constant, ACTIVITY, , 120;\n"
+             "Lights, L1, S1, , Watts/Area, , 10, , 0, 0.4, 0.2, 1;\n"
+             "Lights, L2, BOTH, , Watts/Area, , 5, , 0, 0.4, 0.2, 1;\n"
+             "Lights, L3, S2, , Watts/Person, , , 20, 0, 0.4, 0.2, 1;\n"
+             "People, P, S2, , People, 2, , , 0.3, 0.6, ACTIVITY;\n"
+             "ElectricEquipment, E, S2, , EquipmentLevel, 100, , , 0, 0.3, 0;\n"
+             "ZoneInfiltration:DesignFlowRate, I, S2, , Flow/Area, , 0.001, , , 1, 0, 0, 0;\n")
+    b = convert_idf(write(tmp_path, text))
+    z = b.zone("Z")
+    gains = {g.name: g.power for g in z.gains}
+    assert gains == pytest.approx({"L1": 160.0, "L2": 110.0, "L3": 40.0, "P": 2 * 120 * 0.6, "E": 100.0}, rel=1e-9)
+    assert z.air_change_rate * z.volume == pytest.approx(21.6, rel=1e-9)
