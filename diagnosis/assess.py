@@ -78,7 +78,7 @@ def assess(inputs, pair):
     own = own_nodes(building, [target, *(t for _, t in beside)], sensors, inputs.at_sensors, inputs.sigma,
                     inputs.policy)
     fitted, determined, folds = calibrate(candidate, calibrations, objective, blocks, inputs.numerical, own,
-                                          inputs.policy)
+                                          inputs.policy, inputs.sigma)
     values = [fitted[name]["value"] for name in candidate.names]
     zones = len(objective.air_nodes)
     # the objective air and the other sensors (never the objective air) in one run of each record

@@ -13,8 +13,9 @@ the same (`diagnosis.loop`). The covariance of the estimate is the linearised sa
 `model.significance`, which allows for the residual's correlation in time (the textbook
 s^2 (J^T J)^-1 assumes independent residuals and, on real records, is several times too tight).
 A parameter is called identifiable from the data when that estimate is tight enough to act on
-(`diagnosis.policy.Policy.identifiable`) and it did not end on a bound; one the data leave free
-is held at its physical prior where it has one and the data allow it (`calibrate`).
+(`diagnosis.policy.Policy.identifiable`) and it did not end on a bound. A parameter with a
+physical prior (`model.effects.Prior`) is fitted with it weighed against the data, a maximum a
+posteriori fit (`Penalised`, `calibrate`).
 """
 import logging
 from dataclasses import dataclass
@@ -83,7 +84,7 @@ class Candidate:
     `beside`: effects the building already holds ((effect, target) pairs) refitted together with
     the candidate, their parameters after its own (`names`: theirs as "effect@target/name"), each
     starting from its value in `building`; those named in `held` ({label: names}) stay there
-    (a parameter their own round held at its physical prior). A model's effects refitted
+    (a parameter that rests on its physical prior: `diagnosis.loop.resting_on_priors`). A model's effects refitted
     together is the fair test of one of them against another (`diagnosis.loop.revisit`)."""
 
     def __init__(self, building, effect, target, protocols=None, beside=(), held=None):
@@ -406,7 +407,59 @@ class Residuals:
         return (slopes + np.outer(self.error, share_slope(r, self.error, self.counted, slopes))) * self.scale[:, None]
 
 
-def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None, policy=None):
+class Penalised:
+    """`Residuals` with a row per Gaussian prior (`model.effects.Prior`) after the data's: sigma (x_i
+    - value) / sd for parameter i, sigma the noise's sd (C). Their squares' sum is J (C2) plus
+    sigma^2 sum ((x_i - value) / sd)^2, which is -2 sigma^2 times the log-posterior of the
+    parameters under white noise of sd sigma and the priors (to a constant): least squares on
+    them is the maximum a posteriori fit. The data's rows come first (`data`: how many)."""
+
+    def __init__(self, residuals, priors, sigma):
+        self.residuals = residuals
+        self.indices = np.array(list(priors), dtype=int)
+        self.values = np.array([p.value for p in priors.values()])
+        self.weights = sigma / np.array([p.sd for p in priors.values()])
+        self.data = len(residuals.counted)
+        self.counted = np.r_[residuals.counted, np.ones(len(priors), dtype=bool)]
+
+    def _prior_rows(self, x):
+        return self.weights * (np.asarray(x, dtype=float)[self.indices] - self.values)
+
+    def __call__(self, x, rows=None):
+        return np.r_[self.residuals(x, None if rows is None else rows[:self.data]), self._prior_rows(x)]
+
+    def fitting(self, x):
+        return np.r_[self.residuals.fitting(x), self._prior_rows(x)]
+
+    def jacobian(self, x):
+        rows = np.zeros((len(self.indices), len(x)))
+        rows[np.arange(len(self.indices)), self.indices] = self.weights
+        return np.vstack([self.residuals.jacobian(x), rows])
+
+
+def with_priors(cov, priors):
+    """The posterior covariance of the parameters: the data's `cov` (k, k, units squared)
+    combined with the Gaussian `priors` ({index: Prior}), (cov^+ + P)^+ with P diagonal, 1 / sd^2
+    at a prior's index and 0 elsewhere: the inverse of the log-posterior's Hessian, the priors'
+    terms added to the data's. A direction the data say nothing of (a T_ground whose coupling U
+    is 0, its Jacobian column zero and its data variance 0) has no data precision, and the
+    prior's sd is the posterior's; a parameter held (variance 0, no prior) keeps variance 0.
+    Computed on the correlations (each parameter in units of its data sd), whose inverse's
+    relative cutoff then drops a direction the data leave undetermined, never a parameter whose
+    unit makes its variance small. `cov` itself where there is no prior."""
+    if not priors:
+        return cov
+    d = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    d = np.where(d > 0, d, 1.0)
+    precision = np.zeros(len(cov))
+    for i, prior in priors.items():
+        precision[i] = (d[i] / prior.sd) ** 2
+    posterior = np.linalg.pinv(np.linalg.pinv(cov / np.outer(d, d), hermitian=True) + np.diag(precision),
+                               hermitian=True)
+    return posterior * np.outer(d, d)
+
+
+def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None, policy=None, sigma=None):
     """Least-squares values of the candidate's parameters on the calibration windows of one or
     several records of the building (`cases`), on the residuals of every objective zone of every
     record together (the sum of each window's J), and the same fit with each block of steps left out.
@@ -416,13 +469,14 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None, 
     wall's conductivity or absorptance, slow and weather-driven, would otherwise be fitted to what
     the file's coarse walls make, and chosen for it over the fault the record holds.
 
-    Where the data fix a combination of the parameters but leave one free that physics has a
-    prior for (`model.effects.Prior`: a ground coupling's T_ground, the site's deep ground), the
-    fit is made again with it held there, and kept unless the data reject the prior (a score
-    test, `score_statistic`, `Policy.holds_prior`): the free fit's end along the valley is wherever least squares
-    stopped (a ground at 0.2 C under a cell in Miami, its U a tenth of the truth's), and a
-    building file carrying it would carry that to every later record; the held value is what a
-    modeller would have written.
+    A parameter physics has a prior for (`model.effects.Prior`: a ground coupling's T_ground, the
+    site's deep ground) is fitted with the prior weighed against the data, a maximum a posteriori
+    fit (`Penalised`): where the data fix a combination of the parameters only (the ground's flux
+    U (T_ground - T_face)), the prior sets where along that valley the fit ends, not wherever
+    least squares stopped (a ground at 0.2 C under a cell in Miami, its U a tenth of the
+    truth's); where the data fix the parameter, they move it, the prior's pull some (sd_data /
+    sd_prior)^2 of the way back. No test chooses between a held and a free fit: the posterior is
+    both at once. Its covariance is the data's with the priors' precision added (`with_priors`).
 
     Parameters
     ----------
@@ -439,13 +493,16 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None, 
         is the component's. The fit to the air alone weighs each own node (`own_weights`), and
         the fit is made again with them beside the air, read once the component has forgotten
         the start the burn-in could not set (`Own.measured`)
-    policy : the `diagnosis.policy.Policy` that says what is identifiable, how a sensor weighs and
-        when a prior holds (default: `Policy()`)
+    policy : the `diagnosis.policy.Policy` that says what is identifiable and how a sensor weighs
+        (default: `Policy()`)
+    sigma : the noise's sd (C), which puts a prior's penalty in J's units (`Penalised`); None:
+        the rms residual of the fit without the priors
 
     Returns
     -------
-    dict {name: {"value", "std", "identifiable", "on_bound"}, and "prior": its source where held at
-    its prior (std 0)}; the quantities the data determine
+    dict {name: {"value", "std", "identifiable", "on_bound"}, and "prior": its prior, stated
+    (`stated`), where it has one; "std" the posterior's, "identifiable" whether the data alone
+    fix it}; the quantities the data determine
     even where the parameters are not (see `derived`); and per block the parameter values fitted
     without it (`fold`), the residuals (C, (N_t, zones) of its record, NaN off the block) they
     leave on it, and what they predict there of the own nodes ("own", C, (N_t, len(own ids)))
@@ -491,43 +548,47 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None, 
         steps.append(np.nonzero(h)[0] + offset)
         offset += len(h) + lags + 1
     steps = np.concatenate(steps)
+    priors = wanted_priors(candidate, cases)
     residuals = weighted([np.zeros(len(e)) for e in extra])
     fit = solve(residuals, x0, lows, highs, kept)
+    if priors:
+        # the MAP fit starts from the free fit's end of a valley: from the prior's side a coupling
+        # the data want the other way ends on U = 0, where T_ground acts not at all and its prior
+        # holds it at a point that fits nothing. The noise unknown, the free fit's rms residual.
+        sigma = float(np.sqrt(np.mean(np.square(fit.fun)))) if sigma is None else sigma
+        residuals = Penalised(residuals, priors, sigma)
+        fit = solve(residuals, fit.x, lows, highs, kept)
     if any(h[:, zones:].any() for h in have):
         weights = own_weights(candidate, cases, ids, measured, numerical, fit.x, own, policy)
         log.info("%s: its own nodes read beside the air, weighing %s", candidate.label,
                  "; ".join(", ".join(f"{n}: {w:.2g}" for n, w in zip(e, ws)) for e, ws in zip(extra, weights)))
         residuals = weighted(weights)
+        residuals = Penalised(residuals, priors, sigma) if priors else residuals
         fit = solve(residuals, fit.x, lows, highs, kept)
-    cov = parameter_covariance(fit.jac, fit.fun, steps, lags)
-    priors = wanted_priors(candidate, cases, identified(candidate, fit, cov, policy))
+    data = len(steps)  # the data's rows, the priors' after them
+    data_cov = parameter_covariance(fit.jac[:data], fit.fun[:data], steps, lags)
+    cov = with_priors(data_cov, priors)
     if priors:
-        held = solve(residuals, x0, lows, highs, {**kept, **{i: prior.value for i, prior in priors.items()}})
-        statistic = score_statistic(held, list(priors), residuals, candidate.bounds, steps, lags)
-        if policy.holds_prior(statistic, len(priors)):
-            fit, cov = held, parameter_covariance(held.jac, held.fun, steps, lags)
-            log.info("%s: %s, held at the physical prior: the data fix the parameters' combination only",
-                     candidate.label, ", ".join(f"{candidate.parameters[i].name} = {prior.value:.4g} "
-                                                f"{candidate.parameters[i].unit} ({prior.source})"
-                                                for i, prior in priors.items()))
-        else:
-            priors = {}
+        log.info("%s: %s, each weighed with its prior", candidate.label,
+                 ", ".join(f"{candidate.parameters[i].name} = {fit.x[i]:.4g} {candidate.parameters[i].unit} "
+                           f"(prior {prior.value:.4g} +- {prior.sd:.2g}: {prior.source})" for i, prior in priors.items()))
     std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     result = {}
     for i, (p, name, value, sd, bound, fixed) in enumerate(zip(candidate.parameters, candidate.names, fit.x, std,
-                                                               fit.active_mask, identified(candidate, fit, cov, policy))):
-        identifiable = bool(fixed and i not in priors)
-        if not identifiable and i not in priors:
+                                                               fit.active_mask,
+                                                               identified(candidate, fit, data_cov, policy))):
+        if not fixed and i not in priors:
             log.info("%s: %s = %.4g +- %.2g %s is not identifiable from these data%s", candidate.label,
                      name, value, sd, p.unit, " (it ended on a bound)" if bound else "")
-        result[name] = {"value": float(value), "std": float(sd), "identifiable": identifiable,
-                        "on_bound": bool(bound != 0), **({"prior": priors[i].source} if i in priors else {})}
+        result[name] = {"value": float(value), "std": float(sd), "identifiable": bool(fixed),
+                        "on_bound": bool(bound != 0), **({"prior": stated(priors[i], p.unit)} if i in priors else {})}
     folds = []
     for record, block in blocks:
         train = ~np.concatenate([rows[h] for rows, h in zip(on_block([h.shape for h in have], record, block), have)])
+        train = np.r_[train, np.ones(len(fit.fun) - data, dtype=bool)]  # every fold weighs the priors
         x = fold(fit, train, lows, highs, lambda x: residuals(x, train))
         case, m, h = cases[record], measured[record], have[record]
-        s = share(raw(x), error, train & residuals.counted)
+        s = share(raw(x), error, train[:data] & residuals.counted[:data])
         T = candidate.nodes(case, ids[record], x)
         left = np.where(h & block[:, None], m - T + s * numerical[record], np.nan)
         folds.append({"values": [float(v) for v in x], "residuals": left[:, :zones],
@@ -594,55 +655,25 @@ def identified(candidate, fit, cov, policy):
             for p, value, sd, bound in zip(candidate.parameters, fit.x, std, fit.active_mask)]
 
 
-def wanted_priors(candidate, cases, fixed):
-    """{index: model.effects.Prior} of the parameters the fit leaves free (`fixed`, per parameter:
-    `identified`) that physics has a prior for inside their range, where another parameter is
-    left: a ground coupling's T_ground, the flux fixed and U fitted to it. The prior reads the
-    outdoor air of the weather the `cases` hold, their history included."""
+def wanted_priors(candidate, cases):
+    """{index: model.effects.Prior} of the candidate's own parameters that physics has a prior for
+    inside their range: a ground coupling's T_ground. The prior reads the outdoor air of the
+    weather the `cases` hold, their history included, and the annual mean air of the weather
+    they were prepared from (`Case.annual_air`, the first case's that has one)."""
     effect = EFFECTS[candidate.effect]
-    if effect.priors is None or candidate.own < 2:
+    if effect.priors is None:
         return {}
     outdoor = np.concatenate([case.U[:, case.input_names.index("T_out")] for case in cases])
-    priors = effect.priors(candidate.building, candidate.target, outdoor)
+    annual = next((case.annual_air for case in cases if case.annual_air is not None), None)
+    priors = effect.priors(candidate.building, candidate.target, outdoor, annual)
     return {i: priors[p.name] for i, (p, (low, high)) in
             enumerate(zip(candidate.parameters[:candidate.own], candidate.bounds))
-            if p.name in priors and low <= priors[p.name].value <= high and not fixed[i]}
+            if p.name in priors and low <= priors[p.name].value <= high}
 
 
-def score_statistic(held, indices, residuals, bounds, steps, lags):
-    """The score (Lagrange multiplier) statistic of the parameters `indices` held at their priors,
-    in its one-step Wald form: the Gauss-Newton step of every parameter from the held fit, its
-    held components d and their HAC covariance V (`model.significance`), d' V^-1 d; chi-square
-    with as many degrees of freedom as parameters held where the priors are right. Read at the
-    held fit, not the free one: along a valley the free fit's linearisation is no guide to how
-    far its end is from the prior (T_ground +- 8600 K on a 50 K range). The held parameters'
-    Jacobian columns, which the held fit did not need, are differences of `STEP` of their ranges.
-
-    Those columns are taken where the held parameters act: a parameter the held fit left on a
-    bound is moved one such step into its range first. A bound can switch a held parameter off (a
-    ground coupling's U = 0 leaves no flux for T_ground to set): on it, the held column is the
-    simulation's rounding, and the statistic whatever that rounding makes of it; a step inside,
-    the column has the direction it takes as the bound is left, which is what the test asks
-    about (whether the data want the effect at another value than the prior). The statistic does
-    not depend on the parameters' scales, and is computed with every column scaled to unit
-    length, so that a short column (T_ground's, in proportion to U) is not lost below the
-    solvers' relative cutoffs."""
-    at = held.x.copy()
-    for j, (low, high) in enumerate(bounds):
-        if held.active_mask[j] != 0:
-            at[j] += step_inside(at[j], low, high)
-    base = residuals(at) if (at != held.x).any() else held.fun
-    jac = held.jac.copy()
-    for i in indices:
-        h = step_inside(at[i], *bounds[i])
-        moved = at.copy()
-        moved[i] += h
-        jac[:, i] = (residuals(moved) - base) / h
-    length = np.linalg.norm(jac, axis=0)
-    jac = jac / np.where(length > 0, length, 1.0)
-    step = np.linalg.lstsq(jac, -held.fun, rcond=None)[0][indices]
-    cov = parameter_covariance(jac, held.fun, steps, lags)[np.ix_(indices, indices)]
-    return float(step @ np.linalg.pinv(cov) @ step)
+def stated(prior, unit):
+    """A prior as report.json carries it: its value, sd and source in one sentence."""
+    return f"{prior.value:.4g} +- {prior.sd:.2g} {unit}, {prior.source}"
 
 
 def fold(fit, train, lows, highs, residuals):
@@ -666,8 +697,8 @@ def fold(fit, train, lows, highs, residuals):
     # range. Nor is a step that leaves the range clipped parameter by parameter: where two
     # parameters trade off, the step runs along their valley, and clipping one alone (U to 0)
     # would leave the valley, and the fit, altogether
-    # (a parameter held at its prior has a Jacobian column of zeros: least squares' minimum-norm
-    # step leaves it where it is)
+    # (a parameter held beside the candidate has a Jacobian column of zeros: least squares'
+    # minimum-norm step leaves it where it is)
     free = fit.active_mask == 0
     if not free.any():
         return fit.x.copy()

@@ -1,14 +1,14 @@
 """One calibrated parameter as the diagnosis reads it (`ParameterEstimate`), and as report.json
-writes it ({"value", "std", "identifiable", "on_bound"} and "prior" where held at one)."""
+writes it ({"value", "std", "identifiable", "on_bound"} and "prior" where it has one)."""
 from dataclasses import dataclass
 
 
 @dataclass(frozen=True)
 class ParameterEstimate:
     """A parameter of a calibrated effect (`diagnosis.calibrate`): its `value`, its standard
-    deviation `sd` (report.json's "std"), whether the data identify it, whether it ended on a
-    bound of its search range (`on_bound`), and `prior`, the source of the physical prior it was
-    held at where the calibration held it (None: fitted)."""
+    deviation `sd` (report.json's "std", the posterior's where it has a prior), whether the data
+    alone identify it, whether it ended on a bound of its search range (`on_bound`), and `prior`,
+    the physical prior the fit weighed with the data, stated (`calibrate.stated`; None: none)."""
     value: float
     sd: float
     identifiable: bool
@@ -23,7 +23,7 @@ class ParameterEstimate:
         return cls(p["value"], p["std"], p["identifiable"], bool(p.get("on_bound", False)), p.get("prior") or None)
 
     def to_json(self):
-        """report.json's form: {"value", "std", "identifiable", "on_bound"}, and "prior" where held."""
+        """report.json's form: {"value", "std", "identifiable", "on_bound"}, and "prior" where it has one."""
         return {"value": self.value, "std": self.sd, "identifiable": self.identifiable, "on_bound": self.on_bound,
                 **({"prior": self.prior} if self.prior else {})}
 

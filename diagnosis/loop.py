@@ -360,8 +360,8 @@ def rounds(prepared, localization, objective, workdir, seed, runner=lifetime.InP
 def revisit(prepared, made, fit, objective, folder, seed, runner):
     """An effect an earlier round chose (`fit`), chosen again once the rounds end: it and the
     admissible candidates nearest it in its round (`Policy.revisited`), each calibrated with the
-    other effects the model holds refitted together with it (their parameters held at a prior
-    kept there), against the model without it, the others refitted together without it
+    other effects the model holds refitted together with it (their parameters that rest on their
+    priors kept at their values: `resting_on_priors`), against the model without it, the others refitted together without it
     (`refitted_without`), by the rule of every round (`selection.decide`). Where another is
     chosen, it takes the effect's place, the others at their values refitted with it; where
     none is, the effect itself included, it is removed, the others at their values refitted
@@ -395,7 +395,7 @@ def revisit(prepared, made, fit, objective, folder, seed, runner):
     refit, kept, refitted, spent = refitted_without(model, others, windows, objective, noise.sigma, seed,
                                                     into / "without", runner, number)
     inputs = RoundInputs.of(kept, windows, objective, noise.sigma, seed, [(a.effect, a.target) for a in others],
-                            {a.label: [name for name, p in a.parameters.items() if p.prior] for a in others})
+                            {a.label: resting_on_priors(a) for a in others})
     assessed = assess_all(inputs, pairs, into, runner)
     tried, models = fits_of(kept, windows.sensed_by(kept), pairs, assessed, windows, inputs, number,
                             [a.label for a in others])
@@ -422,13 +422,13 @@ def revisit(prepared, made, fit, objective, folder, seed, runner):
 def refitted_without(model, kept, windows, objective, sigma, seed, into, runner, number):
     """The effects `kept` (`Fit`s) of `model`, which no longer holds the one a revisit removes,
     refitted together without it: the first calibrated as a candidate, the others beside it (a
-    parameter their own round held at a prior kept there), with its cross-validation, which is
+    parameter that rests on its prior kept at its value: `resting_on_priors`), with its cross-validation, which is
     then that of the model left. Its `Fit`, the `Model` it makes, every kept effect's values
     ({label: {name: {"value", "std", ...}}}) and the simulations it took."""
     into.mkdir(exist_ok=True)
     first, beside = kept[0], kept[1:]
     inputs = RoundInputs.of(model, windows, objective, sigma, seed, [(a.effect, a.target) for a in beside],
-                            {a.label: [name for name, p in a.parameters.items() if p.prior] for a in beside})
+                            {a.label: resting_on_priors(a) for a in beside})
     pair = (first.effect, first.target)
     assessed = assess_all(inputs, [pair], into, runner)
     (refit,), models = fits_of(model, windows.sensed_by(model), [pair], assessed, windows, inputs, number,
@@ -461,13 +461,20 @@ def left_by(windows, model):
                                 windows.each[0].measured[:k0][:, 0] - model.runs[0][:k0, 0], inputs)
 
 
+def resting_on_priors(fit):
+    """The names of a `Fit`'s parameters whose value rests on their prior: weighed with one, the
+    data alone not fixing them (a ground's temperature where the data fix its flux only)."""
+    return [name for name, p in fit.parameters.items() if p.prior and not p.identifiable]
+
+
 def priors_stated(building, added):
     """The building with a sentence in its description for each parameter of an added effect
-    (`Fit`s) held at its physical prior: a modeller reading the file learns which of its values
-    the data did not fix and where it comes from."""
-    said = [f"{fit.effect} on {fit.target}: {name} = {p.value:.4g} {EFFECTS[fit.effect].parameter(name).unit}, "
-            f"held at {p.prior}: the data fixed the effect, not {name} apart (nodeforce diagnose)."
-            for fit in added for name, p in fit.parameters.items() if p.prior]
+    (`Fit`s) that rests on its physical prior, the data not fixing it apart: a modeller reading the
+    file learns which of its values the data did not fix and where they come from."""
+    said = [f"{fit.effect} on {fit.target}: {name} = {fit.parameters[name].value:.4g} "
+            f"{EFFECTS[fit.effect].parameter(name).unit}, the data weighed with its prior "
+            f"({fit.parameters[name].prior}): the data fixed the effect, not {name} apart (nodeforce diagnose)."
+            for fit in added for name in resting_on_priors(fit)]
     if not said:
         return building
     return building.edited(lambda data: data.update(description=" ".join([data.get("description", "")] + said).strip()))

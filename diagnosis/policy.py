@@ -9,7 +9,6 @@ import math
 from dataclasses import asdict, dataclass, fields
 
 import numpy as np
-from scipy.special import chdtrc
 
 from nodeforce.diagnosis.estimate import ParameterEstimate
 from nodeforce.model.effects import EFFECTS
@@ -50,12 +49,6 @@ class Policy:
     limit_sds: float = 2.0
     # Each effect's physical limits, the parameters it is judged on and what its parameters trade
     # off along are its record's (`model.effects.Effect`: `physical`, `judged`, `trade_off`).
-
-    # -- priors (`diagnosis.calibrate`): where the data fix a combination of an effect's
-    # parameters but not each one, a parameter with a physical prior (`model.effects.Prior`) is
-    # held at it unless the data reject it at this level (the score test's p-value,
-    # dimensionless): the prior is what a modeller would write, and stands until shown wrong.
-    prior_level: float = 0.05
 
     # -- 3. the band
     # The most a sensor other than the objective air counts in the evidence (dimensionless): a
@@ -138,12 +131,6 @@ class Policy:
     def identifiable(self, value, sd, unit):
         """Whether an estimate `value` +- `sd` in `unit` is tight enough to act on."""
         return sd < (self.identifiable_kelvin if unit == "C" else self.identifiable_share * abs(value))
-
-    def holds_prior(self, statistic, held):
-        """Whether the data leave `held` parameters at their physical priors: the score
-        statistic (`diagnosis.calibrate.score_statistic`, chi-square with `held` degrees of
-        freedom) has a p-value of at least `prior_level`."""
-        return bool(chdtrc(held, statistic) >= self.prior_level)  # the chi-square's survival function
 
     def sensor_weight(self, sd, mean_square):
         """Sensors' weights in the evidence: sd^2 (C2) over each one's mean squared residual (C2,
@@ -231,7 +218,7 @@ class Policy:
 
     def loose(self, effect, parameters, derived, facts):
         """The judged parameters whose value the data leave loose ({name: `ParameterEstimate`}):
-        not identifiable (`identifiable`), neither held at a prior nor determined along with the
+        not identifiable (`identifiable`), neither weighed with a prior nor determined along with the
         others through the quantity they trade off along; what the report says beside the choice."""
         if self._resolved(effect, derived, facts)[0]:
             return {}

@@ -58,6 +58,7 @@ class Case:
     building: object = None  # the Building whose nodes `measured` holds (its state at t_0: `start_state`)
     substeps: int = 1  # integration steps per sample (`integrate.substeps`: of at most MAX_STEP)
     history_steps: int = 0  # H: t_1..t_H the weather before the first measurement (t_H), part of the burn-in
+    annual_air: float | None = None  # C: the weather's mean outdoor air over its whole years (`annual_mean_air`)
     # the `integrate.Plan` of the last layouts run (`run`), by layout
     _plans: dict = field(default_factory=dict, init=False, repr=False, compare=False)
     PLANS = 4
@@ -399,7 +400,22 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
     fluxes = measured_fluxes(building, measurements, times) if measurements is not None else {}
     return Case(times=times, dt=dt, input_names=names, U=U, measured=measured, assumptions=tuple(assumptions),
                 fluxes=fluxes, building=building, substeps=substeps(dt), burn_in_steps=before, history_steps=before,
-                steady_start=bool(before))
+                steady_start=bool(before), annual_air=annual_mean_air(weather))
+
+
+def annual_mean_air(weather):
+    """The mean outdoor air temperature (C) of a weather over as many whole years (365 days) as it
+    spans from its first time (each time the end of its step: a typical year of 8760 hours spans
+    one), NaN ignored; None where it spans less than a year. A season's mean is not the year's:
+    the deep ground under a building follows the year's (`model.effects.deep_ground_temperature`)."""
+    if len(weather.index) < 2:
+        return None
+    first, step = weather.index[0], weather.index[1] - weather.index[0]
+    years = int((weather.index[-1] - first + step) / pd.Timedelta(days=365))
+    if years < 1:
+        return None
+    whole = weather["T_out"][weather.index < first + years * pd.Timedelta(days=365)]
+    return float(np.nanmean(whole.to_numpy(float)))
 
 
 def face_shading(component, shades, position):

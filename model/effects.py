@@ -43,9 +43,12 @@ class Parameter:
 
 @dataclass(frozen=True)
 class Prior:
-    """What physics expects of a parameter the data may leave free (C, or the parameter's unit),
-    and where that expectation comes from, in words a report can quote."""
+    """What physics expects of a parameter the data may leave free: a Gaussian belief of mean
+    `value` and standard deviation `sd` (both in the parameter's unit, C for a temperature), and
+    where that expectation comes from, in words a report can quote. A fit weighs it against the
+    data (`diagnosis.calibrate`, a maximum a posteriori fit); it holds nothing."""
     value: float
+    sd: float
     source: str
 
 
@@ -59,8 +62,9 @@ class Effect:
     write: Callable  # (JSON data, target, {name: value}) -> None: declare the values
     points_at: Callable  # (building, target) -> node ids whose forcing points at it; () none
     limits: Callable | None = None  # (building, target) -> {name: (low, high)} narrower than the parameters'
-    # (building, target, outdoor air (C) over the weather read) -> {name: Prior}: what physics
-    # expects of a parameter where the data fix a combination of the effect's parameters only
+    # (building, target, outdoor air (C) over the records read, the annual mean air (C) of the
+    # weather read or None) -> {name: Prior}: what physics expects of a parameter, weighed with
+    # the data where they fix a combination of the effect's parameters only
     priors: Callable | None = None
     # whether the effect acts on the model's inputs alone (its sources B u + q), affinely in its
     # parameters, the step matrix left as declared: the temperatures are then affine in them
@@ -182,21 +186,38 @@ def _ground_write(data, target, values):
                                                "h": float(values["U"])}
 
 
-def deep_ground_temperature(building, outdoor_air):
-    """The temperature (C) of the ground a few metres down, where the seasons no longer reach: the
-    site's `ground_temperature` where the building file declares one (a typical year's annual mean
-    air temperature, EnergyPlus's deep ground temperature), else the mean of the outdoor air
-    temperatures given (C, any shape; NaN ignored), the weather the diagnosis reads, a rougher
-    estimate of that annual mean the further the record is from spring or autumn."""
+# The spread (K) of each estimate of the deep ground (`deep_ground_temperature`): a modeller's
+# declared value is the site's typical-year mean air, which the ground a few metres down follows to
+# a degree or two (EnergyPlus's deep ground temperature); a year of the site's own weather gives
+# that mean to within its year-to-year swing and the ground's offset from the air; a few weeks'
+# mean air misses the annual mean by up to the season's amplitude, some 5 to 10 K in mid-summer or
+# mid-winter at a mid-latitude site.
+DECLARED_GROUND_SD = 1.5
+ANNUAL_AIR_SD = 2.0
+RECORD_AIR_SD = 5.0
+
+
+def deep_ground_temperature(building, outdoor_air, annual_air=None):
+    """The `Prior` (C) of the ground a few metres down, where the seasons no longer reach: the
+    site's `ground_temperature` where the building file declares one (sd `DECLARED_GROUND_SD`),
+    else the annual mean outdoor air of the weather the diagnosis reads where that weather spans
+    a year or more (`annual_air`, C, or None; sd `ANNUAL_AIR_SD`), else the mean of the outdoor
+    air temperatures given (C, any shape; NaN ignored), the records and their history, with the
+    wide sd `RECORD_AIR_SD`: a few weeks' mean is the annual mean only in spring and autumn."""
     declared = building.site.get("ground_temperature")
     if declared is not None:
-        return Prior(float(declared), "the site's ground temperature, as the building file declares it")
-    return Prior(float(np.nanmean(outdoor_air)), "the mean outdoor air temperature of the weather read (the "
-                                                 "records and their history), the deep-ground estimate")
+        return Prior(float(declared), DECLARED_GROUND_SD, "the site's ground temperature, as the building file "
+                                                          "declares it")
+    if annual_air is not None:
+        return Prior(float(annual_air), ANNUAL_AIR_SD, "the annual mean outdoor air temperature of the weather "
+                                                       "read, the deep-ground estimate")
+    return Prior(float(np.nanmean(outdoor_air)), RECORD_AIR_SD,
+                 "the mean outdoor air temperature of the records and their history, a rough deep-ground "
+                 "estimate (the weather read spans less than a year)")
 
 
-def _ground_priors(building, target, outdoor_air):
-    return {"T_ground": deep_ground_temperature(building, outdoor_air)}
+def _ground_priors(building, target, outdoor_air, annual_air=None):
+    return {"T_ground": deep_ground_temperature(building, outdoor_air, annual_air)}
 
 
 def _absorptance_write(data, target, values):

@@ -196,8 +196,8 @@ def test_demo_finds_the_ground_coupling_and_python_writes_the_same_report(tmp_pa
     assert "validation" in out and "calibration" in out
     report = json.loads((tmp_path / "report.json").read_text())
     # the first screen, in the terminal (after the demo's line on its data) and atop report.md: where,
-    # what was added, what the data fix (U, given the ground's temperature held at the site's deep
-    # ground: the data fix the flux, not U and T_ground apart), before and after
+    # what was added, what the data fix (U, with the ground's temperature weighed with its prior,
+    # the site's deep ground: the data fix the flux, not U and T_ground apart), before and after
     screen = out.split("\n\n")[0].splitlines()[1:]
     md = (tmp_path / "report.md").read_text()
     top = md.split("\n\n")[:2]
@@ -206,11 +206,12 @@ def test_demo_finds_the_ground_coupling_and_python_writes_the_same_report(tmp_pa
         assert lines[0].startswith(("Fault: in floor: forcing node 16", "Fault: in floor: forcing node 17",
                                     "**Fault:** in floor: forcing node 16", "**Fault:** in floor: forcing node 17"))
         assert "ground_coupling on floor" in lines[1]
-        assert "given T_ground = 24.31 C (held at the site's ground temperature" in lines[2]
+        assert "with T_ground = " in lines[2] and "(prior 24.31 +- 1.5 C, the site's ground temperature" in lines[2]
         assert not any("not identifiable" in line for line in lines)
     U = report["effect"]["parameters"]["U"]
-    assert f"U = {U['value']:.3f}" in screen[2]
-    # the synthesis's U is 0.8 on a ground at 24 C: held 0.31 K off, U is fitted within a quarter of it
+    # the data fix the flux, and U only as well as T_ground's prior allows: said so, not given a value
+    assert "ground heat flux = " in screen[2] and "U alone not fixed" in screen[2]
+    # the synthesis's U is 0.8 on a ground at 24 C, the prior 0.31 K off: U is fitted within a quarter of it
     assert abs(U["value"] - 0.8) < 0.25 * 0.8
     validation = [report[s]["validation"] for s in ("before", "after")]
     assert f"RMSE {validation[0]['rmse']:.3f} -> {validation[1]['rmse']:.3f} C" in screen[3]

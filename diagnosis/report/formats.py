@@ -81,16 +81,16 @@ def parameter_unit(effect_id, name):
 
 
 def fmt_parameters(effect_id, parameters, pm="±"):
-    """'U = 0.52 ± 0.03 W/m2/K, T_ground = 24 ± 9 C (not identifiable)', or 'T_ground = 24.31 C
-    (held at <the prior's source>)' for a parameter held at its physical prior; '' for no parameter."""
+    """'U = 0.52 ± 0.03 W/m2/K, T_ground = 24 ± 9 C (not identifiable)', or 'T_ground = 22.1 ± 1.4 C
+    (prior <the prior, stated>)' for a parameter weighed with its physical prior, its sd the
+    posterior's; '' for no parameter."""
     parts = []
     for name, p in (parameters or {}).items():
         unit = parameter_unit(effect_id, name)
-        if p.get("prior"):
-            parts.append(f"{name} = {p['value']:.4g}" + (f" {unit}" if unit else "") + f" (held at {p['prior']})")
-            continue
         text = f"{name} = {fmt_value_std(p.get('value'), p.get('std'), pm)}" + (f" {unit}" if unit else "")
-        if p.get("identifiable") is False:
+        if p.get("prior"):
+            text += f" (prior {p['prior']})"
+        elif p.get("identifiable") is False:
             text += " (not identifiable)"
         parts.append(text)
     return ", ".join(parts)

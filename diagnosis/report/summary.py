@@ -78,18 +78,18 @@ def added_effects(report):
 
 def determined(effect, pm):
     """What the data fix about an added effect: its identifiable parameters and the quantities its
-    parameters trade off along (the heat loss coefficient has its own line), given the parameters
-    held at their physical priors (each with its source); the parameters the data leave free are named as
-    such, their values left to the candidates table."""
+    parameters trade off along (the heat loss coefficient has its own line), and those weighed with
+    their physical priors (each with its prior, the posterior's sd); the parameters the data leave
+    free are named as such, their values left to the candidates table."""
     parameters = effect.get("parameters") or {}
-    held = {k: p for k, p in parameters.items() if p.get("prior")}
-    fixed = {k: p for k, p in parameters.items() if p.get("identifiable") is not False and k not in held}
-    free = [k for k in parameters if k not in fixed and k not in held]
+    weighed = {k: p for k, p in parameters.items() if p.get("prior")}
+    fixed = {k: p for k, p in parameters.items() if p.get("identifiable") is not False and k not in weighed}
+    free = [k for k in parameters if k not in fixed and k not in weighed]
     derived = {k: v for k, v in (effect.get("derived") or {}).items() if k != "heat_loss_coefficient"}
     said = [t for t in [fmt_parameters(effect.get("effect"), fixed, pm)] + fmt_derived(derived, pm) if t]
     text = ", ".join(said) if said else "nothing"
-    if held:  # what the data fix is then fixed given the prior
-        text += f", given {fmt_parameters(effect.get('effect'), held, pm)}"
+    if weighed:
+        text += f", with {fmt_parameters(effect.get('effect'), weighed, pm)}"
     if free:
         text += (f" ({' and '.join(free)} {'each' if len(free) > 1 else 'alone'} not fixed by these data: "
                  "candidates table)")

@@ -5,8 +5,7 @@ from __future__ import annotations
 
 from . import content
 from .content import SCORED, STATES, metrics
-from .formats import (NA, fmt_derived, fmt_int, fmt_parameters, fmt_sig, fmt_temp, fmt_value_std, num,
-                      parameter_unit, time_text)
+from .formats import NA, fmt_derived, fmt_int, fmt_parameters, fmt_sig, fmt_temp, fmt_value_std, num, time_text
 from ..phases import is_worse
 from ..residuals import lag_text
 
@@ -25,20 +24,14 @@ def effect_header(report, pm="+-"):
 
 
 def hlc_lines(report, pm="+-"):
-    """The heat loss coefficient as described and as corrected (W/K, docs/model.md section 8), given
-    the parameters held at their priors, and the sentence saying the data do not fix its split
-    among effects, where they do not."""
+    """The heat loss coefficient as described and as corrected (W/K, docs/model.md section 8), and
+    the sentence saying the data do not fix its split among effects, where they do not."""
     hlc = report.get("heat_loss_coefficient") or {}
     if num(hlc.get("before")) is None:
         return []
     line = f"Heat loss coefficient: {hlc['before']:.1f} W/K as described"
     if num(hlc.get("after")) is not None:
         line += f", {fmt_value_std(hlc['after'], hlc.get('after_sd'), pm)} W/K as corrected"
-        # its uncertainty is the data's with the held parameters fixed, not beside them
-        held = [f"{name} = {p['value']:.4g} {parameter_unit(e.get('effect'), name)}".rstrip()
-                for e in report.get("effects") or [] for name, p in (e.get("parameters") or {}).items()
-                if p.get("prior")]
-        line += f" given {', '.join(held)}" if held else ""
     return [line] + ([hlc["split"]] if hlc.get("split") else [])
 
 
