@@ -46,6 +46,8 @@ def free_floating(idf, out):
         if obj.obj_type.upper() not in KEEP or obj.obj_type == "Version":
             if obj.obj_type != "Version":
                 doc.removeidfobject(obj)
+        elif obj.to_dict().get("frame_and_divider_name"):
+            obj.frame_and_divider_name = ""  # a window's frame, which the converter does not read
     doc.add("RunPeriod", "year", {"begin_month": 1, "begin_day_of_month": 1, "begin_year": YEAR, "end_month": 12,
                                   "end_day_of_month": 31, "end_year": YEAR,
                                   "use_weather_file_holidays_and_special_days": "No",

@@ -23,7 +23,7 @@ import numpy as np
 
 from .building import DAY_TERMS, Adiabatic, Boundary, Exterior, Surface
 from .building_file import schema_default
-from .convection import doe2_faces, tarp_inside_faces, windward_faces
+from .convection import doe2_faces, inside_reference, outside_reference, tarp_inside_faces, windward_faces
 from .discretise import capacities, conductances
 from .longwave import enclosure_exchange
 
@@ -346,11 +346,13 @@ def assemble(building, names=None):
 
     def to_zone(node, area, surface, cos_up):
         zone = building.zone(surface.zone)
-        link(node, zone.air_node - 1, area * surface.h_conv * zone.convection_factor)
+        h = surface.h_conv
+        if zone.inside_convection_algorithm == "tarp":
+            h = inside_reference(surface.h_conv, cos_up)
+            inside.append(((node, zone.air_node - 1), (area * zone.convection_factor, h, cos_up)))
+        link(node, zone.air_node - 1, area * h * zone.convection_factor)
         if zone.longwave == "radiant_node":
             link(node, zone.radiant_node - 1, area * surface.h_rad)
-        if zone.inside_convection_algorithm == "tarp":
-            inside.append(((node, zone.air_node - 1), (area * zone.convection_factor, surface.h_conv, cos_up)))
 
     # where the radiant part of a zone's gains goes: [(node, share)], its radiant node or its faces
     absorbers = {}
@@ -390,15 +392,16 @@ def assemble(building, names=None):
         to_zone(idx[0], c.area, c.inside, -cos_up)
         if isinstance(out, Exterior):
             F = sky_view_factor(c.tilt) if out.sky_view_factor is None else out.sky_view_factor
-            A[e, e] -= c.area * (out.h_conv + out.h_rad)
-            B[e, col["T_out"]] += c.area * (out.h_conv + out.h_rad * (1.0 - F))
+            v, h = out.convection, out.h_conv
+            if v is not None:
+                h = outside_reference(out.h_conv, cos_up, v.roughness, v.wind_factor)
+                outside.append((e, (c.area, h, cos_up, c.azimuth, v.roughness, v.wind_factor)))
+            A[e, e] -= c.area * (h + out.h_rad)
+            B[e, col["T_out"]] += c.area * (h + out.h_rad * (1.0 - F))
             B[e, col["T_sky"]] += c.area * out.h_rad * F
             B[e, col[c.irradiance_input]] += c.area * out.solar_absorptance
             # a glazing's inner panes absorb part of the sun at the inside face (docs/model.md 4.1)
             B[idx[0], col[c.irradiance_input]] += c.area * c.inner_solar_absorptance
-            if out.convection is not None:
-                v = out.convection
-                outside.append((e, (c.area, out.h_conv, cos_up, c.azimuth, v.roughness, v.wind_factor)))
         elif isinstance(out, Surface):
             to_zone(e, c.area, out, cos_up)
         elif isinstance(out, Boundary):
