@@ -38,7 +38,7 @@ def evaluator_kind(kind, buildings):
         return kind
     scheduled = any(v.schedule is not None and not b.schedules[v.schedule].is_constant
                     for b in buildings for z in b.zones for v in z.ventilation)
-    scheduled |= any(b.followed_convection for b in buildings)
+    scheduled |= any(b.followed_coefficients for b in buildings)
     return ("python" if scheduled or not find_compiler() else "standalone") + (f"-fmi{version}" if version else "")
 
 
