@@ -560,8 +560,8 @@ class _Converter:
         outside = self.r.all("SurfaceConvectionAlgorithm:Outside")
         algorithm = self.r.text(outside[0], "algorithm", "DOE-2") if outside else "DOE-2"
         # TARP inside on every face, as the file may declare it, would take a glazing's inside face by
-        # TARP where EnergyPlus takes ISO 15099's: 900FF's minimum then falls to 0.49 C, below ASHRAE
-        # 140's 0.6 (docs/model.md 10.1), so the zones keep their constant inside coefficients
+        # TARP where EnergyPlus takes ISO 15099's: 950FF's maximum then falls to 36.06 C, below ASHRAE
+        # 140's 36.1 (docs/model.md 10.1), so the zones keep their constant inside coefficients
         self.notes.append(f"outside convection EnergyPlus's DOE-2 from each hour's wind and each face's temperature, "
                           f"its value at a {FILMS.wind:g} m/s station wind and a {FILMS.delta_T:g} K face-to-air "
                           "difference in the step matrix" +
