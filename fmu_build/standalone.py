@@ -89,11 +89,11 @@ def network_terms(building, effect):
         from nodeforce.model.errors import InputError
         raise InputError(building.source, "zones", f"{building.switched[0]} follows a schedule: the standalone C FMU "
                          "steps a constant matrix; use the Python FMU")
-    if building.followed_convection:
+    if building.followed_coefficients:
         from nodeforce.model.errors import InputError
-        where, field = building.followed_convection[0]
-        raise InputError(building.source, field, f"{where}'s convective coefficient follows the temperatures or the "
-                                                 "wind: the standalone C FMU steps constant ones; use the Python FMU")
+        where, field = building.followed_coefficients[0]
+        raise InputError(building.source, field, f"{where}'s coefficient follows the temperatures or the wind: the "
+                                                 "standalone C FMU steps constant ones; use the Python FMU")
     start = fmu_parameters(building, effect)
     names = list(start)
     p0 = np.array([start[n] for n in names], dtype=float)

@@ -37,7 +37,7 @@ def evaluator_kind(kind, buildings):
     base, _, version = kind.partition("-fmi")
     if base != "auto":
         return kind
-    scheduled = any(b.switched or b.followed_convection for b in buildings)
+    scheduled = any(b.switched or b.followed_coefficients for b in buildings)
     return ("python" if scheduled or not find_compiler() else "standalone") + (f"-fmi{version}" if version else "")
 
 

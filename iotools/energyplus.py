@@ -571,12 +571,14 @@ class _Converter:
         outside = self.r.all("SurfaceConvectionAlgorithm:Outside")
         algorithm = self.r.text(outside[0], "algorithm", "DOE-2") if outside else "DOE-2"
         # TARP inside on every face, as the file may declare it, would take a glazing's inside face by
-        # TARP where EnergyPlus takes ISO 15099's: 900FF's minimum then falls to 0.49 C, below ASHRAE
-        # 140's 0.6 (docs/model.md 10.1), so the zones keep their constant inside coefficients
+        # TARP where EnergyPlus takes ISO 15099's: 950FF's maximum then falls to 36.06 C, below ASHRAE
+        # 140's 36.1 (docs/model.md 10.1), so the zones keep their constant inside coefficients
         self.notes.append(f"outside convection EnergyPlus's DOE-2 from each hour's wind and each face's temperature, "
                           f"its value at a {FILMS.wind:g} m/s station wind and a {FILMS.delta_T:g} K face-to-air "
                           "difference in the step matrix" +
                           ("" if algorithm.lower() == "doe-2" else f" (the IDF's {algorithm} evaluated as DOE-2)"))
+        self.notes.append(f"outside long-wave toward the sky, the air and the ground from each step's face and sky "
+                          f"temperatures, its value at {FILMS.T_outside - 273.15:g} C in the step matrix")
 
     def inside_algorithm(self, zone_name):
         """'simple' or 'tarp': the zone's inside convection algorithm (its own field, else the
@@ -1730,12 +1732,14 @@ class _Converter:
         if boundary == "outdoors":
             h = round(FILMS.outside_convection(s["tilt"], s["height"], outer["roughness"], s["wind"], self.terrain), 4)
             # h follows the hour's wind and the face's temperature as EnergyPlus's DOE-2 has it (h
-            # the constant above in the step matrix, docs/model.md 3.6); NoWind: natural alone
+            # the constant above in the step matrix, docs/model.md 3.6); NoWind: natural alone.
+            # Likewise h_rad follows the face's and the sky's temperatures, as EnergyPlus's does.
             wind = float(convection.wind_at_height(1.0, s["height"], self.terrain)) if s["wind"] else 0.0
             return {"type": "exterior", "h_conv": h, "h_rad": round(FILMS.radiative(outer["emissivity"], FILMS.T_outside), 4),
                     "solar_absorptance": outer["solar"] if s["sun"] else 0.0,
                     "sky_view_factor": round(float(sky_fraction_energyplus(s["tilt"])), 6),
-                    "convection": {"algorithm": "doe2", "roughness": outer["roughness"], "wind_factor": round(wind, 6)}}
+                    "convection": {"algorithm": "doe2", "roughness": outer["roughness"], "wind_factor": round(wind, 6)},
+                    "longwave": {"emissivity": outer["emissivity"]}}
         if boundary == "ground":
             return {"type": "boundary", "temperature": self.ground_schedule(), "h": FILMS.ground}
         if boundary == "adiabatic":

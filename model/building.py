@@ -52,6 +52,7 @@ class Exterior:
     irradiance: str | None = None  # input column of the measured irradiance on the face, W/m2
     sky_view_factor: float | None = None  # part of the long-wave exchange with the sky; None: (1 + cos tilt) / 2
     convection: "OutsideConvection | None" = None  # h_conv following the wind and the face; None: h_conv constant
+    longwave_emissivity: float | None = None  # h_rad following the face and the sky at this emissivity; None: constant
 
 
 @dataclass(frozen=True)
@@ -283,13 +284,15 @@ class Building:
         return tuple(c for c in self.components if isinstance(c.outside, Exterior))
 
     @property
-    def followed_convection(self):
-        """(where, field) of each zone and exterior face whose convective coefficient follows the
-        temperatures or the wind (docs/model.md section 3.6)."""
+    def followed_coefficients(self):
+        """(where, field) of each zone and exterior face whose convective or long-wave coefficient
+        follows the temperatures or the wind (docs/model.md section 3.6)."""
         return (tuple((f"zone {z.name}", "inside_convection_algorithm") for z in self.zones
                       if z.inside_convection_algorithm != "simple")
                 + tuple((f"component {c.name}", "outside.convection") for c in self.exterior_components
-                        if c.outside.convection is not None))
+                        if c.outside.convection is not None)
+                + tuple((f"component {c.name}", "outside.longwave") for c in self.exterior_components
+                        if c.outside.longwave_emissivity is not None))
 
     @property
     def input_columns(self):

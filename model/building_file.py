@@ -421,7 +421,8 @@ def _outside(check, raw, where, zone_names):
         return Exterior(h_conv=float(raw["h_conv"]), h_rad=float(raw["h_rad"]),
                         solar_absorptance=float(raw["solar_absorptance"]), irradiance=raw.get("irradiance"),
                         sky_view_factor=float(raw["sky_view_factor"]) if "sky_view_factor" in raw else None,
-                        convection=_outside_convection(raw.get("convection")))
+                        convection=_outside_convection(raw.get("convection")),
+                        longwave_emissivity=float(raw["longwave"]["emissivity"]) if "longwave" in raw else None)
     if kind == "zone":
         return _surface(check, raw, where, zone_names)
     if kind == "boundary":

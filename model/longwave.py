@@ -140,3 +140,14 @@ def enclosure_exchange(names, areas, emissivities, tilts, azimuths, classes, dec
     F = fix_view_factors(areas, F)
     return (exchange_conductances(areas, script_f(areas, F, emissivities)),
             absorbed_shares(areas, emissivities))
+
+
+def exterior_coefficient(emissivity, T_face, T_other):
+    """An outside face's long-wave coefficient (W/m2/K) toward the sky, the air or the ground at
+    T_other (C) from its own temperature T_face (C), as EnergyPlus computes it each step
+    (Engineering Reference, "External Longwave Radiation"): h = eps sigma (T_s^4 - T^4) / (T_s - T)
+    in K, written as eps sigma (T_s^2 + T^2)(T_s + T), which is the same where T_s != T and its
+    limit, 4 eps sigma T^3, where they meet. The view factor it is exchanged through multiplies it
+    elsewhere."""
+    T_s, T = np.asarray(T_face, dtype=float) + 273.15, np.asarray(T_other, dtype=float) + 273.15
+    return emissivity * SIGMA * (T_s * T_s + T * T) * (T_s + T)

@@ -12,9 +12,9 @@ fixed boundary and supply temperatures) go to q (W) rather than to a constant in
 holds only what varies in time. The transmitted solar of a shaded glazing, tau s(t) A I(t), is
 the product of two inputs: `products` holds those terms, and `sources` adds them, so the
 network stays linear in the temperatures and M is still factorised once per forcing mask.
-Convective coefficients that follow the state (docs/model.md section 3.6) keep their declared
-value in A; the rest is `convection`, a source each step evaluates from the temperatures at its
-start.
+Convective and outside long-wave coefficients that follow the state (docs/model.md section 3.6)
+keep their declared value in A; the rest is `convection`, a source each step evaluates from the
+temperatures at its start.
 """
 from dataclasses import dataclass
 from functools import cached_property
@@ -25,7 +25,7 @@ from .building import DAY_TERMS, Adiabatic, Boundary, Exterior, Surface
 from .building_file import schema_default
 from .convection import doe2_faces, inside_reference, outside_reference, tarp_inside_faces, windward_faces
 from .discretise import capacities, conductances
-from .longwave import enclosure_exchange
+from .longwave import enclosure_exchange, exterior_coefficient
 
 AIR_DENSITY = schema_default("site", "air_density")  # kg/m3, a building file's default
 C_AIR = 1005.0  # J/kg/K
@@ -36,21 +36,26 @@ WIND_SPEED, WIND_DIRECTION = "wind_speed", "wind_direction"
 
 @dataclass(frozen=True)
 class Convection:
-    """The convective coefficients computed at every step (docs/model.md section 3.6): the step
-    matrix holds each face's declared h0, and the rest, from the temperatures before the step and
-    the inputs at its end, is a source: inside, A phi (h(T_s - T_air) - h0) (T_air - T_s) on the
-    face and its negative on the air (what one gains the other loses); outside,
-    A (h(V, windward, T_e - T_out) - h0) (T_out - T_e) on the face.
+    """The convective and long-wave coefficients computed at every step (docs/model.md section
+    3.6): the step matrix holds each face's declared h0, and the rest, from the temperatures
+    before the step and the inputs at its end, is a source: inside, A phi (h(T_s - T_air) - h0)
+    (T_air - T_s) on the face and its negative on the air (what one gains the other loses);
+    outside, A (h(V, windward, T_e - T_out) - h0) (T_out - T_e) on the face; the outside's
+    long-wave, A [(h_r(T_e, T_sky) - h_rad) F (T_sky - T_e) + (h_r(T_e, T_out) - h_rad) (1 - F)
+    (T_out - T_e)] on the face.
 
     inside: ((face node, air node) int (n, 2), (A phi m2, h0 W/m2/K, cos_up) (n, 3)), cos_up the
     cosine of the face's normal into the air with the vertical; outside: (face node int (m,),
     (A m2, h0 W/m2/K, cos_up, azimuth deg, roughness multiplier R_f, wind factor V_z / V_met)
-    (m, 6)); columns: the input indices of T_out, the wind speed and direction (-1 without an
-    outside face)."""
+    (m, 6)); longwave: (face node int (k,), (A m2, h_rad W/m2/K, sky view F, emissivity) (k, 4));
+    columns: the input indices of T_out, the wind speed and direction (-1 without an outside
+    face) and T_sky."""
     inside_nodes: np.ndarray
     inside: np.ndarray
     outside_nodes: np.ndarray
     outside: np.ndarray
+    longwave_nodes: np.ndarray
+    longwave: np.ndarray
     columns: tuple
 
     def source(self, T, u):
@@ -64,11 +69,18 @@ class Convection:
             np.add.at(q, face, flow)
             np.add.at(q, air, -flow)
         if len(self.outside):
-            t_out, speed, direction = (u[j] for j in self.columns)
+            t_out, speed, direction = (u[j] for j in self.columns[:3])
             area, h0, cos_up, azimuth, roughness, wind = self.outside.T
             dT = t_out - T[self.outside_nodes]
             h = doe2_faces(wind * speed, windward_faces(cos_up, azimuth, direction), -dT, cos_up, roughness)
             np.add.at(q, self.outside_nodes, area * (h - h0) * dT)
+        if len(self.longwave):
+            t_out, t_sky = u[self.columns[0]], u[self.columns[3]]
+            area, h0, F, emissivity = self.longwave.T
+            T_e = T[self.longwave_nodes]
+            sky = (exterior_coefficient(emissivity, T_e, t_sky) - h0) * F * (t_sky - T_e)
+            air = (exterior_coefficient(emissivity, T_e, t_out) - h0) * (1.0 - F) * (t_out - T_e)
+            np.add.at(q, self.longwave_nodes, area * (sky + air))
         return q
 
 
@@ -323,7 +335,7 @@ def assemble(building, names=None):
     A = np.zeros((n, n))
     B = np.zeros((n, len(names)))
     q = np.zeros(n)
-    products, switched, inside, outside = [], [], [], []
+    products, switched, inside, outside, longwave = [], [], [], [], []
 
     def link(i, j, g):
         """A conductance g (W/K) between nodes i and j (0-based)."""
@@ -402,6 +414,8 @@ def assemble(building, names=None):
             B[e, col[c.irradiance_input]] += c.area * out.solar_absorptance
             # a glazing's inner panes absorb part of the sun at the inside face (docs/model.md 4.1)
             B[idx[0], col[c.irradiance_input]] += c.area * c.inner_solar_absorptance
+            if out.longwave_emissivity is not None:
+                longwave.append((e, (c.area, out.h_rad, F, out.longwave_emissivity)))
         elif isinstance(out, Surface):
             to_zone(e, c.area, out, cos_up)
         elif isinstance(out, Boundary):
@@ -494,13 +508,15 @@ def assemble(building, names=None):
                 for r, w in radiant:
                     B[r, col[name]] += gain * f_r * w
     convection = None
-    if inside or outside:
+    if inside or outside or longwave:
         convection = Convection(
             inside_nodes=np.array([n for n, _ in inside], dtype=int).reshape(-1, 2),
             inside=np.array([v for _, v in inside], dtype=float).reshape(-1, 3),
             outside_nodes=np.array([n for n, _ in outside], dtype=int),
             outside=np.array([v for _, v in outside], dtype=float).reshape(-1, 6),
-            columns=tuple(col.get(name, -1) for name in ("T_out", WIND_SPEED, WIND_DIRECTION)))
+            longwave_nodes=np.array([n for n, _ in longwave], dtype=int),
+            longwave=np.array([v for _, v in longwave], dtype=float).reshape(-1, 4),
+            columns=tuple(col.get(name, -1) for name in ("T_out", WIND_SPEED, WIND_DIRECTION, "T_sky")))
     return Network(C=C, A=A, B=B, q=q, input_names=names, products=tuple(products), switched=tuple(switched),
                    convection=convection)
 

@@ -1,6 +1,6 @@
-"""Convective coefficients that follow the state (docs/model.md section 3.6): EnergyPlus's TARP and
-DOE-2 by hand, the lagged source's energy balance and limit, and the same steps in numpy, in C and
-through the Python FMU."""
+"""Convective and outside long-wave coefficients that follow the state (docs/model.md section 3.6):
+EnergyPlus's TARP, DOE-2 and exterior long-wave by hand, the lagged source's energy balance and
+limit, and the same steps in numpy, in C and through the Python FMU."""
 import copy
 
 import numpy as np
@@ -12,17 +12,28 @@ from nodeforce.model.case import prepare_case
 from nodeforce.model.convection import doe2_faces, tarp_inside_faces, windward_faces
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import simulate
+from nodeforce.model.longwave import SIGMA, exterior_coefficient
 from nodeforce.model.network import WIND_DIRECTION, WIND_SPEED, assemble
 
 
 def followed(data, roughness=1.67, wind_factor=0.9):
-    """The building with TARP inside every zone and DOE-2 outside every exterior face."""
-    data = copy.deepcopy(data)
+    """The building with TARP inside every zone and DOE-2 and the long-wave that follows the face
+    outside every exterior face."""
+    data = radiating(data)
     for z in data["zones"]:
         z["inside_convection_algorithm"] = "tarp"
     for c in data["components"]:
         if c["outside"]["type"] == "exterior":
             c["outside"]["convection"] = {"algorithm": "doe2", "roughness": roughness, "wind_factor": wind_factor}
+    return data
+
+
+def radiating(data, emissivity=0.9):
+    """The building with the outside long-wave following every exterior face's temperature."""
+    data = copy.deepcopy(data)
+    for c in data["components"]:
+        if c["outside"]["type"] == "exterior":
+            c["outside"]["longwave"] = {"emissivity": emissivity}
     return data
 
 
@@ -74,10 +85,60 @@ def test_a_wall_is_windward_where_the_wind_comes_from_within_90_degrees_of_its_n
     assert windward_faces(0.0, 0.0, 350.0) and windward_faces(0.0, 0.0, 10.0)
 
 
+def test_a_face_at_minus_10_C_under_a_sky_at_minus_30_C_loses_less_than_the_10_C_linearisation():
+    # eps sigma (T_s^4 - T_sky^4) / (T_s - T_sky) at 263.15 K and 243.15 K, eps 0.9:
+    # (4.795275e9 - 3.495402e9) / 20 = 6.499365e7 K^3, times 0.9 * 5.670374e-8 = 3.31685 W/m2/K,
+    # where 4 eps sigma (283.15 K)^3 = 4.63408
+    assert exterior_coefficient(0.9, -10.0, -30.0) == pytest.approx(3.31685, abs=1e-5)
+    assert 4 * 0.9 * SIGMA * 283.15 ** 3 == pytest.approx(4.63408, abs=1e-5)
+
+
+def test_at_the_linearisation_s_10_C_the_coefficient_is_h_rad_and_leaves_no_source(testcell_data):
+    h0 = 4 * 0.9 * SIGMA * 283.15 ** 3
+    assert exterior_coefficient(0.9, 10.0, 10.0) == pytest.approx(h0, rel=1e-14)
+    data = radiating(testcell_data)
+    for c in data["components"]:
+        if c["outside"]["type"] == "exterior":
+            c["outside"]["h_rad"] = h0
+    network = assemble(parse_building(data))
+    u = np.zeros(len(network.input_names))
+    u[network.input_names.index("T_sky")] = 10.0
+    T = np.full(network.n_nodes, 10.0)
+    # the face at 10 C, the air at 10 C and the sky at -20 C: the air's term vanishes (T_out =
+    # T_e) and the sky's is A (h(10, -20) - h0) F (-20 - 10), h(10, -20) by its quotient form
+    u[network.input_names.index("T_out")] = 10.0
+    assert np.abs(network.convection.source(T, u)).max() < 1e-9
+    u[network.input_names.index("T_sky")] = -20.0
+    q = network.convection.source(T, u)
+    face, (area, h_rad, F, eps) = network.convection.longwave_nodes[0], network.convection.longwave[0]
+    h_sky = eps * SIGMA * (283.15 ** 4 - 253.15 ** 4) / 30.0
+    assert q[face] == pytest.approx(area * (h_sky - h0) * F * (-30.0), rel=1e-12)
+    assert q[face] > 0.0  # a colder sky takes less per kelvin than the linearisation at 10 C
+
+
+def test_the_long_wave_that_follows_the_face_steps_alike_in_c_and_numpy(testcell_data, weather, monkeypatch):
+    from tests.conftest import record_times
+    building, plain = parse_building(radiating(testcell_data)), parse_building(testcell_data)
+    times = record_times(days=3)
+    w = weather[(weather.index >= times[0] - np.timedelta64(2, "h")) & (weather.index <= times[-1] + np.timedelta64(2, "h"))]
+    case = prepare_case(building, w)
+    network = assemble(building)
+    assert network.input_names == assemble(plain).input_names  # the sky's input alone: no wind needed
+    T = simulate(building, network, case.U, case.dt, substeps=case.substeps)
+    constant = simulate(plain, assemble(plain), case.U, case.dt, substeps=case.substeps)
+    faces = network.convection.longwave_nodes
+    assert np.abs(T[:, faces] - constant[:, faces]).max() > 0.05
+    if compiled.available():
+        monkeypatch.setattr(compiled, "available", lambda: False)
+        stepped = simulate(building, network, case.U, case.dt, substeps=case.substeps)
+        assert np.abs(stepped - T).max() < 1e-10 * np.abs(T).max()
+
+
 def test_what_the_faces_gain_the_air_loses(testcell_data):
     data = followed(testcell_data)
     for c in data["components"]:  # inside convection alone
         c["outside"].pop("convection", None)
+        c["outside"].pop("longwave", None)
     building = parse_building(data)
     network = assemble(building)
     rng = np.random.default_rng(1)
@@ -139,6 +200,8 @@ def test_the_standalone_fmu_refuses_coefficients_that_follow_the_state(testcell_
     from nodeforce.fmu_build.standalone import network_terms
     with pytest.raises(InputError, match="inside_convection_algorithm.*standalone C FMU"):
         network_terms(parse_building(followed(testcell_data)), None)
+    with pytest.raises(InputError, match="outside.longwave.*standalone C FMU"):
+        network_terms(parse_building(radiating(testcell_data)), None)
 
 
 @pytest.mark.slow

@@ -14,15 +14,16 @@
    row's links), and a forced row a unit row. Each step is then two sparse triangular solves,
    O(entries), where a product with the dense inverse is O(N^2).
 
-   Where a building's convective coefficients follow its state (model/network.py, `Convection`;
-   docs/model.md section 3.6), each step adds to its sources what the coefficients computed
-   from the temperatures before it and its inputs give beyond the h0 of M: the same arithmetic as
-   model/convection.py's, face by face. */
+   Where a building's convective or outside long-wave coefficients follow its state
+   (model/network.py, `Convection`; docs/model.md section 3.6), each step adds to its sources
+   what the coefficients computed from the temperatures before it and its inputs give beyond the
+   h0 of M: the same arithmetic as model/convection.py's and model/longwave.py's, face by face. */
 #include <math.h>
 #include <stdlib.h>
 
 #define EXPORT __attribute__((visibility("default")))
 #define INSIDE_FLOOR 0.1 /* W/m2/K, model/convection.py */
+#define SIGMA 5.670374419e-8 /* W/m2/K4, model/longwave.py */
 
 /* TARP's natural convection (W/m2/K) at dT = T_s - T_air, cos_up the face's normal into the air
    with the vertical: ASHRAE's on a wall, else Walton's unstable where the heat rises off the face,
@@ -33,12 +34,22 @@ static double tarp_natural(double dT, double cos_up) {
     return dT * cos_up > 0.0 ? 9.482 * root / (7.238 - c) : 1.810 * root / (1.382 + c);
 }
 
-/* The lagged convection's sources (W) into q (N), from T (N) before the step and the step's
+/* An outside face's long-wave coefficient (W/m2/K) at emissivity eps toward T (C) from its own
+   T_s (C): eps sigma (T_s^2 + T^2)(T_s + T) in K */
+static double exterior_coefficient(double eps, double T_s, double T) {
+    T_s += 273.15;
+    T += 273.15;
+    return eps * SIGMA * (T_s * T_s + T * T) * (T_s + T);
+}
+
+/* The lagged coefficients' sources (W) into q (N), from T (N) before the step and the step's
    inputs u: inside, per face, (face, air) and (A phi, h0, cos_up); outside, per face, its node
-   and (A, h0, cos_up, azimuth, R_f, wind factor); columns: u's T_out, wind speed and direction */
+   and (A, h0, cos_up, azimuth, R_f, wind factor); long-wave, per face, its node and (A, h_rad,
+   F, eps); columns: u's T_out, wind speed and direction, T_sky */
 static void convection(int n, const double *T, const double *u, int n_inside, const int *inside_nodes,
                        const double *inside, int n_outside, const int *outside_nodes, const double *outside,
-                       const int *columns, double *q) {
+                       int n_longwave, const int *longwave_nodes, const double *longwave, const int *columns,
+                       double *q) {
     int k;
     for (k = 0; k < n; k++) q[k] = 0.0;
     for (k = 0; k < n_inside; k++) {
@@ -59,6 +70,13 @@ static void convection(int n, const double *T, const double *u, int n_inside, co
         forced = fabs(v[2]) >= 0.98 || fabs(diff) - 90.0 <= 0.001 ? 3.26 * pow(speed, 0.89) : 3.55 * pow(speed, 0.617);
         q[face] += v[0] * (h_n + v[4] * (sqrt(h_n * h_n + forced * forced) - h_n) - v[1]) * dT;
     }
+    for (k = 0; k < n_longwave; k++) {
+        const int face = longwave_nodes[k];
+        const double *v = longwave + 4 * k, T_e = T[face], t_out = u[columns[0]], t_sky = u[columns[3]];
+        const double sky = (exterior_coefficient(v[3], T_e, t_sky) - v[1]) * v[2] * (t_sky - T_e);
+        const double air = (exterior_coefficient(v[3], T_e, t_out) - v[1]) * (1.0 - v[2]) * (t_out - T_e);
+        q[face] += v[0] * (sky + air);
+    }
 }
 
 /* order (N): the node of each position of the elimination order; lower_ptr/lower_col (N + 1,
@@ -70,7 +88,7 @@ static void convection(int n, const double *T, const double *u, int n_inside, co
    n_forced) their temperatures. T (N): the temperatures before the first step, after the last
    on return; path (L x R): the temperatures of the nodes rows (R) after each step. Returns 1, or
    0 where a pivot is zero (M singular) or memory runs out. n_inside ... columns: the lagged
-   convection (`convection`), u each step's first columns of terms (the inputs). */
+   coefficients (`convection`), u each step's first columns of terms (the inputs). */
 EXPORT int nodeforce_steps(int n, const int *order, const int *lower_ptr, const int *lower_col,
                            const int *upper_ptr, const int *upper_col, long nonzeros, const int *slot,
                            const double *value, const double *c, long L, int m, const double *terms,
@@ -78,12 +96,12 @@ EXPORT int nodeforce_steps(int n, const int *order, const int *lower_ptr, const 
                            const double *q, int n_forced, const int *forced, const double *imposed, double *T,
                            int n_rows, const int *rows, double *path, int n_inside, const int *inside_nodes,
                            const double *inside, int n_outside, const int *outside_nodes, const double *outside,
-                           const int *columns) {
+                           int n_longwave, const int *longwave_nodes, const double *longwave, const int *columns) {
     long entries = (long)n + lower_ptr[n] + upper_ptr[n], s, e;
     double *f = calloc((size_t)entries + 1, sizeof(double)), *w = calloc((size_t)n + 1, sizeof(double));
     double *y = malloc(((size_t)n + 1) * sizeof(double));
     int *position = malloc(((size_t)n + 1) * sizeof(int));
-    const int lagged = n_inside > 0 || n_outside > 0;
+    const int lagged = n_inside > 0 || n_outside > 0 || n_longwave > 0;
     double *extra = calloc((size_t)n + 1, sizeof(double));
     double *diagonal = f, *lower = f + n, *upper = f + n + lower_ptr[n];
     int i, p, k, ok = 0;
@@ -110,7 +128,8 @@ EXPORT int nodeforce_steps(int n, const int *order, const int *lower_ptr, const 
         const double *t_s = terms + s * m;
         double *out = path + s * n_rows;
         if (lagged)
-            convection(n, T, t_s, n_inside, inside_nodes, inside, n_outside, outside_nodes, outside, columns, extra);
+            convection(n, T, t_s, n_inside, inside_nodes, inside, n_outside, outside_nodes, outside, n_longwave,
+                       longwave_nodes, longwave, columns, extra);
         for (i = 0; i < n; i++) {
             const int node = order[i];
             double sum = q[node] + extra[node];
