@@ -129,26 +129,13 @@ def doe2_faces(speed, windward, delta_T, cos_up, roughness):
     return h_n + roughness * (np.sqrt(h_n ** 2 + forced ** 2) - h_n)
 
 
-# The step matrix holds a coefficient at least as large as a followed one ever is, and the lagged
-# source their difference, never positive: then an error in a face's temperature shrinks at every
-# step, by (C/dt + (h_ref - h) A) / (C/dt + h_ref A + G) < 1, whatever the face's capacity. With
-# the declared h0 in the matrix, a lagged h above it grows the error once h - h0 exceeds h0 + G on
-# a face of little capacity: a massless outer layer in a gale (EnergyPlus's 1ZoneEvapCooler roof
-# reached 437 C within a day and then overflowed). The bound is the coefficient in a 20 m/s wind at
-# the face, windward, and 50 K across it: a followed h exceeds twice it only beyond 45 m/s.
-BOUND_WIND = 20.0  # m/s at the face
-BOUND_DT = 50.0  # K
 
-
-def outside_reference(h_conv, cos_up, roughness, wind_factor):
-    """The exterior coefficient the step matrix holds for a face whose DOE-2 coefficient is
-    followed (W/m2/K): the larger of its declared h_conv and DOE-2's at BOUND_WIND m/s at the face
-    (`wind_factor` times the station's), windward, BOUND_DT K warmer than the air."""
-    bound = doe2_faces(BOUND_WIND if wind_factor > 0 else 0.0, True, BOUND_DT, cos_up, roughness)
-    return max(float(h_conv), float(bound))
-
-
-def inside_reference(h_conv, cos_up):
-    """The inside coefficient the step matrix holds for a face whose TARP coefficient is followed
-    (W/m2/K): the larger of its declared h_conv and TARP's unstable one at BOUND_DT K."""
-    return max(float(h_conv), float(tarp_inside_faces(BOUND_DT if cos_up >= 0 else -BOUND_DT, cos_up)))
+def lagged_excess(h, h0):
+    """The part of a followed coefficient h (W/m2/K) the lagged source carries beside the h0 the
+    step matrix holds: h - h0, at most h0. An error e in a face's temperature then becomes
+    (C/dt - (h - h0) A) e / (C/dt + h0 A + G) the next step, less than e whatever the face's
+    capacity; uncapped, a face of little capacity grows its error once h - h0 exceeds h0 + G (a
+    massless outer layer in a gale: EnergyPlus's 1ZoneEvapCooler roof overflowed within a day of
+    Golden's wind). The cap acts where h exceeds 2 h0: outside, DOE-2 h0 (at a 4 m/s station
+    wind) is exceeded twice over in a station wind beyond some 15 m/s."""
+    return np.minimum(np.asarray(h, dtype=float) - h0, h0)

@@ -23,7 +23,7 @@ import numpy as np
 
 from .building import DAY_TERMS, Adiabatic, Boundary, Exterior, Surface
 from .building_file import schema_default
-from .convection import doe2_faces, inside_reference, outside_reference, tarp_inside_faces, windward_faces
+from .convection import doe2_faces, lagged_excess, tarp_inside_faces, windward_faces
 from .discretise import capacities, conductances
 from .longwave import enclosure_exchange, exterior_coefficient
 
@@ -65,7 +65,7 @@ class Convection:
             face, air = self.inside_nodes.T
             area, h0, cos_up = self.inside.T
             dT = T[air] - T[face]
-            flow = area * (tarp_inside_faces(-dT, cos_up) - h0) * dT
+            flow = area * lagged_excess(tarp_inside_faces(-dT, cos_up), h0) * dT
             np.add.at(q, face, flow)
             np.add.at(q, air, -flow)
         if len(self.outside):
@@ -73,13 +73,13 @@ class Convection:
             area, h0, cos_up, azimuth, roughness, wind = self.outside.T
             dT = t_out - T[self.outside_nodes]
             h = doe2_faces(wind * speed, windward_faces(cos_up, azimuth, direction), -dT, cos_up, roughness)
-            np.add.at(q, self.outside_nodes, area * (h - h0) * dT)
+            np.add.at(q, self.outside_nodes, area * lagged_excess(h, h0) * dT)
         if len(self.longwave):
             t_out, t_sky = u[self.columns[0]], u[self.columns[3]]
             area, h0, F, emissivity = self.longwave.T
             T_e = T[self.longwave_nodes]
-            sky = (exterior_coefficient(emissivity, T_e, t_sky) - h0) * F * (t_sky - T_e)
-            air = (exterior_coefficient(emissivity, T_e, t_out) - h0) * (1.0 - F) * (t_out - T_e)
+            sky = lagged_excess(exterior_coefficient(emissivity, T_e, t_sky), h0) * F * (t_sky - T_e)
+            air = lagged_excess(exterior_coefficient(emissivity, T_e, t_out), h0) * (1.0 - F) * (t_out - T_e)
             np.add.at(q, self.longwave_nodes, area * (sky + air))
         return q
 
@@ -358,11 +358,9 @@ def assemble(building, names=None):
 
     def to_zone(node, area, surface, cos_up):
         zone = building.zone(surface.zone)
-        h = surface.h_conv
+        link(node, zone.air_node - 1, area * surface.h_conv * zone.convection_factor)
         if zone.inside_convection_algorithm == "tarp":
-            h = inside_reference(surface.h_conv, cos_up)
-            inside.append(((node, zone.air_node - 1), (area * zone.convection_factor, h, cos_up)))
-        link(node, zone.air_node - 1, area * h * zone.convection_factor)
+            inside.append(((node, zone.air_node - 1), (area * zone.convection_factor, surface.h_conv, cos_up)))
         if zone.longwave == "radiant_node":
             link(node, zone.radiant_node - 1, area * surface.h_rad)
 
@@ -404,12 +402,11 @@ def assemble(building, names=None):
         to_zone(idx[0], c.area, c.inside, -cos_up)
         if isinstance(out, Exterior):
             F = sky_view_factor(c.tilt) if out.sky_view_factor is None else out.sky_view_factor
-            v, h = out.convection, out.h_conv
+            v = out.convection
             if v is not None:
-                h = outside_reference(out.h_conv, cos_up, v.roughness, v.wind_factor)
-                outside.append((e, (c.area, h, cos_up, c.azimuth, v.roughness, v.wind_factor)))
-            A[e, e] -= c.area * (h + out.h_rad)
-            B[e, col["T_out"]] += c.area * (h + out.h_rad * (1.0 - F))
+                outside.append((e, (c.area, out.h_conv, cos_up, c.azimuth, v.roughness, v.wind_factor)))
+            A[e, e] -= c.area * (out.h_conv + out.h_rad)
+            B[e, col["T_out"]] += c.area * (out.h_conv + out.h_rad * (1.0 - F))
             B[e, col["T_sky"]] += c.area * out.h_rad * F
             B[e, col[c.irradiance_input]] += c.area * out.solar_absorptance
             # a glazing's inner panes absorb part of the sun at the inside face (docs/model.md 4.1)

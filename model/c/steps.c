@@ -42,6 +42,11 @@ static double exterior_coefficient(double eps, double T_s, double T) {
     return eps * SIGMA * (T_s * T_s + T * T) * (T_s + T);
 }
 
+/* model/convection.py's lagged_excess: h - h0, at most h0, so that the lag never grows an error */
+static double excess(double h, double h0) {
+    return h - h0 < h0 ? h - h0 : h0;
+}
+
 /* The lagged coefficients' sources (W) into q (N), from T (N) before the step and the step's
    inputs u: inside, per face, (face, air) and (A phi, h0, cos_up); outside, per face, its node
    and (A, h0, cos_up, azimuth, R_f, wind factor); long-wave, per face, its node and (A, h_rad,
@@ -57,8 +62,8 @@ static void convection(int n, const double *T, const double *u, int n_inside, co
         const double *v = inside + 3 * k, dT = T[air] - T[face];
         double h = tarp_natural(-dT, v[2]);
         if (h < INSIDE_FLOOR) h = INSIDE_FLOOR;
-        q[face] += v[0] * (h - v[1]) * dT;
-        q[air] -= v[0] * (h - v[1]) * dT;
+        q[face] += v[0] * excess(h, v[1]) * dT;
+        q[air] -= v[0] * excess(h, v[1]) * dT;
     }
     for (k = 0; k < n_outside; k++) {
         const int face = outside_nodes[k];
@@ -68,13 +73,13 @@ static void convection(int n, const double *T, const double *u, int n_inside, co
         double diff = fabs(u[columns[2]] - v[3]), forced;
         if (diff - 180.0 > 0.001) diff -= 360.0;
         forced = fabs(v[2]) >= 0.98 || fabs(diff) - 90.0 <= 0.001 ? 3.26 * pow(speed, 0.89) : 3.55 * pow(speed, 0.617);
-        q[face] += v[0] * (h_n + v[4] * (sqrt(h_n * h_n + forced * forced) - h_n) - v[1]) * dT;
+        q[face] += v[0] * excess(h_n + v[4] * (sqrt(h_n * h_n + forced * forced) - h_n), v[1]) * dT;
     }
     for (k = 0; k < n_longwave; k++) {
         const int face = longwave_nodes[k];
         const double *v = longwave + 4 * k, T_e = T[face], t_out = u[columns[0]], t_sky = u[columns[3]];
-        const double sky = (exterior_coefficient(v[3], T_e, t_sky) - v[1]) * v[2] * (t_sky - T_e);
-        const double air = (exterior_coefficient(v[3], T_e, t_out) - v[1]) * (1.0 - v[2]) * (t_out - T_e);
+        const double sky = excess(exterior_coefficient(v[3], T_e, t_sky), v[1]) * v[2] * (t_sky - T_e);
+        const double air = excess(exterior_coefficient(v[3], T_e, t_out), v[1]) * (1.0 - v[2]) * (t_out - T_e);
         q[face] += v[0] * (sky + air);
     }
 }
