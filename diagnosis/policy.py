@@ -38,8 +38,7 @@ class Policy:
 
     # -- 2. objections
     # A scale parameter, or a derived quantity, is identifiable when its sd is under this share
-    # of its value (dimensionless): a fourth is a value one can act on. It refuses no candidate
-    # (`loose`): what a candidate predicts of the days left out decides, its sd is reported.
+    # of its value (dimensionless): a fourth is a value one can act on.
     identifiable_share: float = 0.25
     # A temperature (T_ground) is identifiable when its sd is under this (K).
     identifiable_kelvin: float = 1.0
@@ -177,53 +176,34 @@ class Policy:
     def objection_of(self, effect, parameters, derived, facts):
         """Why a calibrated effect may not be added to the model, or None: a gain the building
         file's description rules out (`implausible`), a parameter on a bound of its search range
-        (unless the quantity its parameters trade off along is determined, `Effect.trade_off`,
-        and the effect's record waives its bounds then), or a value outside physical limits beyond
-        its uncertainty (`limit_sds`). The judged parameters, their limits and the trade-off are
-        the candidate's `facts`, as report.json records them.
-
-        A wide standard deviation is not an objection (`loose` says it): the candidate has passed
-        on what it predicts of the days no fit read, and between it and a tighter one the evidence
-        chooses, as between any two. A line on the sd would refuse the best predictor for being
-        uncertain about its value, and, drawn at a share, flip a record's answer from one draw of
-        the noise to the next (24.99 % against 25.2 %).
+        or not identifiable from the data (unless the quantity its parameters trade off along
+        is, `Effect.trade_off`, or the calibration held it at its physical prior), or a value
+        outside physical limits beyond its uncertainty (`limit_sds`). The judged parameters, their
+        limits and the trade-off are the candidate's `facts`, as report.json records them.
 
         parameters : {name: `ParameterEstimate`}, or report.json's {"value", "std", "identifiable", "on_bound"}
         derived : what the data determine besides (`diagnosis.calibrate.derived`)
         facts : what the building says of the candidate (`facts`)
         """
         reasons = [facts["implausible"]]
-        resolved, bounds_waived = self._resolved(effect, derived, facts)
+        trade_off = facts["trade_off"] if "trade_off" in facts else EFFECTS[effect].trade_off
+        key, bounds_waived = trade_off or (None, False)
+        fixed = (derived or {}).get(key)
+        resolved = fixed is not None and fixed["std"] < self.identifiable_share * abs(fixed["value"])
         for name in facts["limits"]:
             p, unit = ParameterEstimate.of(parameters[name]), EFFECTS[effect].parameter(name).unit
             low, high = (-math.inf if facts["limits"][name][0] is None else facts["limits"][name][0],
                          math.inf if facts["limits"][name][1] is None else facts["limits"][name][1])
             if p.on_bound and not (resolved and bounds_waived):
                 reasons.append(f"{name} = {p.value:.3g} {unit} ends on a bound of its range")
+            elif not p.identifiable and not resolved and not p.prior:
+                reasons.append(f"{name} = {p.value:.3g} +- {p.sd:.2g} {unit} is not identifiable from these data")
             margin = self.limit_sds * p.sd
             if not low - margin <= p.value <= high + margin:
                 what = "a negative gain (a heat sink)" if low == 0.0 and EFFECTS[effect].source else "outside physical limits"
                 reasons.append(f"{name} = {p.value:.3g} +- {p.sd:.2g} {unit} is {what} [{low:.3g}, {high:.3g}] "
                                f"by more than {self.limit_sds:g} standard deviations")
         return "; ".join(r for r in reasons if r) or None
-
-    def _resolved(self, effect, derived, facts):
-        """Whether the quantity the effect's parameters trade off along (`Effect.trade_off`) is
-        determined (its sd under `identifiable_share` of it), and whether the effect's bounds are
-        then waived."""
-        trade_off = facts["trade_off"] if "trade_off" in facts else EFFECTS[effect].trade_off
-        key, bounds_waived = trade_off or (None, False)
-        fixed = (derived or {}).get(key)
-        return fixed is not None and fixed["std"] < self.identifiable_share * abs(fixed["value"]), bounds_waived
-
-    def loose(self, effect, parameters, derived, facts):
-        """The judged parameters whose value the data leave loose ({name: `ParameterEstimate`}):
-        not identifiable (`identifiable`), neither weighed with a prior nor determined along with the
-        others through the quantity they trade off along; what the report says beside the choice."""
-        if self._resolved(effect, derived, facts)[0]:
-            return {}
-        estimates = {name: ParameterEstimate.of(parameters[name]) for name in facts["limits"]}
-        return {name: p for name, p in estimates.items() if not p.identifiable and not p.prior and not p.on_bound}
 
     # ---- 4. the order
     def claim(self, effect, component, sensed=False):

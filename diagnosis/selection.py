@@ -289,7 +289,6 @@ def _reason(chosen, alike, results, passing, base, n, verdicts, margin, componen
                  f"; among them {best.effect} on {best.target} best predicts {what}, against its "
                  f"{chosen.evidence().sum():.3g} C2)"
                  + (f", but is refused: {verdicts[best.label].objection}" if verdicts[best.label].objection else ""))
-    said += _loose(chosen, passing, verdicts, policy)
     if alike:
         said += ("; within one standard error of the best, and so not told apart by these data: "
                  + ", ".join(f"{r.effect} on {r.target} ({r.evidence().sum():.3g} C2)" for r in alike)
@@ -305,33 +304,6 @@ def _reason(chosen, alike, results, passing, base, n, verdicts, margin, componen
     if policy.is_shape(chosen.effect):
         said += "; no physical effect comes within one standard error of it"
     return said + "."
-
-
-def _loose(chosen, passing, verdicts, policy):
-    """The clause of the reason on the chosen candidate's loose values (`Policy.loose`), "" where
-    none is: each with its sd, and the best predictor among the admissible whose values are all
-    tight, where the chosen predicts better than it: the choice follows what each predicts."""
-    def loose(r):
-        return policy.loose(r.effect, r.parameters, r.derived, r.physics)
-    values = loose(chosen)
-    if not values:
-        return ""
-
-    def spread(name, p):
-        unit = EFFECTS[chosen.effect].parameter(name).unit
-        share = (f"over {policy.identifiable_kelvin:g} K" if unit == "C" else
-                 f"{100 * p.sd / abs(p.value):.0f} % of it" if p.value else "about a value of 0")
-        return f"{name}, {p.value:.3g} +- {p.sd:.2g} {unit} ({share})"
-    said = (f"; its {', '.join(spread(name, p) for name, p in values.items())}, "
-            f"{'is' if len(values) == 1 else 'are'} loose: the data fix what it predicts more than its value")
-    tight = [r for r in passing if r is not chosen and not verdicts[r.label].objection and not loose(r)]
-    if tight:
-        best = min(tight, key=lambda r: r.evidence().sum())
-        if best.evidence().sum() > chosen.evidence().sum():
-            said += (f", and it predicts what no fit read better than the best of the candidates whose values are "
-                     f"tight, {best.effect} on {best.target} (J {chosen.evidence().sum():.3g} against "
-                     f"{best.evidence().sum():.3g} C2): the choice follows the prediction")
-    return said
 
 
 def acting(result):

@@ -20,11 +20,10 @@ def sig(value):
     return f"{value:.3g}"
 
 
-def check_round(r, fits):
-    """Each sentence of one round's reason (report.json's `decision.rounds[i]`) against its numbers
-    and its candidates' fits (report.json's `candidates` of that round, by label): the candidates
-    that pass, the one that best predicts what no fit read, the fall of J, a value said to be
-    loose, and, for a choice made again, whether the effect stays, is replaced or is removed."""
+def check_round(r):
+    """Each sentence of one round's reason (report.json's `decision.rounds[i]`) against its numbers:
+    the candidates that pass, the one that best predicts what no fit read, the fall of J, and,
+    for a choice made again, whether the effect stays, is replaced or is removed."""
     reason, verdicts, chosen = r["reason"], r["candidates"], r["chosen"]
     passing = {label: v for label, v in verdicts.items() if v["passes"]}
     for said, of in re.findall(r"(\d+) of (\d+) candidates pass", reason):
@@ -51,18 +50,6 @@ def check_round(r, fits):
             assert label != chosen and passing[label]["evidence"] == passing[best]["evidence"], reason
             assert other[3] == sig(verdicts[label]["evidence"]) and other[4] == sig(verdicts[chosen]["evidence"])
             assert bool(other[5]) == bool(verdicts[label]["objection"]), reason
-        for name, value, sd, share in re.findall(rf"its (\w+), {NUMBER} \+- {NUMBER} \S+ \(([^)]*)\)", reason):
-            p = fits[chosen]["parameters"][name]
-            assert (value, sd) == (sig(p["value"]), f"{p['std']:.2g}") and p["identifiable"] is False, reason
-            assert share == ("over 1 K" if p["std"] >= 1.0 and name == "T_ground" else
-                             f"{100 * p['std'] / abs(p['value']):.0f} % of it"), reason
-        tight = re.search(rf"better than the best of the candidates whose values are tight, (\S+) on (\S+) "
-                          rf"\(J {NUMBER} against {NUMBER} C2\)", reason)
-        if tight:
-            label = f"{tight[1]}@{tight[2]}"
-            assert (tight[3], tight[4]) == (sig(verdicts[chosen]["evidence"]), sig(verdicts[label]["evidence"]))
-            assert verdicts[chosen]["evidence"] < verdicts[label]["evidence"] and not verdicts[label]["objection"]
-            assert all(p["identifiable"] for p in fits[label]["parameters"].values()), reason
     replaces = r.get("replaces")
     if reason.endswith("it stays."):
         assert replaces is not None and chosen == replaces, reason
@@ -89,15 +76,10 @@ def check_round(r, fits):
 def check_sentences(report):
     """Every round of a report.json's content (`check_round`), and its effects: none removed is
     among them."""
-    for number, r in enumerate(report["decision"]["rounds"], start=1):
-        check_round(r, {f"{c['effect']}@{c['target']}": c for c in report["candidates"] if c["round"] == number})
+    for r in report["decision"]["rounds"]:
+        check_round(r)
     removed = {r["removed"] for r in report["decision"]["rounds"] if r.get("removed")}
     assert not removed & {f"{e['effect']}@{e['target']}" for e in report["effects"]}
-
-
-def fits(*candidates):
-    """Hand-made candidates as report.json keeps them, by label."""
-    return {fit.label: fit.to_json() for fit in candidates}
 
 
 def with_sensors(fit, days):
@@ -114,7 +96,7 @@ def test_a_round_says_which_candidate_best_predicts_even_when_physics_refuses_it
     air = with_sensors(candidate("infiltration", "cell", {"n": parameter(0.8, 0.05)}, [3.0] * 4), [4.8] * 4)
     decision = decide([window, air], Baseline(BASE, SIGMA, N), POLICY)
     assert decision.chosen is air
-    check_round(decision.to_json(), fits(window, air))
+    check_round(decision.to_json())
     assert "among them solar_transmittance on window best predicts" in decision.reason
     assert "but is refused" in decision.reason and "it best predicts" not in decision.reason
 
@@ -124,7 +106,7 @@ def test_a_round_that_chooses_the_best_predictor_says_so_and_its_numbers():
     wall = with_sensors(door([5.0] * 4), [6.0] * 4)
     decision = decide([air, wall], Baseline(BASE, SIGMA, N), POLICY)
     assert decision.chosen is air and "among them it best predicts" in decision.reason
-    check_round(decision.to_json(), fits(air, wall))
+    check_round(decision.to_json())
 
 
 def test_a_revisit_that_keeps_or_removes_the_effect_says_it_in_the_numbers_it_records():
@@ -133,40 +115,13 @@ def test_a_revisit_that_keeps_or_removes_the_effect_says_it_in_the_numbers_it_re
     kept = revisited(decide([envelope], Baseline([4.0, 4.0], SIGMA, N), POLICY), envelope.label,
                      ["conductivity@door"], {}, refit)
     assert kept.reason.endswith("it stays.")
-    check_round(kept.to_json(), {})
+    check_round(kept.to_json())
     worse = type(envelope)(envelope.effect, envelope.target, envelope.parameters, {}, envelope.physics,
                            CrossValidation([5.0, 5.0], N))
     removal = revisited(decide([worse], Baseline([4.0, 4.0], SIGMA, N), POLICY), envelope.label,
                         ["conductivity@door"], {"conductivity@door": {"factor": parameter(1.58, 0.03)}}, refit)
-    check_round(removal.to_json(), {})
+    check_round(removal.to_json())
     # a sentence that said it stays, of the same numbers, is caught
     with pytest.raises(AssertionError):
         check_round({**removal.to_json(), "reason": removal.reason.split("; envelope_conductance on cell is")[0]
-                     + "; it stays."}, {})
-
-
-def window_and_air(share):
-    """The issue's record: the window's transmittance, its sd `share` of its value, predicts what
-    no fit read far better (J 2.4 a day) than the air change, whose value is tight (J 7.8)."""
-    tau = 0.52
-    window = with_sensors(candidate("solar_transmittance", "window",
-                                    {"tau": parameter(tau, share * tau, identifiable=share < 0.25)}, [1.0] * 4),
-                          [1.4] * 4)
-    air = with_sensors(candidate("infiltration", "cell", {"n": parameter(0.8, 0.05)}, [3.0] * 4), [4.8] * 4)
-    return window, air
-
-
-def test_the_best_predictor_is_chosen_whatever_the_spread_of_its_value_and_the_report_says_so():
-    window, air = window_and_air(0.252)
-    decision = decide([window, air], Baseline(BASE, SIGMA, N), POLICY)
-    assert decision.chosen is window and not decision.suggestions
-    assert "its tau, 0.52 +- 0.13 - (25 % of it), is loose" in decision.reason
-    assert "infiltration on cell (J 9.6 against 31.2 C2): the choice follows the prediction" in decision.reason
-    check_round(decision.to_json(), fits(window, air))
-
-
-def test_the_answer_does_not_flip_on_a_line_drawn_through_the_sd():
-    # 24.99 % and 25.2 % of the value: one noise draw from the next, the same choice
-    chosen = [decide(list(window_and_air(share)), Baseline(BASE, SIGMA, N), POLICY).chosen.label
-              for share in (0.2499, 0.252, 0.4)]
-    assert chosen == ["solar_transmittance@window"] * 3
+                     + "; it stays."})
