@@ -118,3 +118,11 @@ def test_shading_a_face_without_vertices_or_facing_away_is_refused(testcell_data
     window["vertices"] = window["vertices"][::-1]  # clockwise from outside: facing north
     with pytest.raises(InputError, match=r"components\[6\]\.vertices: face tilt 90\.0 deg, azimuth 0\.0 deg"):
         parse_building(data)
+
+
+def test_a_face_looking_straight_down_keeps_its_whole_sky_ratio():
+    """A soffit (a horizontal face looking down) sees no sky patch above the horizon: its diffuse
+    ratio is 1, nothing to shade, where the patches' weighted mean would divide 0 by 0."""
+    soffit = [(0.0, 0.0, 3.0), (0.0, 1.0, 3.0), (2.0, 1.0, 3.0), (2.0, 0.0, 3.0)]
+    shade = [(0.0, -1.0, 2.0), (2.0, -1.0, 2.0), (2.0, 2.0, 2.0), (0.0, 2.0, 2.0)]
+    assert sky_diffuse_ratio(soffit, np.array([0.0, 0.0, -1.0]), [shade]) == 1.0
