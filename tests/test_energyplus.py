@@ -308,25 +308,35 @@ def test_cli_convert(tmp_path):
 
 
 # ---- scheduled ventilation ---------------------------------------------------------------
-def test_scheduled_ventilation_steady_states(tmp_path):
-    """A zone of light adiabatic walls, 100 W and 100 m3/h of outdoor air at 0 C by night
-    (schedule 1) and a quarter of it by day: each half day ends at the steady state
-    T_air = Q / (s g), g = rho c V / 3600, with the switched conductance."""
-    from nodeforce.iotools.weather import read_weather
-    from nodeforce.model.case import simulate_building
+def night_and_day_zone():
+    """A zone of light adiabatic walls with a schedule "night": 1 from 18:00 to 06:00, 0.25 by day."""
     light = {"conductivity": 1.0, "density": 1.0, "specific_heat": 100.0}
-    b = minimal_building(
+    return minimal_building(
         materials={"m": light},
         schedules={"night": {"days": {"d": [[6, 1.0], [18, 0.25], [24, 1.0]]},
                              "periods": [{"through": "12-31", "week": ["d"] * 7}]}})
-    b = b.edited(lambda d: d["zones"][0].update(internal_gain=100.0, ventilation=[
-        {"name": "vent", "flow": 100.0, "schedule": "night"}]))
+
+
+def night_and_day_air(b, tmp_path):
+    """The zone's air (C) over three days of 0 C outdoors without sun, every 15 min."""
+    from nodeforce.iotools.weather import read_weather
+    from nodeforce.model.case import simulate_building
     times = pd.date_range("2017-03-01", periods=3 * 24 * 4 + 1, freq="15min", tz="UTC")
     path = tmp_path / "w.csv"
     pd.DataFrame({"time": [t.isoformat() for t in times], "T_out": 0.0, "ghi": 0.0, "dni": 0.0,
                   "dhi": 0.0}).to_csv(path, index=False)
     T = simulate_building(b, read_weather(path))
-    air = pd.Series(T[f"T{b.zones[0].air_node}"].to_numpy(), index=times[1:])
+    return pd.Series(T[f"T{b.zones[0].air_node}"].to_numpy(), index=times[1:])
+
+
+def test_scheduled_ventilation_steady_states(tmp_path):
+    """A zone of light adiabatic walls, 100 W and 100 m3/h of outdoor air at 0 C by night
+    (schedule 1) and a quarter of it by day: each half day ends at the steady state
+    T_air = Q / (s g), g = rho c V / 3600, with the switched conductance."""
+    b = night_and_day_zone()
+    b = b.edited(lambda d: d["zones"][0].update(internal_gain=100.0, ventilation=[
+        {"name": "vent", "flow": 100.0, "schedule": "night"}]))
+    air = night_and_day_air(b, tmp_path)
     g = 1.2 * 1005 * 100 / 3600
     assert air[pd.Timestamp("2017-03-02 17:45", tz="UTC")] == pytest.approx(100 / (0.25 * g), rel=1e-3)
     assert air[pd.Timestamp("2017-03-03 05:45", tz="UTC")] == pytest.approx(100 / g, rel=1e-3)
@@ -337,23 +347,12 @@ def test_gain_following_the_air_steady_states(tmp_path):
     s(t) (P + k (T_air - T_ref)) with P 300 W, k -6 W/K, T_ref 24 C, half of P radiant, s 1 by
     night and 0.25 by day: each half day ends at the steady state of
     0 = -g T + s (P + k (T - T_ref)), T = s (P - k T_ref) / (g - s k)."""
-    from nodeforce.iotools.weather import read_weather
-    from nodeforce.model.case import simulate_building
-    light = {"conductivity": 1.0, "density": 1.0, "specific_heat": 100.0}
-    b = minimal_building(
-        materials={"m": light},
-        schedules={"night": {"days": {"d": [[6, 1.0], [18, 0.25], [24, 1.0]]},
-                             "periods": [{"through": "12-31", "week": ["d"] * 7}]}})
+    b = night_and_day_zone()
     b = b.edited(lambda d: d["zones"][0].update(ventilation=[{"name": "vent", "flow": 100.0}], gains=[
         {"name": "people", "power": 300.0, "radiant_fraction": 0.5, "schedule": "night", "temperature_slope": -6.0,
          "reference_temperature": 24.0}]))
     assert b.switched == ("z's gain people",)
-    times = pd.date_range("2017-03-01", periods=3 * 24 * 4 + 1, freq="15min", tz="UTC")
-    path = tmp_path / "w.csv"
-    pd.DataFrame({"time": [t.isoformat() for t in times], "T_out": 0.0, "ghi": 0.0, "dni": 0.0,
-                  "dhi": 0.0}).to_csv(path, index=False)
-    T = simulate_building(b, read_weather(path))
-    air = pd.Series(T[f"T{b.zones[0].air_node}"].to_numpy(), index=times[1:])
+    air = night_and_day_air(b, tmp_path)
     g = 1.2 * 1005 * 100 / 3600
     steady = lambda s: s * (300.0 + 6.0 * 24.0) / (g + 6.0 * s)  # noqa: E731
     assert air[pd.Timestamp("2017-03-02 17:45", tz="UTC")] == pytest.approx(steady(0.25), rel=1e-3)
@@ -361,8 +360,7 @@ def test_gain_following_the_air_steady_states(tmp_path):
     # without a schedule the conductance is constant: no switched term, the same steady state
     constant = b.edited(lambda d: d["zones"][0]["gains"][0].pop("schedule"))
     assert not constant.switched and not assemble(constant).switched
-    T = simulate_building(constant, read_weather(path))
-    assert T[f"T{b.zones[0].air_node}"].iloc[-1] == pytest.approx(steady(1.0), rel=1e-3)
+    assert night_and_day_air(constant, tmp_path).iloc[-1] == pytest.approx(steady(1.0), rel=1e-3)
 
 
 @pytest.mark.parametrize("gain, expected", [
