@@ -514,6 +514,7 @@ class _Converter:
         self.r = reader
         self._days = _DaySchedules(reader.doc)
         self.materials = {}
+        self.constructions = {}  # CONSTRUCTION NAME -> (its name as first written, [component names])
         self.schedules = {}
         self.not_modelled = []
         self.notes = []
@@ -1022,6 +1023,10 @@ class _Converter:
                        "converter's constants (docs/guide.md, nodeforce convert); " + "; ".join(self.notes or ["no other assumption"]) + ".")
         data = {"format": "nodal-building/1", "name": names[0] if names else "", "description": description,
                 "site": site, "materials": self.materials, "zones": zone_data, "components": components}
+        built = {c["name"] for c in components}
+        constructions = {name: [c for c in names if c in built] for name, names in self.constructions.values()}
+        if any(constructions.values()):
+            data["constructions"] = {name: names for name, names in constructions.items() if names}
         if shading:
             data["shading"] = shading
         if self.schedules:
@@ -1540,6 +1545,7 @@ class _Converter:
                 self.r.fail(obj, "Vertex 1 X-coordinate", f"its windows and doors ({s['area'] - net:.3f} m2) fill all "
                                                           f"of its {s['area']:.3f} m2")
             comps.append(self.component(obj.name, net, s, layers, inner, outside, outer))
+            self.built_of(s["construction"], obj.name)
             lit = outside["type"] == "exterior" and s["sun"] and s["vertices"] is not None
             if lit:
                 comps[-1]["_polygon"] = (s["vertices"], [w["vertices"] for w in s["subsurfaces"]
@@ -1549,6 +1555,7 @@ class _Converter:
                 layers, outer, inner, glass = self.layers(w["construction"], w["obj"], "Construction Name", height)
                 w_outside = self.outside(s, boundary, outer, surfaces, done, subsurface=w)
                 c = self.component(w["obj"].name, w["area"], s, layers, inner, w_outside, outer)
+                self.built_of(w["construction"], c["name"])
                 # a window or door is its own class, not its wall's or roof's
                 for face in (c["inside"], c["outside"]):
                     if "face_class" in face:
@@ -1570,6 +1577,11 @@ class _Converter:
                     c["_polygon"] = (w["vertices"], [])
                 comps.append(c)
         return comps
+
+    def built_of(self, construction, component):
+        """Note that `component` is built of the IDF's Construction `construction` (the building
+        file's `constructions`, which the diagnosis's effects may target as one)."""
+        self.constructions.setdefault(construction.upper(), (construction, []))[1].append(component)
 
     def incident_solar_multiplier(self, window, c):
         """A SurfaceProperty:IncidentSolarMultiplier of an exterior window: EnergyPlus multiplies
@@ -1858,6 +1870,7 @@ class _Converter:
                 s = {"tilt": 90.0, "azimuth": 0.0, "zone": self.zone_objs[zone.upper()].name, "type": "internalmass"}
                 name = o.name if len(zones) == 1 else f"{o.name} {s['zone']}"
                 components.append(self.component(name, area, s, layers[::-1], inner, {"type": "adiabatic"}))
+                self.built_of(self.r.text(o, "construction_name"), name)
 
     def user_view_factors(self, zones, components, surfaces):
         """Every zone exchanges long-wave radiation by ScriptF, as EnergyPlus always does, with the

@@ -250,6 +250,7 @@ class Building:
     boundary_factors: dict = field(default_factory=dict)  # boundary column -> factor on its conductances
     schedules: dict = field(default_factory=dict)  # name -> Schedule
     shading: tuple = ()  # ShadingSurface records
+    constructions: dict = field(default_factory=dict)  # construction name -> names of the components built of it
     source: str = field(default="<building>", compare=False)
     data: dict = field(default_factory=dict, compare=False, repr=False)  # the JSON it was read from
     # what reads an edit again, (data, source=, edited_from=) -> Building: `building_file.parse_building`,

@@ -207,13 +207,15 @@ def parse_checked(data, source="<building>"):
     boundary_factors = _boundary_factors(check, data, zones, components)
     _check_node_ids(check, zones, components)
     zones = _number_added_nodes(zones, sum(len(c.node_ids) for c in components) + 2 * len(zones))
+    constructions = _constructions(check, data, components)
     flux_sensors = {name: (raw["component"], raw["face"]) for name, raw in raw_sensors.items()
                     if raw.get("quantity") == "heat_flux"}
     sensors = {name: _sensor_node(check, name, raw, zones, components) for name, raw in raw_sensors.items()
                if name not in flux_sensors}
     return Building(name=str(data.get("name", "")), site=site, zones=zones, components=components,
                     sensors=sensors, flux_sensors=flux_sensors, boundary_factors=boundary_factors,
-                    schedules=schedules, shading=_shading(check, data, components), source=source, data=json_copy(data),
+                    schedules=schedules, shading=_shading(check, data, components), constructions=constructions,
+                    source=source, data=json_copy(data),
                     reader=parse_building)
 
 
@@ -232,6 +234,21 @@ class _Checker:
             if v in seen:
                 self.fail(where, f"{what} {v!r} appears twice")
             seen.add(v)
+
+
+def _constructions(check, data, components):
+    """{construction: (component, ...)} of `constructions`: each names components of the file, a
+    component in one construction at most."""
+    names, owner = {c.name for c in components}, {}
+    for construction, members in data.get("constructions", {}).items():
+        for k, name in enumerate(members):
+            where = f"constructions.{construction}[{k}]"
+            if name not in names:
+                check.fail(where, f"names no component ({name!r})")
+            if name in owner:
+                check.fail(where, f"{name!r} is built of {owner[name]!r} already: a component has one construction")
+            owner[name] = construction
+    return {construction: tuple(members) for construction, members in data.get("constructions", {}).items()}
 
 
 def _increasing(values):
