@@ -5,7 +5,7 @@ parameter declared absent starts); how many components are tried is the policy's
 """
 import math
 
-from nodeforce.model.effects import EFFECTS, bridge_parts, bridge_target
+from nodeforce.model.effects import EFFECTS, bridge_parts, bridge_target, member_table
 
 # How far inside its range (a fraction of it) a calibration starts a value declared on a bound.
 INSIDE = 1e-3
@@ -62,13 +62,14 @@ def zone_effects(building, name):
 
 def component_effects(building, name):
     """The effects of one component: those whose target it is (a ground coupling under an
-    adiabatic face, its outside absorptance, its conductivity, a glazing's transmittance), and
-    a glazing's transmittance where the component receives its sun; no shape (`Effect.shape`)."""
-    nodes = set(building.component(name).node_ids)
-    components = {c.name for c in building.components}
+    adiabatic face, its outside absorptance, its conductivity, a glazing's transmittance), or a
+    group it is a member of (its construction, a material of it: `model.effects.members`), and a
+    glazing's or a glazings' group's transmittance where the component receives its sun; no
+    shape (`Effect.shape`). A group is a target of its own, its nodes its members' together."""
+    nodes, table = set(building.component(name).node_ids), member_table(building)
     return [(effect.id, target) for effect in EFFECTS.values() if not effect.shape
-            for target in effect.targets(building) if target in components
-            and (target == name or nodes & set(effect.points_at(building, target)))]
+            for target in effect.targets(building) for group in [table.get(target, ())] if group
+            and (name in group or nodes & set(effect.points_at(building, target)))]
 
 
 def calibration_start(building, effect, target):

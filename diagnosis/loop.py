@@ -70,7 +70,7 @@ from nodeforce.diagnosis.windows import Beside, Record, Windows, period
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.iotools.energyplus_corrections import idf_of, write_corrections
 from nodeforce.ga.locate import Execution, SearchSettings, check_measured, evaluator_kind, locate
-from nodeforce.model.effects import EFFECTS
+from nodeforce.model.effects import EFFECTS, members
 from nodeforce.model.errors import InputError
 from nodeforce.model.score import Noise
 
@@ -161,10 +161,12 @@ def fits_of(model, base, pairs, assessed, windows, inputs, number=1, on_top_of=(
 
 
 def own_sensors(building, component, windows, base, sensed):
-    """`OwnSensors` of a candidate on `component`: its own sensors' J (C2) per block under the
-    model (its other sensed nodes `base`) and under the candidate (`sensed`), unweighted, and
-    the file's numerical error there (`Windows.own_numerical`)."""
-    columns = windows.own_columns(set(building.component(component).node_ids))
+    """`OwnSensors` of a candidate on `component` (or a group of them, `model.effects.members`):
+    its own sensors' J (C2) per block under the model (its other sensed nodes `base`) and under
+    the candidate (`sensed`), unweighted, and the file's numerical error there
+    (`Windows.own_numerical`)."""
+    nodes = {i for name in members(building, component) for i in building.component(name).node_ids}
+    columns = windows.own_columns(nodes)
     before, n = windows.own_J(base, columns)
     after, _ = windows.own_J(sensed, columns)
     return OwnSensors([float(v) for v in before], [float(v) for v in after], n, windows.own_numerical(columns))

@@ -11,7 +11,7 @@ from dataclasses import asdict, dataclass, fields
 import numpy as np
 
 from nodeforce.diagnosis.estimate import ParameterEstimate
-from nodeforce.model.effects import EFFECTS
+from nodeforce.model.effects import EFFECTS, members
 from nodeforce.model.score import Yardstick
 
 
@@ -159,15 +159,16 @@ class Policy:
         fix where its parameters trade off (`Effect.trade_off`: [derived quantity, whether a
         bound is then waived], None), why the file's description makes the effect implausible
         (`Effect.implausible`, None), whether its target is one
-        component and whether one of that component's nodes is among the `sensed` node ids, the
-        other sensors the evidence reads (`claim`)."""
-        component = target in {c.name for c in building.components}
+        component or a group of them (`model.effects.members`) and whether one of their nodes is
+        among the `sensed` node ids, the other sensors the evidence reads (`claim`)."""
+        names = members(building, target)
+        component = bool(names)
         return {"limits": {name: [None if math.isinf(v) else v for v in self.limits(building, effect, target, name)]
                            for name in self.judged_parameters(effect)},
                 "trade_off": list(EFFECTS[effect].trade_off) if EFFECTS[effect].trade_off else None,
                 "implausible": implausible(building, effect, target),
                 "component": component,
-                "sensed": component and bool(set(building.component(target).node_ids) & set(sensed))}
+                "sensed": component and any(set(building.component(n).node_ids) & set(sensed) for n in names)}
 
     def objection(self, building, effect, target, parameters, derived=None):
         """`objection_of` the candidate's `facts` in `building`."""

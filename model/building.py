@@ -26,9 +26,11 @@ DAY_TERMS = tuple(f"{f}{h}" for h in range(1, DAY_HARMONICS + 1) for f in ("cos"
 
 @dataclass(frozen=True)
 class Material:
-    conductivity: float  # W/m/K
+    conductivity: float  # W/m/K, as it conducts: the declared one times its conductivity_factor
     density: float  # kg/m3
     specific_heat: float  # J/kg/K
+    name: str = field(default="", compare=False)  # its key in the file's table of materials
+    conductivity_factor: float = 1.0  # -, the conductivity it has over the declared one
 
 
 @dataclass(frozen=True)

@@ -13,8 +13,12 @@ into an EnergyPlus model (`iotools.energyplus_corrections`). Adding an effect is
 (and its fields in the building file format, if it needs new ones). How many candidates a round
 tries and the thresholds of the choice are the diagnosis' policy (`nodeforce.diagnosis.policy`).
 
-A `thermal_bridge` target is a zone name for a bridge to the outdoor air, or `<zone>-><column>`
-for a bridge to a boundary temperature column (attic, cellar, neighbour); a `proportional_gain`
+A surface effect (`conductivity`, `solar_absorptance`, `solar_transmittance`) targets a
+component, or where the building file declares its `constructions`, `construction:<name>` (every
+component built of it) or, for `conductivity`, `material:<name>` (every layer of it in every
+component): one parameter for all its members (`members`). A `thermal_bridge` target is a zone
+name for a bridge to the outdoor air, or `<zone>-><column>` for a bridge to a boundary
+temperature column (attic, cellar, neighbour); a `proportional_gain`
 target is `<zone>-><column>`, the column a heat input or a face's irradiance the building reads;
 a `boundary_conductance` target is a boundary temperature column; an `interzone_air_exchange`
 target is `<zone>|<zone>`, the two zones in the building file's order.
@@ -135,6 +139,77 @@ class Effect:
         return {name: absent[name] if value == 0.0 and name in absent else value for name, value in values.items()}
 
 
+CONSTRUCTION, MATERIAL = "construction:", "material:"
+
+
+def construction_groups(building):
+    """{`construction:<name>`: component names} of the file's constructions of two or more
+    components: a construction of one is its component's own target."""
+    return {CONSTRUCTION + name: names for name, names in building.constructions.items() if len(names) >= 2}
+
+
+def material_groups(building):
+    """{`material:<name>`: names of the components with a layer of it} of each material two or
+    more components are made of, where the file declares its constructions (a modeller's file
+    names its materials as its constructions do). Not a material that alone makes up exactly the
+    components of a construction: scaling it is scaling the construction, offered once."""
+    if not building.constructions:
+        return {}
+    made_of = {}
+    for c in building.components:
+        for material, _ in c.layers:
+            made_of.setdefault(material.name, []).append(c.name)
+    whole = {frozenset(names) for names in construction_groups(building).values()}
+    alone = {names for names in whole
+             if len({m.name for n in names for m, _ in building.component(n).layers}) == 1}
+    return {MATERIAL + name: tuple(dict.fromkeys(names)) for name, names in made_of.items()
+            if len(set(names)) >= 2 and frozenset(names) not in alone}
+
+
+def member_table(building):
+    """{target: `members`} of every component and group target of a building."""
+    return {**{c.name: (c.name,) for c in building.components}, **construction_groups(building),
+            **material_groups(building)}
+
+
+def members(building, target):
+    """Names of the components an effect on `target` acts on: the component itself, or every
+    component of a construction or material group; () for a target of another kind (a zone, an
+    input column)."""
+    if target.startswith((CONSTRUCTION, MATERIAL)):
+        return member_table(building).get(target, ())
+    return (target,) if any(c.name == target for c in building.components) else ()
+
+
+def _surface_targets(building, applies, materials=False):
+    """The components `applies` (Component -> bool) to, then the construction groups all of
+    whose members it applies to, then (`materials`) the material groups."""
+    names = [c.name for c in building.components if applies(c)]
+    ok = set(names)
+    groups = [t for t, group in construction_groups(building).items() if ok.issuperset(group)]
+    return names + groups + (list(material_groups(building)) if materials else [])
+
+
+def _members_write(write):
+    """`write` of a component field, to every member of a construction target too."""
+    def written(data, target, values):
+        for name in members_of_data(data, target):
+            write(data, name, values)
+    return written
+
+
+def members_of_data(data, target):
+    """`members` of a construction or component target, read from the building file's JSON."""
+    if target.startswith(CONSTRUCTION):
+        return data["constructions"][target[len(CONSTRUCTION):]]
+    return (target,)
+
+
+def _first(read):
+    """`read` of a component field, of a group its first member's: one parameter for all."""
+    return lambda building, target: read(building, members(building, target)[0])
+
+
 def _component(data, name):
     return next(c for c in data["components"] if c["name"] == name)
 
@@ -163,7 +238,7 @@ def _heated(building):
 
 
 def _own_nodes(building, target):
-    return building.component(target).node_ids
+    return tuple(i for name in members(building, target) for i in building.component(name).node_ids)
 
 
 def _no_node(building, target):
@@ -220,20 +295,39 @@ def _ground_priors(building, target, outdoor_air, annual_air=None):
     return {"T_ground": deep_ground_temperature(building, outdoor_air, annual_air)}
 
 
+@_members_write
 def _absorptance_write(data, target, values):
     _component(data, target)["outside"]["solar_absorptance"] = float(values["alpha"])
 
 
-def _conductivity_write(data, target, values):
+def _conductivity_read(building, target):
+    if target.startswith(MATERIAL):
+        name = target[len(MATERIAL):]
+        return {"factor": next(m.conductivity_factor for c in building.components for m, _ in c.layers
+                               if m.name == name)}
+    return {"factor": building.component(members(building, target)[0]).conductivity_factor}
+
+
+@_members_write
+def _component_conductivity_write(data, target, values):
     _component(data, target)["conductivity_factor"] = float(values["factor"])
 
 
+def _conductivity_write(data, target, values):
+    if target.startswith(MATERIAL):
+        data["materials"][target[len(MATERIAL):]]["conductivity_factor"] = float(values["factor"])
+    else:
+        _component_conductivity_write(data, target, values)
+
+
+@_members_write
 def _transmittance_write(data, target, values):
     _component(data, target)["solar_transmittance"] = float(values["tau"])
 
 
 def _receiver_nodes(building, target):
-    return tuple(i for name in building.component(target).sun_receivers for i in building.component(name).node_ids)
+    receivers = dict.fromkeys(r for name in members(building, target) for r in building.component(name).sun_receivers)
+    return tuple(i for name in receivers for i in building.component(name).node_ids)
 
 
 # thermal bridge: a conductance UA from a zone's air to the outdoor air or a boundary column
@@ -564,12 +658,12 @@ EFFECTS = {e.id: e for e in (
            energyplus=lambda w, t: w.internal_gain(t)),
     Effect("solar_absorptance", "a corrected outside solar absorptance",
            (Parameter("alpha", "-", 0.0, 1.0),),
-           lambda b: [c.name for c in b.exterior_components],
-           lambda b, t: {"alpha": b.component(t).outside.solar_absorptance}, _absorptance_write, _own_nodes,
+           lambda b: _surface_targets(b, lambda c: isinstance(c.outside, Exterior)),
+           _first(lambda b, t: {"alpha": b.component(t).outside.solar_absorptance}), _absorptance_write, _own_nodes,
            on_inputs=True, energyplus=lambda w, t: w.solar_absorptance(t)),
     Effect("conductivity", "a scale on a component's conductances",
-           (Parameter("factor", "-", 0.05, 20.0),), lambda b: [c.name for c in b.components],
-           lambda b, t: {"factor": b.component(t).conductivity_factor}, _conductivity_write, _own_nodes,
+           (Parameter("factor", "-", 0.05, 20.0),), lambda b: _surface_targets(b, lambda c: True, materials=True),
+           _conductivity_read, _conductivity_write, _own_nodes,
            physical=_fixed_limits(factor=SCALE_LIMITS), derived=_component_loss, trade_off=("component_loss", False),
            energyplus=lambda w, t: w.conductivity(t)),
     Effect("inside_convection", "a scale on the inside convective coefficients",
@@ -578,8 +672,8 @@ EFFECTS = {e.id: e for e in (
            offers=_offered(_zones), physical=_convection_limits),
     Effect("solar_transmittance", "a corrected transmittance of a glazing",
            (Parameter("tau", "-", 0.0, 1.0),),
-           lambda b: [c.name for c in b.components if c.solar_transmittance is not None],
-           lambda b, t: {"tau": b.component(t).solar_transmittance}, _transmittance_write, _receiver_nodes,
+           lambda b: _surface_targets(b, lambda c: c.solar_transmittance is not None),
+           _first(lambda b, t: {"tau": b.component(t).solar_transmittance}), _transmittance_write, _receiver_nodes,
            on_inputs=True, energyplus=lambda w, t: w.solar_transmittance(t)),
     Effect("thermal_bridge", "a conductance from a zone's air to the outdoor air or a boundary temperature",
            (Parameter("UA", "W/K", 0.0, 200.0),), _bridge_targets, _bridge_read, _bridge_write, _no_node,
