@@ -8,7 +8,7 @@ from pathlib import Path
 from scipy.optimize import brentq
 
 from ..model import glazing
-from ..model.effects import EFFECTS
+from ..model.effects import CONSTRUCTION, EFFECTS, MATERIAL, members
 from .energyplus import FILMS, SCHEMA_MIN, _field
 
 ALWAYS_ON = "nodeforce always on"
@@ -127,13 +127,11 @@ class _Writer:
     def _own_construction(self, surface, layers):
         """A new Construction of `layers` for this surface alone, named after it."""
         name = f"{_field(surface, 'construction_name')} for {surface.name} (nodeforce)"
-        fields = {"outside_layer": layers[0], **{f"layer_{k}": n for k, n in enumerate(layers[1:], start=2)}}
-        self._add("Construction", name, fields)
+        self._add("Construction", name, _layer_fields(layers))
         self._set(surface, "construction_name", name)
 
-    def _layers(self, surface):
-        c = self._get(("Construction",), _field(surface, "construction_name"))
-        return [v for k, v in c.to_dict().items() if k != "name" and v not in (None, "")]
+    def _layers(self, construction):
+        return [v for k, v in construction.to_dict().items() if k != "name" and v not in (None, "")]
 
     def _material(self, name):
         return self._get(("Material", "Material:NoMass", "Material:AirGap", "WindowMaterial:Glazing",
@@ -146,54 +144,96 @@ class _Writer:
         self._add(obj.obj_type, name, fields)
         return name
 
-    def conductivity(self, component):
-        surface = self._surface(component)
-        factor = self.after.component(component).conductivity_factor
-        if surface is None or str(_field(surface, "outside_boundary_condition") or "").lower() in ("surface", "zone"):
-            self.not_written.append(f"conductivity on {component}: a partition's construction is its pair's too; "
+    def _relayer(self, target, change):
+        """Give `target`'s construction the layers `change(layers)` returns (its material names,
+        outside first; None: nothing written): a `construction:` target's Construction object
+        itself, every surface built of it with it, as the modeller would; a component's surface
+        a Construction of its own, the others of its construction left as they are."""
+        if target.startswith(CONSTRUCTION):
+            construction = self._get(("Construction",), target[len(CONSTRUCTION):])
+            layers = change(self._layers(construction))
+            if layers is not None:
+                for field, value in _layer_fields(layers).items():
+                    if _field(construction, field) != value:
+                        self._set(construction, field, value)
+            return
+        surface = self._surface(target)
+        layers = change(self._layers(self._get(("Construction",), _field(surface, "construction_name"))))
+        if layers is not None:
+            self._own_construction(surface, layers)
+
+    def _partition(self, target):
+        """Whether a component of `target` is a partition, whose construction is its pair's too."""
+        surfaces = [self._surface(name) for name in members(self.before, target)]
+        return any(s is None or str(_field(s, "outside_boundary_condition") or "").lower() in ("surface", "zone")
+                   for s in surfaces)
+
+    def conductivity(self, target):
+        factor = EFFECTS["conductivity"].read(self.after, target)["factor"]
+        if target.startswith(MATERIAL):
+            m = self._material(target[len(MATERIAL):])
+            if m is not None and m.obj_type.upper() == "MATERIAL":
+                self._set(m, "conductivity", float(m.conductivity) * factor)
+            elif m is not None and m.obj_type.upper() in ("MATERIAL:NOMASS", "MATERIAL:AIRGAP"):
+                self._set(m, "thermal_resistance", float(m.thermal_resistance) / factor)
+            else:
+                self.not_written.append(f"conductivity on {target}: no opaque Material of that name; the factor "
+                                        f"{factor:.4g} is in the corrected building file")
+            return
+        if self._partition(target):
+            self.not_written.append(f"conductivity on {target}: a partition's construction is its pair's too; "
                                     f"the factor {factor:.4g} is in the corrected building file")
             return
-        layers = []
-        for name in self._layers(surface):
-            m = self._material(name)
-            kind = m.obj_type.upper()
-            if kind == "MATERIAL":
-                layers.append(self._copy(m, f"x{factor:.4g}", {"conductivity": float(m.conductivity) * factor}))
-            elif kind in ("MATERIAL:NOMASS", "MATERIAL:AIRGAP"):
-                layers.append(self._copy(m, f"x{factor:.4g}", {"thermal_resistance": float(m.thermal_resistance) / factor}))
-            else:
-                self.not_written.append(f"conductivity on {component}: a window's layers are not scaled; the "
-                                        f"factor {factor:.4g} is in the corrected building file")
-                return
-        self._own_construction(surface, layers)
 
-    def solar_absorptance(self, component):
-        surface = self._surface(component)
-        alpha = self.after.component(component).outside.solar_absorptance
-        layers = self._layers(surface)
-        outer = self._material(layers[0])
-        if outer.obj_type.upper() not in ("MATERIAL", "MATERIAL:NOMASS"):
-            self.not_written.append(f"solar_absorptance on {component}: its outer layer {outer.name} has none")
-            return
-        layers[0] = self._copy(outer, f"alpha {alpha:.4g}", {"solar_absorptance": alpha})
-        self._own_construction(surface, layers)
+        def scaled(names):
+            layers = []
+            for name in names:
+                m = self._material(name)
+                kind = m.obj_type.upper()
+                if kind == "MATERIAL":
+                    layers.append(self._copy(m, f"x{factor:.4g}", {"conductivity": float(m.conductivity) * factor}))
+                elif kind in ("MATERIAL:NOMASS", "MATERIAL:AIRGAP"):
+                    layers.append(self._copy(m, f"x{factor:.4g}",
+                                             {"thermal_resistance": float(m.thermal_resistance) / factor}))
+                else:
+                    self.not_written.append(f"conductivity on {target}: a window's layers are not scaled; the "
+                                            f"factor {factor:.4g} is in the corrected building file")
+                    return None
+            return layers
+        self._relayer(target, scaled)
 
-    def solar_transmittance(self, component):
-        surface = self._surface(component)
-        tau = self.after.component(component).solar_transmittance
-        layers = self._layers(surface)
-        objs = [self._material(n) for n in layers]
-        kinds = [o.obj_type.upper() for o in objs]
-        if kinds == ["WINDOWMATERIAL:SIMPLEGLAZINGSYSTEM"]:
-            U = float(objs[0].u_factor)
-            shgc = brentq(lambda s: glazing.simple_glazing_transmittance(U, s) - tau, 1e-4, 1.0)
-            layers[0] = self._copy(objs[0], f"tau {tau:.4g}", {"solar_heat_gain_coefficient": shgc})
-        else:
+    def solar_absorptance(self, target):
+        alpha = EFFECTS["solar_absorptance"].read(self.after, target)["alpha"]
+
+        def absorbing(layers):
+            outer = self._material(layers[0])
+            if outer.obj_type.upper() not in ("MATERIAL", "MATERIAL:NOMASS"):
+                self.not_written.append(f"solar_absorptance on {target}: its outer layer {outer.name} has none")
+                return None
+            return [self._copy(outer, f"alpha {alpha:.4g}", {"solar_absorptance": alpha}), *layers[1:]]
+        self._relayer(target, absorbing)
+
+    def solar_transmittance(self, target):
+        tau = EFFECTS["solar_transmittance"].read(self.after, target)["tau"]
+
+        def transmitting(layers):
+            objs = [self._material(n) for n in layers]
+            kinds = [o.obj_type.upper() for o in objs]
+            if kinds == ["WINDOWMATERIAL:SIMPLEGLAZINGSYSTEM"]:
+                U = float(objs[0].u_factor)
+                shgc = brentq(lambda s: glazing.simple_glazing_transmittance(U, s) - tau, 1e-4, 1.0)
+                return [self._copy(objs[0], f"tau {tau:.4g}", {"solar_heat_gain_coefficient": shgc})]
             panes = [(float(o.solar_transmittance_at_normal_incidence),
                       float(o.front_side_solar_reflectance_at_normal_incidence))
                      for o in objs if o.obj_type.upper() == "WINDOWMATERIAL:GLAZING"]
             R0 = panes[0][1]
             top = 1.0 - R0 - 1e-6
             T0 = brentq(lambda t: float(glazing.stack_transmittance([(t, R0)] + panes[1:], 0.0)) - tau, 1e-4, top)
-            layers[0] = self._copy(objs[0], f"tau {tau:.4g}", {"solar_transmittance_at_normal_incidence": T0})
-        self._own_construction(surface, layers)
+            return [self._copy(objs[0], f"tau {tau:.4g}", {"solar_transmittance_at_normal_incidence": T0}),
+                    *layers[1:]]
+        self._relayer(target, transmitting)
+
+
+def _layer_fields(layers):
+    """The layer fields of a Construction of `layers` (material names, outside first)."""
+    return {"outside_layer": layers[0], **{f"layer_{k}": n for k, n in enumerate(layers[1:], start=2)}}

@@ -1,6 +1,7 @@
 """Effects on a construction or a material shared by several surfaces: the building file's
 `constructions` group its components, a surface effect may target a group with one parameter for
-all its members, and the diagnosis offers the groups."""
+all its members, the diagnosis offers the groups, and the write-back edits the Construction or
+Material object itself."""
 import copy
 from pathlib import Path
 
@@ -123,6 +124,37 @@ def test_the_converter_groups_the_surfaces_as_the_idfs_constructions(tmp_path):
     assert sorted(b.constructions["LIGHT WALL"]) == ["EAST WALL", "NORTH WALL", "SOUTH WALL", "WEST WALL"]
     assert sorted(b.constructions["DOUBLE CLEAR"]) == ["SOUTH WINDOW EAST", "SOUTH WINDOW WEST"]
     assert "material:WALL FIBERGLASS QUILT" in EFFECTS["conductivity"].targets(b)
+
+
+def test_a_group_is_written_back_into_its_construction_or_material(tmp_path):
+    import idfkit
+    from nodeforce.iotools.energyplus_corrections import write_corrections
+    before = convert_idf(CASE600, tmp_path / "600.json")
+    effects = [("conductivity", "material:WALL FIBERGLASS QUILT", {"factor": 2.0}),
+               ("solar_transmittance", "construction:DOUBLE CLEAR", {"tau": 0.6})]
+    after = before
+    for effect, target, values in effects:
+        after = EFFECTS[effect].apply(after, target, values)
+    out = tmp_path / "model_after.idf"
+    result = write_corrections(before, after, [(e, t) for e, t, _ in effects], CASE600, out)
+    assert result["not_written"] == []
+    doc = idfkit.load_idf(str(out))
+    # the Material itself conducts twice as much (Case 600's 0.040 W/m/K), the walls still built of it
+    assert float(doc.getobject("MATERIAL", "WALL FIBERGLASS QUILT").conductivity) == pytest.approx(2 * 0.040)
+    assert {doc.getobject("BUILDINGSURFACE:DETAILED", w).construction_name
+            for w in ("EAST WALL", "WEST WALL", "NORTH WALL", "SOUTH WALL")} == {"LIGHT WALL"}
+    # the Construction itself has the new glass; both windows are still of it
+    assert {doc.getobject("FENESTRATIONSURFACE:DETAILED", w).construction_name
+            for w in ("SOUTH WINDOW EAST", "SOUTH WINDOW WEST")} == {"DOUBLE CLEAR"}
+    assert [c["object"] for c in result["changes"] if c["field"] != "(new object)"] == ["Material", "Construction"]
+    again = convert_idf(out)
+    for w in ("SOUTH WINDOW EAST", "SOUTH WINDOW WEST"):
+        assert again.component(w).solar_transmittance == pytest.approx(0.6, abs=1e-5)
+    R, R0 = (sum(t / m.conductivity for m, t in c.layers) for c in (again.component("EAST WALL"),
+                                                                        before.component("EAST WALL")))
+    quilt = next(t / m.conductivity for m, t in before.component("EAST WALL").layers
+                 if m.name == "WALL FIBERGLASS QUILT")
+    assert R == pytest.approx(R0 - quilt / 2)
 
 
 @pytest.mark.slow
