@@ -193,12 +193,12 @@ def _surface_targets(building, applies, materials=False):
 def _members_write(write):
     """`write` of a component field, to every member of a construction target too."""
     def written(data, target, values):
-        for name in members_of_data(data, target):
+        for name in _members_of_data(data, target):
             write(data, name, values)
     return written
 
 
-def members_of_data(data, target):
+def _members_of_data(data, target):
     """`members` of a construction or component target, read from the building file's JSON."""
     if target.startswith(CONSTRUCTION):
         return data["constructions"][target[len(CONSTRUCTION):]]
