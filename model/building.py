@@ -131,6 +131,25 @@ class AngularTransmittance:
 
 
 @dataclass(frozen=True)
+class WindowGap:
+    """A window's gas gap (docs/model.md section 4.1): the index of its layer among the component's
+    (from 0 at the inside face), the emissivities of the two panes' faces across it and its gas
+    as `model.glazing.gas_properties` reads it."""
+    layer: int
+    emissivities: tuple  # (-, -)
+    gas: object
+
+
+@dataclass(frozen=True)
+class Window:
+    """A component solved as EnergyPlus solves a window's panes (docs/model.md section 4.1): its
+    gaps' conductances follow the panes' temperatures, and its inside face takes ISO 15099's
+    convection where its zone's inside algorithm is TARP. height in m."""
+    height: float
+    gaps: tuple = ()  # WindowGap, ...
+
+
+@dataclass(frozen=True)
 class ShadingSurface:
     """An opaque polygon ((x, y, z) m) that shades the exterior faces it names (docs/model.md 4.2)."""
     name: str
@@ -192,6 +211,7 @@ class Component:
     vertices: tuple | None = None  # the outside face's polygon ((x, y, z) m, counterclockwise from outside)
     holes: tuple = ()  # polygons cut out of it (its windows), m
     diffuse_distribution: tuple = ()  # (component, fraction) of the transmitted diffuse sun; () as the direct
+    window: Window | None = None  # its panes' gaps and inside face as EnergyPlus's window heat balance
 
     @property
     def receivers(self):
@@ -295,7 +315,8 @@ class Building:
                 + tuple((f"component {c.name}", "outside.convection") for c in self.exterior_components
                         if c.outside.convection is not None)
                 + tuple((f"component {c.name}", "outside.longwave") for c in self.exterior_components
-                        if c.outside.longwave_emissivity is not None))
+                        if c.outside.longwave_emissivity is not None)
+                + tuple((f"component {c.name}", "window") for c in self.components if c.window is not None))
 
     @property
     def input_columns(self):

@@ -23,10 +23,11 @@ import numpy as np
 
 from .building import (DAY_TERMS, Adiabatic, AngularTransmittance, Boundary, Building, Component, Exterior, Gain,
                        Inflow, Lumped, Material, OutsideConvection, ShadingSurface, Supply, Surface, Ventilation,
-                       Zone, boundary_columns, json_copy)
+                       Window, WindowGap, Zone, boundary_columns, json_copy)
 from . import geometry
 from .discretise import generated_depths
 from .errors import InputError
+from .glazing import GASES
 from .schedule import WEEKDAYS, Schedule
 
 # Depths are given in metres with a few decimals; a node "at" the outside face may be
@@ -520,7 +521,47 @@ def _component(check, c, where, materials, zone_names, sensor_depths):
                                             schema_default("component", "inner_solar_absorptance"))),
         vertices=_face_polygon(check, c, where),
         holes=tuple(_polygon(h) for h in c.get("holes", ())),
+        window=_window(check, c, where, layers, depths),
     )
+
+
+def gap_nodes(layers, depths, layer):
+    """(i, i + 1): the positions among a component's node depths of the two faces of its layer
+    `layer` (from 0 at the inside face), or None where a node lies within the layer or none on a
+    face (the gap's conductance is then no single link between two panes)."""
+    bounds = np.concatenate([[0.0], np.cumsum([t for _, t in layers])])
+    depths = np.asarray(depths, dtype=float)
+    at = [np.flatnonzero(np.abs(depths - bounds[k]) <= DEPTH_TOLERANCE) for k in (layer, layer + 1)]
+    if any(len(a) != 1 for a in at) or at[1][0] != at[0][0] + 1:
+        return None
+    return int(at[0][0]), int(at[1][0])
+
+
+def _window(check, c, where, layers, depths):
+    """A component's `window` (docs/model.md section 4.1): each gap a gas layer between two
+    panes, with a node on each of its faces and none within."""
+    raw = c.get("window")
+    if raw is None:
+        return None
+    gaps = []
+    for j, g in enumerate(raw.get("gaps", ())):
+        gw = f"{where}.window.gaps[{j}]"
+        layer = int(g["layer"])
+        if not 0 < layer < len(layers) - 1:
+            check.fail(f"{gw}.layer", f"{layer} is no layer between two others (0 to {len(layers) - 1})")
+        if gap_nodes(layers, depths, layer) is None:
+            check.fail(f"{gw}.layer", f"layer {layer} needs a node on each of its faces and none within")
+        gas = g.get("gas", "air")
+        if isinstance(gas, dict):
+            gas = tuple(tuple(float(x) for x in gas[p]) for p in ("conductivity", "viscosity", "specific_heat")) + (
+                float(gas["molecular_weight"]),)
+        elif isinstance(gas, list):
+            for name, _ in gas:
+                if name not in GASES:
+                    check.fail(f"{gw}.gas", f"{name!r} is none of {', '.join(GASES)}")
+            gas = [(name, float(x)) for name, x in gas]
+        gaps.append(WindowGap(layer=layer, emissivities=tuple(float(e) for e in g["emissivities"]), gas=gas))
+    return Window(height=float(raw["height"]), gaps=tuple(gaps))
 
 
 # How far (deg) a face's vertices may turn from its declared tilt and azimuth: a converter's are

@@ -109,6 +109,45 @@ def tarp_inside_faces(delta_T, cos_up):
     return np.maximum(tarp_natural(delta_T, cos_up), INSIDE_FLOOR)
 
 
+def iso15099_inside(delta_T, T_air, height, tilt, pressure=101325.0):
+    """ISO 15099's inside convection (W/m2/K) of window faces, as EnergyPlus takes a window's where
+    its zone's inside algorithm is TARP (ConvectionCoefficients.cc, CalcISO15099WindowIntConvCoeff;
+    ISO 15099 section 8.3.2.2): h = Nu lambda / H at delta_T = T_s - T_air (K), the zone air at
+    T_air (C), the window `height` H (m) and `tilt` (deg, its outside's: 90 vertical). The air's
+    properties are taken at the film's T_f = T_air + dT / 4 (K): lambda = 2.873e-3 + 7.76e-5 T_f
+    W/m/K, mu = 3.723e-6 + 4.94e-8 T_f kg/m/s (ISO 15099 Tables B.1, B.2), c_p = 1004.84 J/kg/K
+    and rho = p / (287.05 T_f) kg/m3, dry air at the site's `pressure` p (Pa), as EnergyPlus
+    takes its site's (it adds the zone's humidity, which moves h by some 0.1 %). With
+    Ra = rho^2 H^3 g c_p |dT| / (T_f mu lambda) and theta the tilt, 180 - tilt where the face is
+    warmer than the air (the heat then leaves it looking the other way):
+
+        Nu = 0.13 Ra^(1/3)                                     theta < 15
+        Nu = 0.56 (Ra sin tilt)^(1/4)                          15 <= theta <= 90, Ra <= Ra_cv
+        Nu = 0.13 (Ra^(1/3) - Ra_cv^(1/3)) + 0.56 (Ra_cv sin tilt)^(1/4)   above it,
+             Ra_cv = 2.5e5 (exp(0.72 theta) / sin tilt)^(1/5)
+        Nu = 0.56 (Ra sin tilt)^(1/4), Ra sin tilt held within 1e5 .. 1e11   90 < theta <= 179
+        Nu = 0.58 min(Ra, 1e11)^(1/5)                          theta > 179
+
+    at least `INSIDE_FLOOR`. A vertical window is 0.56 Ra^(1/4) both ways."""
+    delta_T, T_air = np.asarray(delta_T, dtype=float), np.asarray(T_air, dtype=float)
+    tilt = np.asarray(tilt, dtype=float)
+    T_f = T_air + 273.15 + 0.25 * delta_T  # K
+    conductivity, viscosity = 2.873e-3 + 7.76e-5 * T_f, 3.723e-6 + 4.94e-8 * T_f
+    rho = pressure / (287.05 * T_f)
+    ra = rho ** 2 * height ** 3 * 9.81 * 1004.84 * np.abs(delta_T) / (T_f * viscosity * conductivity)
+    theta = np.where(delta_T > 0.0, 180.0 - tilt, tilt)
+    sine = np.maximum(np.sin(np.radians(tilt)), 1e-9)  # a horizontal window reads cases a and d alone
+    with np.errstate(over="ignore"):
+        ra_cv = 2.5e5 * (np.exp(0.72 * np.minimum(theta, 90.0)) / sine) ** 0.2
+    tilted = np.where(ra <= ra_cv, 0.56 * (ra * sine) ** 0.25,
+                      0.13 * (np.cbrt(ra) - np.cbrt(ra_cv)) + 0.56 * (ra_cv * sine) ** 0.25)
+    nu = np.where(theta < 15.0, 0.13 * np.cbrt(ra),
+                  np.where(theta <= 90.0, tilted,
+                           np.where(theta <= 179.0, 0.56 * np.clip(ra * sine, 1e5, 1e11) ** 0.25,
+                                    0.58 * np.minimum(ra, 1e11) ** 0.2)))
+    return np.maximum(nu * conductivity / height, INSIDE_FLOOR)
+
+
 def windward_faces(cos_up, azimuth, direction):
     """Whether faces (their normal's cos_up with the vertical, azimuth deg from north) are
     windward of a wind from `direction` (deg from north): as EnergyPlus takes it, a face within

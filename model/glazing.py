@@ -171,24 +171,54 @@ def gas_properties(gas, T):
     return value(k), value(mu), value(cp), M
 
 
-def gap_conductance(thickness, height, emissivity_1, emissivity_2, T_mean=GAP_T_MEAN, delta_T=GAP_DELTA_T,
-                    gas="air"):
-    """Conductance (W/m2/K) of a gas gap (`gas` as `gas_properties` reads it, air unless given) of
-    `thickness` m between two panes `height` m high: conduction and convection, Nu k / d with ISO
-    15099's Nusselt number of a vertical cavity at the Rayleigh number of (T_mean K, delta_T K),
-    plus the radiative exchange of its two faces."""
+def gap_convection(thickness, height, T_mean=GAP_T_MEAN, delta_T=GAP_DELTA_T, gas="air"):
+    """Conduction and convection (W/m2/K) across a gas gap (`gas` as `gas_properties` reads it) of
+    `thickness` m between two panes `height` m high, Nu k / d: ISO 15099's Nusselt number of a
+    vertical cavity, the larger of its Nu_1(Ra) and Nu_2 = 0.242 (Ra / (H / d))^0.272, at the
+    Rayleigh number Ra = rho^2 d^3 g c_p dT / (mu k T_m) of a mean temperature T_mean (K) and a
+    difference delta_T (K) across the gap, the gas's properties at T_mean and its density at
+    101325 Pa (EnergyPlus's WindowManager.cc, NusseltNumber). Arrays of gaps alike."""
     k, mu, cp, M = gas_properties(gas, T_mean)  # W/m/K, Pa s, J/kg/K, g/mol
     rho = 101325 * M / 1000 / (8.314462 * T_mean)  # kg/m3
-    ra = rho ** 2 * thickness ** 3 * 9.81 * cp * delta_T / (mu * k * T_mean)
+    ra = rho ** 2 * thickness ** 3 * 9.81 * cp * np.abs(delta_T) / (mu * k * T_mean)
     aspect = height / thickness
-    if ra > 5e4:
-        nu1 = 0.0673838 * ra ** (1 / 3)
-    elif ra > 1e4:
-        nu1 = 0.028154 * ra ** 0.4134
-    else:
-        nu1 = 1 + 1.7596678e-10 * ra ** 2.2984755
+    nu1 = np.where(ra > 5e4, 0.0673838 * ra ** (1 / 3),
+                   np.where(ra > 1e4, 0.028154 * ra ** 0.4134, 1 + 1.7596678e-10 * ra ** 2.2984755))
     nu2 = 0.242 * (ra / aspect) ** 0.272
-    return max(nu1, nu2) * k / thickness + radiative_conductance(emissivity_1, emissivity_2, T_mean)
+    return np.maximum(nu1, nu2) * k / thickness
+
+
+def gap_conductance(thickness, height, emissivity_1, emissivity_2, T_mean=GAP_T_MEAN, delta_T=GAP_DELTA_T,
+                    gas="air"):
+    """Conductance (W/m2/K) of a gas gap: `gap_convection` plus the radiative exchange of its two
+    faces linearised at T_mean (`radiative_conductance`)."""
+    return float(gap_convection(thickness, height, T_mean, delta_T, gas)
+                 + radiative_conductance(emissivity_1, emissivity_2, T_mean))
+
+
+def gap_coefficients(gas):
+    """A gas as `gas_properties` reads it, as the ten numbers a network holds: the coefficients
+    (a, b, c) of its conductivity, viscosity and specific heat, then its molecular weight; a
+    mixture's are the mole-fraction-weighted means of its gases' (its properties then the
+    weighted means `gas_properties` gives)."""
+    if isinstance(gas, list):
+        total = sum(x for _, x in gas)
+        return tuple(sum(gap_coefficients(g)[i] * x for g, x in gas) / total for i in range(10))
+    k, mu, cp, M = GASES[gas] if isinstance(gas, str) else gas
+    return (*k, *mu, *cp, M)
+
+
+def followed_gap_conductance(T_1, T_2, thickness, height, emissivity, coefficients):
+    """Conductance (W/m2/K) of gas gaps between panes at T_1 and T_2 (C), as EnergyPlus solves its
+    panes (WindowManager.cc, SolveForWindowTemperatures): `gap_convection` at their mean and
+    difference, plus the exact long-wave exchange eps sigma (T_1^4 - T_2^4) / (T_1 - T_2) =
+    eps sigma (T_1^2 + T_2^2)(T_1 + T_2) (K) of two grey planes, eps = 1 / (1/e_1 + 1/e_2 - 1);
+    `coefficients` (n, 10) as `gap_coefficients` gives them."""
+    t1, t2 = np.asarray(T_1, dtype=float) + 273.15, np.asarray(T_2, dtype=float) + 273.15
+    c = np.asarray(coefficients, dtype=float).T
+    gas = ((c[0], c[1], c[2]), (c[3], c[4], c[5]), (c[6], c[7], c[8]), c[9])
+    convective = gap_convection(thickness, height, 0.5 * (t1 + t2), t1 - t2, gas)
+    return convective + emissivity * SIGMA * (t1 * t1 + t2 * t2) * (t1 + t2)
 
 
 def simple_glazing_transmittance(U, shgc):

@@ -16,15 +16,16 @@ Convective and outside long-wave coefficients that follow the state (docs/model.
 keep their declared value in A; the rest is `convection`, a source each step evaluates from the
 temperatures at its start.
 """
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
 
 from .building import DAY_TERMS, Adiabatic, Boundary, Exterior, Surface
-from .building_file import schema_default
-from .convection import doe2_faces, lagged_excess, tarp_inside_faces, windward_faces
+from .building_file import gap_nodes, schema_default
+from .convection import doe2_faces, iso15099_inside, lagged_excess, tarp_inside_faces, windward_faces
 from .discretise import capacities, conductances
+from .glazing import followed_gap_conductance, gap_coefficients
 from .longwave import enclosure_exchange, exterior_coefficient
 
 AIR_DENSITY = schema_default("site", "air_density")  # kg/m3, a building file's default
@@ -49,7 +50,13 @@ class Convection:
     (A m2, h0 W/m2/K, cos_up, azimuth deg, roughness multiplier R_f, wind factor V_z / V_met)
     (m, 6)); longwave: (face node int (k,), (A m2, h_rad W/m2/K, sky view F, emissivity) (k, 4));
     columns: the input indices of T_out, the wind speed and direction (-1 without an outside
-    face) and T_sky."""
+    face) and T_sky. A window's (docs/model.md section 4.1) inside face under TARP takes ISO
+    15099's coefficient, A phi (h_iso(T_s - T_air, T_air) - h0) (T_air - T_s) on the face and its
+    negative on the air, windows: ((face node, air node) (w, 2), (A phi m2, h0 W/m2/K, height m,
+    tilt deg, the site's pressure Pa) (w, 5)); each of its gaps A f (h_gap(T_a, T_b) - h0)
+    (T_b - T_a) on the pane face a and its negative on b, gaps: ((a, b) (g, 2), (A f m2,
+    h0 W/m2/K, thickness m, height m, eps, the gas's ten coefficients) (g, 15)), f the factors
+    that scale the gap's link, eps = 1 / (1/e_1 + 1/e_2 - 1)."""
     inside_nodes: np.ndarray
     inside: np.ndarray
     outside_nodes: np.ndarray
@@ -57,6 +64,10 @@ class Convection:
     longwave_nodes: np.ndarray
     longwave: np.ndarray
     columns: tuple
+    window_nodes: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=int))
+    windows: np.ndarray = field(default_factory=lambda: np.zeros((0, 5)))
+    gap_nodes: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=int))
+    gaps: np.ndarray = field(default_factory=lambda: np.zeros((0, 15)))
 
     def source(self, T, u):
         """(N,) W of the temperatures T (N,) before the step (C) and the inputs u at its end."""
@@ -81,6 +92,20 @@ class Convection:
             sky = lagged_excess(exterior_coefficient(emissivity, T_e, t_sky), h0) * F * (t_sky - T_e)
             air = lagged_excess(exterior_coefficient(emissivity, T_e, t_out), h0) * (1.0 - F) * (t_out - T_e)
             np.add.at(q, self.longwave_nodes, area * (sky + air))
+        if len(self.windows):
+            face, air = self.window_nodes.T
+            area, h0, height, tilt, pressure = self.windows.T
+            dT = T[air] - T[face]
+            flow = area * lagged_excess(iso15099_inside(-dT, T[air], height, tilt, pressure), h0) * dT
+            np.add.at(q, face, flow)
+            np.add.at(q, air, -flow)
+        if len(self.gaps):
+            a, b = self.gap_nodes.T
+            area, h0, thickness, height, emissivity = self.gaps[:, :5].T
+            h = followed_gap_conductance(T[a], T[b], thickness, height, emissivity, self.gaps[:, 5:])
+            flow = area * lagged_excess(h, h0) * (T[b] - T[a])
+            np.add.at(q, a, flow)
+            np.add.at(q, b, -flow)
         return q
 
 
@@ -335,7 +360,7 @@ def assemble(building, names=None):
     A = np.zeros((n, n))
     B = np.zeros((n, len(names)))
     q = np.zeros(n)
-    products, switched, inside, outside, longwave = [], [], [], [], []
+    products, switched, inside, outside, longwave, windows, gaps = [], [], [], [], [], [], []
 
     def link(i, j, g):
         """A conductance g (W/K) between nodes i and j (0-based)."""
@@ -356,14 +381,21 @@ def assemble(building, names=None):
         else:
             q[node] += g * temperature
 
-    def to_zone(node, area, surface, cos_up):
+    def to_zone(node, area, surface, cos_up, window=None, tilt=None):
+        """The face's link to its zone's air and radiant node; a `window`'s inside face (of a
+        component of `tilt` deg) under TARP takes ISO 15099's coefficient (docs/model.md 4.1)."""
         zone = building.zone(surface.zone)
         link(node, zone.air_node - 1, area * surface.h_conv * zone.convection_factor)
-        if zone.inside_convection_algorithm == "tarp":
+        if zone.inside_convection_algorithm == "tarp" and window is not None:
+            windows.append(((node, zone.air_node - 1),
+                            (area * zone.convection_factor, surface.h_conv, window.height, tilt, pressure)))
+        elif zone.inside_convection_algorithm == "tarp":
             inside.append(((node, zone.air_node - 1), (area * zone.convection_factor, surface.h_conv, cos_up)))
         if zone.longwave == "radiant_node":
             link(node, zone.radiant_node - 1, area * surface.h_rad)
 
+    # the site's pressure (Pa), which its air's density at 20 C gives (ISO 15099's inside convection)
+    pressure = building.site.get("air_density", AIR_DENSITY) * 287.05 * 293.15
     # where the radiant part of a zone's gains goes: [(node, share)], its radiant node or its faces
     absorbers = {}
     for z in building.zones:
@@ -395,11 +427,19 @@ def assemble(building, names=None):
         boundary = (building.boundary_factor(out.temperature)
                     if isinstance(out, Boundary) and isinstance(out.temperature, str) else 1.0)
         C[idx] += c.area * capacities(c.layers, c.depths) * c.capacity_factor
-        for k, g in enumerate(conductances(c.layers, c.depths)):
+        G = conductances(c.layers, c.depths)
+        for k, g in enumerate(G):
             link(idx[k], idx[k + 1], c.area * g * c.conductivity_factor * materials * boundary)
+        for gap in () if c.window is None else c.window.gaps:
+            # the gap's link holds its declared conductance; what the panes' temperatures add, the source
+            a, b = gap_nodes(c.layers, c.depths, gap.layer)
+            e1, e2 = gap.emissivities
+            gaps.append(((idx[a], idx[b]), (c.area * c.conductivity_factor * materials * boundary, G[a],
+                                            c.layers[gap.layer][1], c.window.height, 1.0 / (1.0 / e1 + 1.0 / e2 - 1.0),
+                                            *gap_coefficients(gap.gas))))
         # the inside face's normal points into its zone, against the outside's
         cos_up = float(np.cos(np.radians(c.tilt)))
-        to_zone(idx[0], c.area, c.inside, -cos_up)
+        to_zone(idx[0], c.area, c.inside, -cos_up, c.window, c.tilt)
         if isinstance(out, Exterior):
             F = sky_view_factor(c.tilt) if out.sky_view_factor is None else out.sky_view_factor
             v = out.convection
@@ -505,7 +545,7 @@ def assemble(building, names=None):
                 for r, w in radiant:
                     B[r, col[name]] += gain * f_r * w
     convection = None
-    if inside or outside or longwave:
+    if inside or outside or longwave or windows or gaps:
         convection = Convection(
             inside_nodes=np.array([n for n, _ in inside], dtype=int).reshape(-1, 2),
             inside=np.array([v for _, v in inside], dtype=float).reshape(-1, 3),
@@ -513,7 +553,11 @@ def assemble(building, names=None):
             outside=np.array([v for _, v in outside], dtype=float).reshape(-1, 6),
             longwave_nodes=np.array([n for n, _ in longwave], dtype=int),
             longwave=np.array([v for _, v in longwave], dtype=float).reshape(-1, 4),
-            columns=tuple(col.get(name, -1) for name in ("T_out", WIND_SPEED, WIND_DIRECTION, "T_sky")))
+            columns=tuple(col.get(name, -1) for name in ("T_out", WIND_SPEED, WIND_DIRECTION, "T_sky")),
+            window_nodes=np.array([n for n, _ in windows], dtype=int).reshape(-1, 2),
+            windows=np.array([v for _, v in windows], dtype=float).reshape(-1, 5),
+            gap_nodes=np.array([n for n, _ in gaps], dtype=int).reshape(-1, 2),
+            gaps=np.array([v for _, v in gaps], dtype=float).reshape(-1, 15))
     return Network(C=C, A=A, B=B, q=q, input_names=names, products=tuple(products), switched=tuple(switched),
                    convection=convection)
 

@@ -42,6 +42,39 @@ static double exterior_coefficient(double eps, double T_s, double T) {
     return eps * SIGMA * (T_s * T_s + T * T) * (T_s + T);
 }
 
+/* ISO 15099's inside coefficient (W/m2/K) of a window face at dT = T_s - T_air, the air at T_air
+   (C), of height H (m) and tilt (deg), the site's pressure (Pa): model/convection.py's iso15099_inside */
+static double iso15099(double dT, double T_air, double H, double tilt, double pressure) {
+    const double T_f = T_air + 273.15 + 0.25 * dT, lambda = 2.873e-3 + 7.76e-5 * T_f, mu = 3.723e-6 + 4.94e-8 * T_f;
+    const double rho = pressure / (287.05 * T_f), ra = rho * rho * H * H * H * 9.81 * 1004.84 * fabs(dT) / (T_f * mu * lambda);
+    const double theta = dT > 0.0 ? 180.0 - tilt : tilt, sine_raw = sin(tilt * 3.14159265358979323846 / 180.0);
+    const double sine = sine_raw > 1e-9 ? sine_raw : 1e-9;
+    double nu, h;
+    if (theta < 15.0) nu = 0.13 * cbrt(ra);
+    else if (theta <= 90.0) {
+        const double ra_cv = 2.5e5 * pow(exp(0.72 * theta) / sine, 0.2);
+        nu = ra <= ra_cv ? 0.56 * pow(ra * sine, 0.25) : 0.13 * (cbrt(ra) - cbrt(ra_cv)) + 0.56 * pow(ra_cv * sine, 0.25);
+    } else if (theta <= 179.0) {
+        const double x = ra * sine;
+        nu = 0.56 * pow(x < 1e5 ? 1e5 : x > 1e11 ? 1e11 : x, 0.25);
+    } else nu = 0.58 * pow(ra < 1e11 ? ra : 1e11, 0.2);
+    h = nu * lambda / H;
+    return h > INSIDE_FLOOR ? h : INSIDE_FLOOR;
+}
+
+/* A gas gap's conductance (W/m2/K) between panes at T1, T2 (C): model/glazing.py's
+   followed_gap_conductance; v = (thickness m, height m, eps, the gas's ten coefficients) */
+static double gap_conductance(double T1, double T2, const double *v) {
+    const double t1 = T1 + 273.15, t2 = T2 + 273.15, T = 0.5 * (t1 + t2), d = v[0], g = v[2];
+    const double k = v[3] + v[4] * T + v[5] * T * T, mu = v[6] + v[7] * T + v[8] * T * T;
+    const double cp = v[9] + v[10] * T + v[11] * T * T, rho = 101325 * v[12] / 1000 / (8.314462 * T);
+    const double ra = rho * rho * d * d * d * 9.81 * cp * fabs(t1 - t2) / (mu * k * T);
+    const double nu1 = ra > 5e4 ? 0.0673838 * pow(ra, 1.0 / 3.0)
+                     : ra > 1e4 ? 0.028154 * pow(ra, 0.4134) : 1 + 1.7596678e-10 * pow(ra, 2.2984755);
+    const double nu2 = 0.242 * pow(ra / (v[1] / d), 0.272);
+    return (nu1 > nu2 ? nu1 : nu2) * k / d + g * SIGMA * (t1 * t1 + t2 * t2) * (t1 + t2);
+}
+
 /* model/convection.py's lagged_excess: h - h0, at most h0, so that the lag never grows an error */
 static double excess(double h, double h0) {
     return h - h0 < h0 ? h - h0 : h0;
@@ -50,11 +83,14 @@ static double excess(double h, double h0) {
 /* The lagged coefficients' sources (W) into q (N), from T (N) before the step and the step's
    inputs u: inside, per face, (face, air) and (A phi, h0, cos_up); outside, per face, its node
    and (A, h0, cos_up, azimuth, R_f, wind factor); long-wave, per face, its node and (A, h_rad,
-   F, eps); columns: u's T_out, wind speed and direction, T_sky */
+   F, eps); columns: u's T_out, wind speed and direction, T_sky; windows, per window face, (face,
+   air) and (A phi, h0, height, tilt, pressure); gaps, per gap, its two pane faces (a, b) and (A f, h0,
+   thickness, height, eps, the gas's ten coefficients) */
 static void convection(int n, const double *T, const double *u, int n_inside, const int *inside_nodes,
                        const double *inside, int n_outside, const int *outside_nodes, const double *outside,
                        int n_longwave, const int *longwave_nodes, const double *longwave, const int *columns,
-                       double *q) {
+                       int n_windows, const int *window_nodes, const double *windows, int n_gaps,
+                       const int *gap_nodes, const double *gaps, double *q) {
     int k;
     for (k = 0; k < n; k++) q[k] = 0.0;
     for (k = 0; k < n_inside; k++) {
@@ -82,6 +118,20 @@ static void convection(int n, const double *T, const double *u, int n_inside, co
         const double air = excess(exterior_coefficient(v[3], T_e, t_out), v[1]) * (1.0 - v[2]) * (t_out - T_e);
         q[face] += v[0] * (sky + air);
     }
+    for (k = 0; k < n_windows; k++) {
+        const int face = window_nodes[2 * k], air = window_nodes[2 * k + 1];
+        const double *v = windows + 5 * k, dT = T[air] - T[face];
+        const double flow = v[0] * excess(iso15099(-dT, T[air], v[2], v[3], v[4]), v[1]) * dT;
+        q[face] += flow;
+        q[air] -= flow;
+    }
+    for (k = 0; k < n_gaps; k++) {
+        const int a = gap_nodes[2 * k], b = gap_nodes[2 * k + 1];
+        const double *v = gaps + 15 * k;
+        const double flow = v[0] * excess(gap_conductance(T[a], T[b], v + 2), v[1]) * (T[b] - T[a]);
+        q[a] += flow;
+        q[b] -= flow;
+    }
 }
 
 /* order (N): the node of each position of the elimination order; lower_ptr/lower_col (N + 1,
@@ -101,12 +151,14 @@ EXPORT int nodeforce_steps(int n, const int *order, const int *lower_ptr, const 
                            const double *q, int n_forced, const int *forced, const double *imposed, double *T,
                            int n_rows, const int *rows, double *path, int n_inside, const int *inside_nodes,
                            const double *inside, int n_outside, const int *outside_nodes, const double *outside,
-                           int n_longwave, const int *longwave_nodes, const double *longwave, const int *columns) {
+                           int n_longwave, const int *longwave_nodes, const double *longwave, const int *columns,
+                           int n_windows, const int *window_nodes, const double *windows, int n_gaps,
+                           const int *gap_nodes, const double *gaps) {
     long entries = (long)n + lower_ptr[n] + upper_ptr[n], s, e;
     double *f = calloc((size_t)entries + 1, sizeof(double)), *w = calloc((size_t)n + 1, sizeof(double));
     double *y = malloc(((size_t)n + 1) * sizeof(double));
     int *position = malloc(((size_t)n + 1) * sizeof(int));
-    const int lagged = n_inside > 0 || n_outside > 0 || n_longwave > 0;
+    const int lagged = n_inside > 0 || n_outside > 0 || n_longwave > 0 || n_windows > 0 || n_gaps > 0;
     double *extra = calloc((size_t)n + 1, sizeof(double));
     double *diagonal = f, *lower = f + n, *upper = f + n + lower_ptr[n];
     int i, p, k, ok = 0;
@@ -134,7 +186,8 @@ EXPORT int nodeforce_steps(int n, const int *order, const int *lower_ptr, const 
         double *out = path + s * n_rows;
         if (lagged)
             convection(n, T, t_s, n_inside, inside_nodes, inside, n_outside, outside_nodes, outside, n_longwave,
-                       longwave_nodes, longwave, columns, extra);
+                       longwave_nodes, longwave, columns, n_windows, window_nodes, windows, n_gaps, gap_nodes, gaps,
+                       extra);
         for (i = 0; i < n; i++) {
             const int node = order[i];
             double sum = q[node] + extra[node];
