@@ -247,3 +247,14 @@ def test_a_ground_records_truth_has_its_ground_at_the_specs_offset_from_the_reco
     else:
         assert case.annual_air is None and prior.sd == RECORD_AIR_SD
 
+
+@pytest.mark.parametrize("days", [0, 3, 7])
+def test_a_history_record_reads_exactly_its_days_of_weather_before_the_record(days):
+    """The history records' diagnosis reads the weather from 0, 3 or 7 days before the first
+    measurement, no more, and its case simulates all of them before it."""
+    r = record(SPECS_BY_NAME[f"gso-oct-h{days}/none"], 0)
+    assert r.spec.before == days
+    first = r.measurements.index[0]
+    assert r.weather.index[0] == first - pd.Timedelta(days=days)
+    case = r.case()
+    assert case.history_steps * case.dt == days * 86400 and case.times[case.history_steps] == first
