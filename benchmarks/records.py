@@ -14,6 +14,9 @@ The truth is never the diagnosis' own model:
   step's end, which is what a model stepping at the record's step reads: `model.integrate`), so
   both read the same inputs; the diagnosis reads the weather from `Spec.before` days before the
   record, a user's file that starts some days before the measurements, or with them;
+- the file declares the site's ground temperature (the typical year's mean air) unless the spec
+  says not (`Spec.declares_ground`); a ground fault's ground is at a stated temperature or at the
+  spec's offset from the record's mean outdoor air (`truth.grounded`), which its later record keeps;
 - the fault is an effect the file does not declare (or two of them together), applied to the truth with the registry's own
   `apply` (`model.effects.EFFECTS`), or one beyond the catalogue: a gain on a schedule, a gain
   through an opening the file does not have, an envelope whose materials and outside film
@@ -41,7 +44,7 @@ import pandas as pd
 
 from benchmarks.catalogue import SPECS_BY_NAME, Spec
 from benchmarks.sizing import before_error, tuned_scale
-from benchmarks.truth import (CELLS, at_scale, faulty, file_building, fine_weather, frame, measured_nodes,
+from benchmarks.truth import (CELLS, at_scale, faulty, file_building, fine_weather, frame, grounded, measured_nodes,
                               read_by_diagnosis, record_seed, record_times, truth_record)
 from nodeforce.model.case import HISTORY_DAYS, measured_case
 from nodeforce.model.hlc import heat_loss_coefficient
@@ -85,7 +88,7 @@ def _noiseless(spec, scale=None):
     air = building.zone(spec.objective).air_node if spec.objective else building.zones[0].air_node
     truth0 = refined(building, CELLS)
     fine0 = fine_weather(spec, building, times, {})
-    weather0 = read_by_diagnosis(fine0, times, spec.before)
+    weather0 = read_by_diagnosis(spec, building, fine0, times)
     if scale is None:
         scale, ratio = tuned_scale(spec, building, truth0, fine0, weather0, times, nodes, air)
     values = at_scale(building, spec, scale)
@@ -121,13 +124,13 @@ def later_spec(spec):
     """The spec of the same building, fault, sensors, step and length starting two to four weeks
     after `spec` ends, inside the typical year: the span drawn from the scenario's name (the part of the
     record's name before "/"), so that a scenario's records are measured again on the same days,
-    the same every run."""
+    the same every run; its ground where `spec`'s is (`truth.grounded`), not at its own offset."""
     scenario = spec.name.split("/")[0]
     seed = int.from_bytes(hashlib.sha1(scenario.encode()).digest()[:4], "little")
     days = int(np.random.default_rng(seed).integers(LATER_DAYS[0], LATER_DAYS[1] + 1))
     start = pd.Timestamp(f"2001-{spec.start}")  # any year without a 29 February: a month-day
     start = min(start + pd.Timedelta(days=spec.days + days), pd.Timestamp("2001-12-31") - pd.Timedelta(days=spec.days))
-    return dataclasses.replace(spec, start=start.strftime("%m-%d"), name=f"{spec.name}+later")
+    return dataclasses.replace(grounded(spec), start=start.strftime("%m-%d"), name=f"{spec.name}+later")
 
 
 def later_record(r):

@@ -1,6 +1,7 @@
 """The truth of a benchmark record: the building file discretised finer and simulated at the
 minute from a long past, with its fault, read by the record's sensors (benchmarks/records.py
 says why each choice)."""
+import dataclasses
 import functools
 from pathlib import Path
 
@@ -47,11 +48,14 @@ def climate(name):
 
 def file_building(spec):
     """The building file the diagnosis reads: the test cell or the Twin House at the climate's
-    site; the air-only test cell with its heater declared and measured."""
+    site, declaring its ground temperature (the typical year's mean air) unless the spec says
+    not; the air-only test cell with its heater declared and measured."""
     site, _ = climate(spec.climate)
     path = TESTCELL if spec.building == "testcell" else TWINHOUSE
     building = load_building(path)
     data = relocate(building.to_json(), site)
+    if not spec.declares_ground:
+        del data["site"]["ground_temperature"]
     if spec.sensors == "air":
         data["zones"][0]["heat_input"] = "Q_heat"
     return parse_building(data, source=f"{path.name} at {spec.climate}")
@@ -72,7 +76,7 @@ def neutral(building, fault):
 def at_scale(building, spec, scale):
     """[{parameter: value}] of each of the spec's faults at `scale` (0: as declared, 1: its `full`)."""
     out = []
-    for fault in spec.faults:
+    for fault in grounded(spec).faults:
         base = neutral(building, fault)
         values = dict(fault.full)
         for name, full in fault.full.items():
@@ -80,6 +84,27 @@ def at_scale(building, spec, scale):
                 values[name] = base[name] + scale * (full - base[name])
         out.append(values)
     return out
+
+
+@functools.lru_cache(maxsize=None)
+def record_mean_air(spec):
+    """The mean outdoor air temperature (C) over the record's span, the typical year linearly
+    interpolated to the minute as the truth reads it."""
+    _, hourly = climate(spec.climate)
+    times = record_times(spec)
+    grid = pd.date_range(times[0], times[-1], freq=f"{FINE_STEP:g}s", name="time")
+    return float(minutely(cyclic(hourly[["T_out"]], times[0] - pd.Timedelta(hours=1)), grid)["T_out"].mean())
+
+
+def grounded(spec):
+    """The spec with its ground faults' T_ground in C: where the fault leaves it None, the
+    record's mean outdoor air plus the spec's `ground_offset` (K)."""
+    if spec.ground_offset is None:
+        return spec
+    T_ground = record_mean_air(spec) + spec.ground_offset
+    faults = tuple(dataclasses.replace(f, full={**f.full, "T_ground": T_ground})
+                   if "T_ground" in f.full and f.full["T_ground"] is None else f for f in spec.faults)
+    return dataclasses.replace(spec, faults=faults, ground_offset=None)
 
 
 def faulty(truth, spec, values):
@@ -168,21 +193,27 @@ def record_times(spec):
     return pd.date_range(start, periods=spec.days * 1440 // spec.step_min + 1, freq=f"{spec.step_min}min", name="time")
 
 
-def fine_weather(spec, building, times, extra):
-    """The weather at 1 min from `TRUTH_HISTORY_DAYS` before `times` to its end: the typical year
-    (`cyclic` where that reaches before its start) linearly interpolated, the columns the file
-    reads (heat inputs held over each record step), and the truth's `extra` columns."""
+def fine_weather(spec, building, times, extra, days=TRUTH_HISTORY_DAYS):
+    """The weather at 1 min from `days` (default `TRUTH_HISTORY_DAYS`) before `times` to its end:
+    the typical year (`cyclic` where that reaches before its start) linearly interpolated, the
+    columns the file reads (heat inputs held over each record step), and the truth's `extra`
+    columns."""
     site, hourly = climate(spec.climate)
-    start = times[0] - pd.Timedelta(days=TRUTH_HISTORY_DAYS)
+    start = times[0] - pd.Timedelta(days=days)
     hourly = cyclic(hourly, start - pd.Timedelta(hours=1))
     grid = pd.date_range(start, times[-1], freq=f"{FINE_STEP:g}s", name="time")
-    fine = hourly.reindex(hourly.index.union(grid)).interpolate("time").reindex(grid)
+    fine = minutely(hourly, grid)
     for name, values in own_columns(spec, building, grid, fine).items():
         fine[name] = values
     for name, function in extra.items():
         fine[name] = function(grid)
     fine.attrs["source"] = f"{spec.name} weather"
     return fine
+
+
+def minutely(hourly, grid):
+    """The hourly frame linearly interpolated in time onto the finer `grid`."""
+    return hourly.reindex(hourly.index.union(grid)).interpolate("time").reindex(grid)
 
 
 def cyclic(hourly, start):
@@ -196,9 +227,13 @@ def cyclic(hourly, start):
     return pd.concat([earlier, hourly])
 
 
-def read_by_diagnosis(weather, times, before):
-    """The part of the truth's weather the diagnosis reads: from `before` days before `times`."""
-    out = weather[weather.index >= times[0] - pd.Timedelta(days=before)]
+def read_by_diagnosis(spec, building, weather, times):
+    """The weather the diagnosis reads: the truth's `weather` from `spec.before` days before
+    `times`; where that reaches beyond the truth's past (a year of weather, whose mean the
+    diagnosis reads as the deep ground's), the same typical year made as far back."""
+    if spec.before > TRUTH_HISTORY_DAYS:
+        weather = fine_weather(spec, building, times, {}, days=spec.before)
+    out = weather[weather.index >= times[0] - pd.Timedelta(days=spec.before)]
     out.attrs = dict(weather.attrs)
     return out
 

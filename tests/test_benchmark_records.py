@@ -12,12 +12,13 @@ import pandas as pd
 import pytest
 
 from benchmarks.baseline import fit_one
-from benchmarks.catalogue import FAULTS, Spec
-from benchmarks.records import record
+from benchmarks.catalogue import FAULTS, SPECS, SPECS_BY_NAME, Spec
+from benchmarks.records import later_record, record
 from benchmarks.sizing import STRONG_BAND, SUBTLE_BAND, before_error, max_scale
-from benchmarks.truth import (CELLS, FINE_STEP, at_scale, faulty, file_building, fine_weather, record_times, truth_record,
-                              with_envelope_films)
+from benchmarks.truth import (CELLS, FINE_STEP, at_scale, climate, faulty, file_building, fine_weather, record_times,
+                              truth_record, with_envelope_films)
 from nodeforce.model.building_file import parse_building
+from nodeforce.model.effects import RECORD_AIR_SD, deep_ground_temperature
 from nodeforce.model.hlc import heat_loss_coefficient
 from nodeforce.model.numerical import refined
 from tests.test_hlc import series
@@ -196,3 +197,64 @@ def test_two_faults_are_both_found_when_one_component_s_own_sensor_disagrees(tmp
     door = next(d for d in diagnosis.rounds if d.chosen and d.chosen.target == "door")
     assert door.verdicts["conductivity@door"].passes_by_own
     check_replay(tmp_path / "report.json")
+
+
+GROUND_RECORDS = [s for s in SPECS if s.ground_offset is not None]
+SEASONS = {12: "winter", 1: "winter", 2: "winter", 3: "spring", 4: "spring", 5: "spring", 6: "summer", 7: "summer",
+           8: "summer", 9: "autumn", 10: "autumn", 11: "autumn"}
+
+
+def test_the_ground_records_span_the_seasons_the_climates_and_the_priors_sources():
+    """The deep ground 5 to 9 K above and below the record's mean air in each season (of its
+    start), under at least two climates, a record without a fault in each of their scenarios;
+    among them files that declare the site's ground temperature, files that do not with a year
+    of weather before the record, and files that do not with weeks of it: each source of the
+    diagnosis' prior on the deep ground (`model.effects.deep_ground_temperature`)."""
+    signs = {(SEASONS[int(s.start[:2])], s.ground_offset > 0) for s in GROUND_RECORDS}
+    assert signs == {(season, above) for season in SEASONS.values() for above in (True, False)}
+    assert all(5.0 <= abs(s.ground_offset) <= 9.0 for s in GROUND_RECORDS)
+    assert len({s.climate for s in GROUND_RECORDS}) >= 2 and {s.size for s in GROUND_RECORDS} == {"subtle", "strong"}
+    scenarios = {s.name.split("/")[0] for s in GROUND_RECORDS}
+    assert all(f"{name}/none" in SPECS_BY_NAME for name in scenarios)
+    sources = {"declared" if s.declares_ground else "a year" if s.before >= 365 else "weeks" for s in GROUND_RECORDS}
+    assert sources == {"declared", "a year", "weeks"}
+
+
+@pytest.mark.parametrize("name", ["gso-feb-ground/ground-L", "sdp-apr-ground/ground-s"])
+def test_a_ground_records_truth_has_its_ground_at_the_specs_offset_from_the_records_mean_air(name):
+    """The truth's floor lies on a ground at the record's mean outdoor air plus the spec's offset:
+    that mean by hand, the integral of the typical year's hourly temperatures linearly
+    interpolated over the record's span (the truth reads them at 1 min), within a hundredth of a kelvin;
+    the later record keeps the same ground. The diagnosis reads the prior the spec's scenario
+    stands for: without a declared ground temperature, the typical year's mean air from a year of
+    weather (the year read as cyclic), else the weather's mean with the wide sd."""
+    spec = SPECS_BY_NAME[name]
+    r = record(spec, 0, scale=1.0)
+    times = r.measurements.index
+    _, hourly = climate(spec.climate)
+    hours = (hourly.index - times[0]).total_seconds().to_numpy()
+    end = (times[-1] - times[0]).total_seconds()
+    seconds = np.r_[0.0, hours[(hours > 0) & (hours < end)], end]  # the hours inside, and the span's ends
+    mean_air = np.trapezoid(np.interp(seconds, hours, hourly["T_out"].to_numpy()), seconds) / end
+    floor = r.truth.component("floor").outside
+    assert floor.h == pytest.approx(3.0) and floor.temperature == pytest.approx(mean_air + spec.ground_offset, abs=0.01)
+    assert later_record(r).truth.component("floor").outside.temperature == floor.temperature
+    assert "ground_temperature" not in r.building.site
+    case = r.case()
+    prior = deep_ground_temperature(r.building, case.U[:, case.input_names.index("T_out")], case.annual_air)
+    if spec.before >= 365:
+        assert prior.value == pytest.approx(hourly["T_out"].mean(), abs=0.01) and "annual" in prior.source
+    else:
+        assert case.annual_air is None and prior.sd == RECORD_AIR_SD
+
+
+@pytest.mark.parametrize("days", [0, 3, 7])
+def test_a_history_record_reads_exactly_its_days_of_weather_before_the_record(days):
+    """The history records' diagnosis reads the weather from 0, 3 or 7 days before the first
+    measurement, no more, and its case simulates all of them before it."""
+    r = record(SPECS_BY_NAME[f"gso-oct-h{days}/none"], 0)
+    assert r.spec.before == days
+    first = r.measurements.index[0]
+    assert r.weather.index[0] == first - pd.Timedelta(days=days)
+    case = r.case()
+    assert case.history_steps * case.dt == days * 86400 and case.times[case.history_steps] == first
