@@ -119,3 +119,25 @@ def test_the_start_is_fitted_without_the_block_a_fold_scores(testcell, weather):
     file_error = (measured[1:, air - 1] - case.run(testcell, [air - 1])[:, 0])[first]
     assert np.sqrt(np.mean(left ** 2)) < 1.5 * NOISE < 0.5 * np.sqrt(np.mean(file_error ** 2))
 
+
+@pytest.mark.slow  # a diagnosis: not in `make check`
+def test_a_faultless_record_with_three_days_of_history_in_a_moving_season_adds_nothing(tmp_path):
+    """The benchmark's test cell, its air alone measured (a PRBS heater) for 14 days from 10 March
+    in Sandpoint, the truth with its real past, the weather read from 3 days before the record:
+    nothing is added, the validation error is within 1.5 x the noise, and the report states the
+    floor's mode's start it fitted, within 5 K of the steady start (its prior's sd). With the
+    start assumed, the loop added a heat input factor to this record."""
+    from benchmarks.catalogue import Spec
+    from benchmarks.records import record
+    from nodeforce import api
+    spec = Spec(name="sdp-mar-air-h3/none", building="testcell", climate="sandpoint", start="03-10", days=14,
+                step_min=30, noise=0.15, sensors="air", before=3)
+    r = record(spec, 0)
+    diagnosis = api.diagnose(r.building, r.case(), tmp_path, objective=api.objective(r.building, r.zones),
+                             search=api.SearchSettings(generations=30, noise=r.spec.noise, seed=0),
+                             execution=api.Execution(workers=1))
+    assert not diagnosis.added, diagnosis.rounds[0].reason
+    assert diagnosis.after["validation"]["rmse"] < 1.5 * r.spec.noise
+    said, = [a for a in diagnosis.assumptions if a.startswith("The start of record 1")]
+    amplitude = float(said.split("14.7-day mode ")[1].split(" ")[0])
+    assert abs(amplitude) < START_SD
