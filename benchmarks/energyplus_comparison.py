@@ -4,7 +4,8 @@ reports is, the times EnergyPlus's rows stand for, and the two programs' differe
 A converted building names each component after the EnergyPlus surface it comes from
 (iotools/energyplus.py): a surface's inside face is its component's first node (depth 0). Two
 surfaces that name each other are one partition, named after one of them; the other's inside
-face is the partition's last node, its outer face. An InternalMass given to a ZoneList is one
+face is the partition's last node, its outer face; so is the face EnergyPlus makes, named
+"IZ-<surface>", on the other side of a surface whose outside is a Zone. An InternalMass given to a ZoneList is one
 component a zone, named "<mass> <zone>"; EnergyPlus names its surfaces "<zone> <mass>"
 (CheckCreatedZoneItemName). A face none of these finds is returned with the reason, never dropped
 silently.
@@ -55,6 +56,8 @@ def face_nodes(building, names, doc):
             nodes[key] = first[key]
         elif other.get(key) in outer:
             nodes[key] = outer[other[key]]
+        elif key.startswith("IZ-") and key[3:] in outer:  # EnergyPlus's side of a Zone boundary
+            nodes[key] = outer[key[3:]]
         else:
             unpaired[key] = ("its partner is not a partition of the building" if key in other
                              else "no component of the building bears its name")

@@ -57,19 +57,27 @@ def test_every_surface_of_three_zones_pairs_with_its_own_inside_face():
     assert outer_faces == 3  # EAST TO WEST, CORRIDOR TO WEST, CORRIDOR TO EAST (or their partners)
 
 
-def test_a_zone_list_mass_pairs_by_energyplus_name_and_a_stranger_is_said(tmp_path):
+def test_energyplus_made_faces_pair_by_energyplus_name_and_a_stranger_is_said(tmp_path):
     """An InternalMass given to a ZoneList: EnergyPlus reports "<zone> <mass>" (its
     CheckCreatedZoneItemName), the converter makes "<mass> <zone>"; each zone's pairs with its own
-    component's inside face. A face the building has nothing for is returned with its reason."""
+    component's inside face. A wall whose outside is a Zone: EnergyPlus reports the other side as
+    "IZ-<wall>", the wall's outer face. A face the building has nothing for is returned with its
+    reason."""
     text = MULTIZONE.read_text().replace("INT WALL,                !- Construction Name\n    WEST OFFICE,",
                                          "INT WALL,                !- Construction Name\n    ALL ZONES,")
-    assert text != MULTIZONE.read_text()
+    text = text.replace("WEST OFFICE,Surface,EAST TO WEST,", "WEST OFFICE,Zone,EAST OFFICE,")
+    mirror = "EAST TO WEST,Wall,INT WALL,EAST OFFICE,Surface,WEST TO EAST,NoSun,NoWind,0,4,\n    0,5,3, 0,5,0, 0,0,0, 0,0,3;"
+    assert mirror in text
+    text = text.replace("BuildingSurface:Detailed,\n    " + mirror, "")
+    assert text.count("ALL ZONES,") == MULTIZONE.read_text().count("ALL ZONES,") + 1 and "EAST TO WEST" not in text
     path = tmp_path / "listed.idf"
     path.write_text(text)
     building = convert_idf(path)
     zones = ("WEST OFFICE", "EAST OFFICE", "CORRIDOR")
-    names = [f"{z} WEST FURNITURE" for z in zones] + ["GHOST WALL"]
+    names = [f"{z} WEST FURNITURE" for z in zones] + ["IZ-WEST TO EAST", "GHOST WALL"]
     nodes, unpaired = face_nodes(building, names, idfkit.load_idf(str(path)))
+    (wall,) = [c for c in building.components if c.name == "WEST TO EAST"]
+    assert nodes["IZ-WEST TO EAST"] == wall.node_ids[-1] and wall.outside.zone == "EAST OFFICE"
     for z in zones:
         (c,) = [c for c in building.components if c.name.upper() == f"WEST FURNITURE {z}"]
         assert nodes[f"{z} WEST FURNITURE"] == c.node_ids[0] and c.inside.zone.upper() == z
