@@ -1,23 +1,34 @@
-"""EnergyPlus as a second reference (issue 44, item 5): the same IDF run by EnergyPlus 25.2
-(pyenergyplus-lbnl, an optional dependency: `pip install -e '.[energyplus]'`) and by nodeforce
+"""EnergyPlus as a second reference (issue 44, item 5; issue 74, item 2): the same IDF run by
+EnergyPlus 25.2.0 (the engine the pinned pyenergyplus-lbnl 26.1.0 ships, an optional dependency:
+`pip install -e '.[energyplus]'`; it reports itself as 25.2.0 in eplusout.err) and by nodeforce
 (`nodeforce convert`, the direct model), free-floating over a Denver year: the ASHRAE 140 cases
 made from examples/bestest/case600.idf, 610FF (600FF with case 610's overhang: 1 m deep along
 the roof over the south windows, ASHRAE 140-2020 section 5.2.2.1.2) and
-examples/multizone/three_zones.idf; per zone the hourly
-air's RMSE and mean difference (nodeforce - EnergyPlus) and each program's minimum, maximum and
-mean. docs/performance.md carries the table.
+examples/multizone/three_zones.idf. Every zone's air and every inside face (EnergyPlus's
+"Surface Inside Face Temperature" beside the node of the same face, `energyplus_comparison`),
+hourly and at 10-min steps, as RMSE and mean difference (nodeforce - EnergyPlus), with each
+program's minimum, maximum and mean: OUT/comparison.csv, the Markdown table printed, and the
+figure OUT/energyplus_faces.png (each zone's and face's RMSE; a week of the worst zone).
+docs/performance.md carries the table and the figure.
 
-    python benchmarks/bench_energyplus.py [OUT] [--weather EPW] [--only MODEL ...]
+    python benchmarks/bench_energyplus.py [OUT] [--weather EPW] [--only MODEL ...] [--figure PNG]
                                                         (default out/bench_energyplus, every model)
 
 The weather is, unless --weather names another EPW, the Denver TMY3 year the installed
 pyenergyplus package ships (pyenergyplus/data/weather/USA_CO_Denver-Aurora-Buckley.AFB.724695_TMY3.epw),
 found at run time.
 
-An IDF is brought to 25.2 by copying every object by its field names into a 25.2 document
-(idfkit; the fields 25.2 renamed mapped, its new ones left to their defaults) and replacing the
-run's own objects (run period, simulation control, outputs, shadow calculation, costs) with a
-free-floating year and the zones' mean air temperature, hourly.
+Both programs read the IDF with 6 time steps an hour (its `Timestep` replaced). EnergyPlus
+reports every step; its hourly values are the means of the hour's steps, as its own hourly
+report averages them, and are compared with nodeforce's sample at the half hour (nodeforce on
+the hourly weather); its 10-min values, the state at each step's end, with nodeforce's at the
+same time (nodeforce on the weather interpolated onto 10-min steps).
+
+An IDF is brought to EnergyPlus 25.2 by copying every object by its field names into a 25.2
+document (idfkit; the fields 25.2 renamed mapped, its new ones left to their defaults) and
+replacing the run's own objects (run period, simulation control, outputs, shadow calculation,
+costs) with a free-floating year and the zones' mean air and faces' inside temperatures at each
+time step.
 """
 import argparse
 import sys
@@ -29,15 +40,20 @@ import pandas as pd
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "examples" / "bestest"))
+sys.path.insert(0, str(ROOT / "benchmarks"))
 import cases  # noqa: E402
+from energyplus_comparison import (FACE, ZONE_AIR, differences, face_nodes, hourly_means, paired,  # noqa: E402
+                                   read_outputs)
 
 from nodeforce.api import convert_idf  # noqa: E402
 from nodeforce.iotools.typical_year import convert_typical_year  # noqa: E402
 from nodeforce.iotools.weather import read_weather  # noqa: E402
 from nodeforce.model.case import simulate_building  # noqa: E402
+from nodeforce.model.weather import weather_on_grid  # noqa: E402
 
 PACKAGE_WEATHER = Path("data") / "weather" / "USA_CO_Denver-Aurora-Buckley.AFB.724695_TMY3.epw"
 YEAR = 2017
+STEPS = 6  # time steps an hour, both programs: EnergyPlus reports each 10-min step
 # The run's own objects, replaced; HVAC and thermostats go too: both programs run free-floating
 DROP = ("Version", "ShadowCalculation", "RunPeriod", "SimulationControl", "Sizing", "Output", "OutputControl",
         "LifeCycleCost", "ZoneHVAC", "ZoneControl", "ThermostatSetpoint", "NodeList", "OutdoorAir:Node")
@@ -50,8 +66,25 @@ RENAMED = {"zone_or_zonelist_name": "zone_or_zonelist_or_space_or_spacelist_name
            "zone_floor_area_per_person": "floor_area_per_person"}
 
 
+def free_year(doc, frequency):
+    """Add to `doc` a free-floating year, run on the weather file alone, that reports the zones'
+    mean air and the faces' inside temperatures at `frequency` ("Hourly", "Timestep")."""
+    doc.add("RunPeriod", "year", {"begin_month": 1, "begin_day_of_month": 1, "begin_year": YEAR, "end_month": 12,
+                                  "end_day_of_month": 31, "end_year": YEAR,
+                                  "use_weather_file_holidays_and_special_days": "No",
+                                  "use_weather_file_daylight_saving_period": "No", "apply_weekend_holiday_rule": "No",
+                                  "use_weather_file_rain_indicators": "No", "use_weather_file_snow_indicators": "No"})
+    doc.add("SimulationControl", "", {"do_zone_sizing_calculation": "No", "do_system_sizing_calculation": "No",
+                                      "do_plant_sizing_calculation": "No", "run_simulation_for_sizing_periods": "No",
+                                      "run_simulation_for_weather_file_run_periods": "Yes"})
+    for variable in (ZONE_AIR, FACE):
+        doc.add("Output:Variable", "", {"key_value": "*", "variable_name": variable, "reporting_frequency": frequency})
+    return doc
+
+
 def to_energyplus_25(doc):
-    """A 25.2 document of the building of `doc`, free-floating, reporting the zones' mean air."""
+    """A 25.2 document of the building of `doc`, free-floating, reporting the zones' mean air and
+    the faces' inside temperatures at each time step."""
     new = idfkit.new_document(version=(25, 2, 0))
     for obj in list(new.all_objects):  # the defaults of a new document give way to the model's own
         if obj.obj_type != "Version":
@@ -72,17 +105,15 @@ def to_energyplus_25(doc):
             new.add(obj.obj_type, name, {RENAMED.get(k, k): v for k, v in fields.items()})
         except idfkit.exceptions.ValidationFailedError:
             new.add(obj.obj_type, name, fields)
-    new.add("RunPeriod", "year", {"begin_month": 1, "begin_day_of_month": 1, "begin_year": YEAR, "end_month": 12,
-                                  "end_day_of_month": 31, "end_year": YEAR,
-                                  "use_weather_file_holidays_and_special_days": "No",
-                                  "use_weather_file_daylight_saving_period": "No", "apply_weekend_holiday_rule": "No",
-                                  "use_weather_file_rain_indicators": "No", "use_weather_file_snow_indicators": "No"})
-    new.add("SimulationControl", "", {"do_zone_sizing_calculation": "No", "do_system_sizing_calculation": "No",
-                                      "do_plant_sizing_calculation": "No", "run_simulation_for_sizing_periods": "No",
-                                      "run_simulation_for_weather_file_run_periods": "Yes"})
-    new.add("Output:Variable", "", {"key_value": "*", "variable_name": "Zone Mean Air Temperature",
-                                    "reporting_frequency": "Hourly"})
-    return new
+    return free_year(new, "Timestep")
+
+
+def with_steps(doc, steps=STEPS):
+    """`doc` with `steps` time steps an hour in place of its own Timestep."""
+    for obj in [o for o in doc.all_objects if o.obj_type == "Timestep"]:
+        doc.removeidfobject(obj)
+    doc.add("Timestep", "", {"number_of_timesteps_per_hour": steps})
+    return doc
 
 
 def package_weather():
@@ -91,31 +122,16 @@ def package_weather():
     return Path(pyenergyplus.__file__).parent / PACKAGE_WEATHER
 
 
-def energyplus(doc, folder, epw):
-    """{zone (upper case): hourly mean air (C), hour ending 01:00..24:00} of EnergyPlus 25.2's run."""
-    folder.mkdir(parents=True, exist_ok=True)
-    idf = folder / "model_25_2.idf"
-    idfkit.save_idf(to_energyplus_25(doc), str(idf))
-    return zone_air(idf, folder, epw)
-
-
-def zone_air(idf, folder, epw):
-    """{zone (upper case): hourly mean air (C), hour ending 01:00..24:00} of EnergyPlus run on the
-    IDF at `idf` (its outputs in `folder`)."""
+def run_energyplus(idf, folder, epw):
+    """Run EnergyPlus on the IDF at `idf` and the weather `epw`, its outputs in `folder`;
+    RuntimeError where it does not run to its end."""
     from pyenergyplus.api import EnergyPlusAPI
     api = EnergyPlusAPI()
     state = api.state_manager.new_state()
-    if api.runtime.run_energyplus(state, ["-w", str(epw), "-d", str(folder), "-r", str(idf)]) != 0:
-        raise RuntimeError(f"EnergyPlus failed: {folder / 'eplusout.err'}")
+    code = api.runtime.run_energyplus(state, ["-w", str(epw), "-d", str(folder), "-r", str(idf)])
     api.state_manager.delete_state(state)
-    return read_zone_air(folder)
-
-
-def read_zone_air(folder):
-    """{zone (upper case): hourly mean air (C)} of the EnergyPlus run whose outputs are in `folder`."""
-    table = pd.read_csv(folder / "eplusout.csv")
-    return {c.split(":")[0].strip().upper(): table[c].to_numpy(float) for c in table.columns
-            if "Zone Mean Air Temperature" in c}
+    if code != 0:
+        raise RuntimeError(f"EnergyPlus failed: {folder / 'eplusout.err'}")
 
 
 def case_610ff():
@@ -135,38 +151,153 @@ def models():
     return out
 
 
-def nodeforce(path, weather):
-    """{zone (upper case): air (C) at 01:30..23:30 of the year} of the converted building."""
-    building = convert_idf(path)
-    T = simulate_building(building, weather)
-    return {z.name.upper(): T[f"T{z.air_node}"].to_numpy(float) for z in building.zones}
+def ten_minutes(weather):
+    """The hourly weather linearly interpolated onto 10-min steps over its span."""
+    return weather_on_grid(weather, pd.date_range(weather.index[0], weather.index[-1], freq="10min"))
 
 
-def main(out, epw, only=None):
+def compare(model, building, doc, ours, theirs, lag, step):
+    """Rows of the comparison of nodeforce's nodes `ours` with EnergyPlus's (zone air, faces)
+    `theirs`, paired at EnergyPlus's interval ends less `lag`; the faces nodeforce has no node
+    for, listed."""
+    air, faces = theirs
+    nodes, unpaired = face_nodes(building, faces.columns, doc)
+    series = [(z.name.upper(), "air", z.air_node, air[z.name.upper()]) for z in building.zones]
+    # the zone a node faces: its component's inside zone, or for a partition's outer node the other
+    faced = {c.node_ids[0]: c.inside.zone.upper() for c in building.components}
+    faced.update({c.node_ids[-1]: c.outside.zone.upper() for c in building.components
+                  if getattr(c.outside, "zone", None)})
+    series += [(faced[node], face, node, faces[face]) for face, node in nodes.items()]
+    ours_t, theirs_t = paired(ours[[f"T{n}" for _, _, n, _ in series]],
+                              pd.concat([s for *_, s in series], axis=1, keys=range(len(series))), lag)
+    rows = []
+    for k, (zone, face, node, _) in enumerate(series):
+        T, E = ours_t[f"T{node}"].to_numpy(float), theirs_t[k].to_numpy(float)
+        rmse, mean = differences(T, E)
+        rows.append({"model": model, "zone": zone, "face": face, "step": step, "rmse": rmse, "mean_difference": mean,
+                     "nodeforce_min": T.min(), "nodeforce_max": T.max(), "nodeforce_mean": T.mean(),
+                     "energyplus_min": E.min(), "energyplus_max": E.max(), "energyplus_mean": E.mean()})
+    return rows, unpaired
+
+
+def markdown(table):
+    """The Markdown table of every zone's air and face: RMSE / mean difference hourly and at 10 min."""
+    wide = table.pivot_table(index=["model", "zone", "face"], columns="step", values=["rmse", "mean_difference"],
+                             sort=False)
+    lines = ["| model | zone | face | RMSE hourly (K) | mean difference hourly (K) | RMSE 10 min (K) | "
+             "mean difference 10 min (K) |", "|---|---|---|---|---|---|---|"]
+    for (model, zone, face), row in wide.iterrows():
+        lines.append(f"| {model} | {zone} | {face} | {row['rmse', 'hourly']:.2f} | {row['mean_difference', 'hourly']:+.2f} "
+                     f"| {row['rmse', '10 min']:.2f} | {row['mean_difference', '10 min']:+.2f} |")
+    return "\n".join(lines)
+
+
+def zone_markdown(table):
+    """The Markdown table of each zone: its air's RMSE / mean difference hourly and at 10 min, its
+    faces' median RMSE hourly and at 10 min, and its worst face hourly."""
+    lines = ["| model | zone | air RMSE hourly / 10 min (K) | air mean difference hourly / 10 min (K) | faces | "
+             "face RMSE median hourly / 10 min (K) | worst face hourly (K) |", "|---|---|---|---|---|---|---|"]
+    for (model, zone), g in table.groupby(["model", "zone"], sort=False):
+        air = g[g.face == "air"].set_index("step")
+        faces = g[g.face != "air"]
+        hourly = faces[faces.step == "hourly"]
+        worst = hourly.loc[hourly.rmse.idxmax()]
+        median = faces.groupby("step").rmse.median()
+        lines.append(f"| {model} | {zone} | {air.rmse['hourly']:.2f} / {air.rmse['10 min']:.2f} | "
+                     f"{air.mean_difference['hourly']:+.2f} / {air.mean_difference['10 min']:+.2f} | {len(hourly)} | "
+                     f"{median['hourly']:.2f} / {median['10 min']:.2f} | {worst.rmse:.2f} ({worst.face}) |")
+    return "\n".join(lines)
+
+
+def summary(table):
+    """One line a step and kind: the median and largest RMSE of the zones' air and of the faces."""
+    lines = []
+    for step, g in table.groupby("step", sort=False):
+        air, faces = g[g.face == "air"], g[g.face != "air"]
+        worst = faces.loc[faces.rmse.idxmax()]
+        lines.append(f"{step}: zone air RMSE median {air.rmse.median():.2f} K, largest {air.rmse.max():.2f} K "
+                     f"({len(air)} zones); inside faces median {faces.rmse.median():.2f} K, largest "
+                     f"{worst.rmse:.2f} K ({worst.model} {worst.face}; {len(faces)} faces)")
+    return "\n".join(lines)
+
+
+def figure(table, weeks, path):
+    """Each zone's and face's RMSE as bars (hourly, 10 min), and a week of the worst zone's air at
+    10-min steps in both programs."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    wide = table.pivot_table(index=["model", "zone", "face"], columns="step", values="rmse", sort=False)
+    fig, (bars, week) = plt.subplots(2, 1, figsize=(13, 9), gridspec_kw={"height_ratios": [3, 2]})
+    x = np.arange(len(wide))
+    bars.bar(x - 0.2, wide["hourly"], 0.4, label="hourly")
+    bars.bar(x + 0.2, wide["10 min"], 0.4, label="10 min")
+    bars.set_xticks(x, [f"{m} {(z + ' air' if f == 'air' else f).lower()}" for m, z, f in wide.index], rotation=90,
+                    fontsize=5)
+    bars.set_ylabel("RMSE nodeforce - EnergyPlus (K)")
+    bars.legend()
+    air = table[(table.face == "air") & (table.step == "10 min")]
+    worst = air.loc[air.rmse.idxmax()]
+    (ours, theirs) = weeks[(worst.model, worst.zone)]
+    week.plot(ours.index, ours.to_numpy(), label="nodeforce", lw=1)
+    week.plot(theirs.index, theirs.to_numpy(), label="EnergyPlus", lw=1)
+    week.set_ylabel("zone air (C)")
+    week.set_title(f"{worst.model} {worst.zone.lower()}, the zone of the largest 10-min RMSE: the week of its "
+                   "largest difference", fontsize=9)
+    week.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def worst_week(ours, theirs):
+    """The 7 days of two aligned series around their largest absolute difference."""
+    at = (ours - theirs).abs().idxmax()
+    start = max(ours.index[0], at - pd.Timedelta(days=3.5))
+    span = slice(start, start + pd.Timedelta(days=7))
+    return ours.loc[span], theirs.loc[span]
+
+
+def main(out, epw, only=None, figure_path=None):
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     convert_typical_year(epw, out / "weather.csv", year=YEAR)
-    weather = read_weather(out / "weather.csv")
-    rows = []
+    hourly = read_weather(out / "weather.csv")
+    fine = ten_minutes(hourly)
+    rows, weeks = [], {}
     for name, make in models().items():
         if only and name not in only:
             continue
-        doc = make()
+        doc = with_steps(make())
         idfkit.save_idf(doc, str(out / f"{name}.idf"))
-        ours = nodeforce(out / f"{name}.idf", weather)
-        theirs = energyplus(doc, out / name, epw)
-        for zone, T in ours.items():
-            # EnergyPlus's hour ending at k+1 h is the mean over the hour nodeforce samples at k+0.5 h
-            E = theirs[zone][1:len(T) + 1]
-            d = T - E
-            rows.append({"model": name, "zone": zone, "rmse": np.sqrt(np.mean(d ** 2)), "mean_difference": d.mean(),
-                         "nodeforce_min": T.min(), "nodeforce_max": T.max(), "nodeforce_mean": T.mean(),
-                         "energyplus_min": E.min(), "energyplus_max": E.max(), "energyplus_mean": E.mean()})
-            print(f"{name:12} {zone:12} RMSE {rows[-1]['rmse']:.2f} K, mean difference {d.mean():+.2f} K; "
-                  f"nodeforce {T.min():.2f} / {T.max():.2f} / {T.mean():.2f}, "
-                  f"EnergyPlus {E.min():.2f} / {E.max():.2f} / {E.mean():.2f} C")
-    pd.DataFrame(rows).to_csv(out / "comparison.csv", index=False, float_format="%.3f")
-    print(f"wrote {out / 'comparison.csv'}")
+        building = convert_idf(out / f"{name}.idf")
+        folder = out / name
+        folder.mkdir(parents=True, exist_ok=True)
+        idfkit.save_idf(to_energyplus_25(doc), str(folder / "model_25_2.idf"))
+        run_energyplus(folder / "model_25_2.idf", folder, epw)
+        air, faces = read_outputs(folder, YEAR)
+        # the mean over the hour nodeforce samples at its middle; the state at each step's end
+        new, unpaired = compare(name, building, doc, simulate_building(building, hourly), (hourly_means(air),
+                                hourly_means(faces)), "30min", "hourly")
+        ours = simulate_building(building, fine)
+        fine_rows, _ = compare(name, building, doc, ours, (air, faces), "0min", "10 min")
+        rows += new + fine_rows
+        for face, why in unpaired.items():
+            print(f"{name}: EnergyPlus's face {face} not compared: {why}")
+        for z in building.zones:
+            weeks[(name, z.name.upper())] = worst_week(*paired(ours[f"T{z.air_node}"], air[z.name.upper()], "0min"))
+        for row in new + fine_rows:
+            if row["face"] == "air":
+                print(f"{name:12} {row['zone']:12} {row['step']:7} RMSE {row['rmse']:.2f} K, mean difference "
+                      f"{row['mean_difference']:+.2f} K; nodeforce {row['nodeforce_min']:.2f} / "
+                      f"{row['nodeforce_max']:.2f} / {row['nodeforce_mean']:.2f}, EnergyPlus "
+                      f"{row['energyplus_min']:.2f} / {row['energyplus_max']:.2f} / {row['energyplus_mean']:.2f} C",
+                      flush=True)
+    table = pd.DataFrame(rows)
+    table.to_csv(out / "comparison.csv", index=False, float_format="%.3f")
+    figure(table, weeks, figure_path or out / "energyplus_faces.png")
+    print(zone_markdown(table), markdown(table), summary(table), sep="\n\n")
+    print(f"wrote {out / 'comparison.csv'} and {figure_path or out / 'energyplus_faces.png'}")
 
 
 if __name__ == "__main__":
@@ -174,6 +305,7 @@ if __name__ == "__main__":
     parser.add_argument("out", nargs="?", default=ROOT / "out" / "bench_energyplus", type=Path)
     parser.add_argument("--weather", type=Path, help="an EPW (default: pyenergyplus's Denver TMY3)")
     parser.add_argument("--only", nargs="+", choices=list(models()), help="run these models alone")
+    parser.add_argument("--figure", type=Path, help="where the figure goes (default: OUT/energyplus_faces.png)")
     args = parser.parse_args()
     try:
         epw = args.weather or package_weather()
@@ -181,4 +313,4 @@ if __name__ == "__main__":
         sys.exit(print("bench_energyplus needs EnergyPlus: pip install -e '.[energyplus]'", file=sys.stderr) or 2)
     if not epw.is_file():
         sys.exit(print(f"{epw}: no such weather file", file=sys.stderr) or 2)
-    main(args.out, epw, args.only)
+    main(args.out, epw, args.only, args.figure)
