@@ -42,6 +42,14 @@ class Policy:
     identifiable_share: float = 0.25
     # A temperature (T_ground) is identifiable when its sd is under this (K).
     identifiable_kelvin: float = 1.0
+    # A candidate whose values are loose (not identifiable) is admitted only where the data
+    # establish it at this many standard errors (dimensionless), twice over
+    # (`diagnosis.selection.weigh_loose`): its estimate this many sds from the value that is no
+    # effect, and what it predicts of the days no fit read better than the best candidate whose
+    # values are tight by this many standard errors of the paired difference; where no tight
+    # candidate passes, it is refused. Two: a two-sided 95 % interval, the level `limit_sds`
+    # refuses a value at.
+    established_sds: float = 2.0
     # Standard deviations of its estimate a value must lie beyond a physical limit to be refused
     # (dimensionless): a door at ten times its wood's conductivity, estimated at 11.4 +- 1.5, may
     # well be at ten; only an estimate whose two-sided 95 % interval leaves the range is not.
@@ -158,15 +166,17 @@ class Policy:
         each judged parameter's physical limits ([low, high], None where unbounded), what the data
         fix where its parameters trade off (`Effect.trade_off`: [derived quantity, whether a
         bound is then waived], None), why the file's description makes the effect implausible
-        (`Effect.implausible`, None), whether its target is one
-        component or a group of them (`model.effects.members`) and whether one of their nodes is
-        among the `sensed` node ids, the other sensors the evidence reads (`claim`)."""
+        (`Effect.implausible`, None), the values at which it is absent (`Effect.no_effect_values`),
+        whether its target is one component or a group of them (`model.effects.members`) and
+        whether one of their nodes is among the `sensed` node ids, the other sensors the evidence
+        reads (`claim`)."""
         names = members(building, target)
         component = bool(names)
         return {"limits": {name: [None if math.isinf(v) else v for v in self.limits(building, effect, target, name)]
                            for name in self.judged_parameters(effect)},
                 "trade_off": list(EFFECTS[effect].trade_off) if EFFECTS[effect].trade_off else None,
                 "implausible": implausible(building, effect, target),
+                "no_effect": EFFECTS[effect].no_effect_values(building, target),
                 "component": component,
                 "sensed": component and any(set(building.component(n).node_ids) & set(sensed) for n in names)}
 
@@ -174,30 +184,28 @@ class Policy:
         """`objection_of` the candidate's `facts` in `building`."""
         return self.objection_of(effect, parameters, derived, self.facts(building, effect, target))
 
-    def objection_of(self, effect, parameters, derived, facts):
+    def objection_of(self, effect, parameters, derived, facts, loose=True):
         """Why a calibrated effect may not be added to the model, or None: a gain the building
         file's description rules out (`implausible`), a parameter on a bound of its search range
-        or not identifiable from the data (unless the quantity its parameters trade off along
-        is, `Effect.trade_off`, or the calibration held it at its physical prior), or a value
-        outside physical limits beyond its uncertainty (`limit_sds`). The judged parameters, their
-        limits and the trade-off are the candidate's `facts`, as report.json records them.
+        or, where `loose`, one the data leave loose (`loose_values`), or a value outside physical
+        limits beyond its uncertainty (`limit_sds`). The judged parameters, their limits and the
+        trade-off are the candidate's `facts`, as report.json records them. A loose value refuses
+        a candidate only until the choice has weighed what it predicts (`diagnosis.selection.decide`
+        reads the objection without it).
 
         parameters : {name: `ParameterEstimate`}, or report.json's {"value", "std", "identifiable", "on_bound"}
         derived : what the data determine besides (`diagnosis.calibrate.derived`)
         facts : what the building says of the candidate (`facts`)
         """
         reasons = [facts["implausible"]]
-        trade_off = facts["trade_off"] if "trade_off" in facts else EFFECTS[effect].trade_off
-        key, bounds_waived = trade_off or (None, False)
-        fixed = (derived or {}).get(key)
-        resolved = fixed is not None and fixed["std"] < self.identifiable_share * abs(fixed["value"])
+        resolved, bounds_waived = self._resolved(effect, derived, facts)
         for name in facts["limits"]:
             p, unit = ParameterEstimate.of(parameters[name]), EFFECTS[effect].parameter(name).unit
             low, high = (-math.inf if facts["limits"][name][0] is None else facts["limits"][name][0],
                          math.inf if facts["limits"][name][1] is None else facts["limits"][name][1])
             if p.on_bound and not (resolved and bounds_waived):
                 reasons.append(f"{name} = {p.value:.3g} {unit} ends on a bound of its range")
-            elif not p.identifiable and not resolved and not p.prior:
+            elif loose and not p.identifiable and not resolved and not p.prior:
                 reasons.append(f"{name} = {p.value:.3g} +- {p.sd:.2g} {unit} is not identifiable from these data")
             margin = self.limit_sds * p.sd
             if not low - margin <= p.value <= high + margin:
@@ -205,6 +213,35 @@ class Policy:
                 reasons.append(f"{name} = {p.value:.3g} +- {p.sd:.2g} {unit} is {what} [{low:.3g}, {high:.3g}] "
                                f"by more than {self.limit_sds:g} standard deviations")
         return "; ".join(r for r in reasons if r) or None
+
+    def _resolved(self, effect, derived, facts):
+        """Whether the quantity the effect's parameters trade off along (`Effect.trade_off`) is
+        determined (its sd under `identifiable_share` of it), and whether a bound is then waived."""
+        trade_off = facts["trade_off"] if "trade_off" in facts else EFFECTS[effect].trade_off
+        key, bounds_waived = trade_off or (None, False)
+        fixed = (derived or {}).get(key)
+        return fixed is not None and fixed["std"] < self.identifiable_share * abs(fixed["value"]), bounds_waived
+
+    def loose_values(self, effect, parameters, derived, facts):
+        """{name: `ParameterEstimate`} of the judged parameters the data leave loose: not
+        identifiable (`identifiable`), not on a bound, neither weighed with a prior nor determined
+        with the others through the quantity they trade off along."""
+        if self._resolved(effect, derived, facts)[0]:
+            return {}
+        estimates = {name: ParameterEstimate.of(parameters[name]) for name in facts["limits"]}
+        return {name: p for name, p in estimates.items() if not p.identifiable and not p.prior and not p.on_bound}
+
+    def established(self, parameters, facts):
+        """The first parameter (name) whose estimate lies more than `established_sds` of its sd
+        from the value at which the effect is absent (`facts`' "no_effect"), None where every
+        interval includes it (or the facts, from a report that predates them, do not say it): the
+        data rule out that the effect is not there, however loosely they fix its size. An sd of 0
+        is a covariance that did not come out, not certainty."""
+        for name, null in (facts.get("no_effect") or {}).items():
+            p = ParameterEstimate.of(parameters[name])
+            if p.sd > 0 and abs(p.value - null) > self.established_sds * p.sd:
+                return name
+        return None
 
     # ---- 4. the order
     def claim(self, effect, component, sensed=False):

@@ -160,7 +160,11 @@ class Verdict:
     """One candidate's test in a round (`diagnosis.selection.candidate_test`): its cross-validated
     fall of J (C2) and the fall's standard error, what it needs, what the days other than its best
     gain, its evidence (C2), whether it passes, the records it harms, the objection of physics
-    (None if none), and its own sensors' test, whether it passes by them."""
+    (None if none), and its own sensors' test, whether it passes by them; for a candidate whose
+    values are loose, how the choice weighed it (`selection.weigh_loose`: {"established": the
+    parameter whose interval excludes no effect or None, "against": the label of the best
+    candidate whose values are tight, "ahead": how much lower its
+    evidence is (C2), "se": the standard error of that (C2), "needed" (C2), "admitted"})."""
     cv_fall: float
     cv_se: float
     needed: float
@@ -171,9 +175,13 @@ class Verdict:
     objection: str = None
     own: dict = None  # its own sensors' test (`selection.own_test`), None without
     passes_by_own: bool = False  # it passes on them (the air no worse than the noise's margin)
+    weighed: dict = None  # its loose values weighed against what it predicts (`selection.weigh_loose`)
 
     def to_json(self):
-        return asdict(self)
+        out = asdict(self)
+        if self.weighed is None:  # a candidate whose values are tight, as before there was a weighing
+            del out["weighed"]
+        return out
 
 
 @dataclass

@@ -6,6 +6,7 @@ cross-validation blocks of whole days it reads (`blocks`), the records a candida
 (`diagnosis.policy`); the pass rule and the noise's yardstick are `model.score.Yardstick`'s.
 """
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -122,14 +123,21 @@ def decide(results, baseline, policy):
     verdicts = {r.label: candidate_test(r, base, margin, floor_sd, groups, sigma, policy, air_at_noise)
                 for r in results}
     passing = [r for r in results if verdicts[r.label].passes]  # 1.
-    admissible = [r for r in passing if not verdicts[r.label].objection]  # 2.
+    tight = [r for r in passing if not verdicts[r.label].objection]  # 2.
+    loose = [r for r in passing if verdicts[r.label].objection and only_loose(r, verdicts[r.label], policy)]
+    if distances is None and tight:
+        weighed = tight + loose
+        distances = {a.label: {b.label: distance(a, b) for b in weighed} for a in weighed}
+    # loose values are weighed against the best tight candidate: where none passes, the line stands
+    for r in loose if tight else []:
+        verdicts[r.label] = weigh_loose(r, verdicts[r.label], min(tight, key=lambda t: t.evidence().sum()), base,
+                                        sigma, distances, policy)
+    admissible = [r for r in passing if not verdicts[r.label].objection]
     suggestions = [{"candidate": r.label, "reason": verdicts[r.label].objection, "cv_rmse": r.cv.rmse}
                    for r in passing if verdicts[r.label].objection]
     components = {r.target for r in results if r.physics["component"]}
     chosen, alike = None, []
     if admissible:
-        if distances is None:
-            distances = {a.label: {b.label: distance(a, b) for b in admissible} for a in admissible}
         near = band(admissible, base, sigma, floor_sd, n, distances, policy)  # 3.
         chosen = min(near, key=lambda r: (claim(r, policy), r.evidence().sum()))  # 4.
         alike = [r for r in near if r is not chosen]
@@ -194,6 +202,46 @@ def candidate_test(result, base, margin, floor_sd, groups, sigma, policy, air_at
     by_air = bool(judged.beats) and not air_at_noise
     return Verdict(down, judged.se, judged.needed, judged.other_days, float(result.evidence().sum()), by_air or by_own,
                    harms, said, own, by_own)
+
+
+def only_loose(result, verdict, policy):
+    """Whether all that refuses a passing candidate is that the data leave values of it loose
+    (`Policy.loose_values`): no bound, no physical limit, no record it harms. A report that
+    predates the weighing (its facts without "no_effect") replays with its loose values refused."""
+    facts = result.physics
+    return ("no_effect" in facts and not verdict.harms
+            and bool(policy.loose_values(result.effect, result.parameters, result.derived, facts))
+            and policy.objection_of(result.effect, result.parameters, result.derived, facts, loose=False) is None)
+
+
+def weigh_loose(result, verdict, rival, base, sigma, distances, policy):
+    """Step 2 for a candidate whose values are loose (`only_loose`): its `Verdict`, admitted
+    (objection None) where the data establish it at `Policy.established_sds` twice over, refused
+    with the reason otherwise. Its estimate must lie that many sds from the value at which the
+    effect is absent (`Policy.established`): a loose size of an effect that is there, not a value
+    the data cannot tell from none. And what it predicts of the days no fit read must beat the
+    best candidate whose values are tight, `rival`, by that many standard errors of the paired
+    difference (`band`'s: the larger of its day-to-day scatter and what the noise alone makes of
+    it): a better prediction than a tight candidate within that is one the data do not establish,
+    and the value one can act on wins. The weighing is in `Verdict.weighed`."""
+    z = policy.established_sds
+    name = policy.established(result.parameters, result.physics)
+    ahead, se = fall(rival.evidence(), result.evidence())
+    se = max(se, noise_difference(distances[result.label][rival.label], sigma))
+    needed = max(z * se, policy.rounding(float(base.sum())))
+    weighed = {"established": name, "against": rival.label, "ahead": ahead, "se": se, "needed": needed,
+               "admitted": bool(name is not None and ahead > needed)}
+    if weighed["admitted"]:
+        return replace(verdict, objection=None, weighed=weighed)
+    if name is None:
+        why = "; ".join(f"{p} = {result.parameters[p].value:.3g} +- {result.parameters[p].sd:.2g} "
+                        f"{EFFECTS[result.effect].parameter(p).unit} is within {z:g} standard deviations of "
+                        f"{null:.3g}, where the effect is absent" for p, null in result.physics["no_effect"].items())
+    else:
+        why = (f"it predicts what no fit read better than {rival.effect} on {rival.target}, whose values are tight, "
+               f"by no more than {z:g} standard errors of the difference (J {result.evidence().sum():.3g} against "
+               f"{rival.evidence().sum():.3g} C2, {z:g} x {se:.3g} C2)")
+    return replace(verdict, objection=f"{verdict.objection}; {why}", weighed=weighed)
 
 
 def own_test(own, sigma, policy):
@@ -289,6 +337,7 @@ def _reason(chosen, alike, results, passing, base, n, verdicts, margin, componen
                  f"; among them {best.effect} on {best.target} best predicts {what}, against its "
                  f"{chosen.evidence().sum():.3g} C2)"
                  + (f", but is refused: {verdicts[best.label].objection}" if verdicts[best.label].objection else ""))
+    said += _weighed(chosen, verdict, {r.label: r for r in results}, policy)
     if alike:
         said += ("; within one standard error of the best, and so not told apart by these data: "
                  + ", ".join(f"{r.effect} on {r.target} ({r.evidence().sum():.3g} C2)" for r in alike)
@@ -304,6 +353,33 @@ def _reason(chosen, alike, results, passing, base, n, verdicts, margin, componen
     if policy.is_shape(chosen.effect):
         said += "; no physical effect comes within one standard error of it"
     return said + "."
+
+
+def _weighed(chosen, verdict, by_label, policy):
+    """The clause of the reason on a chosen candidate whose values are loose (`weigh_loose`), ""
+    for one whose values are tight: each loose value with its sd, how far the estimate lies from
+    the value at which the effect is absent, and what it predicts against the best candidate whose
+    values are tight, with that one's values and sds."""
+    w = verdict.weighed
+    if not w:
+        return ""
+
+    def values(fit, estimates):
+        return ", ".join(f"{name} = {p.value:.3g} +- {p.sd:.2g} {EFFECTS[fit.effect].parameter(name).unit}"
+                         for name, p in estimates.items())
+    z, name = policy.established_sds, w["established"]
+    loose = policy.loose_values(chosen.effect, chosen.parameters, chosen.derived, chosen.physics)
+    p, null = chosen.parameters[name], chosen.physics["no_effect"][name]
+    said = (f"; its {values(chosen, loose)} {'is' if len(loose) == 1 else 'are'} loose, but the effect is "
+            f"established: {name} lies {abs(p.value - null) / p.sd:.3g} standard deviations from {null:.3g}, where "
+            f"the effect is absent, beyond {z:g}")
+    rival = by_label[w["against"]]
+    judged = {k: q for k, q in rival.parameters.items() if k in rival.physics["limits"]}
+    return said + (f", and it predicts what no fit read better than the best candidate whose values are tight, "
+                   f"{rival.effect} on {rival.target} ({values(rival, judged)}): J {chosen.evidence().sum():.3g} "
+                   f"against {rival.evidence().sum():.3g} C2, lower by more than {z:g} standard errors of the "
+                   f"difference ({z:g} x {w['se']:.3g} C2): the choice follows the prediction, and the size of "
+                   f"{chosen.effect} is as loose as its sd says")
 
 
 def acting(result):

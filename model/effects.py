@@ -90,6 +90,10 @@ class Effect:
     physical: Callable | None = None
     # the parameters whose identifiability and limits decide for it (None: all)
     judged: tuple | None = None
+    # the parameters whose value as the building declares it is the model without the effect, the
+    # value an estimate must be told from for the effect to be established (None: all); a
+    # coupling's temperature or a node's conductance acts only through another
+    no_effect: tuple | None = None
     # Derivation -> {name: {"value", "std", "unit"}}: what the data fix where its parameters
     # trade off (`diagnosis.calibrate.derived`)
     derived: Callable | None = None
@@ -130,6 +134,12 @@ class Effect:
     def judged_parameters(self):
         """The parameters whose identifiability and limits decide for it (`judged`, default all)."""
         return self.judged if self.judged is not None else tuple(p.name for p in self.parameters)
+
+    def no_effect_values(self, building, target):
+        """{name: value} of the parameters (`no_effect`) at which the effect is absent: as the
+        building declares them now (a factor of 1, a gain or a coupling of 0)."""
+        declared = self.read(building, target)
+        return {name: float(declared[name]) for name in (self.no_effect or declared)}
 
     def start(self, building, target):
         """Where a calibration starts: the declared values, a parameter declared 0 at its
@@ -646,7 +656,8 @@ EFFECTS = {e.id: e for e in (
            (Parameter("U", "W/m2/K", 0.0, 20.0), Parameter("T_ground", "C", -10.0, 40.0)),
            lambda b: [c.name for c in b.components if isinstance(c.outside, Adiabatic)],
            _ground_read, _ground_write, _own_nodes, priors=_ground_priors,
-           absent_start=_absent(U=1.0), derived=_ground_flux, trade_off=("ground_heat_flux", True)),
+           absent_start=_absent(U=1.0), derived=_ground_flux, trade_off=("ground_heat_flux", True),
+           no_effect=("U",)),
     Effect("infiltration", "an air change with the outside",
            (Parameter("n", "1/h", 0.0, 20.0),), _zones,
            *_zone_field("air_change_rate", "n"), _no_node,
@@ -687,12 +698,13 @@ EFFECTS = {e.id: e for e in (
            *_lumped_field("internal_mass", "C_m", "H_m"), _no_node, _lumped_limits("C_m"),
            offers=_offered(_zones), absent_start=_air_capacities("C_m", 10.0),
            derived=_time_constant("mass_time_constant"), trade_off=("mass_time_constant", False),
-           energyplus=lambda w, t: w.internal_mass(t)),
+           no_effect=("C_m",), energyplus=lambda w, t: w.internal_mass(t)),
     Effect("heat_input_lag", "the heater's own capacity: a node between its measured heat input and the zone",
            (Parameter("C_h", "J/K", 0.0, 1e8), Parameter("H_h", "W/K", 0.01, 1e5)),
            _heated, *_lumped_field("heat_input_lag", "C_h", "H_h"), _no_node, _lumped_limits("C_h"),
            offers=_offered(_heated), absent_start=_air_capacities("C_h", 1.0),
-           derived=_time_constant("heater_time_constant"), trade_off=("heater_time_constant", False)),
+           derived=_time_constant("heater_time_constant"), trade_off=("heater_time_constant", False),
+           no_effect=("C_h",)),
     Effect("envelope_conductance", "the envelope's materials conducting other than declared: one factor on "
                                    "the layer conductances of a zone's components to the outdoors and to "
                                    "boundaries, not their outside surface coefficients",

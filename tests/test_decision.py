@@ -475,3 +475,19 @@ def test_a_revisit_that_finds_the_effect_no_longer_lowers_j_by_its_margin_remove
     written = removal.to_json()
     assert written["removed"] == "envelope_conductance@cell" and written["chosen"] is None
     assert written["refit"]["cv"]["J"] == pytest.approx(8.0)
+
+
+def test_an_effect_is_absent_at_the_values_the_building_declares(testcell):
+    # the test cell's window transmits 0.8; its floor is adiabatic (no coupling: U 0, whatever
+    # T_ground), its air has no internal mass (C_m 0, whatever H_m), its walls their own conductivity
+    absent = {effect: POLICY.facts(testcell, effect, target)["no_effect"] for effect, target in
+              [("solar_transmittance", "window"), ("ground_coupling", "floor"), ("internal_mass", "cell"),
+               ("conductivity", "door"), ("internal_gain", "cell")]}
+    assert absent == {"solar_transmittance": {"tau": 0.8}, "ground_coupling": {"U": 0.0},
+                      "internal_mass": {"C_m": 0.0}, "conductivity": {"factor": 1.0}, "internal_gain": {"Q": 0.0}}
+    # a coupling 2.2 sds from none is established, however loose its temperature
+    facts = POLICY.facts(testcell, "ground_coupling", "floor")
+    assert POLICY.established({"U": parameter(0.9, 0.4, identifiable=False),
+                               "T_ground": parameter(12.0, 3.0, identifiable=False)}, facts) == "U"
+    assert POLICY.established({"U": parameter(0.7, 0.4, identifiable=False),
+                               "T_ground": parameter(12.0, 0.5)}, facts) is None
