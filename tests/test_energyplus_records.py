@@ -1,14 +1,18 @@
 """The records of the diagnosis benchmark whose truth is EnergyPlus (benchmarks/energyplus_records.py,
 benchmarks/bench_energyplus_diagnosis.py), without EnergyPlus: each change edits the named field
 of the IDF by the named amount and nothing the diagnosis reads besides (the changed IDF written
-and read back with idfkit); the times EnergyPlus reports; the noise's draws.
+and read back with idfkit); the judging on hand-made answers; the noise's draws.
 """
+import math
+
 import idfkit
 import numpy as np
 import pandas as pd
 import pytest
 
 from benchmarks import energyplus_records as records
+from benchmarks.bench_energyplus_diagnosis import summary
+from benchmarks.bench_diagnosis import held, right
 
 ZONE = records.ZONE
 
@@ -153,3 +157,58 @@ def test_noise_is_the_same_for_the_same_record_and_draw():
     # 40 000 draws of N(0, 0.1): the mean's standard error 0.0005 C, the sd's 0.00035 C
     assert abs(d.mean()) < 0.002 and d.std() == pytest.approx(records.NOISE, abs=0.0015)
 
+
+def answered(change, effects, later=(0.3, 0.3)):
+    """A hand-made result of the record 600FF/`change`: the effects added, the later RMSEs."""
+    spec = records.SPECS_BY_NAME[f"600FF/{change}"]
+    return {"name": spec.name, "draw": 0, "fault": spec.label, "noise": 0.1,
+            "faults": [[list(a) for a in spec.answers]] if spec.answers else [],
+            "loop": {"effects": [list(e) for e in effects], "before": 1.0, "after": 0.5, "seconds": 1.0},
+            "idf_changes": [], "not_written": [], "record_energyplus_vs_truth": 1.0,
+            "later": {"written": later[0], "corrected": later[1]}}
+
+
+@pytest.mark.parametrize("change, effect, is_right", [
+    ("air-change", ("infiltration", ZONE), True),
+    ("air-change", ("thermal_bridge", ZONE), True),
+    ("air-change", ("envelope_conductance", ZONE), False),
+    ("insulation", ("conductivity", "NORTH WALL"), True),
+    ("insulation", ("envelope_conductance", ZONE), True),
+    ("insulation", ("conductivity", "ROOF"), False),
+    ("furniture", ("internal_mass", ZONE), True),
+    ("furniture", ("inside_convection", ZONE), False),
+    ("glass", ("solar_transmittance", "SOUTH WINDOW EAST"), True),
+    ("glass", ("envelope_conductance", ZONE), False),
+    ("gain", ("daily_gain", ZONE), True),
+    ("gain", ("internal_gain", ZONE), True),
+    ("gain", ("proportional_gain", f"{ZONE}->I_EAST WALL"), False),
+    ("roof", ("solar_absorptance", "ROOF"), True),
+    ("roof", ("solar_absorptance", "NORTH WALL"), False),
+    ("none", ("inside_convection", ZONE), False),
+])
+def test_first_effect_judged_by_the_change(change, effect, is_right):
+    assert right(answered(change, [effect, ("internal_mass", ZONE)]), "loop") is is_right
+
+
+def test_nothing_added_is_right_only_without_a_change():
+    assert right(answered("none", []), "loop")
+    assert not right(answered("glass", []), "loop")
+
+
+def test_later_record_holds_within_one_and_a_half_noise():
+    assert held(answered("glass", [], later=(0.30, 0.30)))
+    assert held(answered("glass", [], later=(0.05, 0.15)))  # worse, but within 1.5 x 0.1 C
+    assert not held(answered("glass", [], later=(0.05, 0.16)))
+    assert not held(answered("glass", [], later=(0.30, 0.31)))
+
+
+def test_summary_counts_the_criteria():
+    results = [answered("glass", [("solar_transmittance", "SOUTH WINDOW WEST")]),
+               answered("roof", [("inside_convection", ZONE)], later=(0.3, 0.5)),
+               answered("none", []), answered("none", [("daily_gain", ZONE)]),
+               {"name": "900FF/gain", "draw": 0, "error": "RuntimeError: EnergyPlus failed"}]
+    lines, numbers = summary(results, 1)
+    assert numbers["right"] == 0.5 and numbers["clean_untouched"] == 0.5 and numbers["carried"] == 0.75
+    assert numbers["failed"] == 1 and numbers["diagnoses"] == 4
+    assert any(line.startswith("- FAIL: first effect right on 50 %") for line in lines)
+    assert not math.isnan(numbers["seconds_median"])
