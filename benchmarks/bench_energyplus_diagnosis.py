@@ -135,7 +135,8 @@ def summary(results, draws):
     def mark(key):
         return "n/a" if math.isnan(numbers[key]) else "PASS" if numbers[key] >= CRITERIA[key] else "FAIL"
     lines = [
-        f"{len(ok)} diagnoses ({draws} draw(s) a record)"
+        f"{len(ok)} diagnoses of {len({r['name'] for r in ok})} records: "
+        + ", ".join(f"draw {d} of {sum(r['draw'] == d for r in ok)}" for d in range(draws))
         + (f"; {len(failed)} failed: " + "; ".join(f"{r['name']} draw {r['draw']}: {r['error']}" for r in failed)
            if failed else ""), "",
         "## The criteria (issue 74)", "",
@@ -146,10 +147,12 @@ def summary(results, draws):
         f"original IDF beyond {WITHIN} x the noise on {pct(numbers['carried'])} (>= 95 %)", "",
         "## First effect added, every record", "", confusion(ok), "",
         "## Every record", "",
-        "Zone air RMSE in C. 'E+ vs truth' is EnergyPlus on the unchanged IDF against the record; "
+        f"Time per diagnosis: median {numbers['seconds_median']:.0f} s. "
+        "Zone air RMSE in C. 'change (E+)' is EnergyPlus on the unchanged IDF against the record: the change's "
+        "size as EnergyPlus sees it; "
         "'nodeforce before/after' the diagnosis's validation RMSE (its last 40 % of the record); 'later' "
         "EnergyPlus on the later record with the original IDF and with model_after.idf.", "",
-        "| record | draw | effects added | E+ vs truth | nodeforce before, after | later: original, model_after "
+        "| record | draw | effects added | change (E+) | nodeforce before, after | later: original, model_after "
         "| written into the IDF | s |",
         "|---|---|---|---|---|---|---|---|",
     ]
@@ -178,6 +181,9 @@ def page(lines, command):
         "also carries every difference between the two programs on the same IDF "
         "([energyplus.md](energyplus.md#beside-energyplus-free-floating)).", "",
         "Made by", "", f"    {command}", "",
+        "from the records `make benchmark-energyplus` finished (kept in out/bench_energyplus_diagnosis/records, "
+        "each with a digest of its spec and of the code: a rerun skips what is unchanged; `--report` makes "
+        "this page again from them). EnergyPlus is the `energyplus` extra's (pyenergyplus).", "",
         "## The records", "",
         "Made by `benchmarks/energyplus_records.py` (its docstring says each choice). " + " ".join(
             " ".join(line.strip() for line in part.splitlines()) for part in doc[1:2]), "",
@@ -221,8 +227,9 @@ def main(argv=None):
     # every record's first draw before any second: a run stopped early has the most records
     tasks = [(s.name, d, result_path(args.out, s.name, d), args.population, args.generations)
              for d in range(args.draws) for s in specs]
-    todo = [t for t in tasks if args.fresh or not finished(t[2], t[0])] if not args.report else []
-    print(f"{len(specs)} records x {args.draws} draws: {len(tasks) - len(todo)} done before, {len(todo)} to run "
+    unfinished = [t for t in tasks if args.fresh or not finished(t[2], t[0])]
+    todo = [] if args.report else unfinished
+    print(f"{len(specs)} records x {args.draws} draws: {len(tasks) - len(unfinished)} done before, {len(todo)} to run "
           f"on {args.workers} workers", flush=True)
     started = time.time()
     from nodeforce.runtime import lifetime, tempdirs
@@ -236,8 +243,8 @@ def main(argv=None):
                for t in tasks]
     results = [r for r in results if r is not None]
     lines, numbers = summary(results, args.draws)
-    lines.append("")
-    lines.append(f"{(time.time() - started) / 60:.0f} min on {args.workers} workers for {len(todo)} diagnoses")
+    if todo:
+        lines += ["", f"{(time.time() - started) / 60:.0f} min on {args.workers} workers for {len(todo)} diagnoses"]
     print("\n".join(lines))
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "results.json").write_text(json.dumps({"numbers": numbers, "results": results}, indent=1) + "\n")
