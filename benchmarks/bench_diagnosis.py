@@ -203,9 +203,10 @@ def longest_first(tasks):
     return sorted(tasks, key=cost, reverse=True)
 
 
-def run(tasks, workers, scheduler=None):
-    """Each task in a worker process (2 by default), or on the workers of the Dask cluster at
-    `scheduler`, with a progress bar; each result kept as it comes; the results as they came."""
+def run(tasks, workers, scheduler=None, job=diagnose_one):
+    """Each task `job(task)` (a record's diagnosis, `diagnose_one` unless another benchmark's) in a
+    worker process (2 by default), or on the workers of the Dask cluster at `scheduler`, with a
+    progress bar; each result kept as it comes; the results as they came."""
     from concurrent.futures import as_completed
     from nodeforce.runtime import lifetime
     from nodeforce.runtime.cluster import Cluster
@@ -223,10 +224,10 @@ def run(tasks, workers, scheduler=None):
 
         if scheduler is not None:
             with Cluster(scheduler) as cluster:
-                cluster.map(diagnose_one, tasks, done=lambda i, result: arrived(tasks[i], result))
+                cluster.map(job, tasks, done=lambda i, result: arrived(tasks[i], result))
         else:
             with lifetime.worker_pool(min(workers, len(tasks))) as pool:
-                futures = {pool.submit(diagnose_one, t): t for t in tasks}
+                futures = {pool.submit(job, t): t for t in tasks}
                 for future in as_completed(futures):
                     arrived(futures[future], future.result())
     return done
