@@ -23,10 +23,11 @@ surfaces):
 
 - air change x3: the zone's infiltration, or a thermal bridge from its air to the outdoor air
   (one equation: a conductance from the air to the outdoor air);
-- the walls' insulation x2 as conductive: the conductivity of one of the walls, or the zone's
-  envelope factor;
+- the walls' insulation x2 as conductive: the conductivity of one of the walls, of the walls'
+  construction or of their insulation, or the zone's envelope factor;
 - a furniture mass (an InternalMass): the zone's internal mass;
-- the glazing's solar transmittance x0.6: a window's solar transmittance;
+- the glazing's solar transmittance x0.6: a window's solar transmittance, or the windows'
+  construction's;
 - an office-hours gain (300 W on weekdays 08:00 to 18:00): a constant or a daily gain in the zone;
 - the roof's solar absorptance 0.6 -> 0.9: the roof's solar absorptance;
 - none: no effect added.
@@ -172,13 +173,17 @@ class Change:
 
 WALLS = ("SOUTH WALL", "EAST WALL", "NORTH WALL", "WEST WALL")
 WINDOWS = ("SOUTH WINDOW WEST", "SOUTH WINDOW EAST")
+# the walls' construction and insulation as groups (docs/model.md section 7: a target shared by
+# several surfaces), which the converter makes of examples/bestest/cases.py's IDFs
+WALL_GROUPS = ("construction:LIGHT WALL", "construction:HEAVY WALL", "material:WALL FIBERGLASS QUILT",
+               "material:FOAM INSULATION")
 CHANGES = {
     "air-change": Change("air change x3", more_air_change, (("infiltration", ZONE), ("thermal_bridge", ZONE))),
     "insulation": Change("walls' insulation conductivity x2", more_conductive_walls,
-                         tuple(("conductivity", w) for w in WALLS) + (("envelope_conductance", ZONE),)),
+                         tuple(("conductivity", w) for w in WALLS + WALL_GROUPS) + (("envelope_conductance", ZONE),)),
     "furniture": Change("furniture (InternalMass)", furniture, (("internal_mass", ZONE),)),
     "glass": Change("glazing's solar transmittance x0.6", darker_glass,
-                    tuple(("solar_transmittance", w) for w in WINDOWS)),
+                    tuple(("solar_transmittance", w) for w in WINDOWS + ("construction:DOUBLE CLEAR",))),
     "gain": Change("office-hours gain 300 W", office_gain, (("internal_gain", ZONE), ("daily_gain", ZONE))),
     "roof": Change("roof's solar absorptance 0.6 -> 0.9", darker_roof, (("solar_absorptance", "ROOF"),)),
     "none": Change("none", None, ()),
