@@ -6,7 +6,6 @@ its change with the angle of incidence.
 Angles in degrees, conductances in W/m2/K, transmittances and reflectances dimensionless.
 """
 import numpy as np
-from scipy.optimize import brentq
 
 from .longwave import SIGMA
 
@@ -33,6 +32,10 @@ def pane_optics(T0, R0):
 
     if R0 <= 1e-9:
         return 0.0, T0
+    # imported here: the FMU imports this module for its gaps, and scipy's extension modules,
+    # once loaded in an FMU's embedded Python, read freed memory as a C host unloads it
+    # (tests/test_fmu_memory.py); only the converter needs the root
+    from scipy.optimize import brentq
     r = brentq(reflectance, 1e-12, R0)
     return r, tau_of(r)
 
