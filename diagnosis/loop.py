@@ -70,7 +70,7 @@ from nodeforce.diagnosis.windows import Beside, Record, Windows, period
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.iotools.energyplus_corrections import idf_of, write_corrections
 from nodeforce.ga.locate import Execution, SearchSettings, check_measured, evaluator_kind, locate
-from nodeforce.model.effects import EFFECTS, members
+from nodeforce.model.effects import EFFECTS, member_nodes
 from nodeforce.model.errors import InputError
 from nodeforce.model.score import Noise
 
@@ -165,8 +165,7 @@ def own_sensors(building, component, windows, base, sensed):
     its own sensors' J (C2) per block under the model (its other sensed nodes `base`) and under
     the candidate (`sensed`), unweighted, and the file's numerical error there
     (`Windows.own_numerical`)."""
-    nodes = {i for name in members(building, component) for i in building.component(name).node_ids}
-    columns = windows.own_columns(nodes)
+    columns = windows.own_columns(set(member_nodes(building, component)))
     before, n = windows.own_J(base, columns)
     after, _ = windows.own_J(sensed, columns)
     return OwnSensors([float(v) for v in before], [float(v) for v in after], n, windows.own_numerical(columns))

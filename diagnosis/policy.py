@@ -11,7 +11,7 @@ from dataclasses import asdict, dataclass, fields
 import numpy as np
 
 from nodeforce.diagnosis.estimate import ParameterEstimate
-from nodeforce.model.effects import EFFECTS, members
+from nodeforce.model.effects import EFFECTS, member_nodes
 from nodeforce.model.score import Yardstick
 
 
@@ -170,15 +170,15 @@ class Policy:
         whether its target is one component or a group of them (`model.effects.members`) and
         whether one of their nodes is among the `sensed` node ids, the other sensors the evidence
         reads (`claim`)."""
-        names = members(building, target)
-        component = bool(names)
+        nodes = member_nodes(building, target)
+        component = bool(nodes)  # a component has nodes; a zone or an input column none
         return {"limits": {name: [None if math.isinf(v) else v for v in self.limits(building, effect, target, name)]
                            for name in self.judged_parameters(effect)},
                 "trade_off": list(EFFECTS[effect].trade_off) if EFFECTS[effect].trade_off else None,
                 "implausible": implausible(building, effect, target),
                 "no_effect": EFFECTS[effect].no_effect_values(building, target),
                 "component": component,
-                "sensed": component and any(set(building.component(n).node_ids) & set(sensed) for n in names)}
+                "sensed": component and bool(set(nodes) & set(sensed))}
 
     def objection(self, building, effect, target, parameters, derived=None):
         """`objection_of` the candidate's `facts` in `building`."""

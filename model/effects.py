@@ -247,7 +247,8 @@ def _heated(building):
     return [z.name for z in building.zones if z.heat_input]
 
 
-def _own_nodes(building, target):
+def member_nodes(building, target):
+    """The node ids of the components an effect on `target` acts on (`members`), in order."""
     return tuple(i for name in members(building, target) for i in building.component(name).node_ids)
 
 
@@ -655,7 +656,7 @@ EFFECTS = {e.id: e for e in (
     Effect("ground_coupling", "a conductance from an adiabatic face to a ground temperature",
            (Parameter("U", "W/m2/K", 0.0, 20.0), Parameter("T_ground", "C", -10.0, 40.0)),
            lambda b: [c.name for c in b.components if isinstance(c.outside, Adiabatic)],
-           _ground_read, _ground_write, _own_nodes, priors=_ground_priors,
+           _ground_read, _ground_write, member_nodes, priors=_ground_priors,
            absent_start=_absent(U=1.0), derived=_ground_flux, trade_off=("ground_heat_flux", True),
            no_effect=("U",)),
     Effect("infiltration", "an air change with the outside",
@@ -670,11 +671,11 @@ EFFECTS = {e.id: e for e in (
     Effect("solar_absorptance", "a corrected outside solar absorptance",
            (Parameter("alpha", "-", 0.0, 1.0),),
            lambda b: _surface_targets(b, lambda c: isinstance(c.outside, Exterior)),
-           _first(lambda b, t: {"alpha": b.component(t).outside.solar_absorptance}), _absorptance_write, _own_nodes,
+           _first(lambda b, t: {"alpha": b.component(t).outside.solar_absorptance}), _absorptance_write, member_nodes,
            on_inputs=True, energyplus=lambda w, t: w.solar_absorptance(t)),
     Effect("conductivity", "a scale on a component's conductances",
            (Parameter("factor", "-", 0.05, 20.0),), lambda b: _surface_targets(b, lambda c: True, materials=True),
-           _conductivity_read, _conductivity_write, _own_nodes,
+           _conductivity_read, _conductivity_write, member_nodes,
            physical=_fixed_limits(factor=SCALE_LIMITS), derived=_component_loss, trade_off=("component_loss", False),
            energyplus=lambda w, t: w.conductivity(t)),
     Effect("inside_convection", "a scale on the inside convective coefficients",
@@ -783,10 +784,10 @@ def _capacity_write(data, target, value):
 
 
 PROPERTIES = (
-    _effect_property("conductivity_factor", "component", "conductivity", _own_nodes),
+    _effect_property("conductivity_factor", "component", "conductivity", member_nodes),
     Property("capacity_factor", "component", Parameter("factor", "-", 0.05, 20.0), lambda b: [c.name for c in b.components],
-             lambda b, t: float(b.component(t).capacity_factor), _capacity_write, _own_nodes),
-    _effect_property("solar_absorptance", "component", "solar_absorptance", _own_nodes),
+             lambda b, t: float(b.component(t).capacity_factor), _capacity_write, member_nodes),
+    _effect_property("solar_absorptance", "component", "solar_absorptance", member_nodes),
     _effect_property("solar_transmittance", "component", "solar_transmittance", _receiver_nodes),
     _effect_property("air_change_rate", "zone", "infiltration", _air_node),
     _effect_property("internal_gain", "zone", "internal_gain", _air_node),
