@@ -39,6 +39,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from benchmarks.energyplus_comparison import interval_ends
 from benchmarks.truth import record_seed
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -310,18 +311,10 @@ def doc_name(doc):
 
 def read_steps(table):
     """The timestep outputs of an eplusout.csv table: columns named by their key (upper case),
-    the index its "Date/Time" (" MM/DD  HH:MM:SS", 24:00:00 the day's end) in `YEAR`."""
-    stamps = []
-    for text in table["Date/Time"]:
-        date, clock = text.split()
-        month, day = (int(x) for x in date.split("/"))
-        h, m, s = (int(x) for x in clock.split(":"))
-        stamps.append(pd.Timestamp(YEAR, month, day) + pd.Timedelta(hours=h, minutes=m, seconds=s))
-    columns = {}
-    for c in table.columns:
-        if "Zone Mean Air Temperature" in c or "Surface Inside Face Temperature" in c:
-            columns[c.split(":")[0].strip().upper()] = table[c].to_numpy(float)
-    return pd.DataFrame(columns, index=pd.DatetimeIndex(stamps, name="time"))
+    the index the end of each step in `YEAR` (`energyplus_comparison.interval_ends`)."""
+    columns = {c.split(":")[0].strip().upper(): table[c].to_numpy(float) for c in table.columns
+               if "Zone Mean Air Temperature" in c or "Surface Inside Face Temperature" in c}
+    return pd.DataFrame(columns, index=interval_ends(table["Date/Time"], YEAR))
 
 
 # -- the records ------------------------------------------------------------------------------------
