@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..model import convection, geometry, glazing, interior_sun
+from ..model import convection, geometry, glazing, interior_sun, longwave
 from ..model.errors import InputError
 from .energyplus_shading import fin, may_shade, on_surface, overhang, rectangle, window_frame
 from .idf_text import closed_text
@@ -1898,7 +1898,8 @@ class _Converter:
 
     def receivers(self, components):
         """Where the sun a zone's windows let in is absorbed, as EnergyPlus distributes it
-        (`model.interior_sun`): the diffuse sun over every inside face by its area times its
+        (`model.interior_sun`): the diffuse sun a window lets in first on the faces it sees, by its
+        view factors, then what they reflect over every inside face by its area times its
         absorptance, a window's by its panes' back-side absorptance (onto its own inside face) and
         its diffuse transmittance (leaving); the direct sun on the zone's floors (its opaque faces
         if it has none), by area, each absorbing its alpha and reflecting the rest into the diffuse
@@ -1920,8 +1921,11 @@ class _Converter:
             alpha, tau = np.array([f[2] for f in own]), np.array([f[3] for f in own])
             largest = max((f for f, on in zip(own, floor) if on), key=lambda f: f[0]["area"])
             c["transmitted_solar_to"] = largest[0]["name"]
+            window = next(k for k, f in enumerate(own) if f[0] is c)
+            view = self.solar_view_factors(own, c["_zone"])[window]
             for field, shares in (("solar_distribution", interior_sun.beam_fractions(area, alpha, tau, floor)),
-                                  ("diffuse_distribution", interior_sun.diffuse_fractions(area, alpha, tau))):
+                                  ("diffuse_distribution",
+                                   interior_sun.window_diffuse_fractions(area, alpha, tau, view))):
                 split = {}
                 for f, share in zip(own, shares):
                     if share > 0:
@@ -1929,6 +1933,22 @@ class _Converter:
                 c[field] = {name: round(share, 6) for name, share in split.items()}
         for c in components:
             c.pop("_zone"), c.pop("_type"), c.pop("_absorbs"), c.pop("_faces"), c.pop("_back", None)
+
+    @staticmethod
+    def solar_view_factors(faces, zone):
+        """F (n, n) between the faces of `zone` (`receivers`' entries: component, type seen from
+        the zone, ...) as EnergyPlus approximates and fixes them for its solar enclosure
+        (`model.longwave`), a partition's outer face looking the other way."""
+        first = {}
+        for k, f in enumerate(faces):
+            first.setdefault(id(f[0]), k)
+        # a component's first entry in its own zone is its inside face, any other its outer face
+        inner = [f[0]["_zone"] == zone and first[id(f[0])] == k for k, f in enumerate(faces)]
+        tilts = [f[0]["tilt"] if own else 180.0 - f[0]["tilt"] for f, own in zip(faces, inner)]
+        azimuths = [f[0]["azimuth"] if own else (f[0]["azimuth"] + 180.0) % 360 for f, own in zip(faces, inner)]
+        area = [f[0]["area"] for f in faces]
+        classes = [FACE_CLASS.get(f[1], "wall") for f in faces]
+        return longwave.fix_view_factors(area, longwave.approximate_view_factors(area, tilts, azimuths, classes))
 
     def beam_on_floor(self):
         """Say where the Building's Solar Distribution would put the direct sun other than on the floor."""

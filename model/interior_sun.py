@@ -23,6 +23,26 @@ def diffuse_fractions(area, absorptance, transmittance):
     return area * alpha / np.sum(area * (alpha + tau))
 
 
+def window_diffuse_fractions(area, absorptance, transmittance, view):
+    """Fraction of the diffuse sun a window lets into a zone that each face absorbs, its first
+    bounce by the window's view factors (EnergyPlus's CalcWinTransDifSolInitialDistribution):
+    face i receives F_wi of it, absorbs alpha_i and reflects rho_i = 1 - alpha_i - tau_out,i
+    (a window's tau_out of it leaves), and what all faces reflect joins the zone's diffuse pool
+    (`diffuse_fractions`),
+
+        psi_i = F_wi alpha_i + (sum_k F_wk rho_k) A_i alpha_i / sum_j A_j (alpha_j + tau_out,j)
+
+    `view` (n,) is the window's row of the zone's view factors F_wk (-), 0 toward itself and the
+    faces in its own plane, which it does not see: none of the first bounce leaves through the
+    window itself or a window beside it. The row is scaled to sum to 1: EnergyPlus's fixed view
+    factors are complete only to its fix's tolerance (`model.longwave.fix_view_factors`), and the
+    sun a window lets in is then neither lost nor made."""
+    alpha, tau, view = (np.asarray(x, dtype=float) for x in (absorptance, transmittance, view))
+    view = view / np.sum(view)
+    reflected = np.sum(view * (1.0 - alpha - tau))
+    return view * alpha + reflected * diffuse_fractions(area, alpha, tau)
+
+
 def beam_fractions(area, absorptance, transmittance, floor):
     """Fraction of the direct sun in a zone that each face absorbs where it all falls on the floor
     (EnergyPlus's MinimalShadowing and FullExterior solar distributions): the floors (the faces of

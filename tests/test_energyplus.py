@@ -195,9 +195,11 @@ def test_case600_window(case600):
 
 def test_case600_interior_solar_distribution(case600):
     """EnergyPlus's interior distribution by hand (Engineering Reference, interior solar
-    distribution): the diffuse sun over every face as area x absorptance, S = sum A alpha with each
-    window's 6 m2 counted as its panes' back-side absorptance plus its diffuse transmittance out;
-    the direct sun on the floor, which absorbs 0.6 and reflects 0.4 into that split."""
+    distribution): what the faces reflect goes over every face as area x absorptance, S = sum A
+    alpha with each window's 6 m2 counted as its panes' back-side absorptance plus its diffuse
+    transmittance out; the direct sun on the floor, which absorbs 0.6 and reflects 0.4 into that
+    split; the diffuse sun first on the faces the window sees, all opaque (alpha 0.6), never the
+    south wall or the windows in its plane, which get only the 0.4 reflected."""
     w = case600.component("SOUTH WINDOW WEST")
     direct, diffuse = dict(w.solar_distribution), dict(w.diffuse_distribution)
     T, R = 0.86156, 0.07846
@@ -206,9 +208,10 @@ def test_case600_interior_solar_distribution(case600):
     back = a * (1 + T * R / (1 - R * R)) + a * T / (1 - R * R)
     out = T * T / (1 - R * R) * w.angular.diffuse
     S = (48 + 48 + 16.2 + 16.2 + 21.6 + 9.6) * 0.6 + 12 * (back + out)
-    assert diffuse["FLOOR"] == pytest.approx(48 * 0.6 / S, abs=1e-5)
-    assert diffuse["SOUTH WINDOW WEST"] == pytest.approx(6 * back / S, abs=1e-5)
-    assert 1 - sum(diffuse.values()) == pytest.approx(12 * out / S, abs=1e-5)
+    assert diffuse["SOUTH WALL"] == pytest.approx(0.4 * 9.6 * 0.6 / S, abs=1e-5)
+    assert diffuse["SOUTH WINDOW WEST"] == pytest.approx(0.4 * 6 * back / S, abs=1e-5)
+    assert 1 - sum(diffuse.values()) == pytest.approx(0.4 * 12 * out / S, abs=1e-5)
+    assert diffuse["EAST WALL"] == pytest.approx(diffuse["WEST WALL"], abs=1e-6)
     assert direct["FLOOR"] == pytest.approx(0.6 + 0.4 * 48 * 0.6 / S, abs=1e-5)
     assert direct["ROOF"] == pytest.approx(0.4 * 48 * 0.6 / S, abs=1e-5)
     assert 1 - sum(direct.values()) == pytest.approx(0.4 * 12 * out / S, abs=1e-5)

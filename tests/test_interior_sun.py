@@ -8,7 +8,7 @@ import pytest
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import prepare_case, simulate_building
 from nodeforce.model.errors import InputError
-from nodeforce.model.interior_sun import beam_fractions, diffuse_fractions
+from nodeforce.model.interior_sun import beam_fractions, diffuse_fractions, window_diffuse_fractions
 from nodeforce.model.network import assemble
 
 
@@ -112,3 +112,26 @@ def test_a_zone_without_a_window_keeps_all_its_sun():
     area, alpha, out = AREA[:3], ALPHA[:3], OUT[:3]
     assert diffuse_fractions(area, alpha, out).sum() == pytest.approx(1.0, abs=1e-12)
     assert beam_fractions(area, alpha, out, FLOOR[:3]).sum() == pytest.approx(1.0, abs=1e-12)
+
+
+def test_a_windows_diffuse_sun_first_meets_the_faces_it_sees():
+    """The box's window sees the floor by 0.3, the ceiling by 0.3 and the walls by 0.4, not
+    itself: the first bounce absorbs 0.3 x 0.6 + 0.3 x 0.3 + 0.4 x 0.5 = 0.47 and reflects 0.53
+    into the pool of area x absorptance (S = 39.2 m2), of which 0.53 x 2.4 / 39.2 leaves; what the
+    window itself absorbs is only its share of the reflected pool."""
+    view = [0.3, 0.3, 0.4, 0.0]
+    phi = window_diffuse_fractions(AREA, ALPHA, OUT, view)
+    assert phi == pytest.approx([0.18 + 0.53 * 9.6 / 39.2, 0.09 + 0.53 * 4.8 / 39.2, 0.2 + 0.53 * 22.0 / 39.2,
+                                 0.53 * 0.4 / 39.2])
+    assert 1 - phi.sum() == pytest.approx(0.53 * 2.4 / 39.2)
+
+
+def test_a_window_that_sees_another_window_loses_its_first_bounce_through_it():
+    """A second window (back absorptance 0.1, diffuse transmittance 0.6, reflectance 0.3) seen by
+    0.5: 0.5 x 0.6 leaves at once, 0.5 x 0.1 is absorbed; the floor, seen by the rest, absorbs
+    0.5 x 0.6 and the reflected 0.5 x 0.3 + 0.5 x 0.4 = 0.35 joins the pool; sun is conserved."""
+    area, alpha, out = [16.0, 4.0, 4.0], [0.6, 0.1, 0.1], [0.0, 0.6, 0.6]
+    phi = window_diffuse_fractions(area, alpha, out, [0.5, 0.0, 0.5])
+    S = 16 * 0.6 + 8 * 0.7
+    assert phi == pytest.approx([0.3 + 0.35 * 9.6 / S, 0.35 * 0.4 / S, 0.05 + 0.35 * 0.4 / S])
+    assert phi.sum() + 0.3 + 0.35 * 4.8 / S == pytest.approx(1.0)
