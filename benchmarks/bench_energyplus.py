@@ -14,6 +14,12 @@ docs/performance.md carries the table and the figure.
     python benchmarks/bench_energyplus.py [OUT] [--weather EPW] [--only MODEL ...] [--figure PNG]
                                                         (default out/bench_energyplus, every model)
 
+EnergyPlus also reports, at each step, each face's outside heat balance term by term (the
+`OUTSIDE` variables of energyplus_comparison: its incident sun, beam, sky and ground diffuse apart,
+its outside face's temperature, convective and long-wave coefficients, net long-wave and
+conduction), in each model's OUT/<model>/eplusout.csv, to be set beside nodeforce's irradiance
+inputs and outside nodes.
+
 The weather is, unless --weather names another EPW, the Denver TMY3 year the installed
 pyenergyplus package ships (pyenergyplus/data/weather/USA_CO_Denver-Aurora-Buckley.AFB.724695_TMY3.epw),
 found at run time.
@@ -42,7 +48,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "examples" / "bestest"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 import cases  # noqa: E402
-from energyplus_comparison import (FACE, ZONE_AIR, differences, face_nodes, hourly_means, paired,  # noqa: E402
+from energyplus_comparison import (FACE, OUTSIDE, ZONE_AIR, differences, face_nodes, hourly_means, paired,  # noqa: E402
                                    read_outputs)
 
 from nodeforce.api import convert_idf  # noqa: E402
@@ -68,7 +74,8 @@ RENAMED = {"zone_or_zonelist_name": "zone_or_zonelist_or_space_or_spacelist_name
 
 def free_year(doc, frequency):
     """Add to `doc` a free-floating year, run on the weather file alone, that reports the zones'
-    mean air and the faces' inside temperatures at `frequency` ("Hourly", "Timestep")."""
+    mean air, the faces' inside temperatures and their outside terms (`OUTSIDE`) at `frequency`
+    ("Hourly", "Timestep")."""
     doc.add("RunPeriod", "year", {"begin_month": 1, "begin_day_of_month": 1, "begin_year": YEAR, "end_month": 12,
                                   "end_day_of_month": 31, "end_year": YEAR,
                                   "use_weather_file_holidays_and_special_days": "No",
@@ -77,7 +84,7 @@ def free_year(doc, frequency):
     doc.add("SimulationControl", "", {"do_zone_sizing_calculation": "No", "do_system_sizing_calculation": "No",
                                       "do_plant_sizing_calculation": "No", "run_simulation_for_sizing_periods": "No",
                                       "run_simulation_for_weather_file_run_periods": "Yes"})
-    for variable in (ZONE_AIR, FACE):
+    for variable in (ZONE_AIR, FACE, *OUTSIDE):
         doc.add("Output:Variable", "", {"key_value": "*", "variable_name": variable, "reporting_frequency": frequency})
     return doc
 
