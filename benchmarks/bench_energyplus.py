@@ -12,7 +12,17 @@ figure OUT/energyplus_faces.png (each zone's and face's RMSE; a week of the wors
 docs/performance.md carries the table and the figure.
 
     python benchmarks/bench_energyplus.py [OUT] [--weather EPW] [--only MODEL ...] [--figure PNG]
+                                          [--sky-diffuse SKY]
                                                         (default out/bench_energyplus, every model)
+
+--sky-diffuse declares the site's `sky_diffuse` (docs/model.md section 4) in each converted
+building, which `nodeforce convert` does not declare yet (docs/model.md section 10.1).
+
+EnergyPlus also reports, at each step, each face's outside heat balance term by term (the
+`OUTSIDE` variables of energyplus_comparison: its incident sun, beam, sky and ground diffuse apart,
+its outside face's temperature, convective and long-wave coefficients, net long-wave and
+conduction), in each model's OUT/<model>/eplusout.csv, to be set beside nodeforce's irradiance
+inputs and outside nodes.
 
 The weather is, unless --weather names another EPW, the Denver TMY3 year the installed
 pyenergyplus package ships (pyenergyplus/data/weather/USA_CO_Denver-Aurora-Buckley.AFB.724695_TMY3.epw),
@@ -42,13 +52,14 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "examples" / "bestest"))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 import cases  # noqa: E402
-from energyplus_comparison import (FACE, ZONE_AIR, differences, face_nodes, hourly_means, paired,  # noqa: E402
+from energyplus_comparison import (FACE, OUTSIDE, ZONE_AIR, differences, face_nodes, hourly_means, paired,  # noqa: E402
                                    read_outputs)
 
 from nodeforce.api import convert_idf  # noqa: E402
 from nodeforce.iotools.typical_year import convert_typical_year  # noqa: E402
 from nodeforce.iotools.weather import read_weather  # noqa: E402
 from nodeforce.model.case import simulate_building  # noqa: E402
+from nodeforce.model.solar import SKY_MODELS  # noqa: E402
 from nodeforce.model.weather import weather_on_grid  # noqa: E402
 
 PACKAGE_WEATHER = Path("data") / "weather" / "USA_CO_Denver-Aurora-Buckley.AFB.724695_TMY3.epw"
@@ -68,7 +79,8 @@ RENAMED = {"zone_or_zonelist_name": "zone_or_zonelist_or_space_or_spacelist_name
 
 def free_year(doc, frequency):
     """Add to `doc` a free-floating year, run on the weather file alone, that reports the zones'
-    mean air and the faces' inside temperatures at `frequency` ("Hourly", "Timestep")."""
+    mean air, the faces' inside temperatures and their outside terms (`OUTSIDE`) at `frequency`
+    ("Hourly", "Timestep")."""
     doc.add("RunPeriod", "year", {"begin_month": 1, "begin_day_of_month": 1, "begin_year": YEAR, "end_month": 12,
                                   "end_day_of_month": 31, "end_year": YEAR,
                                   "use_weather_file_holidays_and_special_days": "No",
@@ -77,7 +89,7 @@ def free_year(doc, frequency):
     doc.add("SimulationControl", "", {"do_zone_sizing_calculation": "No", "do_system_sizing_calculation": "No",
                                       "do_plant_sizing_calculation": "No", "run_simulation_for_sizing_periods": "No",
                                       "run_simulation_for_weather_file_run_periods": "Yes"})
-    for variable in (ZONE_AIR, FACE):
+    for variable in (ZONE_AIR, FACE, *OUTSIDE):
         doc.add("Output:Variable", "", {"key_value": "*", "variable_name": variable, "reporting_frequency": frequency})
     return doc
 
@@ -258,7 +270,14 @@ def worst_week(ours, theirs):
     return ours.loc[span], theirs.loc[span]
 
 
-def main(out, epw, only=None, figure_path=None):
+def declared(building, sky_diffuse):
+    """The converted `building`, its site's `sky_diffuse` declared where one is given."""
+    if sky_diffuse is None:
+        return building
+    return building.edited(lambda data: data["site"].__setitem__("sky_diffuse", sky_diffuse))
+
+
+def main(out, epw, only=None, figure_path=None, sky_diffuse=None):
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     convert_typical_year(epw, out / "weather.csv", year=YEAR)
@@ -270,7 +289,7 @@ def main(out, epw, only=None, figure_path=None):
             continue
         doc = with_steps(make())
         idfkit.save_idf(doc, str(out / f"{name}.idf"))
-        building = convert_idf(out / f"{name}.idf")
+        building = declared(convert_idf(out / f"{name}.idf"), sky_diffuse)
         folder = out / name
         folder.mkdir(parents=True, exist_ok=True)
         idfkit.save_idf(to_energyplus_25(doc), str(folder / "model_25_2.idf"))
@@ -306,6 +325,7 @@ if __name__ == "__main__":
     parser.add_argument("--weather", type=Path, help="an EPW (default: pyenergyplus's Denver TMY3)")
     parser.add_argument("--only", nargs="+", choices=list(models()), help="run these models alone")
     parser.add_argument("--figure", type=Path, help="where the figure goes (default: OUT/energyplus_faces.png)")
+    parser.add_argument("--sky-diffuse", choices=SKY_MODELS, help="declare the site's sky_diffuse in each building")
     args = parser.parse_args()
     try:
         epw = args.weather or package_weather()
@@ -313,4 +333,4 @@ if __name__ == "__main__":
         sys.exit(print("bench_energyplus needs EnergyPlus: pip install -e '.[energyplus]'", file=sys.stderr) or 2)
     if not epw.is_file():
         sys.exit(print(f"{epw}: no such weather file", file=sys.stderr) or 2)
-    main(args.out, epw, args.only, args.figure)
+    main(args.out, epw, args.only, args.figure, args.sky_diffuse)

@@ -22,6 +22,13 @@ from nodeforce.iotools.energyplus import SIMPLE_SURFACES, SUBSURFACES, SURFACES
 
 ZONE_AIR = "Zone Mean Air Temperature"
 FACE = "Surface Inside Face Temperature"
+#: The outside face's heat balance, term by term (W/m2, C, W/m2/K), each face at each step
+OUTSIDE = tuple(f"Surface Outside Face {term}" for term in (
+    "Incident Solar Radiation Rate per Area", "Incident Beam Solar Radiation Rate per Area",
+    "Incident Sky Diffuse Solar Radiation Rate per Area", "Incident Ground Diffuse Solar Radiation Rate per Area",
+    "Temperature", "Convection Heat Transfer Coefficient", "Net Thermal Radiation Heat Gain Rate per Area",
+    "Conduction Heat Transfer Rate per Area", "Thermal Radiation to Sky Heat Transfer Coefficient",
+    "Thermal Radiation to Air Heat Transfer Coefficient", "Thermal Radiation to Ground Heat Transfer Coefficient"))
 # the heat transfer surfaces of an IDF, each reported by EnergyPlus under its name
 SURFACE_KINDS = {k.upper() for k in (*SURFACES, *SIMPLE_SURFACES, *SUBSURFACES)}
 

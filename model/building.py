@@ -264,7 +264,8 @@ class Component:
 @dataclass(frozen=True)
 class Building:
     name: str
-    site: dict  # latitude, longitude (deg), altitude (m), timezone, ground_albedo, ground_temperature (C) if declared
+    # latitude, longitude (deg), altitude (m), timezone, ground_albedo; if declared, ground_temperature (C), sky_diffuse
+    site: dict
     zones: tuple
     components: tuple
     sensors: dict = field(default_factory=dict)  # sensor name -> node id

@@ -173,6 +173,8 @@ def parse_checked(data, source="<building>"):
             "air_density": float(site.get("air_density", schema_default("site", "air_density")))}
     if "ground_temperature" in data["site"]:
         site["ground_temperature"] = float(data["site"]["ground_temperature"])
+    if "sky_diffuse" in data["site"]:
+        site["sky_diffuse"] = data["site"]["sky_diffuse"]
     schedules = {name: _schedule(check, name, s, f"schedules.{name}") for name, s in data.get("schedules", {}).items()}
     materials = {name: _material(name, m) for name, m in data["materials"].items()}
     raw_zones, raw_components = data["zones"], data["components"]

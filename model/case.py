@@ -297,7 +297,8 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
     Returns
     -------
     Case with inputs `T_out`, `T_sky` (C), `I_<component>` (W/m2, the weather's measured column
-    if `model.solar.measured_irradiance` finds one, else pvlib's isotropic transposition of
+    if `model.solar.measured_irradiance` finds one, else the transposition under the site's sky
+    (`model.solar.incident_irradiance`: isotropic unless it declares `sky_diffuse`) of
     `ghi`, `dni`, `dhi`, those the weather lacks from the others: `model.solar.complete_irradiance`,
     stated in the case's `assumptions`), the building's named columns and, where a zone declares a daily gain,
     the time-of-day basis `day_cos1`, ... (`clock_inputs`).
@@ -358,18 +359,21 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
         if said:
             assumptions.append(f"The weather {source} lacks {', '.join(n for n in IRRADIANCE_COLUMNS if n not in given)}: "
                                f"{said}.")
+        sky_model = {"sky_model": site.get("sky_diffuse", "isotropic"), "altitude": site["altitude"]}
         for c in computed:
             sunlit, sky = face_shading(c, building.shades_of(c.name), position)
             columns[f"I_{c.name}"] = incident_irradiance(position, ghi, dni, dhi, c.tilt, c.azimuth,
-                                                         site["ground_albedo"], sunlit, sky)
+                                                         site["ground_albedo"], sunlit, sky, **sky_model)
             table = () if c.angular is None else (c.angular.angles, c.angular.factors, c.angular.diffuse)
             if c.diffuse_distribution:
                 (direct, _), (diffuse, _) = c.sun_inputs
                 columns[direct], columns[diffuse] = transmitted_split(
-                    position, ghi, dni, dhi, c.tilt, c.azimuth, site["ground_albedo"], *table, sunlit=sunlit, sky=sky)
+                    position, ghi, dni, dhi, c.tilt, c.azimuth, site["ground_albedo"], *table, sunlit=sunlit, sky=sky,
+                    **sky_model)
             elif c.angular is not None:
                 columns[c.transmitted_input] = transmitted_irradiance(
-                    position, ghi, dni, dhi, c.tilt, c.azimuth, site["ground_albedo"], *table, sunlit=sunlit, sky=sky)
+                    position, ghi, dni, dhi, c.tilt, c.azimuth, site["ground_albedo"], *table, sunlit=sunlit, sky=sky,
+                    **sky_model)
     columns.update(clock_inputs(building, times))
     columns.update(schedule_inputs(building, times))
     names = input_names(building)

@@ -117,8 +117,9 @@ _POSITIONS = OrderedDict()
 _KEPT_LOCK = threading.Lock()
 
 
-def incident_irradiance(position, ghi, dni, dhi, tilt, azimuth, albedo, sunlit=1.0, sky=1.0):
-    """Solar irradiance incident on a plane surface, W/m2, isotropic sky.
+def incident_irradiance(position, ghi, dni, dhi, tilt, azimuth, albedo, sunlit=1.0, sky=1.0, sky_model="isotropic",
+                        altitude=0.0):
+    """Solar irradiance incident on a plane surface, W/m2.
 
     Parameters
     ----------
@@ -135,17 +136,119 @@ def incident_irradiance(position, ghi, dni, dhi, tilt, azimuth, albedo, sunlit=1
     sunlit, sky : array_like or float
         The face's sunlit fraction at each time and the part of its sky diffuse it gets, both
         1 for a face no shading surface shades (`model.shading`, docs/model.md section 4.2).
+    sky_model : str
+        How the sky's diffuse sun spreads over the dome (`SKY_MODELS`): "isotropic" (pvlib's
+        isotropic sky) or "energyplus" (EnergyPlus's anisotropic sky, `energyplus_sky`).
+    altitude : float
+        Site altitude, m: the anisotropic sky's air mass reads it.
 
     Returns
     -------
     numpy.ndarray
-        pvlib's isotropic `poa_direct sunlit + (poa_sky_diffuse sky + poa_ground_diffuse)`, W/m2
-        (its `poa_global` where unshaded), with NaN and negative values set to 0: a missing
-        weather sample contributes no sun (docs/model.md section 4).
+        `direct sunlit + (sky_diffuse sky + ground_diffuse)`, plus the circumsolar part times
+        `sunlit` under the anisotropic sky (W/m2; pvlib's isotropic `poa_global` where unshaded
+        and isotropic), with NaN and negative values set to 0: a missing weather sample
+        contributes no sun (docs/model.md section 4).
     """
-    poa = _isotropic(position, ghi, dni, dhi, tilt, azimuth, albedo)
-    poa = _array(poa["poa_direct"]) * sunlit + (_array(poa["poa_sky_diffuse"]) * sky + _array(poa["poa_ground_diffuse"]))
+    direct, diffuse, circumsolar, ground = _sky_parts(position, ghi, dni, dhi, tilt, azimuth, albedo, sky_model,
+                                                      altitude)
+    poa = direct * sunlit + (diffuse * sky + ground)
+    if circumsolar is not None:
+        poa = poa + circumsolar * sunlit
     return np.where(np.isfinite(poa) & (poa > 0.0), poa, 0.0)
+
+
+#: The skies a site may declare (`site.sky_diffuse`): isotropic, or EnergyPlus's anisotropic one.
+SKY_MODELS = ("isotropic", "energyplus")
+
+#: EnergyPlus's Perez (1990) sky: upper limits of the clearness bins (-) and, a row a bin, the
+#: circumsolar (F11, F12, F13) and horizon (F21, F22, F23) coefficients (SolarShading.cc,
+#: AnisoSkyViewFactors; Engineering Reference, "Sky Radiance Model").
+PEREZ_EPSILON_LIMITS = np.array([1.065, 1.23, 1.5, 1.95, 2.8, 4.5, 6.2])
+PEREZ_F1 = np.array([[-0.0083117, 0.5877285, -0.0620636], [0.1299457, 0.6825954, -0.1513752],
+                     [0.3296958, 0.4868735, -0.2210958], [0.5682053, 0.1874525, -0.2951290],
+                     [0.8730280, -0.3920403, -0.3616149], [1.1326077, -1.2367284, -0.4118494],
+                     [1.0601591, -1.5999137, -0.3589221], [0.6777470, -0.3272588, -0.2504286]])
+PEREZ_F2 = np.array([[-0.0596012, 0.0721249, -0.0220216], [-0.0189325, 0.0659650, -0.0288748],
+                     [0.0554140, -0.0639588, -0.0260542], [0.1088631, -0.1519229, -0.0139754],
+                     [0.2255647, -0.4620442, 0.0012448], [0.2877813, -0.8230357, 0.0558651],
+                     [0.2642124, -1.1272340, 0.1310694], [0.1561313, -1.3765031, 0.2506212]])
+#: The cosine of 85 deg: a sun beyond it divides the circumsolar ratio cos(theta) / cos(Z) by it.
+COS_85 = 0.0871557
+
+
+def perez_brightening(zenith, dni, dhi, altitude):
+    """EnergyPlus's circumsolar and horizon brightening coefficients (F1, F2), both -, of the
+    Perez (1990) sky (Engineering Reference, "Sky Radiance Model"):
+
+        m = (1 - 0.1 H / 1000) / cos Z                       Z <= 75 deg
+        m = (1 - 0.1 H / 1000) / (cos Z + 0.15 (93.9 - Z)^-1.253)   beyond (Z in deg)
+        epsilon = ((dni + dhi) / dhi + 1.041 Z^3) / (1 + 1.041 Z^3)   (Z in rad)
+        Delta = dhi m / 1353
+        F1 = max(0, F11 + F12 Delta + F13 Z),   F2 = F21 + F22 Delta + F23 Z
+
+    with the coefficients of epsilon's bin (`PEREZ_EPSILON_LIMITS`, `PEREZ_F1`, `PEREZ_F2`).
+
+    Parameters
+    ----------
+    zenith : array_like
+        The sun's true zenith angle, degrees (below 90: the sun is up).
+    dni, dhi : array_like
+        Direct normal and diffuse horizontal irradiance, W/m2 (dhi > 0).
+    altitude : float
+        Site altitude H, m.
+    """
+    zenith = np.asarray(zenith, dtype=float)
+    dni, dhi = np.asarray(dni, dtype=float), np.asarray(dhi, dtype=float)
+    z = np.radians(zenith)
+    cos_z = np.cos(z)
+    low = np.maximum(93.9 - zenith, 1e-9)  # Kasten's term has no value 3.9 deg below the horizon
+    mass = (1.0 - 0.1 * altitude / 1000.0) / np.where(zenith <= 75.0, cos_z, cos_z + 0.15 * low ** -1.253)
+    kappa = 1.041 * z ** 3
+    epsilon = ((dni + dhi) / dhi + kappa) / (1.0 + kappa)
+    delta = dhi * mass / 1353.0  # 1353 W/m2: EnergyPlus's mean extraterrestrial irradiance
+    k = np.searchsorted(PEREZ_EPSILON_LIMITS, epsilon, side="right")
+    f1 = np.maximum(0.0, PEREZ_F1[k, 0] + PEREZ_F1[k, 1] * delta + PEREZ_F1[k, 2] * z)
+    f2 = PEREZ_F2[k, 0] + PEREZ_F2[k, 1] * delta + PEREZ_F2[k, 2] * z
+    return f1, f2
+
+
+def energyplus_sky(zenith, cos_incidence, dni, dhi, tilt, altitude):
+    """The sky's diffuse sun on a face as EnergyPlus spreads it (W/m2), as two parts: the dome and
+    the horizon, which the face's sky ratio R_sky shades, and the circumsolar disc, which its
+    sunlit fraction shades (Engineering Reference, "Sky Radiance Model"):
+
+        I_dome = dhi [(1 + cos beta) / 2 (1 - F1) + F2 sin beta]
+        I_cs   = dhi F1 max(0, cos theta) / max(cos 85 deg, cos Z)
+
+    (F1, F2 from `perez_brightening`; a face tilted less than 2 deg under a sun beyond 85 deg
+    gets I_cs = dhi F1, as EnergyPlus forces it; both 0 where the sun is down or dhi is not
+    positive, as EnergyPlus has no diffuse sun then).
+
+    Parameters
+    ----------
+    zenith : array_like
+        The sun's true zenith angle Z, degrees.
+    cos_incidence : array_like
+        Cosine of the sun's angle of incidence theta on the face, -.
+    dni, dhi : array_like
+        Direct normal and diffuse horizontal irradiance, W/m2.
+    tilt : float
+        The face's tilt beta, degrees.
+    altitude : float
+        Site altitude, m.
+    """
+    zenith, dhi = np.asarray(zenith, dtype=float), np.asarray(dhi, dtype=float)
+    up = (zenith < 90.0) & (dhi > 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        f1, f2 = perez_brightening(np.where(up, zenith, 0.0), dni, np.where(up, dhi, 1.0), altitude)
+    beta = np.radians(tilt)
+    cos_z = np.cos(np.radians(zenith))
+    ratio = np.maximum(0.0, cos_incidence) / np.maximum(COS_85, cos_z)
+    if tilt < 2.0:
+        ratio = np.where((ratio > 0.0) & (cos_z < COS_85), 1.0, ratio)
+    dome = dhi * ((1.0 + np.cos(beta)) / 2.0 * (1.0 - f1) + f2 * np.sin(beta))
+    return np.where(up, dome, 0.0), np.where(up, dhi * f1 * ratio, 0.0)
 
 
 def _array(values):
@@ -159,6 +262,20 @@ def _isotropic(position, ghi, dni, dhi, tilt, azimuth, albedo):
         tilt, azimuth, np.asarray(position["apparent_zenith"], dtype=float),
         np.asarray(position["azimuth"], dtype=float), np.asarray(dni, dtype=float),
         np.asarray(ghi, dtype=float), np.asarray(dhi, dtype=float), albedo=albedo, model="isotropic")
+
+
+def _sky_parts(position, ghi, dni, dhi, tilt, azimuth, albedo, sky_model, altitude):
+    """(direct, sky diffuse, circumsolar or None, ground diffuse) W/m2 on a plane, unclipped: the
+    isotropic sky's from pvlib (no circumsolar part), or EnergyPlus's anisotropic sky
+    (`energyplus_sky`) in place of the sky's diffuse, the direct and the ground's kept."""
+    poa = _isotropic(position, ghi, dni, dhi, tilt, azimuth, albedo)
+    direct, ground = _array(poa["poa_direct"]), _array(poa["poa_ground_diffuse"])
+    if sky_model == "isotropic":
+        return direct, _array(poa["poa_sky_diffuse"]), None, ground
+    zenith = _array(position["zenith"])
+    cos_incidence = pvlib.irradiance.aoi_projection(tilt, azimuth, zenith, _array(position["azimuth"]))
+    dome, circumsolar = energyplus_sky(zenith, _array(cos_incidence), dni, dhi, tilt, altitude)
+    return direct, dome, circumsolar, ground
 
 
 #: pvlib's decompositions of the global horizontal irradiance into its direct and diffuse parts
@@ -222,36 +339,46 @@ def decompose(ghi, zenith, model="erbs"):
 
 
 def transmitted_irradiance(position, ghi, dni, dhi, tilt, azimuth, albedo, angles, factors, diffuse, sunlit=1.0,
-                           sky=1.0):
+                           sky=1.0, sky_model="isotropic", altitude=0.0):
     """The sun a glazing lets in per m2, relative to its normal-incidence transmittance (W/m2,
     docs/model.md section 4.1): the direct sun times the factor at its angle of incidence (linear
-    between the tabulated angles, 0 beyond 90 deg) plus the isotropic sky's and the ground's diffuse
-    sun times the diffuse factor,
+    between the tabulated angles, 0 beyond 90 deg) plus the sky's and the ground's diffuse sun
+    times the diffuse factor, under the isotropic sky
 
         I_t = f(theta) f_sun dni max(cos theta, 0) + f_d [R_sky dhi (1 + cos beta) / 2 + ghi rho_g (1 - cos beta) / 2]
 
-    Parameters as `incident_irradiance`'s (`sunlit` f_sun, `sky` R_sky: 1 unshaded); angles (deg)
-    and factors (-) the glazing's table, diffuse its factor for diffuse sun (-)."""
+    and under EnergyPlus's the sky's part R_sky I_dome + f_sun I_cs (`energyplus_sky`), the
+    circumsolar sun diffuse to the glazing as it is to EnergyPlus's.
+
+    Parameters as `incident_irradiance`'s (`sunlit` f_sun, `sky` R_sky: 1 unshaded; `sky_model`,
+    `altitude`); angles (deg) and factors (-) the glazing's table, diffuse its factor for diffuse
+    sun (-)."""
     direct, diffuse_sun = _transmitted_parts(position, ghi, dni, dhi, tilt, azimuth, albedo, angles, factors, diffuse,
-                                             sunlit, sky)
+                                             sunlit, sky, sky_model, altitude)
     sun = direct + diffuse_sun
     return np.where(np.isfinite(sun) & (sun > 0.0), sun, 0.0)
 
 
 def transmitted_split(position, ghi, dni, dhi, tilt, azimuth, albedo, angles=(0.0, 90.0),
-                      factors=(1.0, 1.0), diffuse=1.0, sunlit=1.0, sky=1.0):
+                      factors=(1.0, 1.0), diffuse=1.0, sunlit=1.0, sky=1.0, sky_model="isotropic", altitude=0.0):
     """(I_b, I_d) W/m2: `transmitted_irradiance`'s two terms apart, the direct
     f(theta) f_sun dni max(cos theta, 0) and the diffuse f_d [...], each 0 where not positive or not
     finite; the default table (f = 1 up to 90 deg, f_d = 1) is a glazing's without one."""
-    parts = _transmitted_parts(position, ghi, dni, dhi, tilt, azimuth, albedo, angles, factors, diffuse, sunlit, sky)
+    parts = _transmitted_parts(position, ghi, dni, dhi, tilt, azimuth, albedo, angles, factors, diffuse, sunlit, sky,
+                               sky_model, altitude)
     return tuple(np.where(np.isfinite(p) & (p > 0.0), p, 0.0) for p in parts)
 
 
-def _transmitted_parts(position, ghi, dni, dhi, tilt, azimuth, albedo, angles, factors, diffuse, sunlit, sky):
+def _transmitted_parts(position, ghi, dni, dhi, tilt, azimuth, albedo, angles, factors, diffuse, sunlit, sky,
+                       sky_model, altitude):
     """(direct, diffuse) W/m2 of `transmitted_irradiance`, unclipped."""
-    poa = _isotropic(position, ghi, dni, dhi, tilt, azimuth, albedo)
+    direct, dome, circumsolar, ground = _sky_parts(position, ghi, dni, dhi, tilt, azimuth, albedo, sky_model,
+                                                   altitude)
     zenith = np.asarray(position["apparent_zenith"], dtype=float)
     theta = pvlib.irradiance.aoi(tilt, azimuth, zenith, np.asarray(position["azimuth"], dtype=float))
     f = np.interp(np.asarray(theta, dtype=float), list(angles) + [90.0 + 1e-9], list(factors) + [0.0], right=0.0)
-    beam = np.where(zenith < 90, _array(poa["poa_direct"]), 0.0)
-    return f * beam * sunlit, diffuse * (_array(poa["poa_sky_diffuse"]) * sky + _array(poa["poa_ground_diffuse"]))
+    beam = np.where(zenith < 90, direct, 0.0)
+    diffuse_sun = dome * sky + ground
+    if circumsolar is not None:
+        diffuse_sun = diffuse_sun + circumsolar * sunlit
+    return f * beam * sunlit, diffuse * diffuse_sun

@@ -176,6 +176,10 @@ def _latitude_100(d):
     d["site"]["latitude"] = 100.0
 
 
+def _unknown_sky(d):
+    d["site"]["sky_diffuse"] = "perez"
+
+
 def _glazing_without_target(d):
     del _component(d, "window")["transmitted_solar_to"]
 
@@ -200,7 +204,7 @@ def _unknown_field(d):
     _unknown_outside_type, _negative_area, _tilt_200, _missing_layers, _absorptance_1_5,
     _zero_conductivity, _boundary_without_h, _exterior_without_absorptance,
     _negative_air_change_rate, _zero_convection_factor, _layer_without_thickness,
-    _latitude_100, _glazing_without_target, _shading_leak_above_one, _wrong_format,
+    _latitude_100, _unknown_sky, _glazing_without_target, _shading_leak_above_one, _wrong_format,
 ], ids=lambda f: f.__name__.strip("_"))
 def test_wrong_file_is_refused_by_schema_and_parser(validator, mutate):
     data = copy.deepcopy(TESTCELL)
