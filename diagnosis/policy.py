@@ -166,10 +166,10 @@ class Policy:
         each judged parameter's physical limits ([low, high], None where unbounded), what the data
         fix where its parameters trade off (`Effect.trade_off`: [derived quantity, whether a
         bound is then waived], None), why the file's description makes the effect implausible
-        (`Effect.implausible`, None), the values at which it is absent (`Effect.no_effect_values`),
-        whether its target is one component or a group of them (`model.effects.members`) and
-        whether one of their nodes is among the `sensed` node ids, the other sensors the evidence
-        reads (`claim`)."""
+        (`Effect.implausible`, None), the values at which it is absent (`Effect.no_effect_values`)
+        and the derived quantities that are 0 there (`Effect.vanishes`), whether its target is one
+        component or a group of them (`model.effects.members`) and whether one of their nodes is
+        among the `sensed` node ids, the other sensors the evidence reads (`claim`)."""
         nodes = member_nodes(building, target)
         component = bool(nodes)  # a component has nodes; a zone or an input column none
         return {"limits": {name: [None if math.isinf(v) else v for v in self.limits(building, effect, target, name)]
@@ -177,6 +177,7 @@ class Policy:
                 "trade_off": list(EFFECTS[effect].trade_off) if EFFECTS[effect].trade_off else None,
                 "implausible": implausible(building, effect, target),
                 "no_effect": EFFECTS[effect].no_effect_values(building, target),
+                "vanishes": list(EFFECTS[effect].vanishes),
                 "component": component,
                 "sensed": component and bool(set(nodes) & set(sensed))}
 
@@ -231,15 +232,30 @@ class Policy:
         estimates = {name: ParameterEstimate.of(parameters[name]) for name in facts["limits"]}
         return {name: p for name, p in estimates.items() if not p.identifiable and not p.prior and not p.on_bound}
 
-    def established(self, parameters, facts):
-        """The first parameter (name) whose estimate lies more than `established_sds` of its sd
-        from the value at which the effect is absent (`facts`' "no_effect"), None where every
-        interval includes it (or the facts, from a report that predates them, do not say it): the
-        data rule out that the effect is not there, however loosely they fix its size. An sd of 0
-        is a covariance that did not come out, not certainty."""
+    def absence(self, parameters, derived, facts):
+        """{name: (value, sd, value where the effect is absent)} of each quantity that tells the
+        effect from none: the parameters at their declared values (`facts`' "no_effect") and the
+        derived quantities that are 0 there (`facts`' "vanishes", where `derived` has them; a
+        report that predates them says none). A ground coupling's U is as loose as its T_ground
+        is, the two trading off along the flux U (T_ground - T_face); the flux the data fix is 0
+        only where there is no coupling, whatever T_ground."""
+        quantities = {}
         for name, null in (facts.get("no_effect") or {}).items():
             p = ParameterEstimate.of(parameters[name])
-            if p.sd > 0 and abs(p.value - null) > self.established_sds * p.sd:
+            quantities[name] = (p.value, p.sd, null)
+        for name in facts.get("vanishes") or ():
+            if name in (derived or {}):
+                quantities[name] = (derived[name]["value"], derived[name]["std"], 0.0)
+        return quantities
+
+    def established(self, parameters, facts, derived=None):
+        """The first quantity (name) of `absence` whose estimate lies more than `established_sds`
+        of its sd from the value at which the effect is absent, None where every interval includes
+        it (or the facts, from a report that predates them, do not say it): the data rule out
+        that the effect is not there, however loosely they fix its size. An sd of 0 is a
+        covariance that did not come out, not certainty."""
+        for name, (value, sd, null) in self.absence(parameters, derived, facts).items():
+            if sd > 0 and abs(value - null) > self.established_sds * sd:
                 return name
         return None
 

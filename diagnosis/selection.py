@@ -225,7 +225,7 @@ def weigh_loose(result, verdict, rival, base, sigma, distances, policy):
     it): a better prediction than a tight candidate within that is one the data do not establish,
     and the value one can act on wins. The weighing is in `Verdict.weighed`."""
     z = policy.established_sds
-    name = policy.established(result.parameters, result.physics)
+    name = policy.established(result.parameters, result.physics, result.derived)
     ahead, se = fall(rival.evidence(), result.evidence())
     se = max(se, noise_difference(distances[result.label][rival.label], sigma))
     needed = max(z * se, policy.rounding(float(base.sum())))
@@ -234,9 +234,9 @@ def weigh_loose(result, verdict, rival, base, sigma, distances, policy):
     if weighed["admitted"]:
         return replace(verdict, objection=None, weighed=weighed)
     if name is None:
-        why = "; ".join(f"{p} = {result.parameters[p].value:.3g} +- {result.parameters[p].sd:.2g} "
-                        f"{EFFECTS[result.effect].parameter(p).unit} is within {z:g} standard deviations of "
-                        f"{null:.3g}, where the effect is absent" for p, null in result.physics["no_effect"].items())
+        why = "; ".join(f"{q} = {value:.3g} +- {sd:.2g} {unit(result, q)} is within {z:g} standard deviations of "
+                        f"{null:.3g}, where the effect is absent" for q, (value, sd, null) in
+                        policy.absence(result.parameters, result.derived, result.physics).items())
     else:
         why = (f"it predicts what no fit read better than {rival.effect} on {rival.target}, whose values are tight, "
                f"by no more than {z:g} standard errors of the difference (J {result.evidence().sum():.3g} against "
@@ -369,9 +369,9 @@ def _weighed(chosen, verdict, by_label, policy):
                          for name, p in estimates.items())
     z, name = policy.established_sds, w["established"]
     loose = policy.loose_values(chosen.effect, chosen.parameters, chosen.derived, chosen.physics)
-    p, null = chosen.parameters[name], chosen.physics["no_effect"][name]
+    value, sd, null = policy.absence(chosen.parameters, chosen.derived, chosen.physics)[name]
     said = (f"; its {values(chosen, loose)} {'is' if len(loose) == 1 else 'are'} loose, but the effect is "
-            f"established: {name} lies {abs(p.value - null) / p.sd:.3g} standard deviations from {null:.3g}, where "
+            f"established: {name} lies {abs(value - null) / sd:.3g} standard deviations from {null:.3g}, where "
             f"the effect is absent, beyond {z:g}")
     rival = by_label[w["against"]]
     judged = {k: q for k, q in rival.parameters.items() if k in rival.physics["limits"]}
@@ -380,6 +380,13 @@ def _weighed(chosen, verdict, by_label, policy):
                    f"against {rival.evidence().sum():.3g} C2, lower by more than {z:g} standard errors of the "
                    f"difference ({z:g} x {w['se']:.3g} C2): the choice follows the prediction, and the size of "
                    f"{chosen.effect} is as loose as its sd says")
+
+
+def unit(result, name):
+    """The unit of a candidate's parameter or derived quantity `name`."""
+    if name in (result.derived or {}):
+        return result.derived[name]["unit"]
+    return EFFECTS[result.effect].parameter(name).unit
 
 
 def acting(result):

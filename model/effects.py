@@ -94,6 +94,10 @@ class Effect:
     # value an estimate must be told from for the effect to be established (None: all); a
     # coupling's temperature or a node's conductance acts only through another
     no_effect: tuple | None = None
+    # the `derived` quantities that are 0 where the effect is absent, whatever the values of its
+    # parameters that trade off: where the data fix such a quantity and not the parameters, its
+    # distance from 0 is what establishes the effect (`diagnosis.policy.Policy.established`)
+    vanishes: tuple = ()
     # Derivation -> {name: {"value", "std", "unit"}}: what the data fix where its parameters
     # trade off (`diagnosis.calibrate.derived`)
     derived: Callable | None = None
@@ -658,7 +662,7 @@ EFFECTS = {e.id: e for e in (
            lambda b: [c.name for c in b.components if isinstance(c.outside, Adiabatic)],
            _ground_read, _ground_write, member_nodes, priors=_ground_priors,
            absent_start=_absent(U=1.0), derived=_ground_flux, trade_off=("ground_heat_flux", True),
-           no_effect=("U",)),
+           no_effect=("U",), vanishes=("ground_heat_flux",)),
     Effect("infiltration", "an air change with the outside",
            (Parameter("n", "1/h", 0.0, 20.0),), _zones,
            *_zone_field("air_change_rate", "n"), _no_node,

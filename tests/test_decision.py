@@ -491,3 +491,22 @@ def test_an_effect_is_absent_at_the_values_the_building_declares(testcell):
                                "T_ground": parameter(12.0, 3.0, identifiable=False)}, facts) == "U"
     assert POLICY.established({"U": parameter(0.7, 0.4, identifiable=False),
                                "T_ground": parameter(12.0, 0.5)}, facts) is None
+
+
+def test_a_ground_coupling_whose_U_trades_with_its_temperature_is_established_by_its_flux(testcell):
+    # gso-feb-ground/ground-s's fit: U 0.57 +- 0.91 W/m2/K is loose, its T_ground 7.7 +- 4.8 C
+    # trading with it along the flux U (T_ground - T_face), which the data fix at 1.33 +- 0.45
+    # W/m2: 2.96 sds from the 0 of a floor with no coupling, whatever T_ground, so the coupling is
+    # there; at 0.8 +- 0.45 W/m2 (1.8 sds) the data do not rule its absence out
+    facts = POLICY.facts(testcell, "ground_coupling", "floor")
+    assert facts["vanishes"] == ["ground_heat_flux"]
+    traded = {"U": parameter(0.571, 0.91, identifiable=False), "T_ground": parameter(7.7, 4.8, identifiable=False)}
+    assert POLICY.established(traded, facts) is None  # U alone: 0.63 sds from none
+    flux = {"ground_heat_flux": {"value": 1.33, "std": 0.45, "unit": "W/m2"}}
+    assert POLICY.established(traded, facts, flux) == "ground_heat_flux"
+    assert POLICY.absence(traded, flux, facts)["ground_heat_flux"] == (1.33, 0.45, 0.0)
+    assert POLICY.established(traded, facts, {"ground_heat_flux": {"value": 0.8, "std": 0.45, "unit": "W/m2"}}) is None
+    # a report that predates the derived quantities' test says none: U alone decides, as it did
+    assert POLICY.established(traded, {k: v for k, v in facts.items() if k != "vanishes"}, flux) is None
+    # a conductivity's component loss is not 0 where the factor is 1: it establishes nothing
+    assert POLICY.facts(testcell, "conductivity", "door")["vanishes"] == []

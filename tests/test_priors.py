@@ -130,3 +130,25 @@ def test_a_ground_8_K_below_the_records_mean_air_is_found_with_its_temperature_w
     assert "less than a year" in T_ground.prior
     assert abs(T_ground.value - truth) <= 2 * T_ground.sd
     assert diagnosis.after["validation"]["rmse"] <= 1.5 * spec.noise
+
+
+@pytest.mark.slow
+def test_a_subtle_ground_whose_U_trades_with_its_temperature_is_added_by_the_flux_the_data_fix(tmp_path):
+    """gso-feb-ground/ground-s (draw 0): the cell in Greensboro's February on a ground 8 K above
+    the record's mean outdoor air, U scaled to a subtle error, the file declaring no ground
+    temperature (the prior: the records' mean air, sd 5 K). U and T_ground trade off along the
+    flux, U's sd is wider than U, and only the flux is 2 sds from the 0 of no coupling: the
+    coupling is added, established by its flux, its T_ground within 2 of its posterior sds of the
+    truth, and the validation error falls."""
+    r = record("gso-feb-ground/ground-s", 0)
+    truth = r.values[0]["T_ground"]
+    diagnosis = api.diagnose(r.building, r.case(), tmp_path, objective=api.objective(r.building, r.zones),
+                             search=api.SearchSettings(noise=r.spec.noise, seed=0), execution=api.Execution(workers=1))
+    fit = diagnosis.added[0]
+    assert fit.label == "ground_coupling@floor"
+    U, T_ground = fit.parameters["U"], fit.parameters["T_ground"]
+    assert U.value < 2 * U.sd  # U alone would not establish it
+    flux = fit.derived["ground_heat_flux"]
+    assert abs(flux["value"]) > 2 * flux["std"]
+    assert abs(T_ground.value - truth) <= 2 * T_ground.sd
+    assert diagnosis.after["validation"]["rmse"] < diagnosis.before["validation"]["rmse"]

@@ -186,9 +186,26 @@ def test_table_with_no_effect_and_missing_values():
     report, _ = no_effect(*synthetic())
     report["after"]["validation"]["zones"]["bath"] = {"J": None, "rmse": None, "mean": float("nan"), "sd": None, "n": None}
     table = before_after_table(report)
-    assert table.splitlines()[0] == "Effect added: none: no effect improves the validation error"
+    assert table.splitlines()[0] == "Effect added: none: no candidate passes the choice on the calibration window"
     assert row(table, "validation bath")[-4:] == ["n/a"] * 4
-    assert before_after_table({}).splitlines()[0].endswith("none: no effect improves the validation error")
+    assert before_after_table({}).splitlines()[0].endswith("none: no candidate passes the choice on the calibration window")
+
+
+def test_a_diagnosis_that_adds_nothing_says_where_the_validation_is_beyond_the_error_floor():
+    """An error floor of 0.1 C on 100 validation residuals leaves J up to 100 x 0.1^2 = 1.0 C2 and
+    3 sds of its change, 3 x 0.01 x sqrt(200) = 0.424 C2: J 4.0 C2 (0.2 C) is beyond it, twice
+    the floor, and the header says a fault may be there; J 1.2 C2 is within it, and it says not."""
+    report, _ = no_effect(*synthetic())
+    report["noise"] = {"floor": 0.1}
+    report["before"]["validation"].update(J=4.0, n=100, rmse=0.2)
+    header = before_after_table(report).splitlines()[0]
+    assert header == ("Effect added: none: no candidate passes the choice on the calibration window; the validation "
+                      "error, 0.200 C, is 2.00 times the error floor of 0.100 C, beyond what it leaves: a fault these "
+                      "calibration days do not show may be there")
+    report["before"]["validation"].update(J=1.42, n=100, rmse=0.119)
+    assert before_after_table(report).splitlines()[0].endswith("on the calibration window")
+    report["before"]["validation"].update(J=1.43)
+    assert "may be there" in before_after_table(report).splitlines()[0]
 
 
 def check_report(tmp_path, report, series, expected_plots):
@@ -252,7 +269,7 @@ def test_write_report_with_no_effect_and_an_exhaustive_search(tmp_path):
     series["convergence"] = []
     md = check_report(tmp_path, report, series, ["air_temperature.png", "residuals.png", "node_scores.png",
                                                  "candidates.png"])
-    assert "none: no effect improves the validation error" in md
+    assert "none: no candidate passes the choice on the calibration window" in md
     assert "exhaustive" in md and "no convergence curve" in md
     assert "No candidate beats the model without an effect on both tests." in md and "- chosen: none" in md
     assert "No residual diagnostics in this report." in md

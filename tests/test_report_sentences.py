@@ -35,6 +35,16 @@ def check_estimates(text, fit, identifiable):
         assert (value, sd) == (sig(p["value"]), f"{p['std']:.2g}") and p["identifiable"] is identifiable, text
 
 
+def quantity(fit, name):
+    """(report.json's estimate, the value where the effect is absent) of a quantity that tells a
+    fit's effect from none: a parameter at its declared value, or a derived quantity that is 0
+    there (its physics' "vanishes")."""
+    if name in fit["physics"]["no_effect"]:
+        return fit["parameters"][name], fit["physics"]["no_effect"][name]
+    assert name in fit["physics"].get("vanishes", []), name
+    return fit["derived"][name], 0.0
+
+
 def check_weighed(label, verdicts, fits):
     """The clauses a candidate's loose values were refused by (its verdict's `weighed` not
     admitted), against its numbers: an interval that includes the value at which the effect is
@@ -45,9 +55,9 @@ def check_weighed(label, verdicts, fits):
     assert not w["admitted"] and objection, label
     for name, value, sd, z, null in re.findall(rf"(\w+) = {NUMBER} \+- {NUMBER} \S+ is within {NUMBER} standard "
                                                rf"deviations of {NUMBER}, where the effect is absent", objection):
-        p = fit["parameters"][name]
-        assert (value, sd, null) == (sig(p["value"]), f"{p['std']:.2g}", sig(fit["physics"]["no_effect"][name]))
-        assert abs(p["value"] - fit["physics"]["no_effect"][name]) <= float(z) * p["std"] and w["established"] is None
+        p, absent = quantity(fit, name)
+        assert (value, sd, null) == (sig(p["value"]), f"{p['std']:.2g}", sig(absent))
+        assert abs(p["value"] - absent) <= float(z) * p["std"] and w["established"] is None
     short = re.search(rf"better than (\S+) on (\S+), whose values are tight, by no more than {NUMBER} standard errors "
                       rf"of the difference \(J {NUMBER} against {NUMBER} C2, {NUMBER} x {NUMBER} C2\)", objection)
     if short:
@@ -143,8 +153,8 @@ def check_chosen_weighed(reason, verdicts, chosen, passing, fits):
         return
     fit = fits[chosen]
     check_estimates(said[1], fit, identifiable=False)
-    name, null = said[2], fit["physics"]["no_effect"][said[2]]
-    p = fit["parameters"][name]
+    name = said[2]
+    p, null = quantity(fit, name)
     assert name == w["established"] and said[4] == sig(null), reason
     assert said[3] == sig(abs(p["value"] - null) / p["std"]) and abs(p["value"] - null) > z * p["std"], reason
     check_estimates(rival[3], fits[label], identifiable=True)

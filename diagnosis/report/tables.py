@@ -7,6 +7,7 @@ from . import content
 from .content import SCORED, STATES, metrics
 from .formats import NA, fmt_derived, fmt_int, fmt_parameters, fmt_sig, fmt_temp, fmt_value_std, num, time_text
 from ..phases import is_worse
+from ..policy import Policy
 from ..residuals import lag_text
 
 
@@ -14,13 +15,31 @@ def effect_header(report, pm="+-"):
     """The line naming the chosen effect, its target and parameters, or 'none: ...'."""
     effect = report.get("effect") or {}
     if content.is_none_effect(effect):
-        return "Effect added: none: no effect improves the validation error"
+        return none_header(report)
     params = fmt_parameters(effect.get("effect"), effect.get("parameters"), pm)
     line = (f"Effect added: {content.effect_name(effect.get('effect'), effect.get('target'))}"
             + (f": {params}" if params else ""))
     # the HLC has its own line (`hlc_lines`)
     derived = {k: v for k, v in (effect.get("derived") or {}).items() if k != "heat_loss_coefficient"}
     return "\n".join([line] + [f"  the data determine {d}" for d in fmt_derived(derived, pm)])
+
+
+def none_header(report):
+    """The line of a diagnosis that added nothing: no candidate passed the choice, which reads the
+    calibration window alone; and, where the validation error before is more than the error floor
+    leaves (`Policy.at_noise` of its J on its n residuals at report.json's `noise.floor`, the
+    sensors' noise and the file's numerical error), that the calibration days may not show a fault
+    the validation does: a coupling to a ground near the floor's own temperature drifts the slow
+    floor mode over weeks, and a few days' fall of J is within what the noise could make."""
+    line = "Effect added: none: no candidate passes the choice on the calibration window"
+    validation = (report.get("before") or {}).get("validation") or {}
+    J, n, rmse = num(validation.get("J")), num(validation.get("n")), num(validation.get("rmse"))
+    floor = num((report.get("noise") or {}).get("floor"))
+    policy = Policy.of_json(report["policy"]) if report.get("policy") else Policy()
+    if None in (J, n, rmse, floor) or not floor or policy.at_noise(J, n, floor):
+        return line
+    return (line + f"; the validation error, {rmse:.3f} C, is {rmse / floor:.2f} times the error floor of "
+            f"{floor:.3f} C, beyond what it leaves: a fault these calibration days do not show may be there")
 
 
 def hlc_lines(report, pm="+-"):
@@ -54,7 +73,7 @@ def before_after_table(report: dict, header: bool = True) -> str:
     """The before/after table: rows calibration and validation windows (and each zone's, when the
     objective has several), columns RMSE, mean, sd of the air residual (C) and n, before and after;
     with `header`, a line naming the chosen effect, target and its parameters (value +- std, 'not
-    identifiable' flagged), or 'none: no effect improves the validation error', and the heat loss
+    identifiable' flagged), or 'none: ...' (`none_header`), and the heat loss
     coefficient (`nodeforce diagnose` prints the first screen instead, `terminal_summary`); the
     reference model's RMSE when the report has one."""
     cols = ("RMSE", "mean", "sd", "n")
