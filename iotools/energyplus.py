@@ -539,7 +539,9 @@ class _Converter:
         altitude = self.r.number(loc, "elevation", default=0.0, low=-300, high=8000)
         site = {"latitude": self.r.number(loc, "latitude", low=-90, high=90),
                 "longitude": self.r.number(loc, "longitude", low=-180, high=180),
-                "altitude": altitude, "timezone": tz, "air_density": round(air_density_at(altitude), 5)}
+                "altitude": altitude, "timezone": tz, "air_density": round(air_density_at(altitude), 5),
+                # EnergyPlus carries infiltration and ventilation at the outdoor air's density
+                "flow_density": "outdoor"}
         # the deep ground's months average to the temperature a diagnosis holds a ground
         # coupling's at where the data fix its flux only (docs/model.md section 7, Priors)
         deep = self.r.all("Site:GroundTemperature:Deep")
@@ -1873,11 +1875,13 @@ class _Converter:
                 self.built_of(self.r.text(o, "construction_name"), name)
 
     def user_view_factors(self, zones, components, surfaces):
-        """Every zone exchanges long-wave radiation by ScriptF, as EnergyPlus always does, with the
-        view factors a ZoneProperty:UserViewFactors:BySurfaceName gives where one does. A surface
-        is named by its component: a partition's second surface by its pair's."""
+        """Every zone exchanges long-wave radiation by ScriptF at its faces' temperatures of each
+        step, as EnergyPlus always does, with the view factors a
+        ZoneProperty:UserViewFactors:BySurfaceName gives where one does. A surface is named by its
+        component: a partition's second surface by its pair's."""
         for z in zones:
             z["longwave"] = "scriptf"
+            z["longwave_followed"] = True
         by_zone = {z["name"].upper(): z for z in zones}
         names = {c["name"].upper(): c["name"] for c in components}
         for s in surfaces.values():

@@ -484,10 +484,12 @@ def test_declared_sky_fraction_in_the_network():
 
 
 def test_every_zone_exchanges_long_wave_by_script_f(case600):
-    """EnergyPlus always uses ScriptF: every zone gets it, each face its inner layer's thermal
-    absorptance (a simple glazing's 0.84) and its surface type's class (a window its own)."""
+    """EnergyPlus always uses ScriptF at the faces' temperatures: every zone gets it, each face its
+    inner layer's thermal absorptance (a simple glazing's 0.84) and its surface type's class (a
+    window its own); its air flows carry the outdoor air's density."""
     z = case600.zones[0]
-    assert z.longwave == "scriptf" and z.view_factors == ()
+    assert z.longwave == "scriptf" and z.view_factors == () and z.longwave_followed
+    assert case600.site["flow_density"] == "outdoor"
     assert case600.component("SOUTH WINDOW WEST").inside.emissivity == 0.84  # simple glazing's
     assert case600.component("FLOOR").inside.emissivity == 0.9  # the IDF's thermal absorptance
     assert [case600.component(n).inside.face_class for n in ("FLOOR", "ROOF", "EAST WALL", "SOUTH WINDOW EAST")] \
