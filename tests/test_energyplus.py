@@ -658,3 +658,18 @@ def test_the_deep_ground_temperature_of_the_idf_is_the_sites_ground_temperature(
                     + "".join(f"  {t},\n" for t in months) + "  ;\n")
     site = convert_idf(path).site
     assert site["ground_temperature"] == pytest.approx((sum(months) + 16.0) / 12, abs=1e-12)
+
+
+def test_a_layered_window_s_panes_and_the_sky_are_declared_as_energyplus_solves_them():
+    """examples/bestest/case600.idf's windows, 2 m high, are DOUBLE CLEAR: two panes of
+    emissivity 0.84 about 13 mm of air; from the inside face the gap is layer 1 of 3. The site's
+    sky is EnergyPlus's anisotropic one; a simple glazing system (three_zones.idf's east window) has
+    no gap to follow."""
+    building = convert_idf(CASE600)
+    window = building.component("SOUTH WINDOW WEST").window
+    assert window.height == 2.0
+    [gap] = window.gaps
+    assert (gap.layer, gap.emissivities, gap.gas) == (1, (0.84, 0.84), "air")
+    assert building.component("SOUTH WINDOW WEST").layers[1][1] == 0.013
+    assert building.site["sky_diffuse"] == "energyplus"
+    assert convert_idf(MULTIZONE).component("EAST SOUTH WINDOW").window is None  # a simple glazing system
