@@ -205,12 +205,14 @@ def test_the_standalone_fmu_refuses_coefficients_that_follow_the_state(testcell_
 
 
 @pytest.mark.slow
-def test_the_python_fmu_steps_as_the_direct_model(testcell_data, weather, tmp_path):
+@pytest.mark.parametrize("declare", [followed, lambda data: enclosed(ventilated(data))],
+                         ids=["convection", "scriptf_and_flows"])
+def test_the_python_fmu_steps_as_the_direct_model(testcell_data, weather, tmp_path, declare):
     from nodeforce.cosim.fmi import FmuInstance
     from nodeforce.cosim.run import simulate_fmu
     from nodeforce.fmu_build.build import build_fmu
     from tests.conftest import record_times
-    building = parse_building(followed(testcell_data))
+    building = parse_building(declare(testcell_data))
     times = record_times(days=2)
     w = windy(weather)
     w = w[(w.index >= times[0] - np.timedelta64(2, "h")) & (w.index <= times[-1] + np.timedelta64(2, "h"))]
