@@ -15,8 +15,8 @@ docs/performance.md carries the table and the figure.
                                           [--sky-diffuse SKY]
                                                         (default out/bench_energyplus, every model)
 
---sky-diffuse declares the site's `sky_diffuse` (docs/model.md section 4) in each converted
-building, which `nodeforce convert` does not declare yet (docs/model.md section 10.1).
+--sky-diffuse replaces the site's `sky_diffuse` (docs/model.md section 4) in each converted
+building, which `nodeforce convert` declares "energyplus" (docs/model.md section 10.1).
 
 EnergyPlus also reports, at each step, each face's outside heat balance term by term (the
 `OUTSIDE` variables of energyplus_comparison: its incident sun, beam, sky and ground diffuse apart,
@@ -325,7 +325,7 @@ if __name__ == "__main__":
     parser.add_argument("--weather", type=Path, help="an EPW (default: pyenergyplus's Denver TMY3)")
     parser.add_argument("--only", nargs="+", choices=list(models()), help="run these models alone")
     parser.add_argument("--figure", type=Path, help="where the figure goes (default: OUT/energyplus_faces.png)")
-    parser.add_argument("--sky-diffuse", choices=SKY_MODELS, help="declare the site's sky_diffuse in each building")
+    parser.add_argument("--sky-diffuse", choices=SKY_MODELS, help="replace the site's sky_diffuse in each building")
     args = parser.parse_args()
     try:
         epw = args.weather or package_weather()

@@ -509,6 +509,19 @@ class _DaySchedules:
         return self.profiles[key][0]
 
 
+def _json_gas(gas):
+    """A gap's gas (`Converter.gas`, `read_window5`) as a building file's window declares it: a
+    name, a mixture of named gases [[gas, fraction], ...], or a gas of its own {conductivity,
+    viscosity, specific_heat, molecular_weight}; None for a mixture of gases of their own, which
+    the file cannot declare."""
+    if isinstance(gas, str):
+        return gas
+    if isinstance(gas, list):
+        return [[g, x] for g, x in gas] if all(isinstance(g, str) for g, _ in gas) else None
+    k, mu, cp, M = gas
+    return {"conductivity": list(k), "viscosity": list(mu), "specific_heat": list(cp), "molecular_weight": M}
+
+
 class _Converter:
     def __init__(self, reader):
         self.r = reader
@@ -539,7 +552,11 @@ class _Converter:
         altitude = self.r.number(loc, "elevation", default=0.0, low=-300, high=8000)
         site = {"latitude": self.r.number(loc, "latitude", low=-90, high=90),
                 "longitude": self.r.number(loc, "longitude", low=-180, high=180),
-                "altitude": altitude, "timezone": tz, "air_density": round(air_density_at(altitude), 5)}
+                "altitude": altitude, "timezone": tz, "air_density": round(air_density_at(altitude), 5),
+                # EnergyPlus carries infiltration and ventilation at the outdoor air's density
+                "flow_density": "outdoor",
+                # its anisotropic sky (SolarShading.cc, AnisoSkyViewFactors), whatever the IDF says
+                "sky_diffuse": "energyplus"}
         # the deep ground's months average to the temperature a diagnosis holds a ground
         # coupling's at where the data fix its flux only (docs/model.md section 7, Priors)
         deep = self.r.all("Site:GroundTemperature:Deep")
@@ -914,7 +931,11 @@ class _Converter:
         # seen from the room, a glazing takes the diffuse sun it does not reflect (out, or into its panes)
         outer = {"emissivity": panes[0][2], "solar": alpha, "roughness": 1.0}  # glass is very smooth
         inner = {"emissivity": panes[-1][3], "solar": 1 - glazing.stack_reflectance(pairs[::-1])}
-        return layers, outer, inner, {"tau": tau, "inner_alpha": inner_alpha,
+        # each gap between the outer pane's back and the inner pane's front, from the inside face as
+        # the building file counts its layers, its conductance following the panes' (docs/model.md 4.1)
+        gaps = [{"layer": len(layers) - 1 - k, "emissivities": [panes[k // 2 + 1][2], panes[k // 2][3]],
+                 "gas": _json_gas(gases[k])} for k in range(1, len(layers), 2)]
+        return layers, outer, inner, {"tau": tau, "inner_alpha": inner_alpha, "gaps": gaps,
                                       "back_alpha": sum(glazing.pane_absorptances(pairs[::-1])),
                                       "angular": {"angles": list(glazing.ANGLES), "factors": factors,
                                                   "diffuse": diffuse}}
@@ -1562,6 +1583,10 @@ class _Converter:
                         face["face_class"] = "wall"
                 if glass is not None:
                     c["solar_transmittance"] = round(glass["tau"], 6)
+                    if (glass.get("gaps") and w_outside["type"] == "exterior" and height
+                            and all(g["gas"] is not None for g in glass["gaps"])):
+                        # EnergyPlus solves a layered window's panes at every step (WindowManager.cc)
+                        c["window"] = {"height": round(height, 6), "gaps": glass["gaps"]}
                     c["transmitted_solar_to"] = None  # set once every component is known (`receivers`)
                     if "exterior" == w_outside["type"]:
                         c["angular_transmittance"] = glass["angular"]
@@ -1873,11 +1898,13 @@ class _Converter:
                 self.built_of(self.r.text(o, "construction_name"), name)
 
     def user_view_factors(self, zones, components, surfaces):
-        """Every zone exchanges long-wave radiation by ScriptF, as EnergyPlus always does, with the
-        view factors a ZoneProperty:UserViewFactors:BySurfaceName gives where one does. A surface
-        is named by its component: a partition's second surface by its pair's."""
+        """Every zone exchanges long-wave radiation by ScriptF at its faces' temperatures of each
+        step, as EnergyPlus always does, with the view factors a
+        ZoneProperty:UserViewFactors:BySurfaceName gives where one does. A surface is named by its
+        component: a partition's second surface by its pair's."""
         for z in zones:
             z["longwave"] = "scriptf"
+            z["longwave_followed"] = True
         by_zone = {z["name"].upper(): z for z in zones}
         names = {c["name"].upper(): c["name"] for c in components}
         for s in surfaces.values():

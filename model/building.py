@@ -184,6 +184,7 @@ class Zone:
     ventilation: tuple = ()  # Ventilation records
     longwave: str = "radiant_node"  # "radiant_node" (the star node) or "scriptf" (docs/model.md 3.5)
     view_factors: tuple = ()  # (from component, to component, F) declared for "scriptf"; () approximated
+    longwave_followed: bool = False  # "scriptf" at the faces' temperatures of each step, not at 20 C
     mass_node: int | None = None  # ids of the nodes those two add (docs/model.md section 7)
     heater_node: int | None = None
     inside_convection_algorithm: str = "simple"  # "simple": h_conv constant; "tarp": followed step by step
@@ -264,7 +265,8 @@ class Component:
 @dataclass(frozen=True)
 class Building:
     name: str
-    # latitude, longitude (deg), altitude (m), timezone, ground_albedo; if declared, ground_temperature (C), sky_diffuse
+    # latitude, longitude (deg), altitude (m), timezone, ground_albedo; if declared, ground_temperature (C), sky_diffuse,
+    # flow_density
     site: dict
     zones: tuple
     components: tuple
@@ -313,6 +315,8 @@ class Building:
         follows the temperatures or the wind (docs/model.md section 3.6)."""
         return (tuple((f"zone {z.name}", "inside_convection_algorithm") for z in self.zones
                       if z.inside_convection_algorithm != "simple")
+                + tuple((f"zone {z.name}", "longwave_followed") for z in self.zones if z.longwave_followed)
+                + ((("site", "flow_density"),) if self.site.get("flow_density") == "outdoor" else ())
                 + tuple((f"component {c.name}", "outside.convection") for c in self.exterior_components
                         if c.outside.convection is not None)
                 + tuple((f"component {c.name}", "outside.longwave") for c in self.exterior_components

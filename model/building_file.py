@@ -173,8 +173,9 @@ def parse_checked(data, source="<building>"):
             "air_density": float(site.get("air_density", schema_default("site", "air_density")))}
     if "ground_temperature" in data["site"]:
         site["ground_temperature"] = float(data["site"]["ground_temperature"])
-    if "sky_diffuse" in data["site"]:
-        site["sky_diffuse"] = data["site"]["sky_diffuse"]
+    for field in ("sky_diffuse", "flow_density"):
+        if field in data["site"]:
+            site[field] = data["site"][field]
     schedules = {name: _schedule(check, name, s, f"schedules.{name}") for name, s in data.get("schedules", {}).items()}
     materials = {name: _material(name, m) for name, m in data["materials"].items()}
     raw_zones, raw_components = data["zones"], data["components"]
@@ -402,6 +403,7 @@ def _zone(check, z, where, zone_names, explicit, next_id, schedules):
         heat_input_lag=_lumped(z.get("heat_input_lag")),
         longwave=z.get("longwave", schema_default("zone", "longwave")),
         view_factors=tuple((a, b, float(F)) for a, row in z.get("view_factors", {}).items() for b, F in row.items()),
+        longwave_followed=z.get("longwave_followed", schema_default("zone", "longwave_followed")),
         inside_convection_algorithm=z.get("inside_convection_algorithm",
                                           schema_default("zone", "inside_convection_algorithm")),
     )
@@ -690,9 +692,12 @@ def _check_air_exchanges(check, zones):
 
 
 def _check_view_factors(check, zones, components):
-    """A zone's declared view factors are for its ScriptF exchange, between faces it has, each
-    named by one component; their rows sum to at most 1."""
+    """A zone's declared view factors, and its followed long-wave, are for its ScriptF exchange;
+    the view factors between faces it has, each named by one component, their rows summing to at
+    most 1."""
     for i, z in enumerate(zones):
+        if z.longwave_followed and z.longwave != "scriptf":
+            check.fail(f"zones[{i}].longwave_followed", f"follows only longwave \"scriptf\", not {z.longwave!r}")
         if not z.view_factors:
             continue
         where = f"zones[{i}].view_factors"

@@ -52,7 +52,8 @@ def _library():
     function.argtypes = [ctypes.c_int, _INT, _INT, _INT, _INT, _INT, ctypes.c_long, _INT, _DOUBLE, _DOUBLE,
                          ctypes.c_long, ctypes.c_int, _DOUBLE, _INT, _INT, _DOUBLE, _DOUBLE, ctypes.c_int, _INT, _DOUBLE,
                          _DOUBLE, ctypes.c_int, _INT, _DOUBLE, ctypes.c_int, _INT, _DOUBLE, ctypes.c_int, _INT, _DOUBLE,
-                         ctypes.c_int, _INT, _DOUBLE, _INT, ctypes.c_int, _INT, _DOUBLE, ctypes.c_int, _INT, _DOUBLE]
+                         ctypes.c_int, _INT, _DOUBLE, _INT, ctypes.c_int, _INT, _DOUBLE, ctypes.c_int, _INT, _DOUBLE,
+                         ctypes.c_int, _INT, _DOUBLE, ctypes.c_int, _INT, _DOUBLE]
     return function
 
 
@@ -169,7 +170,7 @@ def _convection_arrays(convection):
     if convection is None:
         return (0, np.zeros(2, np.int32), np.zeros(3), 0, np.zeros(1, np.int32), np.zeros(6), 0, np.zeros(1, np.int32),
                 np.zeros(4), np.zeros(4, np.int32), 0, np.zeros(2, np.int32), np.zeros(5), 0, np.zeros(2, np.int32),
-                np.zeros(15))
+                np.zeros(15), 0, np.zeros(2, np.int32), np.zeros(2), 0, np.zeros(2, np.int32), np.zeros(1))
     return (len(convection.inside), np.ascontiguousarray(convection.inside_nodes, dtype=np.int32).ravel(),
             np.ascontiguousarray(convection.inside, dtype=float).ravel(), len(convection.outside),
             np.ascontiguousarray(convection.outside_nodes, dtype=np.int32),
@@ -180,4 +181,8 @@ def _convection_arrays(convection):
             np.ascontiguousarray(convection.window_nodes, dtype=np.int32).ravel(),
             np.ascontiguousarray(convection.windows, dtype=float).ravel(), len(convection.gaps),
             np.ascontiguousarray(convection.gap_nodes, dtype=np.int32).ravel(),
-            np.ascontiguousarray(convection.gaps, dtype=float).ravel())
+            np.ascontiguousarray(convection.gaps, dtype=float).ravel(), len(convection.pairs),
+            np.ascontiguousarray(convection.pair_nodes, dtype=np.int32).ravel(),
+            np.ascontiguousarray(convection.pairs, dtype=float).ravel(), len(convection.flows),
+            np.ascontiguousarray(convection.flow_nodes, dtype=np.int32).ravel(),
+            np.ascontiguousarray(convection.flows, dtype=float))

@@ -142,6 +142,14 @@ def enclosure_exchange(names, areas, emissivities, tilts, azimuths, classes, dec
             absorbed_shares(areas, emissivities))
 
 
+def pair_coefficient(T_a, T_b):
+    """sigma (T_a^4 - T_b^4) / (T_a - T_b) = sigma (T_a^2 + T_b^2)(T_a + T_b) (W/m2/K, T_a and T_b
+    in C, taken in K): times A_a ScriptF_ab the conductance of two faces' exchange at their own
+    temperatures, as EnergyPlus computes it each step (HeatBalanceIntRadExchange.cc,
+    CalcInteriorRadExchange); 4 sigma T^3 where they meet, `exchange_conductances`'s at T_MEAN."""
+    return exterior_coefficient(1.0, T_a, T_b)
+
+
 def exterior_coefficient(emissivity, T_face, T_other):
     """An outside face's long-wave coefficient (W/m2/K) toward the sky, the air or the ground at
     T_other (C) from its own temperature T_face (C), as EnergyPlus computes it each step

@@ -26,7 +26,7 @@ from .building_file import gap_nodes, schema_default
 from .convection import doe2_faces, iso15099_inside, lagged_excess, tarp_inside_faces, windward_faces
 from .discretise import capacities, conductances
 from .glazing import followed_gap_conductance, gap_coefficients
-from .longwave import enclosure_exchange, exterior_coefficient
+from .longwave import T_MEAN, enclosure_exchange, exterior_coefficient, pair_coefficient
 
 AIR_DENSITY = schema_default("site", "air_density")  # kg/m3, a building file's default
 C_AIR = 1005.0  # J/kg/K
@@ -56,7 +56,13 @@ class Convection:
     tilt deg, the site's pressure Pa) (w, 5)); each of its gaps A f (h_gap(T_a, T_b) - h0)
     (T_b - T_a) on the pane face a and its negative on b, gaps: ((a, b) (g, 2), (A f m2,
     h0 W/m2/K, thickness m, height m, eps, the gas's ten coefficients) (g, 15)), f the factors
-    that scale the gap's link, eps = 1 / (1/e_1 + 1/e_2 - 1)."""
+    that scale the gap's link, eps = 1 / (1/e_1 + 1/e_2 - 1). A zone whose ScriptF exchange is
+    followed: each pair of its faces (a, b) (p, 2), (A_a ScriptF_ab m2, G0 W/K) (p, 2), A_a ScriptF_ab
+    (sigma (T_a^2 + T_b^2)(T_a + T_b) - G0) (T_b - T_a) on face a and its negative on b. A site
+    whose air flows carry heat at the outdoor air's density: each flow from outdoors (air node,
+    its schedule's input column or -1) (f, 2), g W/K at the site's air_density (f,),
+    g s (293.15 / (T_out + 273.15) - 1) (T_out - T_air) on the air, s the schedule's value (1
+    without)."""
     inside_nodes: np.ndarray
     inside: np.ndarray
     outside_nodes: np.ndarray
@@ -68,6 +74,10 @@ class Convection:
     windows: np.ndarray = field(default_factory=lambda: np.zeros((0, 5)))
     gap_nodes: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=int))
     gaps: np.ndarray = field(default_factory=lambda: np.zeros((0, 15)))
+    pair_nodes: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=int))
+    pairs: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    flow_nodes: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=int))
+    flows: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def source(self, T, u):
         """(N,) W of the temperatures T (N,) before the step (C) and the inputs u at its end."""
@@ -106,6 +116,18 @@ class Convection:
             flow = area * lagged_excess(h, h0) * (T[b] - T[a])
             np.add.at(q, a, flow)
             np.add.at(q, b, -flow)
+        if len(self.pairs):
+            a, b = self.pair_nodes.T
+            exchange, g0 = self.pairs.T
+            flow = lagged_excess(exchange * pair_coefficient(T[a], T[b]), g0) * (T[b] - T[a])
+            np.add.at(q, a, flow)
+            np.add.at(q, b, -flow)
+        if len(self.flows):
+            t_out = u[self.columns[0]]
+            air, column = self.flow_nodes.T
+            share = np.where(column >= 0, u[np.maximum(column, 0)], 1.0)
+            excess = lagged_excess(outdoor_density_ratio(t_out), 1.0)
+            np.add.at(q, air, self.flows * share * excess * (t_out - T[air]))
         return q
 
 
@@ -341,6 +363,14 @@ def air_density_at(altitude, T=20.0):
     return p / (287.05 * (T + 273.15))
 
 
+def outdoor_density_ratio(T_out, T_site=20.0):
+    """rho(T_out) / rho_site = (T_site + 273.15) / (T_out + 273.15): the outdoor air's density over
+    the site's air_density (taken at T_site C), both at the site's pressure (ideal gas), as
+    EnergyPlus carries infiltration and ventilation at the outdoor air's density
+    (ZoneEquipmentManager.cc, CalcAirFlowSimple)."""
+    return (T_site + 273.15) / (np.asarray(T_out, dtype=float) + 273.15)
+
+
 def air_conductance(flow, density=AIR_DENSITY):
     """(rho c)_air V / 3600 (W/K) of an air flow V (m3/h) of air of a density (kg/m3)."""
     return density * C_AIR * flow / 3600.0
@@ -360,7 +390,7 @@ def assemble(building, names=None):
     A = np.zeros((n, n))
     B = np.zeros((n, len(names)))
     q = np.zeros(n)
-    products, switched, inside, outside, longwave, windows, gaps = [], [], [], [], [], [], []
+    products, switched, inside, outside, longwave, windows, gaps, pairs, flows = [], [], [], [], [], [], [], [], []
 
     def link(i, j, g):
         """A conductance g (W/K) between nodes i and j (0-based)."""
@@ -408,6 +438,9 @@ def assemble(building, names=None):
         for a, b in zip(*np.triu_indices(len(nodes), 1)):
             if G[a, b] != 0.0:
                 link(nodes[a], nodes[b], G[a, b])
+                if z.longwave_followed:  # G is A ScriptF 4 sigma T_m^3: its exchange factor apart
+                    pairs.append(((nodes[a], nodes[b]), (G[a, b] / pair_coefficient(T_MEAN - 273.15,
+                                                                                    T_MEAN - 273.15), G[a, b])))
         # the radiant node carries nothing: it reads the faces' mean radiant temperature,
         # sum A eps T_s / sum A eps (EnergyPlus's zone MRT), a row no other node reads
         radiant = z.radiant_node - 1
@@ -478,22 +511,35 @@ def assemble(building, names=None):
                     B[receiver, sun] += transmitted
 
     rho = building.site.get("air_density", AIR_DENSITY)
+    outdoor = building.site.get("flow_density") == "outdoor"
+
+    def from_outdoors(air, g, column=-1):
+        """An air flow of g W/K (at rho) from outdoors, by the schedule's input `column` (-1: none)
+        where the site's flows carry heat at the outdoor air's density."""
+        if outdoor and g:
+            flows.append(((air, column), g))
+
     for z in building.zones:
         air, radiant = z.air_node - 1, absorbers[z.name]
         C[air] += rho * C_AIR * z.volume
-        to_temperature(air, air_conductance(z.volume * z.air_change_rate, rho), "T_out")
+        infiltration = air_conductance(z.volume * z.air_change_rate, rho)
+        to_temperature(air, infiltration, "T_out")
+        from_outdoors(air, infiltration)
         if z.supply is not None:
             to_temperature(air, air_conductance(z.supply.flow * z.supply.flow_factor, rho), z.supply.temperature)
         for v in z.ventilation:
             schedule = building.schedules.get(v.schedule) if v.schedule is not None else None
             if schedule is None or schedule.is_constant:
-                to_temperature(air, air_conductance(v.flow * (1.0 if schedule is None else schedule.value), rho), "T_out")
+                g = air_conductance(v.flow * (1.0 if schedule is None else schedule.value), rho)
+                to_temperature(air, g, "T_out")
+                from_outdoors(air, g)
             else:
                 # g s(t) (T_out - T_air): the conductance follows the schedule (`Network.switched`),
                 # its T_out term is a product of two inputs
                 g = air_conductance(v.flow, rho)
                 switched.append((air, col[v.schedule], g))
                 products.append((air, col[v.schedule], col["T_out"], g))
+                from_outdoors(air, g, col[v.schedule])
         for inflow in z.airflow_from:
             g = air_conductance(inflow.flow, rho)
             A[air, air] -= g
@@ -545,7 +591,7 @@ def assemble(building, names=None):
                 for r, w in radiant:
                     B[r, col[name]] += gain * f_r * w
     convection = None
-    if inside or outside or longwave or windows or gaps:
+    if inside or outside or longwave or windows or gaps or pairs or flows:
         convection = Convection(
             inside_nodes=np.array([n for n, _ in inside], dtype=int).reshape(-1, 2),
             inside=np.array([v for _, v in inside], dtype=float).reshape(-1, 3),
@@ -557,7 +603,11 @@ def assemble(building, names=None):
             window_nodes=np.array([n for n, _ in windows], dtype=int).reshape(-1, 2),
             windows=np.array([v for _, v in windows], dtype=float).reshape(-1, 5),
             gap_nodes=np.array([n for n, _ in gaps], dtype=int).reshape(-1, 2),
-            gaps=np.array([v for _, v in gaps], dtype=float).reshape(-1, 15))
+            gaps=np.array([v for _, v in gaps], dtype=float).reshape(-1, 15),
+            pair_nodes=np.array([n for n, _ in pairs], dtype=int).reshape(-1, 2),
+            pairs=np.array([v for _, v in pairs], dtype=float).reshape(-1, 2),
+            flow_nodes=np.array([n for n, _ in flows], dtype=int).reshape(-1, 2),
+            flows=np.array([g for _, g in flows], dtype=float))
     return Network(C=C, A=A, B=B, q=q, input_names=names, products=tuple(products), switched=tuple(switched),
                    convection=convection)
 

@@ -12,7 +12,7 @@ from nodeforce.model.case import prepare_case
 from nodeforce.model.convection import doe2_faces, tarp_inside_faces, windward_faces
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import simulate
-from nodeforce.model.longwave import SIGMA, exterior_coefficient
+from nodeforce.model.longwave import SIGMA, enclosure_exchange, exterior_coefficient
 from nodeforce.model.network import WIND_DIRECTION, WIND_SPEED, assemble
 
 
@@ -205,12 +205,14 @@ def test_the_standalone_fmu_refuses_coefficients_that_follow_the_state(testcell_
 
 
 @pytest.mark.slow
-def test_the_python_fmu_steps_as_the_direct_model(testcell_data, weather, tmp_path):
+@pytest.mark.parametrize("declare", [followed, lambda data: enclosed(ventilated(data))],
+                         ids=["convection", "scriptf_and_flows"])
+def test_the_python_fmu_steps_as_the_direct_model(testcell_data, weather, tmp_path, declare):
     from nodeforce.cosim.fmi import FmuInstance
     from nodeforce.cosim.run import simulate_fmu
     from nodeforce.fmu_build.build import build_fmu
     from tests.conftest import record_times
-    building = parse_building(followed(testcell_data))
+    building = parse_building(declare(testcell_data))
     times = record_times(days=2)
     w = windy(weather)
     w = w[(w.index >= times[0] - np.timedelta64(2, "h")) & (w.index <= times[-1] + np.timedelta64(2, "h"))]
@@ -220,3 +222,140 @@ def test_the_python_fmu_steps_as_the_direct_model(testcell_data, weather, tmp_pa
     with FmuInstance(fmu) as instance:
         through_fmu = simulate_fmu(instance, case)
     assert np.abs(through_fmu - direct).max() < 1e-9
+
+
+# ---- ScriptF at the faces' temperatures, air flows at the outdoor air's density -----------------
+
+def enclosed(data, followed_longwave=True):
+    """The building whose zone exchanges long-wave radiation by ScriptF, at the faces' temperatures
+    of each step where `followed_longwave`."""
+    data = copy.deepcopy(data)
+    for z in data["zones"]:
+        z["longwave"] = "scriptf"
+        z["longwave_followed"] = followed_longwave
+    return data
+
+
+def test_scriptf_followed_exchanges_sigma_t4_between_every_pair_of_faces(testcell_data):
+    """The matrix's exchange linearised at 20 C and the lagged source together are each pair's
+    A_i ScriptF_ij sigma (T_j^4 - T_i^4), the grey enclosure's exact exchange, face by face; what
+    one face gains the others lose."""
+    building = parse_building(enclosed(testcell_data))
+    network = assemble(building)
+    zone = building.zones[0].name
+    names, ids, *faces = building.enclosure(zone)
+    G, _ = enclosure_exchange(names, *faces)
+    exchange = G / (4.0 * SIGMA * 293.15 ** 3)  # A_i ScriptF_ij, m2
+    rng = np.random.default_rng(3)
+    T = 5.0 + 12.0 * rng.standard_normal(network.n_nodes)
+    q = network.convection.source(T, np.zeros(len(network.input_names)))
+    nodes = np.array(ids) - 1
+    K = T[nodes] + 273.15
+    exact = (exchange * SIGMA * (K[None, :] ** 4 - K[:, None] ** 4)).sum(axis=1)
+    linear = (G * (T[nodes][None, :] - T[nodes][:, None])).sum(axis=1)
+    np.testing.assert_allclose(q[nodes], exact - linear, rtol=1e-9, atol=1e-9)
+    assert abs(q.sum()) < 1e-9 * np.abs(q).max()
+
+
+def test_scriptf_followed_leaves_no_source_at_20_C_and_less_exchange_when_cold(testcell_data):
+    """At the linearisation's 20 C nothing is added; a window face at -15 C facing faces at -10 C
+    gains (T_a^2 + T_b^2)(T_a + T_b) / (4 T_m^3) = (258.15^2 + 263.15^2) 521.3 / (4 x 293.15^3)
+    = 0.703 of the rate linearised at 20 C."""
+    building = parse_building(enclosed(testcell_data))
+    network = assemble(building)
+    u = np.zeros(len(network.input_names))
+    assert np.abs(network.convection.source(np.full(network.n_nodes, 20.0), u)).max() < 1e-9
+    pairs, (exchange, g0) = network.convection.pair_nodes, network.convection.pairs.T
+    a = pairs[0, 0]
+    T = np.full(network.n_nodes, -10.0)
+    T[a] = -15.0
+    linearised = 5.0 * g0[(pairs == a).any(axis=1)].sum()
+    gained = linearised + network.convection.source(T, u)[a]
+    assert gained == pytest.approx(0.703 * linearised, rel=1e-3)
+
+
+def test_scriptf_followed_steps_alike_in_c_and_numpy_and_is_refused_without_scriptf(testcell_data, weather,
+                                                                                        monkeypatch):
+    from tests.conftest import record_times
+    building, plain = parse_building(enclosed(testcell_data)), parse_building(enclosed(testcell_data, False))
+    times = record_times(days=3)
+    w = weather[(weather.index >= times[0] - np.timedelta64(2, "h")) & (weather.index <= times[-1] + np.timedelta64(2, "h"))]
+    case = prepare_case(building, w)
+    network = assemble(building)
+    T = simulate(building, network, case.U, case.dt, substeps=case.substeps)
+    linear = simulate(plain, assemble(plain), case.U, case.dt, substeps=case.substeps)
+    faces = network.convection.pair_nodes.ravel()
+    assert np.abs(T[:, faces] - linear[:, faces]).max() > 0.01
+    if compiled.available():
+        monkeypatch.setattr(compiled, "available", lambda: False)
+        stepped = simulate(building, network, case.U, case.dt, substeps=case.substeps)
+        assert np.abs(stepped - T).max() < 1e-10 * np.abs(T).max()
+    data = enclosed(testcell_data)
+    data["zones"][0]["longwave"] = "radiant_node"
+    with pytest.raises(InputError, match=r"zones\[0\]\.longwave_followed.*scriptf"):
+        parse_building(data)
+
+
+def ventilated(data, flow_density="outdoor"):
+    """The building with a night ventilation of 300 m3/h by a schedule (1 from 18:00 to 07:00),
+    its air flows carrying heat at `flow_density`."""
+    data = copy.deepcopy(data)
+    data["site"]["flow_density"] = flow_density
+    data["schedules"] = {"night": {"days": {"d": [[7, 1.0], [18, 0.0], [24, 1.0]]},
+                                   "periods": [{"through": "12-31", "week": ["d"] * 7}]}}
+    data["zones"][0]["ventilation"] = [{"name": "vent", "flow": 300.0, "schedule": "night"}]
+    return data
+
+
+def test_air_flows_carry_heat_at_the_outdoor_air_s_density(testcell_data):
+    """By hand: air at 20 C in a zone of infiltration n V and 300 m3/h of ventilation, outdoors at
+    -20 C: the flows carry (n V + 300) / 3600 x rho(-20 C) x 1005 x (T_out - T_air) W, rho(-20 C) =
+    p / (287.05 x 253.15) at the site's pressure p = air_density x 287.05 x 293.15; the matrix
+    carries the part at the site's air_density, the source the rest. With the schedule at 0 only
+    the infiltration's; at 20 C outdoors nothing."""
+    building = parse_building(ventilated(testcell_data))
+    network = assemble(building)
+    z = building.zones[0]
+    air = z.air_node - 1
+    rho_site = building.site["air_density"]
+    rho_out = rho_site * 287.05 * 293.15 / (287.05 * 253.15)
+    u = np.zeros(len(network.input_names))
+    u[network.input_names.index("T_out")] = -20.0
+    u[network.input_names.index("night")] = 1.0
+    T = np.full(network.n_nodes, 20.0)
+    V = z.volume * z.air_change_rate + 300.0
+    carried = V / 3600.0 * 1005.0 * (-40.0)
+    assert network.convection.source(T, u)[air] == pytest.approx(carried * (rho_out - rho_site), rel=1e-12)
+    u[network.input_names.index("night")] = 0.0
+    V = z.volume * z.air_change_rate
+    assert network.convection.source(T, u)[air] == pytest.approx(V / 3600 * 1005 * (-40) * (rho_out - rho_site),
+                                                                   rel=1e-12)
+    u[network.input_names.index("T_out")] = 20.0
+    assert network.convection.source(T, u)[air] == 0.0
+    assert "flow_density" not in parse_building(testcell_data).site  # undeclared: the site's density
+
+
+def test_air_flows_at_the_outdoor_density_step_alike_in_c_and_numpy(testcell_data, weather, monkeypatch):
+    from tests.conftest import record_times
+    building = parse_building(ventilated(testcell_data))
+    plain = parse_building(ventilated(testcell_data, "site"))
+    times = record_times(days=3)
+    w = weather[(weather.index >= times[0] - np.timedelta64(2, "h")) & (weather.index <= times[-1] + np.timedelta64(2, "h"))]
+    case = prepare_case(building, w)
+    network = assemble(building)
+    assert assemble(plain).convection is None
+    T = simulate(building, network, case.U, case.dt, substeps=case.substeps)
+    site = simulate(plain, assemble(plain), case.U, case.dt, substeps=case.substeps)
+    air = building.zones[0].air_node - 1
+    assert np.abs(T[:, air] - site[:, air]).max() > 0.01
+    if compiled.available():
+        monkeypatch.setattr(compiled, "available", lambda: False)
+        stepped = simulate(building, network, case.U, case.dt, substeps=case.substeps)
+        assert np.abs(stepped - T).max() < 1e-10 * np.abs(T).max()
+    from nodeforce.fmu_build.standalone import network_terms
+    data = copy.deepcopy(testcell_data)
+    data["site"]["flow_density"] = "outdoor"
+    with pytest.raises(InputError, match="flow_density.*standalone C FMU"):
+        network_terms(parse_building(data), None)
+    with pytest.raises(InputError, match="longwave_followed.*standalone C FMU"):
+        network_terms(parse_building(enclosed(testcell_data)), None)

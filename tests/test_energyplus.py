@@ -484,10 +484,12 @@ def test_declared_sky_fraction_in_the_network():
 
 
 def test_every_zone_exchanges_long_wave_by_script_f(case600):
-    """EnergyPlus always uses ScriptF: every zone gets it, each face its inner layer's thermal
-    absorptance (a simple glazing's 0.84) and its surface type's class (a window its own)."""
+    """EnergyPlus always uses ScriptF at the faces' temperatures: every zone gets it, each face its
+    inner layer's thermal absorptance (a simple glazing's 0.84) and its surface type's class (a
+    window its own); its air flows carry the outdoor air's density."""
     z = case600.zones[0]
-    assert z.longwave == "scriptf" and z.view_factors == ()
+    assert z.longwave == "scriptf" and z.view_factors == () and z.longwave_followed
+    assert case600.site["flow_density"] == "outdoor"
     assert case600.component("SOUTH WINDOW WEST").inside.emissivity == 0.84  # simple glazing's
     assert case600.component("FLOOR").inside.emissivity == 0.9  # the IDF's thermal absorptance
     assert [case600.component(n).inside.face_class for n in ("FLOOR", "ROOF", "EAST WALL", "SOUTH WINDOW EAST")] \
@@ -656,3 +658,18 @@ def test_the_deep_ground_temperature_of_the_idf_is_the_sites_ground_temperature(
                     + "".join(f"  {t},\n" for t in months) + "  ;\n")
     site = convert_idf(path).site
     assert site["ground_temperature"] == pytest.approx((sum(months) + 16.0) / 12, abs=1e-12)
+
+
+def test_a_layered_window_s_panes_and_the_sky_are_declared_as_energyplus_solves_them():
+    """examples/bestest/case600.idf's windows, 2 m high, are DOUBLE CLEAR: two panes of
+    emissivity 0.84 about 13 mm of air; from the inside face the gap is layer 1 of 3. The site's
+    sky is EnergyPlus's anisotropic one; a simple glazing system (three_zones.idf's east window) has
+    no gap to follow."""
+    building = convert_idf(CASE600)
+    window = building.component("SOUTH WINDOW WEST").window
+    assert window.height == 2.0
+    [gap] = window.gaps
+    assert (gap.layer, gap.emissivities, gap.gas) == (1, (0.84, 0.84), "air")
+    assert building.component("SOUTH WINDOW WEST").layers[1][1] == 0.013
+    assert building.site["sky_diffuse"] == "energyplus"
+    assert convert_idf(MULTIZONE).component("EAST SOUTH WINDOW").window is None  # a simple glazing system

@@ -85,12 +85,16 @@ static double excess(double h, double h0) {
    and (A, h0, cos_up, azimuth, R_f, wind factor); long-wave, per face, its node and (A, h_rad,
    F, eps); columns: u's T_out, wind speed and direction, T_sky; windows, per window face, (face,
    air) and (A phi, h0, height, tilt, pressure); gaps, per gap, its two pane faces (a, b) and (A f, h0,
-   thickness, height, eps, the gas's ten coefficients) */
+   thickness, height, eps, the gas's ten coefficients); pairs, per pair of faces of a followed ScriptF
+   exchange, (a, b) and (A_a ScriptF_ab, G0); flows, per air flow from outdoors at the outdoor
+   air's density, (air node, its schedule's column of u or -1) and g */
 static void convection(int n, const double *T, const double *u, int n_inside, const int *inside_nodes,
                        const double *inside, int n_outside, const int *outside_nodes, const double *outside,
                        int n_longwave, const int *longwave_nodes, const double *longwave, const int *columns,
                        int n_windows, const int *window_nodes, const double *windows, int n_gaps,
-                       const int *gap_nodes, const double *gaps, double *q) {
+                       const int *gap_nodes, const double *gaps, int n_pairs, const int *pair_nodes,
+                       const double *pairs, int n_flows, const int *flow_nodes, const double *flows,
+                       double *q) {
     int k;
     for (k = 0; k < n; k++) q[k] = 0.0;
     for (k = 0; k < n_inside; k++) {
@@ -132,6 +136,19 @@ static void convection(int n, const double *T, const double *u, int n_inside, co
         q[a] += flow;
         q[b] -= flow;
     }
+    for (k = 0; k < n_pairs; k++) {
+        const int a = pair_nodes[2 * k], b = pair_nodes[2 * k + 1];
+        const double *v = pairs + 2 * k;
+        const double flow = excess(v[0] * exterior_coefficient(1.0, T[a], T[b]), v[1]) * (T[b] - T[a]);
+        q[a] += flow;
+        q[b] -= flow;
+    }
+    for (k = 0; k < n_flows; k++) {
+        /* model/network.py's outdoor_density_ratio: (20 + 273.15) / (T_out + 273.15) */
+        const int air = flow_nodes[2 * k], column = flow_nodes[2 * k + 1];
+        const double t_out = u[columns[0]], share = column >= 0 ? u[column] : 1.0;
+        q[air] += flows[k] * share * excess((20.0 + 273.15) / (t_out + 273.15), 1.0) * (t_out - T[air]);
+    }
 }
 
 /* order (N): the node of each position of the elimination order; lower_ptr/lower_col (N + 1,
@@ -153,12 +170,14 @@ EXPORT int nodeforce_steps(int n, const int *order, const int *lower_ptr, const 
                            const double *inside, int n_outside, const int *outside_nodes, const double *outside,
                            int n_longwave, const int *longwave_nodes, const double *longwave, const int *columns,
                            int n_windows, const int *window_nodes, const double *windows, int n_gaps,
-                           const int *gap_nodes, const double *gaps) {
+                           const int *gap_nodes, const double *gaps, int n_pairs, const int *pair_nodes,
+                           const double *pairs, int n_flows, const int *flow_nodes, const double *flows) {
     long entries = (long)n + lower_ptr[n] + upper_ptr[n], s, e;
     double *f = calloc((size_t)entries + 1, sizeof(double)), *w = calloc((size_t)n + 1, sizeof(double));
     double *y = malloc(((size_t)n + 1) * sizeof(double));
     int *position = malloc(((size_t)n + 1) * sizeof(int));
-    const int lagged = n_inside > 0 || n_outside > 0 || n_longwave > 0 || n_windows > 0 || n_gaps > 0;
+    const int lagged = n_inside > 0 || n_outside > 0 || n_longwave > 0 || n_windows > 0 || n_gaps > 0 || n_pairs > 0 ||
+                       n_flows > 0;
     double *extra = calloc((size_t)n + 1, sizeof(double));
     double *diagonal = f, *lower = f + n, *upper = f + n + lower_ptr[n];
     int i, p, k, ok = 0;
@@ -187,7 +206,7 @@ EXPORT int nodeforce_steps(int n, const int *order, const int *lower_ptr, const 
         if (lagged)
             convection(n, T, t_s, n_inside, inside_nodes, inside, n_outside, outside_nodes, outside, n_longwave,
                        longwave_nodes, longwave, columns, n_windows, window_nodes, windows, n_gaps, gap_nodes, gaps,
-                       extra);
+                       n_pairs, pair_nodes, pairs, n_flows, flow_nodes, flows, extra);
         for (i = 0; i < n; i++) {
             const int node = order[i];
             double sum = q[node] + extra[node];
