@@ -26,17 +26,22 @@ def refined(building, cells=REFINEMENT):
     """The building with explicit nodes: each stretch between two of its nodes or layer boundaries
     cut into `cells` equal cells; its own nodes keep their ids (the added ones follow them), so a
     column T<id> or a sensor measures the same point in both. Nodes an effect adds (an internal
-    mass, a heater) are numbered after all of them."""
+    mass, a heater) are numbered after all of them. A window's gas gap keeps its two face nodes
+    alone: its conductance follows the panes on either side (`Component.window`), and the gas
+    stores no heat a finer grid would resolve."""
     data = building.to_json()
     ids = count(building.own_nodes + 1)
     for raw, c in zip(data["components"], building.components):
-        bounds = np.cumsum([t for _, t in c.layers])[:-1]
+        edges = np.cumsum([0.0] + [t for _, t in c.layers])
+        bounds = edges[1:-1]
+        gaps = [(edges[g.layer], edges[g.layer + 1]) for g in (c.window.gaps if c.window else ())]
         points = sorted([(d, i) for i, d in zip(c.node_ids, c.depths)]
                         + [(float(d), None) for d in bounds if np.abs(np.array(c.depths) - d).min() > 1e-9])
         nodes = []
         for (a, i), (b, _) in zip(points, points[1:]):
             nodes.append({"id": i or next(ids), "depth": a})
-            nodes += [{"id": next(ids), "depth": a + (b - a) * k / cells} for k in range(1, cells)]
+            within_gap = any(lo - 1e-9 <= a and b <= hi + 1e-9 for lo, hi in gaps)
+            nodes += [{"id": next(ids), "depth": a + (b - a) * k / cells} for k in range(1, 1 if within_gap else cells)]
         nodes.append({"id": points[-1][1], "depth": points[-1][0]})
         raw["nodes"] = nodes
     for raw, z in zip(data["zones"], building.zones):

@@ -42,6 +42,24 @@ def test_the_refined_file_is_finer_and_has_the_files_conductances_and_capacities
         assert heat_loss_coefficient(fine) == pytest.approx(heat_loss_coefficient(building), rel=1e-9)
 
 
+def test_a_windows_gas_gap_keeps_its_two_face_nodes_in_the_refined_file():
+    """A converted window's gaps (`Component.window`) need a node on each face and none within:
+    the refined file keeps each gap's two nodes alone (their ids and depths the file's) while the
+    panes beside it are cut into `cells` cells, and it parses as a building file."""
+    building = load_building("examples/bestest/case600.json")
+    windows = [c for c in building.components if c.window is not None]
+    assert windows
+    fine = refined(building, 4)
+    for f in windows:
+        c = fine.component(f.name)
+        edges = np.cumsum([0.0] + [t for _, t in c.layers])
+        depths = np.array(c.depths)
+        for gap in c.window.gaps:
+            lo, hi = edges[gap.layer], edges[gap.layer + 1]
+            assert np.sum((depths >= lo - 1e-12) & (depths <= hi + 1e-12)) == 2
+        assert len(c.depths) > len(f.depths)  # the panes are refined
+
+
 def air_case(building, weather, days=5, past=30):
     """The test cell's air alone over `days` at 15 min in June, with `past` days of history."""
     measured = pseudo_measurements(building, weather, record_times(days), [AIR], history_days=past)
