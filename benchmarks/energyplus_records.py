@@ -73,8 +73,25 @@ def _bestest():
 
 
 def building_document(building):
-    """The idfkit document of the unchanged building: "600FF" (light) or "900FF" (heavy)."""
-    return _bestest().CASES[building]()
+    """The idfkit document of the unchanged building: "600FF" (light) or "900FF" (heavy), sited
+    where the climate's EPW was recorded (`at_weather_site`)."""
+    return at_weather_site(_bestest().CASES[building](), package_weather())
+
+
+def at_weather_site(doc, epw):
+    """`doc` with its Site:Location replaced by the EPW's LOCATION line (name, latitude,
+    longitude, time zone, elevation). EnergyPlus run on a weather file takes the file's location
+    and ignores the IDF's; nodeforce converts the IDF's. ASHRAE 140's IDFs say Denver; with
+    Chicago's weather, nodeforce's sun would stand 17 deg of longitude (68 min of solar time) and
+    2 deg of latitude from EnergyPlus's."""
+    with open(epw, encoding="latin-1") as f:
+        fields = f.readline().strip().split(",")
+    for old in list(doc.idfobjects["Site:Location"]):
+        doc.removeidfobject(old)
+    doc.add("Site:Location", f"{fields[1]} {fields[5]}", {
+        "latitude": float(fields[6]), "longitude": float(fields[7]), "time_zone": float(fields[8]),
+        "elevation": float(fields[9])})
+    return doc
 
 
 BUILDINGS = ("600FF", "900FF")

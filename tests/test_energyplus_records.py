@@ -212,3 +212,15 @@ def test_summary_counts_the_criteria():
     assert numbers["failed"] == 1 and numbers["diagnoses"] == 4
     assert any(line.startswith("- FAIL: first effect right on 50 %") for line in lines)
     assert not math.isnan(numbers["seconds_median"])
+
+
+def test_the_building_stands_where_its_weather_was_recorded():
+    """EnergyPlus run on a weather file takes the file's location, not the IDF's (its eplusout.err:
+    "Weather file location will be used rather than entered (IDF) Location object"): the records'
+    IDF, which nodeforce converts, is given the EPW's LOCATION line, O'Hare's 41.98 N, 87.92 W,
+    UTC-6, 201 m, in place of ASHRAE 140's Denver, and holds no other site."""
+    for building in records.BUILDINGS:
+        sites = list(records.building_document(building).idfobjects["Site:Location"])
+        assert len(sites) == 1
+        site = sites[0]
+        assert (site.latitude, site.longitude, site.time_zone, site.elevation) == (41.98, -87.92, -6.0, 201.0)
