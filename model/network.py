@@ -35,6 +35,13 @@ RHO_C_AIR = AIR_DENSITY * C_AIR  # J/m3/K
 WIND_SPEED, WIND_DIRECTION = "wind_speed", "wind_direction"
 
 
+def _between(q, a, b, flow):
+    """Add `flow` (W) into nodes `a` and take it from nodes `b`: a lagged exchange between two
+    nodes conserves the heat it moves."""
+    np.add.at(q, a, flow)
+    np.add.at(q, b, -flow)
+
+
 @dataclass(frozen=True)
 class Convection:
     """The convective and long-wave coefficients computed at every step (docs/model.md section
@@ -87,8 +94,7 @@ class Convection:
             area, h0, cos_up = self.inside.T
             dT = T[air] - T[face]
             flow = area * lagged_excess(tarp_inside_faces(-dT, cos_up), h0) * dT
-            np.add.at(q, face, flow)
-            np.add.at(q, air, -flow)
+            _between(q, face, air, flow)
         if len(self.outside):
             t_out, speed, direction = (u[j] for j in self.columns[:3])
             area, h0, cos_up, azimuth, roughness, wind = self.outside.T
@@ -107,21 +113,18 @@ class Convection:
             area, h0, height, tilt, pressure = self.windows.T
             dT = T[air] - T[face]
             flow = area * lagged_excess(iso15099_inside(-dT, T[air], height, tilt, pressure), h0) * dT
-            np.add.at(q, face, flow)
-            np.add.at(q, air, -flow)
+            _between(q, face, air, flow)
         if len(self.gaps):
             a, b = self.gap_nodes.T
             area, h0, thickness, height, emissivity = self.gaps[:, :5].T
             h = followed_gap_conductance(T[a], T[b], thickness, height, emissivity, self.gaps[:, 5:])
             flow = area * lagged_excess(h, h0) * (T[b] - T[a])
-            np.add.at(q, a, flow)
-            np.add.at(q, b, -flow)
+            _between(q, a, b, flow)
         if len(self.pairs):
             a, b = self.pair_nodes.T
             exchange, g0 = self.pairs.T
             flow = lagged_excess(exchange * pair_coefficient(T[a], T[b]), g0) * (T[b] - T[a])
-            np.add.at(q, a, flow)
-            np.add.at(q, b, -flow)
+            _between(q, a, b, flow)
         if len(self.flows):
             t_out = u[self.columns[0]]
             air, column = self.flow_nodes.T
