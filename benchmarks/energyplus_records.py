@@ -84,8 +84,7 @@ def at_weather_site(doc, epw):
     and ignores the IDF's; nodeforce converts the IDF's. ASHRAE 140's IDFs say Denver; with
     Chicago's weather, nodeforce's sun would stand 17 deg of longitude (68 min of solar time) and
     2 deg of latitude from EnergyPlus's."""
-    with open(epw, encoding="latin-1") as f:
-        fields = f.readline().strip().split(",")
+    fields = location(epw)
     for old in list(doc.idfobjects["Site:Location"]):
         doc.removeidfobject(old)
     doc.add("Site:Location", f"{fields[1]} {fields[5]}", {
@@ -266,10 +265,16 @@ def package_weather():
     return Path(pyenergyplus.__file__).parent / CLIMATE
 
 
+def location(epw):
+    """The fields of the EPW's LOCATION line (its first): name, city and state, ..., WMO code,
+    latitude, longitude, time zone (h from UTC), elevation (m)."""
+    with open(epw, encoding="latin-1") as f:
+        return f.readline().strip().split(",")
+
+
 def utc_offset(epw):
     """The EPW's standard time's offset from UTC (h), its LOCATION line's ninth field."""
-    with open(epw, encoding="latin-1") as f:
-        return float(f.readline().split(",")[8])
+    return float(location(epw)[8])
 
 
 def run_document(doc):
