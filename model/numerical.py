@@ -16,7 +16,7 @@ from itertools import count
 
 import numpy as np
 
-from .building_file import parse_building
+from .building_file import gap_nodes, parse_building
 
 REFINEMENT = 4  # cells of the reference per stretch between two of the file's nodes or layer boundaries
 REFERENCE_STEP = 60.0  # s, the reference's longest integration step
@@ -32,16 +32,15 @@ def refined(building, cells=REFINEMENT):
     data = building.to_json()
     ids = count(building.own_nodes + 1)
     for raw, c in zip(data["components"], building.components):
-        edges = np.cumsum([0.0] + [t for _, t in c.layers])
-        bounds = edges[1:-1]
-        gaps = [(edges[g.layer], edges[g.layer + 1]) for g in (c.window.gaps if c.window else ())]
+        bounds = np.cumsum([t for _, t in c.layers])[:-1]
+        # the depth each gas gap starts at: the first of its two face nodes (`gap_nodes`)
+        gaps = {c.depths[gap_nodes(c.layers, c.depths, g.layer)[0]] for g in (c.window.gaps if c.window else ())}
         points = sorted([(d, i) for i, d in zip(c.node_ids, c.depths)]
                         + [(float(d), None) for d in bounds if np.abs(np.array(c.depths) - d).min() > 1e-9])
         nodes = []
         for (a, i), (b, _) in zip(points, points[1:]):
             nodes.append({"id": i or next(ids), "depth": a})
-            within_gap = any(lo - 1e-9 <= a and b <= hi + 1e-9 for lo, hi in gaps)
-            nodes += [{"id": next(ids), "depth": a + (b - a) * k / cells} for k in range(1, 1 if within_gap else cells)]
+            nodes += [{"id": next(ids), "depth": a + (b - a) * k / cells} for k in range(1, 1 if a in gaps else cells)]
         nodes.append({"id": points[-1][1], "depth": points[-1][0]})
         raw["nodes"] = nodes
     for raw, z in zip(data["zones"], building.zones):
