@@ -41,6 +41,7 @@ import pandas as pd
 
 from benchmarks.energyplus_comparison import interval_ends
 from benchmarks.truth import record_seed
+from nodeforce.iotools.hourly import epw_site
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -84,12 +85,12 @@ def at_weather_site(doc, epw):
     and ignores the IDF's; nodeforce converts the IDF's. ASHRAE 140's IDFs say Denver; with
     Chicago's weather, nodeforce's sun would stand 17 deg of longitude (68 min of solar time) and
     2 deg of latitude from EnergyPlus's."""
-    fields = location(epw)
+    site = epw_site(epw)
     for old in list(doc.idfobjects["Site:Location"]):
         doc.removeidfobject(old)
-    doc.add("Site:Location", f"{fields[1]} {fields[5]}", {
-        "latitude": float(fields[6]), "longitude": float(fields[7]), "time_zone": float(fields[8]),
-        "elevation": float(fields[9])})
+    doc.add("Site:Location", site["name"], {
+        "latitude": site["latitude"], "longitude": site["longitude"], "time_zone": site["utc_offset"],
+        "elevation": site["altitude"]})
     return doc
 
 
@@ -265,16 +266,9 @@ def package_weather():
     return Path(pyenergyplus.__file__).parent / CLIMATE
 
 
-def location(epw):
-    """The fields of the EPW's LOCATION line (its first): name, city and state, ..., WMO code,
-    latitude, longitude, time zone (h from UTC), elevation (m)."""
-    with open(epw, encoding="latin-1") as f:
-        return f.readline().strip().split(",")
-
-
 def utc_offset(epw):
     """The EPW's standard time's offset from UTC (h), its LOCATION line's ninth field."""
-    return float(location(epw)[8])
+    return epw_site(epw)["utc_offset"]
 
 
 def run_document(doc):

@@ -99,6 +99,31 @@ def to_mid_hour(end_of_hour, columns, cyclic):
     return pd.DataFrame(columns, index=index)
 
 
+def epw_site(source):
+    """The site of an EPW's LOCATION line (its first), where its weather was recorded: `name`
+    (city and WMO station), `latitude`, `longitude` (deg, north and east positive), `utc_offset`
+    (h, the file's standard time), `timezone` (`zone_name` of that offset) and `altitude` (m)."""
+    try:
+        with open(source, encoding="latin-1") as f:
+            fields = f.readline().strip().split(",")
+        latitude, longitude, offset, altitude = (float(v) for v in fields[6:10])
+    except OSError as error:
+        raise InputError(source, "file", one_line(error)) from None
+    except ValueError:
+        raise InputError(source, "LOCATION", "the first line must be LOCATION,city,state,country,source,WMO,"
+                                             "latitude,longitude,time zone,elevation (numbers)") from None
+    return {"name": f"{fields[1]} {fields[5]}", "latitude": latitude, "longitude": longitude,
+            "utc_offset": offset, "timezone": zone_name(offset), "altitude": altitude}
+
+
+def zone_name(hours):
+    """The fixed time zone of a standard time `hours` from UTC: "UTC", "Etc/GMT+5" for UTC-5
+    (IANA's Etc zones count the other way round), "+05:30" where it is not a whole hour."""
+    if hours != int(hours):
+        return fixed_offset(hours)
+    return "UTC" if hours == 0 else f"Etc/GMT{-int(hours):+d}"
+
+
 def fixed_offset(hours):
     """"+hh:mm" of a UTC offset in hours."""
     return f"{'+' if hours >= 0 else '-'}{int(abs(hours)):02d}:{int(round(abs(hours) % 1 * 60)):02d}"

@@ -19,7 +19,7 @@ from pathlib import Path
 import pandas as pd
 
 from nodeforce.model.errors import InputError
-from .hourly import fixed_offset, read_epw, read_tmy2, read_tmy3, to_mid_hour
+from .hourly import read_epw, read_tmy2, read_tmy3, to_mid_hour, zone_name
 from .timetable import check_increasing, one_line, write_time_table
 
 
@@ -127,18 +127,13 @@ def main(argv=None):
 
 def _site(meta):
     offset = float(meta["TZ"])
-    if offset == int(offset):
-        # IANA's Etc zones count the other way round: Etc/GMT+5 is UTC-5.
-        timezone = "UTC" if offset == 0 else f"Etc/GMT{-int(offset):+d}"
-    else:
-        timezone = fixed_offset(offset)
     return {
         "name": meta["name"],
         "latitude": float(meta["latitude"]),
         "longitude": float(meta["longitude"]),
         "altitude": float(meta["altitude"]),
         "utc_offset": offset,
-        "timezone": timezone,
+        "timezone": zone_name(offset),
     }
 
 

@@ -11,6 +11,7 @@ import pytest
 from nodeforce.model.errors import InputError
 from nodeforce.model.solar import solar_position
 from nodeforce.iotools.typical_year import convert_typical_year, main, relocate
+from nodeforce.iotools.hourly import epw_site
 from nodeforce.iotools.weather import TYPICAL_YEAR, read_weather
 from nodeforce.model.weather import weather_on_grid
 
@@ -155,6 +156,18 @@ def epw(tmp_path, years, name="site.epw"):
     path = tmp_path / name
     path.write_text("\n".join(header + rows) + "\n")
     return path
+
+
+def test_an_epws_site_is_its_location_line(tmp_path):
+    """LOCATION,Testville,XX,YYY,TMY3,123456,10.0,150.0,10.0,50.0: latitude, longitude, UTC+10
+    (IANA's Etc/GMT-10) and 50 m; a line without them is refused, naming the file."""
+    assert epw_site(epw(tmp_path, [2001, 2001])) == {
+        "name": "Testville 123456", "latitude": 10.0, "longitude": 150.0, "utc_offset": 10.0,
+        "timezone": "Etc/GMT-10", "altitude": 50.0}
+    (tmp_path / "bad.epw").write_text("LOCATION,Testville,XX\n")
+    with pytest.raises(InputError, match="LOCATION") as caught:
+        epw_site(tmp_path / "bad.epw")
+    assert caught.value.source == str(tmp_path / "bad.epw")
 
 
 def test_epw_rows_sit_at_mid_hour_with_codes_as_missing(tmp_path):
