@@ -73,6 +73,7 @@ from nodeforce.ga.locate import Execution, SearchSettings, check_measured, evalu
 from nodeforce.model.effects import EFFECTS, member_nodes
 from nodeforce.model.errors import InputError
 from nodeforce.model.score import Noise
+from nodeforce.model.site import MOVED, at_site
 
 
 @dataclass
@@ -191,7 +192,9 @@ def diagnose(building, records, workdir, objective, *, search=SearchSettings(), 
     under the building file's protocol, read from their files (`nodeforce.read_record`), which
     nothing but the final comparison reads (`scored_later`): no fit, no choice, no
     cross-validation. `policy`: the `diagnosis.policy.Policy` every choice
-    is made under (default `Policy()`), recorded in report.json."""
+    is made under (default `Policy()`), recorded in report.json. The loop runs the building at
+    the site its records' weather gives (`run_site`); the files it writes back keep the
+    building file's site."""
     policy = Policy() if policy is None else policy
     later = list(beside.later)
     if not isinstance(records, (list, tuple)):
@@ -201,6 +204,7 @@ def diagnose(building, records, workdir, objective, *, search=SearchSettings(), 
         if names.count(r.name) > 1:
             raise InputError(r.source, "name", f"two records are named {r.name!r}: each needs its own name")
         check_measured(objective, r.case, r.source)
+    given, building = building, run_site(building, records)
     for r in later:
         if r.read_from is None or protocol(building, r) is not None:
             raise InputError(r.source, "later", f"record {r.name}: a later record is read from its files "
@@ -215,7 +219,30 @@ def diagnose(building, records, workdir, objective, *, search=SearchSettings(), 
         settings = replace(search, noise=prepared.noise.sigma if prepared.noise.given else None)
         located = localise(building, prepared, objective, workdir, settings, Execution(workers=runner))
         made = rounds(prepared, located.localization, objective, workdir, search.seed, runner)
-    return write(building, prepared, located, made, objective, workdir, beside.reference, later)
+    return write(building, prepared, located, made, objective, workdir, beside.reference, later, given)
+
+
+def run_site(building, records):
+    """`building` at the site its records' cases compute at (`model.site.run_building`: an EPW
+    recorded elsewhere moves a case there); InputError naming a record whose weather was recorded
+    at another site than the first's: one house, one site."""
+    ran = [r for r in records if r.case.building is not None]
+    if not ran:
+        return building
+    site = ran[0].case.building.site
+    for r in ran[1:]:
+        if any(r.case.building.site[name] != site[name] for name in MOVED):
+            raise InputError(r.source, "weather", f"record {r.name}'s weather was recorded at another site than "
+                                                  f"record {ran[0].name}'s: the records of one house share its site")
+    return at_site(building, site)
+
+
+def as_given(building, given):
+    """The building file's JSON content of `building`, a model of the loop, with the site of
+    `given`, the file the user gave: the loop ran at the weather's site, the file keeps its own."""
+    data = building.to_json()
+    data["site"] = given.to_json()["site"]
+    return data
 
 
 @dataclass
@@ -481,15 +508,17 @@ def priors_stated(building, added):
     return building.edited(lambda data: data.update(description=" ".join([data.get("description", "")] + said).strip()))
 
 
-def write(building, prepared, located, made, objective, workdir, reference, later=()):
+def write(building, prepared, located, made, objective, workdir, reference, later=(), given=None):
     """Stage 4: the model the rounds leave written (`building_after.json`, `model_after.fmu`,
     each protocol's building, `model_after.idf` for a converted EnergyPlus model), scored on
     each later record (`scored_later`), the `Diagnosis`, written as report.json, report.md and
-    the plots; returns it."""
+    the plots; returns it. The building files keep the site of the files given (`given`, the
+    building's, default `building`; a record's own protocol's), where the loop ran at the
+    weather's (`run_site`); the FMU is the model as run."""
     windows, records, model, added = prepared.windows, prepared.records, made.model, made.added
-    fmu_kind = prepared.fmu_kind
-    (workdir / "building_after.json").write_text(json.dumps(priors_stated(model.building, added).to_json(), indent=2)
-                                                 + "\n")
+    fmu_kind, given = prepared.fmu_kind, building if given is None else given
+    (workdir / "building_after.json").write_text(json.dumps(as_given(priors_stated(model.building, added), given),
+                                                            indent=2) + "\n")
     fmu_after = build_fmu(model.building, workdir / "model_after.fmu", kind=fmu_kind)
     later = [scored_later(record, (building.source, building, prepared.fmu),
                           (workdir / "building_after.json", model.building, fmu_after), objective, fmu_kind)
@@ -497,7 +526,7 @@ def write(building, prepared, located, made, objective, workdir, reference, late
     # a record under another protocol: its own building as corrected, for `nodeforce compare`
     protocols_after = {i: workdir / f"building_after_record{i + 1}.json" for i, b in enumerate(model.bases) if b is not None}
     for i, path in protocols_after.items():
-        path.write_text(json.dumps(model.bases[i].to_json(), indent=2) + "\n")
+        path.write_text(json.dumps(as_given(model.bases[i], records[i].building or given), indent=2) + "\n")
     by_phase = phase_rows(prepared, made, objective)
     diagnosis = Diagnosis(
         objective=list(objective.zones), period=period(windows, 0), before=prepared.model.metrics,
@@ -532,8 +561,13 @@ def scored_later(record, written, corrected, objective, fmu_kind):
     """The later `record` scored as `nodeforce compare` scores it (`diagnosis.compare`): the
     building as written and as corrected, each (path, Building, its FMU or None: built), run
     through its FMU on the record's case prepared for it; their `LaterRecord`."""
-    result, _ = compare([(path, b, record.case_for(b), objective) for path, b, _ in (written, corrected)],
-                        fmu_kind=fmu_kind, fmus=[fmu for _, _, fmu in (written, corrected)])
+    models, fmus = [], []
+    for path, b, fmu in (written, corrected):
+        case = record.case_for(b)
+        models.append((path, case.building, case, objective))
+        # a later weather recorded at another site runs the building there, through an FMU of its own
+        fmus.append(fmu if case.building is b else None)
+    result, _ = compare(models, fmu_kind=fmu_kind, fmus=fmus)
     before, after = (m["metrics"] for m in result["models"])
     return LaterRecord(record.name, str(record.source), result["record"], result["scored_from"], before, after)
 
@@ -581,6 +615,8 @@ def protocol(building, record):
     """The record's own building (its protocol's), None where it is `building`; InputError naming
     its file where it is not the same house node for node."""
     other = record.building if record.building is not None else record.case.building
+    if other is not None and record.case.building is not None:
+        other = at_site(other, record.case.building.site)  # the record's file as its case ran it
     if other is None or other is building or other.to_json() == building.to_json():
         return None
     for what, of in (("zones", lambda b: [z.name for z in b.zones]),

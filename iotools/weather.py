@@ -11,7 +11,7 @@ import pandas as pd
 
 from nodeforce.model.errors import InputError
 from nodeforce.model.weather import IRRADIANCE_COLUMNS, REQUIRED_COLUMNS, TEMPERATURE_COLUMNS, utc_microseconds
-from .hourly import read_epw, to_mid_hour
+from .hourly import epw_site, read_epw, to_mid_hour
 from nodeforce.model.units import check_celsius
 from .timetable import read_time_table
 
@@ -58,7 +58,9 @@ def read_weather(path, year=None, times=None):
         would need the reading before the file starts, is NaN; that of a year read in another
         (a typical year, or `year` given) is the mean of its first and last readings, the year
         taken as cyclic, as `nodeforce.iotools.typical_year.convert_typical_year` writes it.
-        `attrs["typical_year"]` says whether the EPW's own rows mixed years.
+        `attrs["typical_year"]` says whether the EPW's own rows mixed years; `attrs["site"]` is
+        where it was recorded (`iotools.hourly.epw_site`), the site a run under it computes at
+        (`nodeforce.model.site.run_building`). A CSV has no site.
 
     Raises
     ------
@@ -105,7 +107,7 @@ def _read_epw_weather(source, year, record_year):
         weather = to_mid_hour(end_of_hour, columns, cyclic=True)
     else:
         weather = to_mid_hour(end_of_hour, columns, cyclic=False)
-    weather.attrs.update(source=source, typical_year=typical)
+    weather.attrs.update(source=source, typical_year=typical, site=epw_site(source))
     return weather
 
 

@@ -24,6 +24,7 @@ from .network import (WIND_DIRECTION, WIND_SPEED, assemble, clock_input_names, d
 from .units import check_celsius
 from .geometry import outward_normal
 from .shading import sky_diffuse_ratio, sun_vectors, sunlit_fraction
+from .site import run_building
 from .solar import (DECOMPOSITIONS, complete_irradiance, incident_irradiance, measured_irradiance, sky_temperature,
                     solar_position, transmitted_irradiance, transmitted_split)
 from .weather import IRRADIANCE_COLUMNS, check_columns, weather_on_grid
@@ -296,8 +297,10 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
 
     Returns
     -------
-    Case with inputs `T_out`, `T_sky` (C), `I_<component>` (W/m2, the weather's measured column
-    if `model.solar.measured_irradiance` finds one, else the transposition under the site's sky
+    Case of the building at the site its run computes at (`model.site.run_building`: an EPW
+    recorded elsewhere moves it there, said first among the case's assumptions; the case's
+    `building` is the one run) with inputs `T_out`, `T_sky` (C), `I_<component>` (W/m2, the
+    weather's measured column if `model.solar.measured_irradiance` finds one, else the transposition under the site's sky
     (`model.solar.incident_irradiance`: isotropic unless it declares `sky_diffuse`) of
     `ghi`, `dni`, `dhi`, those the weather lacks from the others: `model.solar.complete_irradiance`,
     stated in the case's `assumptions`), the building's named columns and, where a zone declares a daily gain,
@@ -313,6 +316,7 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
         building file: a site timezone that is none, where a daily gain needs the local time.
     """
     source = weather.attrs.get("source", "weather")
+    building, moved = run_building(building, weather)
     check_columns(building, weather)
     if measurements is not None:
         times, dt = uniform_grid(measurements.index, measurements.attrs.get("source", "measurements"))
@@ -345,7 +349,7 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
                                                    "ghi, dni, dhi, not read from a measured column")
         else:
             columns[c.irradiance_input] = w[measured_sun].to_numpy(float)
-    assumptions = []
+    assumptions = [moved] if moved else []
     if computed:
         given = {name: w[name].to_numpy(float) for name in IRRADIANCE_COLUMNS if name in w}
         if "ghi" not in given and len(given) < 2:
@@ -502,6 +506,7 @@ def simulate_building(building, weather, measurements=None, force=(), warmup_day
     columns `T1..TN`
     """
     case = measured_case(building, weather, measurements, burn_in_days)
+    building = case.building  # at the site the weather gives (`model.site.run_building`)
     mask = force_mask(case, force, "force")
     T = simulate(building, assemble(building), case.U, case.dt, case.measured, mask, warmup_days,
                  burn_in_steps=case.burn_in_steps, steady_start=case.steady_start, substeps=case.substeps,

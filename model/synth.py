@@ -39,7 +39,7 @@ def pseudo_measurements(building, weather, times, nodes, noise_sd=0.0, seed=0, h
     empty = pd.DataFrame(index=grid)
     empty.attrs["source"] = "pseudo-measurements"
     case = prepare_case(building, weather, empty, decomposition)
-    T = simulate(building, assemble(building), case.U, case.dt, case.measured,
+    T = simulate(case.building, assemble(case.building), case.U, case.dt, case.measured,
                  warmup_days=spinup_days, include_start=True, substeps=case.substeps)
     record = T[len(grid) - len(times):, np.array(nodes) - 1]
     rng = np.random.default_rng(seed)

@@ -165,10 +165,13 @@ def read_case(building, weather, measurements=None, reading=Reading()):
     Returns
     -------
     (Building, Case)
-        The case's `assumptions` say what was assumed about the files (the weather's history).
+        The building as run, at the site the weather gives (`nodeforce.model.site.run_building`:
+        an EPW recorded elsewhere moves it there), the one to build its FMU from; the case's
+        `assumptions` say what was assumed about the files (the weather's site, its history).
     """
     building, read_from = _read(building, weather, measurements, reading)
-    return building, measured_case(building, **read_from)
+    case = measured_case(building, **read_from)
+    return case.building, case
 
 
 def _read(building, weather, measurements, reading):
@@ -284,7 +287,8 @@ def simulate(building, weather, measurements=None, force=(), burn_in_days=0):
     Returns
     -------
     DataFrame
-        Indexed by time t_1..t_N, columns ``T1..TN``.
+        Indexed by time t_1..t_N, columns ``T1..TN``, of the building at the site the weather
+        gives (`nodeforce.model.site.run_building`).
     """
     return simulate_building(building, weather, measurements, force=force, burn_in_days=burn_in_days)
 
@@ -506,8 +510,9 @@ def compare(models, workdir=None, phases=(), fmu_kind="python"):
     Parameters
     ----------
     models : list of (name, Building, Case, Objective)
-        Each building with the record prepared for it by `measured_case` (same times and burn-in
-        for all) and its objective (the same zone names for all); `name` labels it in the output.
+        Each building as run (the case's `building`, at the site the weather gives) with the
+        record prepared for it by `measured_case` (same times and burn-in for all) and its
+        objective (the same zone names for all); `name` labels it in the output.
     workdir : str or Path, optional
         Folder for compare.json, compare.md and the plot; None writes nothing.
     phases : list of Phase, optional

@@ -343,7 +343,7 @@ def cmd_compare(args):
         building = api.read_building(path)
         case = api.measured_case(building, weather, measurements, args.burn_in_days, args.decomposition,
                                  history(args))
-        models.append((path, building, case, objective_of(building, args)))
+        models.append((path, case.building, case, objective_of(building, args)))
     said_assumed(a for _, _, case, _ in models for a in case.assumptions)
     result = api.compare(models, Path(args.output), api.read_phases(args.phases) if args.phases else (),
                          fmu_kind=args.fmu)

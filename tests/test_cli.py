@@ -325,12 +325,23 @@ def test_every_command_reads_a_typical_year_epw_as_energyplus_does(tmp_path, cap
     bestest = DATA.parents[1] / "examples" / "bestest"
     building, epw = str(bestest / "case600.json"), str(bestest / "data" / "725650TYCST.epw")
     assert main(["simulate", building, "--weather", epw, "-o", str(tmp_path / "epw.csv")]) == 0
+    # the EPW was recorded at Denver's airport (39.83, -104.65, 1650 m), not at the IDF's site (39.76,
+    # -104.86, 1609 m): the run is at the airport, as EnergyPlus's is, which the CSV, with no site, is
+    # not unless the building file says so; the air's density follows the standard atmosphere's pressure
     from nodeforce.iotools.typical_year import convert_typical_year
     convert_typical_year(epw, tmp_path / "denver.csv", year=2017)
-    assert main(["simulate", building, "--weather", str(tmp_path / "denver.csv"), "-o", str(tmp_path / "csv.csv")]) == 0
-    from_epw, from_csv = (pd.read_csv(tmp_path / name, index_col=0) for name in ("epw.csv", "csv.csv"))
-    assert from_epw.index.equals(from_csv.index) and from_epw.index[0].startswith("2017-01-01")
-    assert np.allclose(from_epw.to_numpy(), from_csv.to_numpy(), atol=1e-3)  # the CSV's 6 digits
+    given = json.loads((bestest / "case600.json").read_text())
+    p = lambda z: 101325.0 * (1.0 - 2.25577e-5 * z) ** 5.2559  # noqa: E731
+    airport = {**given, "site": {**given["site"], "latitude": 39.83, "longitude": -104.65, "altitude": 1650.0,
+                                 "air_density": given["site"]["air_density"] * p(1650.0) / p(1609.0)}}
+    (tmp_path / "airport.json").write_text(json.dumps(airport))
+    for name, b in (("csv.csv", building), ("airport.csv", str(tmp_path / "airport.json"))):
+        assert main(["simulate", b, "--weather", str(tmp_path / "denver.csv"), "-o", str(tmp_path / name)]) == 0
+    from_epw, from_csv, at_airport = (pd.read_csv(tmp_path / name, index_col=0)
+                                      for name in ("epw.csv", "csv.csv", "airport.csv"))
+    assert from_epw.index.equals(at_airport.index) and from_epw.index[0].startswith("2017-01-01")
+    assert np.allclose(from_epw.to_numpy(), at_airport.to_numpy(), atol=1e-3)  # the CSV's 6 digits
+    assert not np.allclose(from_epw.to_numpy(), from_csv.to_numpy(), atol=1e-3)
 
     air = str(parse_building(json.loads((bestest / "case600.json").read_text())).zones[0].air_node)
     measured = str(tmp_path / "m.csv")
@@ -344,7 +355,14 @@ def test_every_command_reads_a_typical_year_epw_as_energyplus_does(tmp_path, cap
     assert 0.07 < next(iter(model["metrics"]["zones"].values()))["rmse"] < 0.13
     assert main(["diagnose", building, "--weather", epw, "--measurements", measured, "-o", str(tmp_path / "dg"),
                  "--workers", "1"]) == 0
-    assert json.loads((tmp_path / "dg" / "report.json").read_text())["effects"] == []  # nothing to add
+    report = json.loads((tmp_path / "dg" / "report.json").read_text())
+    assert report["effects"] == []  # nothing to add
+    said = [a for a in report["assumptions"] if a.startswith("The weather file's site")]
+    assert len(said) == 1 and "DENVER INTL AP 725650" in said[0] and "latitude 39.83, longitude -104.65" in said[0]
+    # the building file written back keeps the user's site
+    assert json.loads((tmp_path / "dg" / "building_after.json").read_text())["site"] == given["site"]
+    site = re.search(r"Site:Location,.*?!- Elevation", (tmp_path / "dg" / "model_after.idf").read_text(), re.S)
+    assert re.findall(r"(-?[\d.]+)[,;]\s+!-", site.group(0)) == ["39.76", "-104.86", "-7.0", "1609"]
     # a year given reads the EPW in it: a record of 2013 is then not covered
     capsys.readouterr()
     assert main(["compare", building, "--weather", epw, "--year", "2015", "--measurements", measured,
