@@ -28,11 +28,10 @@ The weather is, unless --weather names another EPW, the Denver TMY3 year the ins
 pyenergyplus package ships (pyenergyplus/data/weather/USA_CO_Denver-Aurora-Buckley.AFB.724695_TMY3.epw),
 found at run time.
 
-Both programs read the IDF with 6 time steps an hour (its `Timestep` replaced). EnergyPlus
-reports every step; its hourly values are the means of the hour's steps, as its own hourly
-report averages them, and are compared with nodeforce's sample at the half hour (nodeforce on
-the hourly weather); its 10-min values, the state at each step's end, with nodeforce's at the
-same time (nodeforce on the weather interpolated onto 10-min steps).
+Both programs read the IDF with 6 time steps an hour (its `Timestep` replaced), nodeforce on the
+hourly weather interpolated onto 10-min steps. Each program's hourly values are the means of the
+hour's steps, as EnergyPlus's own hourly report averages them; its 10-min values, the state at
+each step's end.
 
 An IDF is brought to EnergyPlus 25.2 by copying every object by its field names into a 25.2
 document (idfkit; the fields 25.2 renamed mapped, its new ones left to their defaults) and
@@ -295,10 +294,10 @@ def main(out, epw, only=None, figure_path=None, sky_diffuse=None):
         idfkit.save_idf(to_energyplus_25(doc), str(folder / "model_25_2.idf"))
         run_energyplus(folder / "model_25_2.idf", folder, epw)
         air, faces = read_outputs(folder, YEAR)
-        # the mean over the hour nodeforce samples at its middle; the state at each step's end
-        new, unpaired = compare(name, building, doc, simulate_building(building, hourly), (hourly_means(air),
-                                hourly_means(faces)), "30min", "hourly")
         ours = simulate_building(building, fine)
+        # each program's hourly means of its own steps, and the state at each step's end
+        mine = hourly_means(ours.set_axis(ours.index.tz_localize(None), axis=0)).tz_localize(ours.index.tz)
+        new, unpaired = compare(name, building, doc, mine, (hourly_means(air), hourly_means(faces)), "0min", "hourly")
         fine_rows, _ = compare(name, building, doc, ours, (air, faces), "0min", "10 min")
         rows += new + fine_rows
         for face, why in unpaired.items():

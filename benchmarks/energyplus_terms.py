@@ -31,6 +31,7 @@ from nodeforce.api import convert_idf  # noqa: E402
 from nodeforce.iotools.typical_year import convert_typical_year  # noqa: E402
 from nodeforce.iotools.weather import read_weather  # noqa: E402
 from nodeforce.model.case import measured_case, simulate_building  # noqa: E402
+from nodeforce.model.convection import iso15099_inside, lagged_excess, tarp_inside_faces  # noqa: E402
 from nodeforce.model.network import air_conductance, assemble  # noqa: E402
 
 SUN_IN = "Surface Inside Face Solar Radiation Heat Gain Rate per Area"
@@ -44,7 +45,7 @@ INFILTRATION = ("Zone Infiltration Sensible Heat Loss Energy", "Zone Infiltratio
 VARIABLES = (SUN_IN, H_IN, CONVECTION, LONGWAVE, INCIDENT, TRANSMITTED, PANES, *INFILTRATION,
              "Surface Window Heat Gain Rate", "Surface Window Heat Loss Rate",
              "Surface Window Inside Face Glazing Zone Convection Heat Gain Rate")
-SUN_COLUMNS = ("I_", "It_", "Itb_", "Itd_")
+SUN_COLUMNS = ("I_", "It_", "Itb_", "Itd_", "Iao_", "Iai_")
 
 
 def energyplus_hourly(folder, year):
@@ -80,6 +81,23 @@ def sun_sources(network, U):
     return network.sources(U.to_numpy(float)) - network.sources(dark)
 
 
+def inside_coefficients(network, T):
+    """{face node id: (rows,) W/m2/K} of the faces whose inside convection follows the state
+    (docs/model.md 3.6): TARP, or a window's ISO 15099, at each hour's face-to-air difference,
+    about the step matrix's h0 as the network's lagged source takes it (`lagged_excess`)."""
+    conv, out = network.convection, {}
+    if conv is None:
+        return out
+    temperatures = T.to_numpy(float)  # columns T1..TN
+    for (face, air), (_, h0, cos_up) in zip(conv.inside_nodes, conv.inside):
+        dT = temperatures[:, face] - temperatures[:, air]
+        out[face + 1] = h0 + lagged_excess(tarp_inside_faces(dT, cos_up), h0)
+    for (face, air), (_, h0, height, tilt, pressure) in zip(conv.window_nodes, conv.windows):
+        dT = temperatures[:, face] - temperatures[:, air]
+        out[face + 1] = h0 + lagged_excess(iso15099_inside(dT, temperatures[:, air], height, tilt, pressure), h0)
+    return out
+
+
 def multipliers(doc):
     """{surface name (upper case): its Multiplier} of the IDF's windows and doors that declare one."""
     return {o.name.upper(): float(o.to_dict()["multiplier"]) for o in doc.all_objects
@@ -95,6 +113,7 @@ def terms(name, building, doc, network, U, T, theirs):
     when = T.index.intersection(theirs[ZONE_AIR].index)
     T, U = T.loc[when], U.loc[when]
     sun = pd.DataFrame(sun_sources(network, U), index=when)
+    followed = inside_coefficients(network, T[[f"T{i}" for i in range(1, network.n_nodes + 1)]])
     rows = []
 
     def row(zone, key, term, ours, ep, unit):
@@ -117,10 +136,10 @@ def terms(name, building, doc, network, U, T, theirs):
                 continue
             c, s = by_node[node], node - 1
             Ts = T[f"T{node}"].to_numpy(float)
-            h = network.A[s, z.air_node - 1] / c.area
+            h = followed.get(node, np.full(len(Ts), network.A[s, z.air_node - 1] / c.area))
             add(zone, key, "inside face (C)", Ts, FACE, unit="C")
             add(zone, key, "sun absorbed inside", sun[s], SUN_IN, c.area)
-            add(zone, key, "convective coefficient", np.full(len(Ts), h), H_IN, unit="W/m2/K")
+            add(zone, key, "convective coefficient", h, H_IN, unit="W/m2/K")
             add(zone, key, "convection from the air", c.area * h * (air - Ts), CONVECTION)
             add(zone, key, "net long-wave from the faces",
                 sum(network.A[s, j - 1] * (T[f"T{j}"].to_numpy(float) - Ts) for j in faces if j != node), LONGWAVE)
@@ -132,7 +151,8 @@ def terms(name, building, doc, network, U, T, theirs):
                 add(zone, key, "sun let in", c.solar_transmittance * one * U[names or [f"I_{c.name}"]].sum(axis=1),
                     TRANSMITTED)
                 add(zone, key, "sun the panes absorb",
-                    one * incident * (c.outside.solar_absorptance + c.inner_solar_absorptance), PANES)
+                    one * (U[c.absorbed_input("outside")].to_numpy(float) * c.outside.solar_absorptance
+                           + U[c.absorbed_input("inside")].to_numpy(float) * c.inner_solar_absorptance), PANES)
         g = air_conductance(z.volume * z.air_change_rate, building.site.get("air_density", 1.2))
         if INFILTRATION[0] in theirs and zone in theirs[INFILTRATION[0]]:
             out = (theirs[INFILTRATION[0]][zone] - theirs[INFILTRATION[1]][zone]).loc[when] / 3600.0

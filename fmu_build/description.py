@@ -135,6 +135,11 @@ def _input_meaning(building, name):
         part = "" if len(c.sun_inputs) == 1 else ("direct " if k == 0 else "diffuse ")
         applied = " (its angular transmittance applied)" if c.angular is not None else ""
         return "W/m2", f"{part}sun {c.name} lets in per m2 over its normal-incidence transmittance{applied}"
+    panes = [(c, side) for c in building.exterior_components for sun, side in c.absorbed_inputs if sun == name]
+    if panes:
+        c, side = panes[0]
+        return "W/m2", (f"sun the {'outer' if side == 'outside' else 'inner'} panes of {c.name} absorb per m2 over "
+                        "their normal-incidence absorptance (their angular absorptance applied)")
     faces = [c.name for c in building.exterior_components if c.irradiance_input == name]
     if faces:
         return "W/m2", f"solar irradiance on the outside face of {', '.join(faces)}"

@@ -68,6 +68,15 @@ class Films:
 
 
 FILMS = Films()
+
+
+def _sides(absorbed):
+    """(outer, inner): the absorptances of a stack's panes (outside first) summed toward the face
+    each is nearer, the outer half of the panes to the outside face, the inner half to the inside
+    face, the middle pane of an odd number split."""
+    n = len(absorbed)
+    middle = absorbed[n // 2] / 2 if n % 2 else 0.0
+    return float(sum(absorbed[:n // 2]) + middle), float(sum(absorbed[(n + 1) // 2:]) + middle)
 # An air flow's temperature term is taken at this indoor-outdoor difference, its wind terms at the
 # zone's wind (FILMS.wind at the station, at the height of the zone's surfaces' centroids)
 AIRFLOW_DELTA_T = 10.0  # K
@@ -588,9 +597,6 @@ class _Converter:
         self.default_inside = self.r.text(inside[0], "algorithm", "TARP") if inside else "TARP"
         outside = self.r.all("SurfaceConvectionAlgorithm:Outside")
         algorithm = self.r.text(outside[0], "algorithm", "DOE-2") if outside else "DOE-2"
-        # TARP inside on every face, as the file may declare it, would take a glazing's inside face by
-        # TARP where EnergyPlus takes ISO 15099's: 950FF's maximum then falls to 36.06 C, below ASHRAE
-        # 140's 36.1 (docs/model.md 10.1), so the zones keep their constant inside coefficients
         self.notes.append(f"outside convection EnergyPlus's DOE-2 from each hour's wind and each face's temperature, "
                           f"its value at a {FILMS.wind:g} m/s station wind and a {FILMS.delta_T:g} K face-to-air "
                           "difference in the step matrix" +
@@ -922,12 +928,17 @@ class _Converter:
         tau = float(glazing.stack_transmittance(pairs, 0.0))
         factors = [float(glazing.stack_transmittance(pairs, a)) / tau for a in glazing.ANGLES]
         diffuse = glazing.hemispherical(lambda a: glazing.stack_transmittance(pairs, a)) / tau
-        # each pane's absorbed sun goes to the face it is nearer: the outer half of the panes to the
-        # outside face, the inner half to the inside face (the middle pane of three split)
-        absorbed = glazing.pane_absorptances(pairs)
-        n = len(absorbed)
-        alpha = sum(absorbed[:n // 2]) + (absorbed[n // 2] / 2 if n % 2 else 0.0)
-        inner_alpha = sum(absorbed[(n + 1) // 2:]) + (absorbed[n // 2] / 2 if n % 2 else 0.0)
+        alpha, inner_alpha = _sides(glazing.pane_absorptances(pairs))
+        # as EnergyPlus absorbs the direct sun in each pane at its angle and the diffuse at the
+        # panes' hemispherical absorptance
+        at_angles = np.array([_sides(row) for row in glazing.angular_pane_absorptances(pairs, glazing.ANGLES)])
+        hemispherical = [glazing.hemispherical(lambda a, k=k: np.array(
+            [_sides(row)[k] for row in glazing.angular_pane_absorptances(pairs, a)])) for k in (0, 1)]
+        absorptance = {"angles": list(glazing.ANGLES)}
+        for k, side in enumerate(("outside", "inside")):
+            normal = (alpha, inner_alpha)[k]
+            absorptance[side] = [round(float(f) / normal, 6) if normal > 0 else 1.0 for f in at_angles[:, k]]
+            absorptance[f"{side}_diffuse"] = round(hemispherical[k] / normal, 6) if normal > 0 else 1.0
         # seen from the room, a glazing takes the diffuse sun it does not reflect (out, or into its panes)
         outer = {"emissivity": panes[0][2], "solar": alpha, "roughness": 1.0}  # glass is very smooth
         inner = {"emissivity": panes[-1][3], "solar": 1 - glazing.stack_reflectance(pairs[::-1])}
@@ -935,7 +946,7 @@ class _Converter:
         # the building file counts its layers, its conductance following the panes' (docs/model.md 4.1)
         gaps = [{"layer": len(layers) - 1 - k, "emissivities": [panes[k // 2 + 1][2], panes[k // 2][3]],
                  "gas": _json_gas(gases[k])} for k in range(1, len(layers), 2)]
-        return layers, outer, inner, {"tau": tau, "inner_alpha": inner_alpha, "gaps": gaps,
+        return layers, outer, inner, {"tau": tau, "inner_alpha": inner_alpha, "gaps": gaps, "absorptance": absorptance,
                                       "back_alpha": sum(glazing.pane_absorptances(pairs[::-1])),
                                       "angular": {"angles": list(glazing.ANGLES), "factors": factors,
                                                   "diffuse": diffuse}}
@@ -1040,8 +1051,10 @@ class _Converter:
         self.list_not_modelled()
         names = [b.name for b in self.r.all("Building")]
         description = (f"Converted by nodeforce convert from {self.r.source} (EnergyPlus "
-                       f"{'.'.join(map(str, self.r.doc.version[:2]))}). Inside surface coefficients are the "
-                       "converter's constants (docs/guide.md, nodeforce convert); " + "; ".join(self.notes or ["no other assumption"]) + ".")
+                       f"{'.'.join(map(str, self.r.doc.version[:2]))}). Inside convection by each zone's algorithm, TARP "
+                       "from each step's face-to-air differences (its value at a "
+                       f"{FILMS.delta_T:g} K difference in the step matrix), Simple constant "
+                       "(docs/guide.md, nodeforce convert); " + "; ".join(self.notes or ["no other assumption"]) + ".")
         data = {"format": "nodal-building/1", "name": names[0] if names else "", "description": description,
                 "site": site, "materials": self.materials, "zones": zone_data, "components": components}
         built = {c["name"] for c in components}
@@ -1243,6 +1256,10 @@ class _Converter:
         else:
             volume = self.r.number(z, "volume", low=0, low_open=True)
         data = {"name": z.name, "volume": round(volume, 6), "_floor_area": floor}
+        if self.inside_algorithm(z.name) == "tarp":
+            # each face's coefficient at its own difference from the air, as EnergyPlus's TARP, and
+            # a layered window's inside face by ISO 15099 (its `window`)
+            data["inside_convection_algorithm"] = "tarp"
         exterior = sum(s["area"] for s in own if s["boundary"].lower() == "outdoors")
         walls = sum(s["area"] for s in own if s["boundary"].lower() == "outdoors" and s["type"].lower() == "wall")
         heights = [s["height"] for s in own if s.get("height") is not None]
@@ -1592,6 +1609,8 @@ class _Converter:
                         c["angular_transmittance"] = glass["angular"]
                     if glass["inner_alpha"] > 0 and "exterior" == w_outside["type"]:
                         c["inner_solar_absorptance"] = round(glass["inner_alpha"], 6)
+                    if glass.get("absorptance") and "exterior" == w_outside["type"]:
+                        c["angular_absorptance"] = glass["absorptance"]
                     if w_outside["type"] != "exterior":
                         del c["solar_transmittance"], c["transmitted_solar_to"]
                     else:

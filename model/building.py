@@ -131,6 +131,25 @@ class AngularTransmittance:
 
 
 @dataclass(frozen=True)
+class AngularAbsorptance:
+    """The sun a glazing's panes absorb with the angle of incidence (docs/model.md section 4.1),
+    relative to its normal-incidence absorptance, on each side: the outer panes' (its outside
+    face's `solar_absorptance`) and the inner panes' (`inner_solar_absorptance`), factors at
+    angles of incidence (deg, increasing from 0, factor 1 at 0) for the direct sun and one factor
+    for the diffuse sky and ground."""
+    angles: tuple  # deg
+    outside: tuple  # -
+    outside_diffuse: float  # -
+    inside: tuple  # -
+    inside_diffuse: float  # -
+
+    def table(self, side):
+        """(angles, factors, diffuse) of `side`, "outside" or "inside", as
+        `model.solar.transmitted_irradiance` reads a table."""
+        return self.angles, getattr(self, side), getattr(self, f"{side}_diffuse")
+
+
+@dataclass(frozen=True)
 class WindowGap:
     """A window's gas gap (docs/model.md section 4.1): the index of its layer among the component's
     (from 0 at the inside face), the emissivities of the two panes' faces across it and its gas
@@ -209,6 +228,7 @@ class Component:
     angular: AngularTransmittance | None = None  # the transmittance with the angle of incidence
     solar_distribution: tuple = ()  # (component, fraction) of the transmitted sun; () all to transmitted_solar_to
     inner_solar_absorptance: float = 0.0  # part of the sun on the outside face absorbed at the inside face
+    angular_absorptance: AngularAbsorptance | None = None  # the panes' absorptance with the angle of incidence
     vertices: tuple | None = None  # the outside face's polygon ((x, y, z) m, counterclockwise from outside)
     holes: tuple = ()  # polygons cut out of it (its windows), m
     diffuse_distribution: tuple = ()  # (component, fraction) of the transmitted diffuse sun; () as the direct
@@ -247,6 +267,22 @@ class Component:
         if self.angular is None:
             return self.irradiance_input
         return f"It_{self.name}"
+
+    def absorbed_input(self, side):
+        """Name of the input of the sun the panes of `side` ("outside" or "inside") absorb (W/m2
+        of glazing, before their normal-incidence absorptance): `Iao_<component>` or
+        `Iai_<component>` where the glazing declares an `angular_absorptance`, else its face's
+        irradiance input."""
+        if self.angular_absorptance is None:
+            return self.irradiance_input
+        return f"Ia{side[0]}_{self.name}"
+
+    @property
+    def absorbed_inputs(self):
+        """((input name, side), ...) of an `angular_absorptance`; () without one."""
+        if self.angular_absorptance is None:
+            return ()
+        return tuple((self.absorbed_input(side), side) for side in ("outside", "inside"))
 
     @property
     def thickness(self):

@@ -21,7 +21,7 @@ from importlib.resources import files
 
 import numpy as np
 
-from .building import (DAY_TERMS, Adiabatic, AngularTransmittance, Boundary, Building, Component, Exterior, Gain,
+from .building import (DAY_TERMS, Adiabatic, AngularAbsorptance, AngularTransmittance, Boundary, Building, Component, Exterior, Gain,
                        Inflow, Lumped, Material, OutsideConvection, ShadingSurface, Supply, Surface, Ventilation,
                        Window, WindowGap, Zone, boundary_columns, json_copy)
 from . import geometry
@@ -348,6 +348,23 @@ def _angular(check, c, where):
     return AngularTransmittance(angles=tuple(angles), factors=tuple(factors), diffuse=float(raw["diffuse"]))
 
 
+def _angular_absorptance(check, c, where):
+    raw = c.get("angular_absorptance")
+    if raw is None:
+        return None
+    where = f"{where}.angular_absorptance"
+    angles = [float(a) for a in raw["angles"]]
+    if angles[0] != 0 or not _increasing(angles):
+        check.fail(f"{where}.angles", "must start at 0 and increase")
+    sides = {side: [float(f) for f in raw[side]] for side in ("outside", "inside")}
+    for side, factors in sides.items():
+        if len(factors) != len(angles):
+            check.fail(f"{where}.{side}", f"has {len(factors)} factors for {len(angles)} angles")
+    return AngularAbsorptance(angles=tuple(angles), outside=tuple(sides["outside"]),
+                              outside_diffuse=float(raw["outside_diffuse"]), inside=tuple(sides["inside"]),
+                              inside_diffuse=float(raw["inside_diffuse"]))
+
+
 def _zone_value(z, name):
     """A zone's number `name` as its description gives it, else the schema's default."""
     return float(z.get(name, schema_default("zone", name)))
@@ -519,6 +536,7 @@ def _component(check, c, where, materials, zone_names, sensor_depths):
         conductivity_factor=float(c.get("conductivity_factor", schema_default("component", "conductivity_factor"))),
         capacity_factor=float(c.get("capacity_factor", schema_default("component", "capacity_factor"))),
         angular=_angular(check, c, where),
+        angular_absorptance=_angular_absorptance(check, c, where),
         solar_distribution=_distribution(check, c, where, "solar_distribution"),
         diffuse_distribution=_distribution(check, c, where, "diffuse_distribution"),
         inner_solar_absorptance=float(c.get("inner_solar_absorptance",

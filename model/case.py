@@ -342,8 +342,9 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
         measured_sun = measured_irradiance(c, w.columns)
         if measured_sun is None:
             computed.append(c)
-        elif c.angular is not None or c.diffuse_distribution:
-            declared = "an angular_transmittance" if c.angular is not None else "a diffuse_distribution"
+        elif c.angular is not None or c.diffuse_distribution or c.angular_absorptance is not None:
+            declared = ("an angular_transmittance" if c.angular is not None else "a diffuse_distribution"
+                        if c.diffuse_distribution else "an angular_absorptance")
             raise InputError(source, measured_sun, f"{c.name} declares {declared}, which needs the "
                                                    "direct and diffuse sun apart: its irradiance is computed from "
                                                    "ghi, dni, dhi, not read from a measured column")
@@ -378,6 +379,10 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
                 columns[c.transmitted_input] = transmitted_irradiance(
                     position, ghi, dni, dhi, c.tilt, c.azimuth, site["ground_albedo"], *table, sunlit=sunlit, sky=sky,
                     **sky_model)
+            for name, side in c.absorbed_inputs:
+                columns[name] = transmitted_irradiance(
+                    position, ghi, dni, dhi, c.tilt, c.azimuth, site["ground_albedo"], *c.angular_absorptance.table(side),
+                    sunlit=sunlit, sky=sky, **sky_model)
     columns.update(clock_inputs(building, times))
     columns.update(schedule_inputs(building, times))
     names = input_names(building)

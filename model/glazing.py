@@ -397,3 +397,18 @@ def pane_absorptances(panes):
             row += 1
     flux = np.linalg.solve(M, v)
     return [(1 - T - R) * (flux[k] + flux[n + k]) for k, (T, R) in enumerate(panes)]
+
+
+def angular_pane_absorptances(panes, angles):
+    """(len(angles), N) solar absorptance of each pane of a stack (outside first, each (T0, R0) at
+    normal incidence, the same on both faces) of the direct sun at each angle of incidence (deg):
+    `pane_absorptances` of the panes' (T, R) at that angle (`pane_at`); 0 at grazing incidence,
+    where every pane reflects all."""
+    rows = []
+    for angle in np.atleast_1d(np.asarray(angles, dtype=float)):
+        if angle >= 90.0 - 1e-9:
+            rows.append([0.0] * len(panes))
+        else:
+            rows.append(pane_absorptances([tuple(float(x) for x in pane_at(T0, R0, angle)) for T0, R0 in panes]))
+    return np.array(rows)
+

@@ -326,6 +326,7 @@ def input_names(building):
     irradiance = tuple(dict.fromkeys(c.irradiance_input for c in building.exterior_components))
     named = tuple(n for n in building.input_columns if n not in irradiance)
     transmitted = tuple(name for c in building.components for name, _ in c.sun_inputs if name != c.irradiance_input)
+    transmitted += tuple(name for c in building.exterior_components for name, _ in c.absorbed_inputs)
     wind = (WIND_SPEED, WIND_DIRECTION) if any(c.outside.convection for c in building.exterior_components) else ()
     return (("T_out", "T_sky") + irradiance + named + clock_input_names(building) + transmitted
             + building.schedule_inputs + wind)
@@ -484,9 +485,9 @@ def assemble(building, names=None):
             A[e, e] -= c.area * (out.h_conv + out.h_rad)
             B[e, col["T_out"]] += c.area * (out.h_conv + out.h_rad * (1.0 - F))
             B[e, col["T_sky"]] += c.area * out.h_rad * F
-            B[e, col[c.irradiance_input]] += c.area * out.solar_absorptance
+            B[e, col[c.absorbed_input("outside")]] += c.area * out.solar_absorptance
             # a glazing's inner panes absorb part of the sun at the inside face (docs/model.md 4.1)
-            B[idx[0], col[c.irradiance_input]] += c.area * c.inner_solar_absorptance
+            B[idx[0], col[c.absorbed_input("inside")]] += c.area * c.inner_solar_absorptance
             if out.longwave_emissivity is not None:
                 longwave.append((e, (c.area, out.h_rad, F, out.longwave_emissivity)))
         elif isinstance(out, Surface):

@@ -341,7 +341,8 @@ def decompose(ghi, zenith, model="erbs"):
 def transmitted_irradiance(position, ghi, dni, dhi, tilt, azimuth, albedo, angles, factors, diffuse, sunlit=1.0,
                            sky=1.0, sky_model="isotropic", altitude=0.0):
     """The sun a glazing lets in per m2, relative to its normal-incidence transmittance (W/m2,
-    docs/model.md section 4.1): the direct sun times the factor at its angle of incidence (linear
+    docs/model.md section 4.1), or its panes absorb, relative to their normal-incidence
+    absorptance, by that table: the direct sun times the factor at its angle of incidence (linear
     between the tabulated angles, 0 beyond 90 deg) plus the sky's and the ground's diffuse sun
     times the diffuse factor, under the isotropic sky
 

@@ -71,6 +71,79 @@ def test_transmittance_falls_with_incidence_and_its_diffuse_mean():
     assert 0.8 < glazing.hemispherical(lambda a: glazing.stack_transmittance([(0.86156, 0.07846)] * 2, a)) / T[0] < 0.9
 
 
+@pytest.mark.parametrize("angle", [0.0, 30.0, 60.0, 75.0])
+def test_each_pane_absorbs_by_fresnel_and_the_stack_conserves_the_sun(angle):
+    """One pane: per polarisation, of interface reflectance r (Fresnel) and internal transmittance
+    tau over the refracted path, A = (1 - r)(1 - tau)(1 + r tau) / (1 - r^2 tau^2), s and p
+    averaged. Two panes: what they absorb, transmit and reflect adds up to the sun on them, with
+    R = R1 + T1^2 R2 / (1 - R1 R2) by the panes' own (T, R) at the angle."""
+    T0, R0 = 0.86156, 0.07846
+    r0, tau0 = glazing.pane_optics(T0, R0)
+    n = (1 + np.sqrt(r0)) / (1 - np.sqrt(r0))
+    phi = np.radians(angle)
+    phi_t = np.arcsin(np.sin(phi) / n)
+    tau = tau0 ** (1 / np.cos(phi_t))
+    if angle == 0.0:
+        r_s = r_p = r0
+    else:
+        r_s = (np.sin(phi - phi_t) / np.sin(phi + phi_t)) ** 2
+        r_p = (np.tan(phi - phi_t) / np.tan(phi + phi_t)) ** 2
+    by_hand = np.mean([(1 - r) * (1 - tau) * (1 + r * tau) / (1 - r ** 2 * tau ** 2) for r in (r_s, r_p)])
+    assert glazing.angular_pane_absorptances([(T0, R0)], [angle])[0, 0] == pytest.approx(by_hand, rel=1e-9)
+    A1, A2 = glazing.angular_pane_absorptances([(T0, R0)] * 2, [angle])[0]
+    T, R = (float(x) for x in glazing.pane_at(T0, R0, angle))
+    stack_T = float(glazing.stack_transmittance([(T0, R0)] * 2, angle))
+    assert A1 + A2 + stack_T + R + T ** 2 * R / (1 - R * R) == pytest.approx(1.0, abs=1e-12)
+    assert A1 > A2 > 0  # the outer pane takes the sun first
+
+
+def test_no_pane_absorbs_the_grazing_sun():
+    assert glazing.angular_pane_absorptances([(0.86156, 0.07846)] * 2, [90.0]).tolist() == [[0.0, 0.0]]
+
+
+def test_a_layered_window_s_panes_absorb_the_slanting_and_the_diffuse_sun_as_energyplus(case600):
+    """The outer pane's path through the glass lengthens with the angle: its absorptance rises to
+    grazing, and its diffuse mean is the hemispherical mean of its angular factors
+    (2 integral f cos sin, here on the table's 10-deg steps, within their resolution); 1 at
+    normal incidence, where the face's own absorptances hold."""
+    table = case600.component("SOUTH WINDOW WEST").angular_absorptance
+    assert table.outside[0] == table.inside[0] == 1.0
+    assert np.all(np.diff(table.outside[:-1]) > 0) and table.outside[-1] == 0.0
+    theta = np.radians(table.angles)
+    for factors, diffuse in ((table.outside, table.outside_diffuse), (table.inside, table.inside_diffuse)):
+        mean = np.trapezoid(2 * np.array(factors) * np.cos(theta) * np.sin(theta), theta)
+        assert diffuse == pytest.approx(mean, rel=0.03)
+
+
+def test_unit_angular_absorptances_absorb_the_sun_on_the_window(case600):
+    """Factors of 1 at every angle and for the diffuse sun: the panes absorb their normal
+    absorptances of the sun on the window, each step, as a file without the table."""
+    from nodeforce.iotools.weather import read_weather
+    from nodeforce.model.case import measured_case
+    unit = {"angles": [0, 90], "outside": [1, 1], "outside_diffuse": 1, "inside": [1, 1], "inside_diffuse": 1}
+
+    def with_table(d):
+        for c in d["components"]:
+            if "angular_absorptance" in c:
+                c["angular_absorptance"] = unit
+    b = case600.edited(with_table)
+    weather = read_weather(BESTEST / "data" / "725650TYCST.epw").iloc[3000:3100]
+    case = measured_case(b, weather)
+    names = list(case.input_names)
+    U = np.asarray(case.U)
+    for c in b.components:
+        if c.angular_absorptance is not None:
+            for name, _ in c.absorbed_inputs:
+                assert U[:, names.index(name)] == pytest.approx(U[:, names.index(c.irradiance_input)], abs=1e-9)
+            net = assemble(b)
+            outer, inner = c.node_ids[-1] - 1, c.node_ids[0] - 1
+            assert net.B[outer, names.index(c.absorbed_input("outside"))] == pytest.approx(
+                c.area * c.outside.solar_absorptance)
+            assert net.B[inner, names.index(c.absorbed_input("inside"))] == pytest.approx(
+                c.area * c.inner_solar_absorptance)
+            assert net.B[outer, names.index(c.irradiance_input)] == 0.0
+
+
 def test_gap_conductance_is_conduction_and_radiation_when_still():
     d = 0.013  # a 13 mm gap is below convection's onset: Nu = 1 within 5 %
     k = glazing.AIR_CONDUCTIVITY[0] + glazing.AIR_CONDUCTIVITY[1] * glazing.GAP_T_MEAN
@@ -525,6 +598,9 @@ def test_simple_inside_algorithm_gives_energyplus_constants(tmp_path):
     b = convert_idf(path)
     assert b.component("EAST WALL").inside.h_conv == 3.076
     assert b.component("FLOOR").inside.h_conv == 4.040
+    # Simple's coefficients are constants; TARP's follow each face's difference from the air
+    assert b.zones[0].inside_convection_algorithm == "simple"
+    assert convert_idf(CASE600).zones[0].inside_convection_algorithm == "tarp"
 
 
 # ---- several zones (examples/multizone/three_zones.idf) ----------------------------------
