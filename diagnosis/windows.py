@@ -13,6 +13,7 @@ from nodeforce.model.case import measured_case
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
 from nodeforce.model.numerical import reference, share
+from nodeforce.model.start import fitted_start, free_response
 
 
 def split(case, source, fraction=None, end=None):
@@ -143,18 +144,49 @@ class Windows:
         """Per record the file's numerical error at the other sensors, None if not known."""
         return None if any(w.sensor_numerical is None for w in self.each) else [w.sensor_numerical for w in self.each]
 
-    def metrics(self, objective, runs, record=None):
+    def starts(self, building, bases, air_nodes):
+        """Per record, the free response of its slow modes' start at the objective air over the
+        whole record, (N_t, zones, m), and the `model.start.SlowModes`, under the record's
+        protocol's building (`bases`, None: `building`): `model.start.free_response`."""
+        return [free_response(w.case, base or building, air_nodes) for w, base in zip(self.each, bases)]
+
+    def start_fitted(self, residual, starts, sigma, record, without=None):
+        """The amplitudes (m,) K of `record`'s start, and their covariance, fitted to its
+        `residual` on the calibration window ((k, zones) C, NaN where not scored), the rows of
+        the block `without` (a mask of the window's steps) left out where given
+        (`model.start.fitted_start`, sigma the noise's sd, C)."""
+        F, modes = starts[record]
+        rows = np.isfinite(residual)
+        if without is not None:
+            rows &= ~without[:, None]
+        return fitted_start(F[:len(residual)][rows], residual[rows], modes.sd, sigma)
+
+    def started(self, runs, starts, sigma):
+        """Per record, `runs` (one (N_t, zones) per record) with the start fitted on its calibration
+        window added over the whole record (`start_fitted`): what the model predicts once it
+        starts where the data say. `runs` themselves where `starts` is None."""
+        if starts is None:
+            return runs
+        return [run + F @ self.start_fitted(w.measured[:w.k] - run[:w.k], starts, sigma, i)[0]
+                for i, (w, run, (F, _)) in enumerate(zip(self.each, runs, starts))]
+
+    def metrics(self, objective, runs, record=None, starts=None, sigma=None):
         """{"calibration", "validation"}: the objective's metrics of `runs` (one (N_t, zones) per
-        record) on every record's window together, or on `record`'s (an index) alone."""
+        record) on every record's window together, or on `record`'s (an index) alone; each
+        record's start fitted on its calibration window where its free responses `starts`
+        (`Windows.starts`) are given, sigma the noise's sd (C): `started`."""
+        runs = self.started(runs, starts, sigma)
         chosen = range(len(self.each)) if record is None else [record]
         return {window: objective.metrics(*(np.concatenate([part[i][rows(self.each[i].k)] for i in chosen])
                                             for part in (self.measured, runs)))
                 for window, rows in (("calibration", lambda k: slice(None, k)),
                                      ("validation", lambda k: slice(k, None)))}
 
-    def block_J(self, runs):
+    def block_J(self, runs, starts=None, sigma=None):
         """J (C2) of `runs` on every block, the records' in order, each less the share of the
-        file's numerical error (`model.numerical.share`) the other blocks hold, as a candidate's
+        file's numerical error (`model.numerical.share`) the other blocks hold, and, where the
+        records' free responses `starts` (`Windows.starts`) are given, less the start its
+        record's other blocks fit (`start_fitted`, sigma the noise's sd, C), as a candidate's
         left-out block is scored (`diagnosis.calibrate`)."""
         residuals = [w.measured[:w.k] - run[:w.k] for w, run in zip(self.each, runs)]
         errors = self.calibration_numerical() or [np.zeros_like(r) for r in residuals]
@@ -162,7 +194,10 @@ class Windows:
         out = []
         for i, mask in self.blocks:
             s = share(r, e, ~np.concatenate([rows.ravel() for rows in on_block([a.shape for a in residuals], i, mask)]))
-            out.append(block_J(residuals[i] + s * errors[i], [mask])[0])
+            left = residuals[i] + s * errors[i]
+            if starts is not None:
+                left = left - starts[i][0][:len(left)] @ self.start_fitted(left, starts, sigma, i, mask)[0]
+            out.append(block_J(left, [mask])[0])
         return np.array(out)
 
     def sensor_scores(self, sensed, weights):
