@@ -139,9 +139,8 @@ def fits_of(model, base, pairs, assessed, windows, inputs, number=1, on_top_of=(
     sensed = {i for ids in windows.sensors for i in ids}
     weights = windows.sensor_weights([base] + [a.sensed for a in assessed], sigma)
     results, models = [], {}
-    starts = windows.starts(model.building, model.bases, objective.air_nodes)  # as each candidate's fit started
     for (effect, target), a in zip(pairs, assessed):
-        metrics = windows.metrics(objective, a.runs, starts=starts, sigma=sigma)
+        metrics = windows.metrics(objective, a.runs)
         sensor_blocks, sensor_residuals, readings, counted = windows.sensor_scores(a.sensed, weights)
         physics = windows.policy.facts(model.building, effect, target, sensed)
         fit = Fit(effect, target, a.parameters, a.determined, physics,
@@ -281,12 +280,9 @@ def prepare(building, records, bases, objective, workdir, fmu_kind, noise, polic
             fmus[key] = build_fmu(base or building, workdir / name, kind=fmu_kind)
         with FmuInstance(fmus[key]) as fmu:
             before_runs.append(simulate_fmu(fmu, case, output_ids=objective.air_nodes))
-    model = Model(building, before_runs, None, bases)
+    model = Model(building, before_runs, windows.metrics(objective, before_runs), bases)
     windows = windows.with_numerical(before_runs, windows.sensed_by(model), building, bases, objective)
     noise = Noise.of_records(windows.measured, noise).with_numerical(windows.numerical_rms())
-    # the file's metrics once its start is fitted, as every model's are (`Windows.started`)
-    model.metrics = windows.metrics(objective, before_runs, starts=windows.starts(building, bases, objective.air_nodes),
-                                    sigma=noise.sigma)
     return Prepared(list(records), windows, bases, model, noise, windows.scored(), fmu_kind, fmus.get(None))
 
 
@@ -504,9 +500,7 @@ def write(building, prepared, located, made, objective, workdir, reference, late
     for i, path in protocols_after.items():
         path.write_text(json.dumps(model.bases[i].to_json(), indent=2) + "\n")
     by_phase = phase_rows(prepared, made, objective)
-    sigma, air = prepared.noise.sigma, objective.air_nodes
-    starts_before, starts_after = (windows.starts(building, prepared.bases, air),
-                                   windows.starts(model.building, model.bases, air))
+    starts_after = windows.starts(model.building, model.bases, objective.air_nodes)
     diagnosis = Diagnosis(
         objective=list(objective.zones), period=period(windows, 0), before=prepared.model.metrics,
         after=model.metrics, localization=located.localization, candidates=made.results, rounds=made.decisions,
@@ -515,12 +509,12 @@ def write(building, prepared, located, made, objective, workdir, reference, late
                             prepared.policy.yardstick, last_change(made.decisions)),
         residuals=validation_residuals(prepared, made), sensitivity=made.sensitivities, noise=prepared.noise,
         assumptions=list(dict.fromkeys(a for case in windows.cases for a in case.assumptions))
-        + start_said(windows, model.runs, starts_after, sigma),
+        + start_said(windows, model.runs, starts_after, prepared.noise.sigma),
         node_names={str(i): name for i, name in building.node_names().items()},
         artifacts={"building_after": str(workdir / "building_after.json"), "fmu_after": str(fmu_after)},
         records=[RecordOutcome(r.name, str(r.source), period(windows, i),
-                               windows.metrics(objective, prepared.model.runs, i, starts_before, sigma),
-                               windows.metrics(objective, model.runs, i, starts_after, sigma), located.alone[i],
+                               windows.metrics(objective, prepared.model.runs, i),
+                               windows.metrics(objective, model.runs, i), located.alone[i],
                                str(protocols_after[i]) if i in protocols_after else None)
                  for i, r in enumerate(records)] if len(records) > 1 else [],
         worsened_phases=worsened(by_phase, "before", "after") if by_phase and added else None,
@@ -555,7 +549,8 @@ def start_said(windows, runs, starts, sigma):
                           for tau, a, sd, prior in zip(modes.tau, c, np.sqrt(np.diag(cov)), modes.sd))
         said.append(f"The start of record {i + 1} ({w.record.name or w.record.source}) is fitted with the model "
                     f"(docs/model.md 5.10): at its first measurement, {found}; it takes {1 - left / J:.0%} of the calibration "
-                    f"window's J. The FMUs written start as the history does, without it.")
+                    f"window's J. The metrics given are the runs' as the FMUs and `compare` simulate them, which start as the "
+                    f"history does, without it.")
     return said
 
 

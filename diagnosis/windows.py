@@ -161,21 +161,9 @@ class Windows:
             rows &= ~without[:, None]
         return fitted_start(F[:len(residual)][rows], residual[rows], modes.sd, sigma)
 
-    def started(self, runs, starts, sigma):
-        """Per record, `runs` (one (N_t, zones) per record) with the start fitted on its calibration
-        window added over the whole record (`start_fitted`): what the model predicts once it
-        starts where the data say. `runs` themselves where `starts` is None."""
-        if starts is None:
-            return runs
-        return [run + F @ self.start_fitted(w.measured[:w.k] - run[:w.k], starts, sigma, i)[0]
-                for i, (w, run, (F, _)) in enumerate(zip(self.each, runs, starts))]
-
-    def metrics(self, objective, runs, record=None, starts=None, sigma=None):
+    def metrics(self, objective, runs, record=None):
         """{"calibration", "validation"}: the objective's metrics of `runs` (one (N_t, zones) per
-        record) on every record's window together, or on `record`'s (an index) alone; each
-        record's start fitted on its calibration window where its free responses `starts`
-        (`Windows.starts`) are given, sigma the noise's sd (C): `started`."""
-        runs = self.started(runs, starts, sigma)
+        record) on every record's window together, or on `record`'s (an index) alone."""
         chosen = range(len(self.each)) if record is None else [record]
         return {window: objective.metrics(*(np.concatenate([part[i][rows(self.each[i].k)] for i in chosen])
                                             for part in (self.measured, runs)))
