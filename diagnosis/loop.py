@@ -314,7 +314,8 @@ def rounds(prepared, localization, objective, workdir, seed, runner=lifetime.InP
     measured_ids = sorted({i for case in windows.cases for i in case.measured_ids})
     model, decisions, results, runs, sensitivities = prepared.model, [], [], {}, {}
     for number in range(policy.max_rounds):
-        base_blocks = windows.block_J(model.runs)
+        base_blocks = windows.block_J(model.runs, windows.starts(model.building, model.bases, objective.air_nodes),
+                                      noise.sigma)
         air_at_noise = bool(number) and policy.at_noise(base_blocks.sum(), n, noise.floor_sd)
         base_sensed = windows.sensed_by(model)  # the round's model at the other sensors: one run per record
         if air_at_noise and not windows.disagreeing(model.building, base_sensed, noise.sigma):
@@ -499,6 +500,7 @@ def write(building, prepared, located, made, objective, workdir, reference, late
     for i, path in protocols_after.items():
         path.write_text(json.dumps(model.bases[i].to_json(), indent=2) + "\n")
     by_phase = phase_rows(prepared, made, objective)
+    starts_after = windows.starts(model.building, model.bases, objective.air_nodes)
     diagnosis = Diagnosis(
         objective=list(objective.zones), period=period(windows, 0), before=prepared.model.metrics,
         after=model.metrics, localization=located.localization, candidates=made.results, rounds=made.decisions,
@@ -506,7 +508,8 @@ def write(building, prepared, located, made, objective, workdir, reference, late
         heat_loss=heat_loss(building, model.building, added, made.results, prepared.noise.sigma,
                             prepared.policy.yardstick, last_change(made.decisions)),
         residuals=validation_residuals(prepared, made), sensitivity=made.sensitivities, noise=prepared.noise,
-        assumptions=list(dict.fromkeys(a for case in windows.cases for a in case.assumptions)),
+        assumptions=list(dict.fromkeys(a for case in windows.cases for a in case.assumptions))
+        + start_said(windows, model.runs, starts_after, prepared.noise.sigma),
         node_names={str(i): name for i, name in building.node_names().items()},
         artifacts={"building_after": str(workdir / "building_after.json"), "fmu_after": str(fmu_after)},
         records=[RecordOutcome(r.name, str(r.source), period(windows, i),
@@ -526,6 +529,29 @@ def write(building, prepared, located, made, objective, workdir, reference, late
     diagnosis.artifacts["report"] = str(workdir / "report.md")
     diagnosis.write(workdir / "report.json")
     return diagnosis
+
+
+def start_said(windows, runs, starts, sigma):
+    """A sentence per record whose history leaves a slow mode's start unknown (`model.start`):
+    the start the model's `runs` (one (N_t, zones) per record) find on its calibration window
+    (`Windows.start_fitted`, sigma the noise's sd, C), each mode's time constant and amplitude at
+    the first measurement with its sd and its prior's, and the share of the window's J it
+    takes out."""
+    said = []
+    for i, (w, run, (F, modes)) in enumerate(zip(windows.each, runs, starts)):
+        if not len(modes.tau):
+            continue
+        residual = w.measured[:w.k] - run[:w.k]
+        c, cov = windows.start_fitted(residual, starts, sigma, i)
+        scored = np.isfinite(residual)
+        J, left = np.sum(np.square(residual[scored])), np.sum(np.square((residual - F[:w.k] @ c)[scored]))
+        found = "; ".join(f"its {tau / 86400:.3g}-day mode {a:+.3g} +- {sd:.2g} K (prior sd {prior:.2g} K)"
+                          for tau, a, sd, prior in zip(modes.tau, c, np.sqrt(np.diag(cov)), modes.sd))
+        said.append(f"The start of record {i + 1} ({w.record.name or w.record.source}) is fitted with the model "
+                    f"(docs/model.md 5.10): at its first measurement, {found}; it takes {1 - left / J:.0%} of the calibration "
+                    f"window's J. The metrics given are the runs' as the FMUs and `compare` simulate them, which start as the "
+                    f"history does, without it.")
+    return said
 
 
 def scored_later(record, written, corrected, objective, fmu_kind):
