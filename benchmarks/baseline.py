@@ -7,12 +7,8 @@ the zone), the effect's parameters are fitted, within the registry's bounds, by
 `scipy.optimize.least_squares` to the objective air on the calibration window (the record's
 first `fraction`, after the burn-in), with the direct model (`model.integrate.simulate`, the
 FMU's equal to 1e-9 C) started as the diagnosis starts (the weather's history, the steady state,
-the burn-in's forcing), the slow modes' start a history leaves unknown fitted with every fit's
-parameters as the diagnosis fits it (`model.start`: the file's free response, a Gaussian prior,
-the noise's sd the rms residual of the file once its start is fitted). The candidate of lowest
-BIC = n log(J/n) + k log(n) is the answer if its BIC is more than `BIC_MARGIN` below the file's
-as given; else "none"; the validation errors are the runs' with the start fitted on the
-calibration window. No localisation, no residual
+the burn-in's forcing). The candidate of lowest BIC = n log(J/n) + k log(n) is the answer if its BIC is
+more than `BIC_MARGIN` below the file's as given; else "none". No localisation, no residual
 statistics, no rule beyond that one.
 """
 import math
@@ -23,7 +19,6 @@ from scipy.optimize import least_squares
 
 from nodeforce.model.effects import BRIDGE_TO, EFFECTS, PAIR, bridge_parts, pair_parts
 from nodeforce.model.building import Surface
-from nodeforce.model.start import fitted_start, free_response, residual_sd
 
 BIC_MARGIN = 10.0
 MAX_EVALUATIONS = 40  # least-squares residual evaluations per parameter and candidate
@@ -50,38 +45,8 @@ def air_run(building, case, air_nodes):
     return case.with_inputs(building).run(building, np.array(air_nodes) - 1)
 
 
-class Start:
-    """The slow modes' start of `building`'s objective air (`air_nodes`) on the `rows` of `case`
-    the baseline fits: the free responses there (`F`, (rows x zones, m)), their prior sd and the
-    noise's sd (C), the rms residual of the building once its start is fitted."""
-
-    def __init__(self, building, case, air_nodes, rows):
-        F, modes = free_response(case, building, air_nodes)
-        self.whole, self.rows = F, rows
-        self.measured = case.measured[1:, np.array(air_nodes) - 1][rows]
-        self.F, self.sd = F[rows].reshape(len(rows) * len(air_nodes), -1), modes.sd
-        self.sigma = (residual_sd(self.F, (self.measured - air_run(building, case, air_nodes)[rows]).ravel())
-                      if len(self.sd) else None)
-
-    def __call__(self, r):
-        """The residual `r` (rows x zones,) with the start profiled out, and a row per mode for
-        its prior: its squares' sum is the fit's J with the start (`model.start`)."""
-        if not len(self.sd):
-            return r
-        c = fitted_start(self.F, r, self.sd, self.sigma)[0]
-        return np.r_[r - self.F @ c, self.sigma * c / self.sd]
-
-    def started(self, run):
-        """(N_t, zones) `run` with the start fitted on the rows added over the whole record."""
-        if not len(self.sd):
-            return run
-        c = fitted_start(self.F, (self.measured - run[self.rows]).ravel(), self.sd, self.sigma)[0]
-        return run + self.whole @ c
-
-
-def fit_one(building, case, effect, target, air_nodes, rows, profiled):
-    """(values, J on `rows`, the fitted building) of `effect` on `target` fitted alone, its
-    start (`Start`) `profiled` out."""
+def fit_one(building, case, effect, target, air_nodes, rows):
+    """(values, J on `rows`, the fitted building) of `effect` on `target` fitted alone."""
     record = EFFECTS[effect]
     names = [p.name for p in record.parameters]
     low, high = np.array(record.bounds(building, target), dtype=float).T
@@ -96,9 +61,9 @@ def fit_one(building, case, effect, target, air_nodes, rows, profiled):
     def residual(x):
         try:
             fitted = record.apply(building, target, dict(zip(names, x)))
-            r = profiled((measured - inputs.run(fitted, np.array(air_nodes) - 1)[rows]).ravel())
+            r = (measured - inputs.run(fitted, np.array(air_nodes) - 1)[rows]).ravel()
         except ValueError:  # a value the building refuses (the InputError of an impossible field)
-            return np.full(measured.size + len(profiled.sd), 1e3)
+            return np.full(measured.size, 1e3)
         return r if np.all(np.isfinite(r)) else np.full(r.size, 1e3)
 
     solution = least_squares(residual, start, bounds=(low, high), x_scale=scale,
@@ -129,15 +94,14 @@ def baseline(building, case, zones, fraction=0.6):
     rows = rows[ok]
     n = rows.size * len(air_nodes)
     before = air_run(building, case, air_nodes)
-    start = Start(building, case, air_nodes, rows)
-    J0 = float(np.sum(start((measured[rows] - before[rows]).ravel()) ** 2))
+    J0 = float(np.sum((measured[rows] - before[rows]) ** 2))
     best = {"effect": "none", "target": None, "values": {}, "bic": bic(J0, n, 0), "building": building}
     tried = 0
     for effect, record in EFFECTS.items():
         for target in record.targets(building):
             if not concerns(building, effect, target, zones):
                 continue
-            values, J, fitted = fit_one(building, case, effect, target, air_nodes, rows, start)
+            values, J, fitted = fit_one(building, case, effect, target, air_nodes, rows)
             tried += 1
             b = bic(J, n, len(values))
             if b < best["bic"]:
@@ -151,6 +115,5 @@ def baseline(building, case, zones, fraction=0.6):
         r = (measured[k:] - simulated[k:]).ravel()
         return float(np.sqrt(np.nanmean(r ** 2)))
     return {"effect": best["effect"], "target": best["target"], "values": best["values"], "delta_bic": float(delta),
-            "validation_rmse": {"before": rmse(start.started(before)), "after": rmse(start.started(after))},
-            "candidates": tried,
+            "validation_rmse": {"before": rmse(before), "after": rmse(after)}, "candidates": tried,
             "seconds": time.time() - started}

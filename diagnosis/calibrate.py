@@ -503,7 +503,8 @@ def with_priors(cov, priors):
     return posterior * np.outer(d, d)
 
 
-def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None, policy=None, sigma=None):
+def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None, policy=None, sigma=None,
+              start=False):
     """Least-squares values of the candidate's parameters on the calibration windows of one or
     several records of the building (`cases`), on the residuals of every objective zone of every
     record together (the sum of each window's J), and the same fit with each block of steps left out.
@@ -541,6 +542,9 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None, 
         (default: `Policy()`)
     sigma : the noise's sd (C), which puts a prior's penalty in J's units (`Penalised`); None:
         the rms residual of the fit without the priors
+    start : whether each record's slow modes' start its history leaves unknown is fitted with
+        the parameters (`Started`): once a round of the diagnosis has chosen the start
+        (`diagnosis.selection.decide`), every later fit estimates it
 
     Returns
     -------
@@ -577,11 +581,11 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None, 
     def raw_jacobian(x):
         return -np.concatenate([candidate.jacobian(case, i, x)[h] for case, i, h in zip(cases, ids, have)])
 
-    # each record's slow modes' start, fitted at every value of the parameters (`Started`), on
-    # the model as it stands: its free response is the model's, a candidate's effect aside
-    starts = [free_response(case, candidate.base(case), i) for case, i in zip(cases, ids)]
-    free = block_diag(*[F[h] for (F, _), h in zip(starts, have)])
-    start_sd = np.concatenate([modes.sd for _, modes in starts])
+    # each record's slow modes' start, where `start`, fitted at every value of the parameters
+    # (`Started`), on the model as it stands: its free response is the model's, a candidate's effect aside
+    starts = [free_response(case, candidate.base(case), i) for case, i in zip(cases, ids)] if start else []
+    free = block_diag(*[F[h] for (F, _), h in zip(starts, have)]) if start else None
+    start_sd = np.concatenate([modes.sd for _, modes in starts] or [np.zeros(0)])
     sigma_start = (residual_sd(free, raw(x0)) if sigma is None else sigma) if len(start_sd) else None
 
     def weighted(weights):

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from benchmarks.baseline import Start, fit_one
+from benchmarks.baseline import fit_one
 from benchmarks.catalogue import FAULTS, SPECS, SPECS_BY_NAME, Spec
 from benchmarks.records import later_record, record
 from benchmarks.sizing import STRONG_BAND, SUBTLE_BAND, before_error, max_scale
@@ -130,8 +130,7 @@ def test_the_baseline_fits_a_strong_air_change_to_its_size():
     case = r.case().with_steady_start()
     n_steps, h = len(case.times) - 1, case.history_steps
     rows = np.arange(case.burn_in_steps, h + int(round(0.6 * (n_steps - h))))
-    values, J, _ = fit_one(r.building, case, "infiltration", "cell", [23], rows,
-                           Start(r.building, case, [23], rows))
+    values, J, _ = fit_one(r.building, case, "infiltration", "cell", [23], rows)
     assert values["n"] == pytest.approx(r.values[0]["n"], rel=0.05)
     assert J < 2 * rows.size * r.spec.noise ** 2
 

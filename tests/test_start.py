@@ -3,6 +3,7 @@ leaves unknown, their free response, and their amplitudes fitted with a fit's pa
 variable projection, against a start put off by a known amount, the decay physics gives the
 mode, the prior the weather's spread and a history's length say, and two nearly collinear
 modes that must not trade a model's error between them."""
+import json
 from dataclasses import replace
 
 import numpy as np
@@ -122,7 +123,7 @@ def test_a_start_off_by_a_known_amount_along_the_slow_mode_is_fitted_within_two_
     measured = pattern.copy()
     measured[1 + h:, air - 1] = truth[h:] + np.random.default_rng(days).normal(0.0, NOISE, len(truth) - h)
     fitted, determined, _ = calibrate(Candidate(testcell, "internal_gain", "cell"), replace(case, measured=measured),
-                                      Objective.of(testcell), sigma=NOISE)
+                                      Objective.of(testcell), sigma=NOISE, start=True)
     start, = [d for name, d in determined.items() if name.startswith("start_of_record_1")]
     assert abs(start["value"] - off) < 2 * start["std"] + 1e-3, start
     assert abs(fitted["Q"]["value"]) < 2 * fitted["Q"]["std"]
@@ -168,7 +169,7 @@ def test_the_start_is_fitted_without_the_block_a_fold_scores(testcell, weather):
     first = np.zeros(len(case.times) - 1, dtype=bool)
     first[h:h + 96] = True
     _, _, (fold,) = calibrate(Candidate(testcell, "internal_gain", "cell"), case, Objective.of(testcell),
-                              blocks=[first], sigma=NOISE)
+                              blocks=[first], sigma=NOISE, start=True)
     left = fold["residuals"][first, 0]
     file_error = (measured[1:, air - 1] - case.run(testcell, [air - 1])[:, 0])[first]
     assert np.sqrt(np.mean(left ** 2)) < 1.5 * NOISE < 0.5 * np.sqrt(np.mean(file_error ** 2))
@@ -178,10 +179,11 @@ def test_the_start_is_fitted_without_the_block_a_fold_scores(testcell, weather):
 def test_a_faultless_record_with_three_days_of_history_in_a_moving_season_adds_nothing(tmp_path):
     """The benchmark's test cell, its air alone measured (a PRBS heater) for 14 days from 10 March
     in Sandpoint, the truth with its real past, the weather read from 3 days before the record:
-    nothing is added, the report's metrics are the file's runs as simulated (after equals
-    before), and the report states the floor's mode's start it fitted, within 2 sd of its prior
-    (the weather's spread over the mode's 14.7 days, shrunk by the history). With the start
-    assumed, the loop added a heat input factor to this record."""
+    the first round chooses the start, a candidate beside the effects, and nothing is added; the
+    report's metrics are the file's runs as simulated (after equals before), and report.json
+    states the floor's mode's start fitted to the model, within 2 sd of its prior (the weather's
+    spread over the mode's 14.7 days, shrunk by the history), in the numbers its sentence says.
+    With the start assumed, the loop added a heat input factor to this record."""
     from benchmarks.catalogue import Spec
     from benchmarks.records import record
     from nodeforce import api
@@ -191,9 +193,12 @@ def test_a_faultless_record_with_three_days_of_history_in_a_moving_season_adds_n
     diagnosis = api.diagnose(r.building, r.case(), tmp_path, objective=api.objective(r.building, r.zones),
                              search=api.SearchSettings(generations=30, noise=r.spec.noise, seed=0),
                              execution=api.Execution(workers=1))
-    assert not diagnosis.added, diagnosis.rounds[0].reason
+    assert not diagnosis.added and diagnosis.rounds[0].starts, diagnosis.rounds[0].reason
     assert diagnosis.after["validation"]["rmse"] == diagnosis.before["validation"]["rmse"]
-    said, = [a for a in diagnosis.assumptions if a.startswith("The start of record 1")]
-    amplitude = float(said.split("14.7-day mode ")[1].split(" ")[0])
-    prior = float(said.split("(prior sd ")[1].split(" ")[0])
-    assert abs(amplitude) < 2 * prior
+    written = json.loads((tmp_path / "report.json").read_text())
+    (found,) = written["start"]["records"]
+    (tau,), (amplitude,), (sd,), (prior,) = found["tau_days"], found["amplitude"], found["sd"], found["prior_sd"]
+    assert tau == pytest.approx(14.7, abs=0.05) and abs(amplitude) < 2 * prior and sd < prior
+    said, = [a for a in written["assumptions"] if a.startswith("Round 1 chose the start")]
+    assert f"{amplitude:+.3g} +- {sd:.2g} K (prior sd {prior:.2g} K)" in said
+    assert f"{found['share_of_J']:.0%} of the window's J" in said
