@@ -446,8 +446,8 @@ def refitted_without(model, kept, windows, objective, sigma, seed, into, runner,
     """The effects `kept` (`Fit`s) of `model`, which no longer holds the one a revisit removes,
     refitted together without it: the first calibrated as a candidate, the others beside it (a
     parameter that rests on its prior kept at its value: `resting_on_priors`), with its cross-validation, which is
-    then that of the model left, the start fitted where `started`. Its `Fit`, the `Model` it makes, every kept effect's values
-    ({label: {name: {"value", "std", ...}}}) and the simulations it took."""
+    then that of the model left, the start fitted where `started`. Its `Fit`, the `Model` it makes,
+    every kept effect's values ({label: {name: {"value", "std", ...}}}) and the simulations it took."""
     into.mkdir(exist_ok=True)
     first, beside = kept[0], kept[1:]
     inputs = RoundInputs.of(model, windows, objective, sigma, seed, [(a.effect, a.target) for a in beside],
@@ -568,8 +568,9 @@ def start_found(windows, runs, starts, sigma):
         c, cov = windows.start_fitted(residual, starts, sigma, i)
         scored = np.isfinite(residual)
         J, left = np.sum(np.square(residual[scored])), np.sum(np.square((residual - F[:w.k] @ c)[scored]))
-        found.append({"record": w.record.name or str(w.record.source), "tau_days": [float(t / 86400) for t in modes.tau],
-                      "amplitude": [float(a) for a in c], "sd": [float(v) for v in np.sqrt(np.diag(cov))],
+        found.append({"record": w.record.name or str(w.record.source),
+                      "tau_days": [float(t / 86400) for t in modes.tau], "amplitude": [float(a) for a in c],
+                      "sd": [float(v) for v in np.sqrt(np.diag(cov))],
                       "prior_sd": [float(v) for v in modes.sd], "share_of_J": float(1.0 - left / J) if J > 0 else 0.0})
     return {"records": found}
 
@@ -583,10 +584,11 @@ def start_said(start, chosen_in):
     for r in start["records"]:
         found = "; ".join(f"its {tau:.3g}-day mode {a:+.3g} +- {sd:.2g} K (prior sd {prior:.2g} K)"
                           for tau, a, sd, prior in zip(r["tau_days"], r["amplitude"], r["sd"], r["prior_sd"]))
-        said.append(f"Round {chosen_in} chose the start its history leaves unknown (docs/model.md 5.10): fitted to the "
-                    f"model as corrected on the calibration window of {r['record']}, at its first measurement, {found}; "
-                    f"it takes {r['share_of_J']:.0%} of the window's J. The metrics given are the runs' as the FMUs and "
-                    "`compare` simulate them, which start as the history does, without it.")
+        said.append(f"Round {chosen_in} chose the start its history leaves unknown (docs/model.md 5.10): fitted "
+                    f"to the model as corrected on the calibration window of {r['record']}, at its first "
+                    f"measurement, {found}; it takes {r['share_of_J']:.0%} of the window's J. The metrics given "
+                    "are the runs' as the FMUs and `compare` simulate them, which start as the history does, "
+                    "without it.")
     return said
 
 

@@ -485,6 +485,9 @@ class Diagnosis:
             if recorded.replaces:  # a choice made again, the others refitted with each candidate
                 decision = revisited(decision, recorded.replaces, list(tried[0].on_top_of), recorded.refitted,
                                      recorded.refit)
+            if decision.start is not None and recorded.start and "records" in recorded.start:
+                # the amplitudes the loop fitted are said beside the start's test, not read by the choice
+                decision.start["records"] = recorded.start["records"]
             out.append(decision)
         return out
 

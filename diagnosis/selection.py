@@ -149,6 +149,8 @@ def decide(results, baseline, policy):
         reason = _start_reason(start, base, len(results), len(passing))
     else:
         reason = _reason(chosen, alike, results, passing, base, n, verdicts, margin, components, air_at_noise, policy)
+        if chosen is not None and start is not None and start["within"]:
+            reason = reason[:-1] + _start_beside(start) + "."
     return Decision(chosen, reason, float(base.sum()), len(base), margin, policy.standard_errors, suggestions,
                     [r.label for r in alike], verdicts,
                     # what the steps read besides the candidates' fits: report.json can replay them
@@ -166,24 +168,26 @@ def start_test(start, base, margin, admissible, floor_sd, n, air_at_noise, polic
     band of it (`band`'s rule: the standard errors of the paired difference, at least the
     rounding, and the noise's tolerance `parsimony` gives a candidate that claims less): the
     start claims nothing about the building, so, as a physical effect before a shape, the
-    no-fault explanation wins a tie; a fault is added only where the data tell it from a start
-    the history did not set. The comparison is on the air, the start's only evidence: it is
-    fitted to the air, and what it would make of the other sensors no fit of it read.
-    {"cv_J", "cv_fall", "cv_se", "needed", "other_days", "passes", "chosen"} (C2), and where a
-    candidate was weighed against it, "against" (its label), "ahead" (how much lower its J on
-    the air is) and "band" (what it needs to be told apart)."""
+    no-fault explanation may win the tie (`Policy.prefer_start`); a fault is then added only
+    where the data tell it from a start the history did not set. The comparison is on the air,
+    the start's only evidence: it is fitted to the air, and what it would make of the other
+    sensors no fit of it read. {"cv_J", "cv_fall", "cv_se", "needed", "other_days", "passes",
+    "within": it passes and no admissible candidate is told from it, "chosen": within, and the
+    policy prefers the start} (C2), and where a candidate was weighed against it, "against"
+    (its label), "ahead" (how much lower its J on the air is) and "band" (what it needs to be
+    told apart)."""
     start = np.asarray(start, dtype=float)
     judged = policy.yardstick.judge(base, start, margin)
     out = {"cv_J": float(start.sum()), "cv_fall": judged.fall, "cv_se": judged.se, "needed": judged.needed,
            "other_days": judged.other_days, "passes": bool(judged.beats) and not air_at_noise}
-    chosen = out["passes"]
+    within = out["passes"]
     if out["passes"] and admissible:
         best = min(admissible, key=lambda r: r.evidence().sum())
         ahead, se = fall(start, best.cv.blocks)
         width = max(policy.standard_errors * se, policy.rounding(float(base.sum())), parsimony(best, floor_sd, n, policy))
-        chosen = ahead <= width
+        within = ahead <= width
         out.update({"against": best.label, "ahead": ahead, "band": width})
-    return {**out, "chosen": bool(chosen)}
+    return {**out, "within": bool(within), "chosen": bool(within) and policy.prefer_start}
 
 
 def revisited(decision, replaces, others, refitted, refit):
@@ -398,14 +402,28 @@ def _start_reason(start, base, tried, passing):
             f"{start['cv_J']:.3g} C2, beyond the {start['needed']:.3g} C2 that the noise, the file's numerical "
             f"error and the day-to-day scatter could make")
     if "against" in start:
-        effect, target = start["against"].split("@", 1)
-        said += (f"; the best admissible candidate ({passing} of {tried} pass), {effect} on {target}, is lower on "
-                 f"the air by {start['ahead']:.3g} C2, within the {start['band']:.3g} C2 that tells a candidate "
-                 "from one that claims less")
+        said += (f"; {_against(start)} ({passing} of {tried} candidates pass), within the {start['band']:.3g} C2 "
+                 "that tells a candidate from one that claims less")
     else:
         said += f"; none of the {tried} candidates tried is admitted"
     return (said + ": the start claims nothing about the building and is preferred, so no effect is added in this "
             "round, and the later rounds fit the start with every candidate.")
+
+
+def _start_beside(start):
+    """The clause of the reason where the start is within the band of the effect chosen but the
+    policy does not prefer it (`start_test`)."""
+    return (f"; the start its history leaves unknown, fitted on the days each block leaves, lowers the "
+            f"cross-validated J to {start['cv_J']:.3g} C2, and {_against(start)}, within the {start['band']:.3g} C2 "
+            "that tells a candidate from one that claims less: these data cannot tell the effect from a start the "
+            "history did not set")
+
+
+def _against(start):
+    """The best admissible candidate's air J against the start's, in words (`start_test`)."""
+    effect, target = start["against"].split("@", 1)
+    return (f"the best admissible candidate's, {effect} on {target}, is {abs(start['ahead']):.3g} C2 "
+            f"{'below' if start['ahead'] >= 0 else 'above'} it on the air")
 
 
 def _weighed(chosen, verdict, by_label, policy):

@@ -179,7 +179,8 @@ def test_the_start_is_fitted_without_the_block_a_fold_scores(testcell, weather):
 def test_a_faultless_record_with_three_days_of_history_in_a_moving_season_adds_nothing(tmp_path):
     """The benchmark's test cell, its air alone measured (a PRBS heater) for 14 days from 10 March
     in Sandpoint, the truth with its real past, the weather read from 3 days before the record:
-    the first round chooses the start, a candidate beside the effects, and nothing is added; the
+    under a policy that prefers the start (`Policy.prefer_start`), the first round chooses it, a
+    candidate beside the effects, and nothing is added; the
     report's metrics are the file's runs as simulated (after equals before), and report.json
     states the floor's mode's start fitted to the model, within 2 sd of its prior (the weather's
     spread over the mode's 14.7 days, shrunk by the history), in the numbers its sentence says.
@@ -187,12 +188,13 @@ def test_a_faultless_record_with_three_days_of_history_in_a_moving_season_adds_n
     from benchmarks.catalogue import Spec
     from benchmarks.records import record
     from nodeforce import api
+    from nodeforce.diagnosis.policy import Policy
     spec = Spec(name="sdp-mar-air-h3/none", building="testcell", climate="sandpoint", start="03-10", days=14,
                 step_min=30, noise=0.15, sensors="air", before=3)
     r = record(spec, 0)
     diagnosis = api.diagnose(r.building, r.case(), tmp_path, objective=api.objective(r.building, r.zones),
                              search=api.SearchSettings(generations=30, noise=r.spec.noise, seed=0),
-                             execution=api.Execution(workers=1))
+                             execution=api.Execution(workers=1), policy=Policy(prefer_start=True))
     assert not diagnosis.added and diagnosis.rounds[0].starts, diagnosis.rounds[0].reason
     assert diagnosis.after["validation"]["rmse"] == diagnosis.before["validation"]["rmse"]
     written = json.loads((tmp_path / "report.json").read_text())

@@ -60,8 +60,9 @@ def start_clause(start):
                                        for tau, a, sd, prior in zip(r["tau_days"], r["amplitude"], r["sd"],
                                                                     r["prior_sd"]))
         + f", {r['share_of_J']:.0%} of the window's J" for r in start.get("records", ()))
-    return (f"; the start as a candidate: cross-validated J {fmt_sig(start['cv_J'])} C², "
-            f"{'chosen' if start['chosen'] else 'passes, not chosen' if start['passes'] else 'does not pass'}"
+    verdict = ("chosen" if start["chosen"] else "not told from the best admissible effect" if start.get("within")
+               else "passes, told from the best admissible effect" if start["passes"] else "does not pass")
+    return (f"; the start as a candidate: cross-validated J {fmt_sig(start['cv_J'])} C², {verdict}"
             + (f" ({found})" if found else ""))
 
 
