@@ -178,13 +178,15 @@ def keep(task, result):
 
 def rounded(decision, kept=8):
     """A round's decision as the benchmark keeps it, to see which step chose what: the chosen, the
-    cross-validated J before, and the `kept` candidates of lowest cross-validated J with their test."""
+    cross-validated J before, the `kept` candidates of lowest cross-validated J with their test,
+    and the start's test where it was a candidate (`diagnosis.selection.start_test`)."""
     tests = decision.get("candidates", {})
     best = sorted(tests, key=lambda k: -tests[k]["cv_fall"])[:kept]
     return {"chosen": decision.get("chosen"), "cv_J_before": decision.get("cv_J_before"),
             "needed_noise": decision.get("noise_margin"), "indistinct": decision.get("indistinct", []),
             "best": {k: {key: tests[k].get(key) for key in ("cv_fall", "cv_se", "needed", "passes", "objection", "evidence")}
-                     for k in best}}
+                     for k in best},
+            **({"start": decision["start"]} if decision.get("start") is not None else {})}
 
 
 def longest_first(tasks):

@@ -37,8 +37,9 @@ class RoundInputs:
     the file's numerical error at the objective air and at those sensors (one array per record
     each, or None), the air sensors' noise sd (C), the seed, the effects the model holds that are
     refitted together with each candidate ((effect, target)) with those of their parameters
-    `held` ({label: names}) kept as they are (`calibrate.Candidate`), and the
-    `diagnosis.policy.Policy`."""
+    `held` ({label: names}) kept as they are (`calibrate.Candidate`), the
+    `diagnosis.policy.Policy`, and whether each fit estimates the records' start (`started`:
+    an earlier round chose it, `diagnosis.selection.decide`)."""
     building: object
     bases: list
     calibrations: list
@@ -53,13 +54,14 @@ class RoundInputs:
     policy: object
     beside: tuple = ()
     held: dict = field(default_factory=dict)
+    started: bool = False
 
     @classmethod
-    def of(cls, model, windows, objective, sigma, seed, beside=(), held=None):
+    def of(cls, model, windows, objective, sigma, seed, beside=(), held=None, started=False):
         """The inputs of a round adding to `model` (`loop.Model`) on the `windows`, under their policy."""
         return cls(model.building, model.bases, windows.calibrations, windows.cases, objective, windows.blocks,
                    windows.sensors, windows.calibration_numerical(), windows.calibration_numerical(sensors=True),
-                   sigma, seed, windows.policy, tuple(beside), held or {})
+                   sigma, seed, windows.policy, tuple(beside), held or {}, started)
 
 
 def assess(inputs, pair):
@@ -78,7 +80,7 @@ def assess(inputs, pair):
     own = own_nodes(building, [target, *(t for _, t in beside)], sensors, inputs.at_sensors, inputs.sigma,
                     inputs.policy)
     fitted, determined, folds = calibrate(candidate, calibrations, objective, blocks, inputs.numerical, own,
-                                          inputs.policy, inputs.sigma)
+                                          inputs.policy, inputs.sigma, inputs.started)
     values = [fitted[name]["value"] for name in candidate.names]
     zones = len(objective.air_nodes)
     # the objective air and the other sensors (never the objective air) in one run of each record

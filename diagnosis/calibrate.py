@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from types import SimpleNamespace
 
 import numpy as np
+from scipy.linalg import block_diag
 from scipy.optimize import least_squares
 
 from nodeforce.diagnosis.candidates import calibration_start
@@ -33,6 +34,7 @@ from nodeforce.model.effects import EFFECTS
 from nodeforce.model.hlc import heat_loss_coefficient
 from nodeforce.model.network import assemble, derivative, moved
 from nodeforce.model.numerical import share, share_slope
+from nodeforce.model.start import fitted_start, free_response, residual_sd
 
 log = logging.getLogger("nodeforce.diagnosis")
 
@@ -407,6 +409,48 @@ class Residuals:
         return (slopes + np.outer(self.error, share_slope(r, self.error, self.counted, slopes))) * self.scale[:, None]
 
 
+class Started:
+    """`Residuals` with each record's slow modes' start profiled out (`model.start`, variable
+    projection): the data's rows are r - F c, F the free responses of the start's amplitudes on
+    the rows (`free`, (rows, m), each record's own columns), weighted as the rows are, and c
+    their Gaussian-prior least squares at the same parameters (`fitted_start`); a row per
+    amplitude after the data's, sigma c_j / sd_j, makes the squares' sum the J of
+    `model.start`. F does not move with the parameters, so the Jacobian is the data's projected:
+    (I - F Q) J_r and sigma diag(sd^-1) Q J_r, Q = (F'F + sigma^2 diag(sd^-2))^-1 F'."""
+
+    def __init__(self, residuals, free, sd, sigma):
+        self.residuals = residuals
+        self.F = free * residuals.scale[:, None]
+        self.sd, self.sigma = np.asarray(sd, dtype=float), sigma
+        self.data = len(residuals.counted)
+        self.counted = np.r_[residuals.counted, np.ones(len(self.sd), dtype=bool)]
+
+    def amplitudes(self, r, rows=None):
+        """c (m,) K of the weighted data rows' residual `r`, on the `rows` (bool) alone where given."""
+        F = self.F if rows is None else self.F * rows[:, None]
+        return fitted_start(F, r if rows is None else np.where(rows, r, 0.0), self.sd, self.sigma)[0]
+
+    def at(self, x, rows=None):
+        """c at parameters x, fitted on the data's `rows` (bool, data rows) where given."""
+        return self.amplitudes(self.residuals(x, rows), rows)
+
+    def _started(self, r, rows=None):
+        c = self.amplitudes(r, rows)
+        return np.r_[r - self.F @ c, self.sigma * c / self.sd]
+
+    def __call__(self, x, rows=None):
+        rows = None if rows is None else rows[:self.data]
+        return self._started(self.residuals(x, rows), rows)
+
+    def fitting(self, x):
+        return self._started(self.residuals.fitting(x))
+
+    def jacobian(self, x):
+        J = self.residuals.jacobian(x)
+        QJ = self.amplitudes(J)
+        return np.vstack([J - self.F @ QJ, (self.sigma / self.sd)[:, None] * QJ])
+
+
 class Penalised:
     """`Residuals` with a row per Gaussian prior (`model.effects.Prior`) after the data's: sigma (x_i
     - value) / sd for parameter i, sigma the noise's sd (C). Their squares' sum is J (C2) plus
@@ -459,7 +503,8 @@ def with_priors(cov, priors):
     return posterior * np.outer(d, d)
 
 
-def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None, policy=None, sigma=None):
+def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None, policy=None, sigma=None,
+              start=False):
     """Least-squares values of the candidate's parameters on the calibration windows of one or
     several records of the building (`cases`), on the residuals of every objective zone of every
     record together (the sum of each window's J), and the same fit with each block of steps left out.
@@ -497,6 +542,9 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None, 
         (default: `Policy()`)
     sigma : the noise's sd (C), which puts a prior's penalty in J's units (`Penalised`); None:
         the rms residual of the fit without the priors
+    start : whether each record's slow modes' start its history leaves unknown is fitted with
+        the parameters (`Started`): once a round of the diagnosis has chosen the start
+        (`diagnosis.selection.decide`), every later fit estimates it
 
     Returns
     -------
@@ -533,12 +581,21 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None, 
     def raw_jacobian(x):
         return -np.concatenate([candidate.jacobian(case, i, x)[h] for case, i, h in zip(cases, ids, have)])
 
+    # each record's slow modes' start, where `start`, fitted at every value of the parameters
+    # (`Started`), on the model as it stands: its free response is the model's, a candidate's effect aside
+    starts = [free_response(case, candidate.base(case), i) for case, i in zip(cases, ids)] if start else []
+    free = block_diag(*[F[h] for (F, _), h in zip(starts, have)]) if start else None
+    start_sd = np.concatenate([modes.sd for _, modes in starts] or [np.zeros(0)])
+    sigma_start = (residual_sd(free, raw(x0)) if sigma is None else sigma) if len(start_sd) else None
+
     def weighted(weights):
         """The `Residuals` with each own node's column times the square root of its weight (one
-        (len(ids),) per case; the air's columns weigh 1)."""
+        (len(ids),) per case; the air's columns weigh 1), the start profiled out (`Started`)
+        where a record has a slow mode its history leaves unknown."""
         scale = np.sqrt(np.concatenate([np.broadcast_to(np.r_[np.ones(zones), w], h.shape)[h]
                                         for w, h in zip(weights, have)]))
-        return Residuals(raw, raw_jacobian, error, scale)
+        residuals = Residuals(raw, raw_jacobian, error, scale)
+        return Started(residuals, free, start_sd, sigma_start) if len(start_sd) else residuals
 
     # each record's steps numbered apart from the others' by more than the HAC's lags: residuals
     # of two records are not correlated
@@ -550,6 +607,7 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None, 
     steps = np.concatenate(steps)
     priors = wanted_priors(candidate, cases)
     residuals = weighted([np.zeros(len(e)) for e in extra])
+    started = residuals
     fit = solve(residuals, x0, lows, highs, kept)
     if priors:
         # the MAP fit starts from the free fit's end of a valley: from the prior's side a coupling
@@ -562,7 +620,7 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None, 
         weights = own_weights(candidate, cases, ids, measured, numerical, fit.x, own, policy)
         log.info("%s: its own nodes read beside the air, weighing %s", candidate.label,
                  "; ".join(", ".join(f"{n}: {w:.2g}" for n, w in zip(e, ws)) for e, ws in zip(extra, weights)))
-        residuals = weighted(weights)
+        residuals = started = weighted(weights)
         residuals = Penalised(residuals, priors, sigma) if priors else residuals
         fit = solve(residuals, fit.x, lows, highs, kept)
     data = len(steps)  # the data's rows, the priors' after them
@@ -590,10 +648,49 @@ def calibrate(candidate, cases, objective, blocks=(), numerical=None, own=None, 
         case, m, h = cases[record], measured[record], have[record]
         s = share(raw(x), error, train[:data] & residuals.counted[:data])
         T = candidate.nodes(case, ids[record], x)
+        if len(start_sd):  # the start fitted without the block
+            T = T + start_of(starts, record, started.at(x, train[:data]))
         left = np.where(h & block[:, None], m - T + s * numerical[record], np.nan)
         folds.append({"values": [float(v) for v in x], "residuals": left[:, :zones],
                       "own": np.where(block[:, None], T[:, zones:], np.nan)})
-    return result, derived(candidate, cases[0], fit.x, cov), folds
+    determined = derived(candidate, cases[0], fit.x, cov)
+    if len(start_sd):
+        determined.update(stated_start(starts, started, fit.x, sigma_start))
+    return result, determined, folds
+
+
+def start_of(starts, record, c):
+    """(N_t, nodes) C: what the start's amplitudes `c` (every record's, in order) add to
+    `record`'s run, from its free responses (`starts`: `free_response` of each record)."""
+    offset = sum(len(modes.tau) for _, modes in starts[:record])
+    F, modes = starts[record]
+    return F @ c[offset:offset + len(modes.tau)]
+
+
+def stated_start(starts, started, x, sigma):
+    """What the fit at `x` found of each record's start, as report.json carries what the data
+    determine: each slow mode's amplitude at the first measurement (K) and its posterior sd,
+    keyed by the record's number and the mode's time constant; and the share of the
+    calibration window's J (the data's rows) the fitted start takes out of it. The sd is the
+    amplitudes' and the parameters' together: sigma^2 (A'A)^-1 with A the data's Jacobian in
+    both, [J_r F], over the amplitudes' prior rows [0 sigma diag(sd^-1)], its amplitudes' block;
+    a parameter that trades off against the start (a gain against a warm floor) widens it."""
+    r = started.residuals(x)
+    c = fitted_start(started.F, r, started.sd, sigma)[0]
+    slopes = started.residuals.jacobian(x)
+    k = slopes.shape[1]
+    A = np.vstack([np.hstack([slopes, started.F]), np.hstack([np.zeros((len(c), k)), np.diag(sigma / started.sd)])])
+    sds = np.sqrt(np.clip(np.diag(sigma ** 2 * np.linalg.pinv(A.T @ A, hermitian=True))[k:], 0.0, None))
+    out, j = {}, 0
+    for number, (_, modes) in enumerate(starts, 1):
+        for tau in modes.tau:
+            out[f"start_of_record_{number}_{tau / 86400:.3g}_day_mode"] = {"value": float(c[j]), "std": float(sds[j]),
+                                                                          "unit": "K"}
+            j += 1
+    J = float(r @ r)
+    left = r - started.F @ c
+    out["start_share_of_J"] = {"value": float(1.0 - (left @ left) / J) if J > 0 else 0.0, "std": 0.0, "unit": ""}
+    return out
 
 
 def own_weights(candidate, cases, ids, measured, numerical, x, own, policy):

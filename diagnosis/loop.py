@@ -280,12 +280,14 @@ class Located:
 class Made:
     """What the rounds made: each round's `Decision`, every candidate tried (its `Fit`, as
     report.json keeps it), their runs by label, the Morris screening of each chosen effect, and
-    the model they leave."""
+    the model they leave, and whether a round chose the start (`Decision.starts`): every fit
+    after it estimates the records' start."""
     decisions: list
     results: list
     runs: dict
     sensitivities: dict
     model: Model
+    started: bool = False
 
     @property
     def added(self):
@@ -334,26 +336,39 @@ def localise(building, prepared, objective, workdir, search, execution):
 def rounds(prepared, localization, objective, workdir, seed, runner=lifetime.InProcess()):
     """Stage 3: rounds of candidates, `Policy.max_rounds` at most, each on top of the last,
     while the error left is above the noise and one is chosen (`selection.decide`); the
-    candidates where `runner` runs tasks, which ran the forcing search (`assess_all`)."""
+    candidates where `runner` runs tasks, which ran the forcing search (`assess_all`).
+
+    Where a record's history leaves a slow mode's start unknown (`model.start`), the start is
+    one more candidate of each round, until one chooses it (`selection.start_test`): that round
+    adds no effect, and is not counted among the `max_rounds`; every fit after it, the model's
+    cross-validated J included, fits the start with its parameters."""
     windows, n, noise, policy = prepared.windows, prepared.n, prepared.noise, prepared.policy
     folder = workdir / "candidates"
     folder.mkdir(exist_ok=True)
     measured_ids = sorted({i for case in windows.cases for i in case.measured_ids})
     model, decisions, results, runs, sensitivities = prepared.model, [], [], {}, {}
-    for number in range(policy.max_rounds):
-        base_blocks = windows.block_J(model.runs)
+    start_chosen = False
+    for number in range(policy.max_rounds + 1):
+        if len(decisions) - start_chosen == policy.max_rounds:
+            break
+        starts = windows.starts(model.building, model.bases, objective.air_nodes)
+        base_blocks = windows.block_J(model.runs, starts if start_chosen else None, noise.sigma)
+        # the start as a candidate: the model's J with each record's start fitted on its other blocks
+        start_blocks = (windows.block_J(model.runs, starts, noise.sigma)
+                        if not start_chosen and any(len(modes.tau) for _, modes in starts) else None)
         air_at_noise = bool(number) and policy.at_noise(base_blocks.sum(), n, noise.floor_sd)
         base_sensed = windows.sensed_by(model)  # the round's model at the other sensors: one run per record
         if air_at_noise and not windows.disagreeing(model.building, base_sensed, noise.sigma):
             break  # the error left is the noise's, at the air and at every component's own sensors
-        done = [d.chosen.label for d in decisions]  # every earlier round chose: a round without a choice ends them
+        # every earlier round chose an effect or the start: a round without a choice ends them
+        done = [d.chosen.label for d in decisions if d.chosen]
         started = time.perf_counter()
         # a later round's candidates, on top of the earlier choices, are building files of their own
         into = folder / f"round{number + 1}" if number else folder
         into.mkdir(exist_ok=True)
         pairs = [p for p in physical(model.building, localization["components"], objective.zones,
                                      measured_ids, policy, localization["best_nodes"]) if "@".join(p) not in done]
-        inputs = RoundInputs.of(model, windows, objective, noise.sigma, seed)
+        inputs = RoundInputs.of(model, windows, objective, noise.sigma, seed, started=start_chosen)
         assessed = assess_all(inputs, pairs, into, runner)
         tried, models = fits_of(model, base_sensed, pairs, assessed, windows, inputs, number + 1, done)
         # shapes only where no physical candidate physics admits brings the error left to the
@@ -368,18 +383,25 @@ def rounds(prepared, localization, objective, workdir, seed, runner=lifetime.InP
         simulations = sum(a.simulations for a in assessed)
         # a round run for a component's own sensors alone: only they can make a candidate pass
         decision = decide(tried, Baseline(base_blocks, noise.sigma, n, windows.groups(), noise.floor_sd,
-                                          air_at_noise=air_at_noise), policy)
+                                          air_at_noise=air_at_noise,
+                                          start=None if start_blocks is None else [float(b) for b in start_blocks]),
+                          policy)
+        if decision.start is not None:
+            decision.start.update(start_found(windows, model.runs, starts, noise.sigma))
         decision.cost = {"candidates": len(tried), "simulations": simulations,
                          "seconds": round(time.perf_counter() - started, 1)}
         decisions.append(decision)
         results += [lean(r) for r in tried]
         runs.update({(key if not number else f"{key} (round {number + 1})"): m.runs for key, m in models.items()})
         chosen = decision.chosen
+        if decision.starts:
+            start_chosen = True
+            continue
         if not chosen:
             break
         sensitivities[chosen.label] = screened(model, chosen, windows, objective, seed)
         model = models[chosen.label]
-    made = Made(decisions, results, runs, sensitivities, model)
+    made = Made(decisions, results, runs, sensitivities, model, start_chosen)
     for fit in made.added[:-1]:
         made = revisit(prepared, made, fit, objective, folder, seed, runner)
     return made
@@ -421,9 +443,9 @@ def revisit(prepared, made, fit, objective, folder, seed, runner):
     into = folder / f"revisit{number}"
     into.mkdir(exist_ok=True)
     refit, kept, refitted, spent = refitted_without(model, others, windows, objective, noise.sigma, seed,
-                                                    into / "without", runner, number)
+                                                    into / "without", runner, number, made.started)
     inputs = RoundInputs.of(kept, windows, objective, noise.sigma, seed, [(a.effect, a.target) for a in others],
-                            {a.label: resting_on_priors(a) for a in others})
+                            {a.label: resting_on_priors(a) for a in others}, made.started)
     assessed = assess_all(inputs, pairs, into, runner)
     tried, models = fits_of(kept, windows.sensed_by(kept), pairs, assessed, windows, inputs, number,
                             [a.label for a in others])
@@ -436,7 +458,7 @@ def revisit(prepared, made, fit, objective, folder, seed, runner):
                      "seconds": round(time.perf_counter() - started, 1)}
     runs = {**made.runs, **{f"{key} (revisit of {fit.label})": m.runs for key, m in models.items()}}
     made = Made(made.decisions + [decision], made.results + [lean(r) for r in tried], runs, made.sensitivities,
-                made.model)
+                made.model, made.started)
     if decision.removes:
         return replace(made, sensitivities={k: v for k, v in made.sensitivities.items() if k != fit.label},
                        model=kept)
@@ -447,16 +469,16 @@ def revisit(prepared, made, fit, objective, folder, seed, runner):
                    model=models[chosen.label])
 
 
-def refitted_without(model, kept, windows, objective, sigma, seed, into, runner, number):
+def refitted_without(model, kept, windows, objective, sigma, seed, into, runner, number, started=False):
     """The effects `kept` (`Fit`s) of `model`, which no longer holds the one a revisit removes,
     refitted together without it: the first calibrated as a candidate, the others beside it (a
     parameter that rests on its prior kept at its value: `resting_on_priors`), with its cross-validation, which is
-    then that of the model left. Its `Fit`, the `Model` it makes, every kept effect's values
-    ({label: {name: {"value", "std", ...}}}) and the simulations it took."""
+    then that of the model left, the start fitted where `started`. Its `Fit`, the `Model` it makes,
+    every kept effect's values ({label: {name: {"value", "std", ...}}}) and the simulations it took."""
     into.mkdir(exist_ok=True)
     first, beside = kept[0], kept[1:]
     inputs = RoundInputs.of(model, windows, objective, sigma, seed, [(a.effect, a.target) for a in beside],
-                            {a.label: resting_on_priors(a) for a in beside})
+                            {a.label: resting_on_priors(a) for a in beside}, started)
     pair = (first.effect, first.target)
     assessed = assess_all(inputs, [pair], into, runner)
     (refit,), models = fits_of(model, windows.sensed_by(model), [pair], assessed, windows, inputs, number,
@@ -528,6 +550,8 @@ def write(building, prepared, located, made, objective, workdir, reference, late
     for i, path in protocols_after.items():
         path.write_text(json.dumps(as_given(model.bases[i], records[i].building or given), indent=2) + "\n")
     by_phase = phase_rows(prepared, made, objective)
+    start = (start_found(windows, model.runs, windows.starts(model.building, model.bases, objective.air_nodes),
+                         prepared.noise.sigma) if made.started else None)
     diagnosis = Diagnosis(
         objective=list(objective.zones), period=period(windows, 0), before=prepared.model.metrics,
         after=model.metrics, localization=located.localization, candidates=made.results, rounds=made.decisions,
@@ -535,7 +559,8 @@ def write(building, prepared, located, made, objective, workdir, reference, late
         heat_loss=heat_loss(building, model.building, added, made.results, prepared.noise.sigma,
                             prepared.policy.yardstick, last_change(made.decisions)),
         residuals=validation_residuals(prepared, made), sensitivity=made.sensitivities, noise=prepared.noise,
-        assumptions=list(dict.fromkeys(a for case in windows.cases for a in case.assumptions)),
+        assumptions=list(dict.fromkeys(a for case in windows.cases for a in case.assumptions))
+        + start_said(start, next((n for n, d in enumerate(made.decisions, 1) if d.starts), None)),
         node_names={str(i): name for i, name in building.node_names().items()},
         artifacts={"building_after": str(workdir / "building_after.json"), "fmu_after": str(fmu_after)},
         records=[RecordOutcome(r.name, str(r.source), period(windows, i),
@@ -544,7 +569,7 @@ def write(building, prepared, located, made, objective, workdir, reference, late
                                str(protocols_after[i]) if i in protocols_after else None)
                  for i, r in enumerate(records)] if len(records) > 1 else [],
         worsened_phases=worsened(by_phase, "before", "after") if by_phase and added else None,
-        phases=by_phase or None, reference=reference or None, later=later, policy=prepared.policy)
+        phases=by_phase or None, reference=reference or None, later=later, policy=prepared.policy, start=start)
     idf = idf_of(building)
     if idf is not None:  # a converted EnergyPlus model: its corrections written back into it
         diagnosis.energyplus = write_corrections(building, model.building, [(a.effect, a.target) for a in added],
@@ -555,6 +580,45 @@ def write(building, prepared, located, made, objective, workdir, reference, late
     diagnosis.artifacts["report"] = str(workdir / "report.md")
     diagnosis.write(workdir / "report.json")
     return diagnosis
+
+
+def start_found(windows, runs, starts, sigma):
+    """{"records": [...]}: what the start fitted to the model's `runs` (one (N_t, zones) per
+    record) on each calibration window finds (`Windows.start_fitted`, `starts` the records'
+    `Windows.starts`, sigma the noise's sd, C), for each record whose history leaves a slow mode
+    unset: its name, each mode's time constant (days), its amplitude at the first measurement
+    (K) with its posterior sd and its prior's (K), and the share of the window's J it takes
+    out."""
+    found = []
+    for i, (w, run, (F, modes)) in enumerate(zip(windows.each, runs, starts)):
+        if not len(modes.tau):
+            continue
+        residual = w.measured[:w.k] - run[:w.k]
+        c, cov = windows.start_fitted(residual, starts, sigma, i)
+        scored = np.isfinite(residual)
+        J, left = np.sum(np.square(residual[scored])), np.sum(np.square((residual - F[:w.k] @ c)[scored]))
+        found.append({"record": w.record.name or str(w.record.source),
+                      "tau_days": [float(t / 86400) for t in modes.tau], "amplitude": [float(a) for a in c],
+                      "sd": [float(v) for v in np.sqrt(np.diag(cov))],
+                      "prior_sd": [float(v) for v in modes.sd], "share_of_J": float(1.0 - left / J) if J > 0 else 0.0})
+    return {"records": found}
+
+
+def start_said(start, chosen_in):
+    """A sentence per record of `start` (`start_found` of the model the rounds leave; None: the
+    start was never chosen, nothing to say), chosen in round `chosen_in`."""
+    if start is None:
+        return []
+    said = []
+    for r in start["records"]:
+        found = "; ".join(f"its {tau:.3g}-day mode {a:+.3g} +- {sd:.2g} K (prior sd {prior:.2g} K)"
+                          for tau, a, sd, prior in zip(r["tau_days"], r["amplitude"], r["sd"], r["prior_sd"]))
+        said.append(f"Round {chosen_in} chose the start its history leaves unknown (docs/model.md 5.10): fitted "
+                    f"to the model as corrected on the calibration window of {r['record']}, at its first "
+                    f"measurement, {found}; it takes {r['share_of_J']:.0%} of the window's J. The metrics given "
+                    "are the runs' as the FMUs and `compare` simulate them, which start as the history does, "
+                    "without it.")
+    return said
 
 
 def scored_later(record, written, corrected, objective, fmu_kind):

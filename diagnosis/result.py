@@ -196,7 +196,10 @@ class Baseline:
     every two admissible candidates' residuals ({label: {label: C}}, computed from the residuals
     if None), and whether the round runs only because a component's own sensors disagree, the
     air's error left being the noise's (`Policy.at_noise`): a candidate then passes on its own
-    sensors alone."""
+    sensors alone; and the start as a candidate (`selection.start_test`), where a record's
+    history leaves a slow mode's start unknown and no earlier round chose it: the per-block J
+    (C2) of the model with each record's start fitted on its other blocks
+    (`Windows.block_J`), None otherwise."""
     blocks_before: list
     sigma: float
     n: int
@@ -204,15 +207,17 @@ class Baseline:
     floor_sd: float = None
     distances: dict = None
     air_at_noise: bool = False
+    start: list = None
 
     def to_json(self):
         return {"blocks_before": self.blocks_before, "sigma": self.sigma, "floor_sd": self.floor_sd, "n": self.n,
-                "groups": self.groups, "distances": self.distances, "air_at_noise": self.air_at_noise}
+                "groups": self.groups, "distances": self.distances, "air_at_noise": self.air_at_noise,
+                **({"start": self.start} if self.start is not None else {})}
 
     @classmethod
     def of_json(cls, d):
         return cls(d["blocks_before"], d["sigma"], d["n"], d["groups"], d["floor_sd"], d["distances"],
-                   d.get("air_at_noise", False))
+                   d.get("air_at_noise", False), d.get("start"))
 
 
 @dataclass
@@ -228,7 +233,10 @@ class Decision:
     {"value", "std", ...}}}), judged against `refit`, the fit of the model's other effects
     refitted together without it (the first with the others beside it: its cross-validation is
     the model's without it); where none is chosen, itself included, the effect is removed, the
-    others at the values `refit` gave them, which `refitted` holds."""
+    others at the values `refit` gave them, which `refitted` holds. Where the start was a
+    candidate (`Baseline.start`), `start` holds its test (`selection.start_test`) and, once the
+    loop has fitted it, its amplitudes (`diagnosis.loop.start_found`); where it is chosen
+    (`starts`), no effect is added and the later rounds fit it with every candidate."""
     chosen: Fit
     reason: str
     cv_J_before: float
@@ -243,6 +251,12 @@ class Decision:
     replaces: str = None
     refitted: dict = None
     refit: Fit = None
+    start: dict = None
+
+    @property
+    def starts(self):
+        """Whether the round chose the start, the records' slow modes' amplitudes, and no effect."""
+        return bool(self.start and self.start["chosen"])
 
     @property
     def changes_model(self):
@@ -265,7 +279,8 @@ class Decision:
                 "inputs": self.inputs, **({"cost": self.cost} if self.cost is not None else {}),
                 **({"replaces": self.replaces, "refitted": self.refitted, "refit": self.refit.to_json()}
                    if self.replaces else {}),
-                **({"removed": self.replaces} if self.removes else {})}
+                **({"removed": self.replaces} if self.removes else {}),
+                **({"start": self.start} if self.start is not None else {})}
 
     @classmethod
     def of_json(cls, d, chosen):
@@ -273,7 +288,7 @@ class Decision:
         return cls(chosen, d["reason"], d["cv_J_before"], d["blocks"], d["noise_margin"], d["standard_errors"],
                    d["suggestions"], d["indistinct"], {k: Verdict(**v) for k, v in d["candidates"].items()},
                    d["inputs"], d.get("cost"), d.get("replaces"), d.get("refitted"),
-                   Fit.of_json(d["refit"]) if d.get("refit") else None)
+                   Fit.of_json(d["refit"]) if d.get("refit") else None, d.get("start"))
 
 
 def added_effects(decisions):
@@ -369,6 +384,8 @@ class Diagnosis:
     later : each later record's score as written and as corrected (`LaterRecord`), read by nothing else
     policy : the `diagnosis.policy.Policy` the choices were made under (report.json's `policy`);
         a report without one was made under the default
+    start : where a round chose the start, what it is fitted to the model as corrected
+        (`diagnosis.loop.start_found`), None otherwise
     """
     objective: list
     period: dict
@@ -392,6 +409,7 @@ class Diagnosis:
     energyplus: dict = None
     later: list = ()
     policy: Policy = field(default_factory=Policy)
+    start: dict = None
 
     @property
     def added(self):
@@ -437,7 +455,7 @@ class Diagnosis:
             out["records"] = [r.to_json() for r in self.records]
         if self.later:
             out["later"] = [r.to_json() for r in self.later]
-        for key in ("reference", "energyplus", "phases"):
+        for key in ("reference", "energyplus", "phases", "start"):
             if getattr(self, key):
                 out[key] = getattr(self, key)
         return out
@@ -467,6 +485,9 @@ class Diagnosis:
             if recorded.replaces:  # a choice made again, the others refitted with each candidate
                 decision = revisited(decision, recorded.replaces, list(tried[0].on_top_of), recorded.refitted,
                                      recorded.refit)
+            if decision.start is not None and recorded.start and "records" in recorded.start:
+                # the amplitudes the loop fitted are said beside the start's test, not read by the choice
+                decision.start["records"] = recorded.start["records"]
             out.append(decision)
         return out
 
@@ -485,7 +506,7 @@ class Diagnosis:
                    [RecordOutcome.of_json(r) for r in d.get("records", ())], d["decision"].get("worsened_phases"),
                    d.get("phases"), d.get("reference"), d.get("energyplus"),
                    [LaterRecord.of_json(r) for r in d.get("later", ())],
-                   Policy.of_json(d["policy"]) if "policy" in d else Policy())
+                   Policy.of_json(d["policy"]) if "policy" in d else Policy(), d.get("start"))
 
 
 def _plain(value):

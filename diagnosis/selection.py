@@ -141,13 +141,53 @@ def decide(results, baseline, policy):
         near = band(admissible, base, sigma, floor_sd, n, distances, policy)  # 3.
         chosen = min(near, key=lambda r: (claim(r, policy), r.evidence().sum()))  # 4.
         alike = [r for r in near if r is not chosen]
+    start = (None if baseline.start is None else
+             start_test(baseline.start, base, margin, admissible, floor_sd, n, air_at_noise, policy))
     # the candidates physics refused are in `suggestions`; the report says them grouped by reason
-    reason = _reason(chosen, alike, results, passing, base, n, verdicts, margin, components, air_at_noise, policy)
+    if start is not None and start["chosen"]:
+        chosen, alike = None, []
+        reason = _start_reason(start, base, len(results), len(passing))
+    else:
+        reason = _reason(chosen, alike, results, passing, base, n, verdicts, margin, components, air_at_noise, policy)
+        if chosen is not None and start is not None and start["within"]:
+            reason = reason[:-1] + _start_beside(start) + "."
     return Decision(chosen, reason, float(base.sum()), len(base), margin, policy.standard_errors, suggestions,
                     [r.label for r in alike], verdicts,
                     # what the steps read besides the candidates' fits: report.json can replay them
                     Baseline([float(b) for b in base], sigma, n, list(groups), floor_sd, distances or {},
-                             air_at_noise).to_json())
+                             air_at_noise, baseline.start).to_json(), start=start)
+
+
+def start_test(start, base, margin, admissible, floor_sd, n, air_at_noise, policy):
+    """The test of the start as a candidate: the records' slow modes' amplitudes at the first
+    measurement, a start their short history leaves unknown (`model.start`), fitted on the days
+    each block leaves as a candidate's parameters are; `start` its per-block J (C2), `base` the
+    model's. It passes as a candidate passes (the noise's `margin`, the standard error of its
+    fall, more days than one; never on the air at the noise). It is chosen where it passes and
+    no admissible candidate does, or where the best of them (the lowest evidence) is within the
+    band of it (`band`'s rule: the standard errors of the paired difference, at least the
+    rounding, and the noise's tolerance `parsimony` gives a candidate that claims less): the
+    start claims nothing about the building, so, as a physical effect before a shape, the
+    no-fault explanation may win the tie (`Policy.prefer_start`); a fault is then added only
+    where the data tell it from a start the history did not set. The comparison is on the air,
+    the start's only evidence: it is fitted to the air, and what it would make of the other
+    sensors no fit of it read. {"cv_J", "cv_fall", "cv_se", "needed", "other_days", "passes",
+    "within": it passes and no admissible candidate is told from it, "chosen": within, and the
+    policy prefers the start} (C2), and where a candidate was weighed against it, "against"
+    (its label), "ahead" (how much lower its J on the air is) and "band" (what it needs to be
+    told apart)."""
+    start = np.asarray(start, dtype=float)
+    judged = policy.yardstick.judge(base, start, margin)
+    out = {"cv_J": float(start.sum()), "cv_fall": judged.fall, "cv_se": judged.se, "needed": judged.needed,
+           "other_days": judged.other_days, "passes": bool(judged.beats) and not air_at_noise}
+    within = out["passes"]
+    if out["passes"] and admissible:
+        best = min(admissible, key=lambda r: r.evidence().sum())
+        ahead, se = fall(start, best.cv.blocks)
+        width = max(policy.standard_errors * se, policy.rounding(float(base.sum())), parsimony(best, floor_sd, n, policy))
+        within = ahead <= width
+        out.update({"against": best.label, "ahead": ahead, "band": width})
+    return {**out, "within": bool(within), "chosen": bool(within) and policy.prefer_start}
 
 
 def revisited(decision, replaces, others, refitted, refit):
@@ -353,6 +393,37 @@ def _reason(chosen, alike, results, passing, base, n, verdicts, margin, componen
     if policy.is_shape(chosen.effect):
         said += "; no physical effect comes within one standard error of it"
     return said + "."
+
+
+def _start_reason(start, base, tried, passing):
+    """The decision in words where the start is chosen (`start_test`)."""
+    said = (f"The start its history leaves unknown, the slow modes' amplitudes at the first measurement fitted "
+            f"on the days each block leaves, lowers the cross-validated J from {base.sum():.3g} to "
+            f"{start['cv_J']:.3g} C2, beyond the {start['needed']:.3g} C2 that the noise, the file's numerical "
+            f"error and the day-to-day scatter could make")
+    if "against" in start:
+        said += (f"; {_against(start)} ({passing} of {tried} candidates pass), within the {start['band']:.3g} C2 "
+                 "that tells a candidate from one that claims less")
+    else:
+        said += f"; none of the {tried} candidates tried is admitted"
+    return (said + ": the start claims nothing about the building and is preferred, so no effect is added in this "
+            "round, and the later rounds fit the start with every candidate.")
+
+
+def _start_beside(start):
+    """The clause of the reason where the start is within the band of the effect chosen but the
+    policy does not prefer it (`start_test`)."""
+    return (f"; the start its history leaves unknown, fitted on the days each block leaves, lowers the "
+            f"cross-validated J to {start['cv_J']:.3g} C2, and {_against(start)}, within the {start['band']:.3g} C2 "
+            "that tells a candidate from one that claims less: these data cannot tell the effect from a start the "
+            "history did not set")
+
+
+def _against(start):
+    """The best admissible candidate's air J against the start's, in words (`start_test`)."""
+    effect, target = start["against"].split("@", 1)
+    return (f"the best admissible candidate's, {effect} on {target}, is {abs(start['ahead']):.3g} C2 "
+            f"{'below' if start['ahead'] >= 0 else 'above'} it on the air")
 
 
 def _weighed(chosen, verdict, by_label, policy):

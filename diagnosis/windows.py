@@ -13,6 +13,7 @@ from nodeforce.model.case import measured_case
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import steps_per_day
 from nodeforce.model.numerical import reference, share
+from nodeforce.model.start import fitted_start, free_response
 
 
 def split(case, source, fraction=None, end=None):
@@ -143,6 +144,23 @@ class Windows:
         """Per record the file's numerical error at the other sensors, None if not known."""
         return None if any(w.sensor_numerical is None for w in self.each) else [w.sensor_numerical for w in self.each]
 
+    def starts(self, building, bases, air_nodes):
+        """Per record, the free response of its slow modes' start at the objective air over the
+        whole record, (N_t, zones, m), and the `model.start.SlowModes`, under the record's
+        protocol's building (`bases`, None: `building`): `model.start.free_response`."""
+        return [free_response(w.case, base or building, air_nodes) for w, base in zip(self.each, bases)]
+
+    def start_fitted(self, residual, starts, sigma, record, without=None):
+        """The amplitudes (m,) K of `record`'s start, and their covariance, fitted to its
+        `residual` on the calibration window ((k, zones) C, NaN where not scored), the rows of
+        the block `without` (a mask of the window's steps) left out where given
+        (`model.start.fitted_start`, sigma the noise's sd, C)."""
+        F, modes = starts[record]
+        rows = np.isfinite(residual)
+        if without is not None:
+            rows &= ~without[:, None]
+        return fitted_start(F[:len(residual)][rows], residual[rows], modes.sd, sigma)
+
     def metrics(self, objective, runs, record=None):
         """{"calibration", "validation"}: the objective's metrics of `runs` (one (N_t, zones) per
         record) on every record's window together, or on `record`'s (an index) alone."""
@@ -152,9 +170,11 @@ class Windows:
                 for window, rows in (("calibration", lambda k: slice(None, k)),
                                      ("validation", lambda k: slice(k, None)))}
 
-    def block_J(self, runs):
+    def block_J(self, runs, starts=None, sigma=None):
         """J (C2) of `runs` on every block, the records' in order, each less the share of the
-        file's numerical error (`model.numerical.share`) the other blocks hold, as a candidate's
+        file's numerical error (`model.numerical.share`) the other blocks hold, and, where the
+        records' free responses `starts` (`Windows.starts`) are given, less the start its
+        record's other blocks fit (`start_fitted`, sigma the noise's sd, C), as a candidate's
         left-out block is scored (`diagnosis.calibrate`)."""
         residuals = [w.measured[:w.k] - run[:w.k] for w, run in zip(self.each, runs)]
         errors = self.calibration_numerical() or [np.zeros_like(r) for r in residuals]
@@ -162,7 +182,10 @@ class Windows:
         out = []
         for i, mask in self.blocks:
             s = share(r, e, ~np.concatenate([rows.ravel() for rows in on_block([a.shape for a in residuals], i, mask)]))
-            out.append(block_J(residuals[i] + s * errors[i], [mask])[0])
+            left = residuals[i] + s * errors[i]
+            if starts is not None:
+                left = left - starts[i][0][:len(left)] @ self.start_fitted(left, starts, sigma, i, mask)[0]
+            out.append(block_J(left, [mask])[0])
         return np.array(out)
 
     def sensor_scores(self, sensed, weights):

@@ -135,13 +135,14 @@ class Case:
             raise InputError(building.source, absent[0], "an input column the case was not prepared with")
         return replace(self, input_names=names, U=np.column_stack([columns[n] for n in names]), building=building)
 
-    def run(self, building, nodes=None, network=None, derivatives=()):
+    def run(self, building, nodes=None, network=None, derivatives=(), start_offset=None):
         """The temperatures (C) at t_1..t_N of the `nodes` of `building` (indices, default every
         node) on this case, with the direct model, as a diagnosis runs it: its burn-in, its
         steady start and its sub-steps. The case must carry the inputs `building` reads
         (`with_inputs`). `network`: the building's, where the caller has assembled it;
         `derivatives`: its `network.Derivative` with respect to each of k parameters, whose
-        derivatives (N_t, len(nodes), k) are returned too (`integrate.simulate`).
+        derivatives (N_t, len(nodes), k) are returned too (`integrate.simulate`); `start_offset`:
+        (N,) K added to the state at the history's start (`integrate.Plan.run`, `model.start`).
 
         The run's `integrate.Plan` is kept for its layout (its nodes, its inputs and which are
         held): a calibration runs one building's network at hundreds of values."""
@@ -155,7 +156,7 @@ class Case:
                                            substeps=self.substeps, history_steps=self.history_steps)
             while len(self._plans) > self.PLANS:
                 self._plans.pop(next(iter(self._plans)))
-        return plan.run(building, network, nodes, derivatives)
+        return plan.run(building, network, nodes, derivatives, start_offset=start_offset)
 
     def window(self, start, stop):
         """The sub-case on rows start..stop (inclusive), t_start becoming its t_0; the burn-in

@@ -601,9 +601,10 @@ class Plan:
         self.rows, self.kept = H + ks - start + 1, (ks + 1) * substeps - 1
 
     def run(self, building, network, outputs=None, derivatives=(), include_start=False, stepper=None,
-            steady_stepper=None, history_stepper=None):
+            steady_stepper=None, history_stepper=None, start_offset=None):
         """`simulate` of `building`'s `network`, of the layout the plan was made for (its nodes and
-        inputs)."""
+        inputs); `start_offset` (N,) K, where given, is added to the state after the steady start,
+        before the history (or the warm-up): the start the record's fit finds (`model.start`)."""
         if (network.n_nodes, tuple(network.input_names)) != self.layout:
             raise ValueError("a network of another layout than its plan's")
         n, dt, H = network.n_nodes, self.dt, self.history_steps
@@ -619,6 +620,8 @@ class Plan:
             if derivatives:
                 _, S = sensitivity_steps(steady_stepper, network, derivatives, S, before[None], T[None], u[None],
                                          sources.terms, held, switched, [], [])
+        if start_offset is not None:
+            T = T + start_offset
         out = np.empty((self.n_rows, len(outputs)))
         out[0] = T[outputs]
         d_out = np.empty((self.n_rows, len(outputs), len(derivatives)))

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from nodeforce.diagnosis.policy import Policy
-from nodeforce.diagnosis.result import Baseline, CrossValidation, Fit, OwnSensors, SensorEvidence, added_effects, last_change
+from nodeforce.diagnosis.result import (Baseline, CrossValidation, Decision, Fit, OwnSensors, SensorEvidence,
+                                        added_effects, last_change)
 from nodeforce.diagnosis.selection import blocks, decide, revisited
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.errors import InputError
@@ -153,9 +154,9 @@ def candidate(effect, target, parameters, days):
     return Fit(effect, target, parameters, {}, POLICY.facts(CELL, effect, target), CrossValidation(list(days), N))
 
 
-def choose(results, base, sigma, n, **options):
+def choose(results, base, sigma, n, policy=POLICY, **options):
     """The round's (chosen fit, `Decision`)."""
-    decision = decide(results, Baseline(base, sigma, n, **options), POLICY)
+    decision = decide(results, Baseline(base, sigma, n, **options), policy)
     return decision.chosen, decision
 
 
@@ -421,6 +422,85 @@ def test_a_round_run_for_a_component_s_own_sensors_takes_no_effect_on_the_air_al
     assert decision.chosen is None and "own sensors" in decision.reason
     mends = with_own(door(BASE), [N * 0.25] * 4, [N * SIGMA ** 2] * 4)
     assert choose([wall, mends], BASE, SIGMA, N, air_at_noise=True)[0].target == "door"
+
+
+# --- the start as a candidate (`selection.start_test`): the model's J on each left-out day with
+# the records' start fitted on the other days, beside the candidates; chosen where the policy
+# prefers it (`Policy.prefer_start`)
+
+STARTING = Policy(prefer_start=True)
+
+def test_the_start_claims_nothing_and_wins_the_tie_with_an_effect():
+    """A start that predicts the left-out days as well as a door, or worse by less than what the
+    noise alone could make of J (3 x 0.01 x sqrt(384) = 0.59 C2: 0.4 C2 here, alike every day),
+    is chosen in its place where the policy prefers the start: no effect is added, and the
+    reason says why in its numbers."""
+    physical = door([2.0, 2.4, 1.9, 2.3])
+    for start in ([2.1, 2.3, 2.0, 2.2], [2.1, 2.5, 2.0, 2.4]):
+        chosen, decision = choose([physical], BASE, SIGMA, N, STARTING, start=start)
+        assert chosen is None and decision.starts and not decision.changes_model, decision.reason
+        assert decision.start["against"] == "conductivity@door"
+        assert decision.start["ahead"] == pytest.approx(sum(start) - 8.6)
+        assert decision.start["band"] == pytest.approx(3 * SIGMA ** 2 * np.sqrt(2 * N))
+        assert "no effect is added" in decision.reason and f"from {40.0:.3g} to {sum(start):.3g} C2" in decision.reason
+        assert (f"the best admissible candidate's, conductivity on door, is {abs(decision.start['ahead']):.3g} C2 "
+                f"{'below' if decision.start['ahead'] >= 0 else 'above'} it on the air (1 of 1 candidates pass), "
+                f"within the {3 * SIGMA ** 2 * np.sqrt(2 * N):.3g} C2") in decision.reason
+        assert added_effects([decision]) == []
+
+
+def test_by_default_the_start_is_said_beside_the_effect_it_cannot_be_told_from():
+    """Under the default policy the same door is chosen, as without the start, and the reason
+    says, in the numbers report.json holds, that the start predicts the days as well."""
+    physical = door([2.0, 2.4, 1.9, 2.3])
+    chosen, decision = choose([physical], BASE, SIGMA, N, start=[2.1, 2.5, 2.0, 2.4])
+    alone = choose([physical], BASE, SIGMA, N)[1]
+    assert chosen is physical and decision.start["within"] and not decision.starts
+    assert decision.reason.startswith(alone.reason[:-1]) and decision.reason != alone.reason
+    start = decision.start
+    assert (f"lowers the cross-validated J to {9.0:.3g} C2, and the best admissible candidate's, conductivity on "
+            f"door, is {start['ahead']:.3g} C2 below it on the air, within the {start['band']:.3g} C2") in decision.reason
+    assert start["ahead"] == pytest.approx(0.4)
+
+
+def test_an_effect_the_data_tell_from_the_start_is_chosen_as_without_it():
+    """A door that predicts every left-out day 1 C2 better than the start (4 C2 in all, beyond
+    the 0.59 C2 band) is chosen; the start passes, but is not chosen, and the reason is the one
+    the round gives without the start."""
+    physical = door([2.0, 2.2, 2.1, 2.3])
+    chosen, decision = choose([physical], BASE, SIGMA, N, STARTING, start=[3.0, 3.2, 3.1, 3.3])
+    assert chosen is physical and decision.start["passes"] and not decision.start["within"]
+    assert decision.start["ahead"] == pytest.approx(4.0)
+    alone = choose([physical], BASE, SIGMA, N)[1]
+    assert decision.reason == alone.reason and alone.start is None
+
+
+def test_a_start_must_pass_as_a_candidate_passes():
+    """A start whose fall (0.4 C2, alike every day) the noise alone could make does not pass and
+    leaves the door chosen; one that passes where no candidate is admitted (a heat sink physics
+    refuses) is chosen; a start whose fall comes from one day does not pass."""
+    chosen, decision = choose([door([2.0, 2.2, 2.1, 2.3])], BASE, SIGMA, N, STARTING, start=[9.9, 9.9, 9.9, 9.9])
+    assert chosen.effect == "conductivity" and not decision.start["passes"]
+    sink = candidate("internal_gain", "cell", {"Q": parameter(-545.0, 16.0)}, [1.0, 1.0, 1.0, 1.0])
+    chosen, decision = choose([sink], BASE, SIGMA, N, STARTING, start=[3.0, 3.0, 3.0, 3.0])
+    assert chosen is None and decision.starts and "against" not in decision.start
+    chosen, decision = choose([sink], BASE, SIGMA, N, STARTING, start=[1.0, 10.0, 10.0, 10.0])
+    assert not decision.starts and decision.start["other_days"] <= 0
+
+
+def test_the_start_s_test_is_kept_and_replayed_from_report_json():
+    """The decision with the start as a candidate keeps its per-block J among what the choice
+    read (`inputs`), so that report.json replays it; a round without the start writes nothing of
+    it (a record whose history set every slow mode)."""
+    _, decision = choose([door([2.0, 2.4, 1.9, 2.3])], BASE, SIGMA, N, STARTING, start=[2.1, 2.3, 2.0, 2.2])
+    written = json.loads(json.dumps(decision.to_json()))
+    assert written["start"]["chosen"] and written["inputs"]["start"] == [2.1, 2.3, 2.0, 2.2]
+    read = Decision.of_json(written, None)
+    assert read.starts and Baseline.of_json(read.inputs).start == [2.1, 2.3, 2.0, 2.2]
+    replayed = decide([door([2.0, 2.4, 1.9, 2.3])], Baseline.of_json(read.inputs), STARTING)
+    assert replayed.starts and replayed.reason == decision.reason
+    without = choose([door([2.0, 2.4, 1.9, 2.3])], BASE, SIGMA, N)[1].to_json()
+    assert "start" not in without and "start" not in without["inputs"]
 
 
 def test_a_choice_revisited_takes_the_place_of_the_one_it_replaces_and_the_others_their_refitted_values():

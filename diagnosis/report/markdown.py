@@ -42,10 +42,28 @@ def decision_lines(report):
                      f"{fmt_sig(r.get('standard_errors'), 3)} standard error of its fall from day to day, on more "
                      f"days than its best (the fall needed, per candidate, in the candidates table); {cost.get('candidates', NA)} candidates, "
                      f"{cost.get('simulations', NA)} simulations, {cost.get('seconds', NA)} s; "
-                     f"chosen: {r.get('chosen') or 'none'}"
-                     + (f"; removed: {r['removed']}" if r.get("removed") else ""))
+                     f"chosen: {r.get('chosen') or ('the start' if (r.get('start') or {}).get('chosen') else 'none')}"
+                     + (f"; removed: {r['removed']}" if r.get("removed") else "") + start_clause(r.get("start")))
     lines.append(f"- chosen: {d.get('chosen') or 'none'}")
     return lines
+
+
+def start_clause(start):
+    """What a round's test of the start (report.json's round `start`) found: its cross-validated
+    J, and on each record, fitted to the round's model on the calibration window, each mode's
+    amplitude at the first measurement with its sd and its prior's, and its share of the
+    window's J; "" where the start was no candidate."""
+    if not start:
+        return ""
+    found = "; ".join(
+        f"{r['record']}: " + ", ".join(f"its {tau:.3g}-day mode {a:+.3g} ± {sd:.2g} K (prior sd {prior:.2g} K)"
+                                       for tau, a, sd, prior in zip(r["tau_days"], r["amplitude"], r["sd"],
+                                                                    r["prior_sd"]))
+        + f", {r['share_of_J']:.0%} of the window's J" for r in start.get("records", ()))
+    verdict = ("chosen" if start["chosen"] else "not told from the best admissible effect" if start.get("within")
+               else "passes, told from the best admissible effect" if start["passes"] else "does not pass")
+    return (f"; the start as a candidate: cross-validated J {fmt_sig(start['cv_J'])} C², {verdict}"
+            + (f" ({found})" if found else ""))
 
 
 def localization_lines(report):
