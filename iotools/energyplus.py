@@ -1600,10 +1600,13 @@ class _Converter:
                         face["face_class"] = "wall"
                 if glass is not None:
                     c["solar_transmittance"] = round(glass["tau"], 6)
-                    if (glass.get("gaps") and w_outside["type"] == "exterior" and height
-                            and all(g["gas"] is not None for g in glass["gaps"])):
-                        # EnergyPlus solves a layered window's panes at every step (WindowManager.cc)
-                        c["window"] = {"height": round(height, 6), "gaps": glass["gaps"]}
+                    if w_outside["type"] == "exterior" and height:
+                        # under TARP EnergyPlus takes every window's inside face by ISO 15099, a
+                        # simple glazing system's too (ConvectionCoefficients.cc: TypeIsWindow), and
+                        # solves a layered window's panes at every step (WindowManager.cc)
+                        c["window"] = {"height": round(height, 6)}
+                        if glass.get("gaps") and all(g["gas"] is not None for g in glass["gaps"]):
+                            c["window"]["gaps"] = glass["gaps"]
                     c["transmitted_solar_to"] = None  # set once every component is known (`receivers`)
                     if "exterior" == w_outside["type"]:
                         c["angular_transmittance"] = glass["angular"]
