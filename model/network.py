@@ -645,6 +645,21 @@ def face_heat_flux(building, network, T, U, component, face):
     return (net - within) / c.area
 
 
+def capacity_reduced(network, nodes):
+    """(c, a, K, follow) of the nodes `nodes` (0-based) with every other node and every input
+    held: those with capacity `c` and those without `a` (indices), the conductances among `c`
+    with `a` eliminated, K = K_cc - K_ca K_aa^-1 K_ac (W/K, K = -A), and how `a` follow `c` at
+    once, T_a = follow T_c, follow = -K_aa^-1 K_ac."""
+    has = network.C[nodes] > 0.0
+    c, a = nodes[has], nodes[~has]
+    K = -network.A[np.ix_(c, c)]
+    follow = np.zeros((0, len(c)))
+    if len(a):
+        follow = -np.linalg.solve(network.A[np.ix_(a, a)], network.A[np.ix_(a, c)])
+        K = K - network.A[np.ix_(c, a)] @ follow
+    return c, a, K, follow
+
+
 def slowest_time_constant(network, nodes=None):
     """The slowest time constant (s) of the nodes `nodes` (0-based, each once however often it is
     listed; default every node) with every other node and every input held: the time in which an
@@ -658,13 +673,9 @@ def slowest_time_constant(network, nodes=None):
     eliminated, K_cc - K_ca K_aa^-1 K_ac; computed as the symmetric C^-1/2 K C^-1/2 where K is
     symmetric (conduction; an air flow from zone to zone is not)."""
     nodes = np.arange(network.n_nodes) if nodes is None else np.asarray(list(dict.fromkeys(nodes)), dtype=int)
-    has = network.C[nodes] > 0.0
-    c, a = nodes[has], nodes[~has]
+    c, _, K, _ = capacity_reduced(network, nodes)
     if len(c) == 0:
         return 0.0
-    K = -network.A[np.ix_(c, c)]
-    if len(a):
-        K = K + network.A[np.ix_(c, a)] @ np.linalg.solve(network.A[np.ix_(a, a)], network.A[np.ix_(a, c)])
     root = np.sqrt(network.C[c])
     scaled = K / np.outer(root, root)
     rates = np.linalg.eigvalsh(scaled) if np.allclose(scaled, scaled.T) else np.linalg.eigvals(scaled).real

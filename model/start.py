@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .network import assemble
+from .network import assemble, capacity_reduced
 
 # The modes whose start is fitted are those slower than a day (s): the burn-in's day of forcing,
 # and the record's first hours, set the faster ones (the test cell's next after its floor's 14.7
@@ -68,13 +68,9 @@ class SlowModes:
 def modes(network):
     """Every mode of `network` with every input held: the time constants (n_c,) s, slowest
     first, of C dT/dt = -K T on the nodes with capacity, the nodes without it eliminated
-    (K_cc - K_ca K_aa^-1 K_ac, as `network.slowest_time_constant`), which follow at once,
+    (`network.capacity_reduced`, as `network.slowest_time_constant`), which follow at once,
     T_a = -K_aa^-1 K_ac T_c; and the shapes (N, n_c), K per K, each 1 at its largest node."""
-    has = network.C > 0.0
-    c, a = np.flatnonzero(has), np.flatnonzero(~has)
-    K = -network.A[np.ix_(c, c)]
-    follow = -np.linalg.solve(network.A[np.ix_(a, a)], network.A[np.ix_(a, c)]) if len(a) else np.zeros((0, len(c)))
-    K = K - network.A[np.ix_(c, a)] @ follow
+    c, a, K, follow = capacity_reduced(network, np.arange(network.n_nodes))
     root = np.sqrt(network.C[c])
     scaled = K / np.outer(root, root)
     if np.allclose(scaled, scaled.T):
