@@ -77,6 +77,8 @@ def _sides(absorbed):
     n = len(absorbed)
     middle = absorbed[n // 2] / 2 if n % 2 else 0.0
     return float(sum(absorbed[:n // 2]) + middle), float(sum(absorbed[(n + 1) // 2:]) + middle)
+
+
 # An air flow's temperature term is taken at this indoor-outdoor difference, its wind terms at the
 # zone's wind (FILMS.wind at the station, at the height of the zone's surfaces' centroids)
 AIRFLOW_DELTA_T = 10.0  # K
@@ -931,9 +933,11 @@ class _Converter:
         alpha, inner_alpha = _sides(glazing.pane_absorptances(pairs))
         # as EnergyPlus absorbs the direct sun in each pane at its angle and the diffuse at the
         # panes' hemispherical absorptance
-        at_angles = np.array([_sides(row) for row in glazing.angular_pane_absorptances(pairs, glazing.ANGLES)])
-        hemispherical = [glazing.hemispherical(lambda a, k=k: np.array(
-            [_sides(row)[k] for row in glazing.angular_pane_absorptances(pairs, a)])) for k in (0, 1)]
+        def sides_at(angles):
+            """(2, len(angles)): the outer and the inner panes' absorptance of the direct sun."""
+            return np.array([_sides(row) for row in glazing.angular_pane_absorptances(pairs, angles)]).T
+
+        at_angles, hemispherical = sides_at(glazing.ANGLES).T, glazing.hemispherical(sides_at)
         absorptance = {"angles": list(glazing.ANGLES)}
         for k, side in enumerate(("outside", "inside")):
             normal = (alpha, inner_alpha)[k]

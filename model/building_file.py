@@ -21,9 +21,9 @@ from importlib.resources import files
 
 import numpy as np
 
-from .building import (DAY_TERMS, Adiabatic, AngularAbsorptance, AngularTransmittance, Boundary, Building, Component, Exterior, Gain,
-                       Inflow, Lumped, Material, OutsideConvection, ShadingSurface, Supply, Surface, Ventilation,
-                       Window, WindowGap, Zone, boundary_columns, json_copy)
+from .building import (DAY_TERMS, Adiabatic, AngularAbsorptance, AngularTransmittance, Boundary, Building, Component,
+                       Exterior, Gain, Inflow, Lumped, Material, OutsideConvection, ShadingSurface, Supply, Surface,
+                       Ventilation, Window, WindowGap, Zone, boundary_columns, json_copy)
 from . import geometry
 from .discretise import generated_depths
 from .errors import InputError

@@ -104,9 +104,11 @@ def stack_reflectance(panes):
 
 def hemispherical(transmittance, n=91):
     """The diffuse (hemispherical) mean of an angular transmittance function f(angle deg),
-    2 integral_0^(pi/2) f(theta) cos theta sin theta d theta, by the trapezoid rule on n angles."""
+    2 integral_0^(pi/2) f(theta) cos theta sin theta d theta, by the trapezoid rule on n angles;
+    of several functions at once where f returns (k, n) values: their k means."""
     theta = np.linspace(0.0, np.pi / 2, n)
-    return float(np.trapezoid(2 * np.asarray(transmittance(np.degrees(theta))) * np.cos(theta) * np.sin(theta), theta))
+    mean = np.trapezoid(2 * np.asarray(transmittance(np.degrees(theta))) * np.cos(theta) * np.sin(theta), theta)
+    return float(mean) if np.ndim(mean) == 0 else mean
 
 
 def radiative_conductance(emissivity_1, emissivity_2, T_mean=283.15):
@@ -411,4 +413,3 @@ def angular_pane_absorptances(panes, angles):
         else:
             rows.append(pane_absorptances([tuple(float(x) for x in pane_at(T0, R0, angle)) for T0, R0 in panes]))
     return np.array(rows)
-
