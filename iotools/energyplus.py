@@ -566,8 +566,9 @@ class _Converter:
                 "altitude": altitude, "timezone": tz, "air_density": round(air_density_at(altitude), 5),
                 # EnergyPlus carries infiltration and ventilation at the outdoor air's density
                 "flow_density": "outdoor",
-                # its anisotropic sky (SolarShading.cc, AnisoSkyViewFactors), whatever the IDF says
-                "sky_diffuse": "energyplus"}
+                # its anisotropic sky (SolarShading.cc, AnisoSkyViewFactors) and its sun's daily
+                # series (WeatherManager.cc, CalculateDailySolarCoeffs), whatever the IDF says
+                "sky_diffuse": "energyplus", "solar_position": "energyplus"}
         # the deep ground's months average to the temperature a diagnosis holds a ground
         # coupling's at where the data fix its flux only (docs/model.md section 7, Priors)
         deep = self.r.all("Site:GroundTemperature:Deep")

@@ -302,7 +302,7 @@ class Component:
 class Building:
     name: str
     # latitude, longitude (deg), altitude (m), timezone, ground_albedo; if declared, ground_temperature (C), sky_diffuse,
-    # flow_density
+    # flow_density, solar_position
     site: dict
     zones: tuple
     components: tuple

@@ -173,7 +173,7 @@ def parse_checked(data, source="<building>"):
             "air_density": float(site.get("air_density", schema_default("site", "air_density")))}
     if "ground_temperature" in data["site"]:
         site["ground_temperature"] = float(data["site"]["ground_temperature"])
-    for field in ("sky_diffuse", "flow_density"):
+    for field in ("sky_diffuse", "flow_density", "solar_position"):
         if field in data["site"]:
             site[field] = data["site"][field]
     schedules = {name: _schedule(check, name, s, f"schedules.{name}") for name, s in data.get("schedules", {}).items()}

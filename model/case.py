@@ -24,7 +24,7 @@ from .network import (WIND_DIRECTION, WIND_SPEED, assemble, clock_input_names, d
 from .units import check_celsius
 from .geometry import outward_normal
 from .shading import sky_diffuse_ratio, sun_vectors, sunlit_fraction
-from .site import run_building
+from .site import run_building, standard_offset
 from .solar import (DECOMPOSITIONS, complete_irradiance, incident_irradiance, measured_irradiance, sky_temperature,
                     solar_position, transmitted_irradiance, transmitted_split)
 from .weather import IRRADIANCE_COLUMNS, check_columns, weather_on_grid
@@ -360,7 +360,9 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
                                             f"that face (I_{computed[0].name}, or a column its outside names)")
         if decomposition not in DECOMPOSITIONS:
             raise InputError("--decomposition", decomposition, f"one of pvlib's {', '.join(DECOMPOSITIONS)}")
-        position = solar_position(times, site["latitude"], site["longitude"], site["altitude"])
+        sun = site.get("solar_position", "spa")
+        offset = standard_offset(site["timezone"], times[0], building.source) if sun == "energyplus" else None
+        position = solar_position(times, site["latitude"], site["longitude"], site["altitude"], sun, offset)
         ghi, dni, dhi, said = complete_irradiance(position, **given, decomposition=decomposition)
         if said:
             assumptions.append(f"The weather {source} lacks {', '.join(n for n in IRRADIANCE_COLUMNS if n not in given)}: "

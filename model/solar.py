@@ -73,7 +73,7 @@ def measured_irradiance(component, columns):
     return name if name in columns else None
 
 
-def solar_position(times, latitude, longitude, altitude):
+def solar_position(times, latitude, longitude, altitude, model="spa", utc_offset=None):
     """Sun position at each sample time, to be shared by all surfaces of a building.
 
     Parameters
@@ -85,23 +85,31 @@ def solar_position(times, latitude, longitude, altitude):
         Site, degrees (north and east positive).
     altitude : float
         Site altitude, m.
+    model : str
+        One of `SUN_MODELS`: "spa", pvlib's `get_solarposition` (NREL's SPA, the apparent zenith
+        refracted); "energyplus", EnergyPlus's own daily series (`energyplus_sun`).
+    utc_offset : float
+        The site's standard time less UTC, h: the meridian EnergyPlus's hour angle counts from
+        (needed by "energyplus" only).
 
     Returns
     -------
     pandas.DataFrame
-        pvlib's `get_solarposition(times, latitude, longitude, altitude)`, indexed by `times`; the
-        columns used here are `apparent_zenith` and `azimuth`, degrees (azimuth clockwise from
-        north). A copy: the caller may change it.
+        Indexed by `times`, pvlib's columns; those used here are `zenith`, `apparent_zenith` and
+        `azimuth`, degrees (azimuth clockwise from north). A copy: the caller may change it.
     """
     # pvlib's SPA costs some 10 us a time: a record prepared for the building as written and as
     # corrected, or a synthetic truth run at several fault sizes, asks for the same grid again
-    key = (times.asi8.tobytes(), str(times.tz), float(latitude), float(longitude), float(altitude))
+    key = (times.asi8.tobytes(), str(times.tz), float(latitude), float(longitude), float(altitude), model, utc_offset)
     with _KEPT_LOCK:  # a Dask worker runs tasks in threads
         position = _POSITIONS.get(key)
         if position is not None:
             _POSITIONS.move_to_end(key)
     if position is None:
-        position = pvlib.solarposition.get_solarposition(times, latitude, longitude, altitude)
+        if model == "energyplus":
+            position = energyplus_sun(times, latitude, longitude, utc_offset)
+        else:
+            position = pvlib.solarposition.get_solarposition(times, latitude, longitude, altitude)
         with _KEPT_LOCK:
             _POSITIONS[key] = position
             while len(_POSITIONS) > POSITIONS_KEPT:
@@ -109,6 +117,57 @@ def solar_position(times, latitude, longitude, altitude):
     position = position.copy()
     position.index = times
     return position
+
+
+#: How a site may place the sun (`site.solar_position`): NREL's SPA through pvlib, or EnergyPlus's series.
+SUN_MODELS = ("spa", "energyplus")
+
+#: EnergyPlus's Fourier series in X = 2 pi d / 366 of the day of the year d, each day's sine of the
+#: sun's declination (-) and equation of time (h), coefficients in the order of `_day_series`
+#: (WeatherManager.cc CalculateDailySolarCoeffs, SolarShading.cc SUN3; Engineering Reference,
+#: "Solar Position"; fitted at USACERL to Threlkeld's tables).
+ENERGYPLUS_SINE_DECLINATION = (0.00561800, 0.0657911, -0.392779, 0.00064440, -0.00618495, -0.00010101,
+                               -0.00007951, -0.00011691, 0.00002096)
+ENERGYPLUS_EQUATION_OF_TIME = (0.00021971, -0.122649, 0.00762856, -0.156308, -0.0530028, -0.00388702,
+                               -0.00123978, -0.00270502, -0.00167992)
+
+
+def _day_series(coefficients, x):
+    """sum_k c_k f_k(x) over 1, sin x, cos x, sin 2x, cos 2x, sin 3x, cos 3x, sin 4x, cos 4x, the
+    order of EnergyPlus's coefficients (x in rad)."""
+    harmonics = (np.ones_like(x), np.sin(x), np.cos(x), np.sin(2 * x), np.cos(2 * x), np.sin(3 * x), np.cos(3 * x),
+                 np.sin(4 * x), np.cos(4 * x))
+    return sum(c * f for c, f in zip(coefficients, harmonics))
+
+
+def energyplus_sun(times, latitude, longitude, utc_offset):
+    """The sun as EnergyPlus places it (docs/model.md section 4, "Sun position"): each day's
+    declination and equation of time from its Fourier series of the day of the year
+    (`ENERGYPLUS_SINE_DECLINATION`, `ENERGYPLUS_EQUATION_OF_TIME`), held over the day, and the
+    hour angle of each time's local standard clock t (h since the day's midnight; a time at
+    midnight ends the day before, as EnergyPlus stamps it 24:00),
+
+        H = 15 (12 - (t + EoT)) + (15 utc_offset - longitude)        (deg, + before noon)
+
+    no refraction. `times` tz-aware, `latitude` and `longitude` deg (north, east), `utc_offset`
+    h. A DataFrame indexed by `times` with pvlib's columns (deg; the equation of time in min)."""
+    clock = times.tz_convert("UTC").tz_localize(None) + pd.Timedelta(hours=utc_offset)
+    day = clock - pd.Timedelta(1, "ns")
+    x = 2.0 * np.pi / 366.0 * day.day_of_year.to_numpy(float)
+    hours = (clock - day.normalize()).total_seconds().to_numpy() / 3600.0
+    sin_d = _day_series(ENERGYPLUS_SINE_DECLINATION, x)
+    cos_d = np.sqrt(1.0 - sin_d ** 2)
+    equation = _day_series(ENERGYPLUS_EQUATION_OF_TIME, x)
+    hour_angle = np.radians(15.0 * (12.0 - (hours + equation)) + (15.0 * utc_offset - longitude))
+    phi = np.radians(latitude)
+    up = sin_d * np.sin(phi) + cos_d * np.cos(phi) * np.cos(hour_angle)
+    east = cos_d * np.sin(hour_angle)
+    north = sin_d * np.cos(phi) - cos_d * np.sin(phi) * np.cos(hour_angle)
+    elevation = np.degrees(np.arcsin(np.clip(up, -1.0, 1.0)))
+    return pd.DataFrame({"apparent_zenith": 90.0 - elevation, "zenith": 90.0 - elevation,
+                         "apparent_elevation": elevation, "elevation": elevation,
+                         "azimuth": np.degrees(np.arctan2(east, north)) % 360.0,
+                         "equation_of_time": 60.0 * equation}, index=times)
 
 
 #: How many time grids' sun positions `solar_position` keeps (the least recently asked dropped).

@@ -5,8 +5,8 @@ import pandas as pd
 import pvlib
 import pytest
 
-from nodeforce.model.solar import (energyplus_sky, incident_irradiance, sky_temperature, solar_position,
-                                   transmitted_irradiance)
+from nodeforce.model.solar import (energyplus_sky, energyplus_sun, incident_irradiance, sky_temperature,
+                                   solar_position, transmitted_irradiance)
 
 SIGMA = 5.670374419e-8
 
@@ -101,6 +101,44 @@ def test_a_grid_asked_again_gets_pvlibs_positions_as_its_own_copy():
     assert np.abs(south["apparent_zenith"] - direct["apparent_zenith"]).max() > 10.0
     later = solar_position(times + pd.Timedelta(hours=6), 25.8, -80.3, 2.0)
     assert np.array_equal(later["azimuth"].to_numpy()[:72], direct["azimuth"].to_numpy()[24:])
+
+
+# EnergyPlus 25.2.0's own "Site Solar Altitude Angle" and "Site Solar Azimuth Angle" (deg) at these
+# 10-min steps' ends, local standard time, of a 2017 run on the Denver-Aurora-Buckley TMY3 EPW that
+# pyenergyplus-lbnl 26.1.0 ships (its LOCATION: 39.72 N, 104.75 W, UTC-7), 6 steps an hour
+ENERGYPLUS_DENVER_SUN = [("2017-01-15 09:00", 14.866080, 135.109521), ("2017-03-21 12:00", 50.210615, 177.458042),
+                         ("2017-04-20 07:10", 20.950322, 92.651633), ("2017-06-21 16:00", 37.445355, 270.877224),
+                         ("2017-08-05 18:30", 6.242534, 287.174183), ("2017-09-22 10:00", 43.297915, 139.826776),
+                         ("2017-11-03 13:20", 30.920856, 207.670284), ("2017-12-21 12:00", 26.794632, 180.885433)]
+
+
+def test_energyplus_sun_is_energypluss_own():
+    times = pd.DatetimeIndex([t for t, _, _ in ENERGYPLUS_DENVER_SUN]).tz_localize("Etc/GMT+7")
+    sun = solar_position(times, 39.72, -104.75, 1726.0, "energyplus", -7.0)
+    assert sun["elevation"].to_numpy() == pytest.approx([a for _, a, _ in ENERGYPLUS_DENVER_SUN], abs=1e-4)
+    assert sun["azimuth"].to_numpy() == pytest.approx([z for _, _, z in ENERGYPLUS_DENVER_SUN], abs=1e-4)
+    assert np.array_equal(sun["apparent_zenith"], 90.0 - sun["elevation"])  # no refraction
+    # the same instants on another clock: the position is the instant's, not the clock's
+    again = energyplus_sun(times.tz_convert("UTC"), 39.72, -104.75, -7.0)
+    assert np.array_equal(again.to_numpy(), sun.to_numpy())
+
+
+@pytest.mark.parametrize("latitude, longitude, offset", [(52.0, 13.4, 1.0), (-33.9, 18.4, 2.0), (1.3, 103.8, 8.0)])
+def test_energyplus_sun_is_spa_to_half_a_degree(latitude, longitude, offset):
+    # each day's declination held from the day's start (it moves up to 0.4 deg a day) and the
+    # series' fit put EnergyPlus's sun within half a degree of NREL's SPA (its true, unrefracted
+    # zenith), the sun's direction within that too, over a year
+    times = pd.date_range("2019-01-01 00:30", periods=8760, freq="h", tz="UTC")
+    ours = energyplus_sun(times, latitude, longitude, offset)
+    spa = pvlib.solarposition.get_solarposition(times, latitude, longitude, 0.0)
+    up = spa["elevation"].to_numpy() > 2.0
+    assert np.abs(ours["zenith"].to_numpy() - spa["zenith"].to_numpy())[up].max() < 0.5
+
+    def vector(frame):
+        z, a = np.radians(frame["zenith"].to_numpy()), np.radians(frame["azimuth"].to_numpy())
+        return np.stack([np.sin(z) * np.sin(a), np.sin(z) * np.cos(a), np.cos(z)])
+    cosine = np.sum(vector(ours) * vector(spa), axis=0)[up]
+    assert np.degrees(np.arccos(np.clip(cosine, -1, 1))).max() < 0.5
 
 
 def test_energyplus_sky_by_hand():
