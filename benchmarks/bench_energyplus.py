@@ -66,6 +66,7 @@ PACKAGE_WEATHER = Path("data") / "weather" / "USA_CO_Denver-Aurora-Buckley.AFB.7
 YEAR = 2017
 STEPS = 6  # time steps an hour, both programs: EnergyPlus reports each 10-min step
 SUN_UPDATE_DAYS = 1  # EnergyPlus's sun position and shading recomputed every day
+EVERY_STEP = {variable: "Timestep" for variable in (ZONE_AIR, FACE, *OUTSIDE)}
 # The run's own objects, replaced; HVAC and thermostats go too: both programs run free-floating
 DROP = ("Version", "ShadowCalculation", "RunPeriod", "SimulationControl", "Sizing", "Output", "OutputControl",
         "LifeCycleCost", "ZoneHVAC", "ZoneControl", "ThermostatSetpoint", "NodeList", "OutdoorAir:Node")
@@ -78,10 +79,10 @@ RENAMED = {"zone_or_zonelist_name": "zone_or_zonelist_or_space_or_spacelist_name
            "zone_floor_area_per_person": "floor_area_per_person"}
 
 
-def free_year(doc, frequency):
-    """Add to `doc` a free-floating year, run on the weather file alone, that reports the zones'
-    mean air, the faces' inside temperatures and their outside terms (`OUTSIDE`) at `frequency`
-    ("Hourly", "Timestep")."""
+def free_year(doc, outputs):
+    """Add to `doc` a free-floating year, run on the weather file alone, that reports each
+    variable of `outputs` {variable: frequency ("Hourly", "Timestep")}: `EVERY_STEP`, the zones'
+    mean air, the faces' inside temperatures and their outside terms at each step."""
     doc.add("RunPeriod", "year", {"begin_month": 1, "begin_day_of_month": 1, "begin_year": YEAR, "end_month": 12,
                                   "end_day_of_month": 31, "end_year": YEAR,
                                   "use_weather_file_holidays_and_special_days": "No",
@@ -95,7 +96,7 @@ def free_year(doc, frequency):
     # windows' sun by up to 16 W/m2 a day and the zone air's daily mean by up to 1.4 C
     doc.add("ShadowCalculation", "", {"shading_calculation_update_frequency_method": "Periodic",
                                       "shading_calculation_update_frequency": SUN_UPDATE_DAYS})
-    for variable in (ZONE_AIR, FACE, *OUTSIDE):
+    for variable, frequency in outputs.items():
         doc.add("Output:Variable", "", {"key_value": "*", "variable_name": variable, "reporting_frequency": frequency})
     return doc
 
@@ -123,7 +124,7 @@ def to_energyplus_25(doc):
             new.add(obj.obj_type, name, {RENAMED.get(k, k): v for k, v in fields.items()})
         except idfkit.exceptions.ValidationFailedError:
             new.add(obj.obj_type, name, fields)
-    return free_year(new, "Timestep")
+    return free_year(new, EVERY_STEP)
 
 
 def with_steps(doc, steps=STEPS):
@@ -303,7 +304,7 @@ def main(out, epw, only=None, figure_path=None, sky_diffuse=None):
         air, faces = read_outputs(folder, YEAR)
         ours = simulate_building(building, fine)
         # each program's hourly means of its own steps, and the state at each step's end
-        mine = hourly_means(ours.set_axis(ours.index.tz_localize(None), axis=0)).tz_localize(ours.index.tz)
+        mine = hourly_means(ours)
         new, unpaired = compare(name, building, doc, mine, (hourly_means(air), hourly_means(faces)), "0min", "hourly")
         fine_rows, _ = compare(name, building, doc, ours, (air, faces), "0min", "10 min")
         rows += new + fine_rows
