@@ -37,7 +37,7 @@ VARIABLES = Path(__file__).with_name("variables.py")
 MODEL_DIR = Path(model.__file__).parent
 # The modules the FMU imports; weather and solar stay outside (their results are inputs).
 PHYSICS_MODULES = ("__init__", "errors", "building", "building_file", "convection", "geometry", "discretise", "schedule",
-                   "effects", "glazing", "longwave", "network", "modal", "integrate")
+                   "effects", "gains", "glazing", "longwave", "network", "modal", "integrate")
 SCHEMA = "data/nodal-building.schema.json"
 
 

@@ -1497,13 +1497,15 @@ class _Converter:
         sensible = _field(o, "sensible_heat_fraction")
         gain = {"name": o.name, "radiant_fraction": self.r.number(o, "fraction_radiant", default=0.0, low=0, high=1)}
         if _blank(sensible) or str(sensible).lower() in ("autocalculate", "autosize"):
-            # EnergyPlus's polynomial in the activity and the zone's air, linearised about PEOPLE_T:
-            # free-floating zones run 26 to 35 C, where a person gives 90 to 35 W, not 70
-            gain["power"] = n * people_sensible_heat(activity)
+            # EnergyPlus's polynomial in the activity and the zone's air, followed at each step (it
+            # is 0 above some 36 C, where its line about PEOPLE_T would take heat out of a hot
+            # zone), its line about PEOPLE_T in the step matrix
+            gain["power"] = float(n * people_sensible_heat(activity))
             slope = n * people_sensible_slope(activity)
             if slope < 0:
                 gain.update(temperature_slope=slope, reference_temperature=PEOPLE_T)
-            self.note(f"a person's sensible heat EnergyPlus's polynomial linearised about {PEOPLE_T:g} C")
+            if n > 0:
+                gain["people"] = {"number": n, "activity": activity}
         else:
             gain["power"] = n * activity * self.r.number(o, "sensible_heat_fraction", low=0, high=1)
         self._gain_schedule(gain, o, "number_of_people_schedule_name")

@@ -109,6 +109,9 @@ class Gain:
     schedule: str | None = None  # None: always 1
     temperature_slope: float = 0.0  # W/K at a schedule value of 1, <= 0
     reference_temperature: float | None = None  # C, where the power is `power`; given with a slope
+    # (number, activity W a person): people whose sensible heat follows EnergyPlus's polynomial in
+    # the air at each step, the power and slope above its linear part in the step matrix
+    people: tuple | None = None
 
 
 @dataclass(frozen=True)
@@ -357,7 +360,8 @@ class Building:
                         if c.outside.convection is not None)
                 + tuple((f"component {c.name}", "outside.longwave") for c in self.exterior_components
                         if c.outside.longwave_emissivity is not None)
-                + tuple((f"component {c.name}", "window") for c in self.components if c.window is not None))
+                + tuple((f"component {c.name}", "window") for c in self.components if c.window is not None)
+                + tuple((f"zone {z.name}", f"gains {g.name}.people") for z in self.zones for g in z.gains if g.people))
 
     @property
     def input_columns(self):

@@ -310,11 +310,15 @@ def _gains(check, z, where, schedules):
             check.fail(f"{gw}.reference_temperature", "is required with a temperature_slope")
         if slope and schedule is not None and _negative(schedules[schedule]):
             check.fail(f"{gw}.schedule", f"{schedule!r} takes negative values: with a temperature_slope it is >= 0")
+        people = g.get("people")
+        if people is not None and schedule is not None and _negative(schedules[schedule]):
+            check.fail(f"{gw}.schedule", f"{schedule!r} takes negative values: a number of people is >= 0")
         gains.append(Gain(name=g["name"], power=float(g["power"]),
                           radiant_fraction=float(g.get("radiant_fraction",
                                                        schema_default("zone", "gains", "radiant_fraction"))),
                           schedule=schedule, temperature_slope=slope,
-                          reference_temperature=float(g["reference_temperature"]) if slope else None))
+                          reference_temperature=float(g["reference_temperature"]) if slope else None,
+                          people=None if people is None else (float(people["number"]), float(people["activity"]))))
     return tuple(gains)
 
 

@@ -1,4 +1,5 @@
 """Internal gains as EnergyPlus defines them (docs/model.md section 3.4)."""
+import numpy as np
 
 # EnergyPlus's sensible heat of a person (Engineering Reference, "People"), a polynomial of the
 # activity level M (W) and the zone's air temperature T (C), its coefficients in this order:
@@ -12,12 +13,13 @@ PEOPLE_T = 24.0
 
 def people_sensible_heat(activity, T=PEOPLE_T):
     """Sensible heat of one person (W) at an activity level (W) and an air temperature (C),
-    within 0 and the activity level, where EnergyPlus bounds it."""
+    within 0 and the activity level, where EnergyPlus bounds it (InternalHeatGains.cc); numpy
+    arrays alike."""
     c = PEOPLE_SENSIBLE
     M = activity
     heat = (c[0] + c[1] * M + c[2] * M ** 2 + T * (c[3] + c[4] * M + c[5] * M ** 2)
             + T ** 2 * (c[6] + c[7] * M + c[8] * M ** 2))
-    return min(max(heat, 0.0), M)
+    return np.minimum(np.maximum(heat, 0.0), M)
 
 
 def people_sensible_slope(activity, T=PEOPLE_T):

@@ -25,6 +25,7 @@ from .building import DAY_TERMS, Adiabatic, Boundary, Exterior, Surface
 from .building_file import gap_nodes, schema_default
 from .convection import doe2_faces, iso15099_inside, lagged_excess, tarp_inside_faces, windward_faces
 from .discretise import capacities, conductances
+from .gains import people_sensible_heat
 from .glazing import followed_gap_conductance, gap_coefficients
 from .longwave import T_MEAN, enclosure_exchange, exterior_coefficient, pair_coefficient
 
@@ -69,7 +70,11 @@ class Convection:
     whose air flows carry heat at the outdoor air's density: each flow from outdoors (air node,
     its schedule's input column or -1) (f, 2), g W/K at the site's air_density (f,),
     g s (293.15 / (T_out + 273.15) - 1) (T_out - T_air) on the air, s the schedule's value (1
-    without)."""
+    without). People whose sensible heat is followed (docs/model.md section 3.4): per target node
+    (target, air node, the schedule's input column or -1) (r, 3), (its share of the number n,
+    activity M W, its share of the power P W, the slope k W/K on the air's row (0 on a radiant
+    target's), T_ref C, the schedule's constant value) (r, 6), s (n S(M, T_air) - P - k (T_air -
+    T_ref)) on the target, S EnergyPlus's bounded polynomial (`gains.people_sensible_heat`)."""
     inside_nodes: np.ndarray
     inside: np.ndarray
     outside_nodes: np.ndarray
@@ -85,6 +90,8 @@ class Convection:
     pairs: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
     flow_nodes: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=int))
     flows: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    people_nodes: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), dtype=int))
+    people: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
 
     def source(self, T, u):
         """(N,) W of the temperatures T (N,) before the step (C) and the inputs u at its end."""
@@ -131,6 +138,12 @@ class Convection:
             share = np.where(column >= 0, u[np.maximum(column, 0)], 1.0)
             excess = lagged_excess(outdoor_density_ratio(t_out), 1.0)
             np.add.at(q, air, self.flows * share * excess * (t_out - T[air]))
+        if len(self.people):
+            target, air, column = self.people_nodes.T
+            number, activity, power, slope, reference, value = self.people.T
+            share = np.where(column >= 0, u[np.maximum(column, 0)], value)
+            sensible = number * people_sensible_heat(activity, T[air])
+            np.add.at(q, target, share * (sensible - power - slope * (T[air] - reference)))
         return q
 
 
@@ -394,7 +407,7 @@ def assemble(building, names=None):
     A = np.zeros((n, n))
     B = np.zeros((n, len(names)))
     q = np.zeros(n)
-    products, switched, inside, outside, longwave, windows, gaps, pairs, flows = [], [], [], [], [], [], [], [], []
+    products, switched, inside, outside, longwave, windows, gaps, pairs, flows, people = [], [], [], [], [], [], [], [], [], []
 
     def link(i, j, g):
         """A conductance g (W/K) between nodes i and j (0-based)."""
@@ -562,6 +575,16 @@ def assemble(building, names=None):
                     q[node] += part * gain.power * (1.0 if schedule is None else schedule.value)
                 else:
                     B[node, col[gain.schedule]] += part * gain.power
+            if gain.people:
+                # the followed sensible heat S(T_air) less the step matrix's linear part, on the air
+                # and the radiant targets in the gain's split (the slope's part on the air alone)
+                number, activity = gain.people
+                column = -1 if schedule is None or schedule.is_constant else col[gain.schedule]
+                value = 1.0 if schedule is None or not schedule.is_constant else schedule.value
+                for node, part, slope in ([(air, 1.0 - gain.radiant_fraction, gain.temperature_slope)]
+                                          + [(r, gain.radiant_fraction * w, 0.0) for r, w in radiant]):
+                    people.append(((node, air, column), (part * number, activity, part * gain.power, slope,
+                                                         gain.reference_temperature or 0.0, value)))
             if gain.temperature_slope:
                 # s(t) k (T_air - T_ref), k <= 0: a conductance -k s(t) to T_ref, switched where s varies
                 g = -gain.temperature_slope
@@ -595,7 +618,7 @@ def assemble(building, names=None):
                 for r, w in radiant:
                     B[r, col[name]] += gain * f_r * w
     convection = None
-    if inside or outside or longwave or windows or gaps or pairs or flows:
+    if inside or outside or longwave or windows or gaps or pairs or flows or people:
         convection = Convection(
             inside_nodes=np.array([n for n, _ in inside], dtype=int).reshape(-1, 2),
             inside=np.array([v for _, v in inside], dtype=float).reshape(-1, 3),
@@ -611,7 +634,9 @@ def assemble(building, names=None):
             pair_nodes=np.array([n for n, _ in pairs], dtype=int).reshape(-1, 2),
             pairs=np.array([v for _, v in pairs], dtype=float).reshape(-1, 2),
             flow_nodes=np.array([n for n, _ in flows], dtype=int).reshape(-1, 2),
-            flows=np.array([g for _, g in flows], dtype=float))
+            flows=np.array([g for _, g in flows], dtype=float),
+            people_nodes=np.array([n for n, _ in people], dtype=int).reshape(-1, 3),
+            people=np.array([v for _, v in people], dtype=float).reshape(-1, 6))
     return Network(C=C, A=A, B=B, q=q, input_names=names, products=tuple(products), switched=tuple(switched),
                    convection=convection)
 

@@ -439,10 +439,57 @@ def test_gain_following_the_air_steady_states(tmp_path):
     assert night_and_day_air(constant, tmp_path).iloc[-1] == pytest.approx(steady(1.0), rel=1e-3)
 
 
+def people_zone(extra_gain):
+    """The night-and-day zone losing to 0 C outdoors through 100 m3/h, `extra_gain` W constant,
+    and 20 people at 120 W whose sensible heat is followed, on the "night" schedule; its declared
+    power and slope are the polynomial's line at 24 C (69.5314 W and -4.69664 W/K a person, by
+    hand in test_energyplus_reading.py)."""
+    b = night_and_day_zone()
+    return b.edited(lambda d: d["zones"][0].update(internal_gain=extra_gain, ventilation=[
+        {"name": "vent", "flow": 100.0}], gains=[
+        {"name": "people", "power": 20 * 69.5314, "radiant_fraction": 0.3, "schedule": "night",
+         "temperature_slope": 20 * -4.69664, "reference_temperature": 24.0, "people": {"number": 20, "activity": 120}}]))
+
+
+def test_followed_people_give_energypluss_bounded_heat_at_the_steady_state(tmp_path):
+    """Each half day ends where the air's loss to outdoors, g T, is the people's sensible heat,
+    s 20 S(120 W, T), S EnergyPlus's polynomial bounded by 0 and the activity. With 1500 W more
+    the zone runs above the polynomial's zero, near 35.7 C: the people give nothing (EnergyPlus's
+    bound), and the air settles at 1500 / g, where their line about 24 C would have taken
+    20 x 4.7 W/K x (T - 24) out of it."""
+    from scipy.optimize import brentq
+    from nodeforce.model.gains import people_sensible_heat
+    g = 1.2 * 1005 * 100 / 3600
+    air = night_and_day_air(people_zone(0.0), tmp_path)
+    for s, at in ((0.25, "2017-03-02 17:45"), (1.0, "2017-03-03 05:45")):
+        steady = brentq(lambda T: s * 20 * people_sensible_heat(120.0, T) - g * T, 0.0, 60.0)
+        assert air[pd.Timestamp(at, tz="UTC")] == pytest.approx(steady, rel=1e-3)
+    hot = night_and_day_air(people_zone(1500.0), tmp_path)
+    assert people_sensible_heat(120.0, 1500.0 / g) == 0.0
+    assert hot[pd.Timestamp("2017-03-03 05:45", tz="UTC")] == pytest.approx(1500.0 / g, rel=1e-3)
+    line = (1500.0 + 20 * (69.5314 + 4.69664 * 24.0)) / (g + 20 * 4.69664)
+    assert abs(line - 1500.0 / g) > 3.0  # the line alone would settle 4 K lower
+
+
+def test_followed_people_step_alike_in_c_and_numpy_and_the_standalone_fmu_refuses_them(tmp_path, monkeypatch):
+    from nodeforce.model import compiled
+    from nodeforce.fmu_build.standalone import network_terms
+    b = people_zone(800.0)
+    air = night_and_day_air(b, tmp_path)
+    if compiled.available():
+        monkeypatch.setattr(compiled, "available", lambda: False)
+        assert np.abs(night_and_day_air(b, tmp_path) - air).max() < 1e-10 * air.abs().max()
+    with pytest.raises(InputError, match="people.*standalone C FMU"):
+        network_terms(b, None)
+
+
 @pytest.mark.parametrize("gain, expected", [
     ({"temperature_slope": -1.0}, "reference_temperature: is required with a temperature_slope"),
     ({"temperature_slope": 1.0, "reference_temperature": 24.0}, "temperature_slope"),
-    ({"temperature_slope": -1.0, "reference_temperature": 24.0, "schedule": "minus"}, "takes negative values")])
+    ({"temperature_slope": -1.0, "reference_temperature": 24.0, "schedule": "minus"}, "takes negative values"),
+    ({"people": {"number": 2, "activity": 120}, "schedule": "minus"}, "a number of people is >= 0"),
+    ({"people": {"number": 0, "activity": 120}}, "number"),
+    ({"people": {"number": 2}}, "activity")])
 def test_gain_temperature_slope_refused(gain, expected):
     with pytest.raises(InputError, match=expected):
         minimal_building(schedules={"minus": {"constant": -1.0}}).edited(

@@ -80,6 +80,17 @@ static double excess(double h, double h0) {
     return h - h0 < h0 ? h - h0 : h0;
 }
 
+/* model/gains.py's people_sensible_heat: EnergyPlus's sensible heat of a person (W) at activity M
+   (W) and air temperature T (C), its polynomial bounded by 0 and M (InternalHeatGains.cc) */
+static double people_sensible(double M, double T) {
+    static const double c[9] = {6.461927, 0.946892, 0.0000255737, 7.139322, -0.0627909, 0.0000589172, -0.198550,
+                                0.000940018, -0.00000149532};
+    double h = c[0] + c[1] * M + c[2] * M * M + T * (c[3] + c[4] * M + c[5] * M * M) + T * T * (c[6] + c[7] * M + c[8] * M * M);
+    if (h < 0.0) h = 0.0;
+    if (h > M) h = M;
+    return h;
+}
+
 /* The lagged coefficients' sources (W) into q (N), from T (N) before the step and the step's
    inputs u: inside, per face, (face, air) and (A phi, h0, cos_up); outside, per face, its node
    and (A, h0, cos_up, azimuth, R_f, wind factor); long-wave, per face, its node and (A, h_rad,
@@ -87,14 +98,16 @@ static double excess(double h, double h0) {
    air) and (A phi, h0, height, tilt, pressure); gaps, per gap, its two pane faces (a, b) and (A f, h0,
    thickness, height, eps, the gas's ten coefficients); pairs, per pair of faces of a followed ScriptF
    exchange, (a, b) and (A_a ScriptF_ab, G0); flows, per air flow from outdoors at the outdoor
-   air's density, (air node, its schedule's column of u or -1) and g */
+   air's density, (air node, its schedule's column of u or -1) and g; people, per target of a
+   followed people gain, (target, air node, its schedule's column or -1) and (share of the number,
+   activity, share of the power, slope, T_ref, the schedule's constant value) */
 static void convection(int n, const double *T, const double *u, int n_inside, const int *inside_nodes,
                        const double *inside, int n_outside, const int *outside_nodes, const double *outside,
                        int n_longwave, const int *longwave_nodes, const double *longwave, const int *columns,
                        int n_windows, const int *window_nodes, const double *windows, int n_gaps,
                        const int *gap_nodes, const double *gaps, int n_pairs, const int *pair_nodes,
                        const double *pairs, int n_flows, const int *flow_nodes, const double *flows,
-                       double *q) {
+                       int n_people, const int *people_nodes, const double *people, double *q) {
     int k;
     for (k = 0; k < n; k++) q[k] = 0.0;
     for (k = 0; k < n_inside; k++) {
@@ -149,6 +162,11 @@ static void convection(int n, const double *T, const double *u, int n_inside, co
         const double t_out = u[columns[0]], share = column >= 0 ? u[column] : 1.0;
         q[air] += flows[k] * share * excess((20.0 + 273.15) / (t_out + 273.15), 1.0) * (t_out - T[air]);
     }
+    for (k = 0; k < n_people; k++) {
+        const int target = people_nodes[3 * k], air = people_nodes[3 * k + 1], column = people_nodes[3 * k + 2];
+        const double *v = people + 6 * k, share = column >= 0 ? u[column] : v[5];
+        q[target] += share * (v[0] * people_sensible(v[1], T[air]) - v[2] - v[3] * (T[air] - v[4]));
+    }
 }
 
 /* order (N): the node of each position of the elimination order; lower_ptr/lower_col (N + 1,
@@ -171,13 +189,14 @@ EXPORT int nodeforce_steps(int n, const int *order, const int *lower_ptr, const 
                            int n_longwave, const int *longwave_nodes, const double *longwave, const int *columns,
                            int n_windows, const int *window_nodes, const double *windows, int n_gaps,
                            const int *gap_nodes, const double *gaps, int n_pairs, const int *pair_nodes,
-                           const double *pairs, int n_flows, const int *flow_nodes, const double *flows) {
+                           const double *pairs, int n_flows, const int *flow_nodes, const double *flows,
+                           int n_people, const int *people_nodes, const double *people) {
     long entries = (long)n + lower_ptr[n] + upper_ptr[n], s, e;
     double *f = calloc((size_t)entries + 1, sizeof(double)), *w = calloc((size_t)n + 1, sizeof(double));
     double *y = malloc(((size_t)n + 1) * sizeof(double));
     int *position = malloc(((size_t)n + 1) * sizeof(int));
     const int lagged = n_inside > 0 || n_outside > 0 || n_longwave > 0 || n_windows > 0 || n_gaps > 0 || n_pairs > 0 ||
-                       n_flows > 0;
+                       n_flows > 0 || n_people > 0;
     double *extra = calloc((size_t)n + 1, sizeof(double));
     double *diagonal = f, *lower = f + n, *upper = f + n + lower_ptr[n];
     int i, p, k, ok = 0;
@@ -206,7 +225,7 @@ EXPORT int nodeforce_steps(int n, const int *order, const int *lower_ptr, const 
         if (lagged)
             convection(n, T, t_s, n_inside, inside_nodes, inside, n_outside, outside_nodes, outside, n_longwave,
                        longwave_nodes, longwave, columns, n_windows, window_nodes, windows, n_gaps, gap_nodes, gaps,
-                       n_pairs, pair_nodes, pairs, n_flows, flow_nodes, flows, extra);
+                       n_pairs, pair_nodes, pairs, n_flows, flow_nodes, flows, n_people, people_nodes, people, extra);
         for (i = 0; i < n; i++) {
             const int node = order[i];
             double sum = q[node] + extra[node];
