@@ -2005,12 +2005,16 @@ class _Converter:
         solar_distribution the diffuse split, where the direct sun falling on none of them goes,
         as EnergyPlus adds what its back surfaces do not absorb to the zone's diffuse sun
         (SolarShading.cc, CalcInteriorSolarDistribution). The window and those faces get their
-        polygons. A window without a polygon keeps its direct sun on the floor."""
+        polygons. A window without a polygon keeps its direct sun on the floor; a face no sun
+        above the horizon reaches through the window (`interior_sun.may_receive_beam`) is left
+        out, its share 0 at every time."""
         if not self.has_plane(c):
             return
         beam = {}
         for k, f in enumerate(own):
             if f[0] is c or not self.has_plane(f[0]) or f[0]["name"] in beam:
+                continue
+            if not interior_sun.may_receive_beam(self.ccw_polygon(c), self.ccw_polygon(f[0])):
                 continue
             shares = interior_sun.beam_fractions(area, alpha, tau, np.arange(len(own)) == k)
             split = {}
@@ -2038,16 +2042,19 @@ class _Converter:
         normal = geometry.outward_normal(c["_plane"][0], self.ccw)
         return geometry.turned_from(normal, c["tilt"], c["azimuth"]) <= ORIENTATION_TOLERANCE
 
+    def ccw_polygon(self, c):
+        """A component's surface polygon (n, 3), counterclockwise seen from outside."""
+        return c["_plane"][0] if self.ccw else c["_plane"][0][::-1]
+
     def give_polygon(self, c):
         """A component's `vertices` (and `holes`) from its surface, counterclockwise seen from
         outside, unless its shading gave them already."""
         if "vertices" in c:
             return
         order = (lambda p: p) if self.ccw else (lambda p: p[::-1])  # noqa: E731
-        vertices, holes = c["_plane"]
-        c["vertices"] = _rounded(order(vertices))
-        if holes:
-            c["holes"] = [_rounded(order(h)) for h in holes]
+        c["vertices"] = _rounded(self.ccw_polygon(c))
+        if c["_plane"][1]:
+            c["holes"] = [_rounded(order(h)) for h in c["_plane"][1]]
 
     @staticmethod
     def solar_view_factors(faces, zone):

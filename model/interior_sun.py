@@ -13,7 +13,7 @@ import numpy as np
 import shapely
 
 from .geometry import outward_normal
-from .shading import GRAZING, _robust, plane_axes
+from .shading import GRAZING, _robust, plane_axes, sun_vectors
 
 # A face this far (m) beyond the window's plane along the sun's rays is behind it: a face in the
 # window's own plane (its wall, a window beside it) gets none of its sun
@@ -131,6 +131,26 @@ def beam_shares(window, faces, sun):
         behind = along(inside, vertices) < along(inside, window) - BEHIND
         shares[lit, k] = np.where(behind & (area > 0), np.clip(area, 0.0, None) / total, 0.0)
     return shares / np.maximum(1.0, shares.sum(axis=1, keepdims=True))
+
+
+def may_receive_beam(window, face, step=5.0):
+    """Whether any sun above the horizon sends a window's direct sun onto a face of its zone
+    (`beam_shares`), both plane polygons ((m, 3) m, the window counterclockwise seen from
+    outside): the face reaches beyond the window's plane into the zone, and for some sun in front
+    of the window (s . n_w > 0, s_z > 0; directions every `step` deg) the rays cross the face's
+    plane away from the window (s . n_f < 0, n_f its normal pointing away from the window). A
+    zone's ceiling over a wall's window, the walls facing as the window does and the faces in its
+    plane never do: their shares are 0 at every time, and a converter need not trace them."""
+    window, face = np.asarray(window, dtype=float), np.asarray(face, dtype=float)
+    n_w = outward_normal(window)
+    if not np.any((window[0] - face) @ n_w > BEHIND):
+        return False
+    n_f = outward_normal(face)
+    if (face.mean(axis=0) - window.mean(axis=0)) @ n_f < 0:
+        n_f = -n_f
+    altitude, azimuth = np.meshgrid(np.arange(step / 2, 90.0, step), np.arange(0.0, 360.0, step))
+    sun = sun_vectors(90.0 - altitude.ravel(), azimuth.ravel())
+    return bool(np.any((sun @ n_w > GRAZING) & (sun @ n_f < -GRAZING)))
 
 
 def _point(patch):

@@ -8,7 +8,8 @@ import pytest
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import prepare_case, simulate_building
 from nodeforce.model.errors import InputError
-from nodeforce.model.interior_sun import beam_fractions, beam_shares, diffuse_fractions, window_diffuse_fractions
+from nodeforce.model.interior_sun import (beam_fractions, beam_shares, diffuse_fractions, may_receive_beam,
+                                          window_diffuse_fractions)
 from nodeforce.model.shading import sun_vectors
 from tests.traced import traced_cell
 from nodeforce.model.network import assemble
@@ -184,6 +185,21 @@ def test_a_south_western_sun_lights_a_corner_of_the_east_wall():
     s = box_shares(70.0, 225.0)
     assert s["east"] == pytest.approx(triangle / 6.0, rel=1e-9)
     assert s["floor"] == pytest.approx(1.0 - triangle / 6.0, rel=1e-9)
+
+
+def test_only_the_faces_some_sun_reaches_through_the_window_are_traced():
+    """Through a south window, a sun above the horizon reaches the floor and the north, east and
+    west walls, never the ceiling (the rays go down), the window's own wall nor a window beside
+    it (in its plane); the shares of the others are 0 at every sun in front of the window."""
+    beside = [(5, 0, 0.2), (7, 0, 0.2), (7, 0, 2.2), (5, 0, 2.2)]
+    faces = dict(BOX, beside=(beside, ()))
+    reached = {name for name, (vertices, _) in faces.items() if may_receive_beam(SOUTH_WINDOW, vertices)}
+    assert reached == {"floor", "north", "east", "west"}
+    altitude, azimuth = np.meshgrid(np.arange(1.0, 90.0, 3.0), np.arange(91.0, 270.0, 3.0))
+    shares = beam_shares(SOUTH_WINDOW, list(faces.values()), sun_vectors(90 - altitude.ravel(), azimuth.ravel()))
+    never = [k for k, name in enumerate(faces) if name not in reached]
+    assert (shares[:, never] == 0).all()
+    assert shares.sum(axis=1) == pytest.approx(1.0, abs=1e-9)
 
 
 def test_no_beam_is_traced_with_the_sun_down_or_behind_the_window():
