@@ -13,7 +13,7 @@ import numpy as np
 import shapely
 
 from .geometry import outward_normal
-from .shading import GRAZING, _robust, plane_axes, sun_vectors
+from .shading import GRAZING, _robust, sun_vectors
 
 # A face this far (m) beyond the window's plane along the sun's rays is behind it: a face in the
 # window's own plane (its wall, a window beside it) gets none of its sun
@@ -107,7 +107,11 @@ def beam_shares(window, faces, sun):
     if not len(lit):
         return shares
     s = s[lit]
-    axes = np.array([plane_axes(v) for v in s])  # (T, 2, 3): the plane normal to each ray
+    # (T, 2, 3): each ray's plane's axes (u, v), as `model.shading.plane_axes` makes them
+    helper = np.where(np.abs(s[:, 2:]) < 0.9, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
+    u = np.cross(helper, s)
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    axes = np.stack([u, np.cross(s, u)], axis=1)
 
     def projected(polygon):
         return shapely.make_valid(shapely.polygons(np.einsum("mk,tjk->tmj", np.asarray(polygon, dtype=float), axes)))
@@ -127,7 +131,9 @@ def beam_shares(window, faces, sun):
         area = shapely.area(patch)
         for hole in holes:
             area = area - shapely.area(_robust(shapely.intersection, light, projected(hole)))
-        inside = np.array([_point(g) for g in patch]).reshape(-1, 2)
+        coordinates, which = shapely.get_coordinates(shapely.point_on_surface(patch), return_index=True)
+        inside = np.full((len(patch), 2), np.nan)  # a point in each patch; NaN where there is none
+        inside[which] = coordinates
         behind = along(inside, vertices) < along(inside, window) - BEHIND
         shares[lit, k] = np.where(behind & (area > 0), np.clip(area, 0.0, None) / total, 0.0)
     return shares / np.maximum(1.0, shares.sum(axis=1, keepdims=True))
@@ -151,10 +157,3 @@ def may_receive_beam(window, face, step=5.0):
     altitude, azimuth = np.meshgrid(np.arange(step / 2, 90.0, step), np.arange(0.0, 360.0, step))
     sun = sun_vectors(90.0 - altitude.ravel(), azimuth.ravel())
     return bool(np.any((sun @ n_w > GRAZING) & (sun @ n_f < -GRAZING)))
-
-
-def _point(patch):
-    """A point inside a patch ((2,) m), NaN for an empty one."""
-    if patch.is_empty:
-        return np.full(2, np.nan)
-    return np.asarray(shapely.point_on_surface(patch).coords[0])
