@@ -144,7 +144,7 @@ def terms(name, building, doc, network, U, T, theirs):
             add(zone, key, "net long-wave from the faces",
                 sum(network.A[s, j - 1] * (T[f"T{j}"].to_numpy(float) - Ts) for j in faces if j != node), LONGWAVE)
             if c.solar_transmittance and node == c.node_ids[0]:
-                names = [n for n in U.columns if n in (f"It_{c.name}", f"Itb_{c.name}", f"Itd_{c.name}")]
+                names = [n for n, _ in c.sun_inputs if n != c.irradiance_input]
                 incident = U[f"I_{c.name}"].to_numpy(float)
                 add(zone, key, "sun on the window (W/m2)", incident, INCIDENT, unit="W/m2")
                 one = c.area / copies.get(key, 1.0)

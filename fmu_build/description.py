@@ -132,9 +132,12 @@ def _input_meaning(building, name):
                 if sun == name and sun != c.irradiance_input]
     if glazings:
         c, k = glazings[0]
-        part = "" if len(c.sun_inputs) == 1 else ("direct " if k == 0 else "diffuse ")
+        part = "" if len(c.sun_inputs) == 1 else ("diffuse " if k == 1 else "direct ")
         applied = " (its angular transmittance applied)" if c.angular is not None else ""
-        return "W/m2", f"{part}sun {c.name} lets in per m2 over its normal-incidence transmittance{applied}"
+        # a traced direct sun is one input a face it falls on, and one for what falls on none
+        falls = "" if not c.traced_beam or k == 1 else (
+            f", the part that falls on {c.traced_beam[k - 2][0]}" if k else ", the part that falls on no traced face")
+        return "W/m2", f"{part}sun {c.name} lets in per m2 over its normal-incidence transmittance{applied}{falls}"
     panes = [(c, side) for c in building.exterior_components for sun, side in c.absorbed_inputs if sun == name]
     if panes:
         c, side = panes[0]

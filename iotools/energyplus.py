@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ..model import convection, geometry, glazing, interior_sun, longwave
+from ..model.building_file import ORIENTATION_TOLERANCE
 from ..model.errors import InputError
 from .energyplus_shading import fin, may_shade, on_surface, overhang, rectangle, window_frame
 from .idf_text import closed_text
@@ -1591,6 +1592,9 @@ class _Converter:
                                                           f"of its {s['area']:.3f} m2")
             comps.append(self.component(obj.name, net, s, layers, inner, outside, outer))
             self.built_of(s["construction"], obj.name)
+            if s["vertices"] is not None:  # where a traced direct sun may fall (`receivers`)
+                comps[-1]["_plane"] = (s["vertices"], [w["vertices"] for w in s["subsurfaces"]
+                                                       if w["vertices"] is not None])
             lit = outside["type"] == "exterior" and s["sun"] and s["vertices"] is not None
             if lit:
                 comps[-1]["_polygon"] = (s["vertices"], [w["vertices"] for w in s["subsurfaces"]
@@ -1629,6 +1633,8 @@ class _Converter:
                         self.incident_solar_multiplier(w["obj"], c)
                 if lit and w["vertices"] is not None and w_outside["type"] == "exterior":
                     c["_polygon"] = (w["vertices"], [])
+                if w["vertices"] is not None:
+                    c["_plane"] = (w["vertices"], [])
                 comps.append(c)
         return comps
 
@@ -1960,8 +1966,10 @@ class _Converter:
         its diffuse transmittance (leaving); the direct sun on the zone's floors (its opaque faces
         if it has none), by area, each absorbing its alpha and reflecting the rest into the diffuse
         split. The direct sun's split is the window's solar_distribution, the diffuse sun's its
-        diffuse_distribution; transmitted_solar_to names the largest floor."""
-        self.beam_on_floor()
+        diffuse_distribution; transmitted_solar_to names the largest floor. Under the Building's
+        FullInteriorAndExterior distributions the direct sun is traced onto each face instead
+        (`traced_beam`)."""
+        traced = self.traced_distribution()
         faces = {}  # zone: [(component, type, absorptance, transmittance out)] of every face in it
         for k in components:
             for zone, kind, alpha in k["_faces"]:
@@ -1987,8 +1995,69 @@ class _Converter:
                     if share > 0:
                         split[f[0]["name"]] = split.get(f[0]["name"], 0.0) + float(share)
                 c[field] = {name: round(share, 6) for name, share in split.items()}
+            if traced:
+                self.trace_beam(c, own, area, alpha, tau)
         for c in components:
             c.pop("_zone"), c.pop("_type"), c.pop("_absorbs"), c.pop("_faces"), c.pop("_back", None)
+            c.pop("_plane", None)
+
+    def trace_beam(self, c, own, area, alpha, tau):
+        """A window's `traced_beam`: for each other face of its zone with a polygon, the split of
+        the direct sun that falls on it (it absorbs its alpha, a window lets its tau_out out, the
+        rest joins the diffuse split: `interior_sun.beam_fractions` with that face alone), and its
+        solar_distribution the diffuse split, where the direct sun falling on none of them goes,
+        as EnergyPlus adds what its back surfaces do not absorb to the zone's diffuse sun
+        (SolarShading.cc, CalcInteriorSolarDistribution). The window and those faces get their
+        polygons. A window without a polygon keeps its direct sun on the floor; a face no sun
+        above the horizon reaches through the window (`interior_sun.may_receive_beam`) is left
+        out, its share 0 at every time."""
+        if not self.has_plane(c):
+            return
+        beam = {}
+        for k, f in enumerate(own):
+            if f[0] is c or not self.has_plane(f[0]) or f[0]["name"] in beam:
+                continue
+            if not interior_sun.may_receive_beam(self.ccw_polygon(c), self.ccw_polygon(f[0])):
+                continue
+            shares = interior_sun.beam_fractions(area, alpha, tau, np.arange(len(own)) == k)
+            split = {}
+            for g, share in zip(own, shares):
+                if share > 0:
+                    split[g[0]["name"]] = split.get(g[0]["name"], 0.0) + float(share)
+            beam[f[0]["name"]] = {name: round(share, 6) for name, share in split.items()}
+            self.give_polygon(f[0])
+        if not beam:
+            return
+        self.give_polygon(c)
+        c["traced_beam"] = beam
+        diffuse = {}
+        for g, share in zip(own, interior_sun.diffuse_fractions(area, alpha, tau)):
+            if share > 0:
+                diffuse[g[0]["name"]] = diffuse.get(g[0]["name"], 0.0) + float(share)
+        c["solar_distribution"] = {name: round(share, 6) for name, share in diffuse.items()}
+
+    def has_plane(self, c):
+        """Whether a component has a surface polygon that faces as it does, as the building file
+        checks its vertices (a window in a slightly warped wall takes the wall's tilt and azimuth,
+        not its own plane's)."""
+        if "_plane" not in c:
+            return False
+        normal = geometry.outward_normal(c["_plane"][0], self.ccw)
+        return geometry.turned_from(normal, c["tilt"], c["azimuth"]) <= ORIENTATION_TOLERANCE
+
+    def ccw_polygon(self, c):
+        """A component's surface polygon (n, 3), counterclockwise seen from outside."""
+        return c["_plane"][0] if self.ccw else c["_plane"][0][::-1]
+
+    def give_polygon(self, c):
+        """A component's `vertices` (and `holes`) from its surface, counterclockwise seen from
+        outside, unless its shading gave them already."""
+        if "vertices" in c:
+            return
+        order = (lambda p: p) if self.ccw else (lambda p: p[::-1])  # noqa: E731
+        c["vertices"] = _rounded(self.ccw_polygon(c))
+        if c["_plane"][1]:
+            c["holes"] = [_rounded(order(h)) for h in c["_plane"][1]]
 
     @staticmethod
     def solar_view_factors(faces, zone):
@@ -2006,13 +2075,12 @@ class _Converter:
         classes = [FACE_CLASS.get(f[1], "wall") for f in faces]
         return longwave.fix_view_factors(area, longwave.approximate_view_factors(area, tilts, azimuths, classes))
 
-    def beam_on_floor(self):
-        """Say where the Building's Solar Distribution would put the direct sun other than on the floor."""
+    def traced_distribution(self):
+        """Whether the Building's Solar Distribution follows the direct sun onto every face it
+        reaches (FullInteriorAndExterior, with or without reflections)."""
         buildings = self.r.all("Building")
         method = self.r.text(buildings[0], "solar_distribution", "FullExterior") if buildings else "FullExterior"
-        if method.lower().startswith("fullinterior"):
-            self.note(f"the direct sun a window lets in falls on the zone's floor (the IDF's {method} follows it "
-                      "onto every face it reaches)")
+        return method.lower().startswith("fullinterior")
 
     def list_not_modelled(self):
         for obj in self.r.doc.all_objects:

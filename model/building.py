@@ -212,6 +212,11 @@ class Zone:
     inside_convection_algorithm: str = "simple"  # "simple": h_conv constant; "tarp": followed step by step
 
 
+def traced_input(window, face):
+    """The input of the direct sun `window` lets in that falls on `face` (docs/model.md 4.1)."""
+    return f"Itb_{window}@{face}"
+
+
 @dataclass(frozen=True)
 class Component:
     name: str
@@ -236,6 +241,7 @@ class Component:
     holes: tuple = ()  # polygons cut out of it (its windows), m
     diffuse_distribution: tuple = ()  # (component, fraction) of the transmitted diffuse sun; () as the direct
     window: Window | None = None  # its panes' gaps and inside face as EnergyPlus's window heat balance
+    traced_beam: tuple = ()  # (face, ((component, fraction), ...)): its direct sun traced onto each face, its split there
 
     @property
     def receivers(self):
@@ -250,12 +256,16 @@ class Component:
         """((input name, receivers), ...): the inputs of the sun a glazing lets in and the split of
         each (docs/model.md section 4.1). One input split by `receivers`; where the glazing declares
         a `diffuse_distribution`, its direct sun `Itb_<component>` split by `receivers` and its
-        diffuse sun `Itd_<component>` by the diffuse distribution. () for an opaque component."""
+        diffuse sun `Itd_<component>` by the diffuse distribution; where it also traces its direct
+        sun (`traced_beam`), the part that falls on each face, `Itb_<component>@<face>`, split as
+        the face's entry says, and `Itb_<component>` the part that falls on none. () for an opaque
+        component."""
         if self.solar_transmittance is None:
             return ()
         if not self.diffuse_distribution:
             return ((self.transmitted_input, self.receivers),)
-        return ((f"Itb_{self.name}", self.receivers), (f"Itd_{self.name}", self.diffuse_distribution))
+        return ((f"Itb_{self.name}", self.receivers), (f"Itd_{self.name}", self.diffuse_distribution),
+                *((traced_input(self.name, face), split) for face, split in self.traced_beam))
 
     @property
     def sun_receivers(self):

@@ -194,7 +194,8 @@ def parse_checked(data, source="<building>"):
     zones = tuple(_zone(check, z, f"zones[{i}]", zone_names, explicit, next_id, schedules)
                   for i, z in enumerate(raw_zones))
     components = tuple(Component(**c) for c in components)
-    names = {c.name for c in components}
+    by_name = {c.name: c for c in components}
+    names = set(by_name)
     for i, c in enumerate(components):
         if c.transmitted_solar_to is not None and c.transmitted_solar_to not in names:
             check.fail(f"components[{i}].transmitted_solar_to",
@@ -204,6 +205,7 @@ def parse_checked(data, source="<building>"):
             for name, _ in fractions:
                 if name not in names:
                     check.fail(f"components[{i}].{field}.{name}", f"names no component ({name!r})")
+        _check_traced_beam(check, f"components[{i}]", c, by_name)
     _check_proportional_columns(check, zones, components)
     _check_air_exchanges(check, zones)
     _check_view_factors(check, zones, components)
@@ -543,6 +545,8 @@ def _component(check, c, where, materials, zone_names, sensor_depths):
         angular_absorptance=_angular_absorptance(check, c, where),
         solar_distribution=_distribution(check, c, where, "solar_distribution"),
         diffuse_distribution=_distribution(check, c, where, "diffuse_distribution"),
+        traced_beam=tuple((face, _distribution(check, {face: split}, f"{where}.traced_beam", face))
+                          for face, split in c.get("traced_beam", {}).items()),
         inner_solar_absorptance=float(c.get("inner_solar_absorptance",
                                             schema_default("component", "inner_solar_absorptance"))),
         vertices=_face_polygon(check, c, where),
@@ -608,8 +612,7 @@ def _face_polygon(check, c, where):
     if np.linalg.norm(n) <= 1e-9:
         check.fail(f"{where}.vertices", "enclose no area")
     azimuth, tilt = geometry.azimuth_tilt(n / np.linalg.norm(n))
-    turn = abs((azimuth - float(c["azimuth"]) + 180) % 360 - 180) if 1e-6 < tilt < 180 - 1e-6 else 0.0
-    if abs(tilt - float(c["tilt"])) > ORIENTATION_TOLERANCE or turn > ORIENTATION_TOLERANCE:
+    if geometry.turned_from(n / np.linalg.norm(n), float(c["tilt"]), float(c["azimuth"])) > ORIENTATION_TOLERANCE:
         check.fail(f"{where}.vertices", f"face tilt {tilt:.1f} deg, azimuth {azimuth:.1f} deg (counterclockwise seen "
                                         f"from outside), not the component's {float(c['tilt']):g} and "
                                         f"{float(c['azimuth']):g}")
@@ -638,6 +641,26 @@ def _distribution(check, c, where, field):
         check.fail(f"{where}.{field}", f"the fractions add up to {sum(f for _, f in fractions):g}: at most "
                                                   "1 (the rest leaves through the glazings)")
     return fractions
+
+
+def _check_traced_beam(check, where, c, by_name):
+    """A glazing that traces its direct sun onto faces (docs/model.md 4.1) needs its direct sun
+    apart (a diffuse_distribution) and the polygons of itself and of each face it names."""
+    if not c.traced_beam:
+        return
+    where = f"{where}.traced_beam"
+    if not c.diffuse_distribution:
+        check.fail(where, "needs a diffuse_distribution: the direct sun is traced apart from the diffuse")
+    if c.vertices is None:
+        check.fail(where, "needs the glazing's vertices, the polygon its direct sun comes through")
+    for face, split in c.traced_beam:
+        if face not in by_name:
+            check.fail(f"{where}.{face}", f"names no component ({face!r})")
+        if by_name[face].vertices is None:
+            check.fail(f"{where}.{face}", "declares no vertices for the direct sun to fall on")
+        for name, _ in split:
+            if name not in by_name:
+                check.fail(f"{where}.{face}.{name}", f"names no component ({name!r})")
 
 
 def _explicit_ids(check, raw_zones, components):

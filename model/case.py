@@ -18,11 +18,12 @@ import pandas as pd
 
 from .errors import InputError
 from .integrate import Plan, held_inputs, history_block, initial_state, simulate, steps_per_day, substeps
-from .building import DAY_TERMS
+from .building import DAY_TERMS, traced_input
 from .network import (WIND_DIRECTION, WIND_SPEED, assemble, clock_input_names, day_input, input_names,
                       slowest_time_constant)
 from .units import check_celsius
 from .geometry import outward_normal
+from .interior_sun import beam_shares
 from .shading import sky_diffuse_ratio, sun_vectors, sunlit_fraction
 from .site import run_building, standard_offset
 from .solar import (DECOMPOSITIONS, complete_irradiance, incident_irradiance, measured_irradiance, sky_temperature,
@@ -374,10 +375,12 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
                                                          site["ground_albedo"], sunlit, sky, **sky_model)
             table = () if c.angular is None else (c.angular.angles, c.angular.factors, c.angular.diffuse)
             if c.diffuse_distribution:
-                (direct, _), (diffuse, _) = c.sun_inputs
+                (direct, _), (diffuse, _) = c.sun_inputs[:2]
                 columns[direct], columns[diffuse] = transmitted_split(
                     position, ghi, dni, dhi, c.tilt, c.azimuth, site["ground_albedo"], *table, sunlit=sunlit, sky=sky,
                     **sky_model)
+                if c.traced_beam:
+                    columns.update(traced_beam_columns(building, c, position, columns[direct]))
             elif c.angular is not None:
                 columns[c.transmitted_input] = transmitted_irradiance(
                     position, ghi, dni, dhi, c.tilt, c.azimuth, site["ground_albedo"], *table, sunlit=sunlit, sky=sky,
@@ -445,6 +448,20 @@ def face_shading(component, shades, position):
     sun[np.asarray(position["apparent_zenith"]) >= 90] = 0.0  # no direct sun at night: no shadow to cast
     return (sunlit_fraction(component.vertices, normal, shades, sun, component.holes),
             sky_diffuse_ratio(component.vertices, normal, shades, component.holes))
+
+
+def traced_beam_columns(building, window, position, direct):
+    """{input: W/m2} of a glazing that traces its direct sun (docs/model.md section 4.1): the part
+    of its direct sun `direct` (W/m2, `Itb_<window>`) that falls on each face of its traced_beam
+    at each time of `position` (`model.interior_sun.beam_shares`), and under `Itb_<window>` the
+    part that falls on none."""
+    faces = [building.component(face) for face, _ in window.traced_beam]
+    sun = sun_vectors(position["apparent_zenith"], position["azimuth"])
+    sun[np.asarray(position["apparent_zenith"]) >= 90] = 0.0  # no direct sun at night
+    shares = beam_shares(window.vertices, [(f.vertices, f.holes) for f in faces], sun)
+    columns = {traced_input(window.name, f.name): direct * shares[:, k] for k, f in enumerate(faces)}
+    columns[f"Itb_{window.name}"] = direct * (1.0 - shares.sum(axis=1))
+    return columns
 
 
 def start_memory(building, seconds=None):

@@ -147,7 +147,7 @@ def steps(matrix, c, sources, forced, imposed, T, rows, convection=None):
     T = np.array(T, dtype=float)
     p = pattern(len(T), np.require(starts, np.int32).tobytes(), np.require(nonzero_rows, np.int32).tobytes())
     terms = np.ascontiguousarray(sources.terms, dtype=float)
-    nodes, columns = np.nonzero(sources.B)  # row after row: each node's terms together
+    nodes, columns, coefficients = sources.nonzeros  # row after row: each node's terms together
     source_ptr = np.concatenate([[0], np.cumsum(np.bincount(nodes, minlength=len(T)))]).astype(np.int32)
     forced = np.ascontiguousarray(forced, dtype=np.int32)
     imposed = (np.zeros((len(terms), len(forced))) if imposed is None
@@ -158,7 +158,7 @@ def steps(matrix, c, sources, forced, imposed, T, rows, convection=None):
     if not _library()(p.n, p.order, p.lower_ptr, p.lower_col, p.upper_ptr, p.upper_col, len(p.slot), p.slot,
                       np.ascontiguousarray(values, dtype=float), np.ascontiguousarray(c, dtype=float), len(terms),
                       terms.shape[1], terms, source_ptr, columns.astype(np.int32),
-                      np.ascontiguousarray(sources.B[nodes, columns], dtype=float),
+                      np.ascontiguousarray(coefficients, dtype=float),
                       np.ascontiguousarray(sources.q, dtype=float), len(forced), forced, imposed, T, len(rows), rows,
                       path, *lagged):
         raise ValueError("the step matrix is singular")

@@ -38,6 +38,14 @@ def azimuth_tilt(normal):
     return azimuth, tilt
 
 
+def turned_from(normal, tilt, azimuth):
+    """How far (deg) a unit outward normal turns from a declared tilt and azimuth (deg): the larger
+    of the tilts' difference and the azimuths' (none on a horizontal face)."""
+    own_azimuth, own_tilt = azimuth_tilt(normal)
+    turn = abs((own_azimuth - azimuth + 180) % 360 - 180) if 1e-6 < own_tilt < 180 - 1e-6 else 0.0
+    return max(abs(own_tilt - tilt), turn)
+
+
 def rotate_z(vertices, degrees):
     """Vertices (n, 3) turned clockwise seen from above by `degrees` about the z axis: a zone or a
     building whose relative north is `degrees` east of true north."""

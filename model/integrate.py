@@ -188,14 +188,24 @@ class Sources:
     and their products, `Network.source_terms`), coefficients B (N, m) and constant q (N,): the
     compiled steps form each step's from B's few nonzeros, never the (L, N) array."""
 
-    def __init__(self, terms, B, q):
+    def __init__(self, terms, B, q, found=None):
         self.terms, self.B, self.q = terms, B, q
+        self._found = {} if found is None else found  # B's nonzeros, shared with the slices
 
     def __len__(self):
         return len(self.terms)
 
     def __getitem__(self, steps):
-        return Sources(self.terms[steps], self.B, self.q)
+        return Sources(self.terms[steps], self.B, self.q, self._found)
+
+    @property
+    def nonzeros(self):
+        """(nodes, columns, values) of B's nonzeros, row after row (`sparse`), found once and
+        shared with every slice: a year's run is sliced wherever its switched conductances change,
+        hundreds of times, and B has a column an input, thousands where the direct sun is traced."""
+        if "B" not in self._found:
+            self._found["B"] = sparse(self.B)
+        return self._found["B"]
 
     def dense(self):
         """(L, N) W."""
@@ -664,6 +674,7 @@ def steps(stepper, network, T, inputs, forced, imposed, kept, outputs, derivativ
     modal = not compiled.available() and network.convection is None
     lagged = None if network.convection is None else inputs
     terms, B, q = network.source_terms(inputs)
+    sources = Sources(terms, B, q)
     switched = network.switched_diagonal(inputs)  # None where nothing switches
     bounds = runs(forced, switched)
     out = np.empty((len(kept), len(outputs)))
@@ -687,7 +698,7 @@ def steps(stepper, network, T, inputs, forced, imposed, kept, outputs, derivativ
                 out[here], T = modal_run(solve.inverse, stepper.c_dt, mask, modes, T, terms[a:b], B, q, imposed[a:b],
                                          kept[here] - a, outputs)
         else:  # every node's path where the derivatives' sources read it
-            path, T = stepper.run(T, Sources(terms[a:b], B, q), mask, imposed[a:b], g,
+            path, T = stepper.run(T, sources[a:b], mask, imposed[a:b], g,
                                   None if derivatives else outputs, None if lagged is None else lagged[a:b])
             out[here] = path[kept[here] - a][:, outputs] if derivatives else path[kept[here] - a]
         if derivatives:

@@ -272,9 +272,13 @@ def test_case600_interior_solar_distribution(case600):
     alpha with each window's 6 m2 counted as its panes' back-side absorptance plus its diffuse
     transmittance out; the direct sun on the floor, which absorbs 0.6 and reflects 0.4 into that
     split; the diffuse sun first on the faces the window sees, all opaque (alpha 0.6), never the
-    south wall or the windows in its plane, which get only the 0.4 reflected."""
+    south wall or the windows in its plane, which get only the 0.4 reflected. The IDF's
+    FullInteriorAndExterior traces the direct sun onto each face (`traced_beam`): a face absorbs
+    0.6 of what falls on it and reflects 0.4 into the split; what falls on none joins the split
+    whole."""
     w = case600.component("SOUTH WINDOW WEST")
-    direct, diffuse = dict(w.solar_distribution), dict(w.diffuse_distribution)
+    traced = {face: dict(split) for face, split in w.traced_beam}
+    direct, diffuse = traced["FLOOR"], dict(w.diffuse_distribution)
     T, R = 0.86156, 0.07846
     a = 1 - T - R
     # two alike panes: the inner absorbs a (1 + T R / (1 - R^2)) of the room's sun, the outer a T / (1 - R^2)
@@ -288,6 +292,9 @@ def test_case600_interior_solar_distribution(case600):
     assert direct["FLOOR"] == pytest.approx(0.6 + 0.4 * 48 * 0.6 / S, abs=1e-5)
     assert direct["ROOF"] == pytest.approx(0.4 * 48 * 0.6 / S, abs=1e-5)
     assert 1 - sum(direct.values()) == pytest.approx(0.4 * 12 * out / S, abs=1e-5)
+    assert traced["EAST WALL"]["EAST WALL"] == pytest.approx(0.6 + 0.4 * 16.2 * 0.6 / S, abs=1e-5)
+    assert set(traced) == {"FLOOR", "EAST WALL", "WEST WALL", "NORTH WALL"}  # the faces the sun reaches
+    assert dict(w.solar_distribution)["NORTH WALL"] == pytest.approx(21.6 * 0.6 / S, abs=1e-5)
 
 
 def test_case600_exterior_convection_is_doe2_at_the_reference_wind(case600):

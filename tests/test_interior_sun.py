@@ -8,7 +8,10 @@ import pytest
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import prepare_case, simulate_building
 from nodeforce.model.errors import InputError
-from nodeforce.model.interior_sun import beam_fractions, diffuse_fractions, window_diffuse_fractions
+from nodeforce.model.interior_sun import (beam_fractions, beam_shares, diffuse_fractions, may_receive_beam,
+                                          window_diffuse_fractions)
+from nodeforce.model.shading import sun_vectors
+from tests.traced import traced_cell
 from nodeforce.model.network import assemble
 
 
@@ -135,3 +138,117 @@ def test_a_window_that_sees_another_window_loses_its_first_bounce_through_it():
     S = 16 * 0.6 + 8 * 0.7
     assert phi == pytest.approx([0.3 + 0.35 * 9.6 / S, 0.35 * 0.4 / S, 0.05 + 0.35 * 0.4 / S])
     assert phi.sum() + 0.3 + 0.35 * 4.8 / S == pytest.approx(1.0)
+
+
+# ASHRAE 140's box (8 m east-west, 6 m north-south, 2.7 m high) and a south window 3 m wide and 2 m
+# high, 0.2 m above the floor, each polygon counterclockwise seen from outside
+BOX_W, BOX_D, BOX_H = 8.0, 6.0, 2.7
+SOUTH_WINDOW = [(1, 0, 0.2), (4, 0, 0.2), (4, 0, 2.2), (1, 0, 2.2)]
+BOX = {"floor": ([(0, 0, 0), (0, BOX_D, 0), (BOX_W, BOX_D, 0), (BOX_W, 0, 0)], ()),
+       "roof": ([(0, 0, BOX_H), (BOX_W, 0, BOX_H), (BOX_W, BOX_D, BOX_H), (0, BOX_D, BOX_H)], ()),
+       "south": ([(0, 0, 0), (BOX_W, 0, 0), (BOX_W, 0, BOX_H), (0, 0, BOX_H)], (SOUTH_WINDOW,)),
+       "north": ([(BOX_W, BOX_D, 0), (0, BOX_D, 0), (0, BOX_D, BOX_H), (BOX_W, BOX_D, BOX_H)], ()),
+       "east": ([(BOX_W, 0, 0), (BOX_W, BOX_D, 0), (BOX_W, BOX_D, BOX_H), (BOX_W, 0, BOX_H)], ()),
+       "west": ([(0, BOX_D, 0), (0, 0, 0), (0, 0, BOX_H), (0, BOX_D, BOX_H)], ())}
+
+
+def box_shares(zenith, azimuth):
+    shares = beam_shares(SOUTH_WINDOW, list(BOX.values()), sun_vectors([zenith], [azimuth]))[0]
+    return dict(zip(BOX, shares))
+
+
+def test_a_high_southern_sun_puts_the_whole_beam_on_the_floor():
+    """At 45 deg altitude from the south a ray through the window at height z drops z while it
+    goes z north: the patch spans y = 0.2 to 2.2 m, all on the floor."""
+    s = box_shares(45.0, 180.0)
+    assert s["floor"] == pytest.approx(1.0, abs=1e-9)
+    assert sum(s.values()) == pytest.approx(1.0, abs=1e-9)
+
+
+def test_a_low_southern_sun_reaches_the_north_wall():
+    """At 20 deg altitude a ray through height z reaches y = z / tan 20 deg: past the north wall's
+    6 m above z* = 6 tan 20 deg = 2.184 m, so the window's strip from z* to 2.2 m (of its 2 m
+    height) lights the north wall and the rest the floor; the window's own wall gets none."""
+    z_star = BOX_D * np.tan(np.radians(20.0))
+    s = box_shares(70.0, 180.0)
+    assert s["north"] == pytest.approx((2.2 - z_star) / 2.0, rel=1e-9)
+    assert s["floor"] == pytest.approx((z_star - 0.2) / 2.0, rel=1e-9)
+    assert s["south"] == s["east"] == s["west"] == s["roof"] == 0.0
+
+
+def test_a_south_western_sun_lights_a_corner_of_the_east_wall():
+    """At 20 deg altitude from azimuth 225 deg a ray through (x, z) goes k z east and k z north,
+    k = sin 45 deg / tan 20 deg, reaching the floor at y = k z < 6 m: it meets the east wall where
+    x + k z > 8 m, a triangle of the window of legs 4 - (8 - 2.2 k) in x and 2.2 - 4 / k in z."""
+    k = np.sin(np.radians(45.0)) / np.tan(np.radians(20.0))
+    triangle = 0.5 * (4.0 - (BOX_W - 2.2 * k)) * (2.2 - (BOX_W - 4.0) / k)
+    s = box_shares(70.0, 225.0)
+    assert s["east"] == pytest.approx(triangle / 6.0, rel=1e-9)
+    assert s["floor"] == pytest.approx(1.0 - triangle / 6.0, rel=1e-9)
+
+
+def test_only_the_faces_some_sun_reaches_through_the_window_are_traced():
+    """Through a south window, a sun above the horizon reaches the floor and the north, east and
+    west walls, never the ceiling (the rays go down), the window's own wall nor a window beside
+    it (in its plane); the shares of the others are 0 at every sun in front of the window."""
+    beside = [(5, 0, 0.2), (7, 0, 0.2), (7, 0, 2.2), (5, 0, 2.2)]
+    faces = dict(BOX, beside=(beside, ()))
+    reached = {name for name, (vertices, _) in faces.items() if may_receive_beam(SOUTH_WINDOW, vertices)}
+    assert reached == {"floor", "north", "east", "west"}
+    altitude, azimuth = np.meshgrid(np.arange(1.0, 90.0, 3.0), np.arange(91.0, 270.0, 3.0))
+    shares = beam_shares(SOUTH_WINDOW, list(faces.values()), sun_vectors(90 - altitude.ravel(), azimuth.ravel()))
+    never = [k for k, name in enumerate(faces) if name not in reached]
+    assert (shares[:, never] == 0).all()
+    assert shares.sum(axis=1) == pytest.approx(1.0, abs=1e-9)
+
+
+def test_no_beam_is_traced_with_the_sun_down_or_behind_the_window():
+    """A sun down (its vector 0) or in the north, behind the south window, lets no beam in."""
+    sun = np.vstack([np.zeros(3), sun_vectors([60.0], [0.0])])
+    assert (beam_shares(SOUTH_WINDOW, list(BOX.values()), sun) == 0).all()
+
+
+def test_the_traced_beam_is_the_glazings_direct_sun_shared_out(testcell_data, weather):
+    """The inputs of the traced direct sun, one a face and one for what falls on none, add up to
+    the direct sun of the same window untraced; Miami's low December sun reaches the floor and, in
+    the morning and the evening, the west and east walls."""
+    days = weather.iloc[24 * 335:24 * 342]
+    case = prepare_case(parse_building(traced_cell(testcell_data)), days)
+    plain = prepare_case(split_cell(testcell_data, {"floor": 0.5}, {"floor": 0.3}), days)
+    column = {name: case.U[:, k] for k, name in enumerate(case.input_names)}
+    traced = [name for name in case.input_names if name.startswith("Itb_window")]
+    assert len(traced) == 5
+    total = sum(column[name] for name in traced)
+    assert total == pytest.approx(plain.U[:, plain.input_names.index("Itb_window")], abs=1e-9)
+    assert all(column[f"Itb_window@{face}"].max() > 0 for face in ("floor", "east_wall", "west_wall"))
+
+
+def test_a_traced_beam_split_alike_everywhere_is_the_untraced_building(testcell_data, weather):
+    """Where every face splits what falls on it as the window splits the untraced direct sun, the
+    traced inputs add up to that direct sun, and by superposition the temperatures are the same."""
+    split = {"floor": 0.5, "north_wall": 0.1}
+    same = {face: split for face in ("floor", "north_wall", "east_wall", "west_wall")}
+    days = weather.iloc[24 * 160:24 * 170]
+    traced = simulate_building(parse_building(traced_cell(testcell_data, same, split)), days)
+    plain = copy.deepcopy(traced_cell(testcell_data, residual=split))
+    del plain["components"][[c["name"] for c in plain["components"]].index("window")]["traced_beam"]
+    untraced = simulate_building(parse_building(plain), days)
+    assert np.abs(traced.to_numpy() - untraced.to_numpy()).max() < 1e-9
+    # and the split matters: the beam all absorbed where it falls is another building
+    absorbed = simulate_building(parse_building(traced_cell(testcell_data)), days)
+    assert np.abs(absorbed.to_numpy() - untraced.to_numpy()).max() > 0.01
+
+
+@pytest.mark.parametrize("edit, field", [
+    (lambda w, c: w.pop("diffuse_distribution"), "traced_beam"),
+    (lambda w, c: c["floor"].pop("vertices"), "traced_beam.floor"),
+    (lambda w, c: w["traced_beam"].update(attic={"floor": 0.5}), "traced_beam.attic"),
+    (lambda w, c: w["traced_beam"].update(floor={"floor": 0.7, "roof": 0.5}), "traced_beam.floor"),
+])
+def test_a_traced_beam_is_refused_without_what_it_needs(testcell_data, edit, field):
+    data = traced_cell(testcell_data)
+    components = {c["name"]: c for c in data["components"]}
+    edit(components["window"], components)
+    with pytest.raises(InputError) as e:
+        parse_building(data)
+    assert e.value.field.endswith(field)

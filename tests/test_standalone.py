@@ -23,6 +23,7 @@ from nodeforce.fmu_build.build import build_fmu
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.effects import EFFECTS
 from tests.importers import fmpy_validate, fmutool_check, run_ecos, run_fmpy, run_libcosim
+from tests.traced import traced_cell
 
 HOST = Path(__file__).with_name("c_host") / "host.c"
 HEADERS = Path(__file__).parents[1] / "fmu_build" / "c"
@@ -69,10 +70,10 @@ def shaded(data):
 @pytest.fixture(scope="module")
 def fmus(tmp_path_factory, testcell_data):
     """{(building, kind): FMU path} for the test cell, the two-zone building (its long-wave exchange
-    by a radiant node, and by ScriptF) and the shaded cell."""
+    by a radiant node, and by ScriptF), the shaded cell and the cell whose direct sun is traced."""
     folder = tmp_path_factory.mktemp("standalone")
     buildings = {"testcell": testcell_data, "two_zones": two_zones(testcell_data), "shaded": shaded(testcell_data),
-                 "two_zones_scriptf": scriptf(two_zones(testcell_data))}
+                 "two_zones_scriptf": scriptf(two_zones(testcell_data)), "traced": traced_cell(testcell_data)}
     return {(name, kind): build_fmu(parse_building(data), folder / f"{name}_{kind}.fmu", kind=kind)
             for name, data in buildings.items() for kind in KINDS}
 
@@ -144,7 +145,7 @@ def run_c_host(fmu, parameters, inputs, outputs, dt, n_steps, tmp_path, env=None
     return done, (np.loadtxt(done.stdout.splitlines(), ndmin=2) if done.returncode == 0 else None)
 
 
-@pytest.mark.parametrize("building", ["testcell", "two_zones", "shaded", "two_zones_scriptf"])
+@pytest.mark.parametrize("building", ["testcell", "two_zones", "shaded", "two_zones_scriptf", "traced"])
 def test_standalone_in_a_c_host_equals_the_python_fmu_in_fmpy(fmus, building, tmp_path):
     python_fmu, standalone = fmus[(building, "python")], fmus[(building, "standalone")]
     parameters, inputs, outputs, n_steps = scenario(python_fmu)
@@ -156,6 +157,12 @@ def test_standalone_in_a_c_host_equals_the_python_fmu_in_fmpy(fmus, building, tm
     assert np.ptp(reference[:, 22]) > 1.0
     measured = inputs["T_forced[9]"]
     assert np.array_equal(in_c[np.isfinite(measured), 8], measured[np.isfinite(measured)])
+    if building == "traced":  # each face's share of the direct sun is an input of its own
+        faces = [name for name in inputs if name.startswith("Itb_window@")]
+        assert len(faces) == 4
+        dark = run_fmpy(python_fmu, parameters, {**inputs, **{f: 0 * inputs[f] for f in faces}}, outputs, 900.0,
+                        n_steps)
+        assert np.abs(dark - reference).max() > 0.1
     if building == "shaded":  # the blind matters: the same run without it differs
         unshaded = run_fmpy(fmus[("testcell", "python")], parameters,
                             {name: x for name, x in inputs.items() if name != "blind"}, outputs, 900.0, n_steps)
