@@ -454,6 +454,39 @@ UNREAD_CONSTRUCTIONS = {
 }
 
 
+# The day types of a Schedule:Compact's "For:" field, each word singular or plural as EnergyPlus
+# reads it ("For: Weekday" is Monday to Friday; idfkit knows only some of the plurals, and the
+# 2019 prototypes' lighting schedules are written "Weekday")
+_FOR_WORDS = {"weekday": "Weekdays", "weekend": "Weekends", "allday": "AllDays", "allotherday": "AllOtherDays",
+              "holiday": "Holiday", "summerdesignday": "SummerDesignDay", "winterdesignday": "WinterDesignDay",
+              "customday1": "CustomDay1", "customday2": "CustomDay2",
+              **{d: d.title() for d in ("sunday", "monday", "tuesday", "wednesday", "thursday", "friday", "saturday")}}
+
+
+def compact_day_types(text):
+    """The day types (idfkit's names) of a Schedule:Compact "For:" field `text`, as EnergyPlus
+    reads them: words split by spaces or commas, each singular or plural, case aside. A word that
+    is no day type names no day, as idfkit has it (the 2019 small office's "Weedends", in a
+    schedule of its HVAC, which EnergyPlus runs)."""
+    types = set()
+    for word in re.split(r"[\s,]+", text.split(":", 1)[1].strip().lower()):
+        key = word[:-1] if word.endswith("s") and word[:-1] in _FOR_WORDS else word
+        if key in _FOR_WORDS:
+            types.add(_FOR_WORDS[key])
+    return types
+
+
+def _compact_periods(obj):
+    """idfkit's periods and interpolation of a Schedule:Compact, each rule's day types read as
+    EnergyPlus reads them (`compact_day_types`): each "For:" field makes one rule, in order."""
+    from dataclasses import replace
+    from idfkit.schedules import compact
+    periods, interpolation = compact.parse_compact(obj)
+    fields = [str(item.get("field") or "").strip() for item in obj.data.get("data") or []]
+    days = iter([compact_day_types(f) for f in fields if f.lower().startswith("for:")])
+    return [replace(p, day_rules=[replace(r, day_types=next(days)) for r in p.day_rules]) for p in periods], interpolation
+
+
 class _DaySchedules:
     """A schedule's values over the year `YEAR` on a time step, as idfkit evaluates them, but day by
     day: the document's holidays and special days found once (idfkit's `values` finds them again at
@@ -487,7 +520,7 @@ class _DaySchedules:
             return np.full((len(self.dates()), 24 * ts), value)
         rows = []
         if kind == "SCHEDULE:COMPACT":
-            periods, interpolation = compact.parse_compact(obj)
+            periods, interpolation = _compact_periods(obj)
             for d in self.dates():
                 period = compact._find_period_for_date(periods, d) if periods else None
                 rule = None if period is None else compact._find_matching_rule(

@@ -150,6 +150,43 @@ def test_schedules_evaluated_by_day_are_idfkits_values(tmp_path):
     assert set(mine.reshape(-1, 96)[day]) == {0.05}
 
 
+def test_a_for_field_reads_each_day_type_singular_or_plural(tmp_path):
+    """EnergyPlus reads "For: Weekday" as "Weekdays" (and Saturdays, Holidays, AllOtherDay ...):
+    the 2019 sit-down restaurant's dining lights, "For: Weekday" 13.693 h of full light a day
+    (its Until fields by hand), Saturday 12.857 h, "For: Sunday Holidays AllOtherDays" 10.511 h,
+    over 2017 (53 Sundays, 52 Saturdays, 260 weekdays, the 6 holidays here all weekdays):
+    (254 x 13.693 + 52 x 12.857 + 59 x 10.511) / 24 / 365 = 0.5442, as EnergyPlus's Zone Lights
+    Total Heating Rate over the year gives it (1304 W of 2401 W, 0.543, on the restaurant's own
+    holidays); a weekday read as no day falls to the Sunday profile (0.452). A Saturday of "For:
+    Saturdays" takes its own profile."""
+    import idfkit
+    text = HEADER + HOLIDAYS + """Schedule:Compact,
+  DINING,
+  Fraction,
+  Through: 12/31,
+  For: Weekday,
+  Until: 1:00,0.1407843825, Until: 5:00,0.15, Until: 6:00,0.18771251, Until: 8:00,0.37542502,
+  Until: 10:00,0.56313753, Until: 22:00,0.844706295, Until: 23:00,0.469281275, Until: 24:00,0.281568765,
+  For: Saturdays,
+  Until: 1:00,0.18771251, Until: 6:00,0.15, Until: 8:00,0.281568765, Until: 10:00,0.56313753,
+  Until: 17:00,0.75085004, Until: 22:00,0.844706295, Until: 23:00,0.469281275, Until: 24:00,0.281568765,
+  For: SummerDesignDay, Until: 24:00,1,
+  For: Sunday Holidays AllOtherDays,
+  Until: 1:00,0.18771251, Until: 6:00,0.15, Until: 8:00,0.281568765, Until: 10:00,0.469281275,
+  Until: 16:00,0.656993785, Until: 22:00,0.56313753, Until: 23:00,0.469281275, Until: 24:00,0.281568765;
+"""
+    path = write(tmp_path, text)
+    doc = idfkit.load_idf(str(path))
+    (dining,) = [o for o in doc.all_objects if o.obj_type == "Schedule:Compact"]
+    days = E._DaySchedules(doc).of(dining, 1)
+    assert days.mean() == pytest.approx((254 * 13.693 + 52 * 12.857 + 59 * 10.511) / 24 / 365, abs=1e-4)
+    assert days[1].sum() == pytest.approx(10.511, abs=1e-3)  # 2017-01-02, a Monday and a holiday
+    assert days[3].sum() == pytest.approx(13.693, abs=1e-3)  # Wednesday
+    assert days[6].sum() == pytest.approx(12.857, abs=1e-3)  # Saturday
+    assert days[7].sum() == pytest.approx(10.511, abs=1e-3)  # Sunday
+    assert E.compact_day_types("For: Weedends WinterDesignDay") == {"WinterDesignDay"}
+
+
 def twenty_zones():
     text = HEADER + OCCUPANCY + HOLIDAYS
     for k in range(20):
