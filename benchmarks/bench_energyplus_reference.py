@@ -107,15 +107,13 @@ def severe_error(folder):
 
 
 def beside(name, idf, out):
-    """(rows, stopped): the building `name` (its IDF at `idf`) beside EnergyPlus, its zones' and
+    """(rows, stopped): the building `name` (its IDF at `idf`, its weather converted into `out` by
+    `main`) beside EnergyPlus, its zones' and
     faces' rows (`bench_energyplus.compare`), or where EnergyPlus does not run it to its end, no
     rows and its first severe error."""
     epw = weather_of(idf)
-    weather = out / f"{epw.stem}.csv"
-    if not weather.exists():
-        convert_typical_year(epw, weather, year=YEAR)
     building = convert_idf(idf)
-    ours = simulate_building(building, ten_minutes(read_weather(weather)))
+    ours = simulate_building(building, ten_minutes(read_weather(out / f"{epw.stem}.csv")))
     try:
         air, faces = energyplus(idf, out / name, epw)
     except RuntimeError:

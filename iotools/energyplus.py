@@ -71,6 +71,17 @@ class Films:
 FILMS = Films()
 
 
+def _named_split(faces, shares):
+    """{component name: share} of a zone's `faces` (component, ...) and their `shares` (-), the
+    shares of one component's faces summed (a partition's two sides in the zone) and rounded to 6
+    places, the faces of no share left out."""
+    split = {}
+    for f, share in zip(faces, shares):
+        if share > 0:
+            split[f[0]["name"]] = split.get(f[0]["name"], 0.0) + float(share)
+    return {name: round(share, 6) for name, share in split.items()}
+
+
 def _sides(absorbed):
     """(outer, inner): the absorptances of a stack's panes (outside first) summed toward the face
     each is nearer, the outer half of the panes to the outside face, the inner half to the inside
@@ -2023,11 +2034,7 @@ class _Converter:
             for field, shares in (("solar_distribution", interior_sun.beam_fractions(area, alpha, tau, floor)),
                                   ("diffuse_distribution",
                                    interior_sun.window_diffuse_fractions(area, alpha, tau, view))):
-                split = {}
-                for f, share in zip(own, shares):
-                    if share > 0:
-                        split[f[0]["name"]] = split.get(f[0]["name"], 0.0) + float(share)
-                c[field] = {name: round(share, 6) for name, share in split.items()}
+                c[field] = _named_split(own, shares)
             if traced:
                 self.trace_beam(c, own, area, alpha, tau)
         for c in components:
@@ -2052,22 +2059,14 @@ class _Converter:
                 continue
             if not interior_sun.may_receive_beam(self.ccw_polygon(c), self.ccw_polygon(f[0])):
                 continue
-            shares = interior_sun.beam_fractions(area, alpha, tau, np.arange(len(own)) == k)
-            split = {}
-            for g, share in zip(own, shares):
-                if share > 0:
-                    split[g[0]["name"]] = split.get(g[0]["name"], 0.0) + float(share)
-            beam[f[0]["name"]] = {name: round(share, 6) for name, share in split.items()}
+            beam[f[0]["name"]] = _named_split(own, interior_sun.beam_fractions(area, alpha, tau,
+                                                                              np.arange(len(own)) == k))
             self.give_polygon(f[0])
         if not beam:
             return
         self.give_polygon(c)
         c["traced_beam"] = beam
-        diffuse = {}
-        for g, share in zip(own, interior_sun.diffuse_fractions(area, alpha, tau)):
-            if share > 0:
-                diffuse[g[0]["name"]] = diffuse.get(g[0]["name"], 0.0) + float(share)
-        c["solar_distribution"] = {name: round(share, 6) for name, share in diffuse.items()}
+        c["solar_distribution"] = _named_split(own, interior_sun.diffuse_fractions(area, alpha, tau))
 
     def has_plane(self, c):
         """Whether a component has a surface polygon that faces as it does, as the building file
