@@ -31,7 +31,10 @@ found at run time.
 Both programs read the IDF with 6 time steps an hour (its `Timestep` replaced), nodeforce on the
 hourly weather interpolated onto 10-min steps. Each program's hourly values are the means of the
 hour's steps, as EnergyPlus's own hourly report averages them; its 10-min values, the state at
-each step's end.
+each step's end. EnergyPlus runs the IDF again at `FINE_STEPS` an hour (`--fine-steps`), its
+zones' air hourly: nodeforce's hourly air beside it, and EnergyPlus's own at 6 steps beside it
+(the error of EnergyPlus's step, in OUT/comparison.csv's steps "hourly beside EnergyPlus at
+60/h" and "EnergyPlus at 6/h beside itself at 60/h").
 
 An IDF is brought to EnergyPlus 25.2 by copying every object by its field names into a 25.2
 document (idfkit; the fields 25.2 renamed mapped, its new ones left to their defaults) and
@@ -65,6 +68,9 @@ from nodeforce.model.weather import weather_on_grid  # noqa: E402
 PACKAGE_WEATHER = Path("data") / "weather" / "USA_CO_Denver-Aurora-Buckley.AFB.724695_TMY3.epw"
 YEAR = 2017
 STEPS = 6  # time steps an hour, both programs: EnergyPlus reports each 10-min step
+# EnergyPlus's steps an hour where its answer is taken as converged in time: beside it, its answer
+# at STEPS and nodeforce's
+FINE_STEPS = 60
 SUN_UPDATE_DAYS = 1  # EnergyPlus's sun position and shading recomputed every day
 EVERY_STEP = {variable: "Timestep" for variable in (ZONE_AIR, FACE, *OUTSIDE)}
 # The run's own objects, replaced; HVAC and thermostats go too: both programs run free-floating
@@ -101,9 +107,9 @@ def free_year(doc, outputs):
     return doc
 
 
-def to_energyplus_25(doc):
-    """A 25.2 document of the building of `doc`, free-floating, reporting the zones' mean air and
-    the faces' inside temperatures at each time step."""
+def to_energyplus_25(doc, outputs=EVERY_STEP):
+    """A 25.2 document of the building of `doc`, free-floating, reporting `outputs` (`free_year`):
+    by default the zones' mean air and the faces' inside temperatures at each time step."""
     new = idfkit.new_document(version=(25, 2, 0))
     for obj in list(new.all_objects):  # the defaults of a new document give way to the model's own
         if obj.obj_type != "Version":
@@ -124,7 +130,7 @@ def to_energyplus_25(doc):
             new.add(obj.obj_type, name, {RENAMED.get(k, k): v for k, v in fields.items()})
         except idfkit.exceptions.ValidationFailedError:
             new.add(obj.obj_type, name, fields)
-    return free_year(new, EVERY_STEP)
+    return free_year(new, outputs)
 
 
 def with_steps(doc, steps=STEPS):
@@ -189,14 +195,33 @@ def compare(model, building, doc, ours, theirs, lag, step):
     series += [(faced[node], face, node, faces[face]) for face, node in nodes.items()]
     ours_t, theirs_t = paired(ours[[f"T{n}" for _, _, n, _ in series]],
                               pd.concat([s for *_, s in series], axis=1, keys=range(len(series))), lag)
-    rows = []
-    for k, (zone, face, node, _) in enumerate(series):
-        T, E = ours_t[f"T{node}"].to_numpy(float), theirs_t[k].to_numpy(float)
-        rmse, mean = differences(T, E)
-        rows.append({"model": model, "zone": zone, "face": face, "step": step, "rmse": rmse, "mean_difference": mean,
-                     "nodeforce_min": T.min(), "nodeforce_max": T.max(), "nodeforce_mean": T.mean(),
-                     "energyplus_min": E.min(), "energyplus_max": E.max(), "energyplus_mean": E.mean()})
+    rows = [row(model, zone, face, step, ours_t[f"T{node}"], theirs_t[k])
+            for k, (zone, face, node, _) in enumerate(series)]
     return rows, unpaired
+
+
+def row(model, zone, face, step, ours, theirs):
+    """A row of the table: RMSE, mean difference (ours - theirs, K) and each series' range and mean."""
+    T, E = np.asarray(ours, float), np.asarray(theirs, float)
+    rmse, mean = differences(T, E)
+    return {"model": model, "zone": zone, "face": face, "step": step, "rmse": rmse, "mean_difference": mean,
+            "nodeforce_min": T.min(), "nodeforce_max": T.max(), "nodeforce_mean": T.mean(),
+            "energyplus_min": E.min(), "energyplus_max": E.max(), "energyplus_mean": E.mean()}
+
+
+def own_step_rows(model, building, mine, theirs, converged, steps):
+    """Rows of each zone's hourly air: nodeforce's (`mine`) beside EnergyPlus's at `steps` an hour
+    (`converged`), and EnergyPlus's at STEPS (`theirs`) beside its own at `steps` (in the
+    nodeforce columns): how far EnergyPlus's answer at the IDF's steps is from its own with its
+    steps made small."""
+    rows, common = [], theirs.index.intersection(converged.index)
+    for z in building.zones:
+        key = z.name.upper()
+        rows.append(row(model, key, "air", f"hourly beside EnergyPlus at {steps}/h",
+                        *paired(mine[f"T{z.air_node}"], converged[key], "0min")))
+        rows.append(row(model, key, "air", f"EnergyPlus at {STEPS}/h beside itself at {steps}/h",
+                        theirs.loc[common, key], converged.loc[common, key]))
+    return rows
 
 
 def markdown(table):
@@ -205,17 +230,22 @@ def markdown(table):
                              sort=False)
     lines = ["| model | zone | face | RMSE hourly (K) | mean difference hourly (K) | RMSE 10 min (K) | "
              "mean difference 10 min (K) |", "|---|---|---|---|---|---|---|"]
-    for (model, zone, face), row in wide.iterrows():
-        lines.append(f"| {model} | {zone} | {face} | {row['rmse', 'hourly']:.2f} | {row['mean_difference', 'hourly']:+.2f} "
-                     f"| {row['rmse', '10 min']:.2f} | {row['mean_difference', '10 min']:+.2f} |")
+    for (model, zone, face), r in wide.iterrows():
+        lines.append(f"| {model} | {zone} | {face} | {r['rmse', 'hourly']:.2f} | {r['mean_difference', 'hourly']:+.2f} "
+                     f"| {r['rmse', '10 min']:.2f} | {r['mean_difference', '10 min']:+.2f} |")
     return "\n".join(lines)
 
 
 def zone_markdown(table):
     """The Markdown table of each zone: its air's RMSE / mean difference hourly and at 10 min, its
-    faces' median RMSE hourly and at 10 min, and its worst face hourly."""
+    faces' median RMSE hourly and at 10 min, and its worst face hourly; where EnergyPlus also ran
+    with small steps (`own_step_rows`), the air's hourly RMSE beside that run, and EnergyPlus's
+    own at STEPS beside it."""
+    own = [s for s in table.step.unique() if s not in ("hourly", "10 min")]
     lines = ["| model | zone | air RMSE hourly / 10 min (K) | air mean difference hourly / 10 min (K) | faces | "
-             "face RMSE median hourly / 10 min (K) | worst face hourly (K) |", "|---|---|---|---|---|---|---|"]
+             "face RMSE median hourly / 10 min (K) | worst face hourly (K) |"
+             + "".join(f" air RMSE {s} (K) |" for s in own),
+             "|---|---|---|---|---|---|---|" + "---|" * len(own)]
     for (model, zone), g in table.groupby(["model", "zone"], sort=False):
         air = g[g.face == "air"].set_index("step")
         faces = g[g.face != "air"]
@@ -224,7 +254,8 @@ def zone_markdown(table):
         median = faces.groupby("step").rmse.median()
         lines.append(f"| {model} | {zone} | {air.rmse['hourly']:.2f} / {air.rmse['10 min']:.2f} | "
                      f"{air.mean_difference['hourly']:+.2f} / {air.mean_difference['10 min']:+.2f} | {len(hourly)} | "
-                     f"{median['hourly']:.2f} / {median['10 min']:.2f} | {worst.rmse:.2f} ({worst.face}) |")
+                     f"{median['hourly']:.2f} / {median['10 min']:.2f} | {worst.rmse:.2f} ({worst.face}) |"
+                     + "".join(f" {air.rmse[s]:.2f} |" for s in own))
     return "\n".join(lines)
 
 
@@ -233,10 +264,12 @@ def summary(table):
     lines = []
     for step, g in table.groupby("step", sort=False):
         air, faces = g[g.face == "air"], g[g.face != "air"]
-        worst = faces.loc[faces.rmse.idxmax()]
-        lines.append(f"{step}: zone air RMSE median {air.rmse.median():.2f} K, largest {air.rmse.max():.2f} K "
-                     f"({len(air)} zones); inside faces median {faces.rmse.median():.2f} K, largest "
-                     f"{worst.rmse:.2f} K ({worst.model} {worst.face}; {len(faces)} faces)")
+        line = f"{step}: zone air RMSE median {air.rmse.median():.2f} K, largest {air.rmse.max():.2f} K ({len(air)} zones)"
+        if len(faces):
+            worst = faces.loc[faces.rmse.idxmax()]
+            line += (f"; inside faces median {faces.rmse.median():.2f} K, largest {worst.rmse:.2f} K "
+                     f"({worst.model} {worst.face}; {len(faces)} faces)")
+        lines.append(line)
     return "\n".join(lines)
 
 
@@ -284,7 +317,7 @@ def declared(building, sky_diffuse):
     return building.edited(lambda data: data["site"].__setitem__("sky_diffuse", sky_diffuse))
 
 
-def main(out, epw, only=None, figure_path=None, sky_diffuse=None):
+def main(out, epw, only=None, figure_path=None, sky_diffuse=None, fine_steps=FINE_STEPS):
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     convert_typical_year(epw, out / "weather.csv", year=YEAR)
@@ -307,18 +340,27 @@ def main(out, epw, only=None, figure_path=None, sky_diffuse=None):
         mine = hourly_means(ours)
         new, unpaired = compare(name, building, doc, mine, (hourly_means(air), hourly_means(faces)), "0min", "hourly")
         fine_rows, _ = compare(name, building, doc, ours, (air, faces), "0min", "10 min")
-        rows += new + fine_rows
         for face, why in unpaired.items():
             print(f"{name}: EnergyPlus's face {face} not compared: {why}")
         for z in building.zones:
             weeks[(name, z.name.upper())] = worst_week(*paired(ours[f"T{z.air_node}"], air[z.name.upper()], "0min"))
-        for row in new + fine_rows:
-            if row["face"] == "air":
-                print(f"{name:12} {row['zone']:12} {row['step']:7} RMSE {row['rmse']:.2f} K, mean difference "
-                      f"{row['mean_difference']:+.2f} K; nodeforce {row['nodeforce_min']:.2f} / "
-                      f"{row['nodeforce_max']:.2f} / {row['nodeforce_mean']:.2f}, EnergyPlus "
-                      f"{row['energyplus_min']:.2f} / {row['energyplus_max']:.2f} / {row['energyplus_mean']:.2f} C",
+        if fine_steps:
+            # EnergyPlus again with its steps made small: its own answer's distance from the one at STEPS
+            small = folder / f"steps_{fine_steps}"
+            small.mkdir(exist_ok=True)
+            idfkit.save_idf(to_energyplus_25(with_steps(make(), fine_steps), {ZONE_AIR: "Hourly"}),
+                            str(small / "model_25_2.idf"))
+            run_energyplus(small / "model_25_2.idf", small, epw)
+            fine_rows += own_step_rows(name, building, mine, hourly_means(air), read_outputs(small, YEAR)[0],
+                                       fine_steps)
+        for r in new + fine_rows:
+            if r["face"] == "air":
+                print(f"{name:12} {r['zone']:12} {r['step']:7} RMSE {r['rmse']:.2f} K, mean difference "
+                      f"{r['mean_difference']:+.2f} K; nodeforce {r['nodeforce_min']:.2f} / "
+                      f"{r['nodeforce_max']:.2f} / {r['nodeforce_mean']:.2f}, EnergyPlus "
+                      f"{r['energyplus_min']:.2f} / {r['energyplus_max']:.2f} / {r['energyplus_mean']:.2f} C",
                       flush=True)
+        rows += new + fine_rows
     table = pd.DataFrame(rows)
     table.to_csv(out / "comparison.csv", index=False, float_format="%.3f")
     figure(table, weeks, figure_path or out / "energyplus_faces.png")
@@ -333,6 +375,9 @@ if __name__ == "__main__":
     parser.add_argument("--only", nargs="+", choices=list(models()), help="run these models alone")
     parser.add_argument("--figure", type=Path, help="where the figure goes (default: OUT/energyplus_faces.png)")
     parser.add_argument("--sky-diffuse", choices=SKY_MODELS, help="replace the site's sky_diffuse in each building")
+    parser.add_argument("--fine-steps", type=int, default=FINE_STEPS,
+                        help=f"EnergyPlus again at this many steps an hour, beside its answer at {STEPS} and "
+                             f"nodeforce's (0: not run; default {FINE_STEPS})")
     args = parser.parse_args()
     try:
         epw = args.weather or package_weather()
@@ -340,4 +385,4 @@ if __name__ == "__main__":
         sys.exit(print("bench_energyplus needs EnergyPlus: pip install -e '.[energyplus]'", file=sys.stderr) or 2)
     if not epw.is_file():
         sys.exit(print(f"{epw}: no such weather file", file=sys.stderr) or 2)
-    main(args.out, epw, args.only, args.figure, args.sky_diffuse)
+    main(args.out, epw, args.only, args.figure, args.sky_diffuse, args.fine_steps)

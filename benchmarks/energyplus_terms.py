@@ -32,6 +32,7 @@ from nodeforce.iotools.typical_year import convert_typical_year  # noqa: E402
 from nodeforce.iotools.weather import read_weather  # noqa: E402
 from nodeforce.model.case import measured_case, simulate_building  # noqa: E402
 from nodeforce.model.convection import iso15099_inside, lagged_excess, tarp_inside_faces  # noqa: E402
+from nodeforce.model.longwave import pair_coefficient  # noqa: E402
 from nodeforce.model.network import air_conductance, assemble  # noqa: E402
 
 SUN_IN = "Surface Inside Face Solar Radiation Heat Gain Rate per Area"
@@ -98,6 +99,20 @@ def inside_coefficients(network, T):
     return out
 
 
+def exchange_conductances(network, T):
+    """{(a, b) node ids: (rows,) W/K} of each pair of faces whose long-wave exchange follows their
+    temperatures (a followed ScriptF, docs/model.md 3.6), about the step matrix's G0 as the network's
+    lagged source takes it; pairs not listed exchange through the step matrix's A alone."""
+    conv, out = network.convection, {}
+    if conv is None:
+        return out
+    temperatures = T.to_numpy(float)
+    for (a, b), (exchange, g0) in zip(conv.pair_nodes, conv.pairs):
+        G = g0 + lagged_excess(exchange * pair_coefficient(temperatures[:, a], temperatures[:, b]), g0)
+        out[(a + 1, b + 1)] = out[(b + 1, a + 1)] = G
+    return out
+
+
 def multipliers(doc):
     """{surface name (upper case): its Multiplier} of the IDF's windows and doors that declare one."""
     return {o.name.upper(): float(o.to_dict()["multiplier"]) for o in doc.all_objects
@@ -113,7 +128,8 @@ def terms(name, building, doc, network, U, T, theirs):
     when = T.index.intersection(theirs[ZONE_AIR].index)
     T, U = T.loc[when], U.loc[when]
     sun = pd.DataFrame(sun_sources(network, U), index=when)
-    followed = inside_coefficients(network, T[[f"T{i}" for i in range(1, network.n_nodes + 1)]])
+    nodes_T = T[[f"T{i}" for i in range(1, network.n_nodes + 1)]]
+    followed, exchange = inside_coefficients(network, nodes_T), exchange_conductances(network, nodes_T)
     rows = []
 
     def row(zone, key, term, ours, ep, unit):
@@ -142,7 +158,8 @@ def terms(name, building, doc, network, U, T, theirs):
             add(zone, key, "convective coefficient", h, H_IN, unit="W/m2/K")
             add(zone, key, "convection from the air", c.area * h * (air - Ts), CONVECTION)
             add(zone, key, "net long-wave from the faces",
-                sum(network.A[s, j - 1] * (T[f"T{j}"].to_numpy(float) - Ts) for j in faces if j != node), LONGWAVE)
+                sum(exchange.get((node, j), network.A[s, j - 1]) * (T[f"T{j}"].to_numpy(float) - Ts)
+                    for j in faces if j != node), LONGWAVE)
             if c.solar_transmittance and node == c.node_ids[0]:
                 names = [n for n, _ in c.sun_inputs if n != c.irradiance_input]
                 incident = U[f"I_{c.name}"].to_numpy(float)
