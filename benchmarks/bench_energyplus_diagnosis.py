@@ -190,8 +190,8 @@ def page(lines, command):
         *("- " + " ".join(line.strip() for line in item.splitlines()).lstrip("- ")
           for item in doc[2].split("\n- ")), "",
         f"Here `START` is {records.START} ({records.YEAR}'s calendar), `DAYS` {records.DAYS}, `LATER_GAP_DAYS` "
-        f"{records.LATER_GAP_DAYS}, `RUN_BEFORE_DAYS` {records.RUN_BEFORE_DAYS}, `STEP_MIN` {records.STEP_MIN} "
-        f"and `NOISE` {records.NOISE} C.", "",
+        f"{records.LATER_GAP_DAYS}, `RUN_BEFORE_DAYS` {records.RUN_BEFORE_DAYS}, `ENERGYPLUS_STEPS` "
+        f"{records.ENERGYPLUS_STEPS}, `STEP_MIN` {records.STEP_MIN} and `NOISE` {records.NOISE} C.", "",
         "Each record, under each noise draw, is diagnosed through the public API (`nodeforce.api.convert_idf`, "
         "`nodeforce.api.diagnose`) with the command line's settings: GA population 30, at most 400 generations, "
         "seed 0, one worker, the sensors' noise (0.1 C) given, one day of burn-in, the weather read from the "

@@ -121,10 +121,10 @@ def test_the_faultless_record_is_the_building_as_written(tmp_path):
             sorted((o.obj_type, str(o.to_dict())) for o in original.all_objects)
 
 
-def test_energyplus_runs_the_record_and_the_later_record_at_10_min():
+def test_energyplus_runs_the_record_and_the_later_record_at_1_min_steps():
     doc = records.run_document(records.building_document("600FF"))
     timestep, = doc["Timestep"]
-    assert int(timestep.number_of_timesteps_per_hour) == 6
+    assert int(timestep.number_of_timesteps_per_hour) == 60  # its answer converged in time
     period, = doc["RunPeriod"]
     p = records.periods()
     assert (int(period.begin_month), int(period.begin_day_of_month)) == (3, 18)  # 14 days before 1 April
@@ -134,16 +134,28 @@ def test_energyplus_runs_the_record_and_the_later_record_at_10_min():
     assert {o.reporting_frequency for o in doc["Output:Variable"]} == {"Timestep"}
 
 
-def test_steps_and_samples_keep_the_times_energyplus_gives():
+def test_steps_keep_the_times_energyplus_gives():
     table = pd.DataFrame({"Date/Time": [" 04/01  00:10:00", " 04/01  24:00:00"],
                           "CASE 600 ZONE:Zone Mean Air Temperature [C](TimeStep)": [20.0, 21.0],
                           "ROOF:Surface Inside Face Temperature [C](TimeStep)": [19.0, 18.0]})
     steps = records.read_steps(table)
     assert list(steps.index) == [pd.Timestamp("2017-04-01 00:10"), pd.Timestamp("2017-04-02 00:00")]
     assert list(steps.columns) == [ZONE, "ROOF"]
+
+
+def test_the_sensors_read_every_10_min_of_energyplus_1_min_steps():
+    first, last = records.periods()["record"]
+    times = pd.date_range(first - pd.Timedelta(minutes=9), last, freq="1min")
+    minutes = (times - times[0]).total_seconds().to_numpy() / 60.0
+    steps = pd.DataFrame({ZONE: minutes, "ROOF": -minutes}, index=times)
     part = records.sample(steps, "record", {"T44": ZONE, "T36": "ROOF"}, -6.0)
     assert part.index[0].isoformat() == "2017-04-01T00:10:00-06:00"
-    assert part.loc[part.index[-1], "T36"] == 18.0
+    assert len(part) == records.DAYS * 144
+    # each reading is EnergyPlus's step ending at its time: 9 + 10 k minutes after the first step
+    assert np.array_equal(part["T44"].to_numpy(), 9.0 + 10.0 * np.arange(len(part)))
+    assert np.array_equal(part["T36"].to_numpy(), -part["T44"].to_numpy())
+    with pytest.raises(KeyError):  # a reading EnergyPlus has no step for is not invented
+        records.sample(steps.drop(pd.Timestamp("2017-04-10 12:00")), "record", {"T44": ZONE}, -6.0)
 
 
 def test_noise_is_the_same_for_the_same_record_and_draw():
