@@ -91,9 +91,7 @@ def _sides(absorbed):
     return float(sum(absorbed[:n // 2]) + middle), float(sum(absorbed[(n + 1) // 2:]) + middle)
 
 
-# An air flow's temperature term is taken at this indoor-outdoor difference, its wind terms at the
-# zone's wind (FILMS.wind at the station, at the height of the zone's surfaces' centroids)
-AIRFLOW_DELTA_T = 10.0  # K
+# An air flow's wind is the station's at the height of the zone's surfaces' centroids
 FLOW_WIND_HEIGHT = 1.5  # m, a zone's height where its surfaces give none
 # A surface's vertices off its plane: listed beyond 2 cm, refused beyond a tenth of its size
 PLANAR_LISTED, PLANAR_REFUSED = 0.02, 0.1  # m, fraction of sqrt(area)
@@ -1390,7 +1388,8 @@ class _Converter:
 
     def air_flows(self, z, volume, floor, exterior, walls, wind_height=FLOW_WIND_HEIGHT):
         """The zone's constant outdoor air flow (m3/h) from its design flow rate objects, and its
-        scheduled ones (the building file's `ventilation`)."""
+        scheduled ones and those that follow the temperatures or the wind (the building file's
+        `ventilation`), the wind taken to the zone's height `wind_height` (m)."""
         total, scheduled = 0.0, []
         for kind in FLOWS:
             for o in self.r.all(kind):
@@ -1410,20 +1409,19 @@ class _Converter:
                                 "Flow/ExteriorArea, Flow/ExteriorWallArea, AirChanges/Hour are)")
                 field, scale = per[method]
                 flow = self.design_value(o, field) * sum(scale(m) for m in places)
-                # EnergyPlus's flow is the design flow times A + B |dT| + C v + D v^2; the building
-                # file's flows do not vary with either, so the terms are taken at a stated |dT| and
-                # the zone's wind
-                A = self.r.number(o, "constant_term_coefficient", default=1.0)
-                B, C, D = (self.r.number(o, f, default=0.0) for f in (
-                    "temperature_term_coefficient", "velocity_term_coefficient", "velocity_squared_term_coefficient"))
-                if B or C or D:
-                    v = float(convection.wind_at_height(FILMS.wind, wind_height, self.terrain))
-                    A = A + B * AIRFLOW_DELTA_T + C * v + D * v * v
-                    self.not_modelled.append(
-                        f"{kind} {o.name}: its temperature and wind terms (B {B:g}, C {C:g}, D {D:g}) taken at "
-                        f"|dT| {AIRFLOW_DELTA_T:g} K and the zone's wind {v:.2f} m/s ({FILMS.wind:g} m/s at the "
-                        f"station): A + B |dT| + C v + D v^2 = {A:.4g}, the building file's air flows do not vary "
-                        "with temperature or wind")
+                # EnergyPlus's flow is the design flow times max(0, A + B |dT| + C v + D v^2), v the
+                # wind at the zone's height: the building file's `terms`, followed step by step
+                terms = [self.r.number(o, "constant_term_coefficient", default=1.0)] + [
+                    self.r.number(o, f, default=0.0) for f in ("temperature_term_coefficient",
+                                                               "velocity_term_coefficient",
+                                                               "velocity_squared_term_coefficient")]
+                entry = {"name": o.name}
+                if any(terms[1:]):
+                    entry["terms"] = terms
+                else:
+                    flow *= terms[0]
+                if terms[2] or terms[3]:
+                    entry["wind_factor"] = round(float(convection.wind_at_height(1.0, wind_height, self.terrain)), 6)
                 if kind == "ZoneVentilation:DesignFlowRate":
                     limits = [_field_label(o, f) for f in ("minimum_indoor_temperature", "maximum_indoor_temperature",
                                                            "delta_temperature", "minimum_outdoor_temperature",
@@ -1437,10 +1435,15 @@ class _Converter:
                 if value is None:
                     if np.min([v for p in self.schedules[name]["days"].values() for _, v in p]) < 0:
                         self.r.fail(o, "Schedule Name", f"{name!r} takes negative values: an air flow is >= 0")
-                    if flow * A > 0:
-                        scheduled.append({"name": o.name, "flow": flow * A, "schedule": name})
+                    entry.update(flow=flow, schedule=name)
                 else:
-                    total += flow * A * value
+                    entry["flow"] = flow * value
+                if entry["flow"] <= 0:
+                    continue
+                if len(entry) > 2:
+                    scheduled.append(entry)
+                else:
+                    total += entry["flow"]
         return total, scheduled
 
     def gains(self, z, floor):
