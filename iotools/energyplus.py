@@ -1388,8 +1388,8 @@ class _Converter:
 
     def air_flows(self, z, volume, floor, exterior, walls, wind_height=FLOW_WIND_HEIGHT):
         """The zone's constant outdoor air flow (m3/h) from its design flow rate objects, and its
-        scheduled ones and those that follow the temperatures or the wind (the building file's
-        `ventilation`), the wind taken to the zone's height `wind_height` (m)."""
+        scheduled ones and those that follow the temperatures, the wind or controls (the building
+        file's `ventilation`), the wind taken to the zone's height `wind_height` (m)."""
         total, scheduled = 0.0, []
         for kind in FLOWS:
             for o in self.r.all(kind):
@@ -1415,21 +1415,13 @@ class _Converter:
                     self.r.number(o, f, default=0.0) for f in ("temperature_term_coefficient",
                                                                "velocity_term_coefficient",
                                                                "velocity_squared_term_coefficient")]
-                entry = {"name": o.name}
-                if any(terms[1:]):
+                entry = {"name": o.name, **(self.ventilation_controls(o) if kind == FLOWS[1] else {})}
+                if any(terms[1:]) or "controls" in entry and terms[0] != 1.0:
                     entry["terms"] = terms
-                else:
+                if "terms" not in entry and "controls" not in entry:
                     flow *= terms[0]
-                if terms[2] or terms[3]:
+                if "terms" in entry and (terms[2] or terms[3]) or "maximum_wind_speed" in entry.get("controls", {}):
                     entry["wind_factor"] = round(float(convection.wind_at_height(1.0, wind_height, self.terrain)), 6)
-                if kind == "ZoneVentilation:DesignFlowRate":
-                    limits = [_field_label(o, f) for f in ("minimum_indoor_temperature", "maximum_indoor_temperature",
-                                                           "delta_temperature", "minimum_outdoor_temperature",
-                                                           "maximum_outdoor_temperature", "maximum_wind_speed")
-                              if not _blank(_field(o, f))]
-                    if limits:
-                        self.not_modelled.append(f"{kind} {o.name}: its controls ({', '.join(limits)}) not held; "
-                                                 "the flow runs as scheduled")
                 name = self.r.text(o, "schedule_name")
                 value = self.constant_schedule_value(name, o, "Schedule Name") if name else 1.0
                 if value is None:
@@ -1445,6 +1437,25 @@ class _Converter:
                 else:
                     total += entry["flow"]
         return total, scheduled
+
+    def ventilation_controls(self, o):
+        """{"controls": {...}} of a ZoneVentilation:DesignFlowRate's limits that it declares (the
+        building file's ventilation controls; their schedules, where declared, are not held)."""
+        controls, scheduled = {}, []
+        for field, schedule in (("minimum_indoor_temperature", "minimum_indoor_temperature_schedule_name"),
+                                ("maximum_indoor_temperature", "maximum_indoor_temperature_schedule_name"),
+                                ("delta_temperature", "delta_temperature_schedule_name"),
+                                ("minimum_outdoor_temperature", "minimum_outdoor_temperature_schedule_name"),
+                                ("maximum_outdoor_temperature", "maximum_outdoor_temperature_schedule_name"),
+                                ("maximum_wind_speed", None)):
+            if not _blank(_field(o, field)):
+                controls[field] = self.r.number(o, field)
+            if schedule is not None and not _blank(_field(o, schedule)):
+                scheduled.append(_field_label(o, schedule))
+        if scheduled:
+            self.not_modelled.append(f"ZoneVentilation:DesignFlowRate {o.name}: its control schedules "
+                                     f"({', '.join(scheduled)}) not held; its constant limits are")
+        return {"controls": controls} if controls else {}
 
     def gains(self, z, floor):
         out = []

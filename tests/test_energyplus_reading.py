@@ -465,6 +465,23 @@ def test_an_infiltrations_wind_and_temperature_terms_are_followed(tmp_path):
     assert not any("INFILTRATION" in line for line in b.data["not_modelled"])
 
 
+def test_a_ventilation_s_controls_are_held(tmp_path):
+    """A 2019 warehouse's exhaust: 37.76 m3/s that runs above 29.44 C indoors, its other limits at
+    EnergyPlus's defaults; a limit by schedule is said not held."""
+    vent = ("ZoneVentilation:DesignFlowRate,\n  EXHAUST,\n  CASE 600 ZONE,\n  CONTINUOUS,\n  Flow/Zone,\n"
+            "  37.76,\n  ,\n  ,\n  ,\n  Exhaust,\n  31.1,\n  0.51,\n  1,\n  0,\n  0,\n  0,\n  29.44,\n  ,\n"
+            "  100,\n  ,\n  -100,\n  ,\n  -100,\n  ,\n  100,\n  {},\n  40;\n")
+    b = convert_idf(write(tmp_path, TEXT + vent.format("")))
+    (v,) = b.zones[0].ventilation
+    assert v.flow == pytest.approx(37.76 * 3600)
+    assert (v.terms, v.controls) == (None, (29.44, 100.0, -100.0, -100.0, 100.0, 40.0))
+    assert b.zones[0].air_change_rate == pytest.approx(0.5)  # the infiltration stays constant
+    assert not any("EXHAUST" in line for line in b.data["not_modelled"])
+    b = convert_idf(write(tmp_path, TEXT + vent.format("CONTINUOUS")))
+    assert any(line.startswith("ZoneVentilation:DesignFlowRate EXHAUST: its control schedules (Maximum Outdoor "
+                               "Temperature Schedule Name) not held") for line in b.data["not_modelled"])
+
+
 def test_a_lights_return_air_fraction_leaves_with_the_return_air(tmp_path):
     """480 W of lights, 0.4 to the return air, 0.4 radiant and 0.2 visible: the zone gets 0.6 of
     it, (0.4 + 0.2) / 0.6 of that radiant; EnergyPlus free-floating gives the return air's share
