@@ -91,9 +91,7 @@ def _sides(absorbed):
     return float(sum(absorbed[:n // 2]) + middle), float(sum(absorbed[(n + 1) // 2:]) + middle)
 
 
-# An air flow's temperature term is taken at this indoor-outdoor difference, its wind terms at the
-# zone's wind (FILMS.wind at the station, at the height of the zone's surfaces' centroids)
-AIRFLOW_DELTA_T = 10.0  # K
+# An air flow's wind is the station's at the height of the zone's surfaces' centroids
 FLOW_WIND_HEIGHT = 1.5  # m, a zone's height where its surfaces give none
 # A surface's vertices off its plane: listed beyond 2 cm, refused beyond a tenth of its size
 PLANAR_LISTED, PLANAR_REFUSED = 0.02, 0.1  # m, fraction of sqrt(area)
@@ -1390,7 +1388,8 @@ class _Converter:
 
     def air_flows(self, z, volume, floor, exterior, walls, wind_height=FLOW_WIND_HEIGHT):
         """The zone's constant outdoor air flow (m3/h) from its design flow rate objects, and its
-        scheduled ones (the building file's `ventilation`)."""
+        scheduled ones and those that follow the temperatures, the wind or controls (the building
+        file's `ventilation`), the wind taken to the zone's height `wind_height` (m)."""
         total, scheduled = 0.0, []
         for kind in FLOWS:
             for o in self.r.all(kind):
@@ -1410,38 +1409,53 @@ class _Converter:
                                 "Flow/ExteriorArea, Flow/ExteriorWallArea, AirChanges/Hour are)")
                 field, scale = per[method]
                 flow = self.design_value(o, field) * sum(scale(m) for m in places)
-                # EnergyPlus's flow is the design flow times A + B |dT| + C v + D v^2; the building
-                # file's flows do not vary with either, so the terms are taken at a stated |dT| and
-                # the zone's wind
-                A = self.r.number(o, "constant_term_coefficient", default=1.0)
-                B, C, D = (self.r.number(o, f, default=0.0) for f in (
-                    "temperature_term_coefficient", "velocity_term_coefficient", "velocity_squared_term_coefficient"))
-                if B or C or D:
-                    v = float(convection.wind_at_height(FILMS.wind, wind_height, self.terrain))
-                    A = A + B * AIRFLOW_DELTA_T + C * v + D * v * v
-                    self.not_modelled.append(
-                        f"{kind} {o.name}: its temperature and wind terms (B {B:g}, C {C:g}, D {D:g}) taken at "
-                        f"|dT| {AIRFLOW_DELTA_T:g} K and the zone's wind {v:.2f} m/s ({FILMS.wind:g} m/s at the "
-                        f"station): A + B |dT| + C v + D v^2 = {A:.4g}, the building file's air flows do not vary "
-                        "with temperature or wind")
-                if kind == "ZoneVentilation:DesignFlowRate":
-                    limits = [_field_label(o, f) for f in ("minimum_indoor_temperature", "maximum_indoor_temperature",
-                                                           "delta_temperature", "minimum_outdoor_temperature",
-                                                           "maximum_outdoor_temperature", "maximum_wind_speed")
-                              if not _blank(_field(o, f))]
-                    if limits:
-                        self.not_modelled.append(f"{kind} {o.name}: its controls ({', '.join(limits)}) not held; "
-                                                 "the flow runs as scheduled")
+                # EnergyPlus's flow is the design flow times max(0, A + B |dT| + C v + D v^2), v the
+                # wind at the zone's height: the building file's `terms`, followed step by step
+                terms = [self.r.number(o, "constant_term_coefficient", default=1.0)] + [
+                    self.r.number(o, f, default=0.0) for f in ("temperature_term_coefficient",
+                                                               "velocity_term_coefficient",
+                                                               "velocity_squared_term_coefficient")]
+                entry = {"name": o.name, **(self.ventilation_controls(o) if kind == FLOWS[1] else {})}
+                if any(terms[1:]) or "controls" in entry and terms[0] != 1.0:
+                    entry["terms"] = terms
+                if "terms" not in entry and "controls" not in entry:
+                    flow *= terms[0]
+                if "terms" in entry and (terms[2] or terms[3]) or "maximum_wind_speed" in entry.get("controls", {}):
+                    entry["wind_factor"] = round(float(convection.wind_at_height(1.0, wind_height, self.terrain)), 6)
                 name = self.r.text(o, "schedule_name")
                 value = self.constant_schedule_value(name, o, "Schedule Name") if name else 1.0
                 if value is None:
                     if np.min([v for p in self.schedules[name]["days"].values() for _, v in p]) < 0:
                         self.r.fail(o, "Schedule Name", f"{name!r} takes negative values: an air flow is >= 0")
-                    if flow * A > 0:
-                        scheduled.append({"name": o.name, "flow": flow * A, "schedule": name})
+                    entry.update(flow=flow, schedule=name)
                 else:
-                    total += flow * A * value
+                    entry["flow"] = flow * value
+                if entry["flow"] <= 0:
+                    continue
+                if len(entry) > 2:
+                    scheduled.append(entry)
+                else:
+                    total += entry["flow"]
         return total, scheduled
+
+    def ventilation_controls(self, o):
+        """{"controls": {...}} of a ZoneVentilation:DesignFlowRate's limits that it declares (the
+        building file's ventilation controls; their schedules, where declared, are not held)."""
+        controls, scheduled = {}, []
+        for field, schedule in (("minimum_indoor_temperature", "minimum_indoor_temperature_schedule_name"),
+                                ("maximum_indoor_temperature", "maximum_indoor_temperature_schedule_name"),
+                                ("delta_temperature", "delta_temperature_schedule_name"),
+                                ("minimum_outdoor_temperature", "minimum_outdoor_temperature_schedule_name"),
+                                ("maximum_outdoor_temperature", "maximum_outdoor_temperature_schedule_name"),
+                                ("maximum_wind_speed", None)):
+            if not _blank(_field(o, field)):
+                controls[field] = self.r.number(o, field)
+            if schedule is not None and not _blank(_field(o, schedule)):
+                scheduled.append(_field_label(o, schedule))
+        if scheduled:
+            self.not_modelled.append(f"ZoneVentilation:DesignFlowRate {o.name}: its control schedules "
+                                     f"({', '.join(scheduled)}) not held; its constant limits are")
+        return {"controls": controls} if controls else {}
 
     def gains(self, z, floor):
         out = []

@@ -10,6 +10,7 @@ Layers are listed from the INSIDE face of a component to its outside face; node 
 (components in file order, each inside to outside, then each zone's air and radiant node, unless
 the file numbers them), then the nodes zone effects add.
 """
+import math
 import pickle
 import re
 from dataclasses import dataclass, field
@@ -117,10 +118,28 @@ class Gain:
 @dataclass(frozen=True)
 class Ventilation:
     """An outdoor air flow into a zone that follows a schedule (docs/model.md section 3.4): flow
-    m3/h times its schedule's value, leaving at the zone's air temperature."""
+    m3/h times its schedule's value, leaving at the zone's air temperature; with `terms` (A, B,
+    C, D) times max(0, A + B |T_air - T_out| + C v + D v^2), v = wind_factor times the station's
+    wind (m/s), and with `controls` only while they hold (section 3.6)."""
     name: str
     flow: float  # m3/h at a schedule value of 1
     schedule: str | None = None  # None: always 1
+    terms: tuple | None = None  # (A -, B 1/K, C s/m, D s2/m2); None: the flow times its schedule alone
+    wind_factor: float = 1.0  # v / V_met: the station's wind at the zone's height
+    # (minimum indoor C, maximum indoor C, delta T_air - T_out K, minimum outdoor C, maximum
+    # outdoor C, maximum wind m/s at the zone's height), -inf or inf where not declared; None: none
+    controls: tuple | None = None
+
+    @property
+    def followed(self):
+        """Whether the flow follows the state or the wind (its terms or controls declared)."""
+        return self.terms is not None or self.controls is not None
+
+    @property
+    def reads_wind(self):
+        """Whether the flow follows the wind: a velocity term, or a maximum wind speed."""
+        return bool(self.terms is not None and (self.terms[2] or self.terms[3])
+                    or self.controls is not None and math.isfinite(self.controls[5]))
 
 
 @dataclass(frozen=True)
@@ -371,7 +390,17 @@ class Building:
                 + tuple((f"component {c.name}", "outside.longwave") for c in self.exterior_components
                         if c.outside.longwave_emissivity is not None)
                 + tuple((f"component {c.name}", "window") for c in self.components if c.window is not None)
-                + tuple((f"zone {z.name}", f"gains {g.name}.people") for z in self.zones for g in z.gains if g.people))
+                + tuple((f"zone {z.name}", f"gains {g.name}.people") for z in self.zones for g in z.gains if g.people)
+                + tuple((f"zone {z.name}", f"ventilation {v.name}") for z in self.zones for v in z.ventilation
+                        if v.followed))
+
+    @property
+    def reads_wind(self):
+        """Where the building reads the weather's wind: the first exterior face whose convection
+        follows it, else the first air flow that does ("zone's ventilation name"); None: nowhere."""
+        faces = [f"component {c.name}" for c in self.exterior_components if c.outside.convection is not None]
+        flows = [f"zone {z.name}'s ventilation {v.name}" for z in self.zones for v in z.ventilation if v.reads_wind]
+        return next(iter(faces + flows), None)
 
     @property
     def input_columns(self):

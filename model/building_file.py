@@ -337,8 +337,26 @@ def _ventilation(check, z, where, schedules):
         schedule = _schedule_of(check, v, vw, schedules)
         if schedule is not None and not schedules[schedule].is_constant and _negative(schedules[schedule]):
             check.fail(f"{vw}.schedule", f"{schedule!r} takes negative values: an air flow is >= 0")
-        flows.append(Ventilation(name=v["name"], flow=float(v["flow"]), schedule=schedule))
+        controls = v.get("controls")
+        if controls is not None:
+            limits = tuple(float(controls.get(f, default)) for f, default in CONTROLS)
+            for low, high in (("minimum_indoor_temperature", "maximum_indoor_temperature"),
+                              ("minimum_outdoor_temperature", "maximum_outdoor_temperature")):
+                if low in controls and high in controls and controls[low] > controls[high]:
+                    check.fail(f"{vw}.controls.{low}", f"{controls[low]:g} C is above the {high} "
+                               f"({controls[high]:g} C): the flow would never run")
+        terms = v.get("terms")
+        flows.append(Ventilation(name=v["name"], flow=float(v["flow"]), schedule=schedule,
+                                 terms=None if terms is None else tuple(float(t) for t in terms),
+                                 wind_factor=float(v.get("wind_factor", 1.0)),
+                                 controls=None if controls is None else limits))
     return tuple(flows)
+
+
+# a ventilation's controls in `Ventilation.controls`'s order, each with the value at which it does not act
+CONTROLS = (("minimum_indoor_temperature", -math.inf), ("maximum_indoor_temperature", math.inf),
+            ("delta_temperature", -math.inf), ("minimum_outdoor_temperature", -math.inf),
+            ("maximum_outdoor_temperature", math.inf), ("maximum_wind_speed", math.inf))
 
 
 def _angular(check, c, where):

@@ -394,9 +394,8 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
     names = input_names(building)
     for name in set(names) & {WIND_SPEED, WIND_DIRECTION}:
         if name not in w:
-            face = next(c.name for c in building.exterior_components if c.outside.convection is not None)
-            raise InputError(source, name, f"{face} of {building.source} declares an outside convection, which "
-                                           "reads the wind: the weather file has no such column")
+            raise InputError(source, name, f"{building.reads_wind} of {building.source} follows the wind: the "
+                                           "weather file has no such column")
         columns[name] = w[name].to_numpy(float)
     U = np.column_stack([np.asarray(columns[n], dtype=float) for n in names])
     missing = ~np.isfinite(U)

@@ -170,7 +170,7 @@ def _convection_arrays(convection):
     if convection is None:
         return (0, np.zeros(2, np.int32), np.zeros(3), 0, np.zeros(1, np.int32), np.zeros(6), 0, np.zeros(1, np.int32),
                 np.zeros(4), np.zeros(4, np.int32), 0, np.zeros(2, np.int32), np.zeros(5), 0, np.zeros(2, np.int32),
-                np.zeros(15), 0, np.zeros(2, np.int32), np.zeros(2), 0, np.zeros(2, np.int32), np.zeros(1), 0,
+                np.zeros(15), 0, np.zeros(2, np.int32), np.zeros(2), 0, np.zeros(2, np.int32), np.zeros(14), 0,
                 np.zeros(3, np.int32), np.zeros(6))
     return (len(convection.inside), np.ascontiguousarray(convection.inside_nodes, dtype=np.int32).ravel(),
             np.ascontiguousarray(convection.inside, dtype=float).ravel(), len(convection.outside),
@@ -186,6 +186,6 @@ def _convection_arrays(convection):
             np.ascontiguousarray(convection.pair_nodes, dtype=np.int32).ravel(),
             np.ascontiguousarray(convection.pairs, dtype=float).ravel(), len(convection.flows),
             np.ascontiguousarray(convection.flow_nodes, dtype=np.int32).ravel(),
-            np.ascontiguousarray(convection.flows, dtype=float), len(convection.people),
+            np.ascontiguousarray(convection.flows, dtype=float).ravel(), len(convection.people),
             np.ascontiguousarray(convection.people_nodes, dtype=np.int32).ravel(),
             np.ascontiguousarray(convection.people, dtype=float).ravel())

@@ -27,6 +27,7 @@ from .convection import doe2_faces, iso15099_inside, lagged_excess, tarp_inside_
 from .discretise import capacities, conductances
 from .gains import people_sensible_heat
 from .glazing import followed_gap_conductance, gap_coefficients
+from .integrate import MAX_STEP
 from .longwave import T_MEAN, enclosure_exchange, exterior_coefficient, pair_coefficient
 
 AIR_DENSITY = schema_default("site", "air_density")  # kg/m3, a building file's default
@@ -34,6 +35,11 @@ C_AIR = 1005.0  # J/kg/K
 RHO_C_AIR = AIR_DENSITY * C_AIR  # J/m3/K
 # the weather's inputs an exterior face's convection reads: m/s at the station, deg from north
 WIND_SPEED, WIND_DIRECTION = "wind_speed", "wind_direction"
+# an air flow's numbers in `Convection.flows`
+FLOW_FIELDS = ("g", "cap", "A", "B", "C", "D", "wind_factor", "minimum_indoor", "maximum_indoor", "delta",
+               "minimum_outdoor", "maximum_outdoor", "maximum_wind", "outdoor")
+# a flow that follows nothing: its whole part in the step matrix, its controls always hold
+CONSTANT_TERMS, NO_CONTROLS = (1.0, 0.0, 0.0, 0.0), (-np.inf, np.inf, -np.inf, -np.inf, np.inf, np.inf)
 
 
 def _between(q, a, b, flow):
@@ -67,10 +73,16 @@ class Convection:
     that scale the gap's link, eps = 1 / (1/e_1 + 1/e_2 - 1). A zone whose ScriptF exchange is
     followed: each pair of its faces (a, b) (p, 2), (A_a ScriptF_ab m2, G0 W/K) (p, 2), A_a ScriptF_ab
     (sigma (T_a^2 + T_b^2)(T_a + T_b) - G0) (T_b - T_a) on face a and its negative on b. A site
-    whose air flows carry heat at the outdoor air's density: each flow from outdoors (air node,
-    its schedule's input column or -1) (f, 2), g W/K at the site's air_density (f,),
-    g s (293.15 / (T_out + 273.15) - 1) (T_out - T_air) on the air, s the schedule's value (1
-    without). People whose sensible heat is followed (docs/model.md section 3.4): per target node
+    whose air flows carry heat at the outdoor air's density, and each air flow that follows the
+    state or the wind (docs/model.md section 3.6): per flow from outdoors (air node, its
+    schedule's input column or -1) (f, 2), and (g W/K at the site's air_density, the excess's
+    cap x_max, A, B 1/K, C s/m, D s2/m2, wind factor, minimum indoor C, maximum indoor C, delta K,
+    minimum outdoor C, maximum outdoor C, maximum wind m/s, 1 at the outdoor air's density else 0)
+    (f, 14) (`FLOW_FIELDS`), g s min(r m on - 1, x_max) (T_out - T_air) on the air, s the
+    schedule's value (1 without), r = 293.15 / (T_out + 273.15) (1 at the site's density), m =
+    max(0, A + B |T_air - T_out| + C v + D v^2) at v the wind factor times the station's, on 1
+    while the controls hold, else 0 (`followed_flow`). People whose sensible heat is followed
+    (docs/model.md section 3.4): per target node
     (target, air node, the schedule's input column or -1) (r, 3), (its share of the number n,
     activity M W, its share of the power P W, the slope k W/K on the air's row (0 on a radiant
     target's), T_ref C, the schedule's constant value) (r, 6), s (n S(M, T_air) - P - k (T_air -
@@ -89,7 +101,7 @@ class Convection:
     pair_nodes: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=int))
     pairs: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
     flow_nodes: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), dtype=int))
-    flows: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    flows: np.ndarray = field(default_factory=lambda: np.zeros((0, len(FLOW_FIELDS))))
     people_nodes: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), dtype=int))
     people: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
 
@@ -134,10 +146,14 @@ class Convection:
             _between(q, a, b, flow)
         if len(self.flows):
             t_out = u[self.columns[0]]
+            speed = u[self.columns[1]] if self.columns[1] >= 0 else 0.0
             air, column = self.flow_nodes.T
             share = np.where(column >= 0, u[np.maximum(column, 0)], 1.0)
-            excess = lagged_excess(outdoor_density_ratio(t_out), 1.0)
-            np.add.at(q, air, self.flows * share * excess * (t_out - T[air]))
+            g, cap, terms, wind, limits, outdoor = np.split(self.flows, [1, 2, 6, 7, 13], axis=1)
+            ratio = np.where(outdoor[:, 0] > 0, outdoor_density_ratio(t_out), 1.0)
+            flow = followed_flow(terms.T, limits.T, T[air], t_out, wind[:, 0] * speed)
+            excess = np.minimum(ratio * flow - 1.0, cap[:, 0])
+            np.add.at(q, air, g[:, 0] * share * excess * (t_out - T[air]))
         if len(self.people):
             target, air, column = self.people_nodes.T
             number, activity, power, slope, reference, value = self.people.T
@@ -340,7 +356,7 @@ def input_names(building):
     named = tuple(n for n in building.input_columns if n not in irradiance)
     transmitted = tuple(name for c in building.components for name, _ in c.sun_inputs if name != c.irradiance_input)
     transmitted += tuple(name for c in building.exterior_components for name, _ in c.absorbed_inputs)
-    wind = (WIND_SPEED, WIND_DIRECTION) if any(c.outside.convection for c in building.exterior_components) else ()
+    wind = (WIND_SPEED, WIND_DIRECTION) if building.reads_wind is not None else ()
     return (("T_out", "T_sky") + irradiance + named + clock_input_names(building) + transmitted
             + building.schedule_inputs + wind)
 
@@ -386,6 +402,23 @@ def outdoor_density_ratio(T_out, T_site=20.0):
     EnergyPlus carries infiltration and ventilation at the outdoor air's density
     (ZoneEquipmentManager.cc, CalcAirFlowSimple)."""
     return (T_site + 273.15) / (np.asarray(T_out, dtype=float) + 273.15)
+
+
+def followed_flow(terms, controls, T_air, T_out, v):
+    """An air flow's part of its design flow (-) as EnergyPlus computes it at each step
+    (Engineering Reference, "Infiltration/Ventilation"; ZoneEquipmentManager.cc, CalcAirFlowSimple):
+    max(0, A + B |T_air - T_out| + C v + D v^2) while its controls hold, else 0.
+
+    terms: (A -, B 1/K, C s/m, D s2/m2); controls: (minimum indoor C, maximum indoor C, delta K,
+    minimum outdoor C, maximum outdoor C, maximum wind m/s), each an array or a number, -inf or inf
+    where none; T_air, T_out (C); v the wind at the zone's height (m/s). The flow runs while T_air
+    >= its minimum and <= its maximum, T_air - T_out >= delta, T_out within its limits and v <= its
+    maximum, each limit taken as EnergyPlus takes it: off beyond it, on at it."""
+    A, B, C, D = terms
+    low, high, delta, out_low, out_high, fastest = controls
+    on = ((T_air >= low) & (T_air <= high) & (T_air - T_out >= delta) & (T_out >= out_low) & (T_out <= out_high)
+          & (v <= fastest))
+    return np.maximum(A + B * np.abs(T_air - T_out) + C * v + D * v * v, 0.0) * on
 
 
 def air_conductance(flow, density=AIR_DENSITY):
@@ -530,11 +563,18 @@ def assemble(building, names=None):
     rho = building.site.get("air_density", AIR_DENSITY)
     outdoor = building.site.get("flow_density") == "outdoor"
 
-    def from_outdoors(air, g, column=-1):
-        """An air flow of g W/K (at rho) from outdoors, by the schedule's input `column` (-1: none)
-        where the site's flows carry heat at the outdoor air's density."""
-        if outdoor and g:
-            flows.append(((air, column), g))
+    def from_outdoors(air, g, column=-1, flow=None, capacity=0.0):
+        """An air flow of g W/K (at rho) from outdoors, by the schedule's input `column` (-1: none):
+        its excess over g lagged where the site's flows carry heat at the outdoor air's density or
+        the flow (a `Ventilation`) follows the state or the wind. Its excess is at most g (the
+        project's bound for a lagged coefficient) plus, for a followed flow, its share `capacity`
+        of its zone's air's capacity over the longest sub-step (W/K): an error e in the air then
+        becomes (C/dt - x) e / (C/dt + g + G), less than e, whatever the flow."""
+        if flow is not None and flow.followed and g:
+            flows.append(((air, column), (g, 1.0 + capacity / g, *(flow.terms or CONSTANT_TERMS), flow.wind_factor,
+                                          *(flow.controls or NO_CONTROLS), float(outdoor))))
+        elif outdoor and g:
+            flows.append(((air, column), (g, 1.0, *CONSTANT_TERMS, 0.0, *NO_CONTROLS, 1.0)))
 
     for z in building.zones:
         air, radiant = z.air_node - 1, absorbers[z.name]
@@ -544,19 +584,21 @@ def assemble(building, names=None):
         from_outdoors(air, infiltration)
         if z.supply is not None:
             to_temperature(air, air_conductance(z.supply.flow * z.supply.flow_factor, rho), z.supply.temperature)
+        # each followed flow's share of the air's capacity over the longest sub-step (W/K)
+        capacity = rho * C_AIR * z.volume / MAX_STEP / max(sum(v.followed for v in z.ventilation), 1)
         for v in z.ventilation:
             schedule = building.schedules.get(v.schedule) if v.schedule is not None else None
             if schedule is None or schedule.is_constant:
                 g = air_conductance(v.flow * (1.0 if schedule is None else schedule.value), rho)
                 to_temperature(air, g, "T_out")
-                from_outdoors(air, g)
+                from_outdoors(air, g, flow=v, capacity=capacity)
             else:
                 # g s(t) (T_out - T_air): the conductance follows the schedule (`Network.switched`),
                 # its T_out term is a product of two inputs
                 g = air_conductance(v.flow, rho)
                 switched.append((air, col[v.schedule], g))
                 products.append((air, col[v.schedule], col["T_out"], g))
-                from_outdoors(air, g, col[v.schedule])
+                from_outdoors(air, g, col[v.schedule], v, capacity)
         for inflow in z.airflow_from:
             g = air_conductance(inflow.flow, rho)
             A[air, air] -= g
@@ -634,7 +676,7 @@ def assemble(building, names=None):
             pair_nodes=np.array([n for n, _ in pairs], dtype=int).reshape(-1, 2),
             pairs=np.array([v for _, v in pairs], dtype=float).reshape(-1, 2),
             flow_nodes=np.array([n for n, _ in flows], dtype=int).reshape(-1, 2),
-            flows=np.array([g for _, g in flows], dtype=float),
+            flows=np.array([v for _, v in flows], dtype=float).reshape(-1, len(FLOW_FIELDS)),
             people_nodes=np.array([n for n, _ in people], dtype=int).reshape(-1, 3),
             people=np.array([v for _, v in people], dtype=float).reshape(-1, 6))
     return Network(C=C, A=A, B=B, q=q, input_names=names, products=tuple(products), switched=tuple(switched),

@@ -444,10 +444,10 @@ def test_daylight_saving_is_said(tmp_path):
         b.data["not_modelled"]
 
 
-def test_an_infiltrations_wind_and_temperature_terms_are_taken_at_stated_conditions(tmp_path):
-    """0.5 air changes times 0.1 + 0.01 |dT| + 0.224 v: |dT| 10 K and the wind at the zone's
-    surfaces' mean height (1.35 m in case 600's Country terrain) from the 4 m/s station wind,
-    the 2019 prototypes' form (their constant term is 0: the converter kept only it before)."""
+def test_an_infiltrations_wind_and_temperature_terms_are_followed(tmp_path):
+    """0.5 air changes times 0.1 + 0.01 |dT| + 0.224 v (the 2019 prototypes' form, their constant
+    term 0): the file declares the design flow, the terms and the wind at the zone's surfaces' mean
+    height (1.35 m in case 600's Country terrain) over the station's, and says nothing of them."""
     from nodeforce.model import convection
     text = TEXT.replace("  1,                            !- Constant Term Coefficient\n"
                         "  0,                            !- Temperature Term Coefficient\n"
@@ -455,9 +455,31 @@ def test_an_infiltrations_wind_and_temperature_terms_are_taken_at_stated_conditi
                         "  0.1,\n  0.01,\n  0.224,")
     assert text != TEXT
     b = convert_idf(write(tmp_path, text))
-    v = convection.wind_at_height(4.0, 1.35, "country")
-    assert b.zones[0].air_change_rate == pytest.approx(0.5 * (0.1 + 0.01 * 10 + 0.224 * v), rel=1e-9)
-    assert any("taken at |dT| 10 K" in line for line in b.data["not_modelled"])
+    z = b.zones[0]
+    (v,) = z.ventilation
+    assert (z.air_change_rate, v.schedule, v.controls) == (0.0, None, None)
+    assert v.flow == pytest.approx(0.5 * z.volume, rel=1e-9)
+    assert v.terms == (0.1, 0.01, 0.224, 0.0)
+    assert v.wind_factor == pytest.approx((270 / 10) ** 0.14 * (1.35 / 270) ** 0.14, rel=1e-5)
+    assert v.wind_factor == pytest.approx(convection.wind_at_height(1.0, 1.35, "country"), rel=1e-5)
+    assert not any("INFILTRATION" in line for line in b.data["not_modelled"])
+
+
+def test_a_ventilation_s_controls_are_held(tmp_path):
+    """A 2019 warehouse's exhaust: 37.76 m3/s that runs above 29.44 C indoors, its other limits at
+    EnergyPlus's defaults; a limit by schedule is said not held."""
+    vent = ("ZoneVentilation:DesignFlowRate,\n  EXHAUST,\n  CASE 600 ZONE,\n  CONTINUOUS,\n  Flow/Zone,\n"
+            "  37.76,\n  ,\n  ,\n  ,\n  Exhaust,\n  31.1,\n  0.51,\n  1,\n  0,\n  0,\n  0,\n  29.44,\n  ,\n"
+            "  100,\n  ,\n  -100,\n  ,\n  -100,\n  ,\n  100,\n  {},\n  40;\n")
+    b = convert_idf(write(tmp_path, TEXT + vent.format("")))
+    (v,) = b.zones[0].ventilation
+    assert v.flow == pytest.approx(37.76 * 3600)
+    assert (v.terms, v.controls) == (None, (29.44, 100.0, -100.0, -100.0, 100.0, 40.0))
+    assert b.zones[0].air_change_rate == pytest.approx(0.5)  # the infiltration stays constant
+    assert not any("EXHAUST" in line for line in b.data["not_modelled"])
+    b = convert_idf(write(tmp_path, TEXT + vent.format("CONTINUOUS")))
+    assert any(line.startswith("ZoneVentilation:DesignFlowRate EXHAUST: its control schedules (Maximum Outdoor "
+                               "Temperature Schedule Name) not held") for line in b.data["not_modelled"])
 
 
 def test_a_lights_return_air_fraction_leaves_with_the_return_air(tmp_path):

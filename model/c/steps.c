@@ -98,7 +98,8 @@ static double people_sensible(double M, double T) {
    air) and (A phi, h0, height, tilt, pressure); gaps, per gap, its two pane faces (a, b) and (A f, h0,
    thickness, height, eps, the gas's ten coefficients); pairs, per pair of faces of a followed ScriptF
    exchange, (a, b) and (A_a ScriptF_ab, G0); flows, per air flow from outdoors at the outdoor
-   air's density, (air node, its schedule's column of u or -1) and g; people, per target of a
+   air's density or following the state or wind, (air node, its schedule's column of u or -1) and
+   its 14 numbers (model/network.py's FLOW_FIELDS); people, per target of a
    followed people gain, (target, air node, its schedule's column or -1) and (share of the number,
    activity, share of the power, slope, T_ref, the schedule's constant value) */
 static void convection(int n, const double *T, const double *u, int n_inside, const int *inside_nodes,
@@ -157,10 +158,19 @@ static void convection(int n, const double *T, const double *u, int n_inside, co
         q[b] -= flow;
     }
     for (k = 0; k < n_flows; k++) {
-        /* model/network.py's outdoor_density_ratio: (20 + 273.15) / (T_out + 273.15) */
+        /* model/network.py's outdoor_density_ratio, (20 + 273.15) / (T_out + 273.15), and
+           followed_flow: v = (g, cap, A, B, C, D, wind factor, minimum and maximum indoor, delta,
+           minimum and maximum outdoor, maximum wind, outdoor density or not) */
         const int air = flow_nodes[2 * k], column = flow_nodes[2 * k + 1];
-        const double t_out = u[columns[0]], share = column >= 0 ? u[column] : 1.0;
-        q[air] += flows[k] * share * excess((20.0 + 273.15) / (t_out + 273.15), 1.0) * (t_out - T[air]);
+        const double *v = flows + 14 * k, t_out = u[columns[0]], share = column >= 0 ? u[column] : 1.0;
+        const double wind = v[6] * (columns[1] >= 0 ? u[columns[1]] : 0.0), T_air = T[air];
+        const double ratio = v[13] > 0.0 ? (20.0 + 273.15) / (t_out + 273.15) : 1.0;
+        const int on = T_air >= v[7] && T_air <= v[8] && T_air - t_out >= v[9] && t_out >= v[10] && t_out <= v[11] &&
+                       wind <= v[12];
+        double flow = v[2] + v[3] * fabs(T_air - t_out) + v[4] * wind + v[5] * wind * wind, x;
+        flow = (flow > 0.0 ? flow : 0.0) * on;
+        x = ratio * flow - 1.0;
+        q[air] += v[0] * share * (x < v[1] ? x : v[1]) * (t_out - T_air);
     }
     for (k = 0; k < n_people; k++) {
         const int target = people_nodes[3 * k], air = people_nodes[3 * k + 1], column = people_nodes[3 * k + 2];
