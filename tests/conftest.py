@@ -34,6 +34,23 @@ def weather():
     return read_weather(DATA / "miami_tmy2.csv")
 
 
+@pytest.fixture(scope="session")
+def twinhouse_held():
+    """The Twin House (examples/twinhouse_n2) with every coefficient held at the value it declares:
+    no TARP, no followed window gaps, no outside convection or long-wave that follow the state. A
+    large network with shading columns that the standalone C FMU steps (it refuses coefficients
+    that follow the state, fmu_build/standalone.py)."""
+    path = Path(__file__).parents[1] / "examples" / "twinhouse_n2" / "building.json"
+    data = json.loads(path.read_text())
+    for zone in data["zones"]:
+        zone.pop("inside_convection_algorithm")
+    for component in data["components"]:
+        component.pop("window", None)
+        for field in ("convection", "longwave"):
+            component["outside"].pop(field, None)
+    return parse_building(data, source=f"{path.name}, its coefficients held")
+
+
 @pytest.fixture
 def private_tmp(tmp_path, monkeypatch):
     """A temp directory of the test's own, for this process and every process it starts."""
