@@ -532,8 +532,9 @@ def assemble(building, names=None):
 
     def from_outdoors(air, g, column=-1):
         """An air flow of g W/K (at rho) from outdoors, by the schedule's input `column` (-1: none)
-        where the site's flows carry heat at the outdoor air's density."""
-        if outdoor and g:
+        where the site's flows carry heat at the outdoor air's density; a flow of 0 too, which
+        an FMU parameter (an air change rate) may open."""
+        if outdoor:
             flows.append(((air, column), g))
 
     for z in building.zones:

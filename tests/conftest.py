@@ -9,7 +9,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from nodeforce.model.building_file import parse_building
+from nodeforce.model.building_file import load_building, parse_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.synth import pseudo_measurements
 from nodeforce.iotools.weather import read_weather
@@ -35,20 +35,11 @@ def weather():
 
 
 @pytest.fixture(scope="session")
-def twinhouse_held():
-    """The Twin House (examples/twinhouse_n2) with every coefficient held at the value it declares:
-    no TARP, no followed window gaps, no outside convection or long-wave that follow the state. A
-    large network with shading columns that the standalone C FMU steps (it refuses coefficients
-    that follow the state, fmu_build/standalone.py)."""
-    path = Path(__file__).parents[1] / "examples" / "twinhouse_n2" / "building.json"
-    data = json.loads(path.read_text())
-    for zone in data["zones"]:
-        zone.pop("inside_convection_algorithm")
-    for component in data["components"]:
-        component.pop("window", None)
-        for field in ("convection", "longwave"):
-            component["outside"].pop(field, None)
-    return parse_building(data, source=f"{path.name}, its coefficients held")
+def twinhouse():
+    """The Twin House (examples/twinhouse_n2) as its file declares it: a large network (281 nodes)
+    with shading columns and coefficients that follow the state (TARP inside, its windows' panes
+    and argon gaps, DOE-2 and the long-wave outside), which both FMUs step."""
+    return load_building(Path(__file__).parents[1] / "examples" / "twinhouse_n2" / "building.json")
 
 
 @pytest.fixture

@@ -153,8 +153,8 @@ def test_a_diagnosis_s_candidates_are_calibrated_on_the_equations_their_fmus_car
 
 
 @pytest.mark.slow  # three FMUs of 281 nodes
-def test_fmi3_equals_fmi2_on_the_twin_house(tmp_path, twinhouse_held):
-    building = twinhouse_held  # its coefficients held: the standalone FMU steps constant ones
+def test_fmi3_equals_fmi2_on_the_twin_house(tmp_path, twinhouse):
+    building = twinhouse
     built = {(kind, fmi): build_fmu(building, tmp_path / f"{kind}{fmi}.fmu", kind=fmu_kind(kind, fmi))
              for kind, fmi in (("python", 2), ("python", 3), ("standalone", 3))}
     parameters, inputs, outputs, n_steps = scenario(built[("python", 2)], n_steps=96)
