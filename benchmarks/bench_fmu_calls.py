@@ -50,10 +50,6 @@ def measure():
         for label, path in BUILDINGS.items():
             building = load_building(path)
             for kind in ("python", "standalone"):
-                if kind == "standalone" and building.followed_coefficients:
-                    # the standalone FMU steps constant coefficients and refuses the others
-                    tables.append(f"| {label} | {kind} | | n/a: coefficients that follow the state | | |")
-                    continue
                 folder = Path(tmp) / f"{label}_{kind}".replace(" ", "_")
                 folder.mkdir()
                 fmu = build_fmu(building, folder / "model.fmu", kind=kind)

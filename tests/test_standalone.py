@@ -278,6 +278,18 @@ def test_the_standalone_fmu_steps_followed_coefficients_as_the_direct_model(test
             assert np.abs(run(instance, building, U, values) - expected).max() < 1e-9
 
 
+def test_auto_picks_the_standalone_fmu_for_coefficients_that_follow_the_state(testcell_data):
+    """The search's "auto" runs the FMU that steps a building fastest, the standalone, where the
+    coefficients follow the state too (where a compiler is at hand to export it)."""
+    from nodeforce.ga.locate import evaluator_kind
+    from nodeforce.runtime.compiler import find_compiler
+    buildings = [parse_building(declare(testcell_data)) for declare, _ in followed_buildings().values()]
+    assert all(b.followed_coefficients and not b.switched for b in buildings)
+    expected = "standalone" if find_compiler() else "python"
+    assert evaluator_kind("auto", buildings) == expected
+    assert evaluator_kind("auto-fmi3", buildings) == expected + "-fmi3"
+
+
 @pytest.mark.slow  # two FMUs of 281 nodes
 def test_standalone_equals_the_python_fmu_on_the_twin_house(tmp_path, twinhouse):
     """The Twin House's south glazings have blinds (shading_south) and its coefficients follow
