@@ -33,6 +33,15 @@
 #include "resources.h"
 #include "variables.h"
 
+/* The binary needs glibc 2.14 at most (its documentation, fmu_build/description.py): pow and exp
+   (followed.h) at their first versions, which every glibc's libm holds, not the GLIBC_2.29 ones
+   glibc added when it dropped their SVID error handling (the same results where they are finite;
+   tests/test_fmu_exchange.py reads the versions). */
+#if defined(__x86_64__) && defined(__GLIBC__)
+__asm__(".symver pow,pow@GLIBC_2.2.5");
+__asm__(".symver exp,exp@GLIBC_2.2.5");
+#endif
+
 #define CACHED_PATTERNS 8
 #define MAX_SUBSTEPS 10000000 /* the internal steps of one doStep, at most (variables.py's) */
 #define FOLLOWED_KINDS 8
