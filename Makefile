@@ -49,6 +49,9 @@ bestest: venv
 # saw, compared with the house as written and as corrected (out/twinhouse/exp2/late).
 TWINHOUSE_ROOMS := living,corridor,bath,child,kitchen,doorway,bedroom
 TWINHOUSE_HOUSE_OUT := out/twinhouse
+# processes of the Twin House's diagnoses (make twinhouse WORKERS=1); empty: every core
+WORKERS ?=
+TWINHOUSE_WORKERS = $(if $(WORKERS),--workers $(WORKERS))
 
 twinhouse: venv
 	mkdir -p $(TWINHOUSE_HOUSE_OUT) $(TWINHOUSE_HOUSE_OUT)/exp2
@@ -68,7 +71,8 @@ twinhouse: venv
 	$(BIN)/nodeforce diagnose $(TWINHOUSE_EXAMPLE)/building.json -o $(TWINHOUSE_HOUSE_OUT) \
 		--record name=exp1,weather=$(TWINHOUSE_HOUSE_OUT)/weather.csv,measurements=$(TWINHOUSE_HOUSE_OUT)/measurements.csv,calibration-end=2013-09-14T00:00+01:00,phases=$(TWINHOUSE_EXAMPLE)/phases.csv \
 		--record name=exp2_early,building=$(TWINHOUSE_HOUSE_OUT)/exp2/building_as_written.json,weather=$(TWINHOUSE_HOUSE_OUT)/exp2/weather.csv,measurements=$(TWINHOUSE_HOUSE_OUT)/exp2/measurements_early.csv,calibration-end=2014-04-18T00:00+01:00,phases=$(TWINHOUSE_EXAMPLE)/phases_exp2.csv \
-		--objective $(TWINHOUSE_ROOMS) --burn-in-days 3 --seed 0 --reference $(TWINHOUSE_EXAMPLE)/reference.json
+		--objective $(TWINHOUSE_ROOMS) --burn-in-days 3 --seed 0 --reference $(TWINHOUSE_EXAMPLE)/reference.json \
+		$(TWINHOUSE_WORKERS)
 	$(BIN)/nodeforce compare $(TWINHOUSE_HOUSE_OUT)/exp2/building_as_written.json $(TWINHOUSE_HOUSE_OUT)/building_after_record2.json \
 		--weather $(TWINHOUSE_HOUSE_OUT)/exp2/weather.csv --measurements $(TWINHOUSE_HOUSE_OUT)/exp2/measurements_late.csv \
 		-o $(TWINHOUSE_HOUSE_OUT)/exp2/late --objective $(TWINHOUSE_ROOMS) --burn-in-days 3 --phases $(TWINHOUSE_EXAMPLE)/phases_exp2.csv
@@ -96,7 +100,7 @@ twinhouse-living: venv
 	$(BIN)/nodeforce diagnose $(TWINHOUSE_EXAMPLE)/building.json --weather $(TWINHOUSE_OUT)/weather.csv \
 		--measurements $(TWINHOUSE_OUT)/measurements.csv -o $(TWINHOUSE_OUT) --objective living \
 		--calibration-end 2013-09-14T00:00+01:00 --burn-in-days 3 --seed 0 \
-		--reference $(TWINHOUSE_EXAMPLE)/reference.json --phases $(TWINHOUSE_EXAMPLE)/phases.csv
+		--reference $(TWINHOUSE_EXAMPLE)/reference.json --phases $(TWINHOUSE_EXAMPLE)/phases.csv $(TWINHOUSE_WORKERS)
 	$(TWINHOUSE_TABLE2) --select @$(TWINHOUSE_EXAMPLE)/weather_columns_exp2.txt \
 		--set shading_south=1,shading_W27=0,shading_W33=0 -o $(TWINHOUSE_OUT2)/weather.csv
 	$(BIN)/python $(TWINHOUSE_EXAMPLE)/make_building.py --experiment 2 -o $(TWINHOUSE_OUT2)/building_as_written.json

@@ -28,16 +28,16 @@ from nodeforce.model.score import Noise, removed
 def evaluator_kind(kind, buildings):
     """`kind` as `build_fmu` takes it: "auto" (or "auto-fmi3") is the standalone FMU where a C
     compiler is at hand (it is compiled at export) and every one of `buildings` has a constant
-    network, else the Python FMU; any other kind is itself. Measured (benchmarks/bench_scale.py,
+    matrix, else the Python FMU; any other kind is itself. Measured (benchmarks/bench_scale.py,
     docs/performance.md): a simulation of a new mask costs at least 1.7 times less through the
-    standalone FMU than through the Python FMU, from the test cell's 23 nodes to 2,922. A building
-    with a scheduled air flow, a scheduled gain that follows the air's temperature, or convective
-    coefficients that follow its state (docs/model.md 3.6), runs the Python FMU: the standalone
-    steps one constant matrix and constant sources."""
+    standalone FMU than through the Python FMU, from the test cell's 23 nodes to 2,922. The
+    standalone steps coefficients that follow the state (docs/model.md 3.6) as the direct model
+    does; a building with a scheduled air flow or a scheduled gain that follows the air's
+    temperature runs the Python FMU: the standalone steps one constant matrix."""
     base, _, version = kind.partition("-fmi")
     if base != "auto":
         return kind
-    scheduled = any(b.switched or b.followed_coefficients for b in buildings)
+    scheduled = any(b.switched for b in buildings)
     return ("python" if scheduled or not find_compiler() else "standalone") + (f"-fmi{version}" if version else "")
 
 

@@ -31,6 +31,8 @@ from scipy.sparse.linalg import splu
 
 from nodeforce.runtime.compiler import compiled_function
 
+from .network import FLOW_FIELDS
+
 log = logging.getLogger("nodeforce.model")
 _LOCK = threading.Lock()
 _DOUBLE, _INT = np.ctypeslib.ndpointer(np.float64, flags="C"), np.ctypeslib.ndpointer(np.int32, flags="C")
@@ -165,27 +167,27 @@ def steps(matrix, c, sources, forced, imposed, T, rows, convection=None):
     return path, T
 
 
-def _convection_arrays(convection):
-    """The arguments c/steps.c reads a `Convection` from (none of its faces without one)."""
+# A `Convection`'s kinds in the order c/followed.h reads them: (its values, their width a row; its
+# nodes, their width a row)
+FOLLOWED = (("inside", 3, "inside_nodes", 2), ("outside", 6, "outside_nodes", 1), ("longwave", 4, "longwave_nodes", 1),
+            ("windows", 5, "window_nodes", 2), ("gaps", 15, "gap_nodes", 2), ("pairs", 2, "pair_nodes", 2),
+            ("flows", len(FLOW_FIELDS), "flow_nodes", 2), ("people", 6, "people_nodes", 3))
+
+
+def followed_arrays(convection):
+    """([(count, nodes int32, values float) of each kind of FOLLOWED, flat], columns int32 (4,)) of a
+    `Convection` as c/followed.h reads it (the standalone FMU's export too); none of each, and the
+    columns -1, of None."""
     if convection is None:
-        return (0, np.zeros(2, np.int32), np.zeros(3), 0, np.zeros(1, np.int32), np.zeros(6), 0, np.zeros(1, np.int32),
-                np.zeros(4), np.zeros(4, np.int32), 0, np.zeros(2, np.int32), np.zeros(5), 0, np.zeros(2, np.int32),
-                np.zeros(15), 0, np.zeros(2, np.int32), np.zeros(2), 0, np.zeros(2, np.int32), np.zeros(14), 0,
-                np.zeros(3, np.int32), np.zeros(6))
-    return (len(convection.inside), np.ascontiguousarray(convection.inside_nodes, dtype=np.int32).ravel(),
-            np.ascontiguousarray(convection.inside, dtype=float).ravel(), len(convection.outside),
-            np.ascontiguousarray(convection.outside_nodes, dtype=np.int32),
-            np.ascontiguousarray(convection.outside, dtype=float).ravel(), len(convection.longwave),
-            np.ascontiguousarray(convection.longwave_nodes, dtype=np.int32),
-            np.ascontiguousarray(convection.longwave, dtype=float).ravel(),
-            np.ascontiguousarray(convection.columns, dtype=np.int32), len(convection.windows),
-            np.ascontiguousarray(convection.window_nodes, dtype=np.int32).ravel(),
-            np.ascontiguousarray(convection.windows, dtype=float).ravel(), len(convection.gaps),
-            np.ascontiguousarray(convection.gap_nodes, dtype=np.int32).ravel(),
-            np.ascontiguousarray(convection.gaps, dtype=float).ravel(), len(convection.pairs),
-            np.ascontiguousarray(convection.pair_nodes, dtype=np.int32).ravel(),
-            np.ascontiguousarray(convection.pairs, dtype=float).ravel(), len(convection.flows),
-            np.ascontiguousarray(convection.flow_nodes, dtype=np.int32).ravel(),
-            np.ascontiguousarray(convection.flows, dtype=float).ravel(), len(convection.people),
-            np.ascontiguousarray(convection.people_nodes, dtype=np.int32).ravel(),
-            np.ascontiguousarray(convection.people, dtype=float).ravel())
+        return [(0, np.zeros(0, np.int32), np.zeros(0)) for _ in FOLLOWED], np.full(4, -1, np.int32)
+    array = lambda name, kind: np.ascontiguousarray(getattr(convection, name), dtype=kind).ravel()  # noqa: E731
+    kinds = [(len(getattr(convection, values)), array(nodes, np.int32), array(values, float))
+             for values, _, nodes, _ in FOLLOWED]
+    return kinds, np.ascontiguousarray(convection.columns, dtype=np.int32)
+
+
+def _convection_arrays(convection):
+    """The arguments c/steps.c reads a `Convection` from: the columns after the long-wave."""
+    kinds, columns = followed_arrays(convection)
+    arguments = [x for kind in kinds for x in kind]
+    return (*arguments[:9], columns, *arguments[9:])

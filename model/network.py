@@ -565,15 +565,16 @@ def assemble(building, names=None):
 
     def from_outdoors(air, g, column=-1, flow=None, capacity=0.0):
         """An air flow of g W/K (at rho) from outdoors, by the schedule's input `column` (-1: none):
-        its excess over g lagged where the site's flows carry heat at the outdoor air's density or
-        the flow (a `Ventilation`) follows the state or the wind. Its excess is at most g (the
-        project's bound for a lagged coefficient) plus, for a followed flow, its share `capacity`
-        of its zone's air's capacity over the longest sub-step (W/K): an error e in the air then
-        becomes (C/dt - x) e / (C/dt + g + G), less than e, whatever the flow."""
+        its excess over g lagged where the site's flows carry heat at the outdoor air's density (a
+        flow of 0 too, which an FMU parameter, an air change rate, may open) or the flow (a
+        `Ventilation`) follows the state or the wind. Its excess is at most g (the project's bound
+        for a lagged coefficient) plus, for a followed flow, its share `capacity` of its zone's
+        air's capacity over the longest sub-step (W/K): an error e in the air then becomes
+        (C/dt - x) e / (C/dt + g + G), less than e, whatever the flow."""
         if flow is not None and flow.followed and g:
             flows.append(((air, column), (g, 1.0 + capacity / g, *(flow.terms or CONSTANT_TERMS), flow.wind_factor,
                                           *(flow.controls or NO_CONTROLS), float(outdoor))))
-        elif outdoor and g:
+        elif outdoor:
             flows.append(((air, column), (g, 1.0, *CONSTANT_TERMS, 0.0, *NO_CONTROLS, 1.0)))
 
     for z in building.zones:

@@ -9,7 +9,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from nodeforce.model.building_file import parse_building
+from nodeforce.model.building_file import load_building, parse_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.synth import pseudo_measurements
 from nodeforce.iotools.weather import read_weather
@@ -32,6 +32,14 @@ def testcell(testcell_data):
 @pytest.fixture(scope="session")
 def weather():
     return read_weather(DATA / "miami_tmy2.csv")
+
+
+@pytest.fixture(scope="session")
+def twinhouse():
+    """The Twin House (examples/twinhouse_n2) as its file declares it: a large network (281 nodes)
+    with shading columns and coefficients that follow the state (TARP inside, its windows' panes
+    and argon gaps, DOE-2 and the long-wave outside), which both FMUs step."""
+    return load_building(Path(__file__).parents[1] / "examples" / "twinhouse_n2" / "building.json")
 
 
 @pytest.fixture

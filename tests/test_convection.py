@@ -196,12 +196,32 @@ def test_the_weather_must_give_the_wind(testcell_data, weather):
         prepare_case(parse_building(followed(testcell_data)), weather)
 
 
-def test_the_standalone_fmu_refuses_coefficients_that_follow_the_state(testcell_data, tmp_path):
-    from nodeforce.fmu_build.standalone import network_terms
-    with pytest.raises(InputError, match="inside_convection_algorithm.*standalone C FMU"):
-        network_terms(parse_building(followed(testcell_data)), None)
-    with pytest.raises(InputError, match="outside.longwave.*standalone C FMU"):
-        network_terms(parse_building(radiating(testcell_data)), None)
+@pytest.mark.parametrize("kind, named", [("inside", "inside_convection_algorithm: zone cell's"),
+                                         ("gaps", "window: component window's")])
+def test_the_standalone_fmu_refuses_a_parameter_that_acts_on_a_followed_value_not_affinely(testcell_data,
+                                                                                             monkeypatch, kind, named):
+    """The standalone FMU sets the followed coefficients' values (A phi, A f, h0, ...) from its
+    parameters as it does A's, affinely in each (tests/test_standalone.py); a network where a
+    parameter acts on them otherwise (a stand-in: each face's A phi, or each gap's A f, squared,
+    so that the zone's convection factor, or the window's conductivity factor, acts on it
+    squared) is refused, the field declaring that coefficient named, not exported wrong."""
+    from dataclasses import replace
+
+    from nodeforce.fmu_build import standalone
+    from tests.test_windows import window_data
+    assembled = standalone.assemble
+
+    def squared(building, *args):
+        network = assembled(building, *args)
+        values = getattr(network.convection, kind).copy()
+        values[:, 0] **= 2
+        return replace(network, convection=replace(network.convection, **{kind: values}))
+
+    building = parse_building(followed(testcell_data) if kind == "inside" else window_data())
+    standalone.network_terms(building, None)  # as assembled: affine
+    monkeypatch.setattr(standalone, "assemble", squared)
+    with pytest.raises(InputError, match=f"{named} coefficient follows .*not affinely.*Python FMU"):
+        standalone.network_terms(building, None)
 
 
 @pytest.mark.slow
@@ -352,10 +372,3 @@ def test_air_flows_at_the_outdoor_density_step_alike_in_c_and_numpy(testcell_dat
         monkeypatch.setattr(compiled, "available", lambda: False)
         stepped = simulate(building, network, case.U, case.dt, substeps=case.substeps)
         assert np.abs(stepped - T).max() < 1e-10 * np.abs(T).max()
-    from nodeforce.fmu_build.standalone import network_terms
-    data = copy.deepcopy(testcell_data)
-    data["site"]["flow_density"] = "outdoor"
-    with pytest.raises(InputError, match="flow_density.*standalone C FMU"):
-        network_terms(parse_building(data), None)
-    with pytest.raises(InputError, match="longwave_followed.*standalone C FMU"):
-        network_terms(parse_building(enclosed(testcell_data)), None)

@@ -14,7 +14,6 @@ from nodeforce.cosim.run import simulate_fmu
 from nodeforce.diagnosis.calibrate import Candidate
 from nodeforce.fmu_build import guard
 from nodeforce.fmu_build.build import build_fmu, fmu_kind
-from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import prepare_case
 from nodeforce.model.effects import EFFECTS
 from nodeforce.model.integrate import simulate
@@ -24,7 +23,7 @@ from nodeforce.model.synth import pseudo_measurements
 from tests.conftest import SENSORS, record_times
 from tests.test_fmu_exchange import glibc_versions
 from tests.test_fmu_processes import files  # noqa: F401 (the locate fixture)
-from tests.test_standalone import TWINHOUSE, scenario
+from tests.test_standalone import scenario
 
 KINDS = ("python", "standalone")
 EFFECT = ("ground_coupling", "floor")
@@ -153,9 +152,9 @@ def test_a_diagnosis_s_candidates_are_calibrated_on_the_equations_their_fmus_car
     assert np.abs(direct - candidate.nodes(case, objective.air_nodes, [0.0, 25.0])).max() > 0.05
 
 
-@pytest.mark.slow  # three FMUs of 267 nodes
-def test_fmi3_equals_fmi2_on_the_twin_house(tmp_path):
-    building = parse_building(json.loads(TWINHOUSE.read_text()))
+@pytest.mark.slow  # three FMUs of 281 nodes
+def test_fmi3_equals_fmi2_on_the_twin_house(tmp_path, twinhouse):
+    building = twinhouse
     built = {(kind, fmi): build_fmu(building, tmp_path / f"{kind}{fmi}.fmu", kind=fmu_kind(kind, fmi))
              for kind, fmi in (("python", 2), ("python", 3), ("standalone", 3))}
     parameters, inputs, outputs, n_steps = scenario(built[("python", 2)], n_steps=96)

@@ -142,6 +142,22 @@ def test_the_python_fmu_needs_the_glibc_its_documentation_states(fmus, tmp_path)
     assert f"glibc {guard.GUARD_GLIBC};" in page and f"needs glibc {guard.PYTHONFMU_GLIBC} " in page
 
 
+@pytest.mark.parametrize("fmi", (2, 3))
+def test_the_standalone_fmu_needs_the_glibc_its_documentation_states(testcell_data, tmp_path, fmi):
+    """Its binary, the coefficients that follow the state stepped in it (pow and exp among their
+    functions), needs glibc 2.14 at most, as documentation/index.html says."""
+    from nodeforce.fmu_build.build import fmu_kind
+    from tests.test_convection import followed
+    fmu = build_fmu(parse_building(followed(testcell_data)), tmp_path / "model.fmu", kind=fmu_kind("standalone", fmi))
+    with zipfile.ZipFile(fmu) as archive:
+        page = archive.read("documentation/index.html").decode()
+        binary, = (name for name in archive.namelist() if name.startswith("binaries/") and name.endswith(".so"))
+        (tmp_path / "binary.so").write_bytes(archive.read(binary))
+    needs, _ = glibc_versions(tmp_path / "binary.so")
+    assert max(needs) == (2, 14)
+    assert "symbols up to glibc 2.14" in page
+
+
 def test_outputs_read_one_per_call_are_the_step_s_outputs(fmus, tmp_path):
     """The guard answers reads of outputs from its copy of the step's outputs: read one per
     call, after every step, in the C host, they are FMPy's (all in one call); restoring a state

@@ -290,14 +290,13 @@ def test_the_linux_binaries_find_their_neighbours_by_rpath_origin(fmus, tmp_path
     assert re.search(r"\(RPATH\)\s+Library rpath: \[\$ORIGIN\]", dynamic), dynamic
 
 
-def test_the_twin_houses_properties_through_the_standalone_fmu(tmp_path):
+def test_the_twin_houses_properties_through_the_standalone_fmu(tmp_path, twinhouse):
     """Every property of a real house at once, and one zone's alone, at values drawn within
     their bounds: the standalone FMU (its properties found in batches of nodes apart) against
-    the direct model of the building with those values (267 nodes, shaded glazings)."""
-    from nodeforce.model.building_file import load_building
+    the direct model of the building with those values (281 nodes, shaded glazings, coefficients
+    that follow the state)."""
     from nodeforce.model.effects import properties, with_fmu_parameters
-    from tests.test_standalone import TWINHOUSE
-    building = load_building(TWINHOUSE)
+    building = twinhouse
     network = assemble(building)
     rng = np.random.default_rng(3)
     U = rng.uniform(0.0, 30.0, (97, len(network.input_names)))

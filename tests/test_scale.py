@@ -217,15 +217,16 @@ def test_standalone_fmu_equals_the_direct_model_on_the_generated_office(office, 
 
 
 @pytest.mark.parametrize("steady_start", [False, True], ids=["replay", "steady_start"])
-def test_standalone_fmu_equals_the_direct_model_on_the_twin_house(tmp_path, steady_start):
-    """The Twin House (267 nodes: the direct model's dense inverse) through the C FMU's profile LU,
+def test_standalone_fmu_equals_the_direct_model_on_the_twin_house(tmp_path, steady_start, twinhouse):
+    """The Twin House (281 nodes: the direct model's dense inverse) through the C FMU's profile LU,
     on two days of random inputs, a third of its nodes forced to random measurements, some of
-    them missing at three steps; with a diagnosis' steady start too (its one long step)."""
+    them missing at three steps; with a diagnosis' steady start too (its one long step). Its
+    coefficients that follow the state are stepped in C by both."""
     from nodeforce.cosim.fmi import FmuInstance
     from nodeforce.cosim.run import simulate_fmu
     from nodeforce.fmu_build.build import build_fmu
     from nodeforce.model.case import Case
-    building = load_building(BUILDINGS[1])
+    building = twinhouse
     network = assemble(building)
     rng = np.random.default_rng(6)
     n_rows = 2 * 96 + 1

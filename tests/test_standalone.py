@@ -3,7 +3,6 @@ libcosim and ecos; both FMUs declare units, calculated outputs and their depende
 refuse the calls the FMI 2.0 standard forbids with fmi2Error; the Python FMU runs in a C host
 (its guard loads libpython), as the README says, without crashing at exit."""
 import copy
-import json
 import os
 import shutil
 import subprocess
@@ -206,13 +205,108 @@ def test_a_closed_shadings_leak_is_carried_by_both_fmus(testcell_data, tmp_path)
     assert np.abs(in_c - reference).max() < 1e-9
 
 
-TWINHOUSE = Path(__file__).parents[1] / "examples" / "twinhouse_n2" / "building.json"
+def with_people(data):
+    """The test cell with four people at 120 W whose sensible heat follows its air (docs/model.md
+    3.4), at all hours: their declared power and slope the polynomial's line at 24 C (69.5314 W and
+    -4.69664 W/K a person, test_energyplus_reading.py)."""
+    data = copy.deepcopy(data)
+    data["zones"][0]["gains"] = [{"name": "people", "power": 4 * 69.5314, "radiant_fraction": 0.3,
+                                  "temperature_slope": 4 * -4.69664, "reference_temperature": 24.0,
+                                  "people": {"number": 4, "activity": 120}}]
+    return data
 
 
-@pytest.mark.slow  # two FMUs of 267 nodes
-def test_standalone_equals_the_python_fmu_on_the_twin_house(tmp_path):
-    """The Twin House's south glazings have blinds (shading_south): both FMUs, a day."""
-    building = parse_building(json.loads(TWINHOUSE.read_text()))
+def at_outdoor_density(data):
+    """The building whose air flows carry heat at the outdoor air's density: the test cell's
+    infiltration, none as declared, which its air change rate opens as an FMU parameter."""
+    data = copy.deepcopy(data)
+    data["site"]["flow_density"] = "outdoor"
+    return data
+
+
+def with_followed_flows(data):
+    """The test cell with an exhaust of 20 air changes an hour that runs only above 24 C indoors
+    and leaks in proportion to the wind at the zone's height (docs/model.md 3.6)."""
+    data = copy.deepcopy(data)
+    volume = data["zones"][0]["volume"]
+    data["zones"][0]["ventilation"] = [
+        {"name": "exhaust", "flow": 20.0 * volume, "controls": {"minimum_indoor_temperature": 24.0}},
+        {"name": "leaks", "flow": 0.5 * volume, "terms": [0.0, 0.0, 0.224, 0.0], "wind_factor": 0.6}]
+    return data
+
+
+def followed_buildings():
+    """{name: (JSON data of the test cell -> building data, the kinds of followed coefficient it
+    carries)}: each kind the direct model follows (model/network.py, `Convection`) in one at least."""
+    from tests.test_convection import enclosed, followed
+    from tests.test_windows import window_data
+    return {"tarp_doe2_longwave": (followed, {"inside", "outside", "longwave"}),
+            "window_panes_and_gap": (lambda data: window_data(), {"windows", "gaps"}),
+            "scriptf_outdoor_density": (lambda data: at_outdoor_density(enclosed(data)), {"pairs", "flows"}),
+            "people": (with_people, {"people"}),
+            "flows_with_controls_and_wind": (with_followed_flows, {"flows"})}
+
+
+@pytest.mark.parametrize("fmi", (2, 3))
+@pytest.mark.parametrize("name", list(followed_buildings()))
+def test_the_standalone_fmu_steps_followed_coefficients_as_the_direct_model(testcell_data, tmp_path, name, fmi):
+    """Two days of random inputs (the wind round the compass, the sky 10 K below the air) through
+    the standalone FMU, at the declared parameters and with every property moved (a zone's
+    convection factor scales its faces' A phi, a conductivity factor a gap's A f): the direct
+    model of the building edited alike, to 1e-9 K. The followed terms matter: the direct model
+    without them is 0.01 K away at least."""
+    from dataclasses import replace
+
+    from nodeforce.cosim.fmi import FmuInstance
+    from nodeforce.fmu_build.build import fmu_kind
+    from nodeforce.model.effects import properties, with_fmu_parameters
+    from nodeforce.model.integrate import simulate
+    from nodeforce.model.network import WIND_DIRECTION, assemble
+    from tests.test_fmu_parameters import run
+    declare, kinds = followed_buildings()[name]
+    building = parse_building(declare(testcell_data))
+    network = assemble(building)
+    assert {kind for kind in kinds if len(getattr(network.convection, kind))} == kinds
+    rng = np.random.default_rng(5)
+    U = rng.uniform(0.0, 20.0, (2 * 96 + 1, len(network.input_names)))
+    columns = list(network.input_names)
+    if "T_sky" in columns:
+        U[:, columns.index("T_sky")] = U[:, columns.index("T_out")] - 10.0
+    if WIND_DIRECTION in columns:
+        U[:, columns.index(WIND_DIRECTION)] = rng.uniform(0.0, 360.0, len(U))
+    moved = {}
+    for parameter, p, target in properties(building):
+        low, high = p.bounds(p.read(building, target))
+        moved[parameter] = float(rng.uniform(-100.0, 100.0) if p.parameter.unit == "W"
+                                 else rng.uniform(max(low, 0.5), min(high, 2.0)))
+    fmu = build_fmu(building, tmp_path / f"{name}.fmu", kind=fmu_kind("standalone", fmi))
+    with FmuInstance(fmu) as instance:
+        for values in ({}, moved):
+            edited = with_fmu_parameters(building, None, values)
+            edited_network = assemble(edited)
+            expected = simulate(edited, edited_network, U, 900.0, warmup_days=0)
+            held = simulate(edited, replace(edited_network, convection=None), U, 900.0, warmup_days=0)
+            assert np.abs(held - expected).max() > 0.01
+            assert np.abs(run(instance, building, U, values) - expected).max() < 1e-9
+
+
+def test_auto_picks_the_standalone_fmu_for_coefficients_that_follow_the_state(testcell_data):
+    """The search's "auto" runs the FMU that steps a building fastest, the standalone, where the
+    coefficients follow the state too (where a compiler is at hand to export it)."""
+    from nodeforce.ga.locate import evaluator_kind
+    from nodeforce.runtime.compiler import find_compiler
+    buildings = [parse_building(declare(testcell_data)) for declare, _ in followed_buildings().values()]
+    assert all(b.followed_coefficients and not b.switched for b in buildings)
+    expected = "standalone" if find_compiler() else "python"
+    assert evaluator_kind("auto", buildings) == expected
+    assert evaluator_kind("auto-fmi3", buildings) == expected + "-fmi3"
+
+
+@pytest.mark.slow  # two FMUs of 281 nodes
+def test_standalone_equals_the_python_fmu_on_the_twin_house(tmp_path, twinhouse):
+    """The Twin House's south glazings have blinds (shading_south) and its coefficients follow
+    the state: both FMUs, a day."""
+    building = twinhouse
     python_fmu, standalone = (build_fmu(building, tmp_path / f"{kind}.fmu", kind=kind) for kind in KINDS)
     parameters, inputs, outputs, n_steps = scenario(python_fmu, n_steps=96)
     assert "shading_south" in inputs

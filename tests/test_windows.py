@@ -2,7 +2,6 @@
 coefficient and the gap's conductance by hand, a double-glazed window's steady pane temperatures
 against its energy balance solved independently, the limit of no sun and one temperature, and
 the same steps in numpy and in C."""
-import copy
 
 import numpy as np
 import pytest
@@ -149,14 +148,6 @@ def test_a_gap_with_a_node_within_is_refused():
     data["components"][0]["nodes"] = {"max_spacing": 0.005}
     with pytest.raises(InputError, match=r"components\[0\]\.window\.gaps\[0\]\.layer.*none within"):
         parse_building(data)
-
-
-def test_the_standalone_fmu_refuses_a_window():
-    from nodeforce.fmu_build.standalone import network_terms
-    data = copy.deepcopy(window_data())
-    data["zones"][0].pop("inside_convection_algorithm")
-    with pytest.raises(InputError, match="window.*standalone C FMU"):
-        network_terms(parse_building(data), None)
 
 
 def test_what_one_pane_or_face_gains_the_other_or_the_air_loses():

@@ -14,8 +14,9 @@ closed: a shading column each), optionally with the effects a diagnosis added on
 """
 import argparse
 import json
-import math
 from pathlib import Path
+
+from nodeforce.model import convection, glazing
 
 HERE = Path(__file__).resolve().parent
 
@@ -23,10 +24,26 @@ HERE = Path(__file__).resolve().parent
 EMISSIVITY = 0.9  # BUILDING.md: longwave emissivity 0.9
 H_RAD_IN = 5.1  # EMISSIVITY x 4 sigma T^3 at 20 C (EN ISO 6946 h_r0 = 5.7)
 H_RAD_OUT = 4.6  # EMISSIVITY x 4 sigma T^3 at 10 C (h_r0 = 5.1)
-H_CONV_OUT = 14.6  # EN ISO 6946 4 + 4 v, v = 2.65 m/s, the measured mean wind speed
 H_CONV_HORIZONTAL_FLOW = 2.5  # EN ISO 6946, walls and windows
 H_CONV_UPWARD_FLOW = 5.0  # EN ISO 6946, both faces of the ceiling
 H_CONV_DOWNWARD_FLOW = 0.7  # EN ISO 6946, both faces of the floor
+
+# --- Coefficients that follow the state (README "Surface coefficients"; docs/model.md 3.6) --
+# The rooms' air is stirred by nothing but the heaters' plumes and 120 m3/h of supply air: natural
+# convection, which TARP follows face by face with the air-to-face temperature difference.
+INSIDE_CONVECTION = "tarp"
+# The weather mast measures the wind (m/s, deg from north), taken as EnergyPlus's station at 10 m
+# in open country; the test site is an open field ("country"), and a ground-floor facade's centroid
+# half a storey (3.28 m) above the floor, taken at grade.
+TERRAIN = "country"
+FACADE_CENTROID_HEIGHT = 1.64  # m
+WIND_FACTOR = round(float(convection.wind_at_height(1.0, FACADE_CENTROID_HEIGHT, TERRAIN)), 6)
+MEAN_WIND_SPEED = 2.65  # m/s, the record's mean: where the step matrix holds DOE-2's h
+# DOE-2 roughness multipliers (EnergyPlus's Material Roughness): the thin render MediumRough, the
+# wood door MediumSmooth, glass (and its PVC frame) 1, as EnergyPlus takes a window's outer face
+ROUGHNESS_RENDER = convection.ROUGHNESS["mediumrough"]
+ROUGHNESS_DOOR = convection.ROUGHNESS["mediumsmooth"]
+ROUGHNESS_GLASS = 1.0
 
 # --- Air flows (BUILDING.md "Ventilation", "Zones") ---------------------------------------
 N50 = 1.62  # 1/h, N2
@@ -91,10 +108,15 @@ NODES = {
 }
 
 # --- Glazing (BUILDING.md "Windows and doors") ---------------------------------------------
-U_GLASS, U_FRAME, PSI_GLASS_EDGE = 1.1, 1.0, 0.05  # W/m2/K, W/m2/K, W/m/K
 G_NORMAL, TAU_NORMAL, TAU_DIFFUSE = 0.525, 0.543, 0.427
-GLASS = (1.0, 2500.0, 750.0)  # EN ISO 10456 glass: the two 4 mm panes carry the capacity
-GLASS_THICKNESS = 0.008
+GLASS = (1.0, 2500.0, 750.0)  # EN ISO 10456 glass, W/m/K, kg/m3, J/kg/K
+# 4 mm clear float / 16 mm argon (90 %) / 4 mm low-e, outside first (m); the low-e coating of the
+# inner pane faces the gap (IDEAS Glazing.mo: 0.04 there, 0.837 on every uncoated glass face)
+PANE, GAP = 0.004, 0.016
+GAP_GAS = [["argon", 0.9], ["air", 0.1]]
+EMISSIVITY_GLASS, EMISSIVITY_LOW_E = 0.837, 0.04
+# the gap's gas (argon-air) carries no capacity worth a node's: the air's, as the converter has it
+GAS_DENSITY, GAS_SPECIFIC_HEAT = 1.2, 1005.0
 # id: (zone, azimuth, area m2, frame fraction, opening width m, opening height m)
 WINDOWS = {
     "W27": ("bedroom", 0.0, 2.1402, 0.397, 1.23, 1.54),
@@ -189,36 +211,36 @@ FLOOR_OF = {zone: floor for floor, _, zone, _ in SLABS}
 W9_BL1_DEPTH = 0.34  # int plaster 0.01 + brick 0.30 + former ext plaster 0.03: EPS / old wall
 
 
-def window_u(area, frame_fraction, width, height):
-    """U_w (W/m2/K) of a window, EN ISO 10077-1 style: glass and frame by area plus the glass-edge
-    psi along the perimeter of one pane with the opening's aspect ratio (a lower bound for
-    multi-sash windows).
-
-    area : window area, m2; frame_fraction : 0..1; width, height : opening, m.
-    """
-    glass = area * (1.0 - frame_fraction)
-    aspect = width / height
-    perimeter = 2.0 * (math.sqrt(glass * aspect) + math.sqrt(glass / aspect))
-    return ((1.0 - frame_fraction) * U_GLASS + frame_fraction * U_FRAME
-            + PSI_GLASS_EDGE * perimeter / area)
-
-
-def glazing_conductivity():
-    """Conductivity (W/m/K) of the 8 mm equivalent glazing layer that gives the area-weighted
-    mean U_w of the windows between the model's own inside and outside surface coefficients."""
-    total = sum(w[2] for w in WINDOWS.values())
-    u_w = sum(w[2] * window_u(w[2], w[3], w[4], w[5]) for w in WINDOWS.values()) / total
-    r_layer = 1.0 / u_w - 1.0 / (H_CONV_HORIZONTAL_FLOW + H_RAD_IN) - 1.0 / (H_CONV_OUT + H_RAD_OUT)
-    return GLASS_THICKNESS / r_layer
-
-
 def _surface(zone, h_conv):
     return {"zone": zone, "h_conv": h_conv, "h_rad": H_RAD_IN}
 
 
-def _exterior(irradiance, absorptance):
-    return {"type": "exterior", "h_conv": H_CONV_OUT, "h_rad": H_RAD_OUT,
-            "solar_absorptance": absorptance, "irradiance": irradiance}
+def _exterior(irradiance, absorptance, roughness, emissivity=EMISSIVITY):
+    """An outdoor face under the measured facade irradiance (W/m2), its convection DOE-2's at the
+    measured wind and its long-wave exchange at its own and the sky's temperatures (docs/model.md
+    3.6); the step matrix holds DOE-2's h at the record's mean wind (W/m2/K) and h_rad at 10 C."""
+    h_conv = convection.doe2(90.0, MEAN_WIND_SPEED * WIND_FACTOR, roughness)
+    return {"type": "exterior", "h_conv": round(float(h_conv), 4), "h_rad": round(H_RAD_OUT * emissivity / EMISSIVITY, 4),
+            "solar_absorptance": absorptance, "irradiance": irradiance,
+            "convection": {"algorithm": "doe2", "roughness": roughness, "wind_factor": WIND_FACTOR},
+            "longwave": {"emissivity": emissivity}}
+
+
+def window_emissivity(frame_fraction):
+    """Long-wave emissivity of a window's outer face: its glass's and its PVC frame's by area."""
+    return round(frame_fraction * EMISSIVITY + (1.0 - frame_fraction) * EMISSIVITY_GLASS, 4)
+
+
+def gap_conductivity():
+    """Conductivity (W/m/K) of the argon gap's layer: d times its conductance (W/m2/K) at 10 C with
+    15 K across (ISO 15099, docs/model.md 4.1), which the step matrix holds; its Nusselt number is
+    the gap's own at 16 mm, whatever the windows' heights (1.54 and 2.37 m)."""
+    height = WINDOWS["W31"][5]
+    return GAP * glazing.gap_conductance(GAP, height, EMISSIVITY_LOW_E, EMISSIVITY_GLASS, gas=GAP_GAS)
+
+
+# A window's layers, inside face first: the low-e pane, the argon gap, the clear pane (m)
+WINDOW_LAYERS = [("glass", PANE), ("argon_gap", GAP), ("glass", PANE)]
 
 
 def _component(name, area, tilt, azimuth, layers, nodes, inside, outside, **extra):
@@ -234,7 +256,8 @@ def components(experiment=1):
         nodes = NODES["W9"] if name == "W9" else NODES["thin" if construction == "door" else "extwall"]
         out.append(_component(name, area, 90.0, azimuth, CONSTRUCTIONS[construction], nodes,
                               _surface(zone, H_CONV_HORIZONTAL_FLOW),
-                              _exterior(FACADE_IRRADIANCE[azimuth], SOLAR_ABSORPTANCE_OUT)))
+                              _exterior(FACADE_IRRADIANCE[azimuth], SOLAR_ABSORPTANCE_OUT,
+                                        ROUGHNESS_DOOR if construction == "door" else ROUGHNESS_RENDER)))
     for floor, ceiling, zone, area in SLABS:
         out.append(_component(floor, area, 180.0, 0.0, CONSTRUCTIONS["floor"], NODES["slab"],
                               _surface(zone, H_CONV_DOWNWARD_FLOW),
@@ -244,16 +267,19 @@ def components(experiment=1):
                               _surface(zone, H_CONV_UPWARD_FLOW),
                               {"type": "boundary", "temperature": ATTIC,
                                "h": H_CONV_UPWARD_FLOW + H_RAD_IN}))
-    for name, (zone, azimuth, area, frame, _, _) in WINDOWS.items():
+    for name, (zone, azimuth, area, frame, _, height) in WINDOWS.items():
+        # the gap (layer 1 from the inside) between the inner pane's low-e face and the outer's glass
+        gap = {"layer": 1, "emissivities": [EMISSIVITY_LOW_E, EMISSIVITY_GLASS], "gas": GAP_GAS}
         extra = {"solar_transmittance": round(G_NORMAL * TAU_DIFFUSE / TAU_NORMAL * (1.0 - frame), 4),
-                 "transmitted_solar_to": FLOOR_OF[zone]}
+                 "transmitted_solar_to": FLOOR_OF[zone], "window": {"height": height, "gaps": [gap]}}
         if azimuth == 180.0:
             extra["shading"] = SOUTH_SHADING
         elif name in EXPERIMENTS[experiment]["shaded"]:
             extra["shading"] = EXPERIMENTS[experiment]["shaded"][name]
-        out.append(_component(name, area, 90.0, azimuth, [("glazing_equivalent", GLASS_THICKNESS)],
+        out.append(_component(name, area, 90.0, azimuth, WINDOW_LAYERS,
                               NODES["thin"], _surface(zone, H_CONV_HORIZONTAL_FLOW),
-                              _exterior(FACADE_IRRADIANCE[azimuth], round(SOLAR_ABSORPTANCE_OUT * frame, 4)),
+                              _exterior(FACADE_IRRADIANCE[azimuth], round(SOLAR_ABSORPTANCE_OUT * frame, 4),
+                                        ROUGHNESS_GLASS, window_emissivity(frame)),
                               **extra))
     for name, (construction, area, room, other) in PARTITIONS.items():
         nodes = NODES["intwall" if construction.startswith("intwall") else "thin"]
@@ -269,7 +295,7 @@ def zones(experiment=1):
     out = []
     for name, (volume, heat_input) in ZONES.items():
         zone = {"name": name, "volume": volume, "air_change_rate": AIR_CHANGE_RATE,
-                "internal_gain": 0.0, "occupied": False}
+                "internal_gain": 0.0, "occupied": False, "inside_convection_algorithm": INSIDE_CONVECTION}
         if heat_input:
             zone["heat_input"] = heat_input[0] if len(heat_input) == 1 else heat_input
             zone["heat_input_radiative_fraction"] = HEATER_RADIATIVE_FRACTION
@@ -310,8 +336,9 @@ def building(experiment=1):
     """The whole building file as JSON data, under the protocol of `experiment` (EXPERIMENTS)."""
     materials = {name: {"conductivity": k, "density": rho, "specific_heat": c}
                  for name, (k, rho, c) in MATERIALS.items()}
-    materials["glazing_equivalent"] = {"conductivity": round(glazing_conductivity(), 6),
-                                       "density": GLASS[1], "specific_heat": GLASS[2]}
+    materials["glass"] = {"conductivity": GLASS[0], "density": GLASS[1], "specific_heat": GLASS[2]}
+    materials["argon_gap"] = {"conductivity": round(gap_conductivity(), 6), "density": GAS_DENSITY,
+                              "specific_heat": GAS_SPECIFIC_HEAT}
     return {
         "format": "nodal-building/1",
         "name": "Twin House N2, ground floor (IEA EBC Annex 58)",

@@ -10,6 +10,10 @@
    the rows of forced nodes (force[i] and T_forced[i] not NaN) replaced by T+_i = T_forced[i],
    with M factorised once per pattern of imposed nodes and step size: LU within the profile of
    M reordered by reverse Cuthill-McKee (profile.h), O(N) per step on a building's network.
+   Where coefficients follow the state (docs/model.md section 3.6), each step adds their sources
+   beyond the h0 of A, from T before it and its inputs (followed.h, the direct model's arithmetic):
+   their nodes are data, and their values (areas, h0, ...) entries F of the block C, A, B, q, P,
+   F that the parameters' terms set like any other.
    The state at the start is T_start. The inputs set before doStep(t, h) are those at t, their
    first derivatives (fmi2SetRealInputDerivatives; zero where none is set for this step) make
    them linear over the step: doStep takes k = ceil(h / max_step) steps of h / k, each with the
@@ -24,12 +28,28 @@
 #include <string.h>
 
 #include "fmi2.h"
+#include "followed.h"
 #include "profile.h"
 #include "resources.h"
 #include "variables.h"
 
+/* The binary needs glibc 2.14 at most (its documentation, fmu_build/description.py): pow and exp
+   (followed.h) at their first versions, which every glibc's libm holds, not the GLIBC_2.29 ones
+   glibc added when it dropped their SVID error handling (the same results where they are finite;
+   tests/test_fmu_exchange.py reads the versions). */
+#if defined(__x86_64__) && defined(__GLIBC__)
+__asm__(".symver pow,pow@GLIBC_2.2.5");
+__asm__(".symver exp,exp@GLIBC_2.2.5");
+#endif
+
 #define CACHED_PATTERNS 8
 #define MAX_SUBSTEPS 10000000 /* the internal steps of one doStep, at most (variables.py's) */
+#define FOLLOWED_KINDS 8
+/* a row's values and nodes of each kind of followed coefficient (model/compiled.py's FOLLOWED),
+   and which node of a row is an input's column (or -1) instead: a flow's and people's schedule */
+static const int FOLLOWED_VALUES[FOLLOWED_KINDS] = {3, 6, 4, 5, 15, 2, 14, 6};
+static const int FOLLOWED_NODES[FOLLOWED_KINDS] = {2, 1, 1, 2, 2, 2, 2, 3};
+static const int FOLLOWED_COLUMN[FOLLOWED_KINDS] = {-1, -1, -1, -1, -1, -1, 1, 2};
 
 typedef struct {
     double dt;
@@ -40,6 +60,9 @@ typedef struct {
 
 typedef struct {
     int n, n_in, n_par, n_terms, n_products;
+    int n_followed[FOLLOWED_KINDS]; /* each kind's count (followed.h's order) */
+    int followed_columns[4];        /* the inputs T_out, wind speed and direction, T_sky (or -1) */
+    int *followed_nodes;            /* each kind's nodes, FOLLOWED_NODES[k] a row, concatenated */
     double *p0;       /* n_par */
     double max_step;  /* s: max_step's start */
     int *product;     /* n_products x 3: node, input a, input b */
@@ -60,7 +83,9 @@ typedef struct {
     double *values, *start_values;
     double *derivatives; /* n_in + n: d/dt of the inputs and of T_forced at the communication point */
     double *u;           /* n_in: the inputs at the end of a sub-step */
-    double *C, *A, *B, *q, *P; /* at the parameters' values */
+    double *C, *A, *B, *q, *P, *F; /* at the parameters' values; F the followed coefficients' */
+    Followed followed;             /* its values in F */
+    double *extra;                 /* N: their sources at a step */
     double *v, *work;
     unsigned char *imposed;
     Profile profile;
@@ -112,22 +137,60 @@ static int read_longs(FILE *f, long *x, long count) {
     return 1;
 }
 
-/* The size of the block C, A, B, q, P. */
-static long term_size(const Network *net) { return (long)net->n * (2 + net->n + net->n_in) + net->n_products; }
+/* The number of values (k < FOLLOWED_KINDS) or nodes of the followed coefficients. */
+static long followed_size(const Network *net, const int *width) {
+    long size = 0;
+    int k;
+    for (k = 0; k < FOLLOWED_KINDS; k++) size += (long)net->n_followed[k] * width[k];
+    return size;
+}
 
-/* resources/network.txt: "nodeforce-network/4", "sizes N N_IN N_PAR N_TERMS N_PRODUCTS
-   N_PARAMETER_REFS N_NONZEROS", "p0 ...", "max_step S" (the start of max_step, s), "products (node a b) ...", then per term "term K
-   j_1 .. j_K COUNT" and COUNT pairs "index value" (index into the block C, A, B, q, P), "end". */
+/* The size of the block C, A, B, q, P, F. */
+static long term_size(const Network *net) {
+    return (long)net->n * (2 + net->n + net->n_in) + net->n_products + followed_size(net, FOLLOWED_VALUES);
+}
+
+/* "followed" counts (FOLLOWED_KINDS), columns (4), nodes: each a node, or an input's column or -1
+   where FOLLOWED_COLUMN says, and the columns a kind reads given. */
+static int read_followed(Network *net, FILE *f) {
+    long at = 0, size;
+    int k, r, j;
+    if (!expect(f, "followed") || !read_ints(f, net->n_followed, FOLLOWED_KINDS)
+        || !read_ints(f, net->followed_columns, 4))
+        return 0;
+    for (k = 0; k < FOLLOWED_KINDS; k++)
+        if (net->n_followed[k] < 0) return 0;
+    for (j = 0; j < 4; j++)
+        if (net->followed_columns[j] < -1 || net->followed_columns[j] >= net->n_in) return 0;
+    if ((net->n_followed[1] > 0 || net->n_followed[2] > 0 || net->n_followed[6] > 0) && net->followed_columns[0] < 0)
+        return 0;
+    if (net->n_followed[1] > 0 && (net->followed_columns[1] < 0 || net->followed_columns[2] < 0)) return 0;
+    if (net->n_followed[2] > 0 && net->followed_columns[3] < 0) return 0;
+    size = followed_size(net, FOLLOWED_NODES);
+    net->followed_nodes = calloc((size_t)size + 1, sizeof(int));
+    if (!net->followed_nodes || !read_ints(f, net->followed_nodes, (int)size)) return 0;
+    for (k = 0; k < FOLLOWED_KINDS; k++)
+        for (r = 0; r < net->n_followed[k]; r++)
+            for (j = 0; j < FOLLOWED_NODES[k]; j++, at++) {
+                const int x = net->followed_nodes[at];
+                if (j == FOLLOWED_COLUMN[k] ? x < -1 || x >= net->n_in : x < 0 || x >= net->n) return 0;
+            }
+    return 1;
+}
+
+/* resources/network.txt: "nodeforce-network/5", "sizes N N_IN N_PAR N_TERMS N_PRODUCTS
+   N_PARAMETER_REFS N_NONZEROS", "p0 ...", "max_step S" (the start of max_step, s), "products (node a b) ...",
+   "followed ..." (`read_followed`), then per term "term K j_1 .. j_K COUNT" and COUNT pairs
+   "index value" (index into the block C, A, B, q, P, F), "end". */
 static int read_network(Network *net, FILE *f) {
     long refs, nonzeros, k, count, at = 0, at_par = 0, size;
     int t, j;
-    if (!expect(f, "nodeforce-network/4") || !expect(f, "sizes") || !read_ints(f, &net->n, 1)
+    if (!expect(f, "nodeforce-network/5") || !expect(f, "sizes") || !read_ints(f, &net->n, 1)
         || !read_ints(f, &net->n_in, 1) || !read_ints(f, &net->n_par, 1) || !read_ints(f, &net->n_terms, 1)
         || !read_ints(f, &net->n_products, 1) || !read_longs(f, &refs, 1) || !read_longs(f, &nonzeros, 1)
         || net->n <= 0 || net->n_in < 0 || net->n_par < 0 || net->n_terms < 1 || net->n_products < 0 || refs < 0
         || nonzeros < 0)
         return 0;
-    size = term_size(net);
     net->p0 = calloc((size_t)net->n_par + 1, sizeof(double));
     net->product = calloc((size_t)net->n_products * 3 + 1, sizeof(int));
     net->term_start = calloc((size_t)net->n_terms + 1, sizeof(long));
@@ -145,6 +208,8 @@ static int read_network(Network *net, FILE *f) {
         const int *p = net->product + 3 * k;
         if (p[0] < 0 || p[0] >= net->n || p[1] < 0 || p[1] >= net->n_in || p[2] < 0 || p[2] >= net->n_in) return 0;
     }
+    if (!read_followed(net, f)) return 0;
+    size = term_size(net);
     for (t = 0; t < net->n_terms; t++) {
         int n_par;
         net->term_start[t] = at;
@@ -168,7 +233,7 @@ static int read_network(Network *net, FILE *f) {
 
 static void free_network(Network *net) {
     free(net->p0); free(net->product); free(net->term_start); free(net->par_start); free(net->term_par);
-    free(net->index); free(net->value);
+    free(net->index); free(net->value); free(net->followed_nodes);
 }
 
 /* ------------------------------------------------------------------ the numbers */
@@ -194,6 +259,28 @@ static void network_at_parameters(Model *m) {
             }
     }
     m->b_start[net->n] = k;
+}
+
+/* The followed coefficients' nodes (the network's) and values (in F). */
+static void followed_at(Model *m) {
+    const Network *net = &m->net;
+    Followed *f = &m->followed;
+    const int **nodes[FOLLOWED_KINDS] = {&f->inside_nodes, &f->outside_nodes, &f->longwave_nodes, &f->window_nodes,
+                                         &f->gap_nodes, &f->pair_nodes, &f->flow_nodes, &f->people_nodes};
+    const double **values[FOLLOWED_KINDS] = {&f->inside, &f->outside, &f->longwave, &f->windows,
+                                             &f->gaps, &f->pairs, &f->flows, &f->people};
+    int *counts[FOLLOWED_KINDS] = {&f->n_inside, &f->n_outside, &f->n_longwave, &f->n_windows,
+                                   &f->n_gaps, &f->n_pairs, &f->n_flows, &f->n_people};
+    long at_node = 0, at_value = 0;
+    int k;
+    for (k = 0; k < FOLLOWED_KINDS; k++) {
+        *counts[k] = net->n_followed[k];
+        *nodes[k] = net->followed_nodes + at_node;
+        *values[k] = m->F + at_value;
+        at_node += (long)net->n_followed[k] * FOLLOWED_NODES[k];
+        at_value += (long)net->n_followed[k] * FOLLOWED_VALUES[k];
+    }
+    f->columns = net->followed_columns;
 }
 
 /* The profile of M's links in any term of the network (so in M at any parameter values). */
@@ -276,6 +363,7 @@ static fmi2Status step(Model *m, double h) {
     const double *u0 = m->values + vr_inputs(&m->layout), *T_forced = m->values + vr_T_forced(&m->layout);
     const double *du = m->derivatives, *dT_forced = m->derivatives + n_in;
     double *T = m->values + vr_T(&m->layout), *u = m->u, dt, s;
+    const int followed = followed_any(&m->followed);
     Factors *f;
     for (i = 0; i < n; i++) m->imposed[i] = m->values[vr_force(&m->layout) + i] != 0.0 && isfinite(T_forced[i]);
     if (h / m->values[vr_max_step(&m->layout)] > MAX_SUBSTEPS) {
@@ -302,6 +390,10 @@ static fmi2Status step(Model *m, double h) {
         for (k = 0; k < net->n_products; k++) {
             const int *p = net->product + 3 * k;
             m->v[p[0]] += m->P[k] * u[p[1]] * u[p[2]];
+        }
+        if (followed) { /* from T before the step and its inputs */
+            convection(&m->followed, n, T, u, m->extra);
+            for (i = 0; i < n; i++) m->v[i] += m->extra[i];
         }
         for (i = 0; i < n; i++)
             m->v[i] = m->imposed[i] ? T_forced[i] + dT_forced[i] * s : m->C[i] / dt * T[i] + m->v[i];
@@ -331,6 +423,7 @@ static void free_model(Model *m) {
     free_network(&m->net);
     free_names(&m->layout);
     free(m->name); free(m->values); free(m->start_values); free(m->derivatives); free(m->u); free(m->C); free(m->v); free(m->work);
+    free(m->extra);
     free(m->imposed); profile_free(&m->profile);
     free(m->b_start); free(m->b_column); free(m->b_value);
     free(m);
@@ -382,13 +475,16 @@ FMI2_EXPORT fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2St
     m->B = m->A + m->net.n * m->net.n;
     m->q = m->B + m->net.n * m->net.n_in;
     m->P = m->q + m->net.n;
+    m->F = m->P + m->net.n_products;
+    followed_at(m);
     m->v = calloc((size_t)m->net.n, sizeof(double));
     m->work = calloc((size_t)m->net.n, sizeof(double));
+    m->extra = calloc((size_t)m->net.n, sizeof(double));
     m->b_start = calloc((size_t)m->net.n + 1, sizeof(long));
     m->b_column = calloc((size_t)m->net.n * m->net.n_in + 1, sizeof(int));
     m->b_value = calloc((size_t)m->net.n * m->net.n_in + 1, sizeof(double));
     m->imposed = calloc((size_t)m->net.n, 1);
-    if (!m->values || !m->start_values || !m->derivatives || !m->u || !m->C || !m->v || !m->work || !m->imposed || !m->b_start || !m->b_column
+    if (!m->values || !m->start_values || !m->derivatives || !m->u || !m->C || !m->v || !m->work || !m->extra || !m->imposed || !m->b_start || !m->b_column
         || !m->b_value || !order_network(m)) {
         free_model(m);
         return NULL;
