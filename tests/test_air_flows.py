@@ -8,11 +8,10 @@ import pytest
 
 from nodeforce.model import compiled
 from nodeforce.model.building_file import parse_building
-from nodeforce.model.case import prepare_case
 from nodeforce.model.errors import InputError
 from nodeforce.model.integrate import simulate
 from nodeforce.model.network import C_AIR, WIND_SPEED, assemble
-from tests.test_convection import windy
+from tests.test_convection import assert_python_fmu_steps_as_the_direct_model, windy_case
 
 T_AIR, T_OUT, WIND = 20.0, -5.0, 5.0  # C, C, m/s at the station
 
@@ -110,21 +109,22 @@ def test_a_file_that_declares_neither_assembles_no_lagged_flow(testcell_data):
     assert assemble(building).convection is None and not building.followed_coefficients
 
 
-def test_controlled_and_wind_flows_step_alike_in_c_and_numpy(testcell_data, weather, monkeypatch):
-    """A flow of 20 air changes an hour on only above 24 C indoors, and one following the wind:
-    the air runs otherwise than with the flows constant, the same in C and in numpy (the standalone
-    FMU's: tests/test_standalone.py)."""
-    from tests.conftest import record_times
-    data = copy.deepcopy(testcell_data)
+def controlled_and_windy(data):
+    """The test cell with an exhaust of 20 air changes an hour that runs only above 24 C indoors,
+    and leaks of 0.5 an hour in proportion to the wind at the zone's height."""
+    data = copy.deepcopy(data)
     volume = data["zones"][0]["volume"]
     data["zones"][0]["ventilation"] = [
         {"name": "exhaust", "flow": 20.0 * volume, "controls": {"minimum_indoor_temperature": 24.0}},
         {"name": "leaks", "flow": 0.5 * volume, "terms": [0.0, 0.0, 0.224, 0.0], "wind_factor": 0.6}]
-    building = parse_building(data)
-    times = record_times(days=3)
-    w = windy(weather)
-    w = w[(w.index >= times[0] - np.timedelta64(2, "h")) & (w.index <= times[-1] + np.timedelta64(2, "h"))]
-    case = prepare_case(building, w)
+    return data
+
+
+def test_controlled_and_wind_flows_step_alike_in_c_and_numpy(testcell_data, weather, monkeypatch):
+    """The exhaust and the leaks of `controlled_and_windy`: the air runs otherwise than with the
+    flows constant, the same in C and in numpy (the standalone FMU's: tests/test_standalone.py)."""
+    building = parse_building(controlled_and_windy(testcell_data))
+    case = windy_case(building, weather, days=3)
     network = assemble(building)
     T = simulate(building, network, case.U, case.dt, substeps=case.substeps)
     air = building.zones[0].air_node - 1
@@ -138,21 +138,9 @@ def test_controlled_and_wind_flows_step_alike_in_c_and_numpy(testcell_data, weat
 
 @pytest.mark.slow
 def test_the_python_fmu_steps_followed_flows_as_the_direct_model(testcell_data, weather, tmp_path):
-    from nodeforce.cosim.fmi import FmuInstance
-    from nodeforce.cosim.run import simulate_fmu
-    from nodeforce.fmu_build.build import build_fmu
-    from tests.conftest import record_times
     building = parse_building(with_flow(testcell_data, terms=[0.2, 0.01, 0.224, 0.0], wind_factor=0.6,
                                         controls={"minimum_indoor_temperature": 24.0}))
-    times = record_times(days=2)
-    w = windy(weather)
-    w = w[(w.index >= times[0] - np.timedelta64(2, "h")) & (w.index <= times[-1] + np.timedelta64(2, "h"))]
-    case = prepare_case(building, w)
-    direct = simulate(building, assemble(building), case.U, case.dt, case.measured, substeps=case.substeps)
-    fmu = build_fmu(building, tmp_path / "flows.fmu")
-    with FmuInstance(fmu) as instance:
-        through_fmu = simulate_fmu(instance, case)
-    assert np.abs(through_fmu - direct).max() < 1e-9
+    assert_python_fmu_steps_as_the_direct_model(building, weather, tmp_path / "flows.fmu")
 
 
 def test_a_gale_through_a_large_flow_stays_bounded_by_its_cap(testcell_data, weather):
@@ -161,15 +149,11 @@ def test_a_gale_through_a_large_flow_stays_bounded_by_its_cap(testcell_data, wea
     beyond C_air/dt + g + G); capped at 1 + C_air / (300 s g), the air follows the outdoor air, as
     a flow of so many air changes makes it."""
     import dataclasses
-    from tests.conftest import record_times
     data = copy.deepcopy(testcell_data)
     volume = data["zones"][0]["volume"]
     data["zones"][0]["ventilation"] = [{"name": "gale", "flow": 200.0 * volume, "terms": [0.0, 0.0, 1.0, 0.0]}]
     building = parse_building(data)
-    times = record_times(days=3)
-    w = windy(weather)
-    w = w[(w.index >= times[0] - np.timedelta64(2, "h")) & (w.index <= times[-1] + np.timedelta64(2, "h"))]
-    case = prepare_case(building, w)
+    case = windy_case(building, weather, days=3)
     network = assemble(building)
     air = building.zones[0].air_node - 1
     T = simulate(building, network, case.U, case.dt, substeps=case.substeps)

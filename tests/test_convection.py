@@ -46,6 +46,29 @@ def windy(weather):
     return w
 
 
+def windy_case(building, weather, days):
+    """The `prepare_case` of `building` over a record of `days` (`record_times`) in the `windy`
+    weather, two hours of it either side."""
+    from tests.conftest import record_times
+    times = record_times(days=days)
+    w = windy(weather)
+    w = w[(w.index >= times[0] - np.timedelta64(2, "h")) & (w.index <= times[-1] + np.timedelta64(2, "h"))]
+    return prepare_case(building, w)
+
+
+def assert_python_fmu_steps_as_the_direct_model(building, weather, path):
+    """Two windy days of `building` through its Python FMU (at `path`) and the direct model: the
+    same temperatures to 1e-9 K."""
+    from nodeforce.cosim.fmi import FmuInstance
+    from nodeforce.cosim.run import simulate_fmu
+    from nodeforce.fmu_build.build import build_fmu
+    case = windy_case(building, weather, days=2)
+    direct = simulate(building, assemble(building), case.U, case.dt, case.measured, substeps=case.substeps)
+    with FmuInstance(build_fmu(building, path)) as instance:
+        through_fmu = simulate_fmu(instance, case)
+    assert np.abs(through_fmu - direct).max() < 1e-9
+
+
 def test_a_wall_4_K_warmer_than_the_air_gets_ashrae_s_vertical_coefficient():
     # Engineering Reference, ASHRAE vertical wall: h = 1.31 |dT|^(1/3) = 1.31 * 1.587401 = 2.079495
     assert tarp_inside_faces(4.0, 0.0) == pytest.approx(2.079495, abs=1e-6)
@@ -174,12 +197,8 @@ def test_a_building_at_one_temperature_steps_as_with_constant_coefficients(testc
 
 
 def test_the_coefficients_move_the_air_and_c_and_numpy_step_alike(testcell_data, weather, monkeypatch):
-    from tests.conftest import record_times
     building, plain = parse_building(followed(testcell_data)), parse_building(testcell_data)
-    w = windy(weather)
-    times = record_times(days=3)
-    w = w[(w.index >= times[0] - np.timedelta64(2, "h")) & (w.index <= times[-1] + np.timedelta64(2, "h"))]
-    case = prepare_case(building, w)
+    case = windy_case(building, weather, days=3)
     network = assemble(building)
     T = simulate(building, network, case.U, case.dt, substeps=case.substeps)
     constant = simulate(plain, assemble(plain), case.U[:, :-2], case.dt, substeps=case.substeps)
@@ -228,20 +247,8 @@ def test_the_standalone_fmu_refuses_a_parameter_that_acts_on_a_followed_value_no
 @pytest.mark.parametrize("declare", [followed, lambda data: enclosed(ventilated(data))],
                          ids=["convection", "scriptf_and_flows"])
 def test_the_python_fmu_steps_as_the_direct_model(testcell_data, weather, tmp_path, declare):
-    from nodeforce.cosim.fmi import FmuInstance
-    from nodeforce.cosim.run import simulate_fmu
-    from nodeforce.fmu_build.build import build_fmu
-    from tests.conftest import record_times
-    building = parse_building(declare(testcell_data))
-    times = record_times(days=2)
-    w = windy(weather)
-    w = w[(w.index >= times[0] - np.timedelta64(2, "h")) & (w.index <= times[-1] + np.timedelta64(2, "h"))]
-    case = prepare_case(building, w)
-    direct = simulate(building, assemble(building), case.U, case.dt, case.measured, substeps=case.substeps)
-    fmu = build_fmu(building, tmp_path / "followed.fmu")
-    with FmuInstance(fmu) as instance:
-        through_fmu = simulate_fmu(instance, case)
-    assert np.abs(through_fmu - direct).max() < 1e-9
+    assert_python_fmu_steps_as_the_direct_model(parse_building(declare(testcell_data)), weather,
+                                                tmp_path / "followed.fmu")
 
 
 # ---- ScriptF at the faces' temperatures, air flows at the outdoor air's density -----------------

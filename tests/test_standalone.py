@@ -224,27 +224,17 @@ def at_outdoor_density(data):
     return data
 
 
-def with_followed_flows(data):
-    """The test cell with an exhaust of 20 air changes an hour that runs only above 24 C indoors
-    and leaks in proportion to the wind at the zone's height (docs/model.md 3.6)."""
-    data = copy.deepcopy(data)
-    volume = data["zones"][0]["volume"]
-    data["zones"][0]["ventilation"] = [
-        {"name": "exhaust", "flow": 20.0 * volume, "controls": {"minimum_indoor_temperature": 24.0}},
-        {"name": "leaks", "flow": 0.5 * volume, "terms": [0.0, 0.0, 0.224, 0.0], "wind_factor": 0.6}]
-    return data
-
-
 def followed_buildings():
     """{name: (JSON data of the test cell -> building data, the kinds of followed coefficient it
     carries)}: each kind the direct model follows (model/network.py, `Convection`) in one at least."""
+    from tests.test_air_flows import controlled_and_windy
     from tests.test_convection import enclosed, followed
     from tests.test_windows import window_data
     return {"tarp_doe2_longwave": (followed, {"inside", "outside", "longwave"}),
             "window_panes_and_gap": (lambda data: window_data(), {"windows", "gaps"}),
             "scriptf_outdoor_density": (lambda data: at_outdoor_density(enclosed(data)), {"pairs", "flows"}),
             "people": (with_people, {"people"}),
-            "flows_with_controls_and_wind": (with_followed_flows, {"flows"})}
+            "flows_with_controls_and_wind": (controlled_and_windy, {"flows"})}
 
 
 @pytest.mark.parametrize("fmi", (2, 3))
