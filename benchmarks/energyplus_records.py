@@ -33,7 +33,8 @@ surfaces):
 - a furniture mass (an InternalMass): the zone's internal mass;
 - the glazing's solar transmittance x0.6: a window's solar transmittance, or the windows'
   construction's;
-- an office-hours gain (300 W on weekdays 08:00 to 18:00): a constant or a daily gain in the zone;
+- an office-hours gain (300 W on weekdays 08:00 to 18:00): a constant, a daily or a workday gain in
+  the zone;
 - the roof's solar absorptance 0.6 -> 0.9: the roof's solar absorptance;
 - none: no effect added.
 """
@@ -208,7 +209,8 @@ CHANGES = {
     "furniture": Change("furniture (InternalMass)", furniture, (("internal_mass", ZONE),)),
     "glass": Change("glazing's solar transmittance x0.6", darker_glass,
                     tuple(("solar_transmittance", w) for w in WINDOWS + ("construction:DOUBLE CLEAR",))),
-    "gain": Change("office-hours gain 300 W", office_gain, (("internal_gain", ZONE), ("daily_gain", ZONE))),
+    "gain": Change("office-hours gain 300 W", office_gain,
+                   (("internal_gain", ZONE), ("daily_gain", ZONE), ("workday_gain", ZONE))),
     "roof": Change("roof's solar absorptance 0.6 -> 0.9", darker_roof, (("solar_absorptance", "ROOF"),)),
     "none": Change("none", None, ()),
 }

@@ -93,7 +93,8 @@ def calibration_start(building, effect, target):
 
 def shapes(building, left, zones):
     """The shapes (effect, target) the residual's statistics point at: a gain with a daily
-    profile where the residual follows the time of day, a gain proportional to each input column
+    profile where the residual follows the time of day, one on working days only where it differs
+    between working and rest days, a gain proportional to each input column
     it follows (a heat input mis-measured, sun through an opening the model lacks), for each
     objective zone. None where the residual is white: nothing is left to explain. A round tries
     them only where no physical candidate brings the error to the noise (`diagnosis.loop`).
@@ -111,9 +112,12 @@ def shapes(building, left, zones):
     # input a gain may follow is tried, and the clock; the cross-validated choice judges them.
     named = [follows["input"] for follows in left["follows"]]
     clock = (left["time_of_day"] or {}).get("significant", False)
+    weekly = left.get("working_days")  # None: the window holds one kind of day
+    working = bool(weekly and weekly["significant"])
     if not named:
-        named, clock = shaped_inputs(building), True
+        named, clock, working = shaped_inputs(building), True, weekly is not None
     pairs = [("daily_gain", zone) for zone in zones] if clock else []
+    pairs += [("workday_gain", zone) for zone in zones] if working else []
     targets = EFFECTS["proportional_gain"].targets(building)
     pairs += [("proportional_gain", target) for name in named for zone in zones
               for target in [bridge_target(zone, name)] if target in targets]

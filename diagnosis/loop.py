@@ -47,6 +47,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 from tqdm import tqdm
 
 from nodeforce.runtime import lifetime
@@ -70,6 +71,7 @@ from nodeforce.diagnosis.windows import Beside, Record, Windows, period
 from nodeforce.fmu_build.build import build_fmu
 from nodeforce.iotools.energyplus_corrections import idf_of, write_corrections
 from nodeforce.ga.locate import Execution, SearchSettings, check_measured, evaluator_kind, locate
+from nodeforce.model.case import local_times
 from nodeforce.model.effects import EFFECTS, member_nodes
 from nodeforce.model.errors import InputError
 from nodeforce.model.score import Noise
@@ -507,8 +509,14 @@ def left_by(windows, model):
     first, k0 = windows.each[0].case, windows.each[0].k
     shaped = shaped_inputs(model.building)
     inputs = {name: values for name, values in zip(first.input_names, first.U[1:k0 + 1].T) if name in shaped}
-    return residual_diagnostics(windows.each[0].calibration.times[1:],
+    return residual_diagnostics(on_site_clock(windows.each[0].calibration.times[1:], model.building),
                                 windows.each[0].measured[:k0][:, 0] - model.runs[0][:k0, 0], inputs)
+
+
+def on_site_clock(times, building):
+    """`times` on the site's local clock and calendar, which the building's daily and workday
+    gains follow (`model.case.local_times`)."""
+    return local_times(pd.DatetimeIndex(times), building.site["timezone"], building.source)
 
 
 def resting_on_priors(fit):
@@ -642,7 +650,8 @@ def validation_residuals(prepared, made):
     windows = prepared.windows
     first, k, measured = windows.each[0].case, windows.each[0].k, windows.each[0].measured
     validation = slice(k, None)
-    return {state: residual_diagnostics(first.times[1:][validation], measured[validation, 0] - run[0][validation, 0],
+    return {state: residual_diagnostics(on_site_clock(first.times[1:][validation], prepared.model.building),
+                                        measured[validation, 0] - run[0][validation, 0],
                                         {name: values[validation] for name, values in
                                          zip(first.input_names, first.U[1:].T)})
             for state, run in (("before", prepared.model.runs), ("after", made.model.runs))}

@@ -19,6 +19,9 @@ consecutive steps where the residual and every input are finite, and the result 
   the inputs it follows at their lags (a daily profile those explain is not the clock's), with
   autoregressive errors (feasible GLS, statsmodels GLSAR, order by AIC); the harmonics' joint F
   test at level ALPHA / 2.
+- Working days: where the run holds working and rest days, the same regression with the
+  working-day indicator and its products with the harmonics beside them (a profile of the
+  working days only, an office's gain); their joint F test at level ALPHA / 2.
 """
 from __future__ import annotations
 
@@ -35,6 +38,8 @@ from statsmodels.stats.diagnostic import acorr_ljungbox
 from statsmodels.tools.sm_exceptions import SingularMatrixWarning
 from statsmodels.tsa.ar_model import AutoReg, ar_select_order
 from statsmodels.tsa.stattools import acf, ccf
+
+from nodeforce.model.building import WORKDAYS
 
 ALPHA = 0.05
 HARMONICS = 3  # of the day: a profile resolved to about 4 h
@@ -119,6 +124,32 @@ def time_of_day(times, residual, regressors, max_order):
             "peak_hour": float(np.argmax(profile) / 12), "ar_order": int(order)}
 
 
+def working_days(times, residual, regressors, max_order):
+    """Whether the residual differs between working and rest days beyond a profile every day
+    shares and what `regressors` (columns) explain, or None where the run does not hold both kinds
+    of day (`model.building.WORKDAYS` of `times`' own calendar).
+
+    GLSAR regression on a constant, the daily harmonics, the working-day indicator and its
+    products with the harmonics, and the regressors, AR errors of order by AIC (<= max_order).
+    Returns the F test of the working-day columns (statistic, p value), the working and the rest
+    days in the run (days), and the profile's mean on a working day beyond a rest day's (K)."""
+    t = pd.DatetimeIndex(times)
+    on = np.isin(t.day_of_week, WORKDAYS).astype(float)
+    if on.all() or not on.any():
+        return None
+    harmonic = daily_harmonics(t)
+    exog = np.column_stack([np.ones(len(residual)), harmonic, on, on[:, None] * harmonic] + list(regressors))
+    first = GLSAR(residual, exog, rho=0).fit()
+    order = max(ar_select_order(first.resid, maxlag=max_order, ic="aic", trend="n").ar_lags or [0])
+    fit = GLSAR(residual, exog, rho=order).iterative_fit(maxiter=20) if order else first
+    columns = np.arange(1 + harmonic.shape[1], 2 + 2 * harmonic.shape[1])
+    test = fit.f_test(np.eye(exog.shape[1])[columns])
+    per_day = 24.0 / step_hours(t)
+    return {"F": float(np.squeeze(test.fvalue)), "p_value": float(test.pvalue),
+            "working_days": float(on.sum() / per_day), "rest_days": float((1 - on).sum() / per_day),
+            "excess": float(fit.params[columns[0]]), "ar_order": int(order)}
+
+
 def level(r, rho):
     """The residual's mean (K), its standard deviation as the residual's lag-one autocorrelation
     rho makes it (an AR(1) residual's mean varies (1 + rho) / (1 - rho) times more than white
@@ -139,7 +170,8 @@ def diagnostics(times, residual, inputs, max_lag_hours=24.0):
 
     Parameters
     ----------
-    times : DatetimeIndex, regular grid; the clock of the time of day is that of its time zone
+    times : DatetimeIndex, regular grid; the clock of the time of day and the calendar of the working
+        days are those of its time zone
     residual : array (K), measured - simulated; NaN where not scored or not measured
     inputs : {name: array} the model's inputs on the same grid (any unit: correlations only)
     max_lag_hours : float (h), the longest lag examined, of the residual behind an input
@@ -151,8 +183,9 @@ def diagnostics(times, residual, inputs, max_lag_hours=24.0):
     "acf_bound" (95 % band of white noise), "level" {"mean", "sd", "significant"} (`level`), "follows" [{"input", "lag_hours", "correlation"}]
     strongest first (significant only), "strongest" (the largest prewhitened cross-correlation,
     significant or not, with its curve "ccf" over the lags and its "bound"), "skipped" {name:
-    why}, "time_of_day" {"F", "p_value", "significant", "amplitude" (K), "peak_hour", ...} and
-    "sentence".
+    why}, "time_of_day" {"F", "p_value", "significant", "amplitude" (K), "peak_hour", ...},
+    "working_days" {"F", "p_value", "significant", "working_days", "rest_days", "excess" (K), ...}
+    (None where the run holds one kind of day: `working_days`) and "sentence".
     """
     times = pd.DatetimeIndex(times)
     r = np.asarray(residual, dtype=float)
@@ -171,7 +204,7 @@ def diagnostics(times, residual, inputs, max_lag_hours=24.0):
                    "rule": "longest run of consecutive steps where the residual and every input are measured"},
            "ljung_box": None, "white": None, "acf": [], "acf_bound": None, "level": None, "follows": [],
            "strongest": None,
-           "skipped": {}, "time_of_day": None}
+           "skipped": {}, "time_of_day": None, "working_days": None}
     max_lag = min(int(round(max_lag_hours / dt)), n // 5)
     if n < MIN_STEPS or max_lag < 1:
         out["sentence"] = (f"Too few consecutive scored steps ({n}, at least {MIN_STEPS} needed) "
@@ -210,6 +243,10 @@ def diagnostics(times, residual, inputs, max_lag_hours=24.0):
     daily["significant"] = bool(daily["p_value"] < ALPHA / 2)
     daily["beyond_inputs"] = list(lags)
     out["time_of_day"] = daily
+    weekly = working_days(t[n - m:], r[n - m:], [_lagged(xs[name], k, m) for name, k in lags.items()], max_order)
+    if weekly is not None:
+        weekly["significant"] = bool(weekly["p_value"] < ALPHA / 2)
+    out["working_days"] = weekly
     out["sentence"] = sentence(out)
     return out
 
@@ -224,7 +261,18 @@ def lag_text(hours):
 
 
 def sentence(d):
-    """One sentence saying what the diagnostics found, the strongest relation first."""
+    """What the diagnostics found in a sentence, the strongest relation first, and where the
+    working days differ, a second."""
+    said = _first_sentence(d)
+    weekly = d.get("working_days")
+    if weekly and weekly["significant"]:
+        p = "< 0.001" if weekly["p_value"] < 1e-3 else f"= {weekly['p_value']:.3f}"
+        said += (f" It differs on the working days from the rest days (F test p {p}; their mean "
+                 f"{weekly['excess']:+.2f} K beyond a rest day's).")
+    return said
+
+
+def _first_sentence(d):
     lb = d["ljung_box"]
     p = "< 0.001" if lb["p_value"] < 1e-3 else f"= {lb['p_value']:.3f}"
     whiteness = f"Ljung-Box p {p} over {lb['lag_hours']:g} h"

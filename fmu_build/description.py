@@ -15,7 +15,7 @@ from xml.etree.ElementTree import Element, SubElement, indent, tostring
 from nodeforce.model.building import Boundary
 from nodeforce.model.effects import EFFECTS, fmu_parameters, properties
 from nodeforce.model.integrate import MAX_STEP, held_inputs
-from nodeforce.model.network import WIND_DIRECTION, WIND_SPEED, clock_input_names
+from nodeforce.model.network import WIND_DIRECTION, WIND_SPEED, clock_input_names, workday_input
 
 from .guard import GUARD_GLIBC, PYTHONFMU_GLIBC
 
@@ -123,9 +123,14 @@ def _input_meaning(building, name):
     if name == WIND_DIRECTION:
         return "deg", "the direction the wind comes from, clockwise from north"
     if name in clock_input_names(building):
-        function, h = name.removeprefix("day_")[:3], name.removeprefix("day_")[3:]
-        return None, (f"{function}(2 pi {h} tau / 24 h), tau the local clock time of day (h) at the site "
-                      f"({building.site['timezone']}), the basis of the zones' daily gains")
+        site = f"at the site ({building.site['timezone']})"
+        if name == workday_input("mean"):
+            return None, f"1 on a working day (Monday to Friday) of the local calendar {site}, else 0"
+        workday = name.startswith(workday_input(""))
+        term = name.removeprefix(workday_input("") if workday else "day_")
+        function, h = term[:3], term[3:]
+        return None, (f"{'workday_mean times ' if workday else ''}{function}(2 pi {h} tau / 24 h), tau the local "
+                      f"clock time of day (h) {site}, the basis of the zones' {'workday' if workday else 'daily'} gains")
     if name in building.schedule_inputs:
         return None, f"schedule {name} of the building file, on the site's local clock"
     glazings = [(c, k) for c in building.components for k, (sun, _) in enumerate(c.sun_inputs)

@@ -5,9 +5,12 @@ holds (a shape in time, a heater's lag, a factor on a zone's envelope) is said s
 """
 from pathlib import Path
 
+import numpy as np
 from scipy.optimize import brentq
 
 from ..model import glazing
+from ..model.building import WORKDAY_TERMS
+from ..model.case import day_basis
 from ..model.effects import CONSTRUCTION, EFFECTS, MATERIAL, members
 from .energyplus import FILMS, SCHEMA_MIN, _field
 
@@ -106,6 +109,30 @@ class _Writer:
                   {"fuel_type": "None", "zone_or_zonelist_name": zone, "schedule_name": self._always_on(),
                    "design_level_calculation_method": "EquipmentLevel", "design_level": Q,
                    "fraction_latent": 0, "fraction_radiant": 0, "fraction_lost": 0})
+
+    def workday_gain(self, zone):
+        """The added profile, each hour's mean (W), on EnergyPlus's weekdays and 0 on every other
+        day: an OtherEquipment of 1 W on a Schedule:Compact of its positive part, and where it
+        dips below zero one of -1 W on its negative part (EnergyPlus refuses a gain's schedule
+        value below 0, not a negative design level)."""
+        terms = {t: dict(self.after.zone(zone).workday_gain).get(t, 0.0) - dict(self.before.zone(zone).workday_gain).get(t, 0.0)
+                 for t in WORKDAY_TERMS}
+        minutes = (np.arange(24 * 60) + 0.5) / 60.0  # h, each minute's middle
+        profile = terms["mean"] + sum(W * day_basis(minutes, t) for t, W in terms.items() if t != "mean")
+        hourly = profile.reshape(24, 60).mean(axis=1)
+        for sign, part, suffix in ((1.0, np.maximum(hourly, 0.0), ""), (-1.0, np.maximum(-hourly, 0.0), " (negative)")):
+            if not part.any():
+                continue
+            name = f"nodeforce workday gain {zone}{suffix}"
+            fields = ["Through: 12/31", "For: Weekdays"]
+            for hour, W in enumerate(part, 1):
+                fields += [f"Until: {hour:02d}:00", f"{W:.6g}"]
+            fields += ["For: AllOtherDays", "Until: 24:00", "0"]
+            self._add("Schedule:Compact", name, {"data": [{"field": f} for f in fields]})
+            self._add("OtherEquipment", name,
+                      {"fuel_type": "None", "zone_or_zonelist_name": zone, "schedule_name": name,
+                       "design_level_calculation_method": "EquipmentLevel", "design_level": sign,
+                       "fraction_latent": 0, "fraction_radiant": 0, "fraction_lost": 0})
 
     def internal_mass(self, zone):
         mass = self.after.zone(zone).internal_mass

@@ -23,6 +23,10 @@ NODE_COLUMN = re.compile(r"T([1-9][0-9]*)$")  # no leading zero: T01 is not T1
 # with 6); 4 is where the error nears a sensor's 0.1 C noise with 9 parameters.
 DAY_HARMONICS = 4
 DAY_TERMS = tuple(f"{f}{h}" for h in range(1, DAY_HARMONICS + 1) for f in ("cos", "sin"))
+# A workday gain (an office's, a school's) acts on the working days only, Monday to Friday of the
+# site's local calendar (pandas' dayofweek 0 to 4), with its own mean and the same harmonics.
+WORKDAYS = (0, 1, 2, 3, 4)
+WORKDAY_TERMS = ("mean",) + DAY_TERMS
 
 
 @dataclass(frozen=True)
@@ -214,6 +218,7 @@ class Zone:
     convection_factor: float = 1.0  # scale on the inside h_conv of the surfaces facing the zone
     occupied: bool | None = None  # None: not declared
     daily_gain: tuple = ()  # (term of DAY_TERMS, W) for every term when declared; () not declared
+    workday_gain: tuple = ()  # (term of WORKDAY_TERMS, W) on working days only; () not declared
     proportional_gains: tuple = ()  # (input column, k in W per unit of the column)
     internal_mass: Lumped | None = None  # furniture and undeclared mass, coupled to the air
     heat_input_lag: Lumped | None = None  # the heater's own capacity, between heat input and zone

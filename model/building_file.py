@@ -21,7 +21,7 @@ from importlib.resources import files
 
 import numpy as np
 
-from .building import (DAY_TERMS, Adiabatic, AngularAbsorptance, AngularTransmittance, Boundary, Building, Component,
+from .building import (DAY_TERMS, WORKDAY_TERMS, Adiabatic, AngularAbsorptance, AngularTransmittance, Boundary, Building, Component,
                        Exterior, Gain, Inflow, Lumped, Material, OutsideConvection, ShadingSurface, Supply, Surface,
                        Ventilation, Window, WindowGap, Zone, boundary_columns, json_copy)
 from . import geometry
@@ -406,7 +406,7 @@ def _zone(check, z, where, zone_names, explicit, next_id, schedules):
             check.fail(f"{where}.airflow_from[{j}].zone", f"names no zone ({raw['zone']!r})")
         if raw["zone"] == z["name"]:
             check.fail(f"{where}.airflow_from[{j}].zone", "air cannot flow from a zone into itself")
-    daily = z.get("daily_gain")
+    daily, workday = z.get("daily_gain"), z.get("workday_gain")
     exchange = z.get("air_exchange", {})
     for other in exchange:
         if other not in zone_names:
@@ -433,6 +433,8 @@ def _zone(check, z, where, zone_names, explicit, next_id, schedules):
         occupied=z.get("occupied"),
         daily_gain=() if daily is None else tuple(
             (t, float(daily.get(t, schema_default("zone", "daily_gain", t)))) for t in DAY_TERMS),
+        workday_gain=() if workday is None else tuple(
+            (t, float(workday.get(t, schema_default("zone", "workday_gain", t)))) for t in WORKDAY_TERMS),
         proportional_gains=_floats(z.get("proportional_gains", {})),
         envelope_factor=_zone_value(z, "envelope_factor"),
         shading_transmittance=_zone_value(z, "shading_transmittance"),

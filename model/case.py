@@ -18,9 +18,9 @@ import pandas as pd
 
 from .errors import InputError
 from .integrate import Plan, held_inputs, history_block, initial_state, simulate, steps_per_day, substeps
-from .building import DAY_TERMS, traced_input
+from .building import DAY_TERMS, WORKDAY_TERMS, WORKDAYS, traced_input
 from .network import (WIND_DIRECTION, WIND_SPEED, assemble, clock_input_names, day_input, input_names,
-                      slowest_time_constant)
+                      slowest_time_constant, workday_input)
 from .units import check_celsius
 from .geometry import outward_normal
 from .interior_sun import beam_shares
@@ -189,14 +189,26 @@ def uniform_grid(times, source):
 
 
 
-def clock_hours(times, timezone, source):
-    """Local clock time of day (h, 0 <= tau < 24) of tz-aware `times` at a site's `timezone` (an IANA
-    name, Etc/GMT+-N or +hh:mm): the wall clock a schedule follows, daylight saving included."""
+def local_times(times, timezone, source):
+    """tz-aware `times` on a site's `timezone` (an IANA name, Etc/GMT+-N or +hh:mm): the wall
+    clock and calendar a schedule follows, daylight saving included."""
     try:
-        local = times.tz_convert(timezone)
+        return times.tz_convert(timezone)
     except Exception as e:  # pandas raises several kinds for an unknown zone
         raise InputError(source, "site.timezone", f"{timezone!r} is not a time zone ({e})") from None
+
+
+def clock_hours(times, timezone, source):
+    """Local clock time of day (h, 0 <= tau < 24) of tz-aware `times` at a site's `timezone`
+    (`local_times`)."""
+    local = local_times(times, timezone, source)
     return local.hour + local.minute / 60 + (local.second + local.microsecond / 1e6) / 3600
+
+
+def working_day(times, timezone, source):
+    """1 on the working days (`model.building.WORKDAYS`, Monday to Friday) of the site's local
+    calendar at `times`, 0 on the others (no unit)."""
+    return np.isin(local_times(times, timezone, source).day_of_week, WORKDAYS).astype(float)
 
 
 def day_basis(tau, term):
@@ -207,12 +219,21 @@ def day_basis(tau, term):
 
 
 def clock_inputs(building, times):
-    """{input name: values at `times`} of the time-of-day basis the building's daily gains need
-    (`model.network.clock_input_names`); {} when no zone declares one."""
-    if not clock_input_names(building):
+    """{input name: values at `times`} of the clock's inputs the building's daily and workday gains
+    need (`model.network.clock_input_names`): the time-of-day basis, and the same times the
+    working-day indicator (`working_day`), with the indicator itself as the workday mean's; {}
+    when no zone declares either."""
+    names = set(clock_input_names(building))
+    if not names:
         return {}
-    tau = clock_hours(times, building.site["timezone"], building.source)
-    return {day_input(t): day_basis(tau, t) for t in DAY_TERMS}
+    site, source = building.site, building.source
+    tau = clock_hours(times, site["timezone"], source)
+    out = {day_input(t): day_basis(tau, t) for t in DAY_TERMS if day_input(t) in names}
+    if workday_input("mean") in names:
+        on = working_day(times, site["timezone"], source)
+        out[workday_input("mean")] = on
+        out.update({workday_input(t): on * day_basis(tau, t) for t in DAY_TERMS})
+    return out
 
 
 def schedule_inputs(building, times):
@@ -306,7 +327,7 @@ def prepare_case(building, weather, measurements=None, decomposition="erbs", his
     (`model.solar.incident_irradiance`: isotropic unless it declares `sky_diffuse`) of
     `ghi`, `dni`, `dhi`, those the weather lacks from the others: `model.solar.complete_irradiance`,
     stated in the case's `assumptions`), the building's named columns and, where a zone declares a daily gain,
-    the time-of-day basis `day_cos1`, ... (`clock_inputs`).
+    the time-of-day basis `day_cos1`, ..., or a workday gain, `workday_mean`, ... (`clock_inputs`).
 
     Raises
     ------

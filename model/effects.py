@@ -30,7 +30,7 @@ from typing import Callable
 
 import numpy as np
 
-from .building import DAY_TERMS, Adiabatic, Boundary, Exterior, Surface
+from .building import DAY_TERMS, WORKDAY_TERMS, Adiabatic, Boundary, Exterior, Surface
 from .network import RHO_C_AIR
 
 BRIDGE_TO = "->"
@@ -392,6 +392,16 @@ def _daily_write(data, target, values):
     zone["daily_gain"] = {t: float(values[t]) for t in DAY_TERMS}
 
 
+# workday gain: a zone's gain on working days only, its own mean and harmonics of the local clock
+# time (the zone's workday_gain); the zone's constant internal_gain is apart from it.
+def _workday_read(building, target):
+    return {**dict.fromkeys(WORKDAY_TERMS, 0.0), **dict(building.zone(target).workday_gain)}
+
+
+def _workday_write(data, target, values):
+    _zone(data, target)["workday_gain"] = {t: float(values[t]) for t in WORKDAY_TERMS}
+
+
 # proportional gain: Q = k u_column to a zone's air, for a column the building reads as a heat
 # input (W, k dimensionless) or a face's irradiance (W/m2, k an area in m2)
 def _proportional_targets(building):
@@ -651,6 +661,12 @@ def _daily_acting(target, values):
             f"of {target}")
 
 
+def _workday_acting(target, values):
+    amplitude = math.hypot(values.get("cos1", 0.0), values.get("sin1", 0.0))
+    return (f"on working days only, with a daily profile (mean {values['mean']:.3g} W over a working day, "
+            f"first harmonic {amplitude:.3g} W), to the air of {target}")
+
+
 def _proportional_acting(target, values):
     zone, column = bridge_parts(target)
     return f"in proportion to {column} (k = {values['k']:.3g}) to the air of {zone}"
@@ -726,6 +742,12 @@ EFFECTS = {e.id: e for e in (
            _zones, _daily_read, _daily_write, _no_node, on_inputs=True,
            shape=True, physical=_fixed_limits(mean=(0.0, math.inf)), judged=("mean",), implausible=_unoccupied,
            source=True, acting=_daily_acting),
+    Effect("workday_gain", "a heat gain to the air on working days only (Monday to Friday, local time), with a "
+                           "daily profile: its mean and harmonics of the local time",
+           tuple(Parameter(t, "W", -5000.0, 5000.0) for t in WORKDAY_TERMS),
+           _zones, _workday_read, _workday_write, _no_node, on_inputs=True,
+           shape=True, physical=_fixed_limits(mean=(0.0, math.inf)), judged=("mean",), implausible=_unoccupied,
+           source=True, acting=_workday_acting, energyplus=lambda w, t: w.workday_gain(t)),
     Effect("proportional_gain", "a heat gain to the air of k times an input column (W per unit of the column: "
                                 "dimensionless for a heat input, m2 for an irradiance)",
            (Parameter("k", "-", -10.0, 10.0),), _proportional_targets, _proportional_read, _proportional_write,

@@ -21,7 +21,7 @@ from functools import cached_property
 
 import numpy as np
 
-from .building import DAY_TERMS, Adiabatic, Boundary, Exterior, Surface
+from .building import DAY_TERMS, WORKDAY_TERMS, Adiabatic, Boundary, Exterior, Surface
 from .building_file import gap_nodes, schema_default
 from .convection import doe2_faces, iso15099_inside, lagged_excess, tarp_inside_faces, windward_faces
 from .discretise import capacities, conductances
@@ -362,14 +362,22 @@ def input_names(building):
 
 
 def clock_input_names(building):
-    """The time-of-day inputs (`day_<term>` of `DAY_TERMS`), shared by every zone with a daily gain;
-    () when none declares one."""
-    return tuple(day_input(t) for t in DAY_TERMS) if any(z.daily_gain for z in building.zones) else ()
+    """The clock's inputs: the time-of-day basis (`day_<term>` of `DAY_TERMS`), shared by every
+    zone with a daily gain, and the working days' (`workday_<term>` of `WORKDAY_TERMS`), shared by
+    every zone with a workday gain; () when none declares either."""
+    daily = tuple(day_input(t) for t in DAY_TERMS) if any(z.daily_gain for z in building.zones) else ()
+    return daily + (tuple(workday_input(t) for t in WORKDAY_TERMS)
+                    if any(z.workday_gain for z in building.zones) else ())
 
 
 def day_input(term):
     """The input holding a daily gain's basis function `term` (e.g. "cos1" -> "day_cos1")."""
     return f"day_{term}"
+
+
+def workday_input(term):
+    """The input holding a workday gain's basis function `term` (e.g. "mean" -> "workday_mean")."""
+    return f"workday_{term}"
 
 
 def sky_view_factor(tilt):
@@ -638,6 +646,8 @@ def assemble(building, names=None):
                     B[air, col[gain.schedule]] += g * gain.reference_temperature
         for term, W in z.daily_gain:
             B[air, col[day_input(term)]] += W
+        for term, W in z.workday_gain:
+            B[air, col[workday_input(term)]] += W
         for column, k in z.proportional_gains:
             B[air, col[column]] += k
         if z.internal_mass is not None:

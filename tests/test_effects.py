@@ -32,6 +32,8 @@ CASES = [
     ("thermal_bridge", "cell", {"UA": 4.0}),
     ("daily_gain", "cell", {"mean": 30.0, "cos1": -60.0, "sin1": -20.0, "cos2": 10.0, "sin2": 15.0,
                             "cos3": 5.0, "sin3": -8.0, "cos4": 3.0, "sin4": 2.0}),
+    ("workday_gain", "cell", {"mean": 90.0, "cos1": -80.0, "sin1": -30.0, "cos2": 10.0, "sin2": 15.0,
+                              "cos3": 5.0, "sin3": -8.0, "cos4": 3.0, "sin4": 2.0}),
     ("proportional_gain", "cell->I_window", {"k": 0.5}),
     ("internal_mass", "cell", {"C_m": 3e5, "H_m": 40.0}),
     ("envelope_conductance", "cell", {"factor": 1.8}),
@@ -188,7 +190,7 @@ def test_a_gain_in_a_zone_declared_unoccupied_is_implausible(testcell):
 
 def test_the_residual_left_chooses_the_shapes():
     """Shapes are the residual's to choose: a gain following each input it follows, a daily gain
-    where it follows the clock, every input and the clock where it is structured but follows none
+    where it follows the clock, a workday gain where it tells working from rest days, every input and the clock where it is structured but follows none
     (inputs of one kind are nearly collinear), nothing where it is white."""
     from nodeforce.diagnosis.candidates import shapes
     from .test_zones import multizone_with_everything
@@ -200,6 +202,13 @@ def test_the_residual_left_chooses_the_shapes():
     structured = shapes(b, clock, ["A"])
     assert structured[0] == ("daily_gain", "A") and ("proportional_gain", "A->I_south") in structured
     assert shapes(b, {**left, "white": True}, ["B"]) == []
+    # a gain on working days only where the residual tells them from the rest days, and wherever
+    # every shape is tried if the window holds both kinds of day
+    weekly = {"significant": True, "p_value": 1e-4}
+    assert ("workday_gain", "B") in shapes(b, {**left, "working_days": weekly}, ["B"])
+    assert ("workday_gain", "B") not in shapes(b, {**left, "working_days": {**weekly, "significant": False}}, ["B"])
+    assert ("workday_gain", "A") in shapes(b, {**clock, "working_days": {**weekly, "significant": False}}, ["A"])
+    assert ("workday_gain", "A") not in structured  # the window held one kind of day
 
 
 def test_every_effect_parameter_has_a_unit_the_fmus_declare():

@@ -764,6 +764,32 @@ def test_corrections_written_back_and_read_again(tmp_path):
     assert mass.area * mass.inside.h_conv == pytest.approx(50.0, rel=1e-3)
 
 
+def test_a_workday_gain_is_written_back_as_a_weekday_schedule(tmp_path):
+    """An office's gain written into case 600: converted again, its schedule holds each hour's
+    mean of the profile on a Wednesday, computed by hand, and nothing on a Saturday."""
+    from nodeforce.iotools.energyplus_corrections import write_corrections
+    from nodeforce.model.case import schedule_inputs
+    from nodeforce.model.effects import EFFECTS
+    before = convert_idf(CASE600, tmp_path / "600.json")
+    values = {"mean": 100.0, "cos1": -150.0, **{t: 0.0 for t in ("sin1", "cos2", "sin2", "cos3", "sin3", "cos4", "sin4")}}
+    after = EFFECTS["workday_gain"].apply(before, "CASE 600 ZONE", values)
+    out = tmp_path / "model_after.idf"
+    result = write_corrections(before, after, [("workday_gain", "CASE 600 ZONE")], CASE600, out)
+    assert result["not_written"] == []
+    again = convert_idf(out)
+    gains = [g for g in again.zones[0].gains if g.name.startswith("nodeforce workday gain")]
+    zone = again.site["timezone"]
+    wednesday = pd.date_range("2001-06-13 01:00", periods=24, freq="h", tz=zone)
+    saturday = pd.date_range("2001-06-16 01:00", periods=24, freq="h", tz=zone)
+    hours = np.arange(1, 25)
+    # the mean of 100 - 150 cos(2 pi tau / 24) over the hour (k - 1, k]: below zero at night,
+    # which EnergyPlus takes only as a negative design level on a positive schedule
+    by_hand = 100.0 - 150.0 * 24 / (2 * np.pi) * (np.sin(2 * np.pi * hours / 24) - np.sin(2 * np.pi * (hours - 1) / 24))
+    on, off = (sum(g.power * schedule_inputs(again, days)[g.schedule] for g in gains) for days in (wednesday, saturday))
+    assert len(gains) == 2 and all(min(schedule_inputs(again, wednesday)[g.schedule]) >= 0 for g in gains)
+    assert on[1:] == pytest.approx(by_hand[1:], abs=1e-3) and np.abs(off[1:]).max() == 0.0
+
+
 def test_the_same_model_in_energyplus_25_converts_the_same(tmp_path, three_zones):
     """three_zones.idf brought to EnergyPlus 25.2 (its fields renamed for spaces, new ones at
     their defaults) is the same building file."""

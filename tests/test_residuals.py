@@ -84,20 +84,43 @@ def test_a_daily_profile_is_the_time_of_day():
     assert f"highest at {int(daily['peak_hour']):02d}:" in d["sentence"]
 
 
+def test_a_profile_of_the_working_days_alone_is_told_from_the_time_of_day():
+    """An office's gain: a bump on Monday to Friday only (1 September 2013 is a Sunday), beside
+    the same bump every day, which is the time of day's and not the working days'."""
+    times, tau, inputs, _, ar1 = weather(4, days=14)
+    working = np.isin(times.day_of_week, [0, 1, 2, 3, 4])
+    bump = 0.3 * np.exp(-0.5 * ((tau - 14) / 2) ** 2)
+    d = diagnostics(times, working * bump + ar1(0.9, 0.05), inputs)
+    weekly = d["working_days"]
+    assert weekly["significant"] and (weekly["working_days"], weekly["rest_days"]) == (10.0, 4.0)
+    # its mean on a working day beyond a rest day's: the bump's daily mean, 0.3 x 2 sqrt(2 pi) / 24 K
+    assert weekly["excess"] == pytest.approx(0.3 * 2 * np.sqrt(2 * np.pi) / 24, abs=0.02)
+    assert "differs on the working days" in d["sentence"]
+    every = diagnostics(times, bump + ar1(0.9, 0.05), inputs)
+    assert every["time_of_day"]["significant"] and not every["working_days"]["significant"]
+    assert "working days" not in every["sentence"]
+    # Monday to Friday alone hold no rest day to tell them from: no test
+    days = slice(96, 96 * 6)
+    alone = diagnostics(times[days], (working * bump + ar1(0.9, 0.05))[days], {k: v[days] for k, v in inputs.items()})
+    assert alone["working_days"] is None and alone["time_of_day"]["significant"]
+
+
 @pytest.mark.parametrize("kind", ["white", "autocorrelated"])
 def test_unrelated_residuals_name_no_input_nor_clock_beyond_the_level(kind):
     """Over 20 week-long records, a residual independent of the inputs (white, or a slow AR(1)
-    that correlates with any slow input by chance) names an input or the clock at most as often
-    as the level allows (alpha 5 % in all: 4 of 20 or more has probability < 2 %)."""
-    false = 0
+    that correlates with any slow input by chance) names an input or the clock, and the working
+    days apart, at most as often as the level allows (alpha 5 % in all: 4 of 20 or more has
+    probability < 2 %)."""
+    false = weekly = 0
     for seed in range(20):
         times, _, inputs, rng, ar1 = weather(100 + seed)
         residual = rng.normal(0, 0.1, len(times)) if kind == "white" else ar1(0.97, 0.3)
         d = diagnostics(times, residual, inputs)
         false += bool(d["follows"]) or d["time_of_day"]["significant"]
+        weekly += d["working_days"]["significant"]  # level 2.5 %: 4 of 20 or more has probability < 1 %
         if kind == "autocorrelated":
             assert not d["white"]
-    assert false <= 3
+    assert false <= 3 and weekly <= 3
 
 
 def test_gaps_are_not_filled_the_longest_run_is_used():

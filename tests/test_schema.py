@@ -38,6 +38,7 @@ EFFECT_CASES = {
     "thermal_bridge": ("cell", {"UA": 3.0}),
     "heat_input_split": ("cell", {"f_r": 0.6}),
     "daily_gain": ("cell", {"mean": 60.0, "cos1": -60.0, "sin1": -20.0, "cos2": 10.0, "sin2": 15.0}),
+    "workday_gain": ("cell", {"mean": 80.0, "cos1": -70.0, "sin1": -25.0, "cos2": 12.0}),
     "proportional_gain": ("cell->heater", {"k": -0.2}),
     "internal_mass": ("cell", {"C_m": 4e5, "H_m": 60.0}),
     "heat_input_lag": ("cell", {"C_h": 3e4, "H_h": 12.0}),

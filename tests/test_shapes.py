@@ -1,6 +1,7 @@
-"""Effects with a shape in time: a gain with a daily profile (`daily_gain`) and a gain proportional
-to an input column (`proportional_gain`), against calculations done without the code under test."""
+"""Effects with a shape in time: a gain with a daily profile (`daily_gain`), one on working days
+only (`workday_gain`) and a gain proportional to an input column (`proportional_gain`), against calculations done without the code under test."""
 import copy
+import datetime
 import json
 import shutil
 
@@ -135,9 +136,64 @@ def test_the_standalone_fmu_carries_the_daily_gain(tmp_path, testcell, real_case
     assert np.abs(T - simulate(after, assemble(after), case.U, case.dt, case.measured, substeps=case.substeps)).max() < 1e-9
 
 
+def test_workday_gain_acts_on_the_working_days_of_the_local_calendar(tmp_path):
+    """A workday gain's mean alone, on a room whose air is its only capacity, against backward
+    Euler by hand (inputs at the step's end), the working days told by the local calendar
+    (Kolkata, UTC+05:30) without pandas' time zones: from Friday 8 to Monday 11 June 2001."""
+    dt, Q = 900.0, 400.0
+    times = pd.date_range("2001-06-08", periods=4 * 96 + 1, freq="15min", tz="UTC")
+    csv = tmp_path / "weather.csv"
+    pd.DataFrame({"time": times.strftime("%Y-%m-%dT%H:%M:%S+00:00"), "T_out": 25.0}).to_csv(csv, index=False)
+    data = one_zone("Asia/Kolkata", 0.0, {})
+    del data["zones"][0]["daily_gain"]
+    data["zones"][0]["workday_gain"] = {"mean": Q}
+    building = parse_building(data)
+    case, T = run(building, read_weather(csv))
+    air = T[:, building.zone("room").air_node - 1]
+
+    G = AREA / (1 / H_IN + THICKNESS / K + 1 / H_OUT)
+    C = RHO_C_AIR * VOLUME
+    local = [datetime.datetime(2001, 6, 8) + datetime.timedelta(seconds=900.0 * n, hours=5.5)
+             for n in range(1, len(times))]
+    on = np.array([t.weekday() < 5 for t in local], dtype=float)
+    expected = [air[0]]
+    for n in range(1, len(on)):
+        expected.append((C / dt * expected[-1] + G * T_BEYOND + Q * on[n]) / (C / dt + G))
+    assert np.abs(air - np.array(expected)).max() < 1e-9
+    # the gain's steady rise on Friday afternoon, none by Sunday noon: the gain stops at local
+    # midnight, 18:30 UTC, not at the UTC one
+    assert air[np.argmax(on == 0) - 1] == pytest.approx(T_BEYOND + Q / G, abs=0.01)
+    assert air[int((2 * 24 + 12 - 5.5) * 4) - 1] == pytest.approx(T_BEYOND, abs=1e-6)
+    assert on[int(24 * 4 - 5.5 * 4)] == 0 and case.U[1:, case.input_names.index("workday_mean")].tolist() == on.tolist()
+
+
+def test_workday_gain_reads_back_beside_the_constant_gain(testcell):
+    values = {"mean": 120.0, **HARMONICS}
+    after = EFFECTS["workday_gain"].apply(testcell, "cell", values)
+    assert after.zone("cell").internal_gain == testcell.zone("cell").internal_gain
+    assert dict(after.zone("cell").workday_gain) == values
+    assert EFFECTS["workday_gain"].read(after, "cell") == values
+    assert [p.name for p in EFFECTS["workday_gain"].parameters] == ["mean", *DAY_TERMS]
+
+
+def test_the_standalone_fmu_carries_the_workday_gain(tmp_path, testcell, real_case):
+    shutil.which("cc") or pytest.fail("the standalone FMU needs a C compiler (cc)")
+    values = {"mean": 120.0, **HARMONICS}
+    fmu = build_fmu(testcell, tmp_path / "s.fmu", effect=("workday_gain", "cell"), kind="standalone")
+    after = EFFECTS["workday_gain"].apply(testcell, "cell", values)
+    case = real_case.with_inputs(after)
+    on = case.U[1:, case.input_names.index("workday_mean")]
+    assert 0 < on.mean() < 1  # Sunday to Thursday: both kinds of day
+    with FmuInstance(fmu) as instance:
+        T = simulate_fmu(instance, case, parameters={f"workday_gain.{k}": v for k, v in values.items()})
+    assert np.abs(T - simulate(after, assemble(after), case.U, case.dt, case.measured, substeps=case.substeps)).max() < 1e-9
+
+
 @pytest.mark.parametrize("change,field", [
     (lambda z: z.update(daily_gain={"cos5": 1.0}), "zones[0].daily_gain"),
     (lambda z: z.update(daily_gain={"cos1": "x"}), "zones[0].daily_gain.cos1"),
+    (lambda z: z.update(workday_gain={"peak": 1.0}), "zones[0].workday_gain"),
+    (lambda z: z.update(workday_gain={"mean": None}), "zones[0].workday_gain.mean"),
     (lambda z: z.update(proportional_gains={"heater": 0.5}), "zones[0].proportional_gains.heater"),
     (lambda z: z.update(proportional_gains={"I_roof": None}), "zones[0].proportional_gains.I_roof"),
 ])

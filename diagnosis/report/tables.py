@@ -218,7 +218,8 @@ def sensitivity(report):
 
 
 def residual_diagnostics(report):
-    """Before and after: the run analysed, Ljung-Box, the strongest input and the daily profile."""
+    """Before and after: the run analysed, Ljung-Box, the strongest input, the daily profile and
+    the working days' excess over the rest days (n/a where the run holds one kind of day)."""
     rows = []
     for state in STATES:
         d = (report.get("residuals") or {}).get(state)
@@ -232,9 +233,12 @@ def residual_diagnostics(report):
                      fmt_sig(lb.get("p_value"), 2), _yes_no(d.get("white")),
                      f"{top['input']}, {lag_text(top['lag_hours'])}, {top['correlation']:+.2f}" if top else "none",
                      (f"{fmt_temp(daily.get('amplitude'))} C at {fmt_sig(daily.get('peak_hour'), 3)} h, "
-                      f"p = {fmt_sig(daily.get('p_value'), 2)}") if daily else NA])
+                      f"p = {fmt_sig(daily.get('p_value'), 2)}") if daily else NA,
+                     (f"{fmt_temp(weekly.get('excess'))} C beyond a rest day, p = {fmt_sig(weekly.get('p_value'), 2)}"
+                      if (weekly := d.get("working_days")) else NA)])
     return markdown(["residual", "steps analysed", "Ljung-Box Q", "p", "white",
-                     "follows most (input, lag, prewhitened r)", "daily profile (amplitude, peak)"], rows) if rows else ""
+                     "follows most (input, lag, prewhitened r)", "daily profile (amplitude, peak)",
+                     "working days (mean excess)"], rows) if rows else ""
 
 
 # Columns of the phases table beyond which only the chosen candidates' are shown.
