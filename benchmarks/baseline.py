@@ -17,8 +17,9 @@ import time
 import numpy as np
 from scipy.optimize import least_squares
 
-from nodeforce.model.effects import BRIDGE_TO, EFFECTS, PAIR, bridge_parts, pair_parts
 from nodeforce.model.building import Surface
+from nodeforce.model.case import working_day
+from nodeforce.model.effects import BRIDGE_TO, EFFECTS, PAIR, bridge_parts, pair_parts
 
 BIC_MARGIN = 10.0
 MAX_EVALUATIONS = 40  # least-squares residual evaluations per parameter and candidate
@@ -97,7 +98,12 @@ def baseline(building, case, zones, fraction=0.6):
     J0 = float(np.sum((measured[rows] - before[rows]) ** 2))
     best = {"effect": "none", "target": None, "values": {}, "bic": bic(J0, n, 0), "building": building}
     tried = 0
+    # a gain on working days is the daily gain where the window scores no rest day: the loop
+    # offers it only where the window holds both kinds of day, and so does the baseline
+    rested = (1.0 - working_day(case.times[1:][rows], building.site["timezone"], building.source)).any()
     for effect, record in EFFECTS.items():
+        if effect == "workday_gain" and not rested:
+            continue
         for target in record.targets(building):
             if not concerns(building, effect, target, zones):
                 continue
