@@ -103,6 +103,17 @@ def daily_harmonics(times, harmonics=HARMONICS):
     return np.column_stack([f(2 * np.pi * h * tau / 24) for h in range(1, harmonics + 1) for f in (np.cos, np.sin)])
 
 
+def f_test_glsar(residual, regressors, columns, max_order):
+    """The GLSAR regression of `residual` on the `regressors` (columns, stacked in order), its AR
+    errors' order by AIC (<= max_order), and the joint F test of its coefficients `columns`:
+    (the fit, the test, the order)."""
+    exog = np.column_stack(regressors)
+    first = GLSAR(residual, exog, rho=0).fit()
+    order = max(ar_select_order(first.resid, maxlag=max_order, ic="aic", trend="n").ar_lags or [0])
+    fit = GLSAR(residual, exog, rho=order).iterative_fit(maxiter=20) if order else first
+    return fit, fit.f_test(np.eye(exog.shape[1])[columns]), order
+
+
 def time_of_day(times, residual, regressors, max_order):
     """Whether the residual has a daily profile beyond what `regressors` (columns) explain.
 
@@ -111,12 +122,9 @@ def time_of_day(times, residual, regressors, max_order):
     profile's amplitude (K, half its peak to peak) and the clock hour of its maximum.
     """
     harmonic = daily_harmonics(times)
-    exog = np.column_stack([np.ones(len(residual)), harmonic] + list(regressors))
-    first = GLSAR(residual, exog, rho=0).fit()
-    order = max(ar_select_order(first.resid, maxlag=max_order, ic="aic", trend="n").ar_lags or [0])
-    fit = GLSAR(residual, exog, rho=order).iterative_fit(maxiter=20) if order else first
     columns = np.arange(1, 1 + harmonic.shape[1])
-    test = fit.f_test(np.eye(exog.shape[1])[columns])
+    fit, test, order = f_test_glsar(residual, [np.ones(len(residual)), harmonic] + list(regressors), columns,
+                                    max_order)
     clock = pd.date_range("2000-01-01", periods=24 * 12, freq="5min")
     profile = daily_harmonics(clock) @ fit.params[columns]
     return {"F": float(np.squeeze(test.fvalue)), "p_value": float(test.pvalue),
@@ -138,12 +146,9 @@ def working_days(times, residual, regressors, max_order):
     if on.all() or not on.any():
         return None
     harmonic = daily_harmonics(t)
-    exog = np.column_stack([np.ones(len(residual)), harmonic, on, on[:, None] * harmonic] + list(regressors))
-    first = GLSAR(residual, exog, rho=0).fit()
-    order = max(ar_select_order(first.resid, maxlag=max_order, ic="aic", trend="n").ar_lags or [0])
-    fit = GLSAR(residual, exog, rho=order).iterative_fit(maxiter=20) if order else first
     columns = np.arange(1 + harmonic.shape[1], 2 + 2 * harmonic.shape[1])
-    test = fit.f_test(np.eye(exog.shape[1])[columns])
+    fit, test, order = f_test_glsar(residual, [np.ones(len(residual)), harmonic, on, on[:, None] * harmonic]
+                                    + list(regressors), columns, max_order)
     per_day = 24.0 / step_hours(t)
     return {"F": float(np.squeeze(test.fvalue)), "p_value": float(test.pvalue),
             "working_days": float(on.sum() / per_day), "rest_days": float((1 - on).sum() / per_day),

@@ -655,16 +655,13 @@ def _time_constant(name):
     return derived
 
 
-def _daily_acting(target, values):
-    amplitude = math.hypot(values.get("cos1", 0.0), values.get("sin1", 0.0))
-    return (f"with a daily profile (mean {values['mean']:.3g} W, first harmonic {amplitude:.3g} W) to the air "
-            f"of {target}")
-
-
-def _workday_acting(target, values):
-    amplitude = math.hypot(values.get("cos1", 0.0), values.get("sin1", 0.0))
-    return (f"on working days only, with a daily profile (mean {values['mean']:.3g} W over a working day, "
-            f"first harmonic {amplitude:.3g} W), to the air of {target}")
+def _profile_acting(when, over):
+    """The `acting` words of a gain with a daily profile: `when` it acts, the mean `over` what."""
+    def acting(target, values):
+        amplitude = math.hypot(values.get("cos1", 0.0), values.get("sin1", 0.0))
+        return (f"{when}with a daily profile (mean {values['mean']:.3g} W{over}, first harmonic {amplitude:.3g} W) "
+                f"to the air of {target}")
+    return acting
 
 
 def _proportional_acting(target, values):
@@ -741,13 +738,14 @@ EFFECTS = {e.id: e for e in (
            (Parameter("mean", "W", -5000.0, 5000.0), *(Parameter(t, "W", -5000.0, 5000.0) for t in DAY_TERMS)),
            _zones, _daily_read, _daily_write, _no_node, on_inputs=True,
            shape=True, physical=_fixed_limits(mean=(0.0, math.inf)), judged=("mean",), implausible=_unoccupied,
-           source=True, acting=_daily_acting),
+           source=True, acting=_profile_acting("", "")),
     Effect("workday_gain", "a heat gain to the air on working days only (Monday to Friday, local time), with a "
                            "daily profile: its mean and harmonics of the local time",
            tuple(Parameter(t, "W", -5000.0, 5000.0) for t in WORKDAY_TERMS),
            _zones, _workday_read, _workday_write, _no_node, on_inputs=True,
            shape=True, physical=_fixed_limits(mean=(0.0, math.inf)), judged=("mean",), implausible=_unoccupied,
-           source=True, acting=_workday_acting, energyplus=lambda w, t: w.workday_gain(t)),
+           source=True, acting=_profile_acting("on working days only, ", " over a working day"),
+           energyplus=lambda w, t: w.workday_gain(t)),
     Effect("proportional_gain", "a heat gain to the air of k times an input column (W per unit of the column: "
                                 "dimensionless for a heat input, m2 for an irradiance)",
            (Parameter("k", "-", -10.0, 10.0),), _proportional_targets, _proportional_read, _proportional_write,

@@ -125,14 +125,17 @@ def test_daily_gain_reads_back_and_keeps_its_mean_in_internal_gain(testcell):
     assert [p.name for p in EFFECTS["daily_gain"].parameters] == ["mean", *DAY_TERMS]
 
 
-def test_the_standalone_fmu_carries_the_daily_gain(tmp_path, testcell, real_case):
+@pytest.mark.parametrize("effect,mean", [("daily_gain", 62.5), ("workday_gain", 120.0)])
+def test_the_standalone_fmu_carries_the_gain_with_a_profile(tmp_path, testcell, real_case, effect, mean):
     shutil.which("cc") or pytest.fail("the standalone FMU needs a C compiler (cc)")
-    values = {"mean": 62.5, **HARMONICS}
-    fmu = build_fmu(testcell, tmp_path / "s.fmu", effect=("daily_gain", "cell"), kind="standalone")
-    after = EFFECTS["daily_gain"].apply(testcell, "cell", values)
+    values = {"mean": mean, **HARMONICS}
+    fmu = build_fmu(testcell, tmp_path / "s.fmu", effect=(effect, "cell"), kind="standalone")
+    after = EFFECTS[effect].apply(testcell, "cell", values)
     case = real_case.with_inputs(after)
+    if effect == "workday_gain":  # Sunday to Thursday: both kinds of day
+        assert 0 < case.U[1:, case.input_names.index("workday_mean")].mean() < 1
     with FmuInstance(fmu) as instance:
-        T = simulate_fmu(instance, case, parameters={f"daily_gain.{k}": v for k, v in values.items()})
+        T = simulate_fmu(instance, case, parameters={f"{effect}.{k}": v for k, v in values.items()})
     assert np.abs(T - simulate(after, assemble(after), case.U, case.dt, case.measured, substeps=case.substeps)).max() < 1e-9
 
 
@@ -174,19 +177,6 @@ def test_workday_gain_reads_back_beside_the_constant_gain(testcell):
     assert dict(after.zone("cell").workday_gain) == values
     assert EFFECTS["workday_gain"].read(after, "cell") == values
     assert [p.name for p in EFFECTS["workday_gain"].parameters] == ["mean", *DAY_TERMS]
-
-
-def test_the_standalone_fmu_carries_the_workday_gain(tmp_path, testcell, real_case):
-    shutil.which("cc") or pytest.fail("the standalone FMU needs a C compiler (cc)")
-    values = {"mean": 120.0, **HARMONICS}
-    fmu = build_fmu(testcell, tmp_path / "s.fmu", effect=("workday_gain", "cell"), kind="standalone")
-    after = EFFECTS["workday_gain"].apply(testcell, "cell", values)
-    case = real_case.with_inputs(after)
-    on = case.U[1:, case.input_names.index("workday_mean")]
-    assert 0 < on.mean() < 1  # Sunday to Thursday: both kinds of day
-    with FmuInstance(fmu) as instance:
-        T = simulate_fmu(instance, case, parameters={f"workday_gain.{k}": v for k, v in values.items()})
-    assert np.abs(T - simulate(after, assemble(after), case.U, case.dt, case.measured, substeps=case.substeps)).max() < 1e-9
 
 
 @pytest.mark.parametrize("change,field", [
