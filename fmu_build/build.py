@@ -37,7 +37,7 @@ VARIABLES = Path(__file__).with_name("variables.py")
 MODEL_DIR = Path(model.__file__).parent
 # The modules the FMU imports; weather and solar stay outside (their results are inputs).
 PHYSICS_MODULES = ("__init__", "errors", "building", "building_file", "convection", "geometry", "discretise", "schedule",
-                   "effects", "gains", "glazing", "longwave", "network", "modal", "integrate")
+                   "effects", "gains", "glazing", "interior_sun", "longwave", "network", "modal", "integrate")
 SCHEMA = "data/nodal-building.schema.json"
 
 
@@ -74,6 +74,9 @@ def build_fmu(building, destination, effect=None, kind="python"):
         raise ValueError(f"unknown FMU kind {kind!r}: one of {', '.join(KINDS)}, each optionally -fmi3")
     if effect is not None and not EFFECTS[effect[0]].applies(building, effect[1]):
         raise ValueError(f"effect {effect[0]} does not apply to {effect[1]!r}")
+    if effect is not None and kind.startswith("standalone") and EFFECTS[effect[0]].not_standalone:
+        raise ValueError(f"effect {effect[0]}: {EFFECTS[effect[0]].not_standalone}, which a standalone FMU's form "
+                         "cannot hold: use the Python FMU")
     if effect is not None:  # declared at its present values, so the FMU has every input the effect uses
         building = EFFECTS[effect[0]].apply(building, effect[1], {})
     destination = Path(destination).resolve()

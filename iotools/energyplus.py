@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..model import convection, geometry, glazing, interior_sun, longwave
+from ..model import beam_trace, convection, geometry, glazing, interior_sun, longwave
 from ..model.building_file import ORIENTATION_TOLERANCE
 from ..model.errors import InputError
 from .energyplus_shading import fin, may_shade, on_surface, overhang, rectangle, window_frame
@@ -1688,6 +1688,8 @@ class _Converter:
                     else:
                         # seen from the room: the diffuse sun it absorbs and the part it lets out
                         c["_back"] = (glass["back_alpha"], glass["tau"] * glass["angular"]["diffuse"])
+                        c["inside"].update(solar_absorptance=round(c["_back"][0], 6),
+                                           diffuse_transmittance=round(c["_back"][1], 6))
                         self.incident_solar_multiplier(w["obj"], c)
                 if lit and w["vertices"] is not None and w_outside["type"] == "exterior":
                     c["_polygon"] = (w["vertices"], [])
@@ -1846,6 +1848,7 @@ class _Converter:
         flip = {"ceiling": "floor", "floor": "ceiling", "roof": "floor"}
         if outside["type"] == "zone" and outer is not None:
             faces.append((outside["zone"], flip.get(s["type"].lower(), s["type"].lower()), outer["solar"]))
+            outside["solar_absorptance"] = round(outer["solar"], 6)
         if outside["type"] == "zone":
             # the zones' long-wave exchange (ScriptF) sees the outer face by its own class
             outside["face_class"] = FACE_CLASS.get(flip.get(s["type"].lower(), s["type"].lower()), "wall")
@@ -1854,7 +1857,8 @@ class _Converter:
                 "layers": [[m, t] for m, t in reversed(layers)], "nodes": {"max_spacing": MAX_SPACING},
                 "inside": {"zone": s["zone"], "h_conv": FILMS.inside_convection(s["tilt"], self.inside_algorithm(s["zone"])),
                            "h_rad": round(FILMS.radiative(inner["emissivity"], FILMS.T_inside), 4),
-                           "emissivity": inner["emissivity"], "face_class": FACE_CLASS.get(s["type"].lower(), "wall")},
+                           "emissivity": inner["emissivity"], "face_class": FACE_CLASS.get(s["type"].lower(), "wall"),
+                           "solar_absorptance": round(inner["solar"], 6)},
                 "outside": outside, "_zone": s["zone"], "_type": s["type"].lower(), "_absorbs": inner["solar"]}
 
     def outside(self, s, boundary, outer, surfaces, done, subsurface=None):
@@ -1984,10 +1988,11 @@ class _Converter:
             layers, _, inner, _ = self.layers(self.r.text(o, "construction_name"), o, "Construction Name")
             area = self.r.number(o, "surface_area", low=0, low_open=True)
             for zone in zones:
-                # EnergyPlus's internal mass sees the zone on one face, the other adiabatic
+                # EnergyPlus's internal mass sees the zone on one face; its other face is held at
+                # the first's temperature (an interzone surface that is its own partner)
                 s = {"tilt": 90.0, "azimuth": 0.0, "zone": self.zone_objs[zone.upper()].name, "type": "internalmass"}
                 name = o.name if len(zones) == 1 else f"{o.name} {s['zone']}"
-                components.append(self.component(name, area, s, layers[::-1], inner, {"type": "adiabatic"}))
+                components.append(self.component(name, area, s, layers[::-1], inner, {"type": "inside_face"}))
                 self.built_of(self.r.text(o, "construction_name"), name)
 
     def user_view_factors(self, zones, components, surfaces):
@@ -2063,7 +2068,7 @@ class _Converter:
         as EnergyPlus adds what its back surfaces do not absorb to the zone's diffuse sun
         (SolarShading.cc, CalcInteriorSolarDistribution). The window and those faces get their
         polygons. A window without a polygon keeps its direct sun on the floor; a face no sun
-        above the horizon reaches through the window (`interior_sun.may_receive_beam`) is left
+        above the horizon reaches through the window (`beam_trace.may_receive_beam`) is left
         out, its share 0 at every time."""
         if not self.has_plane(c):
             return
@@ -2071,7 +2076,7 @@ class _Converter:
         for k, f in enumerate(own):
             if f[0] is c or not self.has_plane(f[0]) or f[0]["name"] in beam:
                 continue
-            if not interior_sun.may_receive_beam(self.ccw_polygon(c), self.ccw_polygon(f[0])):
+            if not beam_trace.may_receive_beam(self.ccw_polygon(c), self.ccw_polygon(f[0])):
                 continue
             beam[f[0]["name"]] = _named_split(own, interior_sun.beam_fractions(area, alpha, tau,
                                                                               np.arange(len(own)) == k))

@@ -9,10 +9,10 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ..model import glazing
-from ..model.building import WORKDAY_TERMS
+from ..model.building import MASS_EMISSIVITY, MASS_SOLAR_ABSORPTANCE, WORKDAY_TERMS, mass_area
 from ..model.case import day_basis
 from ..model.effects import CONSTRUCTION, EFFECTS, MATERIAL, members
-from .energyplus import FILMS, SCHEMA_MIN, _field
+from .energyplus import SCHEMA_MIN, _field
 
 ALWAYS_ON = "nodeforce always on"
 # The single layer an InternalMass the diagnosis adds is made of: thin and conductive, so that
@@ -136,12 +136,15 @@ class _Writer:
 
     def internal_mass(self, zone):
         mass = self.after.zone(zone).internal_mass
-        area = mass.conductance / FILMS.inside_convection(90.0)
-        specific_heat = mass.capacity / (area * MASS_THICKNESS * MASS_DENSITY)
+        area = mass_area(mass)
+        # EnergyPlus holds an InternalMass's other face at its first's temperature: a single
+        # layer stores through the zone's face as half its thickness would, so it is twice C_m
+        specific_heat = 2.0 * mass.capacity / (area * MASS_THICKNESS * MASS_DENSITY)
         name = f"nodeforce mass {zone}"
         self._add("Material", name, {"roughness": "MediumSmooth", "thickness": MASS_THICKNESS,
                                      "conductivity": MASS_CONDUCTIVITY, "density": MASS_DENSITY,
-                                     "specific_heat": specific_heat})
+                                     "specific_heat": specific_heat, "thermal_absorptance": MASS_EMISSIVITY,
+                                     "solar_absorptance": MASS_SOLAR_ABSORPTANCE})
         self._add("Construction", name, {"outside_layer": name})
         self._add("InternalMass", name, {"construction_name": name, "zone_or_zonelist_name": zone,
                                          "surface_area": area})

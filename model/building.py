@@ -15,6 +15,8 @@ import pickle
 import re
 from dataclasses import dataclass, field
 
+import numpy as np
+
 NODE_COLUMN = re.compile(r"T([1-9][0-9]*)$")  # no leading zero: T01 is not T1
 # A daily gain profile's harmonics of the day (W on cos and sin of 2 pi h tau / 24 h, tau the local
 # clock time). A block schedule's harmonics fall only as 1/h and the air takes a gain to it almost
@@ -48,6 +50,8 @@ class Surface:
     h_rad: float
     emissivity: float = 0.9  # -, long-wave
     face_class: str | None = None  # "wall", "floor", "roof", "internal_mass"; None: from its tilt
+    solar_absorptance: float | None = None  # -, of the zone's interior sun; None: not declared
+    diffuse_transmittance: float = 0.0  # -, a window's of the zone's diffuse sun back out
 
 
 @dataclass(frozen=True)
@@ -77,6 +81,13 @@ class Adiabatic:
 
 
 @dataclass(frozen=True)
+class InsideFace:
+    """The face held at its component's own inside face's temperature, the heat that crosses it
+    counted in no balance (EnergyPlus's InternalMass: an interzone surface that is its own
+    partner; docs/model.md section 3.2)."""
+
+
+@dataclass(frozen=True)
 class Boundary:
     """A prescribed temperature (C, or the name of an input column) through h (W/m2/K)."""
     temperature: float | str
@@ -101,6 +112,22 @@ class Lumped:
     """A node a zone effect adds (docs/model.md section 7): its capacity and its conductance to the zone."""
     capacity: float  # J/K; 0 makes the node algebraic
     conductance: float  # W/K, > 0
+
+
+# An internal mass is also a face of its zone (docs/model.md section 7): its area H_m / MASS_FILM,
+# TARP's coefficient of a vertical face 5 K from the air (EnergyPlus's InternalMass is vertical),
+# its surface EnergyPlus's Material defaults (thermal absorptance 0.9, solar 0.7). No face holds
+# less than THINNEST_MASS per m2 (some 2 mm of wood, a carpet's pile), so that a mass of no
+# capacity shows no face: it is the building as declared, as the effect's neutral value must be.
+MASS_FILM = 1.31 * 5.0 ** (1 / 3)  # W/m2/K
+MASS_EMISSIVITY, MASS_SOLAR_ABSORPTANCE = 0.9, 0.7
+THINNEST_MASS = 1000.0  # J/m2/K
+
+
+def mass_area(mass):
+    """m2: the face an internal mass (`Lumped`) shows its zone, its conductance over `MASS_FILM`,
+    at most its capacity over `THINNEST_MASS`."""
+    return min(mass.conductance / MASS_FILM, mass.capacity / THINNEST_MASS)
 
 
 @dataclass(frozen=True)
@@ -251,7 +278,7 @@ class Component:
     node_ids: tuple  # ids, ordered by depth
     depths: tuple  # m from the inside face
     inside: Surface
-    outside: Exterior | Adiabatic | Surface | Boundary
+    outside: Exterior | Adiabatic | Surface | Boundary | InsideFace
     solar_transmittance: float | None = None
     transmitted_solar_to: str | None = None
     shading: str | None = None  # input column in 0..1 multiplying the transmittance
@@ -483,6 +510,23 @@ class Building:
                 tuple(180.0 - c.tilt if t else c.tilt for (c, _, _), t in zip(faces, turned)),
                 tuple((c.azimuth + 180.0) % 360.0 if t else c.azimuth for (c, _, _), t in zip(faces, turned)),
                 tuple(side.face_class for _, side, _ in faces))
+
+    def interior_solar(self, zone_name):
+        """(names, areas m2, absorptances, diffuse transmittances back out) of the components that
+        face a zone, for its interior sun (`model.interior_sun`): a component's faces in the zone
+        summed, their absorptances weighed by area; None unless every face declares its
+        solar_absorptance."""
+        faces = self._faces(zone_name)
+        if any(side.solar_absorptance is None for _, side, _ in faces):
+            return None
+        names = tuple(dict.fromkeys(c.name for c, _, _ in faces))
+        area, alpha, tau = (np.zeros(len(names)) for _ in range(3))
+        for c, side, _ in faces:
+            k = names.index(c.name)
+            area[k] += c.area
+            alpha[k] += c.area * side.solar_absorptance
+            tau[k] += c.area * side.diffuse_transmittance
+        return names, area, alpha / area, tau / area
 
     def facing(self, zone_name):
         """Ids of the surface nodes that face a zone (inside faces, and outside faces of partitions)."""

@@ -22,7 +22,7 @@ from importlib.resources import files
 import numpy as np
 
 from .building import (DAY_TERMS, WORKDAY_TERMS, Adiabatic, AngularAbsorptance, AngularTransmittance, Boundary, Building, Component,
-                       Exterior, Gain, Inflow, Lumped, Material, OutsideConvection, ShadingSurface, Supply, Surface,
+                       Exterior, Gain, Inflow, InsideFace, Lumped, Material, OutsideConvection, ShadingSurface, Supply, Surface,
                        Ventilation, Window, WindowGap, Zone, boundary_columns, json_copy)
 from . import geometry
 from .discretise import generated_depths
@@ -482,9 +482,12 @@ def _number_added_nodes(zones, last):
 def _surface(check, raw, where, zone_names):
     if raw["zone"] not in zone_names:
         check.fail(f"{where}.zone", f"names no zone ({raw['zone']!r})")
+    if raw.get("solar_absorptance", 0.0) + raw.get("diffuse_transmittance", 0.0) > 1.0:
+        check.fail(f"{where}.diffuse_transmittance", "with solar_absorptance exceeds 1: the face would give more sun than it gets")
     return Surface(zone=raw["zone"], h_conv=float(raw["h_conv"]), h_rad=float(raw["h_rad"]),
                    emissivity=float(raw.get("emissivity", schema_default("inside", "emissivity"))),
-                   face_class=raw.get("face_class"))
+                   face_class=raw.get("face_class"), solar_absorptance=raw.get("solar_absorptance"),
+                   diffuse_transmittance=float(raw.get("diffuse_transmittance", 0.0)))
 
 
 def _outside(check, raw, where, zone_names):
@@ -499,6 +502,8 @@ def _outside(check, raw, where, zone_names):
         return _surface(check, raw, where, zone_names)
     if kind == "boundary":
         return Boundary(temperature=_temperature(raw["temperature"]), h=float(raw["h"]))
+    if kind == "inside_face":
+        return InsideFace()
     return Adiabatic()
 
 

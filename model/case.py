@@ -23,7 +23,7 @@ from .network import (WIND_DIRECTION, WIND_SPEED, assemble, clock_input_names, d
                       slowest_time_constant, workday_input)
 from .units import check_celsius
 from .geometry import outward_normal
-from .interior_sun import beam_shares
+from .beam_trace import beam_shares
 from .shading import sky_diffuse_ratio, sun_vectors, sunlit_fraction
 from .site import run_building, standard_offset
 from .solar import (DECOMPOSITIONS, complete_irradiance, incident_irradiance, measured_irradiance, sky_temperature,
@@ -473,7 +473,7 @@ def face_shading(component, shades, position):
 def traced_beam_columns(building, window, position, direct):
     """{input: W/m2} of a glazing that traces its direct sun (docs/model.md section 4.1): the part
     of its direct sun `direct` (W/m2, `Itb_<window>`) that falls on each face of its traced_beam
-    at each time of `position` (`model.interior_sun.beam_shares`), and under `Itb_<window>` the
+    at each time of `position` (`model.beam_trace.beam_shares`), and under `Itb_<window>` the
     part that falls on none."""
     faces = [building.component(face) for face, _ in window.traced_beam]
     sun = sun_vectors(position["apparent_zenith"], position["azimuth"])

@@ -74,6 +74,9 @@ class Effect:
     # parameters, the step matrix left as declared: the temperatures are then affine in them
     # (`diagnosis.calibrate.Superposition`)
     on_inputs: bool = False
+    # why a standalone FMU cannot expose its parameters (its form is multi-affine in them,
+    # fmu_build/standalone.py), or None: it can
+    not_standalone: str | None = None
 
     # -- what the diagnosis reads of it (diagnosis/)
     # (building, zone) -> the targets a round on that zone's air tries (`diagnosis.candidates`);
@@ -711,12 +714,14 @@ EFFECTS = {e.id: e for e in (
            (Parameter("f_r", "-", 0.0, 1.0),), _heated,
            *_zone_field("heat_input_radiative_fraction", "f_r"),
            lambda b, t: b.facing(t), on_inputs=True, offers=_offered(_heated)),
-    Effect("internal_mass", "the zone's furniture and undeclared internal mass: a node coupled to its air",
+    Effect("internal_mass", "the zone's furniture and undeclared internal mass: a node coupled to its air, a face of the zone",
            (Parameter("C_m", "J/K", 0.0, 1e9), Parameter("H_m", "W/K", 0.01, 1e5)), _zones,
            *_lumped_field("internal_mass", "C_m", "H_m"), _no_node, _lumped_limits("C_m"),
            offers=_offered(_zones), absent_start=_air_capacities("C_m", 10.0),
            derived=_time_constant("mass_time_constant"), trade_off=("mass_time_constant", False),
-           no_effect=("C_m",), energyplus=lambda w, t: w.internal_mass(t)),
+           no_effect=("C_m",), energyplus=lambda w, t: w.internal_mass(t),
+           not_standalone="its parameters move the mass's face in the zone's long-wave exchange and sun split, "
+                          "not affinely"),
     Effect("heat_input_lag", "the heater's own capacity: a node between its measured heat input and the zone",
            (Parameter("C_h", "J/K", 0.0, 1e8), Parameter("H_h", "W/K", 0.01, 1e5)),
            _heated, *_lumped_field("heat_input_lag", "C_h", "H_h"), _no_node, _lumped_limits("C_h"),

@@ -21,14 +21,16 @@ from functools import cached_property
 
 import numpy as np
 
-from .building import DAY_TERMS, WORKDAY_TERMS, Adiabatic, Boundary, Exterior, Surface
+from .building import (DAY_TERMS, MASS_EMISSIVITY, MASS_SOLAR_ABSORPTANCE, WORKDAY_TERMS, Adiabatic, Boundary, Exterior,
+                       InsideFace, Surface, mass_area)
 from .building_file import gap_nodes, schema_default
 from .convection import doe2_faces, iso15099_inside, lagged_excess, tarp_inside_faces, windward_faces
 from .discretise import capacities, conductances
 from .gains import people_sensible_heat
 from .glazing import followed_gap_conductance, gap_coefficients
 from .integrate import MAX_STEP
-from .longwave import T_MEAN, enclosure_exchange, exterior_coefficient, pair_coefficient
+from .interior_sun import with_absorber
+from .longwave import SIGMA, T_MEAN, enclosure_exchange, exterior_coefficient, pair_coefficient
 
 AIR_DENSITY = schema_default("site", "air_density")  # kg/m3, a building file's default
 C_AIR = 1005.0  # J/kg/K
@@ -491,6 +493,11 @@ def assemble(building, names=None):
             absorbers[z.name] = [(z.radiant_node - 1, 1.0)]
             continue
         face_names, ids, *faces = building.enclosure(z.name)
+        if z.internal_mass is not None and mass_area(z.internal_mass) > 0:
+            # the internal mass is a face of the zone that sees every other (EnergyPlus's class)
+            mass = (f"{z.name} internal mass", z.mass_node, mass_area(z.internal_mass), MASS_EMISSIVITY, 90.0, 0.0,
+                    "internal_mass")
+            face_names, ids, *faces = (known + (added,) for known, added in zip((face_names, ids, *faces), mass))
         G, shares = enclosure_exchange(face_names, *faces, declared=z.view_factors)
         nodes = np.array(ids) - 1
         for a, b in zip(*np.triu_indices(len(nodes), 1)):
@@ -505,6 +512,25 @@ def assemble(building, names=None):
         A[radiant, nodes] += shares
         A[radiant, radiant] -= 1.0
         absorbers[z.name] = list(zip(nodes, shares))
+
+    def absorbed(zone_name, receivers):
+        """[(node, fraction)] of a split of the sun a zone's glazing lets in: each receiver's face
+        in the zone (a partition's outer face where only that face is in it), and where the zone
+        holds an internal mass and its faces declare their solar absorptances, the mass's share
+        of the diffuse pool taken from them (`interior_sun.with_absorber`)."""
+        def face(name):
+            r = building.component(name)
+            face_out = (r.inside.zone != zone_name and isinstance(r.outside, Surface) and r.outside.zone == zone_name)
+            return (r.node_ids[-1] if face_out else r.node_ids[0]) - 1
+
+        z, solar = building.zone(zone_name), building.interior_solar(zone_name)
+        if z.internal_mass is None or solar is None or not {n for n, _ in receivers} <= set(solar[0]):
+            return [(face(name), fraction) for name, fraction in receivers]
+        names, *faces = solar
+        split = dict(receivers)
+        shares, taken = with_absorber([split.get(n, 0.0) for n in names], *faces,
+                                      mass_area(z.internal_mass) * MASS_SOLAR_ABSORPTANCE)
+        return [(face(n), f) for n, f in zip(names, shares) if f] + [(z.mass_node - 1, taken)]
 
     for c in building.components:
         idx = [i - 1 for i in c.node_ids]
@@ -521,6 +547,12 @@ def assemble(building, names=None):
         G = conductances(c.layers, c.depths)
         for k, g in enumerate(G):
             link(idx[k], idx[k + 1], c.area * g * c.conductivity_factor * materials * boundary)
+        if isinstance(out, InsideFace):
+            # the outside face reads the inside face's temperature, as a boundary would hold it:
+            # its own capacity and the heat its last layer draws from it in no balance
+            C[e] = 0.0
+            A[e, :] = 0.0
+            A[e, e], A[e, idx[0]] = -1.0, 1.0
         for gap in () if c.window is None else c.window.gaps:
             # the gap's link holds its declared conductance; what the panes' temperatures add, the source
             a, b = gap_nodes(c.layers, c.depths, gap.layer)
@@ -549,16 +581,10 @@ def assemble(building, names=None):
         elif isinstance(out, Boundary):
             to_temperature(e, c.area * out.h * boundary, out.temperature)
         else:
-            assert isinstance(out, Adiabatic)
+            assert isinstance(out, (Adiabatic, InsideFace))
         for sun_input, receivers in c.sun_inputs:
             sun = col[sun_input]
-            for name, fraction in receivers:
-                # the receiving face is the one in the glazing's zone: a partition's outer face
-                # where only that face is in it
-                r = building.component(name)
-                face_out = (r.inside.zone != c.inside.zone and isinstance(r.outside, Surface)
-                            and r.outside.zone == c.inside.zone)
-                receiver = (r.node_ids[-1] if face_out else r.node_ids[0]) - 1
+            for receiver, fraction in absorbed(c.inside.zone, receivers):
                 transmitted = c.solar_transmittance * c.area * fraction
                 if c.shading:
                     # tau A I (s + f (1 - s)): a closed shading (s = 0) still lets in the part f
@@ -654,6 +680,8 @@ def assemble(building, names=None):
             mass = z.mass_node - 1
             C[mass] += z.internal_mass.capacity
             link(air, mass, z.internal_mass.conductance)
+            if z.longwave == "radiant_node":
+                link(mass, z.radiant_node - 1, mass_area(z.internal_mass) * MASS_EMISSIVITY * 4.0 * SIGMA * T_MEAN ** 3)
         f_r, gain = z.heat_input_radiative_fraction, z.heat_input_factor
         if z.heat_input_lag is not None:
             # the heater's node takes the heat input and gives it to the air and the radiant node

@@ -135,21 +135,21 @@ def test_a_diagnosis_s_candidates_are_calibrated_on_the_equations_their_fmus_car
     measured = pseudo_measurements(testcell, weather, record_times(days=3), SENSORS, noise_sd=0.1, seed=5)
     case = prepare_case(testcell, weather, measured).with_burn_in(1).with_steady_start()
     objective = Objective.of(testcell)
-    candidate = Candidate(testcell, "internal_mass", "cell")
-    values = [4e5, 25.0]
+    candidate = Candidate(testcell, "envelope_conductance", "cell")
+    values = [1.7]
     direct = candidate.nodes(case, objective.air_nodes, values)
-    parameters = {f"internal_mass.{p.name}": v for p, v in zip(candidate.parameters, values)}
+    parameters = {f"envelope_conductance.{p.name}": v for p, v in zip(candidate.parameters, values)}
     for kind, fmi in (("standalone", 2), ("standalone", 3), ("python", 2)):
-        fmu = build_fmu(testcell, tmp_path / f"{kind}{fmi}.fmu", effect=("internal_mass", "cell"),
+        fmu = build_fmu(testcell, tmp_path / f"{kind}{fmi}.fmu", effect=("envelope_conductance", "cell"),
                         kind=fmu_kind(kind, fmi))
         with FmuInstance(fmu) as instance:
-            # the FMU reads the inputs the effect adds (none for a mass: the case's own)
-            through = simulate_fmu(instance, case.with_inputs(EFFECTS["internal_mass"].apply(testcell, "cell", {})),
+            # the FMU reads the inputs the effect adds (none for the envelope's factor: the case's own)
+            through = simulate_fmu(instance, case.with_inputs(EFFECTS["envelope_conductance"].apply(testcell, "cell", {})),
                                    output_ids=objective.air_nodes,
                                    parameters=parameters)
         assert np.abs(through - direct).max() < 1e-9, (kind, fmi)
-    # and the mass is there: the air differs from the building's as declared
-    assert np.abs(direct - candidate.nodes(case, objective.air_nodes, [0.0, 25.0])).max() > 0.05
+    # and the factor acts: the air differs from the building's as declared
+    assert np.abs(direct - candidate.nodes(case, objective.air_nodes, [1.0])).max() > 0.05
 
 
 @pytest.mark.slow  # three FMUs of 281 nodes

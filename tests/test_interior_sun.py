@@ -8,8 +8,8 @@ import pytest
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.case import prepare_case, simulate_building
 from nodeforce.model.errors import InputError
-from nodeforce.model.interior_sun import (beam_fractions, beam_shares, diffuse_fractions, may_receive_beam,
-                                          window_diffuse_fractions)
+from nodeforce.model.beam_trace import beam_shares, may_receive_beam
+from nodeforce.model.interior_sun import beam_fractions, diffuse_fractions, window_diffuse_fractions, with_absorber
 from nodeforce.model.shading import sun_vectors
 from tests.traced import traced_cell
 from nodeforce.model.network import assemble
@@ -76,6 +76,15 @@ def test_a_diffuse_distribution_is_refused_where_it_adds_up_over_1_or_names_no_c
         split_cell(testcell_data, {"floor": 0.9}, {"attic": 0.5})
 
 
+
+def test_a_face_that_would_give_more_sun_than_it_gets_is_refused(testcell_data):
+    data = copy.deepcopy(testcell_data)
+    window = next(c for c in data["components"] if c["name"] == "window")
+    window["inside"].update(solar_absorptance=0.5, diffuse_transmittance=0.6)
+    with pytest.raises(InputError, match=r"components\[\d+\]\.inside\.diffuse_transmittance: with solar_absorptance exceeds 1"):
+        parse_building(data)
+
+
 # ---- EnergyPlus's interior distribution (model.interior_sun) --------------------------------
 # a 4 m x 4 m x 3 m box: floor (alpha 0.6), ceiling (0.3), 44 m2 of walls (0.5) and a 4 m2 window
 # whose panes absorb 0.1 of the room's diffuse sun and let 0.6 of it out
@@ -138,6 +147,33 @@ def test_a_window_that_sees_another_window_loses_its_first_bounce_through_it():
     S = 16 * 0.6 + 8 * 0.7
     assert phi == pytest.approx([0.3 + 0.35 * 9.6 / S, 0.35 * 0.4 / S, 0.05 + 0.35 * 0.4 / S])
     assert phi.sum() + 0.3 + 0.35 * 4.8 / S == pytest.approx(1.0)
+
+
+# an internal mass of 12 m2 of absorptance 0.7 in the box: 8.4 m2 more in the pool's 39.2
+MASS_AREA, MASS_ALPHA = 12.0, 0.7
+
+
+@pytest.mark.parametrize("split, recomputed", [
+    (lambda a, al, o: beam_fractions(a, al, o, FLOOR), lambda a, al, o: beam_fractions(a, al, o, FLOOR + [False])),
+    (lambda a, al, o: window_diffuse_fractions(a, al, o, [0.3, 0.3, 0.4, 0.0]),
+     lambda a, al, o: window_diffuse_fractions(a, al, o, [0.3, 0.3, 0.4, 0.0, 0.0])),
+    (diffuse_fractions, diffuse_fractions)], ids=["beam on the floor", "window's diffuse", "pool"])
+def test_an_internal_mass_takes_the_pools_share_as_the_splits_computed_again_with_it(split, recomputed):
+    """The zone's splits computed afresh with the mass as one more face that the first bounce does
+    not reach (EnergyPlus traces no beam onto an InternalMass; the window's view factors are the
+    box's) equal the declared splits with the mass added, which reads only the splits and the
+    faces: the direct sun's reflected 0.4 gives the mass 0.4 x 8.4 / (39.2 + 8.4)."""
+    shares, mass = with_absorber(split(AREA, ALPHA, OUT), AREA, ALPHA, OUT, MASS_AREA * MASS_ALPHA)
+    again = recomputed(AREA + [MASS_AREA], ALPHA + [MASS_ALPHA], OUT + [0.0])
+    assert [*shares, mass] == pytest.approx(list(again), abs=1e-12)
+    assert with_absorber(beam_fractions(AREA, ALPHA, OUT, FLOOR), AREA, ALPHA, OUT, 8.4)[1] == pytest.approx(
+        0.4 * 8.4 / 47.6)
+
+
+def test_a_split_that_puts_all_its_sun_on_one_face_gives_the_mass_none():
+    """Declared all on the floor (nothing reflected), the split stays as declared."""
+    shares, mass = with_absorber([1.0, 0.0, 0.0, 0.0], AREA, ALPHA, OUT, 8.4)
+    assert mass == 0.0 and list(shares) == [1.0, 0.0, 0.0, 0.0]
 
 
 # ASHRAE 140's box (8 m east-west, 6 m north-south, 2.7 m high) and a south window 3 m wide and 2 m

@@ -350,3 +350,33 @@ def test_a_whole_building_s_slowest_time_constant_from_its_free_decay_through_th
     # slower than the floor alone, its neighbours held: free, they follow it
     floor = np.array(parse_building(TESTCELL).component("floor").node_ids) - 1
     assert tau >= slowest_time_constant(network, floor)
+
+
+def test_a_layer_whose_outside_face_is_held_at_its_inside_face_stores_as_half_of_it_with_an_adiabatic_back():
+    """EnergyPlus's InternalMass (`inside_face`): the outside face at the inside face's
+    temperature and the heat that crosses it counted nowhere. The slab's middle is then a plane of
+    symmetry, so a 0.1 m board in four elements is a 0.05 m board in two with an adiabatic back:
+    every node of the half and the air alike to rounding, the room heated by a step, the mass
+    taking its sun and long-wave through the floor's face."""
+    def box(thickness, outside):
+        data = two_wall_box({"type": "adiabatic"})
+        depths = [0.0, 0.025, 0.05, 0.075, 0.1][:round(thickness / 0.025) + 1]
+        data["components"].append({"name": "mass", "area": 8.0, "tilt": 90.0, "azimuth": 0.0,
+                                   "layers": [["board", thickness]],
+                                   "nodes": [{"id": 7 + k, "depth": d} for k, d in enumerate(depths)],
+                                   "inside": {"zone": "room", "h_conv": 2.5, "h_rad": 5.0}, "outside": outside})
+        return parse_building(data)
+
+    held, half = box(0.1, {"type": "inside_face"}), box(0.05, {"type": "adiabatic"})
+    assert held.component("mass").depths == (0.0, 0.025, 0.05, 0.075, 0.1)
+    inputs = {"T_out": 0.0, "T_sky": -5.0, "I_wall": 200.0}
+    _, _, T_held = run_constant(held, inputs, days=3, dt=600.0, T0=20.0)
+    _, _, T_half = run_constant(half, inputs, days=3, dt=600.0, T0=20.0)
+    kept = [i - 1 for i in range(1, 7)] + [i - 1 for i in half.component("mass").node_ids]
+    assert np.abs(T_held[:, kept] - T_half[:, kept]).max() < 1e-9
+    # the outside face reads the inside face's temperature
+    s, e = (i - 1 for i in held.component("mass").node_ids[::4])
+    assert np.abs(T_held[:, e] - T_held[:, s]).max() < 1e-12
+    # and the mass does something: a free-floating room cools otherwise without it
+    assert np.abs(T_held[:, 4] - run_constant(parse_building(two_wall_box({"type": "adiabatic"})), inputs, 3,
+                                              600.0, 20.0)[2][:, 4]).max() > 0.1
