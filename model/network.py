@@ -30,7 +30,7 @@ from .gains import people_sensible_heat
 from .glazing import followed_gap_conductance, gap_coefficients
 from .integrate import MAX_STEP
 from .interior_sun import with_absorber
-from .longwave import SIGMA, T_MEAN, enclosure_exchange, exterior_coefficient, pair_coefficient
+from .longwave import T_MEAN, enclosure_exchange, exterior_coefficient, pair_coefficient
 
 AIR_DENSITY = schema_default("site", "air_density")  # kg/m3, a building file's default
 C_AIR = 1005.0  # J/kg/K
@@ -513,6 +513,9 @@ def assemble(building, names=None):
         A[radiant, radiant] -= 1.0
         absorbers[z.name] = list(zip(nodes, shares))
 
+    # the diffuse pool of each zone an internal mass takes its share of (its faces, once)
+    pools = {z.name: building.interior_solar(z.name) for z in building.zones if z.internal_mass is not None}
+
     def absorbed(zone_name, receivers):
         """[(node, fraction)] of a split of the sun a zone's glazing lets in: each receiver's face
         in the zone (a partition's outer face where only that face is in it), and where the zone
@@ -523,10 +526,10 @@ def assemble(building, names=None):
             face_out = (r.inside.zone != zone_name and isinstance(r.outside, Surface) and r.outside.zone == zone_name)
             return (r.node_ids[-1] if face_out else r.node_ids[0]) - 1
 
-        z, solar = building.zone(zone_name), building.interior_solar(zone_name)
-        if z.internal_mass is None or solar is None or not {n for n, _ in receivers} <= set(solar[0]):
+        solar = pools.get(zone_name)
+        if solar is None or not {n for n, _ in receivers} <= set(solar[0]):
             return [(face(name), fraction) for name, fraction in receivers]
-        names, *faces = solar
+        z, (names, *faces) = building.zone(zone_name), solar
         split = dict(receivers)
         shares, taken = with_absorber([split.get(n, 0.0) for n in names], *faces,
                                       mass_area(z.internal_mass) * MASS_SOLAR_ABSORPTANCE)
@@ -681,7 +684,8 @@ def assemble(building, names=None):
             C[mass] += z.internal_mass.capacity
             link(air, mass, z.internal_mass.conductance)
             if z.longwave == "radiant_node":
-                link(mass, z.radiant_node - 1, mass_area(z.internal_mass) * MASS_EMISSIVITY * 4.0 * SIGMA * T_MEAN ** 3)
+                link(mass, z.radiant_node - 1, mass_area(z.internal_mass) * MASS_EMISSIVITY
+                     * pair_coefficient(T_MEAN - 273.15, T_MEAN - 273.15))
         f_r, gain = z.heat_input_radiative_fraction, z.heat_input_factor
         if z.heat_input_lag is not None:
             # the heater's node takes the heat input and gives it to the air and the radiant node
