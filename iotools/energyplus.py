@@ -95,8 +95,9 @@ def _sides(absorbed):
 FLOW_WIND_HEIGHT = 1.5  # m, a zone's height where its surfaces give none
 # A surface's vertices off its plane: listed beyond 2 cm, refused beyond a tenth of its size
 PLANAR_LISTED, PLANAR_REFUSED = 0.02, 0.1  # m, fraction of sqrt(area)
-# Glass, where EnergyPlus gives a pane no density or specific heat (it neglects a pane's capacity)
-GLASS_DENSITY, GLASS_SPECIFIC_HEAT = 2500.0, 840.0  # kg/m3, J/kg/K
+# A window's panes and gaps hold no heat: EnergyPlus balances them at each step without capacity
+# (WindowManager.cc, SolveForWindowTemperatures), and its glazing objects declare none
+WINDOW_LAYER_CAPACITY = {"density": 0.0, "specific_heat": 0.0}
 # A massless layer (Material:NoMass, Material:AirGap) is written as a layer this thick with its
 # resistance and no capacity: only thickness / conductivity matters
 MASSLESS_THICKNESS = 0.001  # m
@@ -107,7 +108,6 @@ IR_TRANSPARENT_FACE = {"emissivity": 0.9999, "solar": 1.0}
 THERMOCHROMIC_T = 20.0  # C, the pane temperature at which a thermochromic group's optics are taken
 PANES = ("WINDOWMATERIAL:GLAZING", "WINDOWMATERIAL:GLAZING:REFRACTIONEXTINCTIONMETHOD")
 MAX_SPACING = 0.025  # m, the largest cell of a generated component
-AIR_DENSITY, AIR_SPECIFIC_HEAT = 1.2, 1006.0  # a gas gap's capacity, kg/m3 and J/kg/K
 # EnergyPlus's ground temperature where the IDF gives none (its Site:GroundTemperature:BuildingSurface default)
 DEFAULT_GROUND = 18.0  # C
 # ... and its Site:GroundTemperature:Deep's, for a month the object leaves blank
@@ -902,8 +902,7 @@ class _Converter:
             if R <= 0:
                 self.r.fail(o, "U-Factor", f"{U:g} W/m2/K leaves no resistance for the glazing beside its films")
             name = f"{o.name} (U {U:g})"
-            self.materials[name] = {"conductivity": 0.003 / R, "density": GLASS_DENSITY,
-                                    "specific_heat": GLASS_SPECIFIC_HEAT}
+            self.materials[name] = {"conductivity": 0.003 / R, **WINDOW_LAYER_CAPACITY}
             tau = glazing.simple_glazing_transmittance(U, shgc)
             # EnergyPlus's absorptance of the layer, split between its outer and inner face so that
             # at the converter's films the part flowing in is SHGC - T (absorbing it all at the outer
@@ -953,7 +952,7 @@ class _Converter:
                 thickness = self.r.number(o, "thickness", low=0, low_open=True)
                 name = o.name
                 self.materials.setdefault(name, {"conductivity": self.r.number(o, "conductivity", low=0, low_open=True),
-                                                 "density": GLASS_DENSITY, "specific_heat": GLASS_SPECIFIC_HEAT})
+                                                 **WINDOW_LAYER_CAPACITY})
                 layers.append([name, thickness])
             else:
                 layers.append([o.name, self.r.number(o, "thickness", low=0, low_open=True)])
@@ -968,7 +967,7 @@ class _Converter:
             gap, d = layers[k]
             h = glazing.gap_conductance(d, height or 1.5, panes[k // 2][3], panes[k // 2 + 1][2], gas=gases[k])
             name = f"{gap} in {construction}"
-            self.materials[name] = {"conductivity": h * d, "density": AIR_DENSITY, "specific_heat": AIR_SPECIFIC_HEAT}
+            self.materials[name] = {"conductivity": h * d, **WINDOW_LAYER_CAPACITY}
             layers[k] = [name, d]
         pairs = [(T0, R0) for T0, R0, _, _ in panes]
         tau = float(glazing.stack_transmittance(pairs, 0.0))
@@ -1016,8 +1015,7 @@ class _Converter:
         panes, layers, gases = [], [], {}
         for k, pane in enumerate(window["panes"]):
             name = f"{c.name} pane {k + 1}"
-            self.materials[name] = {"conductivity": pane["conductivity"], "density": GLASS_DENSITY,
-                                    "specific_heat": GLASS_SPECIFIC_HEAT}
+            self.materials[name] = {"conductivity": pane["conductivity"], **WINDOW_LAYER_CAPACITY}
             panes.append((pane["T"], pane["R_front"], pane["emissivity_front"], pane["emissivity_back"]))
             layers.append([name, pane["thickness"]])
             if k < len(window["gaps"]):

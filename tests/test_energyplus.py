@@ -16,7 +16,7 @@ from nodeforce.model import geometry, glazing
 from nodeforce.model.building import MASS_EMISSIVITY, MASS_SOLAR_ABSORPTANCE, InsideFace
 from nodeforce.model.building_file import parse_building
 from nodeforce.model.errors import InputError
-from nodeforce.model.network import air_density_at, assemble, input_names
+from nodeforce.model.network import C_AIR, air_density_at, assemble, input_names
 from nodeforce.model.schedule import Schedule
 
 BESTEST = Path(__file__).resolve().parents[1] / "examples" / "bestest"
@@ -265,6 +265,24 @@ def test_case600_window(case600):
     a = 1 - T - R
     assert w.outside.solar_absorptance == pytest.approx(a * (1 + T * R / (1 - R * R)), abs=1e-6)
     assert w.inner_solar_absorptance == pytest.approx(a * T / (1 - R * R), abs=1e-6)
+
+
+def test_case600_stores_heat_in_its_opaque_layers_and_air_alone(case600):
+    """EnergyPlus balances a window's panes and gaps at each step without capacity, and its
+    glazing objects declare none; the converted case 600 stores heat in its walls, roof, floor and
+    air alone. By hand from case600.idf, J/K/m2: walls 0.012 m x 950 x 840 + 0.066 x 12 x 840 +
+    0.009 x 530 x 900 over 8 x 2.7 x 2 + 6 x 2.7 x 2 - 12 = 63.6 m2; roof 0.010 x 950 x 840 +
+    0.1118 x 12 x 840 + 0.019 x 530 x 900 over 48 m2; floor 0.025 x 650 x 1200 over 48 m2 (its
+    insulation massless); and 129.6 m3 of air at the site's density."""
+    network = assemble(case600)
+    names = case600.node_names()
+    window = [i - 1 for i, n in names.items() if n.startswith("SOUTH WINDOW")]
+    assert len(window) == 8 and not network.C[window].any()
+    walls = 63.6 * (0.012 * 950 * 840 + 0.066 * 12 * 840 + 0.009 * 530 * 900)
+    roof = 48 * (0.010 * 950 * 840 + 0.1118 * 12 * 840 + 0.019 * 530 * 900)
+    floor = 48 * 0.025 * 650 * 1200
+    air = 129.6 * case600.site["air_density"] * C_AIR
+    assert network.C.sum() == pytest.approx(walls + roof + floor + air, rel=1e-9)
 
 
 def test_case600_interior_solar_distribution(case600):
