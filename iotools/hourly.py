@@ -1,13 +1,22 @@
-"""Hourly weather sources (EPW, TMY2, TMY3) read through pvlib, rows put at mid-hour.
+"""Hourly weather sources (EPW, TMY2, TMY3) read through pvlib, rows put where each column was measured.
 
 Time convention. These files' irradiance values are energies received over the hour before the
 stamp (Wh/m2, i.e. the hour's mean W/m2) and their temperatures are readings at the stamp. A row
-here is one instant used for the sun position and for the model's inputs, so hourly rows are put
-at the *middle* of their hour (local standard time, the file's UTC offset): the irradiance keeps
-its value (the hour mean is the best estimate at mid-hour) and the temperature (and the wind
-speed) becomes the mean of the readings at the start and end of the hour (their linear
-interpolation at mid-hour, as `nodeforce.model.weather.weather_on_grid` would do). The infrared `ir_h` is an hour energy like
-the other irradiances.
+here is one instant used for the sun position and for the model's inputs, which
+`nodeforce.model.weather.weather_on_grid` interpolates linearly between rows.
+
+An EPW is read as EnergyPlus reads its own format (WeatherManager.cc, at each of its steps): the
+readings `EPW_READINGS` (the air temperature, the wind, and the sky's infrared, which EnergyPlus
+interpolates as it does the air) linear between the hours' ends, the sun's energies linear
+between the hours' middles. Its rows are every half hour (`to_half_hours`): at an hour's end the
+readings as read and the sun the mean of the two hours about it, at its middle the sun as read
+and the readings the mean of the hour's two ends (a wind direction the mean the short way round
+north), so that interpolating between rows follows each column between its own stamps exactly.
+A TMY2 or TMY3 file's rows are at the *middle* of their hour (`to_mid_hour`, local standard
+time, the file's UTC offset): the irradiance keeps its value (the hour mean is the best estimate
+at mid-hour) and the temperature (and the wind speed) becomes the mean of the readings at the
+start and end of the hour, which between two rows smooths the readings' hour-to-hour course a
+little (the project's TMY records and the bundled Miami year are made so).
 
 Each reader returns `(end_of_hour, columns, meta)`: the tz-aware end-of-hour stamps, a dict of
 float arrays in the weather CSV's names and units, and pvlib's metadata with a `name` for the site.
@@ -18,11 +27,14 @@ import pandas as pd
 import pvlib
 
 from nodeforce.model.errors import InputError
+from nodeforce.model.weather import turn
 from .timetable import one_line
 
 
 # the columns read at an instant, not accumulated over the hour
 READINGS = ("T_out", "wind_speed")
+# an EPW's columns EnergyPlus interpolates between the hours' ends
+EPW_READINGS = ("T_out", "wind_speed", "wind_direction", "ir_h")
 
 
 def read_epw(source, coerce_year=None):
@@ -97,6 +109,35 @@ def to_mid_hour(end_of_hour, columns, cyclic):
             columns[name] = (before + reading) / 2.0
     index = pd.DatetimeIndex(end_of_hour - pd.Timedelta(minutes=30), name="time")
     return pd.DataFrame(columns, index=index)
+
+
+def to_half_hours(end_of_hour, columns, cyclic):
+    """The weather frame of an EPW's hours, a row every half hour (module docstring): the middle of
+    each hour, then its end, the last hour's end left out (the sun after the last middle is
+    unknown). Before the first hour's middle, the reading before the file starts is its last
+    when `cyclic` (a typical year), else missing (NaN)."""
+    n = len(end_of_hour)
+    rows = {}
+    for name, values in columns.items():
+        values = np.asarray(values, float)
+        column = np.empty(2 * n - 1)
+        if name in EPW_READINGS:
+            before = np.concatenate(([values[-1] if cyclic else np.nan], values[:-1]))
+            column[0::2] = (mean_direction(before, values) if name == "wind_direction" else (before + values) / 2.0)
+            column[1::2] = values[:-1]
+        else:
+            column[0::2] = values
+            column[1::2] = (values[:-1] + values[1:]) / 2.0
+        rows[name] = column
+    middles = end_of_hour - pd.Timedelta(minutes=30)
+    index = pd.DatetimeIndex(np.stack([middles, end_of_hour]).T.ravel()[:-1], name="time")
+    return pd.DataFrame(rows, index=index)
+
+
+def mean_direction(a, b):
+    """The direction halfway between directions `a` and `b` (deg from north), the short way round
+    (`model.weather.turn`)."""
+    return (a + turn(a, b) / 2.0) % 360.0
 
 
 def epw_site(source):

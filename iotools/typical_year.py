@@ -19,7 +19,7 @@ from pathlib import Path
 import pandas as pd
 
 from nodeforce.model.errors import InputError
-from .hourly import read_epw, read_tmy2, read_tmy3, to_mid_hour, zone_name
+from .hourly import read_epw, read_tmy2, read_tmy3, to_half_hours, to_mid_hour, zone_name
 from .timetable import check_increasing, one_line, write_time_table
 
 
@@ -27,9 +27,9 @@ def convert_typical_year(src_path, dst_csv_path, year=2001):
     """Convert a typical-year file (TMY2 `.tm2`, TMY3 `.csv`, EPW `.epw`) to a weather CSV.
 
     Typical years splice months from different years; the months are put in one `year`, so the
-    time column is strictly increasing over 8760 hours. Rows are at mid-hour local standard time
-    (`iotools.hourly`); the first row's `T_out` uses the last reading of the file, the year
-    being cyclic. `ir_h` is written when the source has it (EPW); TMY2 and TMY3 have no
+    time column is strictly increasing over the year. An EPW's rows are every half hour, as
+    `read_weather` reads it, a TMY2's or TMY3's at mid-hour, local standard time (`iotools.hourly`);
+    the first row's `T_out` uses the last reading of the file, the year being cyclic. `ir_h` is written when the source has it (EPW); TMY2 and TMY3 have no
     infrared, so the model falls back on Swinbank's sky temperature.
 
     Parameters
@@ -64,7 +64,7 @@ def convert_typical_year(src_path, dst_csv_path, year=2001):
         end_of_hour, columns, meta = readers[suffix](source, year)
     except (OSError, ValueError, KeyError, IndexError, pd.errors.ParserError) as error:
         raise InputError(source, "file", f"not a readable {suffix} typical year: {one_line(error)}") from None
-    weather = to_mid_hour(end_of_hour, columns, cyclic=True)
+    weather = (to_half_hours if suffix == ".epw" else to_mid_hour)(end_of_hour, columns, cyclic=True)
     check_increasing(source, weather.index, where=lambda i: f"record {i + 1}")
     write_time_table(weather, dst_csv_path, float_format="%.6g")
     return {**_site(meta), "ground_temperature": round(float(weather["T_out"].mean()), 2)}

@@ -1,7 +1,7 @@
 """Weather files: the weather CSV of docs/model.md section 4 or an EPW file, read and checked.
 
-Hourly sources (EPW) have their rows at the middle of the hour (`nodeforce.iotools.hourly`). An EPW
-is read as EnergyPlus reads it: its months, days and hours in one calendar year.
+An EPW is read as EnergyPlus reads it: its months, days and hours in one calendar year, its rows
+every half hour so that each column follows EnergyPlus's interpolation (`nodeforce.iotools.hourly`).
 """
 
 from pathlib import Path
@@ -11,7 +11,7 @@ import pandas as pd
 
 from nodeforce.model.errors import InputError
 from nodeforce.model.weather import IRRADIANCE_COLUMNS, REQUIRED_COLUMNS, TEMPERATURE_COLUMNS, utc_microseconds
-from .hourly import epw_site, read_epw, to_mid_hour
+from .hourly import epw_site, read_epw, to_half_hours
 from nodeforce.model.units import check_celsius
 from .timetable import read_time_table
 
@@ -53,7 +53,8 @@ def read_weather(path, year=None, times=None):
     pandas.DataFrame
         Indexed by a tz-aware DatetimeIndex named "time", the file's columns, float, in their
         units; missing values are NaN. `attrs["source"]` is the path. An EPW file gives
-        `T_out`, `ghi`, `dni`, `dhi`, `ir_h` at the middle of each hour (`iotools.hourly`); its
+        `T_out`, `ghi`, `dni`, `dhi`, `ir_h`, `wind_speed`, `wind_direction` every half hour
+        (`iotools.hourly`: the readings as read at the hours' ends, the sun at their middles); its
         missing-value codes (99.9 C, 9999 W/m2) become NaN and the first row's `T_out`, which
         would need the reading before the file starts, is NaN; that of a year read in another
         (a typical year, or `year` given) is the mean of its first and last readings, the year
@@ -104,9 +105,9 @@ def _read_epw_weather(source, year, record_year):
             raise InputError(source, "year", f"{year} has no 29 February, which the EPW has") from None
         end_of_hour = start + pd.Timedelta(hours=1)
         # a year put in one calendar, as EnergyPlus runs it, is cyclic: its first hour follows its last
-        weather = to_mid_hour(end_of_hour, columns, cyclic=True)
+        weather = to_half_hours(end_of_hour, columns, cyclic=True)
     else:
-        weather = to_mid_hour(end_of_hour, columns, cyclic=False)
+        weather = to_half_hours(end_of_hour, columns, cyclic=False)
     weather.attrs.update(source=source, typical_year=typical, site=epw_site(source))
     return weather
 

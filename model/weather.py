@@ -36,7 +36,8 @@ def weather_on_grid(weather, times):
         The weather's columns at `times` (index named "time"), same units. A target time equal
         to a weather time takes that row's value; between two rows the value is their linear
         interpolation, NaN if either is NaN or if the rows are more than `GAP_FACTOR` median steps
-        apart (a gap in the file is missing weather, not something to invent).
+        apart (a gap in the file is missing weather, not something to invent); a
+        `wind_direction` turns the short way round north.
 
     Raises
     ------
@@ -65,8 +66,14 @@ def weather_on_grid(weather, times):
     values = weather.to_numpy(float)
     lo, hi = values[left], values[left + 1]
     w = w[:, None]
+    if "wind_direction" in weather.columns:  # the short way round north
+        k = weather.columns.get_loc("wind_direction")
+        hi = hi.copy()
+        hi[:, k] = lo[:, k] + turn(lo[:, k], hi[:, k])
     # Exact hits take the row itself, so a missing neighbour cannot hide a present sample.
     blended = np.where(w == 0.0, lo, np.where(w == 1.0, hi, (1.0 - w) * lo + w * hi))
+    if "wind_direction" in weather.columns:
+        blended[:, k] %= 360.0
     inside_gap = gap[:, None] & (w > 0.0) & (w < 1.0)
     blended = np.where(inside_gap, np.nan, blended)
     on_grid = pd.DataFrame(blended, index=times, columns=weather.columns)
@@ -104,6 +111,14 @@ def check_columns(building, weather):
             problem = (f"neither a standard weather column ({', '.join(REQUIRED_COLUMNS + IRRADIANCE_COLUMNS + OPTIONAL_COLUMNS)}, "
                        f"I_<exterior component>) nor one {building.source} refers to ({referred}): a misspelt name?")
         raise InputError(weather.attrs.get("source", "weather"), name, problem)
+
+
+def turn(a, b):
+    """The turn (deg) from direction `a` to direction `b` the short way round north, as EnergyPlus
+    interpolates the wind's direction: b - a within half a turn, else a turn the other way; half
+    a turn exactly as it reads."""
+    d = np.asarray(b, float) - np.asarray(a, float)
+    return np.where(d > 180.0, d - 360.0, np.where(d < -180.0, d + 360.0, d))
 
 
 def utc_microseconds(times):

@@ -10,6 +10,7 @@ import pytest
 
 from nodeforce.model.errors import InputError
 from nodeforce.model.solar import solar_position
+from nodeforce.model.weather import weather_on_grid
 from nodeforce.iotools.typical_year import convert_typical_year, main, relocate
 from nodeforce.iotools.hourly import epw_site
 from nodeforce.iotools.weather import TYPICAL_YEAR, read_weather
@@ -170,17 +171,39 @@ def test_an_epws_site_is_its_location_line(tmp_path):
     assert caught.value.source == str(tmp_path / "bad.epw")
 
 
-def test_epw_rows_sit_at_mid_hour_with_codes_as_missing(tmp_path):
+def test_epw_rows_every_half_hour_with_codes_as_missing(tmp_path):
+    """Hour n of the file (1-based) ends at n:00: its readings (T_out = n, ir_h = 300 + n) there,
+    its sun (ghi = 100 + n) at n - 0.5 h, and each between as the linear interpolation of its own
+    neighbours, as EnergyPlus interpolates an EPW."""
     w = read_weather(epw(tmp_path, [2019, 2019]))
-    assert len(w) == 48
+    assert len(w) == 95  # 48 middles and 47 ends: the sun after the last middle is not in the file
     # EPW hour 1 of 1 January (UTC+10) covers 00:00-01:00 local standard time.
     assert w.index[0] == pd.Timestamp("2019-01-01T00:30+10:00")
+    assert w.index[1] == pd.Timestamp("2019-01-01T01:00+10:00")
     assert w["ghi"].iloc[0] == 101 and w["dni"].iloc[0] == 201 and w["dhi"].iloc[0] == 51
-    assert w["ir_h"].iloc[0] == 301
-    assert np.isnan(w["T_out"].iloc[0])  # the reading at 00:00 is before the file
-    assert w["T_out"].iloc[1] == 1.5  # mean of the readings at 01:00 (1.0) and 02:00 (2.0)
-    assert np.isnan(w["ghi"].iloc[29])  # 9999 is EPW's missing code
-    assert np.isnan(w["T_out"].iloc[39]) and np.isnan(w["T_out"].iloc[40])  # 99.9 is missing
+    assert w["ghi"].iloc[1] == 101.5  # the mean of hours 1 and 2's sun, at their meeting
+    assert np.isnan(w["T_out"].iloc[0]) and np.isnan(w["ir_h"].iloc[0])  # the readings at 00:00 are before the file
+    assert w["T_out"].iloc[1] == 1.0 and w["ir_h"].iloc[1] == 301  # the readings at 01:00
+    assert w["T_out"].iloc[2] == 1.5 and w["ir_h"].iloc[2] == 301.5  # their mean at 01:30
+    assert np.isnan(w["ghi"].iloc[57:60]).all() and w["ghi"].notna().sum() == 92  # 9999 is EPW's missing code
+    assert np.isnan(w["T_out"].iloc[78:81]).all() and w["T_out"].notna().sum() == 91  # 99.9 is missing
+
+
+def test_epw_wind_direction_turns_the_short_way_round_north(tmp_path):
+    """Directions read 350 deg at 01:00 and 10 deg at 02:00: 0 deg between them, and at every
+    time between the two as EnergyPlus interpolates them (20 deg an hour through north)."""
+    path = epw(tmp_path, [2019, 2019])
+    lines = path.read_text().splitlines()
+    for k, direction in ((8, 350), (9, 10)):  # the rows of hours 1 and 2
+        fields = lines[k].split(",")
+        fields[20] = str(direction)
+        lines[k] = ",".join(fields)
+    path.write_text("\n".join(lines) + "\n")
+    w = read_weather(path)
+    assert w["wind_direction"].iloc[1] == 350 and w["wind_direction"].iloc[2] == 0.0
+    times = pd.date_range("2019-01-01T01:00+10:00", "2019-01-01T02:00+10:00", freq="10min")
+    expected = (350.0 + 20.0 * np.arange(7) / 6.0) % 360.0
+    assert np.allclose(weather_on_grid(w, times)["wind_direction"].to_numpy(), expected)
 
 
 def test_typical_year_epw_is_read_in_one_calendar_year_as_energyplus_reads_it(tmp_path):
@@ -188,10 +211,10 @@ def test_typical_year_epw_is_read_in_one_calendar_year_as_energyplus_reads_it(tm
     path = epw(tmp_path, [2011, 1997])
     w = read_weather(path)
     assert w.attrs["typical_year"]
-    assert w.index[0] == pd.Timestamp(f"{TYPICAL_YEAR}-01-01T00:30+10:00") and len(w) == 48
+    assert w.index[0] == pd.Timestamp(f"{TYPICAL_YEAR}-01-01T00:30+10:00") and len(w) == 95
     assert w.index.is_monotonic_increasing and (w.index.year == TYPICAL_YEAR).all()
     assert w["T_out"].iloc[0] == (48.0 + 1.0) / 2  # the year wraps around: its first hour follows its last
-    assert w["T_out"].iloc[1] == 1.5 and w["ghi"].iloc[0] == 101
+    assert w["T_out"].iloc[2] == 1.5 and w["ghi"].iloc[0] == 101
     given = read_weather(path, year=2013)
     assert given.index[0] == pd.Timestamp("2013-01-01T00:30+10:00")
     assert np.array_equal(given.to_numpy(), w.to_numpy(), equal_nan=True)
@@ -226,7 +249,7 @@ def test_typical_year_epw_converts_with_infrared(tmp_path):
     assert (meta["latitude"], meta["longitude"], meta["altitude"]) == (10.0, 150.0, 50.0)
     w = read_weather(dst)
     assert w.index[0] == pd.Timestamp("2003-01-01T00:30+10:00")
-    assert w["ir_h"].iloc[0] == 301
+    assert w["ir_h"].iloc[0] == (348 + 301) / 2 and w["ir_h"].iloc[1] == 301
     assert w["T_out"].iloc[0] == (48.0 + 1.0) / 2  # the year wraps around
     assert "ir_h" in dst.read_text().splitlines()[0]
 
