@@ -326,9 +326,12 @@ def _isotropic(position, ghi, dni, dhi, tilt, azimuth, albedo):
 def _sky_parts(position, ghi, dni, dhi, tilt, azimuth, albedo, sky_model, altitude):
     """(direct, sky diffuse, circumsolar or None, ground diffuse) W/m2 on a plane, unclipped: the
     isotropic sky's from pvlib (no circumsolar part), or EnergyPlus's anisotropic sky
-    (`energyplus_sky`) in place of the sky's diffuse, the direct and the ground's kept."""
+    (`energyplus_sky`) in place of the sky's diffuse, the direct and the ground's kept. A sun
+    below the horizon casts no beam, whatever dni the weather gives there (an hour's dni
+    interpolated to a time after sunset)."""
     poa = _isotropic(position, ghi, dni, dhi, tilt, azimuth, albedo)
-    direct, ground = _array(poa["poa_direct"]), _array(poa["poa_ground_diffuse"])
+    up = _array(position["apparent_zenith"]) < 90.0
+    direct, ground = np.where(up, _array(poa["poa_direct"]), 0.0), _array(poa["poa_ground_diffuse"])
     if sky_model == "isotropic":
         return direct, _array(poa["poa_sky_diffuse"]), None, ground
     zenith = _array(position["zenith"])
@@ -437,8 +440,7 @@ def _transmitted_parts(position, ghi, dni, dhi, tilt, azimuth, albedo, angles, f
     zenith = np.asarray(position["apparent_zenith"], dtype=float)
     theta = pvlib.irradiance.aoi(tilt, azimuth, zenith, np.asarray(position["azimuth"], dtype=float))
     f = np.interp(np.asarray(theta, dtype=float), list(angles) + [90.0 + 1e-9], list(factors) + [0.0], right=0.0)
-    beam = np.where(zenith < 90, direct, 0.0)
     diffuse_sun = dome * sky + ground
     if circumsolar is not None:
         diffuse_sun = diffuse_sun + circumsolar * sunlit
-    return f * beam * sunlit, diffuse * diffuse_sun
+    return f * direct * sunlit, diffuse * diffuse_sun

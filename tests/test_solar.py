@@ -66,6 +66,21 @@ def test_north_wall_gets_no_beam_from_a_southern_sun():
     assert got[0] == pytest.approx(80.0 / 2 + 0.2 * 600.0 / 2)
 
 
+def test_a_sun_below_the_horizon_casts_no_beam():
+    """Denver, 4 March 2017 at 18:00 MST: the sun 2.3 deg below the horizon, in the west-southwest,
+    with an EPW hour's dni interpolated there (24.5 W/m2). A west wall faces the sun's azimuth,
+    so that cos theta = cos(2.3 deg) cos(83 deg) > 0 on a south one: neither gets a beam, only
+    the ground's and the sky's diffuse, as a north wall does."""
+    times = pd.DatetimeIndex([pd.Timestamp("2017-03-04T18:00", tz="Etc/GMT+7")])
+    position = energyplus_sun(times, 39.83, -104.65, -7.0)
+    assert -3.0 < position["elevation"].iloc[0] < -2.0
+    ghi, dni, dhi = [16.5], [24.5], [14.5]
+    north = incident_irradiance(position, ghi, dni, dhi, 90.0, 0.0, 0.2)
+    for azimuth in (180.0, 270.0):
+        assert incident_irradiance(position, ghi, dni, dhi, 90.0, azimuth, 0.2) == pytest.approx(north)
+    assert north[0] == pytest.approx(14.5 / 2 + 0.2 * 16.5 / 2)
+
+
 def test_night_missing_and_negative_irradiance_give_zero():
     times = pd.DatetimeIndex(pd.to_datetime(["2021-06-01T00:00-05:00", "2021-06-01T12:00-05:00",
                                              "2021-06-01T23:00-05:00"]))
