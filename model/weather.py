@@ -37,7 +37,8 @@ def weather_on_grid(weather, times):
         to a weather time takes that row's value; between two rows the value is their linear
         interpolation, NaN if either is NaN or if the rows are more than `GAP_FACTOR` median steps
         apart (a gap in the file is missing weather, not something to invent); a
-        `wind_direction` turns the short way round north.
+        `wind_direction` turns the short way round north. Its `attrs` are the weather's (its
+        source, and an EPW's site).
 
     Raises
     ------
@@ -57,7 +58,7 @@ def weather_on_grid(weather, times):
     if len(xp) == 1:
         on_grid = pd.DataFrame(np.repeat(weather.to_numpy(float), len(x), axis=0),
                                index=times, columns=weather.columns)
-        on_grid.attrs["source"] = source
+        on_grid.attrs.update(weather.attrs, source=source)
         return on_grid
     left = np.clip(np.searchsorted(xp, x, side="right") - 1, 0, len(xp) - 2)
     step = xp[left + 1] - xp[left]
@@ -77,7 +78,7 @@ def weather_on_grid(weather, times):
     inside_gap = gap[:, None] & (w > 0.0) & (w < 1.0)
     blended = np.where(inside_gap, np.nan, blended)
     on_grid = pd.DataFrame(blended, index=times, columns=weather.columns)
-    on_grid.attrs["source"] = source
+    on_grid.attrs.update(weather.attrs, source=source)
     return on_grid
 
 

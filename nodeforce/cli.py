@@ -62,9 +62,23 @@ def load_inputs(args):
 
 
 def weather_of(path, args):
-    """The weather file to read, or, with --year, the EPW read in that year (`api.read_weather`)."""
+    """The weather file to read, or, with --year, the EPW read in that year (`api.read_weather`);
+    with --step (`simulate` without measurements), the weather interpolated onto that grid from
+    its first row to its last, its site kept."""
     year = getattr(args, "year", None)  # `demo` reads its own CSV
-    return path if year is None else api.read_weather(path, year=year)
+    step = getattr(args, "step", None)
+    weather = path if year is None and step is None else api.read_weather(path, year=year)
+    if step is None:
+        return weather
+    if getattr(args, "measurements", None):
+        raise InputError("--step", step, "the measurements' times are the grid: give --step without --measurements")
+    if not step > 0:
+        raise InputError("--step", step, "must be a positive number of seconds")
+    import pandas as pd
+
+    from nodeforce.model.weather import weather_on_grid
+    grid = pd.date_range(weather.index[0], weather.index[-1], freq=pd.Timedelta(seconds=step))
+    return weather_on_grid(weather, grid)
 
 
 def said_assumed(assumptions):
@@ -487,6 +501,8 @@ def convert_command(s):
 
 def simulate_command(s):
     case_arguments(s, False, "the CSV of node temperatures to write", output_default="sim.csv")
+    s.add_argument("--step", type=float, help="without --measurements, the output's step in seconds, the weather "
+                                              "interpolated onto it (default: the weather's own rows)")
     s.add_argument("--force", help="node ids forced to their measurements, e.g. 1,7,9")
     fmi_argument(s)
     start_arguments(s, 0.0)

@@ -59,6 +59,28 @@ def test_simulate_writes_every_node_as_the_direct_model_computes(files, testcell
     assert pd.read_csv(out.parent / "sim.nodes.csv")["column"].tolist() == list(sim.columns[1:])
 
 
+def test_simulate_on_a_step_of_its_own_is_the_direct_model_on_that_grid(files, testcell, weather):
+    """Without measurements, `--step 600` simulates from the weather's first row every 10 min, the
+    weather interpolated onto the grid: what the direct model computes on that weather; a step
+    beside measurements, whose times are the grid, or not positive, is refused in one line."""
+    from nodeforce.model.case import simulate_building
+    from nodeforce.model.weather import weather_on_grid
+    out = files["dir"] / "stepped.csv"
+    assert main(["simulate", str(files["building"]), "--weather", str(files["weather"]), "--step", "600",
+                 "-o", str(out)]) == 0
+    sim = pd.read_csv(out, index_col="time")
+    grid = pd.date_range(weather.index[0], weather.index[-1], freq="600s")
+    assert pd.DatetimeIndex(pd.to_datetime(sim.index)).equals(grid[1:])
+    direct = simulate_building(testcell, weather_on_grid(weather, grid))
+    assert np.abs(sim.to_numpy() - direct.to_numpy()).max() < 1e-6
+
+
+def test_a_step_beside_measurements_or_below_zero_is_refused(files, capsys):
+    argv = ["simulate", str(files["building"]), "--weather", str(files["weather"]), "-o", str(files["dir"] / "x.csv")]
+    assert "--measurements" in error_of(capsys, argv + ["--step", "600", "--measurements", str(files["measurements"])])
+    assert "positive" in error_of(capsys, argv + ["--step", "0"])
+
+
 def test_fmu_command_writes_a_valid_fmu(files):
     from fmpy.validation import validate_fmu
     out = files["dir"] / "cell.fmu"
