@@ -102,6 +102,14 @@ def hourly_means(table):
     return table.groupby(hour_end).mean()
 
 
+def at_steps(table, per_hour):
+    """The rows of a run at small steps that end where a step of `per_hour` an hour ends. Their
+    hourly means (`hourly_means`) are the hour's mean as a run at `per_hour` takes it, the mean of
+    the states at its steps' ends; the mean of every small step's state sits half a step earlier
+    (4.5 min from 60 to 6 an hour), 0.3 K in 600FF's air rising 4 K an hour."""
+    return table[(table.index.minute * 60 + table.index.second) % (3600 // per_hour) == 0]
+
+
 def paired(ours, theirs, lag):
     """(nodeforce, EnergyPlus) on their common times: EnergyPlus's rows `theirs` (indexed by the
     end of the interval they report) compared with nodeforce's samples `ours` (tz-aware) at

@@ -16,7 +16,7 @@ none; the diagnosis reads the unchanged IDF's conversion. The choices:
   the inside face temperature of every surface at each step, each stamped at its step's end in the
   weather's standard time; the sensors read every `STEP_MIN` minutes. The truth is EnergyPlus's
   answer converged in time, not its step's error: at 10-min steps 600FF's air swings 21.12 K a
-  day in April, 21.75 K at 1-min steps (0.42 K RMSE between the two over a Denver year,
+  day in April, 21.75 K at 1-min steps (0.49 K RMSE between the two over a Denver year,
   docs/energyplus.md), and the faultless 600FF records took an internal mass for the difference;
 - the sensors (`sensors`): the zone air and the inside faces of the south wall (behind the
   windows), the roof and the floor; Gaussian noise of `NOISE` C on every sensor, seeded by the
@@ -307,13 +307,20 @@ def run_document(doc):
 def simulate_energyplus(doc, epw):
     """DataFrame of EnergyPlus's run of `doc` (`run_document`): columns the zone's name (its mean
     air) and each surface's name (its inside face), C, indexed by the naive local standard time of
-    each step's end. EnergyPlus works in a temporary folder, removed however the run ends."""
+    each step's end."""
+    return read_steps(energyplus_table(run_document(doc), epw))
+
+
+def energyplus_table(doc, epw):
+    """EnergyPlus's eplusout.csv table of its run of `doc` as it is (its outputs and run period
+    the document's own) on the weather `epw`. EnergyPlus works in a temporary folder, removed
+    however the run ends."""
     import idfkit
     from nodeforce.runtime import tempdirs
     from pyenergyplus.api import EnergyPlusAPI
     with tempdirs.folder("energyplus") as folder:
         idf = Path(folder) / "model.idf"
-        idfkit.save_idf(run_document(doc), str(idf))
+        idfkit.save_idf(doc, str(idf))
         api = EnergyPlusAPI()
         state = api.state_manager.new_state()
         api.runtime.set_console_output_status(state, False)  # its lines would bury the progress bar
@@ -324,8 +331,7 @@ def simulate_energyplus(doc, epw):
         if code != 0:
             errors = (Path(folder) / "eplusout.err").read_text(errors="replace")[-2000:]
             raise RuntimeError(f"EnergyPlus failed on {doc_name(doc)}: {errors}")
-        table = pd.read_csv(Path(folder) / "eplusout.csv")
-    return read_steps(table)
+        return pd.read_csv(Path(folder) / "eplusout.csv")
 
 
 def doc_name(doc):

@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from benchmarks.energyplus_comparison import differences, face_nodes, hourly_means, interval_ends, paired
+from benchmarks.energyplus_comparison import at_steps, differences, face_nodes, hourly_means, interval_ends, paired
 from nodeforce.api import convert_idf
 from tests.test_energyplus_reading import MULTIZONE
 
@@ -98,6 +98,18 @@ def test_hourly_means_average_the_steps_ending_in_each_hour():
     means = hourly_means(pd.DataFrame({"A": np.arange(1.0, 13.0)}, index=ends))
     assert list(means.index) == [pd.Timestamp("2017-01-01 01:00"), pd.Timestamp("2017-01-01 02:00")]
     assert means["A"].tolist() == [3.5, 9.5]
+
+
+def test_a_fine_run_is_averaged_at_the_coarse_steps_ends():
+    """A 1-min run of a temperature rising 4 K an hour, and a 10-min run of the same: the fine
+    run's states at the 10-min ends average over each hour to the coarse run's hourly means; the
+    mean of all sixty 1-min states is 4.5 min earlier, 0.3 K below."""
+    fine = pd.date_range("2017-01-01 00:01", periods=120, freq="1min")
+    coarse = pd.date_range("2017-01-01 00:10", periods=12, freq="10min")
+    ramp = lambda t: pd.DataFrame({"A": line(t, a=4.0)}, index=t)  # noqa: E731
+    assert list(at_steps(ramp(fine), 6).index) == list(coarse)
+    assert np.allclose(hourly_means(at_steps(ramp(fine), 6)), hourly_means(ramp(coarse)))
+    assert np.allclose(hourly_means(ramp(coarse)) - hourly_means(ramp(fine)), 4.0 * 4.5 / 60)
 
 
 def line(times, a=0.7, b=-3.0):
