@@ -1,7 +1,7 @@
 """The zone's and the windows' heat balance term by term beside EnergyPlus's own outputs (issue
 74, item 1): the IDF `bench_energyplus` runs, with EnergyPlus, at 60 steps an hour (its answer
 converged in time), reporting besides each hour the terms below, and nodeforce's counterpart of each computed from its network, its inputs and its
-simulated temperatures (the direct model on the hourly weather, at the half hour), both over the
+simulated temperatures (the direct model on the EPW at its site, at the half hour), both over the
 same Denver year:
 
 - each inside face: its temperature, the sun it absorbs ("Surface Inside Face Solar Radiation
@@ -28,7 +28,6 @@ import bench_energyplus as bench  # noqa: E402
 from energyplus_comparison import FACE, ZONE_AIR, face_nodes, interval_ends  # noqa: E402
 
 from nodeforce.api import convert_idf  # noqa: E402
-from nodeforce.iotools.typical_year import convert_typical_year  # noqa: E402
 from nodeforce.iotools.weather import read_weather  # noqa: E402
 from nodeforce.model.case import measured_case, simulate_building  # noqa: E402
 from nodeforce.model.convection import iso15099_inside, lagged_excess, tarp_inside_faces  # noqa: E402
@@ -189,8 +188,8 @@ def markdown(table):
 def main(out, epw, only):
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    convert_typical_year(epw, out / "weather.csv", year=bench.YEAR)
-    weather = read_weather(out / "weather.csv")
+    # the EPW read as EnergyPlus reads it, at its site as EnergyPlus's run is (as `bench_energyplus`)
+    weather = read_weather(epw, year=bench.YEAR)
     for name in only:
         doc = bench.with_steps(bench.models()[name]())
         idfkit.save_idf(doc, str(out / f"{name}.idf"))
