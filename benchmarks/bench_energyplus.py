@@ -29,7 +29,7 @@ pyenergyplus package ships (pyenergyplus/data/weather/USA_CO_Denver-Aurora-Buckl
 found at run time.
 
 Both programs read the IDF with 6 time steps an hour (its `Timestep` replaced), nodeforce on the
-hourly weather interpolated onto 10-min steps. Each program's hourly values are the means of the
+EPW as EnergyPlus reads it, at its site, interpolated onto 10-min steps. Each program's hourly values are the means of the
 hour's steps, as EnergyPlus's own hourly report averages them; its 10-min values, the state at
 each step's end. The reference is EnergyPlus converged in time: it runs the IDF again at
 `FINE_STEPS` an hour (`--fine-steps`; 0 takes its run at 6 an hour), its zones' air and inside
@@ -178,7 +178,7 @@ def models():
 
 
 def ten_minutes(weather):
-    """The hourly weather linearly interpolated onto 10-min steps over its span."""
+    """The weather linearly interpolated onto 10-min steps over its span, its site kept."""
     return weather_on_grid(weather, pd.date_range(weather.index[0], weather.index[-1], freq="10min"))
 
 
