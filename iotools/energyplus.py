@@ -1875,7 +1875,9 @@ class _Converter:
         if boundary == "ground":
             return {"type": "boundary", "temperature": self.ground_schedule(), "h": FILMS.ground}
         if boundary == "adiabatic":
-            return {"type": "adiabatic"}
+            # EnergyPlus makes an adiabatic surface its own partner (SurfaceGeometry.cc): its outer
+            # face held at its inner face's temperature, the heat crossing it counted nowhere
+            return {"type": "inside_face"}
         if boundary in ("surface", "zone"):
             other_name = s["other"]
             if boundary == "zone":
@@ -1891,11 +1893,8 @@ class _Converter:
                 elif other is None:
                     self.r.fail(obj, "Outside Boundary Condition Object", f"names no surface or zone ({other_name!r})")
                 elif other is s:
-                    # its own other side: EnergyPlus sets its outer face to its inner face's temperature,
-                    # no heat crossing its middle; the nearest the file holds is an adiabatic outer face
-                    self.approximated(s, "its other side is itself: read with an adiabatic outer face (the zone "
-                                         "sees its inner face alone, as EnergyPlus has it)")
-                    return {"type": "adiabatic"}
+                    # its own partner, as EnergyPlus makes an adiabatic surface
+                    return {"type": "inside_face"}
                 elif other["other"].upper() != obj.name.upper():
                     # not a pair: this face sees the other surface's zone, the other is its own component
                     self.approximated(s, f"names {other_name!r}, which names {other['other']!r} back: read as "

@@ -30,7 +30,7 @@ from typing import Callable
 
 import numpy as np
 
-from .building import DAY_TERMS, WORKDAY_TERMS, Adiabatic, Boundary, Exterior, Surface
+from .building import DAY_TERMS, WORKDAY_TERMS, Adiabatic, Boundary, Exterior, InsideFace, Surface
 from .network import RHO_C_AIR
 
 BRIDGE_TO = "->"
@@ -277,6 +277,14 @@ def _ground_write(data, target, values):
     if values["U"] != 0:
         _component(data, target)["outside"] = {"type": "boundary", "temperature": float(values["T_ground"]),
                                                "h": float(values["U"])}
+
+
+def _passes_no_heat(component):
+    """Whether a component's outside face passes no heat out of the building: `adiabatic`, or held
+    at its own inside face's temperature (`inside_face`: EnergyPlus's Adiabatic surface), an
+    internal mass (a zone's furniture, not its envelope) excepted."""
+    return (isinstance(component.outside, Adiabatic)
+            or (isinstance(component.outside, InsideFace) and component.inside.face_class != "internal_mass"))
 
 
 # The spread (K) of each estimate of the deep ground (`deep_ground_temperature`): a modeller's
@@ -675,7 +683,7 @@ def _proportional_acting(target, values):
 EFFECTS = {e.id: e for e in (
     Effect("ground_coupling", "a conductance from an adiabatic face to a ground temperature",
            (Parameter("U", "W/m2/K", 0.0, 20.0), Parameter("T_ground", "C", -10.0, 40.0)),
-           lambda b: [c.name for c in b.components if isinstance(c.outside, Adiabatic)],
+           lambda b: [c.name for c in b.components if _passes_no_heat(c)],
            _ground_read, _ground_write, member_nodes, priors=_ground_priors,
            absent_start=_absent(U=1.0), derived=_ground_flux, trade_off=("ground_heat_flux", True),
            no_effect=("U",), vanishes=("ground_heat_flux",)),
