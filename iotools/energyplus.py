@@ -917,9 +917,17 @@ class _Converter:
             faces = {"emissivity": 0.84, "solar": alpha - inner, "roughness": 1.0}
             factors = [float(glazing.simple_glazing_factors(U, shgc, a)) for a in glazing.ANGLES]
             diffuse = glazing.hemispherical(lambda a: glazing.simple_glazing_factors(U, shgc, a))
+            # its one layer absorbs the direct sun at its angle and the diffuse at its hemispherical
+            # absorptance, as EnergyPlus has it, whichever face the converter puts it at
+            at_angles = [round(float(glazing.simple_glazing_angular_absorptance(U, shgc, a)) / alpha, 6)
+                         for a in glazing.ANGLES]
+            spread = round(glazing.hemispherical(lambda a: glazing.simple_glazing_angular_absorptance(U, shgc, a))
+                           / alpha, 6)
+            absorptance = {"angles": list(glazing.ANGLES), "outside": at_angles, "outside_diffuse": spread,
+                           "inside": at_angles, "inside_diffuse": spread}
             # the one layer absorbs alike from either side
             return [[name, 0.003]], faces, {"emissivity": 0.84, "solar": tau + alpha}, {
-                "tau": tau, "inner_alpha": inner, "back_alpha": alpha,
+                "tau": tau, "inner_alpha": inner, "back_alpha": alpha, "absorptance": absorptance,
                 "angular": {"angles": list(glazing.ANGLES), "factors": factors, "diffuse": diffuse}}
         panes, layers, gases = [], [], {}
         for k, o in enumerate(objs):

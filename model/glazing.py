@@ -261,15 +261,53 @@ SIMPLE_TRANSMITTANCE_CURVES = {
 }
 
 
+# ... and the reflectance's, each less the transmittance curve of its letter (WindowManager.cc,
+# TransAndReflAtPhi): coefficients of c^4, c^3, c^2, c, 1
+SIMPLE_REFLECTANCE_CURVES = {
+    "A": (1.33, -3.20, 2.57, -0.70, 1.0),
+    "B": (3.23, -7.86, 6.50, -1.87, 1.0),
+    "C": (3.99, -9.86, 8.40, -2.52, 1.0),
+    "D": (3.11, -7.64, 6.40, -1.85, 1.0),
+    "E": (2.80, -6.82, 5.60, -1.57, 1.0),
+    "F": (5.32, -13.14, 10.98, -3.15, 1.0),
+    "G": (5.49, -13.54, 11.32, -3.25, 1.0),
+    "H": (5.64, -13.94, 11.70, -3.39, 1.0),
+    "I": (6.27, -15.74, 13.55, -4.06, 1.0),
+    "J": (6.39, -16.32, 14.27, -4.35, 1.0),
+}
+
+
+def _cosine(angle):
+    return np.cos(np.radians(np.asarray(angle, dtype=float)))
+
+
 def simple_glazing_curve(U, shgc, angle):
     """The transmittance of EnergyPlus's simple glazing system of U-factor U (W/m2/K) and SHGC (-)
     at an angle of incidence (deg) relative to its normal-incidence one (-), unbounded: the curve
-    (SIMPLE_TRANSMITTANCE_CURVES) of the (U, SHGC) region of the Engineering Reference's map, or
-    between the curves of the neighbouring regions, linearly in U or SHGC or both. FGHI is the
-    mean of F, G, H and I; FH of F and H; BDCD of B, D, C and D (twice D, as EnergyPlus has it).
-    1 at normal incidence exactly."""
-    c = np.cos(np.radians(np.asarray(angle, dtype=float)))
+    of SIMPLE_TRANSMITTANCE_CURVES its (U, SHGC) region takes (`_simple_glazing_region`). 1 at
+    normal incidence exactly."""
+    c = _cosine(angle)
     value = {k: np.polyval(p, c) for k, p in SIMPLE_TRANSMITTANCE_CURVES.items()}
+    return np.where(c == 1.0, 1.0, _simple_glazing_region(U, shgc, value))
+
+
+def simple_glazing_reflectance_curve(U, shgc, angle):
+    """How far the simple glazing system's reflectance at an angle of incidence (deg) has moved from
+    its normal value towards 1 (-): R(angle) = R0 (1 - r) + r, r this curve, the reflectance curve
+    of its (U, SHGC) region (SIMPLE_REFLECTANCE_CURVES less the transmittance curve of the same
+    letter, as EnergyPlus writes them). 0 at normal incidence exactly."""
+    c = _cosine(angle)
+    value = {k: np.polyval(p, c) - np.polyval(SIMPLE_TRANSMITTANCE_CURVES[k], c)
+             for k, p in SIMPLE_REFLECTANCE_CURVES.items()}
+    return np.where(c == 1.0, 0.0, _simple_glazing_region(U, shgc, value))
+
+
+def _simple_glazing_region(U, shgc, value):
+    """The curve of the (U, SHGC) region of the Engineering Reference's map for EnergyPlus's simple
+    glazing system of U-factor U (W/m2/K) and SHGC (-), from `value` {curve A to J: its values}, or
+    between the curves of the neighbouring regions, linearly in U or SHGC or both (WindowManager.cc,
+    TransAndReflAtPhi, cells 1 to 28). FGHI is the mean of F, G, H and I; FH of F and H; BDCD of
+    B, D, C and D (twice D, as EnergyPlus has it)."""
     E, J, A, D = value["E"], value["J"], value["A"], value["D"]
     FGHI = (value["F"] + value["G"] + value["H"] + value["I"]) / 4.0
     FH = (value["F"] + value["H"]) / 2.0
@@ -342,7 +380,7 @@ def simple_glazing_curve(U, shgc, angle):
             f = along(shgc, 0.3, 0.45, D, BDCD)
         else:
             f = D
-    return np.where(c == 1.0, 1.0, f)
+    return f
 
 
 def simple_glazing_factors(U, shgc, angle):
@@ -374,6 +412,20 @@ def simple_glazing_absorptance(U, shgc):
     R_os = 1 / (2.225824 * x + 20.57708)
     inward = (R_os + 0.5 * R_l) / (R_os + R_l + R_is)
     return min(1.0 - tau, x / inward)
+
+
+def simple_glazing_angular_absorptance(U, shgc, angle):
+    """The solar absorptance (-) of EnergyPlus's simple glazing system's one layer at an angle of
+    incidence (deg): 1 - T(angle) - R(angle), T = T0 f_T held within 0..1 (`simple_glazing_factors`)
+    and R = R0 (1 - r) + r (`simple_glazing_reflectance_curve`) held within 0..0.9999 - T, R0 = 1 - T0
+    - alpha0 (`simple_glazing_absorptance`), as EnergyPlus takes them (WindowManager.cc,
+    TransAndReflAtPhi). alpha0 at normal incidence."""
+    tau = simple_glazing_transmittance(U, shgc)
+    T = tau * simple_glazing_factors(U, shgc, angle)
+    R0 = 1.0 - tau - simple_glazing_absorptance(U, shgc)
+    r = simple_glazing_reflectance_curve(U, shgc, angle)
+    R = np.clip(R0 * (1.0 - r) + r, 0.0, np.maximum(0.9999 - T, 0.0))
+    return 1.0 - T - R
 
 
 def pane_absorptances(panes):

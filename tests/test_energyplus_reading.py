@@ -545,6 +545,30 @@ def test_simple_glazing_angular_transmittance_by_region(U, shgc, at_60):
     assert f == pytest.approx([1.0, at_60, 0.0], abs=1e-9)
 
 
+# ... and the reflectance curves' polynomials at 60 deg, 1 + c1/2 + c2/4 + c3/8 + c4/16, from which
+# EnergyPlus takes the transmittance curve of the same letter
+RF60 = 1 - 3.15 / 2 + 10.98 / 4 - 13.14 / 8 + 5.32 / 16  # 0.86
+RG60 = 1 - 3.25 / 2 + 11.32 / 4 - 13.54 / 8 + 5.49 / 16  # 0.855625
+RH60 = 1 - 3.39 / 2 + 11.70 / 4 - 13.94 / 8 + 5.64 / 16  # 0.84
+RI60 = 1 - 4.06 / 2 + 13.55 / 4 - 15.74 / 8 + 6.27 / 16  # 0.781875
+
+
+def test_simple_glazing_absorbs_at_the_angle_energyplus_gives_its_layer():
+    """EnergyPlus's simple glazing layer at 60 deg (U 2.16, SHGC 0.37: region F, G, H, I): T = T0
+    f_T, R = R0 (1 - r) + r with r the reflectance curve less the transmittance curve, and the
+    absorptance 1 - T - R, above its normal value (0.238 against 0.206); 0 of it neither at
+    normal incidence nor beyond, and at grazing incidence all is reflected."""
+    U, shgc = 2.1577388, 0.37
+    T0, a0 = glazing.simple_glazing_transmittance(U, shgc), glazing.simple_glazing_absorptance(U, shgc)
+    f = (F60 + G60 + H60 + I60) / 4
+    r = (RF60 + RG60 + RH60 + RI60) / 4 - f
+    T, R = T0 * f, (1 - T0 - a0) * (1 - r) + r
+    a = glazing.simple_glazing_angular_absorptance(U, shgc, np.array([0.0, 60.0, 90.0]))
+    assert a[:2] == pytest.approx([a0, 1 - T - R], abs=1e-9)
+    assert a[1] == pytest.approx(0.238, abs=1e-3) and a0 == pytest.approx(0.206, abs=1e-3)
+    assert a[2] == pytest.approx(0.0001, abs=1e-9)  # R held at 0.9999 - T, T 0
+
+
 def test_simple_glazing_writes_its_angular_table(tmp_path):
     """The converted simple glazing (U 2.0441736, SHGC 0.38: region F, G, H, I) carries the
     curve every 10 deg, its diffuse factor the table's hemispherical mean: below 1, above the
@@ -555,6 +579,10 @@ def test_simple_glazing_writes_its_angular_table(tmp_path):
     assert a.angles[6] == 60 and a.factors[6] == pytest.approx((F60 + G60 + H60 + I60) / 4, abs=1e-9)
     assert a.factors[0] == 1.0 and a.factors[-1] == pytest.approx(0.0, abs=1e-12)
     assert a.factors[6] < a.diffuse < 1.0
+    g = convert_idf(write(tmp_path, text)).component("SOUTH WINDOW WEST").angular_absorptance
+    alpha = glazing.simple_glazing_absorptance(2.0441736, 0.38)
+    assert g.table("outside")[1][6] * alpha == pytest.approx(
+        float(glazing.simple_glazing_angular_absorptance(2.0441736, 0.38, 60.0)), abs=1e-5)
 
 
 # ---- gains ---------------------------------------------------------------------------------
