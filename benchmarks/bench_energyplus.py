@@ -4,7 +4,8 @@ EnergyPlus 25.2.0 (the engine the pinned pyenergyplus-lbnl 26.1.0 ships, an opti
 (`nodeforce convert`, the direct model), free-floating over a Denver year: the ASHRAE 140 cases
 made from examples/bestest/case600.idf, 610FF (600FF with case 610's overhang: 1 m deep along
 the roof over the south windows, ASHRAE 140-2020 section 5.2.2.1.2) and
-examples/multizone/three_zones.idf. Every zone's air and every inside face (EnergyPlus's
+examples/multizone/three_zones.idf, nodeforce started from the steady state of the first day's mean
+conditions and two passes over that day, as EnergyPlus warms up on it. Every zone's air and every inside face (EnergyPlus's
 "Surface Inside Face Temperature" beside the node of the same face, `energyplus_comparison`),
 hourly and at 10-min steps, as RMSE and mean difference (nodeforce - EnergyPlus), with each
 program's minimum, maximum and mean: OUT/comparison.csv, the Markdown table printed, and the
@@ -340,7 +341,9 @@ def main(out, epw, only=None, figure_path=None, sky_diffuse=None, fine_steps=FIN
             run_energyplus(small / "model_25_2.idf", small, epw)
             coarse_air, (air, faces) = air, (at_steps(t, STEPS) for t in read_outputs(small, YEAR))
             step_error = step_error_rows(name, building, hourly_means(coarse_air), hourly_means(air), fine_steps)
-        ours = simulate_building(building, fine)
+        # EnergyPlus warms up by repeating the first day until its zones converge; the steady
+        # start at that day's mean conditions, then the warm-up passes, is nodeforce's counterpart
+        ours = simulate_building(building, fine, steady_start=True)
         # each program's hourly means of the states at the 10-min steps' ends, and those states
         new, unpaired = compare(name, building, doc, hourly_means(ours), (hourly_means(air), hourly_means(faces)),
                                 "0min", "hourly")

@@ -67,7 +67,7 @@ def nodeforce_run(building, weather):
     local), of the building under the hourly weather."""
     network = assemble(building)
     case = measured_case(building, weather)
-    T = simulate_building(building, weather)
+    T = simulate_building(building, weather, steady_start=True)  # started as EnergyPlus starts
     T.index = T.index.tz_localize(None)
     U = pd.DataFrame(case.U[-len(T):], index=T.index, columns=network.input_names)
     return network, U, T

@@ -530,7 +530,8 @@ def force_mask(case, ids, source):
     return mask
 
 
-def simulate_building(building, weather, measurements=None, force=(), warmup_days=2, burn_in_days=0):
+def simulate_building(building, weather, measurements=None, force=(), warmup_days=2, burn_in_days=0,
+                      steady_start=False):
     """Every node's temperature (C) under a weather, with the direct model: the plain Python API.
 
     Parameters
@@ -544,6 +545,10 @@ def simulate_building(building, weather, measurements=None, force=(), warmup_day
     warmup_days : passes over the first day before the run (docs/model.md section 5)
     burn_in_days : days after the first measurement over which every measured node is forced
         (docs/model.md section 5)
+    steady_start : start from the steady state of the first day's mean conditions before the
+        warm-up (docs/model.md section 5.4), as a diagnosis does; without it, where the weather
+        does not start before the measurements, from `initial_state` (20 C where nothing is
+        measured)
 
     Returns
     -------
@@ -551,6 +556,7 @@ def simulate_building(building, weather, measurements=None, force=(), warmup_day
     columns `T1..TN`
     """
     case = measured_case(building, weather, measurements, burn_in_days)
+    case = case.with_steady_start() if steady_start else case
     building = case.building  # at the site the weather gives (`model.site.run_building`)
     mask = force_mask(case, force, "force")
     T = simulate(building, assemble(building), case.U, case.dt, case.measured, mask, warmup_days,

@@ -84,3 +84,26 @@ def test_a_case_s_kept_plan_runs_every_building_of_its_layout_as_a_fresh_simulat
     assert case.run(massive).shape[1] == case.run(cell).shape[1] + 1
     assert not np.array_equal(case.run(door), case.run(cell))
     assert len(pickle.dumps(case)) == size
+
+
+def test_a_steady_start_begins_a_run_at_the_first_day_s_steady_state(testcell_data, weather):
+    """Constant weather, no sun, and a 150 W gain in the test cell: with the steady start the
+    run begins where the cell settles, the air at T_out + Q / HLC (the heat loss coefficient,
+    `model.hlc`, an independent steady formulation); from 20 C and two days' warm-up instead,
+    its 14.7-day floor still carries the start, kelvins away."""
+    import copy
+    from nodeforce.model.building_file import parse_building
+    from nodeforce.model.hlc import heat_loss_coefficient
+    data = copy.deepcopy(testcell_data)
+    data["zones"][0]["internal_gain"] = 150.0
+    building = parse_building(data)
+    calm = weather.iloc[:24 * 4].copy()
+    calm[["ghi", "dni", "dhi"]] = 0.0
+    calm["T_out"] = 5.0
+    calm["T_sky"] = 5.0
+    air = f"T{building.zones[0].air_node}"
+    expected = 5.0 + 150.0 / heat_loss_coefficient(building)
+    steady = simulate_building(building, calm, steady_start=True)[air]
+    assert steady.iloc[0] == pytest.approx(expected, abs=0.01)
+    assert steady.iloc[-1] == pytest.approx(expected, abs=0.01)
+    assert abs(simulate_building(building, calm)[air].iloc[0] - expected) > 1.0
