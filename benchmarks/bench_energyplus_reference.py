@@ -20,6 +20,7 @@ EnergyPlus does not run to its end is a row saying so, with EnergyPlus's own fir
 error, and the others go on.
 
     python benchmarks/bench_energyplus_reference.py [OUT] [--models NAME,...] [--workers N] [--figure PNG]
+                                                     [--finite-differences CONSTRUCTION,...]
                                                      (default: every shipped IDF, one at a time)
 """
 import argparse
@@ -56,9 +57,12 @@ def weather_of(idf):
     return epw
 
 
-def free_floating(idf, out):
+def free_floating(idf, out, finite=()):
     """The IDF with only the objects the converter reads, 6 steps an hour, a free-floating year
-    reporting the zones' mean air at each step and the faces' inside temperatures hourly."""
+    reporting the zones' mean air at each step and the faces' inside temperatures hourly; the
+    constructions named in `finite` conducted by finite differences (EnergyPlus's
+    ConductionFiniteDifference, which conserves the heat its conduction transfer functions may
+    not)."""
     doc = with_steps(idfkit.load_idf(str(idf)))
     for obj in list(doc.all_objects):
         if obj.obj_type.upper() not in KEEP or obj.obj_type == "Version":
@@ -67,17 +71,22 @@ def free_floating(idf, out):
         elif obj.to_dict().get("frame_and_divider_name"):
             obj.frame_and_divider_name = ""  # a window's frame, which the converter does not read
     free_year(doc, OUTPUTS)
+    # each construction's conduction transfer functions, listed in eplusout.eio (docs/energyplus.md)
+    doc.add("Output:Constructions", "", {"details_type_1": "Constructions"})
+    for construction in finite:
+        doc.add("SurfaceProperty:HeatTransferAlgorithm:Construction", f"finite differences {construction}",
+                {"algorithm": "ConductionFiniteDifference", "construction_name": construction})
     idfkit.save_idf(doc, str(out))
     return out
 
 
-def energyplus(idf, folder, epw):
+def energyplus(idf, folder, epw, finite=()):
     """(zone air at each step, inside faces hourly) (C, `energyplus_comparison.read_outputs`) of
     EnergyPlus's run; a run
     of the same free-floating IDF on the same EPW already in `folder` is read, not repeated
     (EnergyPlus's side does not change with nodeforce's code)."""
     folder.mkdir(parents=True, exist_ok=True)
-    model = free_floating(idf, folder / "next.idf")
+    model = free_floating(idf, folder / "next.idf", finite)
     ran = folder / "free_floating.idf"
     stamp = folder / "weather.txt"
     if (ran.exists() and ran.read_bytes() == model.read_bytes() and stamp.exists()
@@ -109,7 +118,7 @@ def severe_error(folder):
     return " ".join(message)
 
 
-def beside(name, idf, out):
+def beside(name, idf, out, finite=()):
     """(rows, stopped): the building `name` (its IDF at `idf`, its city's EPW read as EnergyPlus reads
     it, at the EPW's site as EnergyPlus's run is) beside EnergyPlus, its zones' and
     faces' rows (`bench_energyplus.compare`), or where EnergyPlus does not run it to its end, no
@@ -120,7 +129,7 @@ def beside(name, idf, out):
     # (`bench_energyplus`'s comment)
     ours = simulate_building(building, ten_minutes(read_weather(epw, year=YEAR)), steady_start=True)
     try:
-        air, faces = energyplus(idf, out / name, epw)
+        air, faces = energyplus(idf, out / name, epw, finite)
     except RuntimeError:
         return [], {"model": name, "message": severe_error(out / name)}
     doc = idfkit.load_idf(str(idf))
@@ -132,7 +141,7 @@ def beside(name, idf, out):
     return rows + fine, None
 
 
-def main(out, models, workers=1):
+def main(out, models, workers=1, finite=()):
     """Every building named in `models` beside EnergyPlus, `workers` at a time; OUT/comparison.csv
     (zones), faces.csv and stopped.csv (the buildings EnergyPlus does not run to their end)
     rewritten as each ends, so that a run cut short keeps what it did; then the table (`report`)."""
@@ -141,7 +150,7 @@ def main(out, models, workers=1):
     idfs = {p.stem: p for p in shipped_idfs()}
     rows, failed = [], []
     with ProcessPoolExecutor(workers) as pool:
-        jobs = {pool.submit(beside, name, idfs[name], out): name for name in models}
+        jobs = {pool.submit(beside, name, idfs[name], out, finite): name for name in models}
         for number, job in enumerate(as_completed(jobs), 1):
             name = jobs[job]
             new, stopped = job.result()
@@ -225,6 +234,10 @@ if __name__ == "__main__":
     parser.add_argument("--models", default=None, help="names of shipped IDFs (default: all)")
     parser.add_argument("--workers", type=int, default=1, help="buildings at a time (processes)")
     parser.add_argument("--figure", type=Path, help="the figure's path (default OUT/energyplus_reference.png)")
+    parser.add_argument("--finite-differences", default="", metavar="CONSTRUCTION,...",
+                        help="constructions EnergyPlus conducts by finite differences, not by its conduction "
+                             "transfer functions")
     args = parser.parse_args()
-    main(args.out, args.models.split(",") if args.models else [p.stem for p in shipped_idfs()], args.workers)
+    main(args.out, args.models.split(",") if args.models else [p.stem for p in shipped_idfs()], args.workers,
+         [c for c in args.finite_differences.split(",") if c])
     figure(args.out, args.figure or args.out / "energyplus_reference.png")
