@@ -860,6 +860,33 @@ def test_a_layered_window_s_panes_and_the_sky_are_declared_as_energyplus_solves_
     assert (simple.height, simple.gaps) == (1.4, ())
 
 
+def effect_on_the_air(tmp_path, edit):
+    """(EnergyPlus's, nodeforce's) effect of `edit` on case 600's zone air, free-floating in
+    Chicago's spring (C, with less without, every 10 min after the burn-in's day): both programs
+    run the same two IDFs, EnergyPlus's at 1-min steps sampled as a record, nodeforce's on that
+    record's grid with its burn-in."""
+    import idfkit
+    from benchmarks import energyplus_records as records
+    from nodeforce import api
+    epw = records.package_weather()
+    effect = {}
+    for label, change in (("with", edit), ("without", None)):
+        doc = records.building_document("600FF")
+        if change:
+            change(doc)
+        steps = records.simulate_energyplus(doc, epw)
+        idfkit.save_idf(doc, str(tmp_path / f"{label}.idf"))
+        b = convert_idf(tmp_path / f"{label}.idf")
+        records.write_measurements(records.sample(steps, "record", records.sensors(b), records.utc_offset(epw)),
+                                   tmp_path / f"{label}.csv")
+        measured = api.read_measurements(tmp_path / f"{label}.csv")
+        air = f"T{b.zone(records.ZONE).air_node}"
+        ours = api.simulate(b, api.read_weather(epw, times=measured.index), measured, burn_in_days=1)[air]
+        effect[label] = (measured[air].iloc[1:].to_numpy(), ours.to_numpy())
+    day = 144  # the burn-in's day of 10-min steps left out
+    return tuple(effect["with"][k][day:] - effect["without"][k][day:] for k in (0, 1))
+
+
 @pytest.mark.slow  # two EnergyPlus runs of 12 weeks at 1-min steps
 def test_an_internal_mass_acts_on_the_air_as_in_energyplus(tmp_path):
     """ASHRAE 140's case 600 free-floating, in Chicago's spring, with and without 30 m2 of 25 mm
@@ -868,27 +895,8 @@ def test_an_internal_mass_acts_on_the_air_as_in_energyplus(tmp_path):
     nodeforce's as EnergyPlus's to 10 % of it (4 % when written). EnergyPlus holds the mass's
     other face at its first's temperature; held adiabatic instead, the whole board stores through
     the face and nodeforce's effect misses EnergyPlus's by 77 % of it."""
-    import idfkit
     from benchmarks import energyplus_records as records
-    from nodeforce import api
-    epw = records.package_weather()
-    offset = records.utc_offset(epw)
-    effect = {}
-    for label, edit in (("with", records.furniture), ("without", None)):
-        doc = records.building_document("600FF")
-        if edit:
-            edit(doc)
-        steps = records.simulate_energyplus(doc, epw)
-        idfkit.save_idf(doc, str(tmp_path / f"{label}.idf"))
-        b = convert_idf(tmp_path / f"{label}.idf")
-        columns = records.sensors(b)
-        records.write_measurements(records.sample(steps, "record", columns, offset), tmp_path / f"{label}.csv")
-        measured = api.read_measurements(tmp_path / f"{label}.csv")
-        air = f"T{b.zone(records.ZONE).air_node}"
-        ours = api.simulate(b, api.read_weather(epw, times=measured.index), measured, burn_in_days=1)[air]
-        effect[label] = (measured[air].iloc[1:].to_numpy(), ours.to_numpy())
-    day = 144  # the burn-in's day of 10-min steps left out
-    theirs, ours = (effect["with"][k][day:] - effect["without"][k][day:] for k in (0, 1))
+    theirs, ours = effect_on_the_air(tmp_path, records.furniture)
     size = np.sqrt(np.mean(theirs ** 2))
     assert size > 0.5
     assert np.sqrt(np.mean((ours - theirs) ** 2)) < 0.1 * size
@@ -915,26 +923,7 @@ def test_an_adiabatic_surface_acts_on_the_air_as_in_energyplus(tmp_path):
     the slab's effect on the zone's air (6.6 K RMS) is nodeforce's as EnergyPlus's to 5 % of it (1 %
     when written); the slab held adiabatic at its outer face, as the converter once read it, missed
     EnergyPlus's by 32 % of it."""
-    import idfkit
-    from benchmarks import energyplus_records as records
-    from nodeforce import api
-    epw = records.package_weather()
-    effect = {}
-    for label, edit in (("with", adiabatic_slab), ("without", None)):
-        doc = records.building_document("600FF")
-        if edit:
-            edit(doc)
-        steps = records.simulate_energyplus(doc, epw)
-        idfkit.save_idf(doc, str(tmp_path / f"{label}.idf"))
-        b = convert_idf(tmp_path / f"{label}.idf")
-        records.write_measurements(records.sample(steps, "record", records.sensors(b), records.utc_offset(epw)),
-                                   tmp_path / f"{label}.csv")
-        measured = api.read_measurements(tmp_path / f"{label}.csv")
-        air = f"T{b.zone(records.ZONE).air_node}"
-        ours = api.simulate(b, api.read_weather(epw, times=measured.index), measured, burn_in_days=1)[air]
-        effect[label] = (measured[air].iloc[1:].to_numpy(), ours.to_numpy())
-    day = 144  # the burn-in's day of 10-min steps left out
-    theirs, ours = (effect["with"][k][day:] - effect["without"][k][day:] for k in (0, 1))
+    theirs, ours = effect_on_the_air(tmp_path, adiabatic_slab)
     size = np.sqrt(np.mean(theirs ** 2))
     assert size > 1.0
     assert np.sqrt(np.mean((ours - theirs) ** 2)) < 0.05 * size
