@@ -32,7 +32,7 @@ from nodeforce.iotools.weather import read_weather  # noqa: E402
 from nodeforce.model.case import measured_case, simulate_building  # noqa: E402
 from nodeforce.model.convection import iso15099_inside, lagged_excess, tarp_inside_faces  # noqa: E402
 from nodeforce.model.longwave import pair_coefficient  # noqa: E402
-from nodeforce.model.network import air_conductance, assemble  # noqa: E402
+from nodeforce.model.network import air_conductance, assemble, outdoor_density_ratio  # noqa: E402
 
 SUN_IN = "Surface Inside Face Solar Radiation Heat Gain Rate per Area"
 H_IN = "Surface Inside Face Convection Heat Transfer Coefficient"
@@ -169,10 +169,13 @@ def terms(name, building, doc, network, U, T, theirs):
                 add(zone, key, "sun the panes absorb",
                     one * (U[c.absorbed_input("outside")].to_numpy(float) * c.outside.solar_absorptance
                            + U[c.absorbed_input("inside")].to_numpy(float) * c.inner_solar_absorptance), PANES)
-        g = air_conductance(z.volume * z.air_change_rate, building.site.get("air_density", 1.2))
+        # the flow carried at the outdoor air's density where the site says so, as the network does
+        T_out = U["T_out"].to_numpy(float)
+        density = outdoor_density_ratio(T_out) if building.site.get("flow_density") == "outdoor" else 1.0
+        g = air_conductance(z.volume * z.air_change_rate, building.site.get("air_density", 1.2)) * density
         if INFILTRATION[0] in theirs and zone in theirs[INFILTRATION[0]]:
             out = (theirs[INFILTRATION[0]][zone] - theirs[INFILTRATION[1]][zone]).loc[when] / 3600.0
-            row(zone, zone, "infiltration out", g * (air - U["T_out"].to_numpy(float)), out, "W")
+            row(zone, zone, "infiltration out", g * (air - T_out), out, "W")
     return rows
 
 
