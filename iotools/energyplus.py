@@ -469,7 +469,7 @@ UNREAD_CONSTRUCTIONS = {
 _FOR_WORDS = {"weekday": "Weekdays", "weekend": "Weekends", "allday": "AllDays", "allotherday": "AllOtherDays",
               "holiday": "Holiday", "summerdesignday": "SummerDesignDay", "winterdesignday": "WinterDesignDay",
               "customday1": "CustomDay1", "customday2": "CustomDay2",
-              **{d: d.title() for d in ("sunday", "monday", "tuesday", "wednesday", "thursday", "friday", "saturday")}}
+              **{d.lower(): d for d in ("Monday", "Tuesday", "Wednesday", "Thursday", "Friday", "Saturday", "Sunday")}}
 
 
 def compact_day_types(text):
@@ -496,11 +496,30 @@ def _compact_periods(obj):
     return [replace(p, day_rules=[replace(r, day_types=next(days)) for r in p.day_rules]) for p in periods], interpolation
 
 
+_WEEKDAYS = ("Monday", "Tuesday", "Wednesday", "Thursday", "Friday", "Saturday", "Sunday")
+
+
+def day_types_of(d, holidays, custom_day_1, custom_day_2):
+    """The day types (idfkit's names) a "For:" field or a week's day list must name to apply on
+    the date `d`: EnergyPlus gives a date one day type, a special day's (CustomDay2, CustomDay1,
+    Holiday, in idfkit's order of precedence) in place of its day of the week's, and "Weekdays"
+    or "Weekends" only to days that are no special day. idfkit's `get_applicable_day_types` adds
+    the day of the week to a special day's, so a Tuesday holiday took "For: Weekdays" where
+    EnergyPlus takes "For: AllOtherDays" (the 2004 reference offices' and schools' gains)."""
+    for days, special in ((custom_day_2, "CustomDay2"), (custom_day_1, "CustomDay1"), (holidays, "Holiday")):
+        if d in days:
+            return {special, "AllDays", "AllOtherDays"}
+    weekday = d.weekday()
+    return {_WEEKDAYS[weekday], "Weekdays" if weekday < 5 else "Weekends",
+            "AllDays", "AllOtherDays"}
+
+
 class _DaySchedules:
-    """A schedule's values over the year `YEAR` on a time step, as idfkit evaluates them, but day by
+    """A schedule's values over the year `YEAR` on a time step, by idfkit's functions but day by
     day: the document's holidays and special days found once (idfkit's `values` finds them again at
-    every time step, some 40 s a schedule of a DOE reference building), and each day profile
-    evaluated once, the days that share it copied."""
+    every time step, some 40 s a schedule of a DOE reference building), each date's day types
+    EnergyPlus's (`day_types_of`), and each day profile evaluated once, the days that share it
+    copied."""
 
     def __init__(self, doc):
         from idfkit.schedules.holidays import get_holidays, get_special_days_by_type
@@ -520,7 +539,7 @@ class _DaySchedules:
 
     def of(self, obj, ts):
         """(days, 24 ts) values of a Schedule:Compact, Schedule:Constant or Schedule:Week:Daily/Compact."""
-        from idfkit.schedules import compact, day_types, week
+        from idfkit.schedules import compact, week
         from idfkit.schedules.time_utils import evaluate_time_values
         from idfkit.schedules.types import DayType
         kind = obj.obj_type.upper()
@@ -533,7 +552,7 @@ class _DaySchedules:
             for d in self.dates():
                 period = compact._find_period_for_date(periods, d) if periods else None
                 rule = None if period is None else compact._find_matching_rule(
-                    period.day_rules, day_types.get_applicable_day_types(d, DayType.NORMAL, *self.special))
+                    period.day_rules, day_types_of(d, *self.special))
                 key = ("rule", id(rule), ts)
                 if key not in self.profiles:
                     self.profiles[key] = (np.zeros(24 * ts) if rule is None else np.array(
@@ -545,7 +564,7 @@ class _DaySchedules:
                 day_name = week._get_day_schedule_name_for_date(obj, d, DayType.NORMAL, *self.special)
             else:
                 day_name = week._find_matching_day_in_week_compact(
-                    obj, day_types.get_applicable_day_types(d, DayType.NORMAL, *self.special))
+                    obj, day_types_of(d, *self.special))
             if day_name is None:
                 rows.append(np.zeros(24 * ts))
                 continue

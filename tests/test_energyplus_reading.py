@@ -187,6 +187,58 @@ def test_a_for_field_reads_each_day_type_singular_or_plural(tmp_path):
     assert E.compact_day_types("For: Weedends WinterDesignDay") == {"WinterDesignDay"}
 
 
+def test_a_holiday_takes_no_weekday_rule(tmp_path):
+    """EnergyPlus gives a holiday its own day type, in place of its day of the week's: a schedule
+    that names no Holiday, "For: Weekdays", "For: Saturday", "For: AllOtherDays" (the 2004
+    reference offices' gains), runs its AllOtherDays profile on a Tuesday holiday (2017-07-04) and
+    a Monday one (2017-01-02), and its weekday profile on the Wednesday after. So does a
+    Schedule:Week:Compact of the same day lists. idfkit's own evaluation gives those holidays the
+    weekday profile."""
+    import idfkit
+    import idfkit.schedules as S
+    text = HEADER + HOLIDAYS + """Schedule:Compact,
+  EQUIP,
+  Fraction,
+  Through: 12/31,
+  For: Weekdays,
+  Until: 08:00, 0.4,
+  Until: 18:00, 0.9,
+  Until: 24:00, 0.4,
+  For: Saturday,
+  Until: 24:00, 0.3,
+  For: AllOtherDays,
+  Until: 24:00, 0.2;
+Schedule:Day:Hourly,
+  WORKDAY,
+  Fraction,
+  0.4, 0.4, 0.4, 0.4, 0.4, 0.4, 0.4, 0.4, 0.9, 0.9, 0.9, 0.9,
+  0.9, 0.9, 0.9, 0.9, 0.9, 0.9, 0.4, 0.4, 0.4, 0.4, 0.4, 0.4;
+Schedule:Day:Hourly,
+  RESTDAY,
+  Fraction,
+  0.2, 0.2, 0.2, 0.2, 0.2, 0.2, 0.2, 0.2, 0.2, 0.2, 0.2, 0.2,
+  0.2, 0.2, 0.2, 0.2, 0.2, 0.2, 0.2, 0.2, 0.2, 0.2, 0.2, 0.2;
+Schedule:Week:Compact,
+  EQUIP WEEK,
+  For: Weekdays,
+  WORKDAY,
+  For: AllOtherDays,
+  RESTDAY;
+"""
+    doc = idfkit.load_idf(str(write(tmp_path, text)))
+    schedules = E._DaySchedules(doc)
+    compact = schedules.of(doc.getobject("Schedule:Compact", "EQUIP"), 1)
+    week = schedules.of(doc.getobject("Schedule:Week:Compact", "EQUIP WEEK"), 1)
+    workday = np.array([0.4] * 8 + [0.9] * 10 + [0.4] * 6)
+    for days in (compact, week):
+        assert np.allclose(days[1], 0.2)  # 2017-01-02, a Monday and a holiday
+        assert np.allclose(days[184], 0.2)  # 2017-07-04, a Tuesday and a holiday
+        assert np.allclose(days[185], workday)  # 2017-07-05, a Wednesday
+    assert np.allclose(compact[6], 0.3)  # 2017-01-07, a Saturday
+    theirs = np.array(S.values(doc.getobject("Schedule:Compact", "EQUIP"), year=E.YEAR, timestep=1, document=doc))
+    assert np.allclose(theirs.reshape(-1, 24)[184], workday)
+
+
 def twenty_zones():
     text = HEADER + OCCUPANCY + HOLIDAYS
     for k in range(20):
