@@ -926,8 +926,8 @@ class _Converter:
             # EnergyPlus's absorptance of the layer, half at each of its faces, as its window heat
             # balance splits a glass layer's short-wave (Engineering Reference, "Window Heat Balance
             # Calculation"); at its simple glazing model's summer films the part flowing in is then
-            # SHGC - T. Split to give SHGC - T at the converter's films instead, the 2019 medium
-            # office's windows let 0.03 of their sun less in, and its zones ran 0.3 K cool
+            # SHGC - T. Split to give SHGC - T at the converter's films instead, the 2019
+            # prototypes' windows let 0.004 of their sun less in, and the medium office ran 0.3 K cool
             alpha = glazing.simple_glazing_absorptance(U, shgc)
             inner = alpha / 2
             faces = {"emissivity": 0.84, "solar": alpha - inner, "roughness": 1.0}
