@@ -346,7 +346,7 @@ class ImplicitEuler:
         v = self.c_dt * T
         v += source
         if inputs is not None and self.network.convection is not None:
-            v += self.network.convection.source(T, inputs)
+            v += self.network.convection.source(T, inputs, self.c_dt)
         solve, index = self.solver(forced, switched)
         if not len(index):
             return solve(v)

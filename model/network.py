@@ -24,7 +24,7 @@ import numpy as np
 from .building import (DAY_TERMS, MASS_EMISSIVITY, MASS_SOLAR_ABSORPTANCE, WORKDAY_TERMS, Adiabatic, Boundary, Exterior,
                        InsideFace, Surface, mass_area)
 from .building_file import gap_nodes, schema_default
-from .convection import doe2_faces, iso15099_inside, lagged_excess, tarp_inside_faces, windward_faces
+from .convection import doe2_faces, iso15099_inside, lagged_excess, outside_cap, tarp_inside_faces, windward_faces
 from .discretise import capacities, conductances
 from .gains import people_sensible_heat
 from .glazing import followed_gap_conductance, gap_coefficients
@@ -107,8 +107,10 @@ class Convection:
     people_nodes: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), dtype=int))
     people: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
 
-    def source(self, T, u):
-        """(N,) W of the temperatures T (N,) before the step (C) and the inputs u at its end."""
+    def source(self, T, u, capacity_rate=None):
+        """(N,) W of the temperatures T (N,) before the step (C) and the inputs u at its end; the
+        nodes' capacities over the sub-step C/dt (N,) W/K (`capacity_rate`, none where not given)
+        cap each outside face's convective excess (`convection.outside_cap`)."""
         q = np.zeros(len(T))
         if len(self.inside):
             face, air = self.inside_nodes.T
@@ -121,7 +123,8 @@ class Convection:
             area, h0, cos_up, azimuth, roughness, wind = self.outside.T
             dT = t_out - T[self.outside_nodes]
             h = doe2_faces(wind * speed, windward_faces(cos_up, azimuth, direction), -dT, cos_up, roughness)
-            np.add.at(q, self.outside_nodes, area * lagged_excess(h, h0) * dT)
+            rate = 0.0 if capacity_rate is None else capacity_rate[self.outside_nodes]
+            np.add.at(q, self.outside_nodes, area * lagged_excess(h, h0, outside_cap(h0, area, rate)) * dT)
         if len(self.longwave):
             t_out, t_sky = u[self.columns[0]], u[self.columns[3]]
             area, h0, F, emissivity = self.longwave.T

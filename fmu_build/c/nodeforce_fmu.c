@@ -392,7 +392,7 @@ static fmi2Status step(Model *m, double h) {
             m->v[p[0]] += m->P[k] * u[p[1]] * u[p[2]];
         }
         if (followed) { /* from T before the step and its inputs */
-            convection(&m->followed, n, T, u, m->extra);
+            convection(&m->followed, n, T, u, m->C, 1.0 / dt, m->extra);
             for (i = 0; i < n; i++) m->v[i] += m->extra[i];
         }
         for (i = 0; i < n; i++)

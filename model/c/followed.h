@@ -61,9 +61,14 @@ static double gap_conductance(double T1, double T2, const double *v) {
     return (nu1 > nu2 ? nu1 : nu2) * k / d + g * SIGMA * (t1 * t1 + t2 * t2) * (t1 + t2);
 }
 
-/* model/convection.py's lagged_excess: h - h0, at most h0, so that the lag never grows an error */
+/* model/convection.py's lagged_excess: h - h0, at most cap, so that the lag never grows an error */
+static double capped_excess(double h, double h0, double cap) {
+    return h - h0 < cap ? h - h0 : cap;
+}
+
+/* ... at most h0 */
 static double excess(double h, double h0) {
-    return h - h0 < h0 ? h - h0 : h0;
+    return capped_excess(h, h0, h0);
 }
 
 /* model/gains.py's people_sensible_heat: EnergyPlus's sensible heat of a person (W) at activity M
@@ -101,8 +106,11 @@ static int followed_any(const Followed *f) {
    air's density or following the state or wind, (air node, its schedule's column of u or -1) and
    its 14 numbers (model/network.py's FLOW_FIELDS); people, per target of a
    followed people gain, (target, air node, its schedule's column or -1) and (share of the number,
-   activity, share of the power, slope, T_ref, the schedule's constant value) */
-static void convection(const Followed *f, int n, const double *T, const double *u, double *q) {
+   activity, share of the power, slope, T_ref, the schedule's constant value). The nodes'
+   capacities times per_second, C/dt (W/K), cap an outside face's convective excess at
+   h0 + 2 C/(A dt) (model/convection.py's outside_cap). */
+static void convection(const Followed *f, int n, const double *T, const double *u, const double *capacity,
+                       double per_second, double *q) {
     int k;
     for (k = 0; k < n; k++) q[k] = 0.0;
     for (k = 0; k < f->n_inside; k++) {
@@ -121,7 +129,8 @@ static void convection(const Followed *f, int n, const double *T, const double *
         double diff = fabs(u[f->columns[2]] - v[3]), forced;
         if (diff - 180.0 > 0.001) diff -= 360.0;
         forced = fabs(v[2]) >= 0.98 || fabs(diff) - 90.0 <= 0.001 ? 3.26 * pow(speed, 0.89) : 3.55 * pow(speed, 0.617);
-        q[face] += v[0] * excess(h_n + v[4] * (sqrt(h_n * h_n + forced * forced) - h_n), v[1]) * dT;
+        q[face] += v[0] * capped_excess(h_n + v[4] * (sqrt(h_n * h_n + forced * forced) - h_n), v[1],
+                                        v[1] + 2.0 * capacity[face] * per_second / v[0]) * dT;
     }
     for (k = 0; k < f->n_longwave; k++) {
         const int face = f->longwave_nodes[k];

@@ -81,7 +81,7 @@ EXPORT int nodeforce_steps(int n, const int *order, const int *lower_ptr, const 
         const double *t_s = terms + s * m;
         double *out = path + s * n_rows;
         if (lagged)
-            convection(&followed, n, T, t_s, extra);
+            convection(&followed, n, T, t_s, c, 1.0, extra);
         for (i = 0; i < n; i++) {
             const int node = order[i];
             double sum = q[node] + extra[node];
