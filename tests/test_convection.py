@@ -168,6 +168,25 @@ def test_in_a_steady_gale_the_lagged_faces_stay_where_doe2_puts_them(testcell_da
     assert np.abs(T_run - T).max() < 1e-9
 
 
+def test_in_a_gale_c_and_numpy_step_alike(testcell_data, monkeypatch):
+    """A day of a 15 m/s wind turning round the compass, from 20 C: the compiled steps read the
+    same cap as numpy's (the roof's excess beyond h0 + 2 C/(A dt) all day, the windward walls' beyond h0)."""
+    building = parse_building(outside_only(testcell_data))
+    network = assemble(building)
+    columns = list(network.input_names)
+    U = np.zeros((6 * 24 + 1, len(columns)))
+    U[:, columns.index("T_out")], U[:, columns.index("T_sky")] = 5.0, -5.0
+    U[:, columns.index(WIND_SPEED)] = 15.0
+    U[:, columns.index(WIND_DIRECTION)] = np.linspace(0.0, 360.0, len(U))
+    T = simulate(building, network, U, 600.0, warmup_days=0, substeps=2)
+    if compiled.available():
+        monkeypatch.setattr(compiled, "available", lambda: False)
+        stepped = simulate(building, network, U, 600.0, warmup_days=0, substeps=2)
+        assert np.abs(stepped - T).max() < 1e-10 * np.abs(T).max()
+    # no sun, no gain: every node between the sky's -5 C and the start's 20 C (the maximum principle)
+    assert T.min() > -5.0 and T.max() < 20.0
+
+
 def roof_excess(building, T):
     """The roof's DOE-2 coefficient beyond its h0 at the temperatures T, in the steady gale above."""
     roof = building.component("roof")
