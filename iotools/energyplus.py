@@ -463,13 +463,16 @@ UNREAD_CONSTRUCTIONS = {
 }
 
 
+# idfkit's names of the days of the week, Monday first as `date.weekday` counts them
+_WEEKDAYS = ("Monday", "Tuesday", "Wednesday", "Thursday", "Friday", "Saturday", "Sunday")
+
 # The day types of a Schedule:Compact's "For:" field, each word singular or plural as EnergyPlus
 # reads it ("For: Weekday" is Monday to Friday; idfkit knows only some of the plurals, and the
 # 2019 prototypes' lighting schedules are written "Weekday")
 _FOR_WORDS = {"weekday": "Weekdays", "weekend": "Weekends", "allday": "AllDays", "allotherday": "AllOtherDays",
               "holiday": "Holiday", "summerdesignday": "SummerDesignDay", "winterdesignday": "WinterDesignDay",
               "customday1": "CustomDay1", "customday2": "CustomDay2",
-              **{d.lower(): d for d in ("Monday", "Tuesday", "Wednesday", "Thursday", "Friday", "Saturday", "Sunday")}}
+              **{d.lower(): d for d in _WEEKDAYS}}
 
 
 def compact_day_types(text):
@@ -494,9 +497,6 @@ def _compact_periods(obj):
     fields = [str(item.get("field") or "").strip() for item in obj.data.get("data") or []]
     days = iter([compact_day_types(f) for f in fields if f.lower().startswith("for:")])
     return [replace(p, day_rules=[replace(r, day_types=next(days)) for r in p.day_rules]) for p in periods], interpolation
-
-
-_WEEKDAYS = ("Monday", "Tuesday", "Wednesday", "Thursday", "Friday", "Saturday", "Sunday")
 
 
 def day_types_of(d, holidays, custom_day_1, custom_day_2):
